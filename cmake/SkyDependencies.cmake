@@ -1,0 +1,69 @@
+# Finds every third-party dependency (all from Debian's packages, installed by
+# deploy/setup) and exposes each as an imported target with a sky:: name, so
+# folders link by name and never spell include paths.
+
+find_package(Threads REQUIRED)
+find_package(PkgConfig REQUIRED)
+
+pkg_check_modules(GEOGRAPHICLIB REQUIRED IMPORTED_TARGET geographiclib)
+add_library(sky::geographiclib INTERFACE IMPORTED)
+target_link_libraries(sky::geographiclib INTERFACE PkgConfig::GEOGRAPHICLIB)
+
+# S2 geometry: Debian's libs2-dev has a CMake config (target s2::s2) on some
+# versions only; fall back to the plain library.
+find_package(s2 CONFIG QUIET)
+add_library(sky::s2 INTERFACE IMPORTED)
+if(TARGET s2::s2)
+  target_link_libraries(sky::s2 INTERFACE s2::s2)
+else()
+  find_library(S2_LIBRARY NAMES s2 REQUIRED)
+  find_path(S2_INCLUDE_DIR s2/s2cell_id.h REQUIRED)
+  target_link_libraries(sky::s2 INTERFACE ${S2_LIBRARY})
+  target_include_directories(sky::s2 SYSTEM INTERFACE ${S2_INCLUDE_DIR})
+endif()
+
+find_package(FlatBuffers CONFIG REQUIRED)
+find_program(FLATC flatc REQUIRED)
+add_library(sky::flatbuffers INTERFACE IMPORTED)
+if(TARGET flatbuffers::flatbuffers_shared)
+  target_link_libraries(sky::flatbuffers INTERFACE flatbuffers::flatbuffers_shared)
+else()
+  target_link_libraries(sky::flatbuffers INTERFACE flatbuffers::flatbuffers)
+endif()
+
+find_package(tl-expected CONFIG REQUIRED)
+add_library(sky::expected INTERFACE IMPORTED)
+target_link_libraries(sky::expected INTERFACE tl::expected)
+
+find_package(Boost 1.74 REQUIRED)
+add_library(sky::asio INTERFACE IMPORTED)
+target_link_libraries(sky::asio INTERFACE Boost::headers Threads::Threads)
+target_compile_definitions(sky::asio INTERFACE BOOST_ASIO_NO_DEPRECATED)
+
+find_package(spdlog CONFIG REQUIRED)
+add_library(sky::spdlog INTERFACE IMPORTED)
+target_link_libraries(sky::spdlog INTERFACE spdlog::spdlog)
+
+find_package(CLI11 CONFIG REQUIRED)
+add_library(sky::cli11 INTERFACE IMPORTED)
+target_link_libraries(sky::cli11 INTERFACE CLI11::CLI11)
+
+pkg_check_modules(TOMLPLUSPLUS REQUIRED IMPORTED_TARGET tomlplusplus)
+add_library(sky::toml INTERFACE IMPORTED)
+target_link_libraries(sky::toml INTERFACE PkgConfig::TOMLPLUSPLUS)
+
+find_package(nlohmann_json CONFIG REQUIRED)
+add_library(sky::json INTERFACE IMPORTED)
+target_link_libraries(sky::json INTERFACE nlohmann_json::nlohmann_json)
+
+find_package(Vulkan REQUIRED)
+find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)
+find_package(glm CONFIG REQUIRED)
+
+find_path(STB_INCLUDE_DIR stb_image_write.h PATH_SUFFIXES stb REQUIRED)
+add_library(sky::stb INTERFACE IMPORTED)
+target_include_directories(sky::stb SYSTEM INTERFACE ${STB_INCLUDE_DIR})
+
+if(SKY_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+endif()

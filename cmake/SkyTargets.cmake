@@ -1,0 +1,29 @@
+# Compile settings every Skyshell target shares: warnings as errors for our own
+# code, the sanitizer option, and the debug assert switch. Third-party headers
+# are included as SYSTEM so their warnings do not fail our build.
+
+add_library(sky_settings INTERFACE)
+target_compile_options(sky_settings INTERFACE -Wall -Wextra -Werror)
+# SKY_ASSERT stays active in every build of ours (tests and the demo run the
+# RelWithDebInfo build, and a broken invariant must stop there, not render junk).
+target_compile_definitions(sky_settings INTERFACE SKY_ENABLE_ASSERTS=1)
+if(SKY_SANITIZE)
+  target_compile_options(sky_settings INTERFACE
+    -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
+  target_link_options(sky_settings INTERFACE -fsanitize=address,undefined)
+endif()
+
+# sky_add_library(name SOURCES ... DEPS ...): a library with a public include/
+# next to its CMakeLists.txt and private sources.
+function(sky_add_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
+  add_library(${name} STATIC ${ARG_SOURCES})
+  target_include_directories(${name} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
+  target_link_libraries(${name} PUBLIC sky_settings ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+endfunction()
+
+function(sky_add_executable name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE sky_settings ${ARG_DEPS})
+endfunction()

@@ -1,0 +1,121 @@
+// CSV flight reader and sampler.
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <string>
+
+#include "sky/flight/flight.hpp"
+
+namespace sky::flight {
+
+namespace {
+
+constexpr std::array<std::string_view, 7> kColumns = {"time_s",  "lat_deg",   "lon_deg", "alt_m",
+                                                       "yaw_deg", "pitch_deg", "roll_deg"};
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  return s;
+}
+
+std::vector<std::string_view> split(std::string_view line) {
+  std::vector<std::string_view> out;
+  std::size_t start = 0;
+  for (std::size_t i = 0; i <= line.size(); ++i) {
+    if (i == line.size() || line[i] == ',') {
+      out.push_back(trim(line.substr(start, i - start)));
+      start = i + 1;
+    }
+  }
+  return out;
+}
+
+struct Range {
+  double lo, hi;
+};
+constexpr std::array<Range, 7> kRanges = {{{0, 1.0e7},
+                                           {-90, 90},
+                                           {-180, 180},
+                                           {-1000, 1.0e6},
+                                           {-360, 360},
+                                           {-90, 90},
+                                           {-180, 180}}};
+
+}  // namespace
+
+Result<Flight> parseCsv(std::string_view text, std::string_view sourceName) {
+  Flight flight;
+  bool headerSeen = false;
+  std::size_t lineNo = 0;
+  std::size_t pos = 0;
+  const std::string src(sourceName);
+  while (pos <= text.size()) {
+    const std::size_t end = std::min(text.find('\n', pos), text.size());
+    const std::string_view line = trim(text.substr(pos, end - pos));
+    pos = end + 1;
+    ++lineNo;
+    if (line.empty() || line.front() == '#') {
+      if (end == text.size()) break;
+      continue;
+    }
+    const auto fields = split(line);
+    const std::string at = src + ":" + std::to_string(lineNo) + ": ";
+    if (!headerSeen) {
+      if (fields.size() != kColumns.size() || !std::equal(fields.begin(), fields.end(), kColumns.begin()))
+        return fail(ErrorCode::Malformed,
+                    at + "header must be 'time_s,lat_deg,lon_deg,alt_m,yaw_deg,pitch_deg,roll_deg'");
+      headerSeen = true;
+      continue;
+    }
+    if (fields.size() != kColumns.size())
+      return fail(ErrorCode::Malformed, at + std::to_string(fields.size()) + " fields, expected " +
+                                            std::to_string(kColumns.size()));
+    std::array<double, 7> v{};
+    for (std::size_t i = 0; i < kColumns.size(); ++i) {
+      const std::string_view f = fields[i];
+      const auto [ptr, ec] = std::from_chars(f.data(), f.data() + f.size(), v[i]);
+      if (ec != std::errc() || ptr != f.data() + f.size() || !std::isfinite(v[i]))
+        return fail(ErrorCode::Malformed,
+                    at + "field '" + std::string(kColumns[i]) + "': '" + std::string(f) + "' is not a number");
+      if (v[i] < kRanges[i].lo || v[i] > kRanges[i].hi)
+        return fail(ErrorCode::InvalidArgument, at + "field '" + std::string(kColumns[i]) + "': " +
+                                                    std::string(f) + " outside [" +
+                                                    std::to_string(kRanges[i].lo) + ", " +
+                                                    std::to_string(kRanges[i].hi) + "]");
+    }
+    if (!flight.fixes.empty() && v[0] <= flight.fixes.back().time_s)
+      return fail(ErrorCode::InvalidArgument,
+                  at + "field 'time_s': " + std::string(fields[0]) + " does not increase");
+    flight.fixes.push_back(Fix{v[0], {{v[1], v[2], v[3]}, v[4], v[5], v[6]}});
+    if (end == text.size()) break;
+  }
+  if (!headerSeen) return fail(ErrorCode::Malformed, src + ": no header line");
+  if (flight.fixes.size() < 2)
+    return fail(ErrorCode::InvalidArgument, src + ": a flight needs at least two fixes");
+  return flight;
+}
+
+geo::GeodeticPose sample(const Flight& flight, double time_s) {
+  const auto& fx = flight.fixes;
+  if (time_s <= fx.front().time_s) return fx.front().pose;
+  if (time_s >= fx.back().time_s) return fx.back().pose;
+  const auto it = std::upper_bound(fx.begin(), fx.end(), time_s,
+                                   [](double t, const Fix& f) { return t < f.time_s; });
+  const Fix& b = *it;
+  const Fix& a = *(it - 1);
+  const double u = (time_s - a.time_s) / (b.time_s - a.time_s);
+  const geo::Vec3d pa = geo::toEcef(a.pose.position), pb = geo::toEcef(b.pose.position);
+  geo::GeodeticPose out;
+  out.position = geo::fromEcef(pa + (pb - pa) * u);
+  // ECEF lerp cuts the chord: re-impose the interpolated altitude.
+  out.position.alt_m = a.pose.position.alt_m + (b.pose.position.alt_m - a.pose.position.alt_m) * u;
+  auto lerpAngle = [u](double x, double y) { return x + geo::angleDiff_deg(x, y) * u; };
+  out.yaw_deg = std::fmod(lerpAngle(a.pose.yaw_deg, b.pose.yaw_deg) + 360.0, 360.0);
+  out.pitch_deg = a.pose.pitch_deg + (b.pose.pitch_deg - a.pose.pitch_deg) * u;
+  out.roll_deg = lerpAngle(a.pose.roll_deg, b.pose.roll_deg);
+  return out;
+}
+
+}  // namespace sky::flight

@@ -1,0 +1,53 @@
+// The weather stream's messages as C++ values, and their FlatBuffers encoding.
+// decodeMessage runs the FlatBuffers verifier and then checks every field's
+// range, so a caller only ever sees values inside the documented ranges.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "sky/core/result.hpp"
+#include "sky/weather/model.hpp"
+#include "sky/weather/tiling.hpp"
+
+namespace sky::stream {
+
+inline constexpr std::uint16_t kProtocolVersion = 1;
+
+struct Hello {
+  std::uint16_t protocolVersion = kProtocolVersion;
+  std::string serverId;
+  double weatherClock_s = 0;
+  double clockRate = 1;  // weather seconds per wall second, [0, 3600]
+};
+
+struct Subscribe {
+  weather::SphericalCap area;
+  double altMin_m = -500;  // altitude band of interest, MSL
+  double altMax_m = 20000;
+  int tileLevel = 8;  // S2 level, [0, 20]
+};
+
+struct Heartbeat {
+  double weatherClock_s = 0;
+};
+
+struct StreamError {
+  std::uint16_t code = 0;
+  std::string detail;
+};
+
+using Message = std::variant<Hello, Subscribe, weather::WeatherSnapshot, Heartbeat, StreamError>;
+
+std::vector<std::uint8_t> encodeMessage(const Message& message);
+
+// Verifies and range-checks one frame's payload.
+Result<Message> decodeMessage(std::span<const std::uint8_t> payload);
+
+// Name of the message kind, for logs ("Hello", "Snapshot", ...).
+const char* kindName(const Message& message);
+
+}  // namespace sky::stream

@@ -1,0 +1,70 @@
+// The weather model both processes agree on: cloud types (CIGI's enum values),
+// a cloud layer's fields with their units and ranges, and coverage tiles on S2
+// cells. The server owns the state; renderers receive it over the stream.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+#include <vector>
+
+#include "sky/core/result.hpp"
+
+namespace sky::weather {
+
+// CIGI 3.3 Weather Control cloud type (4-bit field), values as on the wire.
+enum class CloudType : std::uint8_t {
+  None = 0,
+  Altocumulus = 1,
+  Altostratus = 2,
+  Cirrocumulus = 3,
+  Cirrostratus = 4,
+  Cirrus = 5,
+  Cumulonimbus = 6,
+  Cumulus = 7,
+  Nimbostratus = 8,
+  Stratocumulus = 9,
+  Stratus = 10,
+};
+inline constexpr std::uint8_t kMaxCloudType = 10;
+
+std::string_view toString(CloudType type);  // "cumulus"
+std::optional<CloudType> cloudTypeFromString(std::string_view name);
+
+struct LayerWind {
+  double speed_mps = 0;         // horizontal, parallel to the ellipsoid, [0, 150]
+  double fromDirection_deg = 0; // true, the direction the wind blows FROM, [0, 360)
+  double vertical_mps = 0;      // + up, [-50, 50]
+};
+
+struct CloudLayer {
+  std::uint32_t id = 0;
+  CloudType type = CloudType::Cumulus;
+  double base_m = 0;            // MSL, [-500, 20000]
+  double thickness_m = 0;       // (0, 20000]
+  double transitionBand_m = 0;  // [0, 5000]
+  double coverage = 0;          // fraction of area covered, [0, 1]
+  double density = 1;           // multiplier of the type's extinction, [0, 1]
+  LayerWind wind;
+};
+
+// Checks every field against its range; the error names the first bad field,
+// its value and the allowed range ("layer 3: coverage 1.4 outside [0, 1]").
+Result<void> validate(const CloudLayer& layer);
+
+// Regional value of one layer on one S2 cell.
+struct CoverageTile {
+  std::uint64_t cellId = 0;  // S2CellId, at the snapshot's tile level
+  std::uint32_t layerId = 0;
+  float coverage = 0;  // [0, 1]
+  float density = 1;   // [0, 1]
+};
+
+struct WeatherSnapshot {
+  double weatherClock_s = 0;  // seconds on the weather clock
+  std::vector<CloudLayer> layers;
+  int tileLevel = 0;  // S2 level of every tile, [0, 30]
+  std::vector<CoverageTile> tiles;
+};
+
+}  // namespace sky::weather
