@@ -1,0 +1,169 @@
+// CIGI 3.3 codec against the golden hex vectors of the reference
+// (../shared/reference/cigi.md §9.2, verified there with tshark), in both byte
+// orders, and the malformed datagrams a receiver must reject.
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "sky/cigi/codec.hpp"
+
+namespace sky::cigi {
+namespace {
+
+std::vector<std::uint8_t> fromHex(const std::string& hex) {
+  std::vector<std::uint8_t> out;
+  for (std::size_t i = 0; i + 1 < hex.size(); i += 2)
+    out.push_back(static_cast<std::uint8_t>(std::stoul(hex.substr(i, 2), nullptr, 16)));
+  return out;
+}
+
+// Frame 1: IG Control + Entity Control + Weather Control, big-endian.
+const std::string kFrame1Be =
+    "0118030535008000000004d2004c4b40000004d100000000023000000110ff00"
+    "03e900003fc00000c0100000438700004047bb7b4a2339c140211930be0ded29"
+    "40934a00000000000c3800000150730c40a00000469c400041c80000427a0000"
+    "44bb800044fa000043960000414800003f00000043870000447d50003eb33333";
+// Frame 4: the same, little-endian.
+const std::string kFrame1Le =
+    "0118030535000080d2040000404b4c00d104000000000000023000000110ff00"
+    "e90300000000c03f000010c000008743c139234a7bbb474029ed0dbe30192140"
+    "00000000004a93400c3800000150730c0000a04000409c460000c84100007a42"
+    "0080bb440000fa4400009643000048410000003f0000874300507d443333b33e";
+// Frame 2: Start of Frame + Weather Conditions Response + Aerosol Response.
+const std::string kFrame2Be =
+    "651803050035800000000309004c4ba4000004d2000000006d202a5040a00000"
+    "469c4000414800003f00000043870000447d5000000000006e082a013eb33333";
+
+IgControl goldenIgControl() {
+  IgControl ig;
+  ig.databaseNumber = 5;
+  ig.mode = IgMode::Operate;
+  ig.timestampValid = true;
+  ig.hostFrame = 1234;
+  ig.timestamp_10us = 5000000;
+  ig.lastIgFrame = 1233;
+  return ig;
+}
+
+EntityControl goldenEntity() {
+  EntityControl e;
+  e.entityId = 0;
+  e.state = EntityState::Active;
+  e.linearExtrapolation = true;
+  e.alpha = 255;
+  e.entityType = 1001;
+  e.roll_deg = 1.5f;
+  e.pitch_deg = -2.25f;
+  e.yaw_deg = 270.0f;
+  e.lat_deg = 47.4647;
+  e.lon_deg = 8.5492;
+  e.alt_m = 1234.5;
+  return e;
+}
+
+void expectGoldenFrame1(const Datagram& d) {
+  ASSERT_EQ(d.packets.size(), 2u);
+  EXPECT_EQ(d.skippedPackets, 1u);  // Weather Control: not decoded by this codec yet
+  const auto& ig = std::get<IgControl>(d.packets[0]);
+  EXPECT_EQ(ig.databaseNumber, 5);
+  EXPECT_EQ(ig.mode, IgMode::Operate);
+  EXPECT_TRUE(ig.timestampValid);
+  EXPECT_FALSE(ig.extrapolationEnable);
+  EXPECT_EQ(ig.hostFrame, 1234u);
+  EXPECT_EQ(ig.timestamp_10us, 5000000u);
+  EXPECT_EQ(ig.lastIgFrame, 1233u);
+  const auto& e = std::get<EntityControl>(d.packets[1]);
+  EXPECT_EQ(e.entityId, 0);
+  EXPECT_EQ(e.state, EntityState::Active);
+  EXPECT_TRUE(e.linearExtrapolation);
+  EXPECT_EQ(e.alpha, 255);
+  EXPECT_EQ(e.entityType, 1001);
+  EXPECT_EQ(e.roll_deg, 1.5f);
+  EXPECT_EQ(e.pitch_deg, -2.25f);
+  EXPECT_EQ(e.yaw_deg, 270.0f);
+  EXPECT_EQ(e.lat_deg, 47.4647);
+  EXPECT_EQ(e.lon_deg, 8.5492);
+  EXPECT_EQ(e.alt_m, 1234.5);
+}
+
+TEST(Cigi, DecodesGoldenVectorsInBothByteOrders) {
+  auto be = decodeDatagram(fromHex(kFrame1Be));
+  ASSERT_TRUE(be) << be.error().detail;
+  EXPECT_EQ(be->order, ByteOrder::Big);
+  expectGoldenFrame1(*be);
+  auto le = decodeDatagram(fromHex(kFrame1Le));
+  ASSERT_TRUE(le) << le.error().detail;
+  EXPECT_EQ(le->order, ByteOrder::Little);
+  expectGoldenFrame1(*le);
+}
+
+TEST(Cigi, EncodesTheGoldenBytes) {
+  for (auto [order, hex] : {std::pair{ByteOrder::Big, kFrame1Be}, std::pair{ByteOrder::Little, kFrame1Le}}) {
+    DatagramWriter w(order);
+    w.add(goldenIgControl()).add(goldenEntity());
+    const auto golden = fromHex(hex);
+    ASSERT_EQ(w.bytes().size(), 72u);
+    EXPECT_EQ(w.bytes(), std::vector<std::uint8_t>(golden.begin(), golden.begin() + 72));
+  }
+}
+
+TEST(Cigi, StartOfFrameGoldenAndRoundTrip) {
+  auto d = decodeDatagram(fromHex(kFrame2Be));
+  ASSERT_TRUE(d) << d.error().detail;
+  ASSERT_EQ(d->packets.size(), 1u);
+  EXPECT_EQ(d->skippedPackets, 2u);
+  const auto& sof = std::get<StartOfFrame>(d->packets[0]);
+  EXPECT_EQ(sof.igFrame, 777u);
+  EXPECT_EQ(sof.timestamp_10us, 5000100u);
+  EXPECT_EQ(sof.lastHostFrame, 1234u);
+  EXPECT_EQ(sof.mode, IgMode::Operate);
+  EXPECT_TRUE(sof.timestampValid);
+  DatagramWriter w;
+  w.add(sof);
+  const auto golden = fromHex(kFrame2Be);
+  EXPECT_EQ(w.bytes(), std::vector<std::uint8_t>(golden.begin(), golden.begin() + 24));
+}
+
+TEST(Cigi, RejectsMalformedDatagramsWithAReason) {
+  const auto good = fromHex(kFrame1Be);
+  auto expectError = [](std::vector<std::uint8_t> bytes, const std::string& needle) {
+    auto r = decodeDatagram(bytes);
+    ASSERT_FALSE(r) << "accepted: " << needle;
+    EXPECT_NE(r.error().detail.find(needle), std::string::npos) << r.error().detail;
+  };
+  expectError(std::vector<std::uint8_t>(good.begin(), good.begin() + 10), "shorter");
+  auto bad = good;
+  bad[0] = 2;  // Entity Control first
+  expectError(bad, "must start with IG Control");
+  bad = good;
+  bad[6] = 0x12;  // byte-swap magic
+  expectError(bad, "byte-swap magic");
+  bad = good;
+  bad[25] = 40;  // Entity Control size byte wrong
+  expectError(bad, "size 40, must be 48");
+  bad = good;
+  bad[4] = 0x33;  // IG mode 3
+  expectError(bad, "IG mode 3");
+  // A datagram cut inside the Weather Control packet.
+  expectError(std::vector<std::uint8_t>(good.begin(), good.end() - 8), "runs past");
+  // Entity Control latitude 95 degrees.
+  DatagramWriter w;
+  EntityControl e = goldenEntity();
+  e.lat_deg = 95;
+  w.add(goldenIgControl()).add(e);
+  expectError(w.bytes(), "latitude");
+}
+
+TEST(Cigi, SkipsUserDefinedPacketsBySize) {
+  DatagramWriter w;
+  w.add(goldenIgControl());
+  auto bytes = w.bytes();
+  const std::vector<std::uint8_t> user = {201, 16, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14};
+  bytes.insert(bytes.end(), user.begin(), user.end());
+  auto r = decodeDatagram(bytes);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->skippedPackets, 1u);
+}
+
+}  // namespace
+}  // namespace sky::cigi
