@@ -1,0 +1,83 @@
+// What the network side of a renderer channel hands to its render loop: the
+// latest ownship pose from the host and the latest weather from the server.
+// Written by the io thread, read by the render loop; guarded by one mutex.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <mutex>
+#include <optional>
+
+#include "sky/geo/geodetic.hpp"
+#include "sky/weather/model.hpp"
+
+namespace sky::app {
+
+struct HostPose {
+  geo::GeodeticPose pose;
+  std::uint32_t hostFrame = 0;
+  double hostTime_s = 0;  // CIGI IG Control timestamp, s (0 when not valid)
+  std::uint64_t sequence = 0;  // increments with every pose received
+  std::chrono::steady_clock::time_point receivedAt;
+};
+
+struct WeatherView {
+  weather::WeatherSnapshot snapshot;
+  std::uint64_t version = 0;  // increments with every snapshot received
+  // Weather clock = clockAtSync_s + clockRate * (now - syncedAt).
+  double clockAtSync_s = 0;
+  double clockRate = 1;
+  std::chrono::steady_clock::time_point syncedAt;
+  bool connected = false;
+
+  double clockNow(std::chrono::steady_clock::time_point now) const {
+    return clockAtSync_s + clockRate * std::chrono::duration<double>(now - syncedAt).count();
+  }
+};
+
+class SharedState {
+ public:
+  void setPose(const HostPose& p) {
+    std::lock_guard lock(mutex_);
+    HostPose next = p;
+    next.sequence = pose_ ? pose_->sequence + 1 : 1;
+    pose_ = next;
+  }
+  std::optional<HostPose> pose() const {
+    std::lock_guard lock(mutex_);
+    return pose_;
+  }
+
+  void setSnapshot(weather::WeatherSnapshot s, std::chrono::steady_clock::time_point now) {
+    std::lock_guard lock(mutex_);
+    weather_.clockAtSync_s = s.weatherClock_s;
+    weather_.syncedAt = now;
+    weather_.snapshot = std::move(s);
+    ++weather_.version;
+  }
+  void setClock(double clock_s, double rate, std::chrono::steady_clock::time_point now) {
+    std::lock_guard lock(mutex_);
+    weather_.clockAtSync_s = clock_s;
+    weather_.clockRate = rate;
+    weather_.syncedAt = now;
+  }
+  void setConnected(bool c) {
+    std::lock_guard lock(mutex_);
+    weather_.connected = c;
+  }
+  WeatherView weather() const {
+    std::lock_guard lock(mutex_);
+    return weather_;
+  }
+  std::uint64_t weatherVersion() const {
+    std::lock_guard lock(mutex_);
+    return weather_.version;
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::optional<HostPose> pose_;
+  WeatherView weather_;
+};
+
+}  // namespace sky::app

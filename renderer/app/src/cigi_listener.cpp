@@ -1,0 +1,89 @@
+// CIGI UDP endpoint of a renderer channel (see cigi_listener.hpp).
+#include "sky/app/cigi_listener.hpp"
+
+#include <spdlog/spdlog.h>
+
+namespace sky::app {
+
+namespace asio = boost::asio;
+
+namespace {
+// The part of an error detail before the first digit-bearing position
+// ("packet 1 (Entity Control) at byte 24: latitude 95 outside ...") becomes
+// the kind we log once: the packet name and field, not the values.
+std::string reasonKind(const std::string& detail) {
+  std::string kind;
+  for (char c : detail) {
+    if (c >= '0' && c <= '9') continue;
+    kind += c;
+  }
+  return kind.substr(0, 80);
+}
+}  // namespace
+
+CigiListener::CigiListener(asio::io_context& io, SharedState& state, const std::string& address,
+                           unsigned short port)
+    : socket_(io), state_(state) {
+  const asio::ip::udp::endpoint ep(asio::ip::make_address(address), port);
+  socket_.open(ep.protocol());
+  socket_.bind(ep);
+  port_ = socket_.local_endpoint().port();
+}
+
+void CigiListener::start() { receive(); }
+
+void CigiListener::stop() {
+  boost::system::error_code ec;
+  socket_.close(ec);
+}
+
+void CigiListener::receive() {
+  socket_.async_receive_from(asio::buffer(rx_), from_, [this](boost::system::error_code ec, std::size_t n) {
+    if (ec == asio::error::operation_aborted) return;
+    if (!ec) onDatagram(std::span(rx_.data(), n));
+    receive();
+  });
+}
+
+void CigiListener::dropped(const std::string& reason) {
+  ++dropped_;
+  if (loggedReasons_.insert(reasonKind(reason)).second)
+    spdlog::warn("CIGI: dropped a datagram: {} (further drops of this kind are only counted)", reason);
+}
+
+void CigiListener::onDatagram(std::span<const std::uint8_t> bytes) {
+  auto datagram = cigi::decodeDatagram(bytes);
+  if (!datagram) {
+    dropped(datagram.error().detail);
+    return;
+  }
+  const auto* ig = std::get_if<cigi::IgControl>(&datagram->packets.front());
+  if (!ig) {
+    dropped("datagram starts with Start of Frame: an IG accepts host datagrams only");
+    return;
+  }
+  ++accepted_;
+  for (const auto& packet : datagram->packets) {
+    const auto* entity = std::get_if<cigi::EntityControl>(&packet);
+    if (!entity || entity->entityId != 0 || entity->attached) continue;
+    HostPose p;
+    p.pose.position = {entity->lat_deg, entity->lon_deg, entity->alt_m};
+    p.pose.yaw_deg = entity->yaw_deg;
+    p.pose.pitch_deg = entity->pitch_deg;
+    p.pose.roll_deg = entity->roll_deg;
+    p.hostFrame = ig->hostFrame;
+    p.hostTime_s = ig->timestampValid ? ig->timestamp_10us * 1.0e-5 : 0.0;
+    p.receivedAt = std::chrono::steady_clock::now();
+    state_.setPose(p);
+  }
+  cigi::StartOfFrame sof;
+  sof.mode = cigi::IgMode::Operate;
+  sof.igFrame = igFrame_++;
+  sof.lastHostFrame = ig->hostFrame;
+  cigi::DatagramWriter w;
+  w.add(sof);
+  boost::system::error_code ec;
+  socket_.send_to(asio::buffer(w.bytes()), from_, 0, ec);
+}
+
+}  // namespace sky::app

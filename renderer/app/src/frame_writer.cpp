@@ -1,0 +1,73 @@
+// Headless frame output (see frame_writer.hpp).
+#include "sky/app/frame_writer.hpp"
+
+#include <cstdio>
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+namespace sky::app {
+
+Result<FrameWriter> FrameWriter::open(const std::string& directory, bool writeFloat) {
+  std::error_code ec;
+  std::filesystem::create_directories(directory, ec);
+  if (ec) return fail(ErrorCode::Io, directory + ": cannot create: " + ec.message());
+  FrameWriter w;
+  w.directory_ = directory;
+  w.writeFloat_ = writeFloat;
+  w.metadata_.open(directory + "/frames.jsonl", std::ios::trunc);
+  if (!w.metadata_) return fail(ErrorCode::Io, directory + "/frames.jsonl: cannot open for writing");
+  return w;
+}
+
+Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%06llu", static_cast<unsigned long long>(r.frame));
+  const std::string base = directory_ + "/" + name;
+  if (auto ok = render::writePng(image, base + ".png"); !ok) return ok;
+  if (writeFloat_)
+    if (auto ok = writePfm(image, base + ".pfm"); !ok) return ok;
+  const auto& p = r.host.pose;
+  const nlohmann::json line = {
+      {"frame", r.frame},
+      {"file", std::string(name) + ".png"},
+      {"host_frame", r.host.hostFrame},
+      {"host_time_s", r.host.hostTime_s},
+      {"lat_deg", p.position.lat_deg},
+      {"lon_deg", p.position.lon_deg},
+      {"alt_m", p.position.alt_m},
+      {"yaw_deg", p.yaw_deg},
+      {"pitch_deg", p.pitch_deg},
+      {"roll_deg", p.roll_deg},
+      {"weather_clock_s", r.weatherClock_s},
+      {"weather_version", r.weatherVersion},
+      {"layers", r.layerCount},
+      {"non_finite", r.stats.nonFinite},
+      {"mean_luminance", r.stats.meanLuminance},
+      {"render_ms", r.render_ms},
+  };
+  metadata_ << line.dump() << '\n';
+  metadata_.flush();
+  if (!metadata_) return fail(ErrorCode::Io, directory_ + "/frames.jsonl: write failed");
+  return {};
+}
+
+Result<void> writePfm(const render::Image& image, const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  if (!f) return fail(ErrorCode::Io, path + ": cannot open for writing");
+  // "-1.0" scale: little-endian floats. Rows go bottom to top in PFM.
+  std::fprintf(f, "PF\n%u %u\n-1.0\n", image.width, image.height);
+  std::vector<float> row(static_cast<std::size_t>(image.width) * 3);
+  bool ok = true;
+  for (std::uint32_t y = image.height; y-- > 0;) {
+    for (std::uint32_t x = 0; x < image.width; ++x)
+      for (int c = 0; c < 3; ++c)
+        row[x * 3 + c] = image.rgba[(static_cast<std::size_t>(y) * image.width + x) * 4 + c];
+    ok = ok && std::fwrite(row.data(), sizeof(float), row.size(), f) == row.size();
+  }
+  ok = (std::fclose(f) == 0) && ok;
+  if (!ok) return fail(ErrorCode::Io, path + ": write failed");
+  return {};
+}
+
+}  // namespace sky::app

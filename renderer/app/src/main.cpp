@@ -1,0 +1,250 @@
+// skyshell-render: one image-generator channel. Takes its camera from a CIGI
+// host over UDP, its weather from skyshell-weatherd over TCP, and renders the
+// clouds on Vulkan. Headless: writes a PNG (and metadata) per frame.
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+#include <boost/asio.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include "sky/app/cigi_listener.hpp"
+#include "sky/app/frame_writer.hpp"
+#include "sky/app/weather_client.hpp"
+#include "sky/geo/geodetic.hpp"
+#include "sky/render/cloud_renderer.hpp"
+
+namespace asio = boost::asio;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+// Area of interest: the weather texture spans about 100 km around the camera;
+// subscribe a little wider so the edge is never empty, and again when the
+// camera has moved a quarter of that.
+constexpr double kSubscribeRadius_m = 120000.0;
+constexpr double kResubscribeDistance_m = 30000.0;
+// S2 level 11 cells are about 4.9 km across (S2 average edge): a few thousand
+// tiles for the area above. The real weather tiles (~1 km) come with the
+// weather-texture rings of the renderer issue.
+constexpr int kTileLevel = 11;
+
+struct Options {
+  std::string server = "127.0.0.1:47800";
+  std::string cigiAddress = "127.0.0.1";
+  unsigned cigiPort = 8004;
+  std::string portFile;
+  std::string outDir = "skyshell-frames";
+  bool headless = false;
+  bool writeFloat = false;
+  unsigned width = 320, height = 180;
+  double fov_deg = 60;
+  double sunAzimuth_deg = 135, sunElevation_deg = 40;
+  std::uint64_t maxFrames = 0;
+  double idleExit_s = 0;
+  double weatherTimeout_s = 30;
+};
+
+bool writePortFile(const std::string& path, unsigned port) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::trunc);
+    f << port << '\n';
+    if (!f) return false;
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  return !ec;
+}
+
+sky::stream::Subscribe areaAround(const sky::geo::GeodeticPose& pose) {
+  sky::stream::Subscribe s;
+  s.area = {pose.position.lat_deg, pose.position.lon_deg, kSubscribeRadius_m};
+  s.altMin_m = -500;
+  s.altMax_m = 20000;
+  s.tileLevel = kTileLevel;
+  return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  CLI::App app{"skyshell-render: a Skyshell image generator channel"};
+  app.add_option("--server", o.server, "weather server HOST:PORT");
+  app.add_option("--cigi-address", o.cigiAddress, "address to receive CIGI on");
+  app.add_option("--cigi-port", o.cigiPort, "UDP port to receive CIGI on (0 = any free port)")
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--port-file", o.portFile, "write the CIGI port here once listening");
+  app.add_flag("--headless", o.headless, "render off-screen and write frames to --out");
+  app.add_option("--out", o.outDir, "output folder for headless frames");
+  app.add_flag("--write-float", o.writeFloat, "also write each frame's linear radiance as .pfm");
+  app.add_option("--width", o.width)->check(CLI::Range(16, 8192));
+  app.add_option("--height", o.height)->check(CLI::Range(16, 8192));
+  app.add_option("--fov", o.fov_deg, "vertical field of view, deg")->check(CLI::Range(1.0, 170.0));
+  app.add_option("--sun-azimuth", o.sunAzimuth_deg, "deg from true north");
+  app.add_option("--sun-elevation", o.sunElevation_deg, "deg above the horizon");
+  app.add_option("--max-frames", o.maxFrames, "stop after this many frames (0 = no limit)");
+  app.add_option("--idle-exit", o.idleExit_s,
+                 "stop when no CIGI arrived for this many seconds after the first (0 = never)");
+  app.add_option("--weather-timeout", o.weatherTimeout_s, "seconds to wait for the first weather");
+  app.set_config("--config", "", "config file (TOML keys named like the long options)");
+  CLI11_PARSE(app, argc, argv);
+  spdlog::set_default_logger(spdlog::stderr_color_mt("render"));
+
+  if (!o.headless) {
+    std::fprintf(stderr, "skyshell-render: only --headless is available in this build (the windowed front end comes later)\n");
+    return 2;
+  }
+  const auto colon = o.server.rfind(':');
+  if (colon == std::string::npos) {
+    std::fprintf(stderr, "skyshell-render: --server '%s' must be HOST:PORT\n", o.server.c_str());
+    return 2;
+  }
+  const std::string serverHost = o.server.substr(0, colon);
+  const unsigned serverPort = static_cast<unsigned>(std::stoul(o.server.substr(colon + 1)));
+
+  auto renderer = sky::render::CloudRenderer::create({o.width, o.height, o.fov_deg, 1});
+  if (!renderer) {
+    std::fprintf(stderr, "skyshell-render: %s\n", sky::describe(renderer.error()).c_str());
+    return 3;
+  }
+  auto writer = sky::app::FrameWriter::open(o.outDir, o.writeFloat);
+  if (!writer) {
+    std::fprintf(stderr, "skyshell-render: %s\n", sky::describe(writer.error()).c_str());
+    return 2;
+  }
+
+  sky::app::SharedState state;
+  asio::io_context io;
+  auto guard = asio::make_work_guard(io);
+  std::atomic<bool> stopRequested{false};
+  asio::signal_set signals(io, SIGINT, SIGTERM);
+  signals.async_wait([&](boost::system::error_code ec, int) {
+    if (!ec) stopRequested = true;
+  });
+  std::optional<sky::app::CigiListener> cigi;
+  try {
+    cigi.emplace(io, state, o.cigiAddress, static_cast<unsigned short>(o.cigiPort));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "skyshell-render: cannot listen for CIGI on %s:%u: %s\n", o.cigiAddress.c_str(),
+                 o.cigiPort, e.what());
+    return 2;
+  }
+  cigi->start();
+  sky::app::WeatherClient weather(io, state, serverHost, static_cast<unsigned short>(serverPort));
+  weather.start();
+  std::thread ioThread([&] { io.run(); });
+  auto shutdown = [&] {
+    weather.stop();
+    asio::post(io, [&] {
+      cigi->stop();
+      signals.cancel();
+    });
+    guard.reset();
+    ioThread.join();
+  };
+
+  if (!o.portFile.empty() && !writePortFile(o.portFile, cigi->port())) {
+    std::fprintf(stderr, "skyshell-render: cannot write --port-file %s\n", o.portFile.c_str());
+    shutdown();
+    return 2;
+  }
+  std::printf("skyshell-render: device '%s', CIGI on %s:%u, weather from %s, frames to %s\n",
+              (*renderer)->deviceName().c_str(), o.cigiAddress.c_str(), cigi->port(), o.server.c_str(),
+              o.outDir.c_str());
+  std::fflush(stdout);
+
+  std::uint64_t frames = 0, lastSequence = 0;
+  std::optional<sky::geo::Geodetic> subscribedAt;
+  const auto start = Clock::now();
+  auto lastReport = start;
+  Clock::time_point lastPoseAt{};
+  int exitCode = 0;
+  while (!stopRequested) {
+    const auto now = Clock::now();
+    const auto pose = state.pose();
+    if (pose && (!subscribedAt || sky::geo::geodesicDistance_m(
+                                      subscribedAt->lat_deg, subscribedAt->lon_deg,
+                                      pose->pose.position.lat_deg,
+                                      pose->pose.position.lon_deg) > kResubscribeDistance_m)) {
+      weather.subscribe(areaAround(pose->pose));
+      subscribedAt = pose->pose.position;
+    }
+    if (pose) lastPoseAt = pose->receivedAt;
+    if (o.idleExit_s > 0 && pose &&
+        std::chrono::duration<double>(now - lastPoseAt).count() > o.idleExit_s) {
+      spdlog::info("no CIGI for {:.1f} s: stopping", o.idleExit_s);
+      break;
+    }
+    const auto view = state.weather();
+    if (view.version == 0) {
+      if (std::chrono::duration<double>(now - start).count() > o.weatherTimeout_s) {
+        std::fprintf(stderr, "skyshell-render: no weather from %s within %.0f s\n", o.server.c_str(),
+                     o.weatherTimeout_s);
+        exitCode = 4;
+        break;
+      }
+    }
+    if (!pose || pose->sequence == lastSequence || view.version == 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      continue;
+    }
+    lastSequence = pose->sequence;
+
+    sky::render::FrameInputs in;
+    in.camera = pose->pose;
+    in.weather = &view.snapshot;
+    in.weatherClock_s = view.clockNow(now);
+    in.sunAzimuth_deg = o.sunAzimuth_deg;
+    in.sunElevation_deg = o.sunElevation_deg;
+    in.frameIndex = frames;
+    const auto t0 = Clock::now();
+    auto image = (*renderer)->render(in);
+    if (!image) {
+      std::fprintf(stderr, "skyshell-render: frame %llu: %s\n", static_cast<unsigned long long>(frames),
+                   sky::describe(image.error()).c_str());
+      exitCode = 3;
+      break;
+    }
+    sky::app::FrameRecord record;
+    record.frame = frames;
+    record.host = *pose;
+    record.weatherClock_s = in.weatherClock_s;
+    record.weatherVersion = view.version;
+    record.layerCount = view.snapshot.layers.size();
+    record.stats = sky::render::computeStats(*image);
+    record.render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    if (auto ok = writer->write(*image, record); !ok) {
+      std::fprintf(stderr, "skyshell-render: %s\n", sky::describe(ok.error()).c_str());
+      exitCode = 2;
+      break;
+    }
+    ++frames;
+    const auto after = Clock::now();
+    if (after - lastReport > std::chrono::seconds(1)) {
+      lastReport = after;
+      const double elapsed = std::chrono::duration<double>(after - start).count();
+      std::printf("render: %llu frames, %.1f frames/s, last %.0f ms, host frame %u, CIGI dropped %llu\n",
+                  static_cast<unsigned long long>(frames), frames / elapsed, record.render_ms,
+                  pose->hostFrame, static_cast<unsigned long long>(cigi->datagramsDropped()));
+      std::fflush(stdout);
+    }
+    if (o.maxFrames > 0 && frames >= o.maxFrames) break;
+  }
+  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+  std::printf("render: wrote %llu frames to %s in %.1f s; CIGI datagrams accepted %llu, dropped %llu; "
+              "weather frames dropped %llu\n",
+              static_cast<unsigned long long>(frames), o.outDir.c_str(), elapsed,
+              static_cast<unsigned long long>(cigi->datagramsAccepted()),
+              static_cast<unsigned long long>(cigi->datagramsDropped()),
+              static_cast<unsigned long long>(weather.malformedFrames()));
+  std::fflush(stdout);
+  shutdown();
+  return exitCode;
+}

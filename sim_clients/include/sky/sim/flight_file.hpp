@@ -1,0 +1,16 @@
+// Reading a recorded flight from disk: the file I/O half of the flight readers
+// in protocol/ (which parse text and open nothing).
+#pragma once
+
+#include <string>
+
+#include "sky/core/result.hpp"
+#include "sky/flight/flight.hpp"
+
+namespace sky::sim {
+
+// Reads and parses a flight file; the format is chosen by extension (.csv).
+// Errors name the file, and the parser's errors the line and field.
+Result<flight::Flight> loadFlight(const std::string& path);
+
+}  // namespace sky::sim

@@ -1,0 +1,177 @@
+// skyshell-replay: replays a recorded flight as a CIGI 3.3 host over UDP, in
+// real time (optionally scaled), so a renderer channel flies it as it would
+// fly a simulator's ownship.
+#include <array>
+#include <chrono>
+#include <functional>
+#include <cstdio>
+#include <iostream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <boost/asio.hpp>
+
+#include "sky/sim/cigi_host.hpp"
+#include "sky/sim/flight_file.hpp"
+
+namespace asio = boost::asio;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+struct Options {
+  std::string flightPath;
+  std::string host = "127.0.0.1";
+  unsigned port = 8004;
+  double rate_hz = 60;
+  double speed = 1;
+  double start_s = 0;
+  double end_s = -1;
+  bool loop = false;
+  bool littleEndian = false;
+  bool quiet = false;
+};
+
+class Replay {
+ public:
+  Replay(asio::io_context& io, const Options& o, sky::flight::Flight flight,
+         std::function<void()> onDone)
+      : o_(o), flight_(std::move(flight)), onDone_(std::move(onDone)), socket_(io), timer_(io),
+        host_(o.littleEndian ? sky::cigi::ByteOrder::Little : sky::cigi::ByteOrder::Big) {
+    socket_.open(asio::ip::udp::v4());
+    socket_.bind({asio::ip::make_address(o.host), 0});
+    target_ = {asio::ip::make_address(o.host), static_cast<unsigned short>(o.port)};
+    t0_ = flight_.fixes.front().time_s + o.start_s;
+    t1_ = o.end_s >= 0 ? std::min(flight_.fixes.front().time_s + o.end_s, flight_.fixes.back().time_s)
+                       : flight_.fixes.back().time_s;
+  }
+
+  void start() {
+    wallStart_ = Clock::now();
+    lastReport_ = wallStart_;
+    receive();
+    tick();
+  }
+
+  int exitCode() const { return exitCode_; }
+
+ private:
+  void tick() {
+    const double elapsed = std::chrono::duration<double>(Clock::now() - wallStart_).count();
+    double t = t0_ + elapsed * o_.speed;
+    const bool done = t >= t1_;
+    if (done && o_.loop) {
+      wallStart_ = Clock::now();
+      t = t0_;
+    }
+    if (done && !o_.loop) t = t1_;
+    const auto bytes = host_.nextFrame(sky::flight::sample(flight_, t), t - flight_.fixes.front().time_s);
+    boost::system::error_code ec;
+    socket_.send_to(asio::buffer(bytes), target_, 0, ec);
+    if (ec) {
+      std::fprintf(stderr, "skyshell-replay: send to %s:%u failed: %s\n", o_.host.c_str(), o_.port,
+                   ec.message().c_str());
+      exitCode_ = 1;
+      finish();
+      return;
+    }
+    report(t, done && !o_.loop);
+    if (done && !o_.loop) {
+      finish();
+      return;
+    }
+    // Schedule on absolute times so the rate does not drift.
+    ++ticks_;
+    timer_.expires_at(wallTick0() + std::chrono::duration_cast<Clock::duration>(
+                                        std::chrono::duration<double>(ticks_ / o_.rate_hz)));
+    timer_.async_wait([this](boost::system::error_code e) {
+      if (!e) tick();
+    });
+  }
+
+  Clock::time_point wallTick0() {
+    if (!tick0Set_) {
+      tick0_ = wallStart_;
+      tick0Set_ = true;
+    }
+    return tick0_;
+  }
+
+  void report(double t, bool final) {
+    const auto now = Clock::now();
+    if (o_.quiet || (!final && now - lastReport_ < std::chrono::seconds(1))) return;
+    lastReport_ = now;
+    const double wall = std::chrono::duration<double>(now - tick0_).count();
+    std::printf("replay: flight time %.1f / %.1f s, %u frames sent (%.1f Hz), %llu Start of Frame received%s\n",
+                t - flight_.fixes.front().time_s, t1_ - flight_.fixes.front().time_s, host_.framesSent(),
+                wall > 0 ? host_.framesSent() / wall : 0.0,
+                static_cast<unsigned long long>(host_.startOfFramesReceived()), final ? ", done" : "");
+    std::fflush(stdout);
+  }
+
+  void finish() {
+    socket_.close();
+    onDone_();
+  }
+
+  void receive() {
+    socket_.async_receive_from(asio::buffer(rx_), from_, [this](boost::system::error_code ec, std::size_t n) {
+      if (ec) return;
+      host_.onIgDatagram(std::span(rx_.data(), n));
+      receive();
+    });
+  }
+
+  Options o_;
+  sky::flight::Flight flight_;
+  std::function<void()> onDone_;
+  asio::ip::udp::socket socket_;
+  asio::steady_timer timer_;
+  asio::ip::udp::endpoint target_, from_;
+  sky::sim::CigiHost host_;
+  std::array<std::uint8_t, 2048> rx_{};
+  double t0_ = 0, t1_ = 0;
+  Clock::time_point wallStart_, lastReport_, tick0_;
+  bool tick0Set_ = false;
+  std::uint64_t ticks_ = 0;
+  int exitCode_ = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  CLI::App app{"skyshell-replay: replay a recorded flight as a CIGI 3.3 host over UDP"};
+  app.add_option("flight", o.flightPath, "flight file (.csv: time_s,lat_deg,lon_deg,alt_m,yaw_deg,pitch_deg,roll_deg)")
+      ->required();
+  app.add_option("--host", o.host, "IG (renderer) address");
+  app.add_option("--port", o.port, "IG (renderer) CIGI UDP port")->check(CLI::Range(1, 65535));
+  app.add_option("--rate", o.rate_hz, "host frames per second")->check(CLI::Range(1.0, 1000.0));
+  app.add_option("--speed", o.speed, "replay speed factor")->check(CLI::Range(0.05, 100.0));
+  app.add_option("--start", o.start_s, "start offset into the flight, s")->check(CLI::NonNegativeNumber);
+  app.add_option("--end", o.end_s, "end offset into the flight, s (default: the whole flight)");
+  app.add_flag("--loop", o.loop, "start again at the end");
+  app.add_flag("--little-endian", o.littleEndian, "send little-endian CIGI (default big-endian)");
+  app.add_flag("--quiet", o.quiet, "no progress lines");
+  CLI11_PARSE(app, argc, argv);
+
+  auto flight = sky::sim::loadFlight(o.flightPath);
+  if (!flight) {
+    std::fprintf(stderr, "skyshell-replay: %s\n", sky::describe(flight.error()).c_str());
+    return 2;
+  }
+  try {
+    asio::io_context io;
+    asio::signal_set signals(io, SIGINT, SIGTERM);
+    signals.async_wait([&](boost::system::error_code ec, int) {
+      if (!ec) io.stop();
+    });
+    Replay replay(io, o, std::move(*flight), [&] { signals.cancel(); });
+    replay.start();
+    io.run();
+    return replay.exitCode();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "skyshell-replay: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,93 @@
+// A child process for integration tests: spawned with its output in a log
+// file, and always stopped (SIGTERM, then SIGKILL) when the object goes away,
+// also when the test fails half-way.
+#pragma once
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+extern char** environ;
+
+namespace sky::test {
+
+class ChildProcess {
+ public:
+  ChildProcess(std::vector<std::string> argv, const std::string& logPath) : logPath_(logPath) {
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, logPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&actions, 1, 2);
+    std::vector<char*> args;
+    for (auto& a : argv) args.push_back(a.data());
+    args.push_back(nullptr);
+    const int rc = posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (rc != 0) throw std::runtime_error("cannot spawn " + argv[0]);
+  }
+  ChildProcess(const ChildProcess&) = delete;
+  ChildProcess& operator=(const ChildProcess&) = delete;
+  ~ChildProcess() { stop(); }
+
+  // Waits for the process to exit by itself; nullopt on timeout.
+  std::optional<int> wait(std::chrono::milliseconds timeout) {
+    if (exitCode_) return exitCode_;
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < deadline) {
+      int status = 0;
+      if (waitpid(pid_, &status, WNOHANG) == pid_) {
+        exitCode_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+        return exitCode_;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return std::nullopt;
+  }
+
+  // SIGTERM, then SIGKILL if it is still there after a grace period.
+  int stop() {
+    if (exitCode_) return *exitCode_;
+    kill(pid_, SIGTERM);
+    if (auto c = wait(std::chrono::seconds(5))) return *c;
+    kill(pid_, SIGKILL);
+    return wait(std::chrono::seconds(5)).value_or(-1);
+  }
+
+  std::string log() const {
+    std::ifstream f(logPath_);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+  }
+
+ private:
+  pid_t pid_ = -1;
+  std::string logPath_;
+  std::optional<int> exitCode_;
+};
+
+// Waits until a port file appears (written atomically by the process) and
+// returns the port, or 0 on timeout.
+inline unsigned waitForPortFile(const std::string& path, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    std::ifstream f(path);
+    unsigned port = 0;
+    if (f >> port && port > 0) return port;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return 0;
+}
+
+}  // namespace sky::test
