@@ -1,0 +1,87 @@
+// The weather stream server: owns the io_context (one, run on one thread), the
+// acceptor, the heartbeat timer, optional SIGINT/SIGTERM handling and the
+// session registry. Shuts down by cancelling its work, so run() returns.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include "sky/core/result.hpp"
+#include "sky/server/session.hpp"
+#include "sky/server/session_registry.hpp"
+#include "sky/server/snapshot_builder.hpp"
+#include "sky/server/weather_state.hpp"
+
+namespace spdlog {
+class logger;
+}
+
+namespace sky::server {
+
+struct ServerOptions {
+  std::string listenAddress = "127.0.0.1";  // loopback unless a deployment opens it
+  std::uint16_t port = 0;                   // 0: an ephemeral port (see Server::port)
+  std::chrono::milliseconds heartbeatInterval{1000};  // > 0
+  std::string serverId = "skyshell-weatherd";         // sent in Hello
+  std::size_t maxCellsPerSnapshot = kDefaultMaxCells;
+  bool handleSignals = true;  // SIGINT/SIGTERM stop the server (off in tests)
+  std::function<WallClock::time_point()> wallNow = [] { return WallClock::now(); };
+  std::shared_ptr<spdlog::logger> log;  // null: log nothing
+};
+
+class Server final : private SessionHandler {
+ public:
+  // Binds and listens. Errors: InvalidArgument (listen address), Io (bind).
+  static Result<std::unique_ptr<Server>> create(ServerOptions options, WeatherState state);
+
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+  ~Server();
+
+  std::uint16_t port() const { return port_; }
+
+  // Serves until stop() or a signal. Call from one thread only.
+  void run();
+  // Asks the server to shut down; safe from any thread and from signal-free
+  // tests. run() returns once every session is closed.
+  void stop();
+
+ private:
+  Server(ServerOptions options, WeatherState state);
+  Result<void> listen();
+  void accept();
+  void onAccept(const boost::system::error_code& ec, boost::asio::ip::tcp::socket socket);
+  void scheduleHeartbeat();
+  void shutdown();
+  double clockNow() const;
+
+  Frame snapshotFrame(const stream::Subscribe& request) override;
+  void sessionClosed(Session& session) override;
+
+  // Member order is destruction order in reverse: the io_context goes last,
+  // destroying handlers (and the sessions they keep alive) after the rest.
+  boost::asio::io_context io_;
+  ServerOptions options_;
+  std::shared_ptr<spdlog::logger> log_;
+  WeatherState state_;
+  boost::asio::ip::tcp::acceptor acceptor_;
+  boost::asio::steady_timer acceptRetry_;
+  boost::asio::steady_timer heartbeat_;
+  std::optional<boost::asio::signal_set> signals_;
+  SessionRegistry registry_;
+  std::uint16_t port_ = 0;
+  std::uint64_t nextSessionId_ = 1;
+  bool stopped_ = false;
+};
+
+}  // namespace sky::server

@@ -1,0 +1,86 @@
+// One subscriber's TCP connection: frames in through an incremental decoder,
+// out through a bounded Outbox with one write in flight. A protocol error is
+// answered with an Error message, after which the session closes; other
+// sessions and the server are not affected.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include "sky/core/result.hpp"
+#include "sky/server/outbox.hpp"
+#include "sky/stream/framing.hpp"
+#include "sky/stream/messages.hpp"
+
+namespace spdlog {
+class logger;
+}
+
+namespace sky::server {
+
+class Session;
+
+// What a session needs from its owner. Called on the io_context's thread.
+class SessionHandler {
+ public:
+  // The snapshot frame answering `request`, at the weather clock of now.
+  virtual Frame snapshotFrame(const stream::Subscribe& request) = 0;
+  // The session has closed its socket and will do no more work.
+  virtual void sessionClosed(Session& session) = 0;
+
+ protected:
+  ~SessionHandler() = default;
+};
+
+class Session : public std::enable_shared_from_this<Session> {
+ public:
+  // handler and log must outlive every call into the session.
+  Session(boost::asio::ip::tcp::socket socket, std::uint64_t id, SessionHandler& handler,
+          spdlog::logger& log);
+
+  // Sends `hello` (an encoded frame) first and starts reading.
+  void start(Frame hello);
+  // Queues a heartbeat frame, replacing one not yet sent. Ignored once closing.
+  void sendHeartbeat(const Frame& heartbeat);
+  // Closes the socket now, cancelling pending I/O. Idempotent.
+  void close();
+
+  std::uint64_t id() const { return id_; }
+  const std::string& peer() const { return peer_; }
+
+ private:
+  enum class State {
+    Open,         // reading messages, sending weather
+    ErrorQueued,  // an Error is on its way out; input is discarded
+    Draining,     // Error sent and our side shut down; waiting for the peer's EOF
+    Closed,
+  };
+
+  void readMore();
+  void onRead(const boost::system::error_code& ec, std::size_t bytes);
+  void handleMessage(const stream::Message& message);
+  void protocolError(const Error& error);
+  void writeNext();
+  void onWritten(const boost::system::error_code& ec);
+  void beginDrain();
+
+  boost::asio::ip::tcp::socket socket_;
+  boost::asio::steady_timer drainTimer_;
+  std::uint64_t id_;
+  std::string peer_;
+  SessionHandler& handler_;
+  spdlog::logger& log_;
+  State state_ = State::Open;
+  stream::FrameDecoder decoder_;
+  std::array<std::uint8_t, 64 * 1024> readBuffer_{};
+  Outbox outbox_;
+  Frame writing_;  // the frame async_write is sending; untouched until it completes
+  bool writeInFlight_ = false;
+};
+
+}  // namespace sky::server

@@ -1,0 +1,124 @@
+// skyshell-weatherd: the Skyshell weather server. Loads a scenario, listens on
+// TCP (loopback by default) and streams the weather to renderers. This file is
+// the edge: command line, config file, logging to stderr, exit codes.
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <spdlog/sinks/stdout_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include "sky/server/scenario.hpp"
+#include "sky/server/server.hpp"
+#include "sky/server/weather_state.hpp"
+
+namespace {
+
+// Exit codes: 0 clean shutdown, 1 runtime failure (bind, port file), 2 bad
+// input (command line, config file, scenario).
+constexpr int kExitRuntime = 1;
+constexpr int kExitBadInput = 2;
+
+// Writes `port` to `path` via a temporary file and a rename, so a reader
+// polling for the file never sees it half written.
+sky::Result<void> writePortFile(const std::filesystem::path& path, std::uint16_t port) {
+  std::filesystem::path tmp = path;
+  tmp += ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << port << '\n';
+    out.close();
+    if (!out) return sky::fail(sky::ErrorCode::Io, tmp.string() + ": cannot write");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    return sky::fail(sky::ErrorCode::Io, path.string() + ": cannot rename into place");
+  }
+  return {};
+}
+
+std::string hostName() {
+  char name[256] = {};
+  if (::gethostname(name, sizeof name - 1) != 0) return "unknown-host";
+  return name;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"skyshell-weatherd: streams the Skyshell weather state to renderers"};
+  app.set_config("--config", "",
+                 "TOML file whose keys are these options without the dashes "
+                 "(see deploy/weatherd.example.toml); the command line wins");
+  // A misspelt key in the config must be an error, not silently ignored.
+  app.allow_config_extras(CLI::config_extras_mode::error);
+
+  std::string scenarioPath;
+  sky::server::ServerOptions options;
+  std::string portFile;
+  int heartbeatMs = 1000;
+  std::string logLevel = "info";
+  app.add_option("--scenario", scenarioPath, "Scenario TOML file (deploy/scenarios/*.toml)")
+      ->required();
+  app.add_option("--listen", options.listenAddress, "Address to listen on")->capture_default_str();
+  app.add_option("--port", options.port, "TCP port; 0 picks a free one")->capture_default_str();
+  app.add_option("--port-file", portFile, "Write the port number here once listening");
+  app.add_option("--heartbeat-ms", heartbeatMs, "Heartbeat period, ms")
+      ->check(CLI::Range(1, 3'600'000))
+      ->capture_default_str();
+  app.add_option("--log-level", logLevel, "trace, debug, info, warn, error")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : kExitBadInput;
+  }
+
+  // Logs go to stderr (journald under systemd); stdout carries only the
+  // "listening on" line that scripts wait for.
+  auto log = std::make_shared<spdlog::logger>(
+      "weatherd", std::make_shared<spdlog::sinks::stderr_sink_mt>());
+  log->set_level(spdlog::level::from_str(logLevel));
+  log->flush_on(spdlog::level::info);
+
+  auto scenario = sky::server::loadScenario(scenarioPath);
+  if (!scenario) {
+    log->error("bad scenario: {}", sky::describe(scenario.error()));
+    return kExitBadInput;
+  }
+
+  options.heartbeatInterval = std::chrono::milliseconds(heartbeatMs);
+  options.serverId = "skyshell-weatherd@" + hostName();
+  options.log = log;
+  sky::server::WeatherState state(*scenario, sky::server::WallClock::now());
+  auto server = sky::server::Server::create(options, std::move(state));
+  if (!server) {
+    log->error("{}", sky::describe(server.error()));
+    return kExitRuntime;
+  }
+
+  const bool v6 = options.listenAddress.find(':') != std::string::npos;
+  const std::string host = v6 ? "[" + options.listenAddress + "]" : options.listenAddress;
+  std::cout << "skyshell-weatherd listening on " << host << ":" << (*server)->port() << std::endl;
+  if (!portFile.empty()) {
+    if (auto r = writePortFile(portFile, (*server)->port()); !r) {
+      log->error("{}", sky::describe(r.error()));
+      return kExitRuntime;
+    }
+  }
+  log->info("scenario {}: {} layer(s); listening on {}:{}", scenarioPath, scenario->layers.size(),
+            host, (*server)->port());
+
+  (*server)->run();
+  return EXIT_SUCCESS;
+}

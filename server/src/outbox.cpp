@@ -1,0 +1,51 @@
+// Bounded per-session outbound state (see outbox.hpp).
+#include "sky/server/outbox.hpp"
+
+#include <utility>
+
+#include "sky/core/assert.hpp"
+
+namespace sky::server {
+
+namespace {
+// Hello, then at most one Error before the session closes.
+constexpr std::size_t kMaxControlFrames = 2;
+}  // namespace
+
+void Outbox::pushControl(Frame frame) {
+  SKY_ASSERT(control_.size() < kMaxControlFrames);
+  control_.push_back(std::move(frame));
+}
+
+void Outbox::requestSnapshot(const stream::Subscribe& request) { snapshot_ = request; }
+
+void Outbox::setHeartbeat(Frame frame) { heartbeat_ = std::move(frame); }
+
+void Outbox::dropWeather() {
+  snapshot_.reset();
+  heartbeat_.reset();
+}
+
+std::optional<Outbox::Item> Outbox::takeNext() {
+  if (!control_.empty()) {
+    Frame f = std::move(control_.front());
+    control_.pop_front();
+    return Item(std::move(f));
+  }
+  if (snapshot_) {
+    const stream::Subscribe request = *snapshot_;
+    snapshot_.reset();
+    heartbeat_.reset();
+    return Item(request);
+  }
+  if (heartbeat_) {
+    Frame f = std::move(*heartbeat_);
+    heartbeat_.reset();
+    return Item(std::move(f));
+  }
+  return std::nullopt;
+}
+
+bool Outbox::empty() const { return control_.empty() && !snapshot_ && !heartbeat_; }
+
+}  // namespace sky::server

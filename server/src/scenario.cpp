@@ -1,0 +1,239 @@
+// Scenario TOML parsing (see scenario.hpp). toml++ gives every node its source
+// position, so each error can point at the line that caused it.
+#include "sky/server/scenario.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include <toml++/toml.h>
+
+namespace sky::server {
+
+namespace {
+
+// Builds error details "file:line:col: field: what" for one scenario source.
+class Where {
+ public:
+  explicit Where(std::string_view sourceName) : source_(sourceName) {}
+
+  tl::unexpected<Error> error(ErrorCode code, const toml::source_region& at,
+                              const std::string& field, const std::string& what) const {
+    return fail(code, source_ + ":" + std::to_string(at.begin.line) + ":" +
+                          std::to_string(at.begin.column) + ": " + field + ": " + what);
+  }
+
+ private:
+  std::string source_;
+};
+
+std::string singleQuoted(std::string_view s) { return "'" + std::string(s) + "'"; }
+
+std::string join(std::initializer_list<std::string_view> names) {
+  std::string out;
+  for (std::string_view n : names) out += (out.empty() ? "" : ", ") + std::string(n);
+  return out;
+}
+
+// Rejects keys outside `allowed`: a typo must never be ignored silently.
+Result<void> onlyKeys(const toml::table& table, std::initializer_list<std::string_view> allowed,
+                      const std::string& prefix, const Where& where) {
+  for (auto&& [key, node] : table) {
+    bool known = false;
+    for (std::string_view a : allowed) known = known || key.str() == a;
+    if (!known)
+      return where.error(ErrorCode::Malformed, node.source(), prefix + std::string(key.str()),
+                         "unknown key (expected one of: " + join(allowed) + ")");
+  }
+  return {};
+}
+
+Result<const toml::node*> required(const toml::table& table, std::string_view key,
+                                   const std::string& prefix, const Where& where) {
+  const toml::node* node = table.get(key);
+  if (!node)
+    return where.error(ErrorCode::Malformed, table.source(), prefix + std::string(key),
+                       "missing (required)");
+  return node;
+}
+
+// A number: TOML integers are accepted where a float is expected (base_m = 1500).
+Result<double> number(const toml::table& table, std::string_view key, const std::string& prefix,
+                      const Where& where) {
+  auto node = required(table, key, prefix, where);
+  if (!node) return tl::unexpected(node.error());
+  if (const auto* f = (*node)->as_floating_point()) {
+    if (!std::isfinite(f->get()))
+      return where.error(ErrorCode::InvalidArgument, (*node)->source(), prefix + std::string(key),
+                         "must be finite");
+    return f->get();
+  }
+  if (const auto* i = (*node)->as_integer()) return static_cast<double>(i->get());
+  return where.error(ErrorCode::Malformed, (*node)->source(), prefix + std::string(key),
+                     "must be a number");
+}
+
+Result<const toml::table*> table(const toml::table& parent, std::string_view key,
+                                 const std::string& prefix, const Where& where) {
+  auto node = required(parent, key, prefix, where);
+  if (!node) return tl::unexpected(node.error());
+  if (const auto* t = (*node)->as_table()) return t;
+  return where.error(ErrorCode::Malformed, (*node)->source(), prefix + std::string(key),
+                     "must be a table");
+}
+
+Result<ClockSettings> parseClock(const toml::table& root, const Where& where) {
+  auto clock = table(root, "clock", "", where);
+  if (!clock) return tl::unexpected(clock.error());
+  const toml::table& t = **clock;
+  if (auto r = onlyKeys(t, {"start_s", "rate"}, "clock.", where); !r)
+    return tl::unexpected(r.error());
+  ClockSettings out;
+  auto start = number(t, "start_s", "clock.", where);
+  if (!start) return tl::unexpected(start.error());
+  auto rate = number(t, "rate", "clock.", where);
+  if (!rate) return tl::unexpected(rate.error());
+  // Same range as Hello.clock_rate on the stream: 0 freezes the weather, 3600
+  // plays an hour per second.
+  if (*rate < 0 || *rate > 3600)
+    return where.error(ErrorCode::InvalidArgument, t.get("rate")->source(), "clock.rate",
+                       std::to_string(*rate) + " outside [0, 3600]");
+  out.start_s = *start;
+  out.rate = *rate;
+  return out;
+}
+
+// The field validate() blames: its detail reads "layer <id>: <field> <value> ...".
+std::string blamedField(const std::string& detail) {
+  const auto colon = detail.find(": ");
+  if (colon == std::string::npos) return {};
+  const auto begin = colon + 2;
+  const auto end = detail.find(' ', begin);
+  return detail.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+}
+
+Result<weather::CloudLayer> parseLayer(const toml::table& t, std::size_t index,
+                                       const Where& where) {
+  const std::string prefix = "layer[" + std::to_string(index) + "].";
+  if (auto r = onlyKeys(t,
+                        {"id", "type", "base_m", "thickness_m", "transition_band_m", "coverage",
+                         "density", "wind"},
+                        prefix, where);
+      !r)
+    return tl::unexpected(r.error());
+
+  weather::CloudLayer layer;
+
+  auto idNode = required(t, "id", prefix, where);
+  if (!idNode) return tl::unexpected(idNode.error());
+  const auto* id = (*idNode)->as_integer();
+  if (!id || id->get() < 0 || id->get() > std::int64_t{UINT32_MAX})
+    return where.error(ErrorCode::InvalidArgument, (*idNode)->source(), prefix + "id",
+                       "must be an integer in [0, 4294967295]");
+  layer.id = static_cast<std::uint32_t>(id->get());
+
+  auto typeNode = required(t, "type", prefix, where);
+  if (!typeNode) return tl::unexpected(typeNode.error());
+  const auto* typeName = (*typeNode)->as_string();
+  std::optional<weather::CloudType> type;
+  if (typeName) type = weather::cloudTypeFromString(typeName->get());
+  if (!type) {
+    std::string names;
+    for (std::uint8_t i = 0; i <= weather::kMaxCloudType; ++i)
+      names += (i ? ", " : "") + std::string(weather::toString(static_cast<weather::CloudType>(i)));
+    return where.error(ErrorCode::InvalidArgument, (*typeNode)->source(), prefix + "type",
+                       (typeName ? singleQuoted(typeName->get()) : std::string("value")) +
+                           " is not a cloud type (one of: " + names + ")");
+  }
+  layer.type = *type;
+
+  struct Field {
+    std::string_view key;
+    double* out;
+  };
+  for (const Field& f : {Field{"base_m", &layer.base_m}, Field{"thickness_m", &layer.thickness_m},
+                         Field{"transition_band_m", &layer.transitionBand_m},
+                         Field{"coverage", &layer.coverage}, Field{"density", &layer.density}}) {
+    auto v = number(t, f.key, prefix, where);
+    if (!v) return tl::unexpected(v.error());
+    *f.out = *v;
+  }
+
+  auto wind = table(t, "wind", prefix, where);
+  if (!wind) return tl::unexpected(wind.error());
+  const std::string windPrefix = prefix + "wind.";
+  if (auto r = onlyKeys(**wind, {"speed_mps", "from_deg", "vertical_mps"}, windPrefix, where); !r)
+    return tl::unexpected(r.error());
+  for (const Field& f : {Field{"speed_mps", &layer.wind.speed_mps},
+                         Field{"from_deg", &layer.wind.fromDirection_deg},
+                         Field{"vertical_mps", &layer.wind.vertical_mps}}) {
+    auto v = number(**wind, f.key, windPrefix, where);
+    if (!v) return tl::unexpected(v.error());
+    *f.out = *v;
+  }
+
+  if (auto r = weather::validate(layer); !r) {
+    // Point at the value validate() blames; fall back to the layer's header.
+    const std::string field = blamedField(r.error().detail);
+    const toml::node* blamed = field.empty() ? nullptr : t.at_path(field).node();
+    return where.error(ErrorCode::InvalidArgument, blamed ? blamed->source() : t.source(),
+                       prefix + (field.empty() ? std::string("?") : field), r.error().detail);
+  }
+  return layer;
+}
+
+}  // namespace
+
+Result<Scenario> parseScenario(std::string_view text, std::string_view sourceName) {
+  const Where where(sourceName);
+  toml::table root;
+  try {
+    root = toml::parse(text, sourceName);
+  } catch (const toml::parse_error& e) {
+    return where.error(ErrorCode::Malformed, e.source(), "TOML", std::string(e.description()));
+  }
+  if (auto r = onlyKeys(root, {"clock", "layer"}, "", where); !r) return tl::unexpected(r.error());
+
+  Scenario scenario;
+  auto clock = parseClock(root, where);
+  if (!clock) return tl::unexpected(clock.error());
+  scenario.clock = *clock;
+
+  // No [[layer]] at all is a clear sky.
+  if (const toml::node* layersNode = root.get("layer")) {
+    const toml::array* layers = layersNode->as_array();
+    if (!layers || !layers->is_array_of_tables())
+      return where.error(ErrorCode::Malformed, layersNode->source(), "layer",
+                         "must be an array of tables ([[layer]])");
+    if (layers->size() > kMaxScenarioLayers)
+      return where.error(ErrorCode::InvalidArgument, layersNode->source(), "layer",
+                         std::to_string(layers->size()) + " layers, at most " +
+                             std::to_string(kMaxScenarioLayers));
+    std::set<std::uint32_t> ids;
+    for (std::size_t i = 0; i < layers->size(); ++i) {
+      const toml::table& t = *(*layers)[i].as_table();
+      auto layer = parseLayer(t, i, where);
+      if (!layer) return tl::unexpected(layer.error());
+      if (!ids.insert(layer->id).second)
+        return where.error(ErrorCode::InvalidArgument, t.get("id")->source(),
+                           "layer[" + std::to_string(i) + "].id",
+                           "id " + std::to_string(layer->id) + " used by an earlier layer");
+      scenario.layers.push_back(*layer);
+    }
+  }
+  return scenario;
+}
+
+Result<Scenario> loadScenario(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return fail(ErrorCode::Io, path.string() + ": cannot open scenario file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) return fail(ErrorCode::Io, path.string() + ": read failed");
+  return parseScenario(text.str(), path.string());
+}
+
+}  // namespace sky::server

@@ -1,0 +1,152 @@
+// The weather stream server (see server.hpp).
+#include "sky/server/server.hpp"
+
+#include <csignal>
+#include <utility>
+
+#include <boost/asio/post.hpp>
+#include <spdlog/spdlog.h>
+
+#include "sky/core/assert.hpp"
+#include "sky/stream/framing.hpp"
+
+namespace sky::server {
+
+namespace asio = boost::asio;
+using asio::ip::tcp;
+
+namespace {
+
+// Pause before accepting again after a failed accept (e.g. out of file
+// descriptors), so a persistent failure does not spin the loop.
+constexpr std::chrono::milliseconds kAcceptRetryDelay{100};
+
+}  // namespace
+
+Result<std::unique_ptr<Server>> Server::create(ServerOptions options, WeatherState state) {
+  SKY_ASSERT(options.heartbeatInterval.count() > 0);
+  std::unique_ptr<Server> server(new Server(std::move(options), std::move(state)));
+  if (auto r = server->listen(); !r) return tl::unexpected(r.error());
+  return server;
+}
+
+Server::Server(ServerOptions options, WeatherState state)
+    : options_(std::move(options)),
+      // A logger without sinks: the library stays silent unless a main asks.
+      log_(options_.log ? options_.log : std::make_shared<spdlog::logger>("sky_server")),
+      state_(std::move(state)),
+      acceptor_(io_),
+      acceptRetry_(io_),
+      heartbeat_(io_) {}
+
+Server::~Server() = default;
+
+Result<void> Server::listen() {
+  boost::system::error_code ec;
+  const asio::ip::address address = asio::ip::make_address(options_.listenAddress, ec);
+  if (ec)
+    return fail(ErrorCode::InvalidArgument,
+                "listen address '" + options_.listenAddress + "': " + ec.message());
+  const tcp::endpoint endpoint(address, options_.port);
+  const std::string where = "listen " + options_.listenAddress + ":" + std::to_string(options_.port);
+  if (acceptor_.open(endpoint.protocol(), ec); ec)
+    return fail(ErrorCode::Io, where + ": open: " + ec.message());
+  if (acceptor_.set_option(tcp::acceptor::reuse_address(true), ec); ec)
+    return fail(ErrorCode::Io, where + ": SO_REUSEADDR: " + ec.message());
+  if (acceptor_.bind(endpoint, ec); ec) return fail(ErrorCode::Io, where + ": bind: " + ec.message());
+  if (acceptor_.listen(asio::socket_base::max_listen_connections, ec); ec)
+    return fail(ErrorCode::Io, where + ": listen: " + ec.message());
+  port_ = acceptor_.local_endpoint().port();
+  return {};
+}
+
+void Server::run() {
+  if (options_.handleSignals) {
+    signals_.emplace(io_, SIGINT, SIGTERM);
+    signals_->async_wait([this](const boost::system::error_code& ec, int signal) {
+      if (ec) return;
+      log_->info("signal {}: shutting down", signal);
+      shutdown();
+    });
+  }
+  accept();
+  scheduleHeartbeat();
+  log_->info("serving {} layer(s), weather clock {:.3f} s at rate {}", state_.layers().size(),
+             clockNow(), state_.clock().rate());
+  io_.run();
+  log_->info("stopped");
+}
+
+void Server::stop() {
+  asio::post(io_, [this] { shutdown(); });
+}
+
+void Server::shutdown() {
+  if (stopped_) return;
+  stopped_ = true;
+  boost::system::error_code ignored;
+  acceptor_.close(ignored);
+  acceptRetry_.cancel();
+  heartbeat_.cancel();
+  if (signals_) signals_->cancel(ignored);
+  registry_.closeAll();
+}
+
+void Server::accept() {
+  acceptor_.async_accept([this](const boost::system::error_code& ec, tcp::socket socket) {
+    onAccept(ec, std::move(socket));
+  });
+}
+
+void Server::onAccept(const boost::system::error_code& ec, tcp::socket socket) {
+  if (stopped_) return;
+  if (ec) {
+    log_->warn("accept failed: {}; retrying", ec.message());
+    acceptRetry_.expires_after(kAcceptRetryDelay);
+    acceptRetry_.async_wait([this](const boost::system::error_code& e) {
+      if (!e && !stopped_) accept();
+    });
+    return;
+  }
+  boost::system::error_code ignored;
+  // Frames are whole messages: send each as soon as it is written.
+  socket.set_option(tcp::no_delay(true), ignored);
+  auto session = std::make_shared<Session>(std::move(socket), nextSessionId_++,
+                                           static_cast<SessionHandler&>(*this), *log_);
+  log_->info("session {} ({}): connected", session->id(), session->peer());
+  registry_.add(session);
+  const stream::Hello hello{stream::kProtocolVersion, options_.serverId, clockNow(),
+                            state_.clock().rate()};
+  session->start(stream::encodeFrame(stream::encodeMessage(hello)));
+  accept();
+}
+
+void Server::scheduleHeartbeat() {
+  heartbeat_.expires_after(options_.heartbeatInterval);
+  heartbeat_.async_wait([this](const boost::system::error_code& ec) {
+    if (ec || stopped_) return;
+    const Frame frame = stream::encodeFrame(stream::encodeMessage(stream::Heartbeat{clockNow()}));
+    registry_.forEach([&frame](Session& s) { s.sendHeartbeat(frame); });
+    scheduleHeartbeat();
+  });
+}
+
+double Server::clockNow() const { return state_.clock().at(options_.wallNow()); }
+
+Frame Server::snapshotFrame(const stream::Subscribe& request) {
+  const weather::WeatherSnapshot snapshot =
+      buildSnapshot(request, state_.layers(), clockNow(), options_.maxCellsPerSnapshot);
+  const std::vector<std::uint8_t> payload = stream::encodeMessage(snapshot);
+  // cellBudget keeps tiles × 24 bytes under the cap; a bigger frame is our bug.
+  SKY_ASSERT(payload.size() <= stream::kMaxFrameBytes);
+  log_->debug("snapshot: level {} (asked {}), {} tiles, {} bytes", snapshot.tileLevel,
+              request.tileLevel, snapshot.tiles.size(), payload.size());
+  return stream::encodeFrame(payload);
+}
+
+void Server::sessionClosed(Session& session) {
+  log_->info("session {} ({}): closed", session.id(), session.peer());
+  registry_.remove(session);
+}
+
+}  // namespace sky::server

@@ -1,0 +1,172 @@
+// A subscriber's connection (see session.hpp).
+#include "sky/server/session.hpp"
+
+#include <chrono>
+#include <span>
+#include <type_traits>
+#include <utility>
+#include <variant>
+
+#include <boost/asio/write.hpp>
+#include <spdlog/spdlog.h>
+
+namespace sky::server {
+
+namespace asio = boost::asio;
+
+namespace {
+
+// How long a session that was sent an Error waits for the peer to close before
+// closing itself. Closing at once could reset the connection while the Error
+// is still unread (unread input makes the kernel send RST, not FIN).
+constexpr std::chrono::seconds kDrainTimeout{2};
+
+Frame encodeErrorFrame(const Error& error) {
+  // StreamError codes are sky::ErrorCode values, so both ends read one enum.
+  const stream::StreamError message{static_cast<std::uint16_t>(error.code), error.detail};
+  return stream::encodeFrame(stream::encodeMessage(message));
+}
+
+}  // namespace
+
+Session::Session(asio::ip::tcp::socket socket, std::uint64_t id, SessionHandler& handler,
+                 spdlog::logger& log)
+    : socket_(std::move(socket)),
+      drainTimer_(socket_.get_executor()),
+      id_(id),
+      handler_(handler),
+      log_(log) {
+  boost::system::error_code ec;
+  const auto remote = socket_.remote_endpoint(ec);
+  peer_ = ec ? std::string("?") : remote.address().to_string() + ":" + std::to_string(remote.port());
+}
+
+void Session::start(Frame hello) {
+  outbox_.pushControl(std::move(hello));
+  writeNext();
+  readMore();
+}
+
+void Session::sendHeartbeat(const Frame& heartbeat) {
+  if (state_ != State::Open) return;
+  outbox_.setHeartbeat(heartbeat);
+  writeNext();
+}
+
+void Session::close() {
+  if (state_ == State::Closed) return;
+  state_ = State::Closed;
+  boost::system::error_code ignored;
+  socket_.close(ignored);
+  drainTimer_.cancel();
+  handler_.sessionClosed(*this);
+}
+
+void Session::readMore() {
+  socket_.async_read_some(asio::buffer(readBuffer_),
+                          [self = shared_from_this()](const boost::system::error_code& ec,
+                                                      std::size_t bytes) { self->onRead(ec, bytes); });
+}
+
+void Session::onRead(const boost::system::error_code& ec, std::size_t bytes) {
+  if (state_ == State::Closed) return;
+  if (ec) {
+    if (ec == asio::error::eof)
+      log_.info("session {} ({}): peer closed", id_, peer_);
+    else
+      log_.info("session {} ({}): read failed: {}", id_, peer_, ec.message());
+    close();
+    return;
+  }
+  if (state_ == State::Open) {
+    decoder_.append(std::span<const std::uint8_t>(readBuffer_.data(), bytes));
+    while (state_ == State::Open) {
+      auto frame = decoder_.next();
+      if (!frame) {
+        protocolError(frame.error());
+        break;
+      }
+      if (!*frame) break;
+      auto message = stream::decodeMessage(**frame);
+      if (!message) {
+        protocolError(message.error());
+        break;
+      }
+      handleMessage(*message);
+    }
+  }
+  // After an Error the rest of the input is read and discarded until EOF.
+  if (state_ != State::Closed) readMore();
+}
+
+void Session::handleMessage(const stream::Message& message) {
+  if (const auto* subscribe = std::get_if<stream::Subscribe>(&message)) {
+    log_.debug("session {} ({}): subscribe lat {} lon {} radius {} m level {}", id_, peer_,
+               subscribe->area.centerLat_deg, subscribe->area.centerLon_deg,
+               subscribe->area.radius_m, subscribe->tileLevel);
+    outbox_.requestSnapshot(*subscribe);
+    writeNext();
+  } else if (std::holds_alternative<stream::Heartbeat>(message)) {
+    // A client's keep-alive: nothing to answer.
+  } else if (const auto* error = std::get_if<stream::StreamError>(&message)) {
+    log_.info("session {} ({}): client reported error {}: {}; closing", id_, peer_, error->code,
+              error->detail);
+    close();
+  } else {
+    protocolError(Error{ErrorCode::Unsupported, std::string(stream::kindName(message)) +
+                                                    " is sent by servers, not clients"});
+  }
+}
+
+void Session::protocolError(const Error& error) {
+  log_.warn("session {} ({}): {}; sending Error and closing", id_, peer_, describe(error));
+  state_ = State::ErrorQueued;
+  outbox_.dropWeather();
+  outbox_.pushControl(encodeErrorFrame(error));
+  writeNext();
+}
+
+void Session::writeNext() {
+  if (writeInFlight_ || state_ == State::Closed || state_ == State::Draining) return;
+  auto item = outbox_.takeNext();
+  if (!item) {
+    if (state_ == State::ErrorQueued) beginDrain();
+    return;
+  }
+  std::visit(
+      [this](auto&& next) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(next)>, stream::Subscribe>)
+          writing_ = handler_.snapshotFrame(next);
+        else
+          writing_ = std::move(next);
+      },
+      std::move(*item));
+  writeInFlight_ = true;
+  asio::async_write(socket_, asio::buffer(writing_),
+                    [self = shared_from_this()](const boost::system::error_code& ec, std::size_t) {
+                      self->onWritten(ec);
+                    });
+}
+
+void Session::onWritten(const boost::system::error_code& ec) {
+  writeInFlight_ = false;
+  if (state_ == State::Closed) return;
+  if (ec) {
+    log_.info("session {} ({}): write failed: {}", id_, peer_, ec.message());
+    close();
+    return;
+  }
+  writeNext();
+}
+
+void Session::beginDrain() {
+  state_ = State::Draining;
+  boost::system::error_code ignored;
+  socket_.shutdown(asio::ip::tcp::socket::shutdown_send, ignored);
+  drainTimer_.expires_after(kDrainTimeout);
+  drainTimer_.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+    if (!ec) self->close();
+  });
+}
+
+}  // namespace sky::server

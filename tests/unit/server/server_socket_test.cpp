@@ -1,0 +1,274 @@
+// The server on a real loopback socket, driven by a plain asio client: Hello,
+// Subscribe -> Snapshot, Heartbeats, and protocol errors answered with Error and
+// a close while another client keeps being served.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <chrono>
+#include <thread>
+
+#include <boost/asio/connect.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/read.hpp>
+#include <boost/asio/write.hpp>
+
+#include "sky/server/scenario.hpp"
+#include "sky/server/server.hpp"
+#include "sky/stream/framing.hpp"
+#include "sky/stream/messages.hpp"
+
+namespace sky::server {
+namespace {
+
+namespace asio = boost::asio;
+using asio::ip::tcp;
+using namespace std::chrono_literals;
+
+constexpr auto kTimeout = 5s;
+
+// A blocking-style client with a deadline on every read, so a server bug fails
+// the test instead of hanging it.
+class TestClient {
+ public:
+  explicit TestClient(std::uint16_t port) : socket_(io_) {
+    socket_.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+  }
+
+  void sendBytes(const std::vector<std::uint8_t>& bytes) { asio::write(socket_, asio::buffer(bytes)); }
+  void send(const stream::Message& m) { sendBytes(stream::encodeFrame(stream::encodeMessage(m))); }
+
+  // The next message; fails with Io "eof" when the server closed the stream.
+  Result<stream::Message> read(std::chrono::milliseconds timeout = kTimeout) {
+    std::array<std::uint8_t, stream::kFrameHeaderBytes> header{};
+    std::vector<std::uint8_t> payload;
+    bool done = false;
+    boost::system::error_code error;
+    asio::async_read(socket_, asio::buffer(header), [&](const boost::system::error_code& ec, std::size_t) {
+      if (ec) {
+        error = ec;
+        done = true;
+        return;
+      }
+      const std::size_t n = (std::size_t{header[0]} << 24) | (std::size_t{header[1]} << 16) |
+                            (std::size_t{header[2]} << 8) | header[3];
+      payload.resize(n);
+      asio::async_read(socket_, asio::buffer(payload), [&](const boost::system::error_code& ec2, std::size_t) {
+        error = ec2;
+        done = true;
+      });
+    });
+    io_.restart();
+    io_.run_for(timeout);
+    if (!done) {
+      socket_.cancel();
+      io_.restart();
+      io_.run();
+      return fail(ErrorCode::Timeout, "no message within the deadline");
+    }
+    if (error == asio::error::eof) return fail(ErrorCode::Io, "eof");
+    if (error) return fail(ErrorCode::Io, error.message());
+    return stream::decodeMessage(payload);
+  }
+
+  // The next message of type T, skipping heartbeats (unless T is Heartbeat).
+  template <class T>
+  Result<T> readNext() {
+    for (;;) {
+      auto m = read();
+      if (!m) return tl::unexpected(m.error());
+      if (auto* t = std::get_if<T>(&*m)) return *t;
+      if (!std::holds_alternative<stream::Heartbeat>(*m))
+        return fail(ErrorCode::Malformed, std::string("unexpected ") + stream::kindName(*m));
+    }
+  }
+
+ private:
+  asio::io_context io_;
+  tcp::socket socket_;
+};
+
+// A server on an ephemeral loopback port, run on its own thread; the weather
+// clock is frozen at a known wall time so every clock on the wire is exact.
+class ServerFixture : public ::testing::Test {
+ protected:
+  static constexpr double kStart_s = 500.0;
+
+  void SetUp() override {
+    auto scenario = loadScenario(SKY_SOURCE_DIR "/deploy/scenarios/skeleton-cumulus.toml");
+    ASSERT_TRUE(scenario) << scenario.error().detail;
+    scenario->clock.start_s = kStart_s;
+    const WallClock::time_point t0{std::chrono::seconds(1)};
+    ServerOptions options;
+    options.port = 0;
+    options.heartbeatInterval = 50ms;
+    options.serverId = "test-server";
+    options.handleSignals = false;
+    options.wallNow = [t0] { return t0; };
+    auto server = Server::create(options, WeatherState(*scenario, t0));
+    ASSERT_TRUE(server) << server.error().detail;
+    server_ = std::move(*server);
+    ASSERT_NE(server_->port(), 0);
+    thread_ = std::thread([this] { server_->run(); });
+  }
+
+  void TearDown() override {
+    if (!server_) return;
+    server_->stop();
+    thread_.join();  // run() returns: shutdown closed every session and the acceptor
+  }
+
+  std::unique_ptr<Server> server_;
+  std::thread thread_;
+};
+
+stream::Subscribe subscribe(double lat_deg, double lon_deg, double radius_m, int level) {
+  stream::Subscribe s;
+  s.area = {lat_deg, lon_deg, radius_m};
+  s.tileLevel = level;
+  return s;
+}
+
+void expectServing(TestClient& client, double lat_deg) {
+  client.send(subscribe(lat_deg, 8.5, 20'000, 10));
+  auto snapshot = client.readNext<weather::WeatherSnapshot>();
+  ASSERT_TRUE(snapshot) << snapshot.error().detail;
+  EXPECT_EQ(snapshot->tileLevel, 10);
+  EXPECT_FALSE(snapshot->tiles.empty());
+}
+
+TEST_F(ServerFixture, HelloSubscribeSnapshotHeartbeat) {
+  TestClient client(server_->port());
+  auto hello = client.readNext<stream::Hello>();
+  ASSERT_TRUE(hello) << hello.error().detail;
+  EXPECT_EQ(hello->protocolVersion, stream::kProtocolVersion);
+  EXPECT_EQ(hello->serverId, "test-server");
+  EXPECT_DOUBLE_EQ(hello->weatherClock_s, kStart_s);
+  EXPECT_DOUBLE_EQ(hello->clockRate, 1.0);
+
+  client.send(subscribe(47.4, 8.5, 30'000, 10));
+  auto snapshot = client.readNext<weather::WeatherSnapshot>();
+  ASSERT_TRUE(snapshot) << snapshot.error().detail;
+  EXPECT_DOUBLE_EQ(snapshot->weatherClock_s, kStart_s);
+  EXPECT_EQ(snapshot->tileLevel, 10);
+  ASSERT_EQ(snapshot->layers.size(), 1u);
+  EXPECT_EQ(snapshot->layers[0].type, weather::CloudType::Cumulus);
+  EXPECT_NEAR(snapshot->layers[0].coverage, 0.6, 1e-6);
+  ASSERT_FALSE(snapshot->tiles.empty());
+  for (const auto& t : snapshot->tiles) {
+    EXPECT_EQ(t.layerId, 1u);
+    EXPECT_FLOAT_EQ(t.coverage, 0.6f);
+  }
+
+  auto heartbeat = client.readNext<stream::Heartbeat>();
+  ASSERT_TRUE(heartbeat) << heartbeat.error().detail;
+  EXPECT_DOUBLE_EQ(heartbeat->weatherClock_s, kStart_s);
+
+  // Re-subscribing (the camera moved) gets a new snapshot for the new area.
+  client.send(subscribe(-33.9, 151.2, 10'000, 11));
+  auto again = client.readNext<weather::WeatherSnapshot>();
+  ASSERT_TRUE(again) << again.error().detail;
+  EXPECT_EQ(again->tileLevel, 11);
+  EXPECT_NE(again->tiles.front().cellId, snapshot->tiles.front().cellId);
+}
+
+TEST_F(ServerFixture, TooFineALevelIsLoweredAndReported) {
+  TestClient client(server_->port());
+  ASSERT_TRUE(client.readNext<stream::Hello>());
+  client.send(subscribe(45.0, 10.0, 1'000'000, 20));
+  auto snapshot = client.readNext<weather::WeatherSnapshot>();
+  ASSERT_TRUE(snapshot) << snapshot.error().detail;
+  EXPECT_LT(snapshot->tileLevel, 20);
+  EXPECT_LE(snapshot->tiles.size(), kDefaultMaxCells);
+}
+
+TEST_F(ServerFixture, GarbageGetsErrorAndCloseWhileOthersKeepWorking) {
+  TestClient good(server_->port());
+  ASSERT_TRUE(good.readNext<stream::Hello>());
+  expectServing(good, 47.0);
+
+  TestClient bad(server_->port());
+  ASSERT_TRUE(bad.readNext<stream::Hello>());
+  bad.sendBytes(stream::encodeFrame(std::vector<std::uint8_t>(16, 0xAB)));
+  auto error = bad.readNext<stream::StreamError>();
+  ASSERT_TRUE(error) << error.error().detail;
+  EXPECT_EQ(error->code, static_cast<std::uint16_t>(ErrorCode::Malformed));
+  EXPECT_FALSE(error->detail.empty());
+  auto after = bad.read();
+  ASSERT_FALSE(after);
+  EXPECT_EQ(after.error().detail, "eof");
+
+  expectServing(good, 48.0);
+  ASSERT_TRUE(good.readNext<stream::Heartbeat>());
+}
+
+TEST_F(ServerFixture, OversizedFrameGetsTooLargeError) {
+  TestClient bad(server_->port());
+  ASSERT_TRUE(bad.readNext<stream::Hello>());
+  bad.sendBytes({0xFF, 0xFF, 0xFF, 0xFF, 0x00});
+  auto error = bad.readNext<stream::StreamError>();
+  ASSERT_TRUE(error) << error.error().detail;
+  EXPECT_EQ(error->code, static_cast<std::uint16_t>(ErrorCode::TooLarge));
+  EXPECT_EQ(bad.read().error().detail, "eof");
+}
+
+TEST_F(ServerFixture, ServerOnlyMessagesFromAClientAreRejected) {
+  for (const stream::Message& m :
+       {stream::Message(stream::Hello{}), stream::Message(weather::WeatherSnapshot{})}) {
+    TestClient bad(server_->port());
+    ASSERT_TRUE(bad.readNext<stream::Hello>());
+    bad.send(m);
+    auto error = bad.readNext<stream::StreamError>();
+    ASSERT_TRUE(error) << error.error().detail;
+    EXPECT_EQ(error->code, static_cast<std::uint16_t>(ErrorCode::Unsupported));
+    EXPECT_NE(error->detail.find(stream::kindName(m)), std::string::npos) << error->detail;
+    EXPECT_EQ(bad.read().error().detail, "eof");
+  }
+  TestClient good(server_->port());
+  ASSERT_TRUE(good.readNext<stream::Hello>());
+  expectServing(good, 10.0);
+}
+
+TEST_F(ServerFixture, StopsWithClientsConnected) {
+  TestClient a(server_->port());
+  TestClient b(server_->port());
+  ASSERT_TRUE(a.readNext<stream::Hello>());
+  ASSERT_TRUE(b.readNext<stream::Hello>());
+  server_->stop();
+  thread_.join();
+  server_.reset();
+  // Both connections are closed by the shutdown (possibly after heartbeats).
+  for (TestClient* c : {&a, &b}) {
+    for (;;) {
+      auto m = c->read();
+      if (!m) {
+        EXPECT_NE(m.error().code, ErrorCode::Timeout);
+        break;
+      }
+    }
+  }
+}
+
+TEST(Server, BadListenAddressIsAnError) {
+  Scenario scenario;
+  ServerOptions options;
+  options.listenAddress = "not-an-address";
+  auto server = Server::create(options, WeatherState(scenario, WallClock::now()));
+  ASSERT_FALSE(server);
+  EXPECT_EQ(server.error().code, ErrorCode::InvalidArgument);
+}
+
+TEST(Server, PortInUseIsAnIoError) {
+  Scenario scenario;
+  ServerOptions options;
+  options.handleSignals = false;
+  auto first = Server::create(options, WeatherState(scenario, WallClock::now()));
+  ASSERT_TRUE(first) << first.error().detail;
+  options.port = (*first)->port();
+  auto second = Server::create(options, WeatherState(scenario, WallClock::now()));
+  ASSERT_FALSE(second);
+  EXPECT_EQ(second.error().code, ErrorCode::Io);
+}
+
+}  // namespace
+}  // namespace sky::server

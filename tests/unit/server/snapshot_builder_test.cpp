@@ -1,0 +1,205 @@
+// Snapshot tiling, checked against S2 directly: every point of the cap lies in
+// a tile, every tile touches the cap, the level is lowered only when the cell
+// budget demands it, and tiles carry their layer's coverage and density.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <set>
+
+#include <s2/s1angle.h>
+#include <s2/s2cap.h>
+#include <s2/s2cell.h>
+#include <s2/s2cell_id.h>
+#include <s2/s2latlng.h>
+
+#include "sky/server/snapshot_builder.hpp"
+#include "sky/stream/framing.hpp"
+
+namespace sky::server {
+namespace {
+
+// The sphere tiling.hpp measures caps on (IUGG mean Earth radius).
+constexpr double kRadius_m = 6371008.8;
+
+S2Cap s2Cap(const weather::SphericalCap& cap) {
+  return S2Cap(S2LatLng::FromDegrees(cap.centerLat_deg, cap.centerLon_deg).Normalized().ToPoint(),
+               S1Angle::Radians(cap.radius_m / kRadius_m));
+}
+
+// The point `fraction` of the cap's radius from its centre along `bearing_rad`
+// (great-circle destination formula, written out here independently of S2).
+S2LatLng pointInCap(const weather::SphericalCap& cap, double fraction, double bearing_rad) {
+  const double lat1 = cap.centerLat_deg * std::numbers::pi / 180;
+  const double lon1 = cap.centerLon_deg * std::numbers::pi / 180;
+  const double d = fraction * cap.radius_m / kRadius_m;
+  const double lat2 =
+      std::asin(std::sin(lat1) * std::cos(d) + std::cos(lat1) * std::sin(d) * std::cos(bearing_rad));
+  const double lon2 = lon1 + std::atan2(std::sin(bearing_rad) * std::sin(d) * std::cos(lat1),
+                                        std::cos(d) - std::sin(lat1) * std::sin(lat2));
+  return S2LatLng::FromRadians(lat2, lon2).Normalized();
+}
+
+// Checks that `cells` are valid, distinct, all at `level`, each touching the
+// cap, and that sample points across the cap (centre to rim) all fall in one.
+void expectCovers(const weather::SphericalCap& cap, int level,
+                  const std::vector<std::uint64_t>& cells) {
+  ASSERT_FALSE(cells.empty());
+  const std::set<std::uint64_t> set(cells.begin(), cells.end());
+  EXPECT_EQ(set.size(), cells.size()) << "duplicate cells";
+  const S2Cap region = s2Cap(cap);
+  for (const std::uint64_t id : cells) {
+    const S2CellId cell(id);
+    ASSERT_TRUE(cell.is_valid());
+    EXPECT_EQ(cell.level(), level);
+    EXPECT_TRUE(region.MayIntersect(S2Cell(cell))) << cell.ToString() << " misses the cap";
+  }
+  constexpr int kBearings = 72;
+  for (const double fraction : {0.0, 0.25, 0.5, 0.75, 0.999}) {
+    for (int i = 0; i < kBearings; ++i) {
+      const S2LatLng p = pointInCap(cap, fraction, 2 * std::numbers::pi * i / kBearings);
+      const S2CellId cell = S2CellId(p).parent(level);
+      EXPECT_TRUE(set.count(cell.id()))
+          << "point " << p.ToStringInDegrees() << " (" << fraction << " of radius) not covered";
+    }
+  }
+}
+
+weather::CloudLayer layer(std::uint32_t id, double coverage, double density) {
+  weather::CloudLayer l;
+  l.id = id;
+  l.base_m = 1500;
+  l.thickness_m = 1500;
+  l.coverage = coverage;
+  l.density = density;
+  return l;
+}
+
+stream::Subscribe request(double lat_deg, double lon_deg, double radius_m, int level) {
+  stream::Subscribe s;
+  s.area = {lat_deg, lon_deg, radius_m};
+  s.tileLevel = level;
+  return s;
+}
+
+TEST(CoverArea, MidLatitudeCapAtWantedLevel) {
+  const weather::SphericalCap cap{47.4, 8.5, 30'000};
+  const Covering c = coverArea(cap, 10, kDefaultMaxCells);
+  EXPECT_EQ(c.level, 10);
+  expectCovers(cap, c.level, c.cells);
+}
+
+TEST(CoverArea, CapAtTheNorthPole) {
+  const weather::SphericalCap cap{90.0, 0.0, 100'000};
+  const Covering c = coverArea(cap, 9, kDefaultMaxCells);
+  EXPECT_EQ(c.level, 9);
+  expectCovers(cap, c.level, c.cells);
+  // Every longitude meets the pole: cell centres fall in all four quadrants.
+  std::set<int> quadrants;
+  for (const std::uint64_t id : c.cells)
+    quadrants.insert(static_cast<int>(std::floor((S2CellId(id).ToLatLng().lng().degrees() + 180) / 90)));
+  EXPECT_EQ(quadrants.size(), 4u);
+}
+
+TEST(CoverArea, CapAcrossTheAntimeridian) {
+  const weather::SphericalCap cap{-15.0, 179.8, 80'000};
+  const Covering c = coverArea(cap, 10, kDefaultMaxCells);
+  EXPECT_EQ(c.level, 10);
+  expectCovers(cap, c.level, c.cells);
+  bool east = false, west = false;
+  for (const std::uint64_t id : c.cells) {
+    const double lon_deg = S2CellId(id).ToLatLng().lng().degrees();
+    east = east || lon_deg > 0;
+    west = west || lon_deg < 0;
+  }
+  EXPECT_TRUE(east && west) << "the covering should straddle +-180";
+}
+
+TEST(CoverArea, UnnormalisedLongitudeGivesTheSameCells) {
+  const Covering a = coverArea({10.0, -179.9, 20'000}, 11, kDefaultMaxCells);
+  const Covering b = coverArea({10.0, 180.1, 20'000}, 11, kDefaultMaxCells);
+  EXPECT_EQ(std::set<std::uint64_t>(a.cells.begin(), a.cells.end()),
+            std::set<std::uint64_t>(b.cells.begin(), b.cells.end()));
+}
+
+TEST(CoverArea, LowersTheLevelWhenTooManyCells) {
+  const weather::SphericalCap cap{45.0, 10.0, 2'000'000};
+  const Covering c = coverArea(cap, 14, kDefaultMaxCells);
+  EXPECT_LT(c.level, 14);
+  EXPECT_LE(c.cells.size(), kDefaultMaxCells);
+  expectCovers(cap, c.level, c.cells);
+  // And it is the finest level that fits: one level finer would not.
+  EXPECT_GT(weather::coverCap(cap, c.level + 1, kDefaultMaxCells).size(), kDefaultMaxCells);
+}
+
+TEST(CoverArea, WholeEarthAtFineLevelTerminatesWithinBudget) {
+  const weather::SphericalCap cap{0.0, 0.0, 2.0e7};
+  const Covering c = coverArea(cap, 20, kDefaultMaxCells);
+  EXPECT_LE(c.cells.size(), kDefaultMaxCells);
+  EXPECT_GE(c.level, 4);  // 6 × 4^5 = 6144 cells fit; 6 × 4^6 do not
+}
+
+TEST(CellBudget, KeepsEveryTileInOneFrame) {
+  for (std::size_t layers : {0u, 1u, 4u, 32u}) {
+    const std::size_t cells = cellBudget(kDefaultMaxCells, layers);
+    EXPECT_LE(cells, kDefaultMaxCells);
+    EXPECT_LT(cells * std::max<std::size_t>(layers, 1) * kTileWireBytes, stream::kMaxFrameBytes);
+  }
+  EXPECT_EQ(cellBudget(kDefaultMaxCells, 1), kDefaultMaxCells);
+}
+
+TEST(DeriveTiles, OneTilePerCellAndLayerWithTheLayersValues) {
+  const std::vector<std::uint64_t> cells = {S2CellId::FromFace(0).child_begin(2).id(),
+                                            S2CellId::FromFace(1).child_begin(2).id()};
+  const std::vector<weather::CloudLayer> layers = {layer(1, 0.6, 1.0), layer(5, 0.2, 0.5)};
+  const auto tiles = deriveTiles(cells, layers);
+  ASSERT_EQ(tiles.size(), 4u);
+  std::set<std::pair<std::uint64_t, std::uint32_t>> seen;
+  for (const auto& t : tiles) {
+    seen.insert({t.cellId, t.layerId});
+    const weather::CloudLayer& l = t.layerId == 1 ? layers[0] : layers[1];
+    EXPECT_FLOAT_EQ(t.coverage, static_cast<float>(l.coverage));
+    EXPECT_FLOAT_EQ(t.density, static_cast<float>(l.density));
+  }
+  EXPECT_EQ(seen.size(), 4u);
+}
+
+TEST(BuildSnapshot, CarriesLayersClockAndTilesOverTheCap) {
+  const std::vector<weather::CloudLayer> layers = {layer(1, 0.6, 1.0)};
+  const stream::Subscribe req = request(90.0, 0.0, 50'000, 10);
+  const weather::WeatherSnapshot s = buildSnapshot(req, layers, 1234.5, kDefaultMaxCells);
+  EXPECT_DOUBLE_EQ(s.weatherClock_s, 1234.5);
+  ASSERT_EQ(s.layers.size(), 1u);
+  EXPECT_EQ(s.layers[0].id, 1u);
+  EXPECT_EQ(s.tileLevel, 10);
+  std::vector<std::uint64_t> cells;
+  for (const auto& t : s.tiles) {
+    EXPECT_EQ(t.layerId, 1u);
+    EXPECT_FLOAT_EQ(t.coverage, 0.6f);
+    EXPECT_FLOAT_EQ(t.density, 1.0f);
+    cells.push_back(t.cellId);
+  }
+  expectCovers(req.area, s.tileLevel, cells);
+}
+
+TEST(BuildSnapshot, NoLayersMeansNoTiles) {
+  const weather::WeatherSnapshot s =
+      buildSnapshot(request(0, 0, 10'000, 10), {}, 0.0, kDefaultMaxCells);
+  EXPECT_TRUE(s.layers.empty());
+  EXPECT_TRUE(s.tiles.empty());
+}
+
+TEST(BuildSnapshot, ManyLayersOverALargeCapStillFitOneFrame) {
+  std::vector<weather::CloudLayer> layers;
+  for (std::uint32_t i = 0; i < 32; ++i) layers.push_back(layer(i, 0.5, 0.5));
+  const weather::WeatherSnapshot s =
+      buildSnapshot(request(45, 10, 500'000, 12), layers, 0.0, kDefaultMaxCells);
+  const auto payload = stream::encodeMessage(s);
+  EXPECT_LE(payload.size(), stream::kMaxFrameBytes);
+  auto decoded = stream::decodeMessage(payload);
+  ASSERT_TRUE(decoded) << decoded.error().detail;
+  EXPECT_EQ(std::get<weather::WeatherSnapshot>(*decoded).tiles.size(), s.tiles.size());
+}
+
+}  // namespace
+}  // namespace sky::server
