@@ -61,9 +61,34 @@ EntityControl goldenEntity() {
   return e;
 }
 
+WeatherControl goldenWeather() {
+  WeatherControl w;
+  w.layerId = 1;
+  w.humidity_pct = 80;
+  w.weatherEnable = true;
+  w.scudEnable = true;
+  w.cloudType = weather::CloudType::Cumulus;
+  w.scope = WeatherScope::Global;
+  w.severity = 3;
+  w.airTemperature_c = 5;
+  w.visibility_m = 20000;
+  w.scudFrequency_pct = 25;
+  w.coverage_pct = 62.5f;
+  w.baseElevation_m = 1500;
+  w.thickness_m = 2000;
+  w.transitionBand_m = 300;
+  w.horizontalWind_mps = 12.5f;
+  w.verticalWind_mps = 0.5f;
+  w.windDirection_deg = 270;
+  w.pressure_hpa = 1013.25f;
+  w.aerosol_gpm3 = 0.35f;
+  return w;
+}
+
 void expectGoldenFrame1(const Datagram& d) {
-  ASSERT_EQ(d.packets.size(), 2u);
-  EXPECT_EQ(d.skippedPackets, 1u);  // Weather Control: not decoded by this codec yet
+  ASSERT_EQ(d.packets.size(), 3u);
+  EXPECT_EQ(d.skippedPackets, 0u);
+  EXPECT_EQ(std::get<WeatherControl>(d.packets[2]), goldenWeather());
   const auto& ig = std::get<IgControl>(d.packets[0]);
   EXPECT_EQ(ig.databaseNumber, 5);
   EXPECT_EQ(ig.mode, IgMode::Operate);
@@ -98,30 +123,40 @@ TEST(Cigi, DecodesGoldenVectorsInBothByteOrders) {
 }
 
 TEST(Cigi, EncodesTheGoldenBytes) {
-  for (auto [order, hex] : {std::pair{ByteOrder::Big, kFrame1Be}, std::pair{ByteOrder::Little, kFrame1Le}}) {
+  for (const auto& [order, hex] :
+       {std::pair{ByteOrder::Big, kFrame1Be}, std::pair{ByteOrder::Little, kFrame1Le}}) {
     DatagramWriter w(order);
-    w.add(goldenIgControl()).add(goldenEntity());
-    const auto golden = fromHex(hex);
-    ASSERT_EQ(w.bytes().size(), 72u);
-    EXPECT_EQ(w.bytes(), std::vector<std::uint8_t>(golden.begin(), golden.begin() + 72));
+    w.add(goldenIgControl()).add(goldenEntity()).add(goldenWeather());
+    EXPECT_EQ(w.bytes(), fromHex(hex));
   }
 }
 
 TEST(Cigi, StartOfFrameGoldenAndRoundTrip) {
   auto d = decodeDatagram(fromHex(kFrame2Be));
   ASSERT_TRUE(d) << d.error().detail;
-  ASSERT_EQ(d->packets.size(), 1u);
-  EXPECT_EQ(d->skippedPackets, 2u);
+  ASSERT_EQ(d->packets.size(), 3u);
+  EXPECT_EQ(d->direction, Direction::IgToHost);
   const auto& sof = std::get<StartOfFrame>(d->packets[0]);
   EXPECT_EQ(sof.igFrame, 777u);
   EXPECT_EQ(sof.timestamp_10us, 5000100u);
   EXPECT_EQ(sof.lastHostFrame, 1234u);
   EXPECT_EQ(sof.mode, IgMode::Operate);
   EXPECT_TRUE(sof.timestampValid);
+  WeatherConditionsResponse wcr;
+  wcr.requestId = 42;
+  wcr.humidity_pct = 80;
+  wcr.airTemperature_c = 5;
+  wcr.visibility_m = 20000;
+  wcr.horizontalWind_mps = 12.5f;
+  wcr.verticalWind_mps = 0.5f;
+  wcr.windDirection_deg = 270;
+  wcr.pressure_hpa = 1013.25f;
+  EXPECT_EQ(std::get<WeatherConditionsResponse>(d->packets[1]), wcr);
+  const AerosolConcentrationResponse acr{42, 1, 0.35f};
+  EXPECT_EQ(std::get<AerosolConcentrationResponse>(d->packets[2]), acr);
   DatagramWriter w;
-  w.add(sof);
-  const auto golden = fromHex(kFrame2Be);
-  EXPECT_EQ(w.bytes(), std::vector<std::uint8_t>(golden.begin(), golden.begin() + 24));
+  w.add(sof).add(wcr).add(acr);
+  EXPECT_EQ(w.bytes(), fromHex(kFrame2Be));
 }
 
 TEST(Cigi, RejectsMalformedDatagramsWithAReason) {
@@ -152,6 +187,69 @@ TEST(Cigi, RejectsMalformedDatagramsWithAReason) {
   e.lat_deg = 95;
   w.add(goldenIgControl()).add(e);
   expectError(w.bytes(), "latitude");
+}
+
+TEST(Cigi, EveryPacketRoundTripsInBothByteOrders) {
+  // Frame 3 of the reference, with the values it lists as decoded by tshark.
+  CelestialSphereControl cel{14, 30, true, true, true, true, true, 6212025, 50};
+  AtmosphereControl atm{true, 45, 15, 30000, 5, 0, 250, 1013.25f};
+  EnvironmentalRegionControl reg;
+  reg.regionId = 7;
+  reg.mergeWeather = true;
+  reg.lat_deg = 47;
+  reg.lon_deg = 8;
+  reg.sizeX_m = 50000;
+  reg.sizeY_m = 40000;
+  reg.cornerRadius_m = 5000;
+  reg.rotation_deg = 30;
+  reg.transitionPerimeter_m = 2000;
+  ViewDefinition vd;
+  vd.nearEnable = vd.farEnable = vd.leftEnable = vd.rightEnable = vd.topEnable = vd.bottomEnable = true;
+  vd.near_m = 0.5f;
+  vd.far_m = 100000;
+  vd.left_deg = -40;
+  vd.right_deg = 40;
+  vd.top_deg = 25;
+  vd.bottom_deg = -25;
+  ViewControl vc;
+  vc.xEnable = vc.yEnable = vc.zEnable = vc.rollEnable = vc.pitchEnable = vc.yawEnable = true;
+  vc.z_m = -1.2f;
+  vc.pitch_deg = -5;
+  const EnvironmentalConditionsRequest ecr{kRequestWeather | kRequestAerosol, 42, 47.4647, 8.5492, 3000};
+  for (ByteOrder order : {ByteOrder::Big, ByteOrder::Little}) {
+    DatagramWriter w(order);
+    w.add(goldenIgControl()).add(cel).add(atm).add(reg).add(vd).add(vc).add(ecr).add(goldenWeather());
+    auto d = decodeDatagram(w.bytes());
+    ASSERT_TRUE(d) << d.error().detail;
+    ASSERT_EQ(d->packets.size(), 8u);
+    EXPECT_EQ(std::get<CelestialSphereControl>(d->packets[1]), cel);
+    EXPECT_EQ(std::get<AtmosphereControl>(d->packets[2]), atm);
+    EXPECT_EQ(std::get<EnvironmentalRegionControl>(d->packets[3]), reg);
+    EXPECT_EQ(std::get<ViewDefinition>(d->packets[4]), vd);
+    EXPECT_EQ(std::get<ViewControl>(d->packets[5]), vc);
+    EXPECT_EQ(std::get<EnvironmentalConditionsRequest>(d->packets[6]), ecr);
+    EXPECT_EQ(std::get<WeatherControl>(d->packets[7]), goldenWeather());
+  }
+}
+
+TEST(Cigi, RejectsPacketsOfTheOtherDirection) {
+  DatagramWriter w;
+  w.add(goldenIgControl()).add(AerosolConcentrationResponse{1, 1, 0.1f});
+  auto r = decodeDatagram(w.bytes());
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().detail.find("IG-to-host packet inside a host datagram"), std::string::npos);
+}
+
+TEST(Cigi, RejectsOutOfRangeWeather) {
+  WeatherControl w = goldenWeather();
+  w.coverage_pct = 120;
+  DatagramWriter d;
+  d.add(goldenIgControl()).add(w);
+  auto r = decodeDatagram(d.bytes());
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().detail.find("packet 1 (Weather Control) at byte 44: coverage 120 outside [0, 100]"),
+            std::string::npos)
+      << r.error().detail;
 }
 
 TEST(Cigi, SkipsUserDefinedPacketsBySize) {

@@ -14,15 +14,17 @@
 
 namespace sky::cigi {
 
-using Packet = std::variant<IgControl, EntityControl, StartOfFrame>;
+using Packet = std::variant<IgControl, EntityControl, CelestialSphereControl, AtmosphereControl,
+                            EnvironmentalRegionControl, WeatherControl, ViewControl, ViewDefinition,
+                            EnvironmentalConditionsRequest, StartOfFrame, WeatherConditionsResponse,
+                            AerosolConcentrationResponse>;
 
-// Appends packets to a datagram under construction, in one byte order.
+// Appends packets to a datagram under construction, in one byte order. The
+// caller puts IG Control (or Start of Frame) first.
 class DatagramWriter {
  public:
   explicit DatagramWriter(ByteOrder order = ByteOrder::Big) : order_(order) {}
-  DatagramWriter& add(const IgControl& p);
-  DatagramWriter& add(const EntityControl& p);
-  DatagramWriter& add(const StartOfFrame& p);
+  DatagramWriter& add(const Packet& packet);
   const std::vector<std::uint8_t>& bytes() const { return bytes_; }
 
  private:
@@ -30,14 +32,22 @@ class DatagramWriter {
   std::vector<std::uint8_t> bytes_;
 };
 
+enum class Direction { HostToIg, IgToHost };
+
 struct Datagram {
   ByteOrder order = ByteOrder::Big;
-  std::vector<Packet> packets;  // the packets we decode, in datagram order
-  std::size_t skippedPackets = 0;  // valid-sized packets of ids we do not decode
+  Direction direction = Direction::HostToIg;
+  std::vector<Packet> packets;     // the packets we decode, in datagram order
+  std::size_t skippedPackets = 0;  // well-sized packets of ids we do not decode (incl. user-defined 201-255)
 };
 
 // Decodes a whole datagram, or rejects it with the packet index, byte offset
-// and reason. Never reads outside `bytes`.
+// and reason: a wrong first packet, a size byte that is wrong for its id or
+// runs past the datagram, a packet of the other direction, or a field out of
+// range. Never reads outside `bytes`.
 Result<Datagram> decodeDatagram(std::span<const std::uint8_t> bytes);
+
+// Packet name for logs ("Weather Control").
+const char* packetName(const Packet& packet);
 
 }  // namespace sky::cigi
