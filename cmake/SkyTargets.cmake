@@ -7,7 +7,13 @@ target_compile_options(sky_settings INTERFACE -Wall -Wextra -Werror)
 # SKY_ASSERT stays active in every build of ours (tests and the demo run the
 # RelWithDebInfo build, and a broken invariant must stop there, not render junk).
 target_compile_definitions(sky_settings INTERFACE SKY_ENABLE_ASSERTS=1)
-if(SKY_SANITIZE)
+if(SKY_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "SKY_FUZZ needs clang: -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++")
+  endif()
+  target_compile_options(sky_settings INTERFACE -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer)
+  target_link_options(sky_settings INTERFACE -fsanitize=address,undefined)
+elseif(SKY_SANITIZE)
   target_compile_options(sky_settings INTERFACE
     -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
   target_link_options(sky_settings INTERFACE -fsanitize=address,undefined)

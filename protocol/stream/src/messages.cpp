@@ -17,6 +17,8 @@ template <class... Ts>
 struct Overloaded : Ts... {
   using Ts::operator()...;
 };
+template <class... Ts>
+Overloaded(Ts...) -> Overloaded<Ts...>;  // clang 14 lacks aggregate CTAD
 
 flatbuffers::Offset<fbs::Layer> encodeLayer(flatbuffers::FlatBufferBuilder& b,
                                             const weather::CloudLayer& l) {
@@ -166,6 +168,12 @@ Result<Message> decodeMessage(std::span<const std::uint8_t> payload) {
     return fail(ErrorCode::Malformed,
                 "frame of " + std::to_string(payload.size()) + " bytes fails FlatBuffers verification");
   const fbs::Message* m = fbs::GetMessage(payload.data());
+  // The verifier accepts a union whose type is set but whose table is absent
+  // (the field is optional): reject that here, before any body_as_*().
+  if (m->body_type() != fbs::Body::NONE && m->body() == nullptr)
+    return fail(ErrorCode::Malformed, "message names body type " +
+                                          std::to_string(static_cast<int>(m->body_type())) +
+                                          " but carries no body");
   switch (m->body_type()) {
     case fbs::Body::Hello: return decodeHello(*m->body_as_Hello());
     case fbs::Body::Subscribe: return decodeSubscribe(*m->body_as_Subscribe());

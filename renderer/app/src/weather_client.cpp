@@ -13,6 +13,8 @@ template <class... Ts>
 struct Overloaded : Ts... {
   using Ts::operator()...;
 };
+template <class... Ts>
+Overloaded(Ts...) -> Overloaded<Ts...>;  // clang 14 lacks aggregate CTAD
 // Reconnect backoff grows to this cap: short enough that a restarted server
 // is picked up within seconds, long enough not to spin on a dead one.
 constexpr std::chrono::milliseconds kMaxBackoff{2000};

@@ -111,5 +111,25 @@ TEST(Messages, CorruptedBuffersNeverDecodeOutOfBounds) {
   EXPECT_FALSE(decodeMessage(junk));
 }
 
+// Regression, found by fuzz_stream_frame: a Message whose union type says
+// ErrorMessage but whose body table is absent passed the FlatBuffers verifier
+// and decodeMessage then read through a null table (SEGV).
+TEST(Messages, UnionTypeWithoutBodyIsRejected) {
+  const std::string hex =
+      "000000340c00000008000c000700000008000000000000050c00000008000c0006000800080000000000"
+      "01ffffffffffffffffffffffffffffffffffffffffffffffffffffffffffffffffffffffffffffffffff"
+      "ffffffff00040000000300000062616400";
+  std::vector<std::uint8_t> bytes;
+  for (std::size_t i = 0; i + 1 < hex.size(); i += 2)
+    bytes.push_back(static_cast<std::uint8_t>(std::stoul(hex.substr(i, 2), nullptr, 16)));
+  FrameDecoder d;
+  d.append(bytes);
+  auto frame = d.next();
+  ASSERT_TRUE(frame && *frame);
+  auto m = decodeMessage(**frame);
+  ASSERT_FALSE(m);
+  EXPECT_NE(m.error().detail.find("carries no body"), std::string::npos) << m.error().detail;
+}
+
 }  // namespace
 }  // namespace sky::stream
