@@ -1,0 +1,79 @@
+// The headless cloud renderer's public face: settings, one frame's inputs (a
+// CIGI camera pose, the weather, the weather clock, the sun), the linear image
+// it returns, and PNG output. The Vulkan machinery stays behind a pimpl.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sky/core/result.hpp"
+#include "sky/geo/geodetic.hpp"
+#include "sky/weather/model.hpp"
+
+namespace sky::render {
+
+struct RenderSettings {
+  std::uint32_t width = 320, height = 180;  // pixels, [1, 8192]
+  double verticalFov_deg = 60;              // (0, 179)
+  std::uint32_t noiseSeed = 1;              // shape noise; same seed, same clouds
+};
+
+struct FrameInputs {
+  geo::GeodeticPose camera;  // CIGI pose: lat/lon/alt (m above the ellipsoid, >= 0), yaw/pitch/roll deg
+  const weather::WeatherSnapshot* weather = nullptr;  // layers + coverage tiles; nullptr = clear sky.
+                                                      // Up to kMaxLayers layers. A layer with no
+                                                      // tiles is uniform (its own coverage and
+                                                      // density); with tiles, a missing cell is empty.
+  double weatherClock_s = 0;  // clouds advect with each layer's wind by this clock
+  double sunAzimuth_deg = 135, sunElevation_deg = 40;  // in the camera's local ENU frame
+  std::uint64_t frameIndex = 0;  // carried for reprojection; the skeleton's image does not depend on it
+};
+
+// Linear radiance, rgba per pixel (a = view-ray transmittance through the
+// clouds), row-major, top row first.
+struct Image {
+  std::uint32_t width = 0, height = 0;
+  std::vector<float> rgba;
+};
+
+struct ImageStats {
+  std::size_t nonFinite = 0;  // pixels with any NaN or Inf channel
+  double meanLuminance = 0;   // Rec. 709 luminance of the finite pixels' rgb
+};
+
+class CloudRenderer {
+ public:
+  // Picks a Vulkan device with a compute queue (SKY_VULKAN_DEVICE=<substring>
+  // chooses by name), loads the SPIR-V and builds the pass. Errors: Unsupported
+  // when there is no Vulkan driver or device, Io when the shader is missing,
+  // Device for any other Vulkan failure, InvalidArgument for bad settings.
+  static Result<std::unique_ptr<CloudRenderer>> create(const RenderSettings& settings);
+
+  // Renders one frame (blocking). Errors: InvalidArgument for out-of-range
+  // inputs (more than kMaxLayers layers, bad pose), Device/Timeout from the GPU.
+  Result<Image> render(const FrameInputs& inputs);
+
+  std::string deviceName() const;
+  const RenderSettings& settings() const;
+
+  CloudRenderer(CloudRenderer&&) noexcept;
+  CloudRenderer& operator=(CloudRenderer&&) noexcept;
+  ~CloudRenderer();
+
+ private:
+  struct Impl;
+  explicit CloudRenderer(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+ImageStats computeStats(const Image& image);
+
+// Writes an 8-bit sRGB PNG (rgb only): fixed exposure, ACES filmic tonemap
+// (Narkowicz 2015 fit), sRGB transfer. Errors: InvalidArgument for an empty or
+// inconsistent image, Io when the file cannot be written.
+Result<void> writePng(const Image& image, const std::string& path);
+
+}  // namespace sky::render

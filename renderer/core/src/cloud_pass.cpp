@@ -1,0 +1,111 @@
+// Cloud pass resources and dispatch (see cloud_pass.hpp).
+#include "cloud_pass.hpp"
+
+#include <array>
+#include <cstring>
+#include <span>
+
+#include "frame_setup.hpp"
+
+namespace sky::render {
+
+namespace {
+
+vk::raii::Sampler makeSampler(const GpuContext& ctx, vk::SamplerAddressMode mode, const char* debugName) {
+  const vk::SamplerCreateInfo info({}, vk::Filter::eLinear, vk::Filter::eLinear, vk::SamplerMipmapMode::eNearest,
+                                   mode, mode, mode, 0.0f, VK_FALSE, 1.0f, VK_FALSE, vk::CompareOp::eNever, 0.0f,
+                                   0.0f, vk::BorderColor::eFloatTransparentBlack, VK_FALSE);
+  vk::raii::Sampler sampler(ctx.device(), info);
+  ctx.name(sampler, debugName);
+  return sampler;
+}
+
+}  // namespace
+
+Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, std::uint32_t height,
+                                    const NoiseVolume& noise, const WeatherTexture& weather) {
+  CloudPass pass;
+  pass.width_ = width;
+  pass.height_ = height;
+  const auto& device = ctx.device();
+
+  ComputePipelineBuilder builder("sky.clouds");
+  builder.binding(gpu::kBindingFrame, vk::DescriptorType::eUniformBuffer)
+      .binding(gpu::kBindingNoise, vk::DescriptorType::eCombinedImageSampler)
+      .binding(gpu::kBindingWeather, vk::DescriptorType::eCombinedImageSampler)
+      .binding(gpu::kBindingOutput, vk::DescriptorType::eStorageBuffer)
+      .shader("clouds.comp.spv");
+  auto pipeline = builder.build(ctx);
+  if (!pipeline) return tl::unexpected(pipeline.error());
+  pass.pipeline_ = std::move(*pipeline);
+
+  pass.noiseSampler_ = makeSampler(ctx, vk::SamplerAddressMode::eRepeat, "sky.noiseSampler");
+  pass.weatherSampler_ = makeSampler(ctx, vk::SamplerAddressMode::eClampToBorder, "sky.weatherSampler");
+
+  pass.noise_ = createSampledImage(ctx, vk::ImageType::e3D, vk::Format::eR8Unorm,
+                                   vk::Extent3D(noise.size, noise.size, noise.size), 1, "sky.shapeNoise");
+  if (auto ok = uploadImage(ctx, pass.noise_, std::as_bytes(std::span(noise.texels))); !ok)
+    return tl::unexpected(ok.error());
+
+  pass.uniforms_ = createHostBuffer(ctx, sizeof(gpu::SkyFrame), vk::BufferUsageFlagBits::eUniformBuffer, "sky.frameUniforms");
+  pass.output_ = createHostBuffer(ctx, vk::DeviceSize(width) * height * 4 * sizeof(float),
+                                  vk::BufferUsageFlagBits::eStorageBuffer, "sky.cloudOutput");
+
+  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eUniformBuffer, 1),
+                             vk::DescriptorPoolSize(vk::DescriptorType::eCombinedImageSampler, 2),
+                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 1)};
+  pass.descriptorPool_ = vk::raii::DescriptorPool(
+      device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSizes));
+  ctx.name(pass.descriptorPool_, "sky.clouds.descriptorPool");
+  const vk::DescriptorSetLayout setLayout = *pass.pipeline_.setLayout;
+  vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*pass.descriptorPool_, setLayout));
+  pass.descriptorSet_ = std::move(sets.front());
+  ctx.name(pass.descriptorSet_, "sky.clouds.descriptorSet");
+
+  const vk::DescriptorBufferInfo uniformInfo(*pass.uniforms_.buffer, 0, pass.uniforms_.size);
+  const vk::DescriptorBufferInfo outputInfo(*pass.output_.buffer, 0, pass.output_.size);
+  const vk::DescriptorImageInfo noiseInfo(*pass.noiseSampler_, *pass.noise_.view, vk::ImageLayout::eShaderReadOnlyOptimal);
+  const vk::DescriptorImageInfo weatherInfo(*pass.weatherSampler_, *weather.image().view,
+                                            vk::ImageLayout::eShaderReadOnlyOptimal);
+  const vk::DescriptorSet set = *pass.descriptorSet_;
+  const std::array writes{
+      vk::WriteDescriptorSet(set, gpu::kBindingFrame, 0, vk::DescriptorType::eUniformBuffer, {}, uniformInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingNoise, 0, vk::DescriptorType::eCombinedImageSampler, noiseInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingWeather, 0, vk::DescriptorType::eCombinedImageSampler, weatherInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingOutput, 0, vk::DescriptorType::eStorageBuffer, {}, outputInfo)};
+  device.updateDescriptorSets(writes, {});
+
+  pass.commands_ = ctx.allocateCommandBuffer();
+  ctx.name(pass.commands_, "sky.clouds.commands");
+  pass.fence_ = vk::raii::Fence(device, vk::FenceCreateInfo());
+  ctx.name(pass.fence_, "sky.clouds.fence");
+  return pass;
+}
+
+Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame) {
+  std::memcpy(uniforms_.mapped, &frame, sizeof frame);
+
+  commands_.reset();
+  commands_.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
+  commands_.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_.pipeline);
+  commands_.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *descriptorSet_, {});
+  // One workgroup per 8x8 tile, in a 1D grid: the shader maps ids to tiles
+  // through the permutation in frame.dispatch.
+  commands_.dispatch(tileCount(width_, height_), 1, 1);
+  const vk::BufferMemoryBarrier toHost(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead,
+                                       VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *output_.buffer, 0,
+                                       VK_WHOLE_SIZE);
+  commands_.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, {},
+                            toHost, {});
+  commands_.end();
+  if (auto ok = ctx.submitAndWait(commands_, fence_); !ok) return tl::unexpected(ok.error());
+
+  Image image;
+  image.width = width_;
+  image.height = height_;
+  image.rgba.resize(std::size_t(width_) * height_ * 4);
+  std::memcpy(image.rgba.data(), output_.mapped, image.rgba.size() * sizeof(float));
+  return image;
+}
+
+}  // namespace sky::render

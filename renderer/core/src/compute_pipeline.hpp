@@ -1,0 +1,42 @@
+// One builder for every compute pass: descriptor bindings + a SPIR-V file in,
+// descriptor set layout, pipeline layout and pipeline out, all debug-named.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan_raii.hpp>
+
+#include "gpu_context.hpp"
+
+namespace sky::render {
+
+struct ComputePipeline {
+  // Destroyed in reverse order: pipeline, then its layout, then the set layout.
+  vk::raii::DescriptorSetLayout setLayout{nullptr};
+  vk::raii::PipelineLayout layout{nullptr};
+  vk::raii::Pipeline pipeline{nullptr};
+};
+
+class ComputePipelineBuilder {
+ public:
+  explicit ComputePipelineBuilder(std::string name) : name_(std::move(name)) {}
+
+  // Adds a compute-stage binding in set 0 (count 1).
+  ComputePipelineBuilder& binding(std::uint32_t index, vk::DescriptorType type);
+  // SPIR-V file name, looked up with findShader().
+  ComputePipelineBuilder& shader(std::string fileName);
+
+  // Errors: Io/Malformed from the SPIR-V lookup; Vulkan failures throw.
+  Result<ComputePipeline> build(const GpuContext& ctx) const;
+
+  const std::vector<vk::DescriptorSetLayoutBinding>& bindings() const { return bindings_; }
+
+ private:
+  std::string name_;
+  std::string shaderFile_;
+  std::vector<vk::DescriptorSetLayoutBinding> bindings_;
+};
+
+}  // namespace sky::render

@@ -1,0 +1,186 @@
+// Frame derivation in double precision (see frame_setup.hpp).
+#include "frame_setup.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <numeric>
+#include <string>
+
+#include "sky/core/assert.hpp"
+
+namespace sky::render {
+
+namespace {
+
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+// Largest image edge, pixels: keeps buffers and the tile permutation in range.
+constexpr std::uint32_t kMaxImageEdge = 8192;
+// Sun irradiance at the clouds and the ambient radiance inside them, linear
+// units shared with the sky colours in cloud_core.glsl. Chosen by eye so a
+// sunlit cloud top is white (~1 after exposure) and a shadowed base is grey,
+// until the atmosphere model supplies physical values.
+constexpr double kSunIrradiance = 9.0;
+const glm::dvec3 kSunColour(1.0, 0.96, 0.90);
+const glm::dvec3 kAmbientRadiance(0.42, 0.46, 0.55);
+// Tile permutation stride as a fraction of the tile count (golden ratio
+// conjugate, lavapipe.md): any stride coprime to n permutes the tiles.
+constexpr double kStrideFraction = 0.618;
+// (id * stride) must fit 32 bits in the shader: above this count the identity
+// permutation is used.
+constexpr std::uint32_t kMaxPermutedTiles = 65536;
+
+glm::dvec3 toGlm(const geo::Vec3d& v) { return {v.x, v.y, v.z}; }
+
+glm::dvec3 inFrame(const geo::EnuFrame& f, const geo::Vec3d& v) {
+  return {geo::dot(v, f.east), geo::dot(v, f.north), geo::dot(v, f.up)};
+}
+
+std::string num(double v) { return std::to_string(v); }
+
+}  // namespace
+
+std::uint32_t tileCount(std::uint32_t width, std::uint32_t height) {
+  const std::uint32_t tx = (width + gpu::kLocalSize - 1) / gpu::kLocalSize;
+  const std::uint32_t ty = (height + gpu::kLocalSize - 1) / gpu::kLocalSize;
+  return tx * ty;
+}
+
+Result<void> validateSettings(const RenderSettings& s) {
+  if (s.width == 0 || s.height == 0 || s.width > kMaxImageEdge || s.height > kMaxImageEdge)
+    return fail(ErrorCode::InvalidArgument, "render settings: size " + std::to_string(s.width) + "x" +
+                                                std::to_string(s.height) + " outside [1, 8192]");
+  if (!(s.verticalFov_deg > 0 && s.verticalFov_deg < 179))
+    return fail(ErrorCode::InvalidArgument,
+                "render settings: verticalFov_deg " + num(s.verticalFov_deg) + " outside (0, 179)");
+  return {};
+}
+
+Result<void> validateInputs(const FrameInputs& in) {
+  const auto& c = in.camera;
+  const auto& p = c.position;
+  for (double v : {p.lat_deg, p.lon_deg, p.alt_m, c.yaw_deg, c.pitch_deg, c.roll_deg, in.weatherClock_s,
+                   in.sunAzimuth_deg, in.sunElevation_deg})
+    if (!std::isfinite(v)) return fail(ErrorCode::InvalidArgument, "frame inputs: non-finite value");
+  if (p.lat_deg < -90 || p.lat_deg > 90)
+    return fail(ErrorCode::InvalidArgument, "frame inputs: camera lat_deg " + num(p.lat_deg) + " outside [-90, 90]");
+  if (p.alt_m < -1000 || p.alt_m > 1e6)
+    return fail(ErrorCode::InvalidArgument, "frame inputs: camera alt_m " + num(p.alt_m) + " outside [-1000, 1e6]");
+  if (in.weather == nullptr) return {};
+  const auto& w = *in.weather;
+  if (w.layers.size() > gpu::kMaxLayers)
+    return fail(ErrorCode::InvalidArgument, "frame inputs: " + std::to_string(w.layers.size()) +
+                                                " cloud layers, at most " + std::to_string(gpu::kMaxLayers));
+  for (const auto& layer : w.layers)
+    if (auto ok = weather::validate(layer); !ok) return fail(ErrorCode::InvalidArgument, ok.error().detail);
+  if (w.tileLevel < 0 || w.tileLevel > 30)
+    return fail(ErrorCode::InvalidArgument, "frame inputs: tileLevel " + std::to_string(w.tileLevel) + " outside [0, 30]");
+  for (const auto& t : w.tiles)
+    if (!(t.coverage >= 0 && t.coverage <= 1 && t.density >= 0 && t.density <= 1))
+      return fail(ErrorCode::InvalidArgument,
+                  "frame inputs: tile " + std::to_string(t.cellId) + " coverage/density outside [0, 1]");
+  return {};
+}
+
+FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, const WeatherField& field) {
+  FrameSetup s;
+  s.width = settings.width;
+  s.height = settings.height;
+  s.tanHalfFov = std::tan(0.5 * settings.verticalFov_deg * kDegToRad);
+  s.aspect = double(settings.width) / double(settings.height);
+
+  const geo::EnuFrame enu = geo::enuFrameAt(in.camera.position);
+  const geo::BodyAxes axes = geo::bodyAxes(in.camera);
+  s.camForward = inFrame(enu, axes.forward);
+  s.camRight = inFrame(enu, axes.right);
+  s.camDown = inFrame(enu, axes.down);
+  s.localToEcef = glm::dmat3(toGlm(enu.east), toGlm(enu.north), toGlm(enu.up));
+
+  const geo::EnuFrame& a = field.frame;
+  s.camToAnchor = glm::dmat3(inFrame(a, enu.east), inFrame(a, enu.north), inFrame(a, enu.up));
+  s.camInAnchor_m = inFrame(a, enu.originEcef_m - field.centreEcef_m);
+  s.anchorRadius_m = field.radius_m;
+  s.mapHalfExtent_m = field.halfExtent_m;
+
+  // The local sphere: centre below the camera along its up vector, radius
+  // |camera ECEF|, so R_local = r - alt and heights above it are altitudes.
+  const double alt_m = in.camera.position.alt_m;
+  s.r_m = geo::length(enu.originEcef_m);
+  s.hGround_m = alt_m;
+  s.cGround_m2 = alt_m * (2 * s.r_m - alt_m);
+
+  const double az = in.sunAzimuth_deg * kDegToRad, el = in.sunElevation_deg * kDegToRad;
+  s.sunDir = {std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), std::sin(el)};
+  s.sunRadiance = kSunIrradiance * kSunColour;
+  s.ambient = kAmbientRadiance;
+
+  if (in.weather == nullptr) return s;
+  const double sinceSnapshot_s = in.weatherClock_s - in.weather->weatherClock_s;
+  for (const auto& layer : in.weather->layers) {
+    LayerSetup l;
+    l.thickness_m = layer.thickness_m;
+    l.hBase_m = alt_m - layer.base_m;
+    l.hTop_m = alt_m - (layer.base_m + layer.thickness_m);
+    l.cBase_m2 = l.hBase_m * (2 * s.r_m - l.hBase_m);
+    l.cTop_m2 = l.hTop_m * (2 * s.r_m - l.hTop_m);
+    // Wind blows from fromDirection: the air moves towards fromDirection + 180.
+    const double downwind = (layer.wind.fromDirection_deg + 180.0) * kDegToRad;
+    const glm::dvec3 windEnu_mps(layer.wind.speed_mps * std::sin(downwind),
+                                 layer.wind.speed_mps * std::cos(downwind), layer.wind.vertical_mps);
+    // Earth-fixed noise that drifts with the wind: sample (x - wind t). The
+    // drift uses the wind's direction at the camera, so it turns slowly
+    // (~1 degree per 100 km) as the camera travels; per-point advection comes
+    // with the full model.
+    const glm::dvec3 origin = toGlm(enu.originEcef_m) - s.localToEcef * windEnu_mps * in.weatherClock_s;
+    for (int k = 0; k < 3; ++k) {
+      const double m = std::fmod(origin[k], kNoisePeriod_m);
+      l.noiseOrigin[k] = (m < 0 ? m + kNoisePeriod_m : m) / kNoisePeriod_m;
+    }
+    l.coverageShift_m = glm::dvec2(windEnu_mps.x, windEnu_mps.y) * sinceSnapshot_s;
+    s.layers.push_back(l);
+  }
+  return s;
+}
+
+gpu::SkyFrame packFrame(const FrameSetup& s) {
+  SKY_ASSERT(s.layers.size() <= gpu::kMaxLayers);
+  gpu::SkyFrame f{};
+  auto v4 = [](const glm::dvec3& v, double w = 0) { return gpu::vec4(glm::dvec4(v, w)); };
+  f.camForward = v4(s.camForward);
+  f.camRight = v4(s.camRight, s.tanHalfFov);
+  f.camDown = v4(s.camDown, s.aspect);
+  for (int row = 0; row < 3; ++row) {
+    f.localToEcef[row] = v4(glm::dvec3(s.localToEcef[0][row], s.localToEcef[1][row], s.localToEcef[2][row]));
+    f.camToAnchor[row] = v4(glm::dvec3(s.camToAnchor[0][row], s.camToAnchor[1][row], s.camToAnchor[2][row]));
+  }
+  f.camInAnchor = v4(s.camInAnchor_m, s.anchorRadius_m);
+  f.weatherMap = gpu::vec4(float(1.0 / (2 * s.mapHalfExtent_m)), float(s.layers.size()),
+                           float(1.0 / kNoisePeriod_m), 0.0f);
+  f.earth = gpu::vec4(float(s.r_m), float(s.hGround_m), float(s.cGround_m2), 0.0f);
+  f.sunDir = v4(s.sunDir);
+  f.sunRadiance = v4(s.sunRadiance);
+  f.ambient = v4(s.ambient);
+
+  const std::uint32_t tilesX = (s.width + gpu::kLocalSize - 1) / gpu::kLocalSize;
+  const std::uint32_t n = tileCount(s.width, s.height);
+  std::uint32_t stride = 1;
+  if (n < kMaxPermutedTiles) {
+    stride = std::max<std::uint32_t>(1, std::uint32_t(std::lround(kStrideFraction * n)));
+    while (std::gcd(stride, n) != 1) ++stride;
+  }
+  f.image = gpu::uvec4(s.width, s.height, tilesX, n);
+  f.dispatch = gpu::uvec4(stride, 0, 0, 0);
+
+  for (std::size_t i = 0; i < s.layers.size(); ++i) {
+    const LayerSetup& l = s.layers[i];
+    gpu::SkyLayer& g = f.layers[i];
+    g.heights = gpu::vec4(glm::dvec4(l.hBase_m, l.hTop_m, l.cBase_m2, l.cTop_m2));
+    g.shape = gpu::vec4(float(l.thickness_m), float(i), 0.0f, 0.0f);
+    g.noiseOrigin = v4(l.noiseOrigin);
+    g.coverageShift = gpu::vec4(float(l.coverageShift_m.x), float(l.coverageShift_m.y), 0.0f, 0.0f);
+  }
+  // Unused slots keep a positive thickness so the shader's per-layer setup never divides by 0.
+  for (std::size_t i = s.layers.size(); i < gpu::kMaxLayers; ++i) f.layers[i].shape.x = 1.0f;
+  return f;
+}
+
+}  // namespace sky::render

@@ -1,0 +1,82 @@
+// Buffer/image creation and the staged image upload (see gpu_memory.hpp).
+#include "gpu_memory.hpp"
+
+#include <cstring>
+
+#include "sky/core/assert.hpp"
+
+namespace sky::render {
+
+GpuBuffer createHostBuffer(const GpuContext& ctx, vk::DeviceSize size, vk::BufferUsageFlags usage,
+                           const char* debugName) {
+  const auto& device = ctx.device();
+  GpuBuffer b;
+  b.size = size;
+  b.buffer = vk::raii::Buffer(device, vk::BufferCreateInfo({}, size, usage, vk::SharingMode::eExclusive));
+  const vk::MemoryRequirements req = b.buffer.getMemoryRequirements();
+  b.memory = vk::raii::DeviceMemory(
+      device, vk::MemoryAllocateInfo(req.size, ctx.memoryType(req.memoryTypeBits,
+                                                              vk::MemoryPropertyFlagBits::eHostVisible |
+                                                                  vk::MemoryPropertyFlagBits::eHostCoherent)));
+  b.buffer.bindMemory(*b.memory, 0);
+  b.mapped = b.memory.mapMemory(0, size);
+  ctx.name(b.buffer, debugName);
+  ctx.name(b.memory, debugName);
+  return b;
+}
+
+GpuImage createSampledImage(const GpuContext& ctx, vk::ImageType type, vk::Format format, vk::Extent3D extent,
+                            std::uint32_t layers, const char* debugName) {
+  const auto& device = ctx.device();
+  GpuImage img;
+  img.format = format;
+  img.extent = extent;
+  img.layers = layers;
+  const vk::ImageCreateInfo info({}, type, format, extent, 1, layers, vk::SampleCountFlagBits::e1,
+                                 vk::ImageTiling::eOptimal,
+                                 vk::ImageUsageFlagBits::eSampled | vk::ImageUsageFlagBits::eTransferDst);
+  img.image = vk::raii::Image(device, info);
+  const vk::MemoryRequirements req = img.image.getMemoryRequirements();
+  img.memory = vk::raii::DeviceMemory(
+      device, vk::MemoryAllocateInfo(req.size, ctx.memoryType(req.memoryTypeBits,
+                                                              vk::MemoryPropertyFlagBits::eDeviceLocal)));
+  img.image.bindMemory(*img.memory, 0);
+  const vk::ImageViewType viewType = type == vk::ImageType::e3D ? vk::ImageViewType::e3D
+                                                                 : vk::ImageViewType::e2DArray;
+  img.view = vk::raii::ImageView(
+      device, vk::ImageViewCreateInfo({}, *img.image, viewType, format, {},
+                                      vk::ImageSubresourceRange(vk::ImageAspectFlagBits::eColor, 0, 1, 0, layers)));
+  ctx.name(img.image, debugName);
+  ctx.name(img.memory, debugName);
+  ctx.name(img.view, debugName);
+  return img;
+}
+
+Result<void> uploadImage(const GpuContext& ctx, GpuImage& image, std::span<const std::byte> texels) {
+  GpuBuffer staging = createHostBuffer(ctx, texels.size(), vk::BufferUsageFlagBits::eTransferSrc, "sky.staging");
+  std::memcpy(staging.mapped, texels.data(), texels.size());
+
+  const vk::ImageSubresourceRange range(vk::ImageAspectFlagBits::eColor, 0, 1, 0, image.layers);
+  vk::raii::CommandBuffer cmd = ctx.allocateCommandBuffer();
+  cmd.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
+  // Undefined -> transfer destination: discards what the image held; the
+  // source stage covers an earlier frame's shader reads.
+  const vk::ImageMemoryBarrier toTransfer({}, vk::AccessFlagBits::eTransferWrite, vk::ImageLayout::eUndefined,
+                                          vk::ImageLayout::eTransferDstOptimal, VK_QUEUE_FAMILY_IGNORED,
+                                          VK_QUEUE_FAMILY_IGNORED, *image.image, range);
+  cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eTransfer, {}, {}, {},
+                      toTransfer);
+  const vk::BufferImageCopy region(0, 0, 0, vk::ImageSubresourceLayers(vk::ImageAspectFlagBits::eColor, 0, 0, image.layers),
+                                   {0, 0, 0}, image.extent);
+  cmd.copyBufferToImage(*staging.buffer, *image.image, vk::ImageLayout::eTransferDstOptimal, region);
+  const vk::ImageMemoryBarrier toShader(vk::AccessFlagBits::eTransferWrite, vk::AccessFlagBits::eShaderRead,
+                                        vk::ImageLayout::eTransferDstOptimal, vk::ImageLayout::eShaderReadOnlyOptimal,
+                                        VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *image.image, range);
+  cmd.pipelineBarrier(vk::PipelineStageFlagBits::eTransfer, vk::PipelineStageFlagBits::eComputeShader, {}, {}, {},
+                      toShader);
+  cmd.end();
+  const vk::raii::Fence fence(ctx.device(), vk::FenceCreateInfo());
+  return ctx.submitAndWait(cmd, fence);
+}
+
+}  // namespace sky::render

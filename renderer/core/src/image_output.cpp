@@ -1,0 +1,70 @@
+// Image statistics and PNG output: exposure, ACES filmic tonemap (Narkowicz
+// 2015 fit), sRGB transfer, 8-bit RGB through stb_image_write.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "sky/render/cloud_renderer.hpp"
+
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#define STBI_WRITE_NO_STDIO_FOPEN_S
+#include <stb_image_write.h>
+
+namespace sky::render {
+
+namespace {
+
+// Exposure applied before the tonemap: the skeleton's radiance units put a
+// clear zenith near 0.4 and a sunlit cloud near 1, which this maps to mid and
+// upper tones.
+constexpr double kPngExposure = 1.0;
+
+// Narkowicz 2015, "ACES Filmic Tone Mapping Curve".
+double acesFilmic(double x) {
+  constexpr double a = 2.51, b = 0.03, c = 2.43, d = 0.59, e = 0.14;
+  return std::clamp((x * (a * x + b)) / (x * (c * x + d) + e), 0.0, 1.0);
+}
+
+// IEC 61966-2-1 sRGB encoding of a linear value in [0, 1].
+double srgbEncode(double v) { return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055; }
+
+bool consistent(const Image& image) {
+  return image.width > 0 && image.height > 0 && image.rgba.size() == std::size_t(image.width) * image.height * 4;
+}
+
+}  // namespace
+
+ImageStats computeStats(const Image& image) {
+  ImageStats stats;
+  double sum = 0;
+  std::size_t finite = 0;
+  for (std::size_t i = 0; i + 3 < image.rgba.size(); i += 4) {
+    const float* p = &image.rgba[i];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]) || !std::isfinite(p[3])) {
+      ++stats.nonFinite;
+      continue;
+    }
+    sum += 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];  // Rec. 709 luminance
+    ++finite;
+  }
+  stats.meanLuminance = finite ? sum / double(finite) : 0.0;
+  return stats;
+}
+
+Result<void> writePng(const Image& image, const std::string& path) {
+  if (!consistent(image))
+    return fail(ErrorCode::InvalidArgument, "writePng " + path + ": image size does not match its pixels");
+  std::vector<std::uint8_t> rgb(std::size_t(image.width) * image.height * 3);
+  for (std::size_t px = 0; px < std::size_t(image.width) * image.height; ++px)
+    for (int c = 0; c < 3; ++c) {
+      const double v = image.rgba[px * 4 + std::size_t(c)];
+      const double mapped = std::isfinite(v) ? srgbEncode(acesFilmic(std::max(0.0, v * kPngExposure))) : 0.0;
+      rgb[px * 3 + std::size_t(c)] = static_cast<std::uint8_t>(std::lround(mapped * 255.0));
+    }
+  const int ok = stbi_write_png(path.c_str(), int(image.width), int(image.height), 3, rgb.data(), int(image.width) * 3);
+  if (ok == 0) return fail(ErrorCode::Io, "writePng " + path + ": cannot write file");
+  return {};
+}
+
+}  // namespace sky::render

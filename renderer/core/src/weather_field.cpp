@@ -1,0 +1,138 @@
+// Weather-map construction from S2 coverage tiles (see weather_field.hpp).
+#include "weather_field.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <unordered_map>
+
+#include <glm/gtc/packing.hpp>
+
+#include "sky/core/assert.hpp"
+#include "sky/weather/tiling.hpp"
+#include "sky_shared.h"
+
+namespace sky::render {
+
+namespace {
+
+struct TileValue {
+  float coverage = 0;
+  float density = 0;
+};
+
+void mix64(std::uint64_t& h, std::uint64_t v) {
+  // FNV-1a over the value's bytes.
+  for (int i = 0; i < 8; ++i) {
+    h ^= (v >> (8 * i)) & 0xffu;
+    h *= 1099511628211ull;
+  }
+}
+
+std::uint64_t bitsOf(double d) {
+  std::uint64_t u = 0;
+  std::memcpy(&u, &d, sizeof u);
+  return u;
+}
+
+}  // namespace
+
+glm::dvec2 WeatherField::sample(std::uint32_t slice, double x_m, double y_m) const {
+  SKY_ASSERT(slice < sliceCount);
+  const int n = static_cast<int>(size);
+  const double tx = (x_m / (2 * halfExtent_m) + 0.5) * size - 0.5;
+  const double ty = (y_m / (2 * halfExtent_m) + 0.5) * size - 0.5;
+  if (!(std::abs(tx) < 2.0 * size && std::abs(ty) < 2.0 * size)) return {0, 0};  // far outside, or NaN
+  const double fx = std::floor(tx), fy = std::floor(ty);
+  const int i0 = static_cast<int>(fx), j0 = static_cast<int>(fy);
+  const double ax = tx - fx, ay = ty - fy;
+  glm::dvec2 sum(0);
+  for (int dj = 0; dj <= 1; ++dj)
+    for (int di = 0; di <= 1; ++di) {
+      const int i = i0 + di, j = j0 + dj;
+      if (i < 0 || j < 0 || i >= n || j >= n) continue;
+      const std::size_t idx = ((std::size_t(slice) * size + std::size_t(j)) * size + std::size_t(i)) * 2;
+      const double w = (di ? ax : 1 - ax) * (dj ? ay : 1 - ay);
+      sum += w * glm::dvec2(glm::unpackHalf1x16(texels[idx]), glm::unpackHalf1x16(texels[idx + 1]));
+    }
+  return sum;
+}
+
+std::uint64_t weatherContentKey(const weather::WeatherSnapshot* snapshot) {
+  std::uint64_t h = 14695981039346656037ull;
+  if (snapshot == nullptr) return h;
+  mix64(h, snapshot->layers.size());
+  for (const auto& layer : snapshot->layers) {
+    mix64(h, layer.id);
+    mix64(h, bitsOf(layer.coverage));
+    mix64(h, bitsOf(layer.density));
+  }
+  mix64(h, static_cast<std::uint64_t>(snapshot->tileLevel));
+  mix64(h, snapshot->tiles.size());
+  for (const auto& tile : snapshot->tiles) {
+    mix64(h, tile.cellId);
+    mix64(h, tile.layerId);
+    mix64(h, bitsOf(tile.coverage));
+    mix64(h, bitsOf(tile.density));
+  }
+  return h;
+}
+
+WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const geo::Geodetic& anchor) {
+  WeatherField field;
+  field.frame = geo::enuFrameAt(anchor);
+  field.anchorAlt_m = anchor.alt_m;
+  field.radius_m = geo::length(field.frame.originEcef_m);
+  field.centreEcef_m = field.frame.originEcef_m - field.frame.up * field.radius_m;
+  field.sliceCount = gpu::kMaxLayers;
+  field.contentKey = weatherContentKey(snapshot);
+  const std::size_t sliceTexels = std::size_t(field.size) * field.size;
+  field.texels.assign(sliceTexels * field.sliceCount * 2, glm::packHalf1x16(0.0f));
+  if (snapshot == nullptr) return field;
+  SKY_ASSERT(snapshot->layers.size() <= gpu::kMaxLayers);
+
+  // Per slice: the tiles of that layer by cell id (empty map = uniform layer).
+  std::vector<std::unordered_map<std::uint64_t, TileValue>> tilesBySlice(snapshot->layers.size());
+  bool anyTiles = false;
+  for (const auto& tile : snapshot->tiles)
+    for (std::size_t s = 0; s < snapshot->layers.size(); ++s)
+      if (snapshot->layers[s].id == tile.layerId) {
+        tilesBySlice[s][tile.cellId] = {tile.coverage, tile.density};
+        anyTiles = true;
+      }
+
+  const double groundRadius_m = field.radius_m - anchor.alt_m;
+  for (std::uint32_t j = 0; j < field.size; ++j)
+    for (std::uint32_t i = 0; i < field.size; ++i) {
+      const double x_m = ((i + 0.5) / field.size - 0.5) * 2 * field.halfExtent_m;
+      const double y_m = ((j + 0.5) / field.size - 0.5) * 2 * field.halfExtent_m;
+      std::uint64_t cell = 0;
+      if (anyTiles) {
+        // Inverse gnomonic: the direction from the sphere centre through the
+        // plane point, down to the ground on the anchor sphere.
+        const geo::Vec3d dir = geo::normalize(field.frame.east * x_m + field.frame.north * y_m +
+                                              field.frame.up * field.radius_m);
+        const geo::Geodetic g = geo::fromEcef(field.centreEcef_m + dir * groundRadius_m);
+        cell = weather::cellAt(g.lat_deg, g.lon_deg, snapshot->tileLevel);
+      }
+      for (std::size_t s = 0; s < snapshot->layers.size(); ++s) {
+        const auto& layer = snapshot->layers[s];
+        TileValue v{static_cast<float>(layer.coverage), static_cast<float>(layer.density)};
+        if (!tilesBySlice[s].empty()) {
+          const auto it = tilesBySlice[s].find(cell);
+          v = it == tilesBySlice[s].end() ? TileValue{} : it->second;
+        }
+        const std::size_t idx = ((s * field.size + j) * field.size + i) * 2;
+        field.texels[idx] = glm::packHalf1x16(std::clamp(v.coverage, 0.0f, 1.0f));
+        field.texels[idx + 1] = glm::packHalf1x16(std::clamp(v.density, 0.0f, 1.0f));
+      }
+    }
+  return field;
+}
+
+bool weatherFieldStale(const WeatherField& field, std::uint64_t contentKey, const geo::Vec3d& cameraEcef_m) {
+  if (field.texels.empty() || field.contentKey != contentKey) return true;
+  return geo::length(cameraEcef_m - field.frame.originEcef_m) > kWeatherRecentre_m;
+}
+
+}  // namespace sky::render

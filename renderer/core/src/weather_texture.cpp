@@ -1,0 +1,31 @@
+// Weather map upload and caching (see weather_texture.hpp).
+#include "weather_texture.hpp"
+
+#include <span>
+
+#include "sky_shared.h"
+
+namespace sky::render {
+
+Result<WeatherTexture> WeatherTexture::create(const GpuContext& ctx) {
+  WeatherTexture t;
+  t.image_ = createSampledImage(ctx, vk::ImageType::e2D, vk::Format::eR16G16Sfloat,
+                                vk::Extent3D(kWeatherMapSize, kWeatherMapSize, 1), gpu::kMaxLayers, "sky.weatherMap");
+  t.field_ = buildWeatherField(nullptr, geo::Geodetic{});
+  if (auto ok = t.upload(ctx); !ok) return tl::unexpected(ok.error());
+  return t;
+}
+
+Result<void> WeatherTexture::update(const GpuContext& ctx, const FrameInputs& inputs) {
+  const std::uint64_t key = weatherContentKey(inputs.weather);
+  if (!weatherFieldStale(field_, key, geo::toEcef(inputs.camera.position))) return {};
+  field_ = buildWeatherField(inputs.weather, inputs.camera.position);
+  return upload(ctx);
+}
+
+Result<void> WeatherTexture::upload(const GpuContext& ctx) {
+  ++uploads_;
+  return uploadImage(ctx, image_, std::as_bytes(std::span(field_.texels)));
+}
+
+}  // namespace sky::render

@@ -1,0 +1,76 @@
+// Layout of the cloud pass's uniform block and its binding numbers, shared by
+// C++ (renderer/core) and GLSL (shaders/clouds.comp). Only vec4/uvec4 members,
+// so std140 and C++ agree without hidden padding; the C++ side pins sizes and
+// offsets with static_assert below.
+#ifndef SKY_SHARED_H
+#define SKY_SHARED_H
+
+#ifdef __cplusplus
+#include <cstddef>
+#include <cstdint>
+#include <glm/vec4.hpp>
+namespace sky::gpu {
+using vec4 = glm::vec4;
+using uvec4 = glm::uvec4;
+#define SKY_SHARED_CONST static constexpr std::uint32_t
+#else
+#define SKY_SHARED_CONST const uint
+#endif
+
+// Descriptor set 0 bindings of the cloud pass.
+SKY_SHARED_CONST kBindingFrame = 0u;    // uniform SkyFrame
+SKY_SHARED_CONST kBindingNoise = 1u;    // sampler3D, tileable shape noise (R8, repeat)
+SKY_SHARED_CONST kBindingWeather = 2u;  // sampler2DArray, RG = coverage, density; one slice per layer
+SKY_SHARED_CONST kBindingOutput = 3u;   // storage buffer of vec4 radiance (rgb) + transmittance (a)
+
+// Workgroup edge of the cloud pass, pixels (8x8 = 64 invocations = 8 lavapipe
+// subgroups of 8 lanes).
+SKY_SHARED_CONST kLocalSize = 8u;
+// Cloud layers the pass draws; also the slice count of the weather texture.
+SKY_SHARED_CONST kMaxLayers = 4u;
+
+// One cloud layer as the GPU sees it. Heights are computed on the CPU in double
+// from altitudes, because r - R of two Earth-sized radii cancels in float.
+struct SkyLayer {
+  vec4 heights;        // x: camera height above base (m), y: camera height above top (m),
+                       // z: hBase (2r - hBase), w: hTop (2r - hTop) (m^2, r = camera radius)
+  vec4 shape;          // x: thickness (m), y: weather slice index, zw: unused
+  vec4 noiseOrigin;    // xyz: camera ECEF minus wind drift, modulo the noise period, in periods
+  vec4 coverageShift;  // xy: coverage drift east/north in the weather map plane (m), zw: unused
+};
+
+struct SkyFrame {
+  vec4 camForward;      // xyz: camera forward in the local frame (x east, y north, z up)
+  vec4 camRight;        // xyz: camera right; w: tan(vertical fov / 2)
+  vec4 camDown;         // xyz: camera down; w: width / height
+  vec4 localToEcef[3];  // rows of the rotation local -> ECEF
+  vec4 camToAnchor[3];  // rows of the rotation camera-local -> weather-anchor-local
+  vec4 camInAnchor;     // xyz: camera relative to the anchor sphere centre, anchor frame (m);
+                        // w: anchor sphere radius (m)
+  vec4 weatherMap;      // x: 1 / (2 half extent) (1/m), y: layer count, zw: unused
+  vec4 earth;           // x: camera radius r (m), y: camera height above ground (m),
+                        // z: hGround (2r - hGround) (m^2), w: unused
+  vec4 sunDir;          // xyz: unit vector towards the sun, local frame; w: unused
+  vec4 sunRadiance;     // rgb: sun irradiance at the clouds (linear units); w: unused
+  vec4 ambient;         // rgb: isotropic ambient radiance inside the clouds; w: unused
+  uvec4 image;          // x: width, y: height, z: tiles per row, w: tile count
+  uvec4 dispatch;       // x: tile permutation stride (coprime to the tile count), yzw: unused
+  SkyLayer layers[kMaxLayers];
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(vec4) == 16 && sizeof(uvec4) == 16);
+static_assert(sizeof(SkyLayer) == 64);
+static_assert(offsetof(SkyLayer, noiseOrigin) == 32);
+static_assert(offsetof(SkyFrame, localToEcef) == 48);
+static_assert(offsetof(SkyFrame, camToAnchor) == 96);
+static_assert(offsetof(SkyFrame, camInAnchor) == 144);
+static_assert(offsetof(SkyFrame, image) == 240);
+static_assert(offsetof(SkyFrame, dispatch) == 256);
+static_assert(offsetof(SkyFrame, layers) == 272);
+static_assert(sizeof(SkyFrame) == 272 + 64 * kMaxLayers);
+}  // namespace sky::gpu
+#endif
+#undef SKY_SHARED_CONST
+
+#endif  // SKY_SHARED_H
