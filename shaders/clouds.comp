@@ -37,6 +37,13 @@ float sampleNoise(int layer, vec3 p) {
   return textureLod(noiseTex, frame.layers[layer].noiseOrigin.xyz + e * frame.weatherMap.z, 0.0).r;
 }
 
+// Large-scale modulation of coverage: the same noise, its own origin and period.
+float sampleCloudMap(int layer, vec3 p) {
+  vec3 e = vec3(dot(frame.localToEcef[0].xyz, p), dot(frame.localToEcef[1].xyz, p),
+                dot(frame.localToEcef[2].xyz, p));
+  return textureLod(noiseTex, frame.layers[layer].cloudMapOrigin.xyz + e * frame.weatherMap.w, 0.0).r;
+}
+
 #include "cloud_core.glsl"
 
 void main() {

@@ -6,6 +6,7 @@
 // the two texture hooks before including this file:
 //   real2 sampleWeather(int layer, real3 pLocal)  // (coverage, density), 0 outside the map
 //   real  sampleNoise(int layer, real3 pLocal)    // tileable shape noise in [0, 1]
+//   real  sampleCloudMap(int layer, real3 pLocal) // the same noise at a larger, incommensurate period
 // pLocal is camera-relative, local frame: x east, y north, z up (m).
 
 SKY_CORE_CONST real kPi = 3.14159265358979323846;
@@ -42,6 +43,10 @@ SKY_CORE_CONST real kCoverageEdge = 0.25;
 // a thinner top, the shape of Haggstrom's SA term without the weather inputs.
 SKY_CORE_CONST real kProfileBottomFade = 0.1;
 SKY_CORE_CONST real kProfileTopFade = 0.2;
+// How far the cloud map moves partial coverage (Schneider's low-frequency
+// weather channel): c' = c + A (m - 0.5) 4c(1 - c), so coverage 0 and 1 stay
+// exact and 0.5 spans [0.2, 0.8]; breaks up the noise's 5 km repetition.
+SKY_CORE_CONST real kCloudMapAmplitude = 0.6;
 // Ambient light at a layer's base relative to its top (the base sees the dark
 // ground and is shadowed by the cloud above it).
 SKY_CORE_CONST real kAmbientBottomFactor = 0.3;
@@ -176,6 +181,11 @@ real heightProfile(real ph) {
   return clamp(ph / kProfileBottomFade, 0.0, 1.0) * clamp((1.0 - ph) / kProfileTopFade, 0.0, 1.0);
 }
 
+// Coverage in [0, 1] after the cloud map m in [0, 1] moved it; 0 and 1 are fixed points.
+real mappedCoverage(real coverage, real m) {
+  return clamp(coverage + kCloudMapAmplitude * (m - 0.5) * 4.0 * coverage * (1.0 - coverage), 0.0, 1.0);
+}
+
 // Density in [0, 1] from shape noise n in [0, 1], coverage in [0, 1], the
 // layer's density multiplier and the height fraction ph. Coverage 0 gives
 // exactly 0 (n <= 1); the remap follows Ford's N - (1 - coverage).
@@ -204,6 +214,7 @@ MarchState marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, March
     if (heightProfile(ph) <= 0.0) continue;
     real2 weather = sampleWeather(li, p);
     if (weather.x <= 0.0) continue;
+    if (weather.x < 1.0) weather.x = mappedCoverage(weather.x, sampleCloudMap(li, p));
     real rho = cloudDensity(sampleNoise(li, p), weather.x, weather.y, ph);
     if (rho <= 0.0) continue;
     // Optical depth towards the sun; the coverage of the primary sample stands

@@ -37,6 +37,7 @@ struct SkyLayer {
   vec4 shape;          // x: thickness (m), y: weather slice index, zw: unused
   vec4 noiseOrigin;    // xyz: camera ECEF minus wind drift, modulo the noise period, in periods
   vec4 coverageShift;  // xy: coverage drift east/north in the weather map plane (m), zw: unused
+  vec4 cloudMapOrigin; // xyz: as noiseOrigin, modulo the cloud-map period, in cloud-map periods
 };
 
 struct SkyFrame {
@@ -47,7 +48,8 @@ struct SkyFrame {
   vec4 camToAnchor[3];  // rows of the rotation camera-local -> weather-anchor-local
   vec4 camInAnchor;     // xyz: camera relative to the anchor sphere centre, anchor frame (m);
                         // w: anchor sphere radius (m)
-  vec4 weatherMap;      // x: 1 / (2 half extent) (1/m), y: layer count, zw: unused
+  vec4 weatherMap;      // x: 1 / (2 half extent) (1/m), y: layer count, z: 1 / noise period (1/m),
+                        // w: 1 / cloud-map period (1/m)
   vec4 earth;           // x: camera radius r (m), y: camera height above ground (m),
                         // z: hGround (2r - hGround) (m^2), w: unused
   vec4 sunDir;          // xyz: unit vector towards the sun, local frame; w: unused
@@ -60,7 +62,7 @@ struct SkyFrame {
 
 #ifdef __cplusplus
 static_assert(sizeof(vec4) == 16 && sizeof(uvec4) == 16);
-static_assert(sizeof(SkyLayer) == 64);
+static_assert(sizeof(SkyLayer) == 80);
 static_assert(offsetof(SkyLayer, noiseOrigin) == 32);
 static_assert(offsetof(SkyFrame, localToEcef) == 48);
 static_assert(offsetof(SkyFrame, camToAnchor) == 96);
@@ -68,7 +70,8 @@ static_assert(offsetof(SkyFrame, camInAnchor) == 144);
 static_assert(offsetof(SkyFrame, image) == 240);
 static_assert(offsetof(SkyFrame, dispatch) == 256);
 static_assert(offsetof(SkyFrame, layers) == 272);
-static_assert(sizeof(SkyFrame) == 272 + 64 * kMaxLayers);
+static_assert(offsetof(SkyLayer, cloudMapOrigin) == 64);
+static_assert(sizeof(SkyFrame) == 272 + 80 * kMaxLayers);
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

@@ -45,6 +45,11 @@ class CpuCore {
     return noise_.sample(setup_.layers[std::size_t(layer)].noiseOrigin + (setup_.localToEcef * p) / kNoisePeriod_m);
   }
 
+  // Mirrors sampleCloudMap in shaders/clouds.comp.
+  real sampleCloudMap(int layer, real3 p) const {
+    return noise_.sample(setup_.layers[std::size_t(layer)].cloudMapOrigin + (setup_.localToEcef * p) / kCloudMapPeriod_m);
+  }
+
 #define SKY_CORE_CONST static constexpr
 #include "cloud_core.glsl"
 #undef SKY_CORE_CONST

@@ -131,10 +131,16 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
     // (~1 degree per 100 km) as the camera travels; per-point advection comes
     // with the full model.
     const glm::dvec3 origin = toGlm(enu.originEcef_m) - s.localToEcef * windEnu_mps * in.weatherClock_s;
-    for (int k = 0; k < 3; ++k) {
-      const double m = std::fmod(origin[k], kNoisePeriod_m);
-      l.noiseOrigin[k] = (m < 0 ? m + kNoisePeriod_m : m) / kNoisePeriod_m;
-    }
+    auto inPeriods = [&](double period_m) {
+      glm::dvec3 out;
+      for (int k = 0; k < 3; ++k) {
+        const double m = std::fmod(origin[k], period_m);
+        out[k] = (m < 0 ? m + period_m : m) / period_m;
+      }
+      return out;
+    };
+    l.noiseOrigin = inPeriods(kNoisePeriod_m);
+    l.cloudMapOrigin = inPeriods(kCloudMapPeriod_m);
     l.coverageShift_m = glm::dvec2(windEnu_mps.x, windEnu_mps.y) * sinceSnapshot_s;
     s.layers.push_back(l);
   }
@@ -154,7 +160,7 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   }
   f.camInAnchor = v4(s.camInAnchor_m, s.anchorRadius_m);
   f.weatherMap = gpu::vec4(float(1.0 / (2 * s.mapHalfExtent_m)), float(s.layers.size()),
-                           float(1.0 / kNoisePeriod_m), 0.0f);
+                           float(1.0 / kNoisePeriod_m), float(1.0 / kCloudMapPeriod_m));
   f.earth = gpu::vec4(float(s.r_m), float(s.hGround_m), float(s.cGround_m2), 0.0f);
   f.sunDir = v4(s.sunDir);
   f.sunRadiance = v4(s.sunRadiance);
@@ -176,6 +182,7 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
     g.heights = gpu::vec4(glm::dvec4(l.hBase_m, l.hTop_m, l.cBase_m2, l.cTop_m2));
     g.shape = gpu::vec4(float(l.thickness_m), float(i), 0.0f, 0.0f);
     g.noiseOrigin = v4(l.noiseOrigin);
+    g.cloudMapOrigin = v4(l.cloudMapOrigin);
     g.coverageShift = gpu::vec4(float(l.coverageShift_m.x), float(l.coverageShift_m.y), 0.0f, 0.0f);
   }
   // Unused slots keep a positive thickness so the shader's per-layer setup never divides by 0.

@@ -20,6 +20,9 @@ namespace sky::render {
 // World size of one period of the shape noise, m: with 4 Worley cells per
 // period, cells are ~1.2 km, the scale of fair-weather cumulus.
 inline constexpr double kNoisePeriod_m = 5000.0;
+// Period of the cloud map (the same noise sampled larger), m: 23 km and 5 km
+// share no small common multiple, so the pattern repeats only every 115 km.
+inline constexpr double kCloudMapPeriod_m = 23000.0;
 
 struct LayerSetup {
   double hBase_m = 0;       // camera height above the base (negative below)
@@ -29,6 +32,7 @@ struct LayerSetup {
   double thickness_m = 0;
   glm::dvec3 noiseOrigin{0};       // (camera ECEF - wind drift) mod period, in periods
   glm::dvec2 coverageShift_m{0};   // wind drift of the coverage since the snapshot, east/north
+  glm::dvec3 cloudMapOrigin{0};    // as noiseOrigin, in cloud-map periods
 };
 
 struct FrameSetup {
