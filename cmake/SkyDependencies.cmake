@@ -67,3 +67,9 @@ target_include_directories(sky::stb SYSTEM INTERFACE ${STB_INCLUDE_DIR})
 if(SKY_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()
+
+# GPX flight tracks are XML; expat is Debian's well-kept streaming XML parser
+# (libexpat1-dev ships a CMake config with target expat::expat).
+find_package(expat CONFIG REQUIRED)
+add_library(sky::expat INTERFACE IMPORTED)
+target_link_libraries(sky::expat INTERFACE expat::expat)

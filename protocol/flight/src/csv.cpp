@@ -1,4 +1,5 @@
-// CSV flight reader and sampler.
+// CSV flight reader (strict: every anomaly is an error) and the sampler all
+// flights share.
 #include <algorithm>
 #include <array>
 #include <charconv>
@@ -45,8 +46,8 @@ constexpr std::array<Range, 7> kRanges = {{{0, 1.0e7},
 
 }  // namespace
 
-Result<Flight> parseCsv(std::string_view text, std::string_view sourceName) {
-  Flight flight;
+Result<ParsedFlight> parseCsv(std::string_view text, std::string_view sourceName) {
+  ParsedFlight flight;
   bool headerSeen = false;
   std::size_t lineNo = 0;
   std::size_t pos = 0;

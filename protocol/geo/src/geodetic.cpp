@@ -70,4 +70,11 @@ double geodesicDistance_m(double lat1_deg, double lon1_deg, double lat2_deg, dou
   return s12;
 }
 
+double geodesicAzimuth_deg(double lat1_deg, double lon1_deg, double lat2_deg, double lon2_deg) {
+  if (lat1_deg == lat2_deg && lon1_deg == lon2_deg) return 0.0;
+  double azi1 = 0, azi2 = 0;
+  GeographicLib::Geodesic::WGS84().Inverse(lat1_deg, lon1_deg, lat2_deg, lon2_deg, azi1, azi2);
+  return azi1;
+}
+
 }  // namespace sky::geo

@@ -9,8 +9,10 @@
 
 namespace sky::sim {
 
-// Reads and parses a flight file; the format is chosen by extension (.csv).
-// Errors name the file, and the parser's errors the line and field.
-Result<flight::Flight> loadFlight(const std::string& path);
+// Reads and parses a flight file; the format is chosen by extension, in any
+// letter case: .csv, .igc or .gpx. Errors name the file, and the parser's
+// errors the line and field; the parser's warnings come with the flight for
+// the caller to log.
+Result<flight::ParsedFlight> loadFlight(const std::string& path);
 
 }  // namespace sky::sim

@@ -1,7 +1,12 @@
 // Recorded flights: a time series of geodetic poses, read from text the
 // caller hands in (protocol/ opens no files), and sampled at any time.
+// Readers: CSV (our own format, with attitude), IGC (FAI glider loggers) and
+// GPX (XML tracks); the last two carry no attitude, which deriveAttitude fills.
 #pragma once
 
+#include <cstdint>
+#include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -17,15 +22,98 @@ struct Fix {
 
 struct Flight {
   std::vector<Fix> fixes;  // at least two
+  // UTC of time_s == 0 in seconds since 1970-01-01T00:00:00Z, when the record
+  // says (IGC with a date header, GPX); lets a replay send the recorded date.
+  std::optional<std::int64_t> startUtc_s;
   double duration_s() const { return fixes.empty() ? 0 : fixes.back().time_s - fixes.front().time_s; }
 };
+
+// What a reader returns: the flight plus what it chose to skip or assume,
+// one human line each ("a.igc:37: field 'validity': 'V' ... fix skipped").
+// It is a Flight (public base) so that code wanting only the fixes can take it
+// as one; the warnings are for the main to log.
+struct ParsedFlight : Flight {
+  std::vector<std::string> warnings;
+};
+
+// Fixes dropped or kept with a warning, shared by the IGC and GPX readers
+// (CSV is our own format and stays strict: every anomaly is an error):
+//  * time not after the previous kept fix (out of order) ... skipped, warning
+//  * time equal to the previous kept fix (duplicate) ....... skipped, warning
+//  * gap of more than kGapWarning_s after the previous fix .. kept, warning
+//    (sample() interpolates straight across it; deriveAttitude does not
+//    differentiate across it)
+// At most kMaxWarningsPerKind warnings of one kind name their line; one more
+// says how many were not listed, so a long bad stretch cannot flood a log.
+// Loggers record every 1-20 s; a minute without a fix means the signal or
+// the power was lost, and a straight line across it is a guess.
+inline constexpr double kGapWarning_s = 60.0;
+inline constexpr std::size_t kMaxWarningsPerKind = 8;
 
 // CSV flight: a header line naming the columns
 //   time_s,lat_deg,lon_deg,alt_m,yaw_deg,pitch_deg,roll_deg
 // (altitude MSL; yaw = true heading; pitch nose-up +; roll right-wing-down +),
 // then one fix per line. Blank lines and lines starting with '#' are ignored.
 // Errors name the source, line and field: "climb.csv:7: field 'lat_deg': ...".
-Result<Flight> parseCsv(std::string_view text, std::string_view sourceName);
+// Never warns; startUtc_s stays empty.
+Result<ParsedFlight> parseCsv(std::string_view text, std::string_view sourceName);
+
+// IGC flight (FAI Technical Specification for IGC-approved flight recorders,
+// Appendix A): one record per line, any line ending, bytes beyond ASCII
+// allowed in records we do not read.
+//  * Date: the first HFDTE record, as 'HFDTEDDMMYY' or 'HFDTEDATE:DDMMYY,NN'
+//    (YY < 80 is 20YY, else 19YY). Missing or unreadable: warning, and
+//    startUtc_s stays empty.
+//  * I record: extension byte ranges in B records. LAD/LOD (extra digit of
+//    decimal minutes) refine the position when present; every other extension
+//    is skipped. An unreadable I record: warning, extensions ignored.
+//  * B records: HHMMSS DDMMmmm[NS] DDDMMmmm[EW] [AV] PPPPP GGGGG (UTC time,
+//    latitude, longitude, validity, pressure altitude ISA, GNSS altitude, m).
+//    Altitude: GNSS if non-zero, else pressure (warning once, at the first
+//    such fix). Times that fall back by more than 12 h are a crossing of
+//    midnight UTC: a day is added.
+// Anomalies (besides the time rules above), each skipped with a warning
+// naming line and field, never fatal:
+//  * validity 'V' (2D or no GNSS fix) ...................... fix skipped
+//  * pressure and GNSS altitude both 0 (no altitude) ........ fix skipped
+//  * a B record that does not parse (short, non-digit, minutes >= 60,
+//    latitude > 90, bad hemisphere) ......................... line skipped
+//  * a line that is not a record (first byte not 'A'-'Z') .. line skipped
+// Records of other types (A, G, L, C, E, F, K, ...) are ignored silently.
+// Fails (Malformed) only with fewer than two usable fixes.
+// Altitudes are taken as they are written (GNSS: ellipsoid or geoid per the
+// logger's HFALG, pressure: ISA); no geoid model is applied.
+// time_s is 0 at the first kept fix; startUtc_s is that fix's UTC.
+// Attitude is derived by deriveAttitude.
+Result<ParsedFlight> parseIgc(std::string_view text, std::string_view sourceName);
+
+// GPX 1.0/1.1 track: every <trk>/<trkseg>/<trkpt lat=".." lon=".."> in
+// document order, each with <ele> (m) and <time> (ISO 8601 with 'Z' or a
+// +hh:mm offset, optional fractional seconds). Namespace prefixes are ignored;
+// waypoints and routes are not part of a flight and are ignored.
+// A track point that lacks lat, lon, ele or time, or whose value does not
+// parse or is out of range, is an error (InvalidArgument / Malformed) naming
+// source, line and field: "a.gpx:12: field 'lat': 'x' is not a number".
+// Malformed XML is an error naming the line (expat's message). Time order:
+// the shared rules above (skipped or kept with a warning).
+// time_s is 0 at the whole second at or before the first kept point;
+// startUtc_s is that second. Attitude is derived by deriveAttitude.
+Result<ParsedFlight> parseGpx(std::string_view text, std::string_view sourceName);
+
+// Fills yaw, pitch and roll of every fix from the track alone:
+//  * yaw: geodesic azimuth of the chord through the neighbouring fixes;
+//  * pitch: climb angle atan2(climb rate, ground speed);
+//  * roll: bank of a coordinated turn atan(v * omega / g) from the turn rate;
+// each smoothed by a centred moving average (angles unwrapped first) and
+// clamped to the limits in attitude.cpp. Differences never span a gap of more
+// than kGapWarning_s. Below a ground speed of 1 m/s the heading is held.
+// Needs fixes.size() >= 2 (a precondition, asserted).
+void deriveAttitude(Flight& flight);
+
+// Days from 1970-01-01 to the proleptic Gregorian date y-m-d (negative
+// before), month in [1, 12], day in [1, 31]. H. Hinnant, "chrono-Compatible
+// Low-Level Date Algorithms", days_from_civil.
+std::int64_t daysFromCivil(std::int64_t y, unsigned m, unsigned d);
 
 // The pose at time t (clamped to the record): position interpolated along the
 // ellipsoid (ECEF lerp re-projected), angles along their shortest arc.

@@ -54,5 +54,8 @@ double angleDiff_deg(double a_deg, double b_deg);
 
 // Great-circle (on the ellipsoid: geodesic) distance between two points, m.
 double geodesicDistance_m(double lat1_deg, double lon1_deg, double lat2_deg, double lon2_deg);
+// Azimuth at point 1 of the geodesic to point 2 (clockwise from true north),
+// deg in [-180, 180]; 0 when the points coincide (no direction exists).
+double geodesicAzimuth_deg(double lat1_deg, double lon1_deg, double lat2_deg, double lon2_deg);
 
 }  // namespace sky::geo

@@ -1,0 +1,238 @@
+// GPX track reader: expat (streaming XML) hands us elements; we keep the
+// track points of trk/trkseg with their ele and time. Strict on values (an
+// error names line and field), shared time-order rules (flight.hpp).
+#include <charconv>
+#include <climits>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <expat.h>
+
+#include "reader_common.hpp"
+#include "sky/flight/flight.hpp"
+
+namespace sky::flight {
+
+namespace {
+
+using detail::isDigit;
+using detail::printable;
+
+// A number or timestamp is never longer; longer text is kept only this far,
+// so a huge text node cannot grow a buffer (and still fails to parse).
+constexpr std::size_t kMaxValueChars = 64;
+// expat takes int lengths: feed large documents in slices.
+constexpr std::size_t kChunkBytes = std::size_t{1} << 24;
+
+// Same bounds as the CSV reader: below the Dead Sea shore, above any balloon.
+constexpr double kMinEle_m = -1000.0, kMaxEle_m = 1.0e6;
+
+std::string_view trim(std::string_view s) {
+  const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; };
+  while (!s.empty() && space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && space(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+std::optional<double> number(std::string_view s) {
+  s = trim(s);
+  double v = 0;
+  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (s.empty() || ec != std::errc() || ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+// ISO 8601 / RFC 3339 date-time "YYYY-MM-DDThh:mm:ss[.fff][Z|+hh:mm|-hh:mm]"
+// as UTC seconds since 1970. A time zone is required (a local time is not a
+// recording time we can place).
+std::optional<double> isoUtc_s(std::string_view s) {
+  s = trim(s);
+  const auto num = [&](std::size_t at, std::size_t n) { return detail::digitsValue(detail::sub(s, at, n)); };
+  if (s.size() < 20 || s[4] != '-' || s[7] != '-' || (s[10] != 'T' && s[10] != 't') || s[13] != ':' ||
+      s[16] != ':')
+    return std::nullopt;
+  const long long y = num(0, 4), mo = num(5, 2), d = num(8, 2), h = num(11, 2), mi = num(14, 2), sec = num(17, 2);
+  if (y < 0 || mo < 1 || mo > 12 || d < 1 || d > 31 || h < 0 || h > 23 || mi < 0 || mi > 59 || sec < 0 ||
+      sec > 60)
+    return std::nullopt;
+  std::size_t i = 19;
+  double fraction = 0;
+  if (s[i] == '.') {
+    double scale = 0.1;
+    for (++i; i < s.size() && isDigit(s[i]); ++i, scale /= 10) fraction += (s[i] - '0') * scale;
+  }
+  if (i >= s.size()) return std::nullopt;
+  long long offset_s = 0;
+  if (s[i] == 'Z' || s[i] == 'z') {
+    ++i;
+  } else if (s[i] == '+' || s[i] == '-') {
+    const long long oh = num(i + 1, 2), om = num(i + 4, 2);
+    if (s.size() < i + 6 || s[i + 3] != ':' || oh < 0 || oh > 23 || om < 0 || om > 59) return std::nullopt;
+    offset_s = (s[i] == '+' ? 1 : -1) * (oh * 3600 + om * 60);
+    i += 6;
+  } else {
+    return std::nullopt;
+  }
+  if (i != s.size()) return std::nullopt;
+  const std::int64_t days = daysFromCivil(y, static_cast<unsigned>(mo), static_cast<unsigned>(d));
+  return static_cast<double>(days * 86400 + h * 3600 + mi * 60 + sec - offset_s) + fraction;
+}
+
+std::string_view localName(const XML_Char* name) {
+  const std::string_view n(name);
+  const auto colon = n.rfind(':');
+  return colon == std::string_view::npos ? n : n.substr(colon + 1);
+}
+
+struct Point {
+  std::size_t line = 0;
+  double lat_deg = 0, lon_deg = 0;
+  std::optional<std::string> ele, time;
+  std::size_t eleLine = 0, timeLine = 0;
+};
+
+struct Kept {
+  double utc_s;
+  geo::Geodetic position;
+};
+
+class GpxReader {
+ public:
+  GpxReader(XML_Parser parser, std::string_view source) : parser_(parser), warnings_(source) {}
+
+  static void XMLCALL onStart(void* self, const XML_Char* name, const XML_Char** attrs) {
+    static_cast<GpxReader*>(self)->start(localName(name), attrs);
+  }
+  static void XMLCALL onEnd(void* self, const XML_Char*) { static_cast<GpxReader*>(self)->end(); }
+  static void XMLCALL onText(void* self, const XML_Char* s, int len) {
+    auto* r = static_cast<GpxReader*>(self);
+    if (r->text_ && r->text_->size() <= kMaxValueChars)
+      r->text_->append(s, std::min(static_cast<std::size_t>(len), kMaxValueChars + 1 - r->text_->size()));
+  }
+
+  std::optional<Error> error;
+  std::vector<Kept> kept;
+  detail::Warnings& warnings() { return warnings_; }
+
+ private:
+  std::size_t line() const { return static_cast<std::size_t>(XML_GetCurrentLineNumber(parser_)); }
+
+  void stop(ErrorCode code, std::size_t line, const std::string& what) {
+    if (error) return;
+    error = Error{code, warnings_.source() + ":" + std::to_string(line) + ": " + what};
+    XML_StopParser(parser_, XML_FALSE);
+  }
+
+  void start(std::string_view name, const XML_Char** attrs) {
+    const std::size_t depth = stack_.size();
+    stack_.emplace_back(name);
+    text_ = nullptr;  // character data counts only directly inside <ele>/<time>
+    if (error) return;
+    // A <trkpt> nested in an open one (found by fuzzing: it replaced the open
+    // point while text_ still pointed into it) is not a track point.
+    if (name == "trkpt" && !point_ && depth >= 2 && stack_[depth - 1] == "trkseg" && stack_[depth - 2] == "trk") {
+      point_ = Point{line(), 0, 0, {}, {}, 0, 0};
+      pointDepth_ = depth;
+      readCoordinate(attrs, "lat", 90.0, point_->lat_deg);
+      readCoordinate(attrs, "lon", 180.0, point_->lon_deg);
+      return;
+    }
+    if (point_ && depth == pointDepth_ + 1 && (name == "ele" || name == "time")) {
+      auto& slot = name == "ele" ? point_->ele : point_->time;
+      (name == "ele" ? point_->eleLine : point_->timeLine) = line();
+      slot.emplace();
+      text_ = &*slot;
+    }
+  }
+
+  void readCoordinate(const XML_Char** attrs, std::string_view field, double limit, double& out) {
+    for (std::size_t i = 0; attrs[i]; i += 2) {
+      if (localName(attrs[i]) != field) continue;
+      const auto v = number(attrs[i + 1]);
+      if (!v) {
+        stop(ErrorCode::Malformed, point_->line,
+             "field '" + std::string(field) + "': '" + printable(attrs[i + 1]) + "' is not a number");
+      } else if (*v < -limit || *v > limit) {
+        stop(ErrorCode::InvalidArgument, point_->line,
+             "field '" + std::string(field) + "': " + printable(attrs[i + 1]) + " outside [-" +
+                 std::to_string(static_cast<int>(limit)) + ", " + std::to_string(static_cast<int>(limit)) + "]");
+      }
+      out = v.value_or(0);
+      return;
+    }
+    stop(ErrorCode::Malformed, point_->line, "field '" + std::string(field) + "': missing from <trkpt>");
+  }
+
+  void end() {
+    const std::size_t depth = stack_.size() - 1;
+    stack_.pop_back();
+    text_ = nullptr;
+    if (error || !point_ || depth != pointDepth_) return;
+    const Point p = std::move(*point_);
+    point_.reset();
+    if (!p.ele) return stop(ErrorCode::Malformed, p.line, "field 'ele': missing from <trkpt>");
+    if (!p.time) return stop(ErrorCode::Malformed, p.line, "field 'time': missing from <trkpt>");
+    const auto ele = number(*p.ele);
+    if (!ele) return stop(ErrorCode::Malformed, p.eleLine, "field 'ele': '" + printable(*p.ele) + "' is not a number");
+    if (*ele < kMinEle_m || *ele > kMaxEle_m)
+      return stop(ErrorCode::InvalidArgument, p.eleLine, "field 'ele': " + printable(*p.ele) + " m out of range");
+    const auto utc = isoUtc_s(*p.time);
+    if (!utc)
+      return stop(ErrorCode::Malformed, p.timeLine,
+                  "field 'time': '" + printable(trim(*p.time)) + "' is not an ISO 8601 UTC time");
+    if (!order_.accept(*utc, p.line, warnings_)) return;
+    kept.push_back(Kept{*utc, {p.lat_deg, p.lon_deg, *ele}});
+  }
+
+  XML_Parser parser_;
+  detail::Warnings warnings_;
+  detail::TimeOrder order_;
+  std::vector<std::string> stack_;  // local names of the open elements
+  std::optional<Point> point_;      // the <trkpt> being read
+  std::size_t pointDepth_ = 0;
+  std::string* text_ = nullptr;  // where character data goes (inside <ele>/<time>)
+};
+
+struct ParserFree {
+  void operator()(XML_Parser p) const { XML_ParserFree(p); }
+};
+
+}  // namespace
+
+Result<ParsedFlight> parseGpx(std::string_view text, std::string_view sourceName) {
+  const std::string src(sourceName);
+  const std::unique_ptr<XML_ParserStruct, ParserFree> parser(XML_ParserCreate(nullptr));
+  if (!parser) return fail(ErrorCode::Io, src + ": cannot create an XML parser (out of memory)");
+  GpxReader reader(parser.get(), sourceName);
+  XML_SetUserData(parser.get(), &reader);
+  XML_SetElementHandler(parser.get(), &GpxReader::onStart, &GpxReader::onEnd);
+  XML_SetCharacterDataHandler(parser.get(), &GpxReader::onText);
+
+  std::size_t pos = 0;
+  do {
+    const std::size_t n = std::min(kChunkBytes, text.size() - pos);
+    const bool last = pos + n == text.size();
+    if (XML_Parse(parser.get(), text.data() + pos, static_cast<int>(n), last) != XML_STATUS_OK) {
+      if (reader.error) return tl::unexpected(*reader.error);
+      return fail(ErrorCode::Malformed, src + ":" + std::to_string(XML_GetCurrentLineNumber(parser.get())) +
+                                            ": XML: " + XML_ErrorString(XML_GetErrorCode(parser.get())));
+    }
+    pos += n;
+  } while (pos < text.size());
+
+  if (reader.kept.size() < 2)
+    return fail(ErrorCode::Malformed, src + ": " + std::to_string(reader.kept.size()) +
+                                          " usable <trkpt>, a flight needs at least two");
+  ParsedFlight flight;
+  const double start_s = std::floor(reader.kept.front().utc_s);
+  flight.startUtc_s = static_cast<std::int64_t>(start_s);
+  for (const Kept& k : reader.kept) flight.fixes.push_back(Fix{k.utc_s - start_s, {k.position, 0, 0, 0}});
+  deriveAttitude(flight);
+  flight.warnings = reader.warnings().finish();
+  return flight;
+}
+
+}  // namespace sky::flight

@@ -1,0 +1,93 @@
+// Pieces the IGC and GPX readers share: byte classes that ignore the locale,
+// capped warnings, and the time-order rules documented in flight.hpp.
+// Private to protocol/flight/src.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "sky/flight/flight.hpp"
+
+namespace sky::flight::detail {
+
+// <cctype> takes int and is undefined for negative chars (bytes >= 0x80).
+constexpr bool isDigit(char c) { return c >= '0' && c <= '9'; }
+constexpr bool isUpper(char c) { return c >= 'A' && c <= 'Z'; }
+
+// s.substr(pos, n) that is empty instead of throwing when pos > s.size()
+// (records from outside are any length).
+constexpr std::string_view sub(std::string_view s, std::size_t pos, std::size_t n = std::string_view::npos) {
+  return pos > s.size() ? std::string_view() : s.substr(pos, n);
+}
+
+// Value of s (all digits, non-empty) or -1.
+constexpr long long digitsValue(std::string_view s) {
+  if (s.empty()) return -1;
+  long long v = 0;
+  for (char c : s) {
+    if (!isDigit(c)) return -1;
+    v = v * 10 + (c - '0');
+  }
+  return v;
+}
+
+// Printable rendering of a field for a message: bytes outside ASCII
+// printables become '?', and long fields are cut.
+std::string printable(std::string_view s);
+
+enum class WarningKind : std::size_t {
+  OutOfOrder,
+  Duplicate,
+  Gap,
+  Validity,
+  NoAltitude,
+  Junk,
+  Other,
+  Count_,
+};
+
+// Warnings of one reader; at most kMaxWarningsPerKind per kind are listed.
+class Warnings {
+ public:
+  explicit Warnings(std::string_view source) : source_(source) {}
+  // "source:line: text" (line 0: "source: text").
+  void add(WarningKind kind, std::size_t line, const std::string& text);
+  // Appends the "N more ..." summaries and hands the list over.
+  std::vector<std::string> finish();
+  const std::string& source() const { return source_; }
+
+ private:
+  std::string source_;
+  std::vector<std::string> list_;
+  std::array<std::size_t, static_cast<std::size_t>(WarningKind::Count_)> counts_{};
+};
+
+// Splits text into lines at "\n", "\r\n" or "\r"; calls f(line, lineNo)
+// with lineNo from 1 and the ending removed.
+template <class F>
+void forEachLine(std::string_view text, F&& f) {
+  std::size_t lineNo = 0, pos = 0;
+  while (pos < text.size()) {
+    std::size_t end = pos;
+    while (end < text.size() && text[end] != '\n' && text[end] != '\r') ++end;
+    f(text.substr(pos, end - pos), ++lineNo);
+    if (end < text.size() && text[end] == '\r' && end + 1 < text.size() && text[end + 1] == '\n') ++end;
+    pos = end + 1;
+  }
+}
+
+// Applies the shared time rules to a candidate fix at t (any origin, s).
+// Returns whether to keep it; warns for skipped fixes and gaps.
+class TimeOrder {
+ public:
+  bool accept(double t_s, std::size_t line, Warnings& warnings);
+
+ private:
+  bool any_ = false;
+  double last_s_ = 0;
+};
+
+}  // namespace sky::flight::detail
