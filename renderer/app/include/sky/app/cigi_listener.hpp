@@ -9,6 +9,7 @@
 #include <set>
 #include <string>
 
+#include <utility>  // before asio: Boost 1.74 asio uses std::exchange without including it
 #include <boost/asio.hpp>
 
 #include "sky/app/shared_state.hpp"
