@@ -24,7 +24,9 @@ namespace sky::test {
 
 class ChildProcess {
  public:
-  ChildProcess(std::vector<std::string> argv, const std::string& logPath) : logPath_(logPath) {
+  // env: extra NAME=value entries on top of this process's environment.
+  ChildProcess(std::vector<std::string> argv, const std::string& logPath, std::vector<std::string> env = {})
+      : logPath_(logPath) {
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_addopen(&actions, 1, logPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -32,7 +34,11 @@ class ChildProcess {
     std::vector<char*> args;
     for (auto& a : argv) args.push_back(a.data());
     args.push_back(nullptr);
-    const int rc = posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environ);
+    std::vector<char*> envp;
+    for (char** e = environ; *e; ++e) envp.push_back(*e);
+    for (auto& e : env) envp.push_back(e.data());
+    envp.push_back(nullptr);
+    const int rc = posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), envp.data());
     posix_spawn_file_actions_destroy(&actions);
     if (rc != 0) throw std::runtime_error("cannot spawn " + argv[0]);
   }

@@ -25,8 +25,10 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
   std::snprintf(name, sizeof name, "frame_%06llu", static_cast<unsigned long long>(r.frame));
   const std::string base = directory_ + "/" + name;
   if (auto ok = render::writePng(image, base + ".png"); !ok) return ok;
-  if (writeFloat_)
-    if (auto ok = writePfm(image, base + ".pfm"); !ok) return ok;
+  if (writeFloat_) {
+    if (auto ok = writePfm(image, base + ".pfm", PfmChannels::Radiance); !ok) return ok;
+    if (auto ok = writePfm(image, base + ".transmittance.pfm", PfmChannels::Transmittance); !ok) return ok;
+  }
   const auto& p = r.host.pose;
   const nlohmann::json line = {
       {"frame", r.frame},
@@ -52,17 +54,21 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
   return {};
 }
 
-Result<void> writePfm(const render::Image& image, const std::string& path) {
+Result<void> writePfm(const render::Image& image, const std::string& path, PfmChannels channels) {
   std::FILE* f = std::fopen(path.c_str(), "wb");
   if (!f) return fail(ErrorCode::Io, path + ": cannot open for writing");
-  // "-1.0" scale: little-endian floats. Rows go bottom to top in PFM.
-  std::fprintf(f, "PF\n%u %u\n-1.0\n", image.width, image.height);
-  std::vector<float> row(static_cast<std::size_t>(image.width) * 3);
+  // "PF" colour or "Pf" grey; "-1.0" scale: little-endian floats. Rows go
+  // bottom to top in PFM.
+  const bool rgb = channels == PfmChannels::Radiance;
+  std::fprintf(f, "%s\n%u %u\n-1.0\n", rgb ? "PF" : "Pf", image.width, image.height);
+  const std::size_t n = rgb ? 3 : 1;
+  std::vector<float> row(static_cast<std::size_t>(image.width) * n);
   bool ok = true;
   for (std::uint32_t y = image.height; y-- > 0;) {
-    for (std::uint32_t x = 0; x < image.width; ++x)
-      for (int c = 0; c < 3; ++c)
-        row[x * 3 + c] = image.rgba[(static_cast<std::size_t>(y) * image.width + x) * 4 + c];
+    for (std::uint32_t x = 0; x < image.width; ++x) {
+      const float* px = &image.rgba[(static_cast<std::size_t>(y) * image.width + x) * 4];
+      for (std::size_t c = 0; c < n; ++c) row[x * n + c] = rgb ? px[c] : px[3];
+    }
     ok = ok && std::fwrite(row.data(), sizeof(float), row.size(), f) == row.size();
   }
   ok = (std::fclose(f) == 0) && ok;

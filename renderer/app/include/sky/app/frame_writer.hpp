@@ -1,5 +1,5 @@
 // Writes a headless channel's output: one PNG per frame (optionally the
-// linear float image as PFM), and one JSON line of metadata per frame in
+// linear radiance and the transmittance as PFM), and one JSON line of metadata per frame in
 // frames.jsonl (camera pose, host frame, weather clock, image statistics).
 #pragma once
 
@@ -35,8 +35,10 @@ class FrameWriter {
   std::ofstream metadata_;
 };
 
-// Portable float map (PFM, colour, little-endian, bottom row first), the
-// linear radiance without tone mapping, for tests that check every value.
-Result<void> writePfm(const render::Image& image, const std::string& path);
+// Portable float map (PFM, little-endian, bottom row first) of the linear
+// radiance (colour, no tone mapping) or of the view-ray transmittance through
+// the clouds (grey), for tests that check every value.
+enum class PfmChannels { Radiance, Transmittance };
+Result<void> writePfm(const render::Image& image, const std::string& path, PfmChannels channels);
 
 }  // namespace sky::app
