@@ -2,6 +2,7 @@
 // range checks on decode.
 #include "sky/stream/messages.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -62,6 +63,10 @@ Result<Message> decodeHello(const fbs::Hello& h) {
 
 Result<Message> decodeSubscribe(const fbs::Subscribe& s) {
   Subscribe out;
+  out.protocolVersion = s.protocol_version();
+  if (out.protocolVersion != kProtocolVersion)
+    return fail(ErrorCode::Unsupported, "Subscribe.protocol_version " + std::to_string(out.protocolVersion) +
+                                            ", this server speaks " + std::to_string(kProtocolVersion));
   out.area = {s.center_lat_deg(), s.center_lon_deg(), s.radius_m()};
   out.altMin_m = s.alt_min_m();
   out.altMax_m = s.alt_max_m();
@@ -76,6 +81,62 @@ Result<Message> decodeSubscribe(const fbs::Subscribe& s) {
   return Message(out);
 }
 
+Result<weather::CloudLayer> decodeLayer(const char* message, const fbs::Layer& l) {
+  weather::CloudLayer layer;
+  layer.id = l.id();
+  if (l.cloud_type() > weather::kMaxCloudType)
+    return fail(ErrorCode::InvalidArgument, std::string(message) + ".layers[id " + std::to_string(l.id()) +
+                                                "].cloud_type " + std::to_string(l.cloud_type()) + " outside [0, 10]");
+  layer.type = static_cast<weather::CloudType>(l.cloud_type());
+  layer.base_m = l.base_m();
+  layer.thickness_m = l.thickness_m();
+  layer.transitionBand_m = l.transition_band_m();
+  layer.coverage = l.coverage();
+  layer.density = l.density();
+  if (const fbs::Wind* w = l.wind()) layer.wind = {w->speed_mps(), w->from_deg(), w->vertical_mps()};
+  if (auto r = weather::validate(layer); !r)
+    return fail(ErrorCode::InvalidArgument, std::string(message) + ": " + r.error().detail);
+  return layer;
+}
+
+Result<std::vector<weather::CloudLayer>> decodeLayers(
+    const char* message, const flatbuffers::Vector<flatbuffers::Offset<fbs::Layer>>* layers) {
+  std::vector<weather::CloudLayer> out;
+  if (!layers) return out;
+  for (const fbs::Layer* l : *layers) {
+    auto layer = decodeLayer(message, *l);
+    if (!layer) return tl::unexpected(layer.error());
+    for (const auto& seen : out)
+      if (seen.id == layer->id)
+        return fail(ErrorCode::InvalidArgument,
+                    std::string(message) + ".layers: id " + std::to_string(layer->id) + " appears twice");
+    out.push_back(*layer);
+  }
+  return out;
+}
+
+Result<std::vector<weather::CoverageTile>> decodeTiles(const char* message, int level,
+                                                       const flatbuffers::Vector<const fbs::Tile*>* tiles) {
+  std::vector<weather::CoverageTile> out;
+  if (!tiles) return out;
+  out.reserve(tiles->size());
+  for (flatbuffers::uoffset_t i = 0; i < tiles->size(); ++i) {
+    const fbs::Tile* t = tiles->Get(i);
+    if (!weather::isCellAtLevel(t->cell_id(), level))
+      return fail(ErrorCode::InvalidArgument, std::string(message) + ".tiles[" + std::to_string(i) + "].cell_id " +
+                                                  std::to_string(t->cell_id()) + " is not an S2 cell of level " +
+                                                  std::to_string(level));
+    if (t->blend_type() > weather::kMaxCloudType)
+      return fail(ErrorCode::InvalidArgument, std::string(message) + ".tiles[" + std::to_string(i) +
+                                                  "].blend_type " + std::to_string(t->blend_type()) +
+                                                  " outside [0, 10]");
+    out.push_back({t->cell_id(), t->layer_id(), weather::dequantizeUnit(t->coverage()),
+                   weather::dequantizeUnit(t->density()), static_cast<weather::CloudType>(t->blend_type()),
+                   weather::dequantizeUnit(t->blend())});
+  }
+  return out;
+}
+
 Result<Message> decodeSnapshot(const fbs::Snapshot& s) {
   weather::WeatherSnapshot out;
   out.weatherClock_s = s.weather_clock_s();
@@ -84,41 +145,46 @@ Result<Message> decodeSnapshot(const fbs::Snapshot& s) {
     return tl::unexpected(r.error());
   if (auto r = checkRange("Snapshot", "tile_level", out.tileLevel, 0, 30); !r)
     return tl::unexpected(r.error());
-  if (s.layers()) {
-    for (const fbs::Layer* l : *s.layers()) {
-      weather::CloudLayer layer;
-      layer.id = l->id();
-      if (l->cloud_type() > weather::kMaxCloudType)
-        return fail(ErrorCode::InvalidArgument, "Snapshot.layers[" + std::to_string(l->id()) +
-                                                    "].cloud_type " +
-                                                    std::to_string(l->cloud_type()) +
-                                                    " outside [0, 10]");
-      layer.type = static_cast<weather::CloudType>(l->cloud_type());
-      layer.base_m = l->base_m();
-      layer.thickness_m = l->thickness_m();
-      layer.transitionBand_m = l->transition_band_m();
-      layer.coverage = l->coverage();
-      layer.density = l->density();
-      if (const fbs::Wind* w = l->wind())
-        layer.wind = {w->speed_mps(), w->from_deg(), w->vertical_mps()};
-      if (auto r = weather::validate(layer); !r)
-        return fail(ErrorCode::InvalidArgument, "Snapshot: " + r.error().detail);
-      out.layers.push_back(layer);
-    }
-  }
-  if (s.tiles()) {
-    out.tiles.reserve(s.tiles()->size());
-    for (const fbs::Tile* t : *s.tiles()) {
-      const weather::CoverageTile tile{t->cell_id(), t->layer_id(), t->coverage(), t->density()};
-      if (auto r = checkRange("Snapshot.tiles", "coverage", tile.coverage, 0, 1); !r)
-        return tl::unexpected(r.error());
-      if (auto r = checkRange("Snapshot.tiles", "density", tile.density, 0, 1); !r)
-        return tl::unexpected(r.error());
-      out.tiles.push_back(tile);
-    }
-  }
+  auto layers = decodeLayers("Snapshot", s.layers());
+  if (!layers) return tl::unexpected(layers.error());
+  out.layers = std::move(*layers);
+  auto tiles = decodeTiles("Snapshot", out.tileLevel, s.tiles());
+  if (!tiles) return tl::unexpected(tiles.error());
+  out.tiles = std::move(*tiles);
+  for (const auto& t : out.tiles)
+    if (std::none_of(out.layers.begin(), out.layers.end(), [&](const auto& l) { return l.id == t.layerId; }))
+      return fail(ErrorCode::InvalidArgument,
+                  "Snapshot.tiles: a tile of layer " + std::to_string(t.layerId) + ", which the Snapshot does not have");
   return Message(std::move(out));
 }
+
+Result<Message> decodeDelta(const fbs::Delta& d) {
+  weather::WeatherDelta out;
+  out.weatherClock_s = d.weather_clock_s();
+  out.tileLevel = d.tile_level();
+  if (auto r = checkFinite("Delta", "weather_clock_s", out.weatherClock_s); !r) return tl::unexpected(r.error());
+  if (auto r = checkRange("Delta", "tile_level", out.tileLevel, 0, 30); !r) return tl::unexpected(r.error());
+  auto layers = decodeLayers("Delta", d.layers());
+  if (!layers) return tl::unexpected(layers.error());
+  out.layers = std::move(*layers);
+  if (d.removed_layer_ids()) out.removedLayerIds.assign(d.removed_layer_ids()->begin(), d.removed_layer_ids()->end());
+  auto tiles = decodeTiles("Delta", out.tileLevel, d.tiles());
+  if (!tiles) return tl::unexpected(tiles.error());
+  out.tiles = std::move(*tiles);
+  return Message(std::move(out));
+}
+
+std::vector<fbs::Tile> encodeTiles(const std::vector<weather::CoverageTile>& tiles) {
+  std::vector<fbs::Tile> out;
+  out.reserve(tiles.size());
+  for (const auto& t : tiles)
+    out.emplace_back(t.cellId, static_cast<std::uint16_t>(t.layerId), weather::quantizeUnit(t.coverage),
+                     weather::quantizeUnit(t.density), static_cast<std::uint8_t>(t.blendType),
+                     weather::quantizeUnit(t.blend));
+  return out;
+}
+
+static_assert(sizeof(fbs::Tile) == kTileWireBytes, "kTileWireBytes must match the schema's Tile");
 
 }  // namespace
 
@@ -134,17 +200,15 @@ std::vector<std::uint8_t> encodeMessage(const Message& message) {
           },
           [&](const Subscribe& s) {
             return std::pair{fbs::Body::Subscribe,
-                             fbs::CreateSubscribe(b, s.area.centerLat_deg, s.area.centerLon_deg,
-                                                  s.area.radius_m, s.altMin_m, s.altMax_m,
-                                                  static_cast<std::uint8_t>(s.tileLevel))
+                             fbs::CreateSubscribe(b, s.protocolVersion, s.area.centerLat_deg,
+                                                  s.area.centerLon_deg, s.area.radius_m, s.altMin_m,
+                                                  s.altMax_m, static_cast<std::uint8_t>(s.tileLevel))
                                  .Union()};
           },
           [&](const weather::WeatherSnapshot& s) {
             std::vector<flatbuffers::Offset<fbs::Layer>> layers;
             for (const auto& l : s.layers) layers.push_back(encodeLayer(b, l));
-            std::vector<fbs::Tile> tiles;
-            tiles.reserve(s.tiles.size());
-            for (const auto& t : s.tiles) tiles.emplace_back(t.cellId, t.layerId, t.coverage, t.density);
+            const std::vector<fbs::Tile> tiles = encodeTiles(s.tiles);
             return std::pair{fbs::Body::Snapshot,
                              fbs::CreateSnapshotDirect(b, s.weatherClock_s, &layers,
                                                        static_cast<std::uint8_t>(s.tileLevel), &tiles)
@@ -156,6 +220,15 @@ std::vector<std::uint8_t> encodeMessage(const Message& message) {
           [&](const StreamError& e) {
             return std::pair{fbs::Body::ErrorMessage,
                              fbs::CreateErrorMessageDirect(b, e.code, e.detail.c_str()).Union()};
+          },
+          [&](const weather::WeatherDelta& d) {
+            std::vector<flatbuffers::Offset<fbs::Layer>> layers;
+            for (const auto& l : d.layers) layers.push_back(encodeLayer(b, l));
+            const std::vector<fbs::Tile> tiles = encodeTiles(d.tiles);
+            return std::pair{fbs::Body::Delta,
+                             fbs::CreateDeltaDirect(b, d.weatherClock_s, &layers, &d.removedLayerIds,
+                                                    static_cast<std::uint8_t>(d.tileLevel), &tiles)
+                                 .Union()};
           }},
       message);
   b.Finish(fbs::CreateMessage(b, type, body));
@@ -188,6 +261,7 @@ Result<Message> decodeMessage(std::span<const std::uint8_t> payload) {
       const auto* e = m->body_as_ErrorMessage();
       return Message(StreamError{e->code(), e->detail() ? e->detail()->str() : std::string()});
     }
+    case fbs::Body::Delta: return decodeDelta(*m->body_as_Delta());
     case fbs::Body::NONE: break;
   }
   return fail(ErrorCode::Malformed,
@@ -199,7 +273,8 @@ const char* kindName(const Message& message) {
                                [](const Subscribe&) { return "Subscribe"; },
                                [](const weather::WeatherSnapshot&) { return "Snapshot"; },
                                [](const Heartbeat&) { return "Heartbeat"; },
-                               [](const StreamError&) { return "Error"; }},
+                               [](const StreamError&) { return "Error"; },
+                               [](const weather::WeatherDelta&) { return "Delta"; }},
                     message);
 }
 

@@ -1,9 +1,11 @@
 // Cloud type names and layer validation.
 #include "sky/weather/model.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
+#include <map>
 
 namespace sky::weather {
 
@@ -40,6 +42,8 @@ Result<void> validate(const CloudLayer& layer) {
                 "layer " + std::to_string(layer.id) + ": cloud type " +
                     std::to_string(static_cast<int>(layer.type)) + " outside [0, 10]");
   Result<void> r;
+  // Tiles carry the layer id in 16 bits on the stream.
+  if (!(r = checkRange(layer, "id", layer.id, 0, 65535))) return r;
   if (!(r = checkRange(layer, "base_m", layer.base_m, -500, 20000))) return r;
   if (!(r = checkRange(layer, "thickness_m", layer.thickness_m, 0, 20000, true))) return r;
   if (!(r = checkRange(layer, "transition_band_m", layer.transitionBand_m, 0, 5000))) return r;
@@ -48,6 +52,55 @@ Result<void> validate(const CloudLayer& layer) {
   if (!(r = checkRange(layer, "wind.speed_mps", layer.wind.speed_mps, 0, 150))) return r;
   if (!(r = checkRange(layer, "wind.from_deg", layer.wind.fromDirection_deg, 0, 360))) return r;
   if (!(r = checkRange(layer, "wind.vertical_mps", layer.wind.vertical_mps, -50, 50))) return r;
+  return {};
+}
+
+std::uint8_t quantizeUnit(double v) {
+  if (!(v > 0)) return 0;
+  if (v >= 1) return 255;
+  return static_cast<std::uint8_t>(std::lround(v * 255.0));
+}
+
+Result<void> applyDelta(WeatherSnapshot& snapshot, const WeatherDelta& delta) {
+  WeatherSnapshot next = snapshot;  // all or nothing
+  next.weatherClock_s = delta.weatherClock_s;
+  for (const CloudLayer& layer : delta.layers) {
+    auto it = std::find_if(next.layers.begin(), next.layers.end(),
+                           [&](const CloudLayer& l) { return l.id == layer.id; });
+    if (it != next.layers.end())
+      *it = layer;
+    else
+      next.layers.push_back(layer);
+  }
+  for (std::uint32_t id : delta.removedLayerIds) {
+    auto it = std::find_if(next.layers.begin(), next.layers.end(),
+                           [&](const CloudLayer& l) { return l.id == id; });
+    if (it == next.layers.end())
+      return fail(ErrorCode::InvalidArgument, "delta removes layer " + std::to_string(id) + ", which does not exist");
+    next.layers.erase(it);
+    std::erase_if(next.tiles, [&](const CoverageTile& t) { return t.layerId == id; });
+  }
+  if (!delta.tiles.empty()) {
+    if (!next.tiles.empty() && delta.tileLevel != next.tileLevel)
+      return fail(ErrorCode::InvalidArgument, "delta tiles at S2 level " + std::to_string(delta.tileLevel) +
+                                                  ", the snapshot's are at " + std::to_string(next.tileLevel));
+    next.tileLevel = delta.tileLevel;
+    std::map<std::pair<std::uint64_t, std::uint32_t>, std::size_t> index;  // (cell, layer) -> position
+    auto key = [](std::uint64_t cell, std::uint32_t layer) { return std::pair{cell, layer}; };
+    for (std::size_t i = 0; i < next.tiles.size(); ++i) index.emplace(key(next.tiles[i].cellId, next.tiles[i].layerId), i);
+    for (const CoverageTile& t : delta.tiles) {
+      if (std::none_of(next.layers.begin(), next.layers.end(), [&](const CloudLayer& l) { return l.id == t.layerId; }))
+        return fail(ErrorCode::InvalidArgument, "delta tile of layer " + std::to_string(t.layerId) + ", which does not exist");
+      auto it = index.find(key(t.cellId, t.layerId));
+      if (it != index.end()) {
+        next.tiles[it->second] = t;
+      } else {
+        index.emplace(key(t.cellId, t.layerId), next.tiles.size());
+        next.tiles.push_back(t);
+      }
+    }
+  }
+  snapshot = std::move(next);
   return {};
 }
 

@@ -1,8 +1,12 @@
 // S2 coverings of spherical caps.
 #include "sky/weather/tiling.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include <s2/s1angle.h>
 #include <s2/s2cap.h>
+#include <s2/s2cell.h>
 #include <s2/s2cell_id.h>
 #include <s2/s2latlng.h>
 #include <s2/s2metrics.h>
@@ -37,6 +41,31 @@ std::uint64_t cellAt(double lat_deg, double lon_deg, int level) {
 
 double averageCellEdge_m(int level) {
   return S2::kAvgEdge.GetValue(level) * kMeanEarthRadius_m;
+}
+
+int levelForRadius(double radius_m, std::size_t maxCells, int maxLevel) {
+  // Cap area on the sphere: 2 pi R^2 (1 - cos(r / R)).
+  const double capArea_m2 =
+      2.0 * M_PI * kMeanEarthRadius_m * kMeanEarthRadius_m * (1.0 - std::cos(radius_m / kMeanEarthRadius_m));
+  // A covering also takes the ring of cells cut by the cap's edge: about
+  // perimeter / edge more. Both terms are estimated with S2's averages.
+  const double perimeter_m = 2.0 * M_PI * kMeanEarthRadius_m * std::sin(std::min(radius_m / kMeanEarthRadius_m, M_PI / 2));
+  for (int level = maxLevel; level > 0; --level) {
+    const double cellArea = S2::kAvgArea.GetValue(level) * kMeanEarthRadius_m * kMeanEarthRadius_m;
+    const double edge = averageCellEdge_m(level);
+    const double expected = capArea_m2 / cellArea + perimeter_m / edge + 4;
+    if (expected <= static_cast<double>(maxCells)) return level;
+  }
+  return 0;
+}
+
+bool isCellAtLevel(std::uint64_t id, int level) {
+  const S2CellId c(id);
+  return c.is_valid() && c.level() == level;
+}
+
+double cellArea_m2(std::uint64_t id) {
+  return S2Cell(S2CellId(id)).ExactArea() * kMeanEarthRadius_m * kMeanEarthRadius_m;
 }
 
 }  // namespace sky::weather

@@ -124,6 +124,13 @@ void WeatherClient::onFrame(std::span<const std::uint8_t> payload) {
                                 s.tiles.size(), s.tileLevel);
                    state_.setSnapshot(s, now);
                  },
+                 [&](const weather::WeatherDelta& d) {
+                   if (auto r = state_.applyDelta(d, now); !r) {
+                     ++malformed_;
+                     spdlog::warn("weather stream: dropped a Delta: {}; asking for a new Snapshot", r.error().detail);
+                     if (area_) send(*area_);
+                   }
+                 },
                  [&](const stream::Heartbeat& h) { state_.setClock(h.weatherClock_s, clockRate_, now); },
                  [&](const stream::StreamError& e) {
                    spdlog::warn("weather server error {}: {}", e.code, e.detail);

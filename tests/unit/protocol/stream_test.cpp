@@ -1,9 +1,12 @@
 // Weather stream: frames split anywhere reassemble; oversize frames and
 // corrupted buffers are rejected; every message kind round-trips.
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "sky/stream/framing.hpp"
 #include "sky/stream/messages.hpp"
+#include "sky/weather/tiling.hpp"
 
 namespace sky::stream {
 namespace {
@@ -20,7 +23,7 @@ weather::WeatherSnapshot sampleSnapshot() {
   l.coverage = 0.625;
   l.wind = {10, 270, 0.5};
   s.layers.push_back(l);
-  s.tiles.push_back({0x89c2590000000000ull, 1, 0.625f, 1.0f});
+  s.tiles.push_back({weather::cellAt(46.2, 12.8, 9), 1, 0.6f, 1.0f, weather::CloudType::Cumulonimbus, 0.2f});
   return s;
 }
 
@@ -59,7 +62,7 @@ TEST(Messages, RoundTripEveryKind) {
   EXPECT_EQ(std::get<Hello>(*m).serverId, "weatherd-test");
   EXPECT_EQ(std::get<Hello>(*m).clockRate, 10.0);
 
-  const Subscribe s{{46.2, 12.8, 80000}, 0, 12000, 9};
+  const Subscribe s{kProtocolVersion, {46.2, 12.8, 80000}, 0, 12000, 9};
   m = decodeMessage(encodeMessage(s));
   ASSERT_TRUE(m);
   EXPECT_EQ(std::get<Subscribe>(*m).area.radius_m, 80000);
@@ -73,7 +76,11 @@ TEST(Messages, RoundTripEveryKind) {
   EXPECT_FLOAT_EQ(static_cast<float>(snap.layers[0].coverage), 0.625f);
   EXPECT_FLOAT_EQ(static_cast<float>(snap.layers[0].wind.vertical_mps), 0.5f);
   ASSERT_EQ(snap.tiles.size(), 1u);
-  EXPECT_EQ(snap.tiles[0].cellId, 0x89c2590000000000ull);
+  EXPECT_EQ(snap.tiles[0].cellId, weather::cellAt(46.2, 12.8, 9));
+  // Tiles travel quantised to 1/255: 0.6 = 153/255 exactly, 0.2 = 51/255.
+  EXPECT_EQ(snap.tiles[0].coverage, 153.0f / 255.0f);
+  EXPECT_EQ(snap.tiles[0].blend, 51.0f / 255.0f);
+  EXPECT_EQ(snap.tiles[0].blendType, weather::CloudType::Cumulonimbus);
 
   m = decodeMessage(encodeMessage(StreamError{7, "bad subscribe"}));
   ASSERT_TRUE(m);
@@ -81,7 +88,7 @@ TEST(Messages, RoundTripEveryKind) {
 }
 
 TEST(Messages, RejectsOutOfRangeValues) {
-  Subscribe s{{95.0, 0, 1000}, 0, 1000, 9};  // latitude 95
+  Subscribe s{kProtocolVersion, {95.0, 0, 1000}, 0, 1000, 9};  // latitude 95
   auto m = decodeMessage(encodeMessage(s));
   ASSERT_FALSE(m);
   EXPECT_NE(m.error().detail.find("center_lat_deg"), std::string::npos);
@@ -96,6 +103,83 @@ TEST(Messages, RejectsOutOfRangeValues) {
   m = decodeMessage(encodeMessage(h));
   ASSERT_FALSE(m);
   EXPECT_EQ(m.error().code, ErrorCode::Unsupported);
+}
+
+TEST(Messages, QuantisationErrorIsAtMostHalfAStep) {
+  for (double v = 0; v <= 1.0; v += 0.001)
+    EXPECT_LE(std::abs(weather::dequantizeUnit(weather::quantizeUnit(v)) - v), 0.5 / 255 + 1e-7) << v;
+  EXPECT_EQ(weather::quantizeUnit(-1), 0);
+  EXPECT_EQ(weather::quantizeUnit(7), 255);
+  EXPECT_EQ(weather::quantizeUnit(std::nan("")), 0);
+}
+
+TEST(Messages, SnapshotTileChecksNameTheProblem) {
+  weather::WeatherSnapshot s = sampleSnapshot();
+  s.tiles[0].cellId = weather::cellAt(46.2, 12.8, 10);  // a level-10 cell in a level-9 snapshot
+  auto m = decodeMessage(encodeMessage(s));
+  ASSERT_FALSE(m);
+  EXPECT_NE(m.error().detail.find("is not an S2 cell of level 9"), std::string::npos) << m.error().detail;
+  s = sampleSnapshot();
+  s.tiles[0].layerId = 2;  // no such layer
+  m = decodeMessage(encodeMessage(s));
+  ASSERT_FALSE(m);
+  EXPECT_NE(m.error().detail.find("layer 2, which the Snapshot does not have"), std::string::npos);
+  s = sampleSnapshot();
+  s.layers.push_back(s.layers[0]);  // duplicate id
+  m = decodeMessage(encodeMessage(s));
+  ASSERT_FALSE(m);
+  EXPECT_NE(m.error().detail.find("appears twice"), std::string::npos);
+}
+
+TEST(Messages, SubscribeOfAnotherVersionIsUnsupported) {
+  Subscribe s{kProtocolVersion + 1, {46.2, 12.8, 80000}, 0, 12000, 9};
+  auto m = decodeMessage(encodeMessage(s));
+  ASSERT_FALSE(m);
+  EXPECT_EQ(m.error().code, ErrorCode::Unsupported);
+  EXPECT_NE(m.error().detail.find("protocol_version " + std::to_string(kProtocolVersion + 1)), std::string::npos);
+}
+
+TEST(Messages, DeltaRoundTripsAndApplies) {
+  weather::WeatherSnapshot state = sampleSnapshot();
+  weather::WeatherDelta d;
+  d.weatherClock_s = 20;
+  d.tileLevel = 9;
+  weather::CloudLayer stratus = state.layers[0];
+  stratus.id = 2;
+  stratus.type = weather::CloudType::Stratus;
+  stratus.base_m = 400;
+  stratus.thickness_m = 300;
+  d.layers.push_back(stratus);
+  const std::uint64_t other = weather::cellAt(46.3, 12.9, 9);
+  d.tiles.push_back({weather::cellAt(46.2, 12.8, 9), 1, 0.2f, 1.0f});  // changes the existing tile
+  d.tiles.push_back({other, 2, 1.0f, 0.5f});                          // a tile of the new layer
+  auto m = decodeMessage(encodeMessage(d));
+  ASSERT_TRUE(m) << m.error().detail;
+  const auto& got = std::get<weather::WeatherDelta>(*m);
+  ASSERT_TRUE(weather::applyDelta(state, got));
+  EXPECT_EQ(state.weatherClock_s, 20);
+  ASSERT_EQ(state.layers.size(), 2u);
+  ASSERT_EQ(state.tiles.size(), 2u);
+  EXPECT_EQ(state.tiles[0].coverage, 51.0f / 255.0f);
+  EXPECT_EQ(state.tiles[1].layerId, 2u);
+
+  // Removing a layer takes its tiles; a bad delta leaves the state unchanged.
+  weather::WeatherDelta remove;
+  remove.weatherClock_s = 21;
+  remove.removedLayerIds = {2};
+  ASSERT_TRUE(weather::applyDelta(state, remove));
+  EXPECT_EQ(state.layers.size(), 1u);
+  EXPECT_EQ(state.tiles.size(), 1u);
+  const weather::WeatherSnapshot before = state;
+  weather::WeatherDelta bad;
+  bad.weatherClock_s = 22;
+  bad.tileLevel = 9;
+  bad.tiles.push_back({other, 7, 1.0f, 1.0f});  // layer 7 does not exist
+  auto r = weather::applyDelta(state, bad);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().detail.find("layer 7"), std::string::npos);
+  EXPECT_EQ(state.weatherClock_s, before.weatherClock_s);
+  EXPECT_EQ(state.tiles, before.tiles);
 }
 
 TEST(Messages, CorruptedBuffersNeverDecodeOutOfBounds) {

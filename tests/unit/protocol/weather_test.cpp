@@ -1,5 +1,9 @@
 // Weather model: validation names the bad field; tiling covers caps at the
 // poles and across the antimeridian; advection moves air downwind.
+#include <cmath>
+#include <random>
+#include <set>
+
 #include <gtest/gtest.h>
 
 #include "sky/geo/geodetic.hpp"
@@ -64,6 +68,66 @@ TEST(Tiling, CoversCapsAtThePoleAndAcrossTheAntimeridian) {
   expectCovers({89.99, 0, 50000}, 9);
   expectCovers({-89.99, 45, 50000}, 9);
   expectCovers({10, 179.99, 50000}, 9);
+}
+
+// Property test: random points inside the cap lie in the covering, and the
+// covering's area stays within a stated factor of the cap's.
+void coverageProperty(const SphericalCap& cap, std::uint32_t seed) {
+  constexpr std::size_t kMaxCells = 4000;
+  const int level = levelForRadius(cap.radius_m, kMaxCells);
+  const auto cells = coverCap(cap, level, kMaxCells * 2);
+  ASSERT_LE(cells.size(), kMaxCells) << "levelForRadius underestimated at level " << level;
+  const std::set<std::uint64_t> set(cells.begin(), cells.end());
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 2000; ++i) {
+    // Uniform in area on the (locally flat) cap: distance ~ r sqrt(u).
+    const double az = 360.0 * u(rng), dist = cap.radius_m * std::sqrt(u(rng)) * 0.999;
+    const SurfacePoint p = advect({cap.centerLat_deg, cap.centerLon_deg}, {1.0, az + 180.0, 0}, dist);
+    ASSERT_TRUE(set.count(cellAt(p.lat_deg, p.lon_deg, level)))
+        << "point " << p.lat_deg << "," << p.lon_deg << " outside the covering of cap at " << cap.centerLat_deg
+        << "," << cap.centerLon_deg;
+  }
+  double area_m2 = 0;
+  for (auto c : cells) area_m2 += cellArea_m2(c);
+  const double capArea_m2 = 2 * M_PI * 6371008.8 * 6371008.8 * (1 - std::cos(cap.radius_m / 6371008.8));
+  // A covering by cells of edge e exceeds the cap by about its perimeter x e;
+  // levelForRadius keeps e small against r, so twice the cap bounds it.
+  EXPECT_GE(area_m2, capArea_m2 * 0.99);
+  EXPECT_LE(area_m2, capArea_m2 * 2.0) << "level " << level << ", " << cells.size() << " cells";
+}
+
+TEST(Tiling, RandomPointsAreCoveredEverywhere) {
+  coverageProperty({0, 0, 100000}, 1);           // equator
+  coverageProperty({90, 0, 100000}, 2);          // north pole
+  coverageProperty({-90, 0, 100000}, 3);         // south pole
+  coverageProperty({-12, 180, 100000}, 4);       // across the antimeridian
+  coverageProperty({65, -179.95, 30000}, 5);     // antimeridian, high latitude, small cap
+}
+
+TEST(Tiling, LevelForRadiusGetsCoarserForLargerAreas) {
+  EXPECT_GT(levelForRadius(10000, 4000), levelForRadius(100000, 4000));
+  EXPECT_GT(levelForRadius(100000, 4000), levelForRadius(1000000, 4000));
+  EXPECT_EQ(levelForRadius(1.0, 4000, 13), 13);
+}
+
+TEST(Advection, MatchesHandComputedDisplacements) {
+  // Along the equator (a geodesic of radius a): 100 km east is 100000/a rad.
+  SurfacePoint p = advect({0, 10}, {10, 270, 0}, 10000);
+  EXPECT_NEAR(p.lat_deg, 0, 1e-12);
+  EXPECT_NEAR(p.lon_deg, 10 + 100000.0 / 6378137.0 * 180 / M_PI, 1e-9);
+  // Across the north pole: from 89.9N 0E blowing north (wind from 180) twice
+  // the distance to the pole lands at 89.9N 180E. Near the pole the meridian's
+  // radius of curvature is a^2/b = 6399593.626 m, so 0.1 deg is 11169.3 m.
+  const double toPole_m = 0.1 * M_PI / 180 * 6399593.626;
+  p = advect({89.9, 0}, {1, 180, 0}, 2 * toPole_m);
+  EXPECT_NEAR(p.lat_deg, 89.9, 1e-6);
+  EXPECT_NEAR(std::abs(p.lon_deg), 180, 1e-6);
+  // Local north at 180E points over the pole again: the same wind from 180
+  // there carries the parcel back to where it started.
+  const SurfacePoint back = advect(p, {1, 180, 0}, 2 * toPole_m);
+  EXPECT_NEAR(back.lat_deg, 89.9, 1e-6);
+  EXPECT_NEAR(back.lon_deg, 0, 1e-6);
 }
 
 TEST(Advection, MovesDownwindBySpeedTimesTime) {

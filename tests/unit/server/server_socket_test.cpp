@@ -229,6 +229,22 @@ TEST_F(ServerFixture, ServerOnlyMessagesFromAClientAreRejected) {
   expectServing(good, 10.0);
 }
 
+TEST_F(ServerFixture, SubscribeOfAnotherProtocolVersionGetsErrorAndClose) {
+  TestClient old(server_->port());
+  ASSERT_TRUE(old.readNext<stream::Hello>());
+  stream::Subscribe s;
+  s.protocolVersion = stream::kProtocolVersion - 1;
+  s.area = {46.2, 12.8, 50000};
+  old.send(s);
+  auto error = old.readNext<stream::StreamError>();
+  ASSERT_TRUE(error) << error.error().detail;
+  EXPECT_EQ(error->code, static_cast<std::uint16_t>(ErrorCode::Unsupported));
+  EXPECT_NE(error->detail.find("protocol_version " + std::to_string(stream::kProtocolVersion - 1)),
+            std::string::npos)
+      << error->detail;
+  EXPECT_EQ(old.read().error().detail, "eof");
+}
+
 TEST_F(ServerFixture, StopsWithClientsConnected) {
   TestClient a(server_->port());
   TestClient b(server_->port());

@@ -19,9 +19,9 @@ namespace sky::server {
 // one cloud layer's tiles then take ~480 kB of a frame.
 inline constexpr std::size_t kDefaultMaxCells = 20000;
 
-// Bytes one CoverageTile takes on the wire (FlatBuffers struct Tile: u64 + u32
-// + 2 × f32), used to keep a snapshot under sky::stream::kMaxFrameBytes.
-inline constexpr std::size_t kTileWireBytes = 24;
+// Bytes one CoverageTile takes on the wire, used to keep a snapshot under
+// sky::stream::kMaxFrameBytes (the schema's size, pinned in protocol/).
+inline constexpr std::size_t kTileWireBytes = stream::kTileWireBytes;
 
 // Cells allowed for `layerCount` layers: maxCells, lowered so that cells ×
 // layers tiles still fit one stream frame (with room for the layer table).

@@ -15,7 +15,13 @@
 
 namespace sky::stream {
 
-inline constexpr std::uint16_t kProtocolVersion = 1;
+// Major version of the stream: bumped on any incompatible schema change. A
+// server answers a Subscribe of another version with an Error and closes.
+inline constexpr std::uint16_t kProtocolVersion = 2;
+
+// Bytes one coverage tile takes on the wire (FlatBuffers struct Tile),
+// for budgeting tiles against kMaxFrameBytes.
+inline constexpr std::size_t kTileWireBytes = 16;
 
 struct Hello {
   std::uint16_t protocolVersion = kProtocolVersion;
@@ -25,6 +31,7 @@ struct Hello {
 };
 
 struct Subscribe {
+  std::uint16_t protocolVersion = kProtocolVersion;
   weather::SphericalCap area;
   double altMin_m = -500;  // altitude band of interest, MSL
   double altMax_m = 20000;
@@ -40,11 +47,16 @@ struct StreamError {
   std::string detail;
 };
 
-using Message = std::variant<Hello, Subscribe, weather::WeatherSnapshot, Heartbeat, StreamError>;
+using Message = std::variant<Hello, Subscribe, weather::WeatherSnapshot, Heartbeat, StreamError,
+                             weather::WeatherDelta>;
 
 std::vector<std::uint8_t> encodeMessage(const Message& message);
 
-// Verifies and range-checks one frame's payload.
+// Verifies and range-checks one frame's payload: finite numbers, fractions in
+// [0, 1], latitudes, longitudes and altitudes in range, every tile a valid S2
+// cell of the stated level, every Snapshot tile of a layer the Snapshot has,
+// layer ids unique. A Hello or Subscribe of another protocol version is an
+// Unsupported error that says both versions.
 Result<Message> decodeMessage(std::span<const std::uint8_t> payload);
 
 // Name of the message kind, for logs ("Hello", "Snapshot", ...).

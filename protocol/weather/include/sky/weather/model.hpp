@@ -52,12 +52,16 @@ struct CloudLayer {
 // its value and the allowed range ("layer 3: coverage 1.4 outside [0, 1]").
 Result<void> validate(const CloudLayer& layer);
 
-// Regional value of one layer on one S2 cell.
+// Regional value of one layer on one S2 cell. On the wire the fractions are
+// quantised to 1/255 (see quantizeUnit).
 struct CoverageTile {
   std::uint64_t cellId = 0;  // S2CellId, at the snapshot's tile level
-  std::uint32_t layerId = 0;
+  std::uint32_t layerId = 0; // [0, 65535] on the wire
   float coverage = 0;  // [0, 1]
   float density = 1;   // [0, 1]
+  CloudType blendType = CloudType::None;  // type mixed into the layer's own type
+  float blend = 0;     // [0, 1], weight of blendType
+  bool operator==(const CoverageTile&) const = default;
 };
 
 struct WeatherSnapshot {
@@ -66,5 +70,24 @@ struct WeatherSnapshot {
   int tileLevel = 0;  // S2 level of every tile, [0, 30]
   std::vector<CoverageTile> tiles;
 };
+
+// A change to a snapshot: layers upserted by id, layers removed (with their
+// tiles), tiles upserted by (cell, layer).
+struct WeatherDelta {
+  double weatherClock_s = 0;
+  std::vector<CloudLayer> layers;
+  std::vector<std::uint32_t> removedLayerIds;
+  int tileLevel = 0;  // must equal the snapshot's when tiles are present
+  std::vector<CoverageTile> tiles;
+};
+
+// Applies a delta; on error (a tile level that differs from the snapshot's,
+// a tile of a layer that does not exist afterwards, removal of an unknown
+// layer) the snapshot is left exactly as it was.
+Result<void> applyDelta(WeatherSnapshot& snapshot, const WeatherDelta& delta);
+
+// Fractions on the wire: [0, 1] -> 0..255, rounding to nearest; NaN -> 0.
+std::uint8_t quantizeUnit(double v);
+inline float dequantizeUnit(std::uint8_t q) { return static_cast<float>(q) / 255.0f; }
 
 }  // namespace sky::weather

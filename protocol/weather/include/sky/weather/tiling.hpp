@@ -25,4 +25,15 @@ std::uint64_t cellAt(double lat_deg, double lon_deg, int level);
 // Mean edge length of a cell at `level`, m (S2's average, for choosing levels).
 double averageCellEdge_m(int level);
 
+// The finest level (<= maxLevel) at which a covering of a cap of this radius
+// is expected to need at most maxCells cells (cap area over S2's average cell
+// area, with a margin for the cells cut by the edge).
+int levelForRadius(double radius_m, std::size_t maxCells, int maxLevel = 20);
+
+// Whether id is a valid S2CellId of exactly `level`.
+bool isCellAtLevel(std::uint64_t id, int level);
+
+// Area of an S2 cell, m^2 (exact on the sphere of mean Earth radius).
+double cellArea_m2(std::uint64_t id);
+
 }  // namespace sky::weather

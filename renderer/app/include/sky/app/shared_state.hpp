@@ -55,6 +55,17 @@ class SharedState {
     weather_.snapshot = std::move(s);
     ++weather_.version;
   }
+  // Applies a Delta to the held snapshot; on error nothing changes.
+  Result<void> applyDelta(const weather::WeatherDelta& d, std::chrono::steady_clock::time_point now) {
+    std::lock_guard lock(mutex_);
+    if (weather_.version == 0)
+      return fail(ErrorCode::InvalidArgument, "Delta before any Snapshot");
+    if (auto r = weather::applyDelta(weather_.snapshot, d); !r) return r;
+    weather_.clockAtSync_s = d.weatherClock_s;
+    weather_.syncedAt = now;
+    ++weather_.version;
+    return {};
+  }
   void setClock(double clock_s, double rate, std::chrono::steady_clock::time_point now) {
     std::lock_guard lock(mutex_);
     weather_.clockAtSync_s = clock_s;
