@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "weather_stream_generated.h"
@@ -120,6 +121,12 @@ Result<std::vector<weather::CoverageTile>> decodeTiles(const char* message, int 
   std::vector<weather::CoverageTile> out;
   if (!tiles) return out;
   out.reserve(tiles->size());
+  // The FlatBuffers verifier checks a vector's length prefix (4-byte aligned)
+  // but not the alignment of 8-byte-aligned struct elements; a crafted buffer
+  // can place them at 4 mod 8 (found by fuzz_stream_frame). Our builder never
+  // does, so such a buffer is malformed.
+  if (reinterpret_cast<std::uintptr_t>(tiles->Data()) % alignof(fbs::Tile) != 0)
+    return fail(ErrorCode::Malformed, std::string(message) + ".tiles: vector of structs is misaligned");
   for (flatbuffers::uoffset_t i = 0; i < tiles->size(); ++i) {
     const fbs::Tile* t = tiles->Get(i);
     if (!weather::isCellAtLevel(t->cell_id(), level))
@@ -236,6 +243,14 @@ std::vector<std::uint8_t> encodeMessage(const Message& message) {
 }
 
 Result<Message> decodeMessage(std::span<const std::uint8_t> payload) {
+  // Alignment inside a FlatBuffer is relative to its start: give it a start
+  // aligned for the widest scalar when the caller's bytes are not.
+  std::vector<std::uint64_t> aligned;
+  if (reinterpret_cast<std::uintptr_t>(payload.data()) % alignof(std::uint64_t) != 0) {
+    aligned.resize((payload.size() + 7) / 8);
+    std::memcpy(aligned.data(), payload.data(), payload.size());
+    payload = std::span(reinterpret_cast<const std::uint8_t*>(aligned.data()), payload.size());
+  }
   flatbuffers::Verifier verifier(payload.data(), payload.size());
   if (!fbs::VerifyMessageBuffer(verifier))
     return fail(ErrorCode::Malformed,

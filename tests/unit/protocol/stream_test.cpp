@@ -182,6 +182,18 @@ TEST(Messages, DeltaRoundTripsAndApplies) {
   EXPECT_EQ(state.tiles, before.tiles);
 }
 
+// Regression: FlatBuffers reads scalars in place, so a payload starting at an
+// address not aligned for doubles was undefined behaviour (UBSan: misaligned
+// load); decodeMessage now realigns such payloads first.
+TEST(Messages, DecodesAPayloadAtAnOddAddress) {
+  const auto good = encodeMessage(sampleSnapshot());
+  std::vector<std::uint8_t> shifted(good.size() + 1);
+  std::copy(good.begin(), good.end(), shifted.begin() + 1);
+  auto m = decodeMessage(std::span(shifted).subspan(1));
+  ASSERT_TRUE(m) << m.error().detail;
+  EXPECT_EQ(std::get<weather::WeatherSnapshot>(*m).tiles.size(), 1u);
+}
+
 TEST(Messages, CorruptedBuffersNeverDecodeOutOfBounds) {
   // Flip every byte of a valid snapshot in turn: each result is either a
   // clean error or a range-checked message (ASan catches any overread).
