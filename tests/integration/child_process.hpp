@@ -9,7 +9,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <string_view>
 #include <fstream>
 #include <optional>
 #include <sstream>
@@ -34,8 +36,17 @@ class ChildProcess {
     std::vector<char*> args;
     for (auto& a : argv) args.push_back(a.data());
     args.push_back(nullptr);
+    // An entry of `env` replaces the inherited variable of the same name
+    // (getenv would return the first of two).
     std::vector<char*> envp;
-    for (char** e = environ; *e; ++e) envp.push_back(*e);
+    for (char** e = environ; *e; ++e) {
+      const std::string_view inherited(*e);
+      const bool overridden = std::any_of(env.begin(), env.end(), [&](const std::string& o) {
+        const auto eq = o.find('=');
+        return inherited.substr(0, inherited.find('=')) == std::string_view(o).substr(0, eq);
+      });
+      if (!overridden) envp.push_back(*e);
+    }
     for (auto& e : env) envp.push_back(e.data());
     envp.push_back(nullptr);
     const int rc = posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), envp.data());

@@ -86,7 +86,7 @@ PipelineRun runPipeline(const std::string& name, const std::string& scenario) {
                        "--cigi-port", "0", "--port-file", d + "/render.port", "--out", d + "/frames",
                        "--width", "160", "--height", "90", "--write-float", "--idle-exit", "3",
                        "--weather-timeout", "60"},
-                      d + "/render.log", {"ASAN_OPTIONS=detect_leaks=0"});
+                      d + "/render.log", {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
   const unsigned cigiPort = waitForPortFile(d + "/render.port", 60s);
   EXPECT_GT(cigiPort, 0u) << render.log();
   if (cigiPort == 0) return run;
