@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <functional>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -37,7 +38,8 @@ class Replay {
   Replay(asio::io_context& io, const Options& o, sky::flight::Flight flight,
          std::function<void()> onDone)
       : o_(o), flight_(std::move(flight)), onDone_(std::move(onDone)), socket_(io), timer_(io),
-        host_(o.littleEndian ? sky::cigi::ByteOrder::Little : sky::cigi::ByteOrder::Big) {
+        host_(sky::sim::HostOptions{o.littleEndian ? sky::cigi::ByteOrder::Little : sky::cigi::ByteOrder::Big,
+                                    60, 16.0 / 9.0, flight_.startUtc_s}) {
     socket_.open(asio::ip::udp::v4());
     socket_.bind({asio::ip::make_address(o.host), 0});
     target_ = {asio::ip::make_address(o.host), static_cast<unsigned short>(o.port)};
@@ -102,10 +104,15 @@ class Replay {
     if (o_.quiet || (!final && now - lastReport_ < std::chrono::seconds(1))) return;
     lastReport_ = now;
     const double wall = std::chrono::duration<double>(now - tick0_).count();
-    std::printf("replay: flight time %.1f / %.1f s, %u frames sent (%.1f Hz), %llu Start of Frame received%s\n",
-                t - flight_.fixes.front().time_s, t1_ - flight_.fixes.front().time_s, host_.framesSent(),
+    const double total = t1_ - t0_, done = t - t0_;
+    const double left_s = o_.speed > 0 ? (total - done) / o_.speed : 0;
+    std::printf("replay: flight time %.1f / %.1f s (%.0f%%, %.0f s left), %u frames sent (%.1f Hz), "
+                "%llu Start of Frame received, IG %u frames behind%s\n",
+                t - flight_.fixes.front().time_s, t1_ - flight_.fixes.front().time_s,
+                total > 0 ? 100.0 * done / total : 100.0, left_s, host_.framesSent(),
                 wall > 0 ? host_.framesSent() / wall : 0.0,
-                static_cast<unsigned long long>(host_.startOfFramesReceived()), final ? ", done" : "");
+                static_cast<unsigned long long>(host_.startOfFramesReceived()), host_.igLagFrames(),
+                final ? ", done" : "");
     std::fflush(stdout);
   }
 
@@ -160,6 +167,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "skyshell-replay: %s\n", sky::describe(flight.error()).c_str());
     return 2;
   }
+  for (const auto& warning : flight->warnings) std::fprintf(stderr, "skyshell-replay: warning: %s\n", warning.c_str());
   try {
     asio::io_context io;
     asio::signal_set signals(io, SIGINT, SIGTERM);

@@ -5,6 +5,28 @@
 
 namespace sky::sim {
 
+cigi::CelestialSphereControl celestialAt(std::int64_t utc_s) {
+  // Civil date from days since 1970-01-01 (H. Hinnant's civil_from_days).
+  const std::int64_t days = utc_s >= 0 ? utc_s / 86400 : (utc_s - 86399) / 86400;
+  const std::int64_t secs = utc_s - days * 86400;
+  const std::int64_t z = days + 719468;
+  const std::int64_t era = (z >= 0 ? z : z - 146096) / 146097;
+  const std::int64_t doe = z - era * 146097;
+  const std::int64_t yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
+  const std::int64_t doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+  const std::int64_t mp = (5 * doy + 2) / 153;
+  const std::int64_t day = doy - (153 * mp + 2) / 5 + 1;
+  const std::int64_t month = mp < 10 ? mp + 3 : mp - 9;
+  const std::int64_t year = yoe + era * 400 + (month <= 2 ? 1 : 0);
+  cigi::CelestialSphereControl c;
+  c.hour = static_cast<std::uint8_t>(secs / 3600);
+  c.minute = static_cast<std::uint8_t>(secs / 60 % 60);
+  c.dateTimeValid = true;
+  c.ephemerisEnable = true;
+  c.dateMmddyyyy = static_cast<std::uint32_t>(month * 1000000 + day * 10000 + year);
+  return c;
+}
+
 std::vector<std::uint8_t> CigiHost::nextFrame(const geo::GeodeticPose& pose, double flightTime_s) {
   cigi::IgControl ig;
   ig.mode = cigi::IgMode::Operate;
@@ -25,8 +47,28 @@ std::vector<std::uint8_t> CigiHost::nextFrame(const geo::GeodeticPose& pose, dou
   own.pitch_deg = static_cast<float>(pose.pitch_deg);
   own.roll_deg = static_cast<float>(geo::angleDiff_deg(0.0, pose.roll_deg));
 
-  cigi::DatagramWriter w(order_);
+  cigi::DatagramWriter w(options_.order);
   w.add(ig).add(own);
+  if (ig.hostFrame == 0) {
+    // Symmetric frustum from the vertical field of view and the aspect ratio.
+    constexpr double kDegPerRad = 57.29577951308232;
+    const double halfV_deg = options_.verticalFov_deg / 2;
+    const double halfH_deg = std::atan(std::tan(halfV_deg / kDegPerRad) * options_.aspect) * kDegPerRad;
+    cigi::ViewDefinition vd;
+    vd.leftEnable = vd.rightEnable = vd.topEnable = vd.bottomEnable = true;
+    vd.left_deg = static_cast<float>(-halfH_deg);
+    vd.right_deg = static_cast<float>(halfH_deg);
+    vd.top_deg = static_cast<float>(halfV_deg);
+    vd.bottom_deg = static_cast<float>(-halfV_deg);
+    w.add(vd);
+  }
+  if (options_.startUtc_s) {
+    const auto utc = *options_.startUtc_s + static_cast<std::int64_t>(std::floor(flightTime_s));
+    if (!lastCelestialMinute_ || *lastCelestialMinute_ != utc / 60) {
+      lastCelestialMinute_ = utc / 60;
+      w.add(celestialAt(utc));
+    }
+  }
   return w.bytes();
 }
 
@@ -36,7 +78,9 @@ bool CigiHost::onIgDatagram(std::span<const std::uint8_t> bytes) {
     ++malformed_;
     return false;
   }
-  lastIgFrame_ = std::get<cigi::StartOfFrame>(d->packets[0]).igFrame;
+  const auto& sof = std::get<cigi::StartOfFrame>(d->packets[0]);
+  lastIgFrame_ = sof.igFrame;
+  if (!lastAckedHostFrame_ || sof.lastHostFrame > *lastAckedHostFrame_) lastAckedHostFrame_ = sof.lastHostFrame;
   ++sofReceived_;
   return true;
 }

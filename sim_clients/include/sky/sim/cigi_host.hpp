@@ -13,12 +13,27 @@
 
 namespace sky::sim {
 
+struct HostOptions {
+  cigi::ByteOrder order = cigi::ByteOrder::Big;
+  double verticalFov_deg = 60;  // View Definition sent with the first frame
+  double aspect = 16.0 / 9.0;   // width / height of the channel
+  // UTC (s since 1970) at flight time 0, when the record has a date: then
+  // Celestial Sphere Control carries the recorded date and time.
+  std::optional<std::int64_t> startUtc_s;
+};
+
+// UTC seconds since 1970 -> CIGI's Celestial Sphere Control fields (hour,
+// minute, MMDDYYYY date). Proleptic Gregorian, valid for any year >= 1970.
+cigi::CelestialSphereControl celestialAt(std::int64_t utc_s);
+
 class CigiHost {
  public:
-  explicit CigiHost(cigi::ByteOrder order = cigi::ByteOrder::Big) : order_(order) {}
+  explicit CigiHost(HostOptions options = {}) : options_(options) {}
 
   // The datagram for the next host frame, showing the ownship at `pose`.
-  // flightTime_s becomes the CIGI timestamp (10 us ticks).
+  // flightTime_s becomes the CIGI timestamp (10 us ticks). The first frame
+  // also carries View Definition; with a start date, every frame whose UTC
+  // minute changed (and the first) carries Celestial Sphere Control.
   std::vector<std::uint8_t> nextFrame(const geo::GeodeticPose& pose, double flightTime_s);
 
   // Feeds one datagram received from the IG; returns whether it was a valid
@@ -26,13 +41,17 @@ class CigiHost {
   bool onIgDatagram(std::span<const std::uint8_t> bytes);
 
   std::uint32_t framesSent() const { return hostFrame_; }
+  // Host frames the newest Start of Frame says the IG has not seen yet.
+  std::uint32_t igLagFrames() const { return lastAckedHostFrame_ ? hostFrame_ - 1 - *lastAckedHostFrame_ : hostFrame_; }
   std::uint64_t startOfFramesReceived() const { return sofReceived_; }
   std::uint64_t malformedReceived() const { return malformed_; }
   std::optional<std::uint32_t> lastIgFrame() const { return lastIgFrame_; }
 
  private:
-  cigi::ByteOrder order_;
+  HostOptions options_;
   std::uint32_t hostFrame_ = 0;
+  std::optional<std::int64_t> lastCelestialMinute_;
+  std::optional<std::uint32_t> lastAckedHostFrame_;
   std::optional<std::uint32_t> lastIgFrame_;
   std::uint64_t sofReceived_ = 0;
   std::uint64_t malformed_ = 0;

@@ -1,0 +1,77 @@
+// The replay's CIGI host frames: what a simulator host sends, decoded by our
+// own (tshark-checked) CIGI reader; the UTC-to-CIGI date conversion against
+// dates computed independently (Python's datetime).
+#include <gtest/gtest.h>
+
+#include "sky/sim/cigi_host.hpp"
+
+namespace sky::sim {
+namespace {
+
+TEST(CelestialAt, ConvertsUtcToCigiDateAndTime) {
+  auto c = celestialAt(0);
+  EXPECT_EQ(c.dateMmddyyyy, 1011970u);
+  EXPECT_EQ(c.hour, 0);
+  // 2026-11-21 22:21:24 UTC (the FlightGear capture's cur_time).
+  c = celestialAt(1795299684);
+  EXPECT_EQ(c.dateMmddyyyy, 11212026u);
+  EXPECT_EQ(c.hour, 22);
+  EXPECT_EQ(c.minute, 21);
+  // 2000-02-29 23:59:59: a leap day of a century year divisible by 400.
+  c = celestialAt(951782400 + 86399);
+  EXPECT_EQ(c.dateMmddyyyy, 2292000u);
+  EXPECT_EQ(c.hour, 23);
+  EXPECT_EQ(c.minute, 59);
+  EXPECT_TRUE(c.dateTimeValid);
+}
+
+TEST(CigiHost, FirstFrameCarriesViewDefinitionAndCelestial) {
+  CigiHost host({cigi::ByteOrder::Little, 60, 2.0, 1795299684});
+  geo::GeodeticPose pose{{46.2, 12.8, 900}, 370, 5, -190};  // yaw and roll outside CIGI's ranges
+  auto first = cigi::decodeDatagram(host.nextFrame(pose, 0.0));
+  ASSERT_TRUE(first) << first.error().detail;
+  EXPECT_EQ(first->order, cigi::ByteOrder::Little);
+  ASSERT_EQ(first->packets.size(), 4u);
+  const auto& ig = std::get<cigi::IgControl>(first->packets[0]);
+  EXPECT_EQ(ig.hostFrame, 0u);
+  const auto& own = std::get<cigi::EntityControl>(first->packets[1]);
+  EXPECT_FLOAT_EQ(own.yaw_deg, 10.0f);    // wrapped into [0, 360)
+  EXPECT_FLOAT_EQ(own.roll_deg, 170.0f);  // wrapped into (-180, 180]
+  const auto& vd = std::get<cigi::ViewDefinition>(first->packets[2]);
+  EXPECT_FLOAT_EQ(vd.top_deg, 30.0f);
+  // tan(h) = tan(30 deg) * 2
+  EXPECT_NEAR(vd.right_deg, 49.1066, 1e-3);
+  const auto& cel = std::get<cigi::CelestialSphereControl>(first->packets[3]);
+  EXPECT_EQ(cel.dateMmddyyyy, 11212026u);
+
+  // Within the same UTC minute: ownship only. A minute later: Celestial again.
+  auto second = cigi::decodeDatagram(host.nextFrame(pose, 1.0));
+  ASSERT_TRUE(second);
+  EXPECT_EQ(second->packets.size(), 2u);
+  EXPECT_EQ(std::get<cigi::IgControl>(second->packets[0]).hostFrame, 1u);
+  auto later = cigi::decodeDatagram(host.nextFrame(pose, 60.0));
+  ASSERT_TRUE(later);
+  ASSERT_EQ(later->packets.size(), 3u);
+  EXPECT_EQ(std::get<cigi::CelestialSphereControl>(later->packets[2]).minute, 22);
+}
+
+TEST(CigiHost, TracksStartOfFrameAndCountsJunk) {
+  CigiHost host;
+  geo::GeodeticPose pose{{0, 0, 100}, 0, 0, 0};
+  for (int i = 0; i < 5; ++i) host.nextFrame(pose, i / 60.0);
+  EXPECT_EQ(host.igLagFrames(), 5u);
+  cigi::StartOfFrame sof;
+  sof.igFrame = 9;
+  sof.lastHostFrame = 3;
+  cigi::DatagramWriter w;
+  w.add(sof);
+  EXPECT_TRUE(host.onIgDatagram(w.bytes()));
+  EXPECT_EQ(host.lastIgFrame(), std::optional<std::uint32_t>(9));
+  EXPECT_EQ(host.igLagFrames(), 1u);  // frame 4 not yet seen
+  const std::vector<std::uint8_t> junk = {1, 2, 3};
+  EXPECT_FALSE(host.onIgDatagram(junk));
+  EXPECT_EQ(host.malformedReceived(), 1u);
+}
+
+}  // namespace
+}  // namespace sky::sim
