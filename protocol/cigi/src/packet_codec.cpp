@@ -7,6 +7,38 @@ namespace sky::cigi::detail {
 namespace {
 constexpr std::uint16_t kByteSwapMagic = 0x8000;
 constexpr std::uint8_t kMinorNibble = kMinorVersion << 4;
+// Atmosphere Control and Weather Conditions Response carry the same block of
+// fields at the same offsets (3: humidity, 4: temperature, 8: visibility,
+// 12/16: horizontal/vertical wind, 20: direction, 24: pressure).
+template <class T>
+void writeAtmosphericBlock(PacketBuilder& b, const T& p) {
+  b.u8(3, p.humidity_pct);
+  b.f32(4, p.airTemperature_c);
+  b.f32(8, p.visibility_m);
+  b.f32(12, p.horizontalWind_mps);
+  b.f32(16, p.verticalWind_mps);
+  b.f32(20, p.windDirection_deg);
+  b.f32(24, p.pressure_hpa);
+}
+
+template <class T>
+void readAtmosphericBlock(PacketReader& r, T& p) {
+  p.humidity_pct = r.u8(3);
+  p.airTemperature_c = r.f32(4);
+  p.visibility_m = r.f32(8);
+  p.horizontalWind_mps = r.f32(12);
+  p.verticalWind_mps = r.f32(16);
+  p.windDirection_deg = r.f32(20);
+  p.pressure_hpa = r.f32(24);
+  r.range(3, "humidity", p.humidity_pct, 0, 100);
+  r.range(4, "air temperature", p.airTemperature_c, -100, 100);
+  r.range(8, "visibility", p.visibility_m, 0, 1.0e7);
+  r.range(12, "horizontal wind", p.horizontalWind_mps, 0, 500);
+  r.range(16, "vertical wind", p.verticalWind_mps, -500, 500);
+  r.range(20, "wind direction", p.windDirection_deg, -180, 360);
+  r.range(24, "barometric pressure", p.pressure_hpa, 0, 2000);
+}
+
 }  // namespace
 
 // --- IG Control (1) ---------------------------------------------------------
@@ -125,32 +157,13 @@ Result<CelestialSphereControl> Codec<CelestialSphereControl>::read(PacketReader&
 // --- Atmosphere Control (10) --------------------------------------------------
 void Codec<AtmosphereControl>::write(PacketBuilder& b, const AtmosphereControl& p) {
   b.u8(2, bit(p.atmosphericModelEnable, 0));
-  b.u8(3, p.humidity_pct);
-  b.f32(4, p.airTemperature_c);
-  b.f32(8, p.visibility_m);
-  b.f32(12, p.horizontalWind_mps);
-  b.f32(16, p.verticalWind_mps);
-  b.f32(20, p.windDirection_deg);
-  b.f32(24, p.pressure_hpa);
+  writeAtmosphericBlock(b, p);
 }
 
 Result<AtmosphereControl> Codec<AtmosphereControl>::read(PacketReader& r) {
   AtmosphereControl p;
   p.atmosphericModelEnable = isSet(r.u8(2), 0);
-  p.humidity_pct = r.u8(3);
-  p.airTemperature_c = r.f32(4);
-  p.visibility_m = r.f32(8);
-  p.horizontalWind_mps = r.f32(12);
-  p.verticalWind_mps = r.f32(16);
-  p.windDirection_deg = r.f32(20);
-  p.pressure_hpa = r.f32(24);
-  r.range(3, "humidity", p.humidity_pct, 0, 100);
-  r.range(4, "air temperature", p.airTemperature_c, -100, 100);
-  r.range(8, "visibility", p.visibility_m, 0, 1.0e7);
-  r.range(12, "horizontal wind", p.horizontalWind_mps, 0, 500);
-  r.range(16, "vertical wind", p.verticalWind_mps, -500, 500);
-  r.range(20, "wind direction", p.windDirection_deg, -180, 360);
-  r.range(24, "barometric pressure", p.pressure_hpa, 0, 2000);
+  readAtmosphericBlock(r, p);
   return r.result(p);
 }
 
@@ -409,32 +422,13 @@ Result<StartOfFrame> Codec<StartOfFrame>::read(PacketReader& r) {
 // --- Weather Conditions Response (109) ----------------------------------------
 void Codec<WeatherConditionsResponse>::write(PacketBuilder& b, const WeatherConditionsResponse& p) {
   b.u8(2, p.requestId);
-  b.u8(3, p.humidity_pct);
-  b.f32(4, p.airTemperature_c);
-  b.f32(8, p.visibility_m);
-  b.f32(12, p.horizontalWind_mps);
-  b.f32(16, p.verticalWind_mps);
-  b.f32(20, p.windDirection_deg);
-  b.f32(24, p.pressure_hpa);
+  writeAtmosphericBlock(b, p);
 }
 
 Result<WeatherConditionsResponse> Codec<WeatherConditionsResponse>::read(PacketReader& r) {
   WeatherConditionsResponse p;
   p.requestId = r.u8(2);
-  p.humidity_pct = r.u8(3);
-  p.airTemperature_c = r.f32(4);
-  p.visibility_m = r.f32(8);
-  p.horizontalWind_mps = r.f32(12);
-  p.verticalWind_mps = r.f32(16);
-  p.windDirection_deg = r.f32(20);
-  p.pressure_hpa = r.f32(24);
-  r.range(3, "humidity", p.humidity_pct, 0, 100);
-  r.range(4, "air temperature", p.airTemperature_c, -100, 100);
-  r.range(8, "visibility", p.visibility_m, 0, 1.0e7);
-  r.range(12, "horizontal wind", p.horizontalWind_mps, 0, 500);
-  r.range(16, "vertical wind", p.verticalWind_mps, -500, 500);
-  r.range(20, "wind direction", p.windDirection_deg, -180, 360);
-  r.range(24, "barometric pressure", p.pressure_hpa, 0, 2000);
+  readAtmosphericBlock(r, p);
   return r.result(p);
 }
 

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <string>
 
+#include "sky/core/overloaded.hpp"
 #include "weather_stream_generated.h"
 
 namespace sky::stream {
@@ -15,12 +16,6 @@ namespace fbs = sky::stream::fb;
 
 namespace {
 
-template <class... Ts>
-struct Overloaded : Ts... {
-  using Ts::operator()...;
-};
-template <class... Ts>
-Overloaded(Ts...) -> Overloaded<Ts...>;  // clang 14 lacks aggregate CTAD
 
 flatbuffers::Offset<fbs::Layer> encodeLayer(flatbuffers::FlatBufferBuilder& b,
                                             const weather::CloudLayer& l) {

@@ -3,18 +3,14 @@
 
 #include <spdlog/spdlog.h>
 
+#include "sky/core/overloaded.hpp"
+
 namespace sky::app {
 
 namespace asio = boost::asio;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-template <class... Ts>
-struct Overloaded : Ts... {
-  using Ts::operator()...;
-};
-template <class... Ts>
-Overloaded(Ts...) -> Overloaded<Ts...>;  // clang 14 lacks aggregate CTAD
 // Reconnect backoff grows to this cap: short enough that a restarted server
 // is picked up within seconds, long enough not to spin on a dead one.
 constexpr std::chrono::milliseconds kMaxBackoff{2000};
