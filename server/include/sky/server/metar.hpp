@@ -1,0 +1,172 @@
+// METAR/SPECI reports become weather layers.
+//
+// parseMetar is a pure decoder of one report (no I/O, no logging). It reads the
+// header (METAR/SPECI, COR, station, DDHHMMZ, NIL, AUTO/COR, wind, variable
+// sector) in order, then the body groups in any order (visibility incl. statute
+// miles "1 1/2SM", RVR, present weather, CAVOK, clouds, VV, NSC/NCD/SKC/CLR),
+// then temperature/dewpoint and QNH. It stops at the first trend or remarks
+// keyword (NOSIG, BECMG, TEMPO, INTER, FMhhmm, PROBnn, RMK) and after the first
+// QNH group: what follows the pressure (recent weather RE.., wind shear WS,
+// runway state, sea state W../S.., colour states BLU/GRN/...) is supplementary
+// and not decoded. A group that fits no pattern rejects the report: the error
+// names the group by position and text ("group 5 'BKN0x5': height is not three
+// digits"). Group numbers count every whitespace-separated group from 1,
+// including a leading METAR/SPECI.
+//
+// layersFromMetar maps a decoded report to CloudLayers (see the rules at the
+// function). layersFromMetarBatch does a set of reports against a station
+// table, each report on its own. coverageAt interpolates total cloud cover
+// between stations by inverse-distance weighting on geodesic distance.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "sky/core/result.hpp"
+#include "sky/weather/model.hpp"
+
+namespace sky::server {
+
+enum class WindUnit : std::uint8_t { Knots, MetresPerSecond, KilometresPerHour };
+
+struct MetarWind {
+  std::optional<int> direction_deg;  // true, wind FROM, [0, 360]; empty for VRB
+  bool variable = false;             // VRB: direction varies (light or convective)
+  double speed_kt = 0;               // converted from the reported unit
+  std::optional<double> gust_kt;     // Gff: kept, not used by the mapping
+  WindUnit reportedUnit = WindUnit::Knots;
+  // dddVddd: the direction varies clockwise from .. to, deg
+  std::optional<int> variableFrom_deg;
+  std::optional<int> variableTo_deg;
+};
+
+enum class CloudAmount : std::uint8_t { Few, Scattered, Broken, Overcast, Unknown };  // "///"
+enum class ConvectiveCloud : std::uint8_t { None, Cumulonimbus, ToweringCumulus, Unknown };  // "///"
+
+struct MetarCloud {
+  CloudAmount amount = CloudAmount::Unknown;
+  std::optional<int> height_ft;  // base above the station, ft; empty for "///"
+  ConvectiveCloud convective = ConvectiveCloud::None;
+};
+
+// Codes meaning "no cloud to report" (CAVOK is its own flag).
+enum class NoCloud : std::uint8_t { None, NSC, NCD, SKC, CLR };
+
+struct MetarTime {
+  int day = 0;     // [1, 31]
+  int hour = 0;    // [0, 23]
+  int minute = 0;  // [0, 59]
+};
+
+struct MetarReport {
+  std::string icao;
+  bool speci = false;
+  bool nil = false;        // "NIL": the report is missing; nothing else is decoded
+  bool automatic = false;  // AUTO
+  bool corrected = false;  // COR
+  std::optional<MetarTime> time;
+  std::optional<MetarWind> wind;  // empty when absent or "/////KT"
+  bool cavok = false;
+  NoCloud noCloud = NoCloud::None;
+  std::vector<MetarCloud> clouds;  // in report order (ascending height by rule)
+  bool verticalVisibility = false;                // a VV group is present
+  std::optional<int> verticalVisibility_ft;       // empty for "VV///"
+  std::optional<int> temperature_degC;
+  std::optional<int> dewpoint_degC;
+  std::optional<double> qnh_hPa;  // Q in hPa, or A (hundredths of inHg) converted
+};
+
+// Errors: Malformed (a group that fits no pattern, or a report ending before
+// its station), InvalidArgument (a number out of range: day 32, direction 370).
+Result<MetarReport> parseMetar(std::string_view report);
+
+struct Station {
+  std::string icao;
+  double lat_deg = 0;
+  double lon_deg = 0;
+  double elevation_m = 0;  // MSL
+};
+
+// Layer thickness per cloud type, m. Not in formulas.md (which gives only the
+// WMO heights and the cumulonimbus tops): typical depths from the WMO
+// International Cloud Atlas descriptions, chosen as round mid values.
+inline constexpr double kStratusThickness_m = 300;        // thin grey sheet, few hundred m
+inline constexpr double kStratocumulusThickness_m = 500;  // rolls/patches, 200-800 m
+inline constexpr double kCumulusThickness_m = 1000;       // fair-weather cumulus humilis/mediocris
+inline constexpr double kToweringCumulusThickness_m = 3000;  // cumulus congestus (TCU)
+inline constexpr double kAltocumulusThickness_m = 500;
+inline constexpr double kAltostratusThickness_m = 1500;   // 1-2 km deep sheet
+inline constexpr double kCirrusThickness_m = 1000;
+// formulas.md: cumulonimbus tops reach 12-15 km; the low end, MSL.
+inline constexpr double kCumulonimbusTop_m = 12000;
+inline constexpr double kCumulonimbusMinThickness_m = 3000;  // a CB is at least a congestus
+// VV000 means "less than 100 ft": the fog layer is at least this deep.
+inline constexpr double kMinFogThickness_m = 30;
+// Transition band at a layer's base and top as a fraction of its thickness: a
+// soft edge for the renderer, not a METAR quantity.
+inline constexpr double kTransitionFraction = 0.1;
+
+// WMO étages by base above the station (formulas.md, mid-latitudes): low below
+// 2 km, middle 2-7 km, high above. Below kStratusMaxBase_m an OVC layer is stratus.
+inline constexpr double kLowCloudTop_m = 2000;
+inline constexpr double kMiddleCloudTop_m = 7000;
+inline constexpr double kStratusMaxBase_m = 300;
+
+// Coverage per METAR amount: the middle of the okta range, so that the error is
+// at most half the range either way (FEW 1-2 -> 1.5/8, SCT 3-4 -> 3.5/8,
+// BKN 5-7 -> 6/8, OVC 8/8).
+inline constexpr double kFewCoverage = 1.5 / 8;
+inline constexpr double kScatteredCoverage = 3.5 / 8;
+inline constexpr double kBrokenCoverage = 6.0 / 8;
+inline constexpr double kOvercastCoverage = 1.0;
+
+// Maps one report at its station to layers, ids 1..n in report order (VV
+// first). Rules:
+// * cloud base MSL = station elevation + height above the station;
+// * CB -> cumulonimbus up to kCumulonimbusTop_m; TCU (towering cumulus) ->
+//   cumulus, kToweringCumulusThickness_m deep; otherwise by base above the
+//   station: low FEW/SCT cumulus, BKN stratocumulus, OVC stratus below
+//   kStratusMaxBase_m else stratocumulus; middle FEW/SCT altocumulus, BKN/OVC
+//   altostratus; high cirrus;
+// * VV hhh -> stratus (fog) from the station elevation, coverage 1, top at the
+//   vertical visibility;
+// * a cloud group with unknown amount or height ("///") cannot be placed and
+//   gives no layer; an unknown type is chosen from the height;
+// * every layer gets the surface wind (VRB -> direction 0; calm or missing
+//   wind -> 0 m/s; gusts ignored);
+// * CAVOK/NSC/NCD/SKC/CLR with no cloud group -> no layers.
+// Errors (InvalidArgument): a NIL report, a station of another ICAO or with
+// non-finite position, a report with no usable sky information (no cloud
+// group that can be placed, no VV height and no clear-sky code: an empty sky
+// must be reported, never inferred), a layer weather::validate rejects.
+Result<std::vector<weather::CloudLayer>> layersFromMetar(const MetarReport& report,
+                                                         const Station& station);
+
+struct StationWeather {
+  Station station;
+  MetarReport report;
+  std::vector<weather::CloudLayer> layers;
+};
+
+// One result per input report, same order. A report that does not parse, whose
+// station is not in the table, or that does not map, is an error ("report 3:
+// group 5 'BKN0x5': height is not three digits") and the others still apply.
+// Several reports of one station give several results; the caller picks.
+std::vector<Result<StationWeather>> layersFromMetarBatch(std::span<const std::string> reports,
+                                                         std::span<const Station> stations);
+
+// Total cloud cover of a station's layers: the largest layer coverage (METAR
+// amounts are cumulative, each one counts the layers below it too).
+double totalCoverage(std::span<const weather::CloudLayer> layers);
+
+// Total cloud cover at a point: inverse-distance weighting (power 2) of the
+// stations' total cover on geodesic distance; a station within 1 m gives its
+// own value. Empty when there are no stations.
+std::optional<double> coverageAt(double lat_deg, double lon_deg,
+                                 std::span<const StationWeather> stations);
+
+}  // namespace sky::server

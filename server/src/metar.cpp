@@ -1,0 +1,423 @@
+// METAR/SPECI decoder (see metar.hpp): groups are matched by hand-written
+// pattern checks, no regex, so any byte string is decoded in linear time.
+#include "sky/server/metar.hpp"
+
+#include <array>
+#include <cstddef>
+
+namespace sky::server {
+
+namespace {
+
+// Knots per unit (1 kt = 1852 m / 3600 s).
+constexpr double kKnotsPerMps = 3600.0 / 1852.0;
+constexpr double kKnotsPerKmh = 1.0 / 1.852;
+// hPa per inch of mercury (ICAO standard atmosphere conversion).
+constexpr double kHpaPerInHg = 33.8639;
+
+bool isDigit(char c) { return c >= '0' && c <= '9'; }
+bool isUpper(char c) { return c >= 'A' && c <= 'Z'; }
+
+bool allDigits(std::string_view s) {
+  if (s.empty()) return false;
+  for (char c : s)
+    if (!isDigit(c)) return false;
+  return true;
+}
+
+bool allSlashes(std::string_view s) {
+  if (s.empty()) return false;
+  for (char c : s)
+    if (c != '/') return false;
+  return true;
+}
+
+// Value of an all-digits string of at most 9 digits (callers check the length).
+int toInt(std::string_view s) {
+  int v = 0;
+  for (char c : s) v = v * 10 + (c - '0');
+  return v;
+}
+
+bool endsWith(std::string_view s, std::string_view suffix) {
+  return s.size() >= suffix.size() && s.substr(s.size() - suffix.size()) == suffix;
+}
+
+bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f'; }
+
+std::vector<std::string_view> splitGroups(std::string_view text) {
+  std::vector<std::string_view> groups;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    while (i < text.size() && isSpace(text[i])) ++i;
+    std::size_t j = i;
+    while (j < text.size() && !isSpace(text[j])) ++j;
+    if (j > i) groups.push_back(text.substr(i, j - i));
+    i = j;
+  }
+  // The end-of-message '=' may stick to the last group or stand alone.
+  while (!groups.empty()) {
+    std::string_view& last = groups.back();
+    while (!last.empty() && last.back() == '=') last.remove_suffix(1);
+    if (!last.empty()) break;
+    groups.pop_back();
+  }
+  return groups;
+}
+
+class Groups {
+ public:
+  explicit Groups(std::vector<std::string_view> groups) : groups_(std::move(groups)) {}
+  bool done() const { return next_ >= groups_.size(); }
+  std::string_view peek(std::size_t ahead = 0) const {
+    return next_ + ahead < groups_.size() ? groups_[next_ + ahead] : std::string_view{};
+  }
+  void advance(std::size_t n = 1) { next_ += n; }
+  tl::unexpected<Error> error(ErrorCode code, const std::string& what) const {
+    if (done()) return fail(code, "report ends early: " + what);
+    return fail(code, "group " + std::to_string(next_ + 1) + " '" + std::string(peek()) +
+                          "': " + what);
+  }
+
+ private:
+  std::vector<std::string_view> groups_;
+  std::size_t next_ = 0;
+};
+
+bool isTrendOrRemarks(std::string_view g) {
+  if (g == "NOSIG" || g == "BECMG" || g == "TEMPO" || g == "INTER" || g == "RMK") return true;
+  if (g.size() == 6 && g.substr(0, 4) == "PROB" && allDigits(g.substr(4))) return true;
+  if (g.size() >= 6 && g.substr(0, 2) == "FM" && allDigits(g.substr(2))) return true;
+  return false;
+}
+
+bool isStation(std::string_view g) {
+  if (g.size() != 4 || !isUpper(g[0])) return false;
+  for (char c : g)
+    if (!isUpper(c) && !isDigit(c)) return false;
+  return true;
+}
+
+Result<MetarTime> parseTime(const Groups& in) {
+  std::string_view g = in.peek();
+  if (g.size() != 7 || g[6] != 'Z' || !allDigits(g.substr(0, 6)))
+    return in.error(ErrorCode::Malformed, "time is not DDHHMMZ");
+  MetarTime t{toInt(g.substr(0, 2)), toInt(g.substr(2, 2)), toInt(g.substr(4, 2))};
+  if (t.day < 1 || t.day > 31) return in.error(ErrorCode::InvalidArgument, "day outside [1, 31]");
+  if (t.hour > 23) return in.error(ErrorCode::InvalidArgument, "hour outside [0, 23]");
+  if (t.minute > 59) return in.error(ErrorCode::InvalidArgument, "minute outside [0, 59]");
+  return t;
+}
+
+bool looksLikeWind(std::string_view g) {
+  return endsWith(g, "KT") || endsWith(g, "MPS") || endsWith(g, "KMH");
+}
+
+// dddff(f)(Gff(f))KT|MPS|KMH, VRBff.., 00000KT (calm), /////KT (not measured).
+Result<std::optional<MetarWind>> parseWind(const Groups& in) {
+  std::string_view g = in.peek();
+  MetarWind wind;
+  std::string_view body = g;
+  double toKnots = 1;
+  if (endsWith(g, "KT")) {
+    body.remove_suffix(2);
+  } else if (endsWith(g, "MPS")) {
+    body.remove_suffix(3);
+    wind.reportedUnit = WindUnit::MetresPerSecond;
+    toKnots = kKnotsPerMps;
+  } else {
+    body.remove_suffix(3);
+    wind.reportedUnit = WindUnit::KilometresPerHour;
+    toKnots = kKnotsPerKmh;
+  }
+  if (allSlashes(body) && body.size() == 5) return std::optional<MetarWind>{};
+  if (body.size() < 5) return in.error(ErrorCode::Malformed, "wind is not dddff");
+  std::string_view dir = body.substr(0, 3);
+  if (dir == "VRB") {
+    wind.variable = true;
+  } else if (allDigits(dir)) {
+    wind.direction_deg = toInt(dir);
+    if (*wind.direction_deg > 360)
+      return in.error(ErrorCode::InvalidArgument, "wind direction above 360");
+  } else {
+    return in.error(ErrorCode::Malformed, "wind direction is not three digits or VRB");
+  }
+  std::string_view rest = body.substr(3);
+  std::size_t gustAt = rest.find('G');
+  std::string_view speed = rest.substr(0, gustAt);
+  if (speed.size() < 2 || speed.size() > 3 || !allDigits(speed))
+    return in.error(ErrorCode::Malformed, "wind speed is not two or three digits");
+  wind.speed_kt = toInt(speed) * toKnots;
+  if (gustAt != std::string_view::npos) {
+    std::string_view gust = rest.substr(gustAt + 1);
+    if (gust.size() < 2 || gust.size() > 3 || !allDigits(gust))
+      return in.error(ErrorCode::Malformed, "gust is not two or three digits");
+    wind.gust_kt = toInt(gust) * toKnots;
+  }
+  return std::optional<MetarWind>{wind};
+}
+
+bool looksLikeVariableSector(std::string_view g) {
+  return g.size() == 7 && g[3] == 'V' && allDigits(g.substr(0, 3)) && allDigits(g.substr(4));
+}
+
+bool isCompass(std::string_view s) {
+  static constexpr std::array<std::string_view, 8> kPoints{"N", "NE", "E", "SE", "S", "SW", "W", "NW"};
+  for (std::string_view p : kPoints)
+    if (s == p) return true;
+  return false;
+}
+
+// 9999, 0800, 4000N, 0000E, 9999NDV, //// (metres); 10SM, P6SM, M1/4SM, 3/4SM.
+bool isVisibility(std::string_view g) {
+  if (g == "////") return true;
+  if (g.size() >= 4 && allDigits(g.substr(0, 4))) {
+    std::string_view rest = g.substr(4);
+    return rest.empty() || rest == "NDV" || isCompass(rest);
+  }
+  if (!endsWith(g, "SM")) return false;
+  std::string_view v = g.substr(0, g.size() - 2);
+  if (!v.empty() && (v[0] == 'P' || v[0] == 'M')) v.remove_prefix(1);
+  std::size_t slash = v.find('/');
+  if (slash == std::string_view::npos) return allDigits(v) && v.size() <= 2;
+  return allDigits(v.substr(0, slash)) && allDigits(v.substr(slash + 1));
+}
+
+// The whole-miles part of "1 1/2SM": one or two digits followed by a fraction.
+bool isWholeMilesBefore(std::string_view g, std::string_view next) {
+  return !g.empty() && g.size() <= 2 && allDigits(g) && endsWith(next, "SM") &&
+         next.find('/') != std::string_view::npos && isVisibility(next);
+}
+
+// Runway visual range: Rdd[LCR]/..., R//////, e.g. R24/P2000N, R19R/1600V2000FT.
+bool isRunwayVisualRange(std::string_view g) {
+  if (g.size() < 4 || g[0] != 'R') return false;
+  std::size_t slash = g.find('/');
+  if (slash == std::string_view::npos) return false;
+  std::string_view runway = g.substr(1, slash - 1);
+  bool runwayOk = runway.empty() || runway == "//" ||
+                  (runway.size() >= 2 && runway.size() <= 3 && allDigits(runway.substr(0, 2)) &&
+                   (runway.size() == 2 || runway[2] == 'L' || runway[2] == 'C' || runway[2] == 'R'));
+  if (!runwayOk) return false;
+  std::string_view value = g.substr(slash + 1);
+  if (value.empty()) return false;
+  for (char c : value)
+    if (!(isDigit(c) || c == '/' || c == 'P' || c == 'M' || c == 'V' || c == 'N' || c == 'U' ||
+          c == 'D' || c == 'F' || c == 'T'))
+      return false;
+  return true;
+}
+
+// Present weather: (+|-|VC)? descriptor? phenomena*, at least one code; "//"
+// is weather not observed.
+bool isWeather(std::string_view g) {
+  if (g == "//") return true;
+  static constexpr std::array<std::string_view, 8> kDescriptors{"MI", "PR", "BC", "DR",
+                                                                "BL", "SH", "TS", "FZ"};
+  static constexpr std::array<std::string_view, 22> kPhenomena{
+      "DZ", "RA", "SN", "SG", "IC", "PL", "GR", "GS", "UP", "BR", "FG",
+      "FU", "VA", "DU", "SA", "HZ", "PY", "PO", "SQ", "FC", "SS", "DS"};
+  std::string_view s = g;
+  if (!s.empty() && (s[0] == '+' || s[0] == '-')) s.remove_prefix(1);
+  else if (s.substr(0, 2) == "VC") s.remove_prefix(2);
+  bool any = false;
+  if (s.size() >= 2) {
+    for (std::string_view d : kDescriptors)
+      if (s.substr(0, 2) == d) {
+        s.remove_prefix(2);
+        any = true;
+        break;
+      }
+  }
+  while (s.size() >= 2) {
+    bool found = false;
+    for (std::string_view p : kPhenomena)
+      if (s.substr(0, 2) == p) {
+        found = true;
+        break;
+      }
+    if (!found) return false;
+    s.remove_prefix(2);
+    any = true;
+  }
+  return any && s.empty();
+}
+
+bool startsCloudGroup(std::string_view g) {
+  std::string_view a = g.substr(0, 3);
+  if (a == "FEW" || a == "SCT" || a == "BKN" || a == "OVC") return true;
+  // "///..." is a cloud group of unknown amount when 6 or more long ("////" is
+  // visibility, "//" weather).
+  return a == "///" && g.size() >= 6;
+}
+
+Result<MetarCloud> parseCloud(const Groups& in) {
+  std::string_view g = in.peek();
+  MetarCloud cloud;
+  std::string_view a = g.substr(0, 3);
+  if (a == "FEW") cloud.amount = CloudAmount::Few;
+  else if (a == "SCT") cloud.amount = CloudAmount::Scattered;
+  else if (a == "BKN") cloud.amount = CloudAmount::Broken;
+  else if (a == "OVC") cloud.amount = CloudAmount::Overcast;
+  else cloud.amount = CloudAmount::Unknown;
+  std::string_view height = g.substr(3, 3);
+  if (height.size() == 3 && allDigits(height)) {
+    cloud.height_ft = toInt(height) * 100;
+  } else if (height != "///") {
+    return in.error(ErrorCode::Malformed, "height is not three digits");
+  }
+  std::string_view type = g.size() > 6 ? g.substr(6) : std::string_view{};
+  if (type.empty()) cloud.convective = ConvectiveCloud::None;
+  else if (type == "CB") cloud.convective = ConvectiveCloud::Cumulonimbus;
+  else if (type == "TCU") cloud.convective = ConvectiveCloud::ToweringCumulus;
+  else if (type == "///") cloud.convective = ConvectiveCloud::Unknown;
+  else return in.error(ErrorCode::Malformed, "cloud type is not CB, TCU or ///");
+  return cloud;
+}
+
+// M05/M07, 27/25, 15/, 15///, M01/// ; "//" for a missing value.
+bool parseTemperature(std::string_view g, MetarReport& out) {
+  std::size_t slash = g.find('/');
+  if (slash == std::string_view::npos || slash == 0) return false;
+  auto value = [](std::string_view s, std::optional<int>& v) {
+    if (s.empty() || s == "//") return true;
+    bool minus = s[0] == 'M';
+    if (minus) s.remove_prefix(1);
+    if (s.size() != 2 || !allDigits(s)) return false;
+    v = minus ? -toInt(s) : toInt(s);
+    return true;
+  };
+  std::optional<int> t, d;
+  std::string_view left = g.substr(0, slash);
+  if (left.empty() || !value(left, t) || !value(g.substr(slash + 1), d)) return false;
+  out.temperature_degC = t;
+  out.dewpoint_degC = d;
+  return true;
+}
+
+bool isPressure(std::string_view g) {
+  return g.size() == 5 && (g[0] == 'Q' || g[0] == 'A') &&
+         (allDigits(g.substr(1)) || g.substr(1) == "////");
+}
+
+void parsePressure(std::string_view g, MetarReport& out) {
+  if (!allDigits(g.substr(1))) return;
+  double v = toInt(g.substr(1));
+  out.qnh_hPa = g[0] == 'Q' ? v : v / 100.0 * kHpaPerInHg;
+}
+
+// Header: [METAR|SPECI] [COR] CCCC [DDHHMMZ] [NIL] [AUTO|COR]* [wind [dddVddd]].
+Result<void> parseHeader(Groups& in, MetarReport& out) {
+  if (in.peek() == "METAR" || in.peek() == "SPECI") {
+    out.speci = in.peek() == "SPECI";
+    in.advance();
+  }
+  if (in.peek() == "COR") {
+    out.corrected = true;
+    in.advance();
+  }
+  if (in.done()) return in.error(ErrorCode::Malformed, "no station");
+  if (!isStation(in.peek()))
+    return in.error(ErrorCode::Malformed, "station is not a four-character ICAO code");
+  out.icao = std::string(in.peek());
+  in.advance();
+  if (!in.done() && in.peek() != "NIL") {
+    auto time = parseTime(in);
+    if (!time) return tl::unexpected(time.error());
+    out.time = *time;
+    in.advance();
+  }
+  if (in.peek() == "NIL") {
+    out.nil = true;
+    in.advance();
+    if (!in.done()) return in.error(ErrorCode::Malformed, "group after NIL");
+    return {};
+  }
+  while (in.peek() == "AUTO" || in.peek() == "COR") {
+    (in.peek() == "AUTO" ? out.automatic : out.corrected) = true;
+    in.advance();
+  }
+  if (!in.done() && looksLikeWind(in.peek())) {
+    auto wind = parseWind(in);
+    if (!wind) return tl::unexpected(wind.error());
+    out.wind = *wind;
+    in.advance();
+    if (!in.done() && looksLikeVariableSector(in.peek())) {
+      int from = toInt(in.peek().substr(0, 3));
+      int to = toInt(in.peek().substr(4, 3));
+      if (from > 360 || to > 360)
+        return in.error(ErrorCode::InvalidArgument, "variable sector direction above 360");
+      if (out.wind) {
+        out.wind->variableFrom_deg = from;
+        out.wind->variableTo_deg = to;
+      }
+      in.advance();
+    }
+  }
+  return {};
+}
+
+// Body: visibility, RVR, weather and sky groups in any order, then
+// temperature, then pressure.
+Result<void> parseBody(Groups& in, MetarReport& out) {
+  bool temperatureSeen = false;
+  while (!in.done()) {
+    std::string_view g = in.peek();
+    if (isTrendOrRemarks(g)) return {};
+    if (isPressure(g)) {
+      parsePressure(g, out);
+      return {};  // what follows the pressure is supplementary
+    }
+    if (temperatureSeen) return in.error(ErrorCode::Malformed, "expected QNH after temperature");
+    if (g == "CAVOK") {
+      out.cavok = true;
+    } else if (g == "NSC" || g == "NCD" || g == "SKC" || g == "CLR") {
+      out.noCloud = g == "NSC"   ? NoCloud::NSC
+                    : g == "NCD" ? NoCloud::NCD
+                    : g == "SKC" ? NoCloud::SKC
+                                 : NoCloud::CLR;
+    } else if (startsCloudGroup(g)) {
+      auto cloud = parseCloud(in);
+      if (!cloud) return tl::unexpected(cloud.error());
+      out.clouds.push_back(*cloud);
+    } else if (g.substr(0, 2) == "VV") {
+      std::string_view h = g.substr(2);
+      if (h == "///") {
+        out.verticalVisibility_ft.reset();
+      } else if (h.size() == 3 && allDigits(h)) {
+        out.verticalVisibility_ft = toInt(h) * 100;
+      } else {
+        return in.error(ErrorCode::Malformed, "vertical visibility is not three digits");
+      }
+      out.verticalVisibility = true;
+    } else if (isWholeMilesBefore(g, in.peek(1))) {
+      in.advance();  // "1" of "1 1/2SM"; the fraction is the next group
+    } else if (isVisibility(g) || isRunwayVisualRange(g) || isWeather(g)) {
+      // recognised, not used by the mapping
+    } else if (parseTemperature(g, out)) {
+      temperatureSeen = true;
+    } else if (looksLikeWind(g)) {
+      return in.error(ErrorCode::Malformed, "wind group out of place");
+    } else if (g == "CB" || g == "TCU") {
+      return in.error(ErrorCode::Malformed, "cloud type without amount and height");
+    } else {
+      return in.error(ErrorCode::Malformed, "unrecognised group");
+    }
+    in.advance();
+  }
+  return {};
+}
+
+}  // namespace
+
+Result<MetarReport> parseMetar(std::string_view report) {
+  Groups in(splitGroups(report));
+  if (in.done()) return fail(ErrorCode::Malformed, "empty report");
+  MetarReport out;
+  if (auto header = parseHeader(in, out); !header) return tl::unexpected(header.error());
+  if (out.nil) return out;
+  if (auto body = parseBody(in, out); !body) return tl::unexpected(body.error());
+  return out;
+}
+
+}  // namespace sky::server

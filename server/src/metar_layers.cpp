@@ -1,0 +1,180 @@
+// METAR report -> cloud layers, the batch over a station table, and the
+// inverse-distance interpolation of cover between stations (see metar.hpp).
+#include "sky/server/metar.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sky/geo/geodetic.hpp"
+
+namespace sky::server {
+
+namespace {
+
+constexpr double kMetresPerFoot = 0.3048;
+constexpr double kMpsPerKnot = 1852.0 / 3600.0;
+// Inverse-distance weighting: weight = 1 / d^kIdwPower (Shepard's method with
+// the usual power 2); closer than kIdwSnap_m a station gives its own value.
+constexpr double kIdwPower = 2;
+constexpr double kIdwSnap_m = 1;
+
+double coverageOf(CloudAmount amount) {
+  switch (amount) {
+    case CloudAmount::Few: return kFewCoverage;
+    case CloudAmount::Scattered: return kScatteredCoverage;
+    case CloudAmount::Broken: return kBrokenCoverage;
+    case CloudAmount::Overcast: return kOvercastCoverage;
+    case CloudAmount::Unknown: break;
+  }
+  return 0;
+}
+
+// Type from amount and base above the station (WMO étages, formulas.md).
+weather::CloudType typeFromHeight(CloudAmount amount, double heightAgl_m) {
+  using weather::CloudType;
+  const bool patchy = amount == CloudAmount::Few || amount == CloudAmount::Scattered;
+  if (heightAgl_m < kLowCloudTop_m) {
+    if (patchy) return CloudType::Cumulus;
+    if (amount == CloudAmount::Overcast && heightAgl_m < kStratusMaxBase_m) return CloudType::Stratus;
+    return CloudType::Stratocumulus;
+  }
+  if (heightAgl_m < kMiddleCloudTop_m) return patchy ? CloudType::Altocumulus : CloudType::Altostratus;
+  return CloudType::Cirrus;
+}
+
+double thicknessOf(weather::CloudType type) {
+  using weather::CloudType;
+  switch (type) {
+    case CloudType::Stratus: return kStratusThickness_m;
+    case CloudType::Stratocumulus: return kStratocumulusThickness_m;
+    case CloudType::Altocumulus: return kAltocumulusThickness_m;
+    case CloudType::Altostratus: return kAltostratusThickness_m;
+    case CloudType::Cirrus: return kCirrusThickness_m;
+    default: return kCumulusThickness_m;
+  }
+}
+
+weather::LayerWind layerWind(const std::optional<MetarWind>& wind) {
+  weather::LayerWind out;
+  if (!wind) return out;  // missing wind: still air
+  out.speed_mps = wind->speed_kt * kMpsPerKnot;
+  // VRB has no direction: 0 (north) stands in; the speed is still right.
+  const int dir = wind->direction_deg.value_or(0);
+  out.fromDirection_deg = dir == 360 ? 0.0 : static_cast<double>(dir);
+  return out;
+}
+
+}  // namespace
+
+Result<std::vector<weather::CloudLayer>> layersFromMetar(const MetarReport& report,
+                                                         const Station& station) {
+  if (report.nil)
+    return fail(ErrorCode::InvalidArgument, report.icao + ": NIL report (no observation)");
+  if (report.icao != station.icao)
+    return fail(ErrorCode::InvalidArgument,
+                "report of " + report.icao + " given station " + station.icao);
+  if (!std::isfinite(station.lat_deg) || !std::isfinite(station.lon_deg) ||
+      !std::isfinite(station.elevation_m) || std::abs(station.lat_deg) > 90)
+    return fail(ErrorCode::InvalidArgument, station.icao + ": station position not finite or lat outside [-90, 90]");
+
+  const weather::LayerWind wind = layerWind(report.wind);
+  std::vector<weather::CloudLayer> layers;
+  auto add = [&](weather::CloudType type, double base_m, double thickness_m, double coverage) {
+    weather::CloudLayer layer;
+    layer.id = static_cast<std::uint32_t>(layers.size() + 1);
+    layer.type = type;
+    layer.base_m = base_m;
+    layer.thickness_m = thickness_m;
+    layer.transitionBand_m = kTransitionFraction * thickness_m;
+    layer.coverage = coverage;
+    layer.density = 1;
+    layer.wind = wind;
+    layers.push_back(layer);
+  };
+
+  if (report.verticalVisibility_ft) {
+    const double top_m = *report.verticalVisibility_ft * kMetresPerFoot;
+    add(weather::CloudType::Stratus, station.elevation_m, std::max(top_m, kMinFogThickness_m), 1.0);
+  }
+  for (const MetarCloud& cloud : report.clouds) {
+    if (cloud.amount == CloudAmount::Unknown || !cloud.height_ft) continue;  // cannot place
+    const double heightAgl_m = *cloud.height_ft * kMetresPerFoot;
+    const double base_m = station.elevation_m + heightAgl_m;
+    weather::CloudType type;
+    double thickness_m;
+    if (cloud.convective == ConvectiveCloud::Cumulonimbus) {
+      type = weather::CloudType::Cumulonimbus;
+      thickness_m = std::max(kCumulonimbusTop_m - base_m, kCumulonimbusMinThickness_m);
+    } else if (cloud.convective == ConvectiveCloud::ToweringCumulus) {
+      type = weather::CloudType::Cumulus;  // CIGI has no towering cumulus: a deep cumulus
+      thickness_m = kToweringCumulusThickness_m;
+    } else {
+      type = typeFromHeight(cloud.amount, heightAgl_m);
+      thickness_m = thicknessOf(type);
+    }
+    add(type, base_m, thickness_m, coverageOf(cloud.amount));
+  }
+
+  const bool reportedClear = report.cavok || report.noCloud != NoCloud::None;
+  if (layers.empty() && !reportedClear)
+    return fail(ErrorCode::InvalidArgument,
+                report.icao + ": no usable sky condition (no cloud group with amount and "
+                              "height, no VV height, no CAVOK/NSC/NCD/SKC/CLR)");
+  for (const weather::CloudLayer& layer : layers)
+    if (auto ok = weather::validate(layer); !ok)
+      return fail(ok.error().code, report.icao + ": " + ok.error().detail);
+  return layers;
+}
+
+std::vector<Result<StationWeather>> layersFromMetarBatch(std::span<const std::string> reports,
+                                                         std::span<const Station> stations) {
+  std::vector<Result<StationWeather>> out;
+  out.reserve(reports.size());
+  for (std::size_t i = 0; i < reports.size(); ++i) {
+    const std::string where = "report " + std::to_string(i + 1) + ": ";
+    auto report = parseMetar(reports[i]);
+    if (!report) {
+      out.push_back(fail(report.error().code, where + report.error().detail));
+      continue;
+    }
+    auto station = std::find_if(stations.begin(), stations.end(),
+                                [&](const Station& s) { return s.icao == report->icao; });
+    if (station == stations.end()) {
+      out.push_back(fail(ErrorCode::InvalidArgument,
+                         where + "station " + report->icao + " is not in the station table"));
+      continue;
+    }
+    auto layers = layersFromMetar(*report, *station);
+    if (!layers) {
+      out.push_back(fail(layers.error().code, where + layers.error().detail));
+      continue;
+    }
+    out.push_back(StationWeather{*station, std::move(*report), std::move(*layers)});
+  }
+  return out;
+}
+
+double totalCoverage(std::span<const weather::CloudLayer> layers) {
+  double total = 0;
+  for (const weather::CloudLayer& layer : layers) total = std::max(total, layer.coverage);
+  return total;
+}
+
+std::optional<double> coverageAt(double lat_deg, double lon_deg,
+                                 std::span<const StationWeather> stations) {
+  if (stations.empty()) return std::nullopt;
+  double weightSum = 0;
+  double weighted = 0;
+  for (const StationWeather& s : stations) {
+    const double d_m =
+        geo::geodesicDistance_m(lat_deg, lon_deg, s.station.lat_deg, s.station.lon_deg);
+    const double cover = totalCoverage(s.layers);
+    if (d_m < kIdwSnap_m) return cover;
+    const double w = 1.0 / std::pow(d_m, kIdwPower);
+    weightSum += w;
+    weighted += w * cover;
+  }
+  return weighted / weightSum;
+}
+
+}  // namespace sky::server
