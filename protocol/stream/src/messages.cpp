@@ -120,7 +120,8 @@ Result<std::vector<weather::CoverageTile>> decodeTiles(const char* message, int 
   // but not the alignment of 8-byte-aligned struct elements; a crafted buffer
   // can place them at 4 mod 8 (found by fuzz_stream_frame). Our builder never
   // does, so such a buffer is malformed.
-  if (reinterpret_cast<std::uintptr_t>(tiles->Data()) % alignof(fbs::Tile) != 0)
+  // (An empty vector has no elements to misread, and FlatBuffers may leave it unpadded.)
+  if (tiles->size() > 0 && reinterpret_cast<std::uintptr_t>(tiles->Data()) % alignof(fbs::Tile) != 0)
     return fail(ErrorCode::Malformed, std::string(message) + ".tiles: vector of structs is misaligned");
   for (flatbuffers::uoffset_t i = 0; i < tiles->size(); ++i) {
     const fbs::Tile* t = tiles->Get(i);

@@ -194,6 +194,15 @@ TEST(Messages, DecodesAPayloadAtAnOddAddress) {
   EXPECT_EQ(std::get<weather::WeatherSnapshot>(*m).tiles.size(), 1u);
 }
 
+// Regression: the tile-vector alignment check rejected an empty Snapshot,
+// whose (empty) tile vector FlatBuffers does not pad.
+TEST(Messages, EmptySnapshotAndDeltaDecode) {
+  auto m = decodeMessage(encodeMessage(weather::WeatherSnapshot{}));
+  ASSERT_TRUE(m) << m.error().detail;
+  m = decodeMessage(encodeMessage(weather::WeatherDelta{}));
+  ASSERT_TRUE(m) << m.error().detail;
+}
+
 TEST(Messages, CorruptedBuffersNeverDecodeOutOfBounds) {
   // Flip every byte of a valid snapshot in turn: each result is either a
   // clean error or a range-checked message (ASan catches any overread).
