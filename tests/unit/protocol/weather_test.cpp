@@ -8,6 +8,7 @@
 
 #include "sky/geo/geodetic.hpp"
 #include "sky/weather/advection.hpp"
+#include "sky/weather/clock.hpp"
 #include "sky/weather/model.hpp"
 #include "sky/weather/tiling.hpp"
 
@@ -128,6 +129,21 @@ TEST(Advection, MatchesHandComputedDisplacements) {
   const SurfacePoint back = advect(p, {1, 180, 0}, 2 * toPole_m);
   EXPECT_NEAR(back.lat_deg, 89.9, 1e-6);
   EXPECT_NEAR(back.lon_deg, 0, 1e-6);
+}
+
+TEST(WeatherClock, AReanchoredCopyAgreesWithTheOriginal) {
+  // The server's clock, and a renderer's copy re-anchored from a Heartbeat
+  // that carried the server's clock at wall time t1: both give the same
+  // weather time at any later wall time.
+  const auto t0 = WallClock::time_point{} + std::chrono::seconds(1000);
+  const WeatherClock server(3600.0, 10.0, t0);
+  const auto t1 = t0 + std::chrono::milliseconds(2500);
+  const WeatherClock renderer(server.at(t1), server.rate(), t1);
+  const auto t2 = t1 + std::chrono::seconds(7);
+  EXPECT_DOUBLE_EQ(server.at(t2), 3600.0 + 10.0 * 9.5);
+  EXPECT_NEAR(renderer.at(t2), server.at(t2), 1e-9);
+  const WeatherClock paused(50.0, 0.0, t0);
+  EXPECT_EQ(paused.at(t2), 50.0);
 }
 
 TEST(Advection, MovesDownwindBySpeedTimesTime) {

@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "sky/geo/geodetic.hpp"
+#include "sky/weather/clock.hpp"
 #include "sky/weather/model.hpp"
 
 namespace sky::app {
@@ -24,15 +25,12 @@ struct HostPose {
 struct WeatherView {
   weather::WeatherSnapshot snapshot;
   std::uint64_t version = 0;  // increments with every snapshot received
-  // Weather clock = clockAtSync_s + clockRate * (now - syncedAt).
-  double clockAtSync_s = 0;
-  double clockRate = 1;
-  std::chrono::steady_clock::time_point syncedAt;
+  // The server's weather clock, re-anchored on every Hello, Snapshot, Delta
+  // and Heartbeat (protocol/'s WeatherClock: the same formula as the server's).
+  weather::WeatherClock clock;
   bool connected = false;
 
-  double clockNow(std::chrono::steady_clock::time_point now) const {
-    return clockAtSync_s + clockRate * std::chrono::duration<double>(now - syncedAt).count();
-  }
+  double clockNow(std::chrono::steady_clock::time_point now) const { return clock.at(now); }
 };
 
 class SharedState {
@@ -50,8 +48,7 @@ class SharedState {
 
   void setSnapshot(weather::WeatherSnapshot s, std::chrono::steady_clock::time_point now) {
     std::lock_guard lock(mutex_);
-    weather_.clockAtSync_s = s.weatherClock_s;
-    weather_.syncedAt = now;
+    weather_.clock = weather::WeatherClock(s.weatherClock_s, weather_.clock.rate(), now);
     weather_.snapshot = std::move(s);
     ++weather_.version;
   }
@@ -61,16 +58,13 @@ class SharedState {
     if (weather_.version == 0)
       return fail(ErrorCode::InvalidArgument, "Delta before any Snapshot");
     if (auto r = weather::applyDelta(weather_.snapshot, d); !r) return r;
-    weather_.clockAtSync_s = d.weatherClock_s;
-    weather_.syncedAt = now;
+    weather_.clock = weather::WeatherClock(d.weatherClock_s, weather_.clock.rate(), now);
     ++weather_.version;
     return {};
   }
   void setClock(double clock_s, double rate, std::chrono::steady_clock::time_point now) {
     std::lock_guard lock(mutex_);
-    weather_.clockAtSync_s = clock_s;
-    weather_.clockRate = rate;
-    weather_.syncedAt = now;
+    weather_.clock = weather::WeatherClock(clock_s, rate, now);
   }
   void setConnected(bool c) {
     std::lock_guard lock(mutex_);

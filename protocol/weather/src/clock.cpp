@@ -1,15 +1,15 @@
-// The weather clock (see weather_clock.hpp).
-#include "sky/server/weather_clock.hpp"
+// The weather clock (see clock.hpp).
+#include "sky/weather/clock.hpp"
 
 #include <cmath>
 
 #include "sky/core/assert.hpp"
 
-namespace sky::server {
+namespace sky::weather {
 
 WeatherClock::WeatherClock(double start_s, double rate, WallClock::time_point wallStart)
     : start_s_(start_s), rate_(rate), wallStart_(wallStart) {
-  // Scenario loading checks both; a bad value here is a bug of the caller.
+  // Callers check both at their input edge; a bad value here is a bug.
   SKY_ASSERT(std::isfinite(start_s));
   SKY_ASSERT(std::isfinite(rate) && rate >= 0 && rate <= 3600);
 }
@@ -19,4 +19,4 @@ double WeatherClock::at(WallClock::time_point wallNow) const {
   return start_s_ + rate_ * elapsed.count();
 }
 
-}  // namespace sky::server
+}  // namespace sky::weather

@@ -1,0 +1,33 @@
+// The weather clock every process advects clouds with: `rate` weather seconds
+// per wall second from an anchor. Defined once here; the server runs it and a
+// renderer re-anchors its copy on every Hello, Snapshot and Heartbeat. Wall
+// time is always passed in (protocol/ reads no clocks), so it is testable.
+#pragma once
+
+#include <chrono>
+
+namespace sky::weather {
+
+using WallClock = std::chrono::steady_clock;
+
+class WeatherClock {
+ public:
+  WeatherClock() = default;
+  // start_s: weather clock at wallStart, s (finite). rate: weather seconds per
+  // wall second, [0, 3600] (the range Hello carries).
+  WeatherClock(double start_s, double rate, WallClock::time_point wallStart);
+
+  // clock_s = start_s + rate × (wallNow − wallStart). wallNow may precede
+  // wallStart (the result is then before start_s).
+  double at(WallClock::time_point wallNow) const;
+
+  double start_s() const { return start_s_; }
+  double rate() const { return rate_; }
+
+ private:
+  double start_s_ = 0;
+  double rate_ = 1;
+  WallClock::time_point wallStart_{};
+};
+
+}  // namespace sky::weather
