@@ -81,7 +81,7 @@ HostFrame hostFrame() {
   reg.transitionPerimeter_m = 2000;
   WeatherControl w;
   w.entityOrRegionId = 7;
-  w.layerId = 2;
+  w.layerId = LayerId::CloudLayer2;
   w.humidity_pct = 80;
   w.weatherEnable = true;
   w.randomWindsEnable = true;
@@ -198,7 +198,7 @@ HostFrame igFrame() {
   sof.timestamp_10us = 5000100;
   sof.lastHostFrame = 1234;
   WeatherConditionsResponse wcr{42, 80, 5, 20000, 12.5f, 0.5f, 270, 1013.25f};
-  AerosolConcentrationResponse acr{42, 1, 0.35f};
+  AerosolConcentrationResponse acr{42, LayerId::CloudLayer1, 0.35f};
   f.packets = {sof, wcr, acr};
   f.fields = {
       {"cigi.sof.db_number", 5}, {"cigi.sof.ig_status", 2}, {"cigi.sof.ig_mode", 1},

@@ -211,7 +211,7 @@ Result<EnvironmentalRegionControl> Codec<EnvironmentalRegionControl>::read(Packe
 // --- Weather Control (12) -----------------------------------------------------
 void Codec<WeatherControl>::write(PacketBuilder& b, const WeatherControl& p) {
   b.u16(2, p.entityOrRegionId);
-  b.u8(4, p.layerId);
+  b.u8(4, static_cast<std::uint8_t>(p.layerId));
   b.u8(5, p.humidity_pct);
   b.u8(6, static_cast<std::uint8_t>(bit(p.weatherEnable, 0) | bit(p.scudEnable, 1) | bit(p.randomWindsEnable, 2) |
                                     bit(p.randomLightningEnable, 3) |
@@ -234,7 +234,7 @@ void Codec<WeatherControl>::write(PacketBuilder& b, const WeatherControl& p) {
 Result<WeatherControl> Codec<WeatherControl>::read(PacketReader& r) {
   WeatherControl p;
   p.entityOrRegionId = r.u16(2);
-  p.layerId = r.u8(4);
+  p.layerId = static_cast<LayerId>(r.u8(4));
   p.humidity_pct = r.u8(5);
   const std::uint8_t f = r.u8(6);
   p.weatherEnable = isSet(f, 0);
@@ -435,14 +435,14 @@ Result<WeatherConditionsResponse> Codec<WeatherConditionsResponse>::read(PacketR
 // --- Aerosol Concentration Response (110) -------------------------------------
 void Codec<AerosolConcentrationResponse>::write(PacketBuilder& b, const AerosolConcentrationResponse& p) {
   b.u8(2, p.requestId);
-  b.u8(3, p.layerId);
+  b.u8(3, static_cast<std::uint8_t>(p.layerId));
   b.f32(4, p.concentration_gpm3);
 }
 
 Result<AerosolConcentrationResponse> Codec<AerosolConcentrationResponse>::read(PacketReader& r) {
   AerosolConcentrationResponse p;
   p.requestId = r.u8(2);
-  p.layerId = r.u8(3);
+  p.layerId = static_cast<LayerId>(r.u8(3));
   p.concentration_gpm3 = r.f32(4);
   r.range(4, "aerosol concentration", p.concentration_gpm3, 0, 1.0e4);
   return r.result(p);

@@ -63,7 +63,7 @@ EntityControl goldenEntity() {
 
 WeatherControl goldenWeather() {
   WeatherControl w;
-  w.layerId = 1;
+  w.layerId = LayerId::CloudLayer1;
   w.humidity_pct = 80;
   w.weatherEnable = true;
   w.scudEnable = true;
@@ -152,7 +152,7 @@ TEST(Cigi, StartOfFrameGoldenAndRoundTrip) {
   wcr.windDirection_deg = 270;
   wcr.pressure_hpa = 1013.25f;
   EXPECT_EQ(std::get<WeatherConditionsResponse>(d->packets[1]), wcr);
-  const AerosolConcentrationResponse acr{42, 1, 0.35f};
+  const AerosolConcentrationResponse acr{42, LayerId::CloudLayer1, 0.35f};
   EXPECT_EQ(std::get<AerosolConcentrationResponse>(d->packets[2]), acr);
   DatagramWriter w;
   w.add(sof).add(wcr).add(acr);
@@ -234,7 +234,7 @@ TEST(Cigi, EveryPacketRoundTripsInBothByteOrders) {
 
 TEST(Cigi, RejectsPacketsOfTheOtherDirection) {
   DatagramWriter w;
-  w.add(goldenIgControl()).add(AerosolConcentrationResponse{1, 1, 0.1f});
+  w.add(goldenIgControl()).add(AerosolConcentrationResponse{1, LayerId::CloudLayer1, 0.1f});
   auto r = decodeDatagram(w.bytes());
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().detail.find("IG-to-host packet inside a host datagram"), std::string::npos);

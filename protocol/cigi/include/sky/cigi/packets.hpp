@@ -20,7 +20,8 @@ enum class EntityState : std::uint8_t { Inactive = 0, Active = 1, Destroyed = 2 
 enum class RegionState : std::uint8_t { Inactive = 0, Active = 1, Destroyed = 2 };
 enum class WeatherScope : std::uint8_t { Global = 0, Regional = 1, Entity = 2 };
 
-// Weather Control layer ids 0-9 (10-255 are IG-defined and kept as numbers).
+// Weather Control layer ids: 0-9 are standard; 10-255 are IG-defined and
+// carried as LayerId{n} (an enum class holds any value of its underlying type).
 enum class LayerId : std::uint8_t {
   GroundFog = 0, CloudLayer1 = 1, CloudLayer2 = 2, CloudLayer3 = 3, Rain = 4,
   Snow = 5, Sleet = 6, Hail = 7, Sand = 8, Dust = 9,
@@ -113,7 +114,7 @@ struct EnvironmentalRegionControl {
 struct WeatherControl {
   static constexpr std::uint8_t kId = 12, kSize = 56;
   std::uint16_t entityOrRegionId = 0;
-  std::uint8_t layerId = 1;  // LayerId values 0-9, 10-255 IG-defined
+  LayerId layerId = LayerId::CloudLayer1;
   std::uint8_t humidity_pct = 0;  // [0, 100]
   bool weatherEnable = true, scudEnable = false, randomWindsEnable = false, randomLightningEnable = false;
   weather::CloudType cloudType = weather::CloudType::None;  // 11-15 rejected: IG-defined, we have none
@@ -209,7 +210,7 @@ struct WeatherConditionsResponse {
 struct AerosolConcentrationResponse {
   static constexpr std::uint8_t kId = 110, kSize = 8;
   std::uint8_t requestId = 0;
-  std::uint8_t layerId = 0;
+  LayerId layerId = LayerId::GroundFog;
   float concentration_gpm3 = 0;
   bool operator==(const AerosolConcentrationResponse&) const = default;
 };
