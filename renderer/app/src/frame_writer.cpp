@@ -33,6 +33,7 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
   const nlohmann::json line = {
       {"frame", r.frame},
       {"file", std::string(name) + ".png"},
+      {"source", r.source},
       {"host_frame", r.host.hostFrame},
       {"host_time_s", r.host.hostTime_s},
       {"lat_deg", p.position.lat_deg},

@@ -1,5 +1,6 @@
 // skyshell-render: one image-generator channel. Takes its camera from a CIGI
-// host over UDP, its weather from skyshell-weatherd over TCP, and renders the
+// host over UDP (or, with --fdm-port, from FlightGear's --native-fdm stream,
+// smoothed), its weather from skyshell-weatherd over TCP, and renders the
 // clouds on Vulkan. Headless: writes a PNG (and metadata) per frame.
 #include <atomic>
 #include <chrono>
@@ -14,6 +15,7 @@
 #include <spdlog/spdlog.h>
 
 #include "sky/app/cigi_listener.hpp"
+#include "sky/app/fdm_listener.hpp"
 #include "sky/app/frame_writer.hpp"
 #include "sky/app/weather_client.hpp"
 #include "sky/geo/geodetic.hpp"
@@ -39,6 +41,10 @@ struct Options {
   std::string cigiAddress = "127.0.0.1";
   unsigned cigiPort = 8004;
   std::string portFile;
+  std::string fdmAddress = "127.0.0.1";
+  int fdmPort = -1;  // -1: no FlightGear input
+  std::string fdmPortFile;
+  double fdmFrameRate_hz = 30;
   std::string outDir = "skyshell-frames";
   bool headless = false;
   bool writeFloat = false;
@@ -81,6 +87,16 @@ int main(int argc, char** argv) {
   app.add_option("--cigi-port", o.cigiPort, "UDP port to receive CIGI on (0 = any free port)")
       ->check(CLI::Range(0, 65535));
   app.add_option("--port-file", o.portFile, "write the CIGI port here once listening");
+  app.add_option("--fdm-port", o.fdmPort,
+                 "take the camera from FlightGear --native-fdm datagrams on this UDP port (0 = any free port) "
+                 "instead of from CIGI")
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--fdm-address", o.fdmAddress, "address to receive FlightGear native FDM on");
+  app.add_option("--fdm-port-file", o.fdmPortFile, "write the FlightGear FDM port here once listening");
+  app.add_option("--fdm-frame-rate", o.fdmFrameRate_hz,
+                 "with --fdm-port: render at most this many frames per second (the camera is smoothed, so "
+                 "frames are not tied to packets)")
+      ->check(CLI::Range(0.1, 1000.0));
   app.add_flag("--headless", o.headless, "render off-screen and write frames to --out");
   app.add_option("--out", o.outDir, "output folder for headless frames");
   app.add_flag("--write-float", o.writeFloat, "also write each frame's linear radiance as .pfm");
@@ -91,7 +107,7 @@ int main(int argc, char** argv) {
   app.add_option("--sun-elevation", o.sunElevation_deg, "deg above the horizon");
   app.add_option("--max-frames", o.maxFrames, "stop after this many frames (0 = no limit)");
   app.add_option("--idle-exit", o.idleExit_s,
-                 "stop when no CIGI arrived for this many seconds after the first (0 = never)");
+                 "stop when no pose (CIGI or FDM) arrived for this many seconds after the first (0 = never)");
   app.add_option("--weather-timeout", o.weatherTimeout_s, "seconds to wait for the first weather");
   app.set_config("--config", "", "config file (TOML keys named like the long options)");
   CLI11_PARSE(app, argc, argv);
@@ -137,6 +153,19 @@ int main(int argc, char** argv) {
     return 2;
   }
   cigi->start();
+  // With --fdm-port the camera comes from FlightGear only; the CIGI endpoint
+  // stays open (and answers Start of Frame) but its pose is not used.
+  std::optional<sky::app::FdmListener> fdm;
+  if (o.fdmPort >= 0) {
+    try {
+      fdm.emplace(io, o.fdmAddress, static_cast<unsigned short>(o.fdmPort));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "skyshell-render: cannot listen for FlightGear FDM on %s:%d: %s\n",
+                   o.fdmAddress.c_str(), o.fdmPort, e.what());
+      return 2;
+    }
+    fdm->start();
+  }
   sky::app::WeatherClient weather(io, state, serverHost, static_cast<unsigned short>(serverPort));
   weather.start();
   std::thread ioThread([&] { io.run(); });
@@ -144,6 +173,7 @@ int main(int argc, char** argv) {
     weather.stop();
     asio::post(io, [&] {
       cigi->stop();
+      if (fdm) fdm->stop();
       signals.cancel();
     });
     guard.reset();
@@ -155,9 +185,17 @@ int main(int argc, char** argv) {
     shutdown();
     return 2;
   }
+  if (fdm && !o.fdmPortFile.empty() && !writePortFile(o.fdmPortFile, fdm->port())) {
+    std::fprintf(stderr, "skyshell-render: cannot write --fdm-port-file %s\n", o.fdmPortFile.c_str());
+    shutdown();
+    return 2;
+  }
   std::printf("skyshell-render: device '%s', CIGI on %s:%u, weather from %s, frames to %s\n",
               (*renderer)->deviceName().c_str(), o.cigiAddress.c_str(), cigi->port(), o.server.c_str(),
               o.outDir.c_str());
+  if (fdm)
+    std::printf("skyshell-render: camera from FlightGear native FDM on %s:%u\n", o.fdmAddress.c_str(),
+                fdm->port());
   std::fflush(stdout);
 
   std::uint64_t frames = 0, lastSequence = 0;
@@ -165,10 +203,15 @@ int main(int argc, char** argv) {
   const auto start = Clock::now();
   auto lastReport = start;
   Clock::time_point lastPoseAt{};
+  // FDM frames are paced by this clock, CIGI frames by the host's datagrams.
+  const auto fdmFramePeriod = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double>(1.0 / o.fdmFrameRate_hz));
+  Clock::time_point nextFdmFrameAt{};
   int exitCode = 0;
   while (!stopRequested) {
+    if (fdm && Clock::now() < nextFdmFrameAt) std::this_thread::sleep_until(nextFdmFrameAt);
     const auto now = Clock::now();
-    const auto pose = state.pose();
+    const auto pose = fdm ? fdm->poseAt(now) : state.pose();
     if (pose && (!subscribedAt || sky::geo::geodesicDistance_m(
                                       subscribedAt->lat_deg, subscribedAt->lon_deg,
                                       pose->pose.position.lat_deg,
@@ -179,7 +222,7 @@ int main(int argc, char** argv) {
     if (pose) lastPoseAt = pose->receivedAt;
     if (o.idleExit_s > 0 && pose &&
         std::chrono::duration<double>(now - lastPoseAt).count() > o.idleExit_s) {
-      spdlog::info("no CIGI for {:.1f} s: stopping", o.idleExit_s);
+      spdlog::info("no {} for {:.1f} s: stopping", fdm ? "FlightGear FDM" : "CIGI", o.idleExit_s);
       break;
     }
     const auto view = state.weather();
@@ -196,6 +239,7 @@ int main(int argc, char** argv) {
       continue;
     }
     lastSequence = pose->sequence;
+    nextFdmFrameAt = now + fdmFramePeriod;
 
     sky::render::FrameInputs in;
     in.camera = pose->pose;
@@ -215,6 +259,7 @@ int main(int argc, char** argv) {
     sky::app::FrameRecord record;
     record.frame = frames;
     record.host = *pose;
+    record.source = fdm ? "fdm" : "cigi";
     record.weatherClock_s = in.weatherClock_s;
     record.weatherVersion = view.version;
     record.layerCount = view.snapshot.layers.size();
@@ -244,6 +289,11 @@ int main(int argc, char** argv) {
               static_cast<unsigned long long>(cigi->datagramsAccepted()),
               static_cast<unsigned long long>(cigi->datagramsDropped()),
               static_cast<unsigned long long>(weather.malformedFrames()));
+  if (fdm)
+    std::printf("render: FlightGear FDM datagrams accepted %llu, dropped %llu, outliers discarded %llu\n",
+                static_cast<unsigned long long>(fdm->datagramsAccepted()),
+                static_cast<unsigned long long>(fdm->datagramsDropped()),
+                static_cast<unsigned long long>(fdm->outliersDropped()));
   std::fflush(stdout);
   shutdown();
   return exitCode;

@@ -1,6 +1,6 @@
 // Writes a headless channel's output: one PNG per frame (optionally the
 // linear radiance and the transmittance as PFM), and one JSON line of metadata per frame in
-// frames.jsonl (camera pose, host frame, weather clock, image statistics).
+// frames.jsonl (camera pose and its source, host frame, weather clock, image statistics).
 #pragma once
 
 #include <cstdint>
@@ -16,6 +16,7 @@ namespace sky::app {
 struct FrameRecord {
   std::uint64_t frame = 0;
   HostPose host;
+  std::string source = "cigi";  // where the camera came from: "cigi" or "fdm" (FlightGear)
   double weatherClock_s = 0;
   std::uint64_t weatherVersion = 0;
   std::size_t layerCount = 0;
