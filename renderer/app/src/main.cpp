@@ -20,6 +20,7 @@
 #include "sky/app/weather_client.hpp"
 #include "sky/geo/geodetic.hpp"
 #include "sky/render/cloud_renderer.hpp"
+#include "sky/weather/tiling.hpp"
 
 namespace asio = boost::asio;
 using Clock = std::chrono::steady_clock;
@@ -31,10 +32,10 @@ namespace {
 // camera has moved a quarter of that.
 constexpr double kSubscribeRadius_m = 120000.0;
 constexpr double kResubscribeDistance_m = 30000.0;
-// S2 level 11 cells are about 4.9 km across (S2 average edge): a few thousand
-// tiles for the area above. The real weather tiles (~1 km) come with the
-// weather-texture rings of the renderer issue.
-constexpr int kTileLevel = 11;
+// The finest S2 level whose covering of that cap stays within this many tiles
+// (level 11 for 120 km: cells about 4.9 km across, ~1900 tiles). The real
+// weather tiles (~1 km) come with the weather-texture rings of the renderer issue.
+constexpr std::size_t kMaxSubscribedTiles = 4096;
 
 struct Options {
   std::string server = "127.0.0.1:47800";
@@ -73,7 +74,7 @@ sky::stream::Subscribe areaAround(const sky::geo::GeodeticPose& pose) {
   s.area = {pose.position.lat_deg, pose.position.lon_deg, kSubscribeRadius_m};
   s.altMin_m = -500;
   s.altMax_m = 20000;
-  s.tileLevel = kTileLevel;
+  s.tileLevel = sky::weather::levelForRadius(kSubscribeRadius_m, kMaxSubscribedTiles);
   return s;
 }
 
@@ -220,7 +221,11 @@ int main(int argc, char** argv) {
       subscribedAt = pose->pose.position;
     }
     if (pose) lastPoseAt = pose->receivedAt;
-    if (o.idleExit_s > 0 && pose &&
+    // Idle only once the newest pose has been rendered: a slow frame must not
+    // skip the host's last pose (seen in CI under load: the final fix of the
+    // replay arrived while a frame took longer than --idle-exit).
+    // (FDM frames are rendered continuously from the smoother: always current.)
+    if (o.idleExit_s > 0 && pose && (fdm || pose->sequence == lastSequence) &&
         std::chrono::duration<double>(now - lastPoseAt).count() > o.idleExit_s) {
       spdlog::info("no {} for {:.1f} s: stopping", fdm ? "FlightGear FDM" : "CIGI", o.idleExit_s);
       break;
