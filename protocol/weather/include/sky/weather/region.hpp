@@ -1,0 +1,35 @@
+// Regional weather, as CIGI 3.3's Environmental Region Control describes a
+// region: a rounded rectangle on the surface (centre, size along and across,
+// rotation, corner radius) with a transition perimeter outside it in which the
+// region's weather blends into the global weather. Inside the region its own
+// layers replace the global layer of the same id; in the perimeter both blend.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "sky/core/result.hpp"
+#include "sky/weather/model.hpp"
+
+namespace sky::weather {
+
+struct Region {
+  std::uint32_t id = 0;          // [1, 65535] (CIGI region id is 16 bits)
+  double centerLat_deg = 0;      // [-90, 90]
+  double centerLon_deg = 0;      // any; normalised to [-180, 180)
+  double sizeX_m = 1000;         // along the rotated x axis (east at rotation 0), (0, 2e6]
+  double sizeY_m = 1000;         // along the rotated y axis (north at rotation 0), (0, 2e6]
+  double cornerRadius_m = 0;     // [0, min(sizeX, sizeY) / 2]
+  double rotation_deg = 0;       // clockwise from true north of the y axis, [-180, 180]
+  double transition_m = 0;       // transition perimeter width outside the edge, [0, 2e6]
+  // Whether the region moves with the wind of its first layer (a storm cell
+  // drifting) on the weather clock, from where it was at placedAtClock_s.
+  bool driftsWithWind = false;
+  double placedAtClock_s = 0;
+  std::vector<CloudLayer> layers;  // validated; ids match global layers or are new
+};
+
+// Checks every field; the error names the field, its value and the range.
+Result<void> validate(const Region& region);
+
+}  // namespace sky::weather
