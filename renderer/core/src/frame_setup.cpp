@@ -7,6 +7,7 @@
 #include <string>
 
 #include "sky/core/assert.hpp"
+#include "sky/weather/advection.hpp"
 
 namespace sky::render {
 
@@ -141,7 +142,15 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
     };
     l.noiseOrigin = inPeriods(kNoisePeriod_m);
     l.cloudMapOrigin = inPeriods(kCloudMapPeriod_m);
-    l.coverageShift_m = glm::dvec2(windEnu_mps.x, windEnu_mps.y) * sinceSnapshot_s;
+    // The coverage tiles are the server's field at the snapshot's clock; the
+    // air over the camera now was, then, where the shared advection formula
+    // (weather::advect, the one the server moves its regions with) says: the
+    // map is sampled that far upwind. East/north of the camera's frame.
+    const weather::SurfacePoint upwind = weather::advect(
+        {in.camera.position.lat_deg, in.camera.position.lon_deg}, layer.wind, -sinceSnapshot_s);
+    const geo::Vec3d upwindEcef = geo::toEcef({upwind.lat_deg, upwind.lon_deg, alt_m});
+    const glm::dvec3 drift = inFrame(enu, enu.originEcef_m - upwindEcef);
+    l.coverageShift_m = glm::dvec2(drift.x, drift.y);
     s.layers.push_back(l);
   }
   return s;
