@@ -65,3 +65,20 @@ bool TimeOrder::accept(double t_s, std::size_t line, Warnings& warnings) {
 }
 
 }  // namespace sky::flight::detail
+
+namespace sky::flight {
+
+Result<ParsedFlight> parseFlight(std::string_view text, std::string_view sourceName) {
+  const auto dot = sourceName.rfind('.');
+  const auto slash = sourceName.rfind('/');
+  std::string ext;
+  if (dot != std::string_view::npos && (slash == std::string_view::npos || dot > slash))
+    for (char c : sourceName.substr(dot + 1)) ext.push_back(c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c);
+  if (ext == "csv") return parseCsv(text, sourceName);
+  if (ext == "igc") return parseIgc(text, sourceName);
+  if (ext == "gpx") return parseGpx(text, sourceName);
+  return fail(ErrorCode::Unsupported, std::string(sourceName) + ": unknown flight format '." + detail::printable(ext) +
+                                          "' (expected .csv, .igc or .gpx)");
+}
+
+}  // namespace sky::flight

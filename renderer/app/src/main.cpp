@@ -3,6 +3,10 @@
 // smoothed), its weather from skyshell-weatherd over TCP, and renders the
 // clouds on Vulkan. Headless: writes a PNG (and metadata) per frame.
 #include <atomic>
+#include <charconv>
+#include <cmath>
+#include <csignal>
+#include <limits>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -14,28 +18,19 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "sky/app/area_of_interest.hpp"
 #include "sky/app/cigi_listener.hpp"
 #include "sky/app/fdm_listener.hpp"
 #include "sky/app/frame_writer.hpp"
+#include "sky/app/headless_replay.hpp"
 #include "sky/app/weather_client.hpp"
 #include "sky/geo/geodetic.hpp"
 #include "sky/render/cloud_renderer.hpp"
-#include "sky/weather/tiling.hpp"
 
 namespace asio = boost::asio;
 using Clock = std::chrono::steady_clock;
 
 namespace {
-
-// Area of interest: the weather texture spans about 100 km around the camera;
-// subscribe a little wider so the edge is never empty, and again when the
-// camera has moved a quarter of that.
-constexpr double kSubscribeRadius_m = 120000.0;
-constexpr double kResubscribeDistance_m = 30000.0;
-// The finest S2 level whose covering of that cap stays within this many tiles
-// (level 11 for 120 km: cells about 4.9 km across, ~1900 tiles). The real
-// weather tiles (~1 km) come with the weather-texture rings of the renderer issue.
-constexpr std::size_t kMaxSubscribedTiles = 4096;
 
 struct Options {
   std::string server = "127.0.0.1:47800";
@@ -55,7 +50,19 @@ struct Options {
   std::uint64_t maxFrames = 0;
   double idleExit_s = 0;
   double weatherTimeout_s = 30;
+  // --replay: headless replay of a flight file instead of listening to a host.
+  std::string replayFlight;
+  double replayStep_s = 1.0 / 30.0;
+  double replayStart_s = 0;
+  double replayEnd_s = -1;
+  double replayWeatherClock_s = std::numeric_limits<double>::quiet_NaN();
+  bool noVideo = false;
 };
+
+// Set by SIGINT/SIGTERM during a --replay (which runs no io_context of its own
+// on this thread to catch them with).
+std::atomic<bool> gReplayStop{false};
+extern "C" void onReplaySignal(int) { gReplayStop = true; }
 
 bool writePortFile(const std::string& path, unsigned port) {
   const std::string tmp = path + ".tmp";
@@ -69,14 +76,6 @@ bool writePortFile(const std::string& path, unsigned port) {
   return !ec;
 }
 
-sky::stream::Subscribe areaAround(const sky::geo::GeodeticPose& pose) {
-  sky::stream::Subscribe s;
-  s.area = {pose.position.lat_deg, pose.position.lon_deg, kSubscribeRadius_m};
-  s.altMin_m = -500;
-  s.altMax_m = 20000;
-  s.tileLevel = sky::weather::levelForRadius(kSubscribeRadius_m, kMaxSubscribedTiles);
-  return s;
-}
 
 }  // namespace
 
@@ -110,6 +109,18 @@ int main(int argc, char** argv) {
   app.add_option("--idle-exit", o.idleExit_s,
                  "stop when no pose (CIGI or FDM) arrived for this many seconds after the first (0 = never)");
   app.add_option("--weather-timeout", o.weatherTimeout_s, "seconds to wait for the first weather");
+  app.add_option("--replay", o.replayFlight,
+                 "render this flight file (.csv, .igc, .gpx) headless, one frame per --step of flight time, "
+                 "then write a video, a contact sheet and report.json into --out");
+  app.add_option("--step", o.replayStep_s, "with --replay: flight seconds per frame")->check(CLI::Range(1e-3, 3600.0));
+  app.add_option("--replay-start", o.replayStart_s, "with --replay: start offset into the flight, s")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--replay-end", o.replayEnd_s, "with --replay: end offset into the flight, s (default: its end)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--weather-clock", o.replayWeatherClock_s,
+                 "with --replay: weather clock of the first frame, s (default: the server's); pin it for "
+                 "byte-identical re-renders");
+  app.add_flag("--no-video", o.noVideo, "with --replay: skip the MP4");
   app.set_config("--config", "", "config file (TOML keys named like the long options)");
   CLI11_PARSE(app, argc, argv);
   spdlog::set_default_logger(spdlog::stderr_color_mt("render"));
@@ -124,12 +135,40 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string serverHost = o.server.substr(0, colon);
-  const unsigned serverPort = static_cast<unsigned>(std::stoul(o.server.substr(colon + 1)));
+  unsigned serverPort = 0;
+  {
+    const std::string portText = o.server.substr(colon + 1);
+    const auto [end, ec] = std::from_chars(portText.data(), portText.data() + portText.size(), serverPort);
+    if (ec != std::errc() || end != portText.data() + portText.size() || serverPort == 0 || serverPort > 65535) {
+      std::fprintf(stderr, "skyshell-render: --server '%s': port '%s' is not in 1..65535\n", o.server.c_str(),
+                   portText.c_str());
+      return 2;
+    }
+  }
 
   auto renderer = sky::render::CloudRenderer::create({o.width, o.height, o.fov_deg, 1});
   if (!renderer) {
     std::fprintf(stderr, "skyshell-render: %s\n", sky::describe(renderer.error()).c_str());
     return 3;
+  }
+  if (!o.replayFlight.empty()) {
+    sky::app::ReplayOptions r;
+    r.flightPath = o.replayFlight;
+    r.step_s = o.replayStep_s;
+    r.start_s = o.replayStart_s;
+    if (o.replayEnd_s >= 0) r.end_s = o.replayEnd_s;
+    if (std::isfinite(o.replayWeatherClock_s)) r.weatherClock_s = o.replayWeatherClock_s;
+    r.serverHost = serverHost;
+    r.serverPort = static_cast<unsigned short>(serverPort);
+    r.weatherTimeout_s = o.weatherTimeout_s;
+    r.outDir = o.outDir;
+    r.writeFloat = o.writeFloat;
+    r.video = !o.noVideo;
+    r.sunAzimuth_deg = o.sunAzimuth_deg;
+    r.sunElevation_deg = o.sunElevation_deg;
+    std::signal(SIGINT, onReplaySignal);
+    std::signal(SIGTERM, onReplaySignal);
+    return sky::app::runHeadlessReplay(r, **renderer, &gReplayStop);
   }
   auto writer = sky::app::FrameWriter::open(o.outDir, o.writeFloat);
   if (!writer) {
@@ -213,11 +252,8 @@ int main(int argc, char** argv) {
     if (fdm && Clock::now() < nextFdmFrameAt) std::this_thread::sleep_until(nextFdmFrameAt);
     const auto now = Clock::now();
     const auto pose = fdm ? fdm->poseAt(now) : state.pose();
-    if (pose && (!subscribedAt || sky::geo::geodesicDistance_m(
-                                      subscribedAt->lat_deg, subscribedAt->lon_deg,
-                                      pose->pose.position.lat_deg,
-                                      pose->pose.position.lon_deg) > kResubscribeDistance_m)) {
-      weather.subscribe(areaAround(pose->pose));
+    if (pose && (!subscribedAt || sky::app::needsResubscribe(*subscribedAt, pose->pose.position))) {
+      weather.subscribe(sky::app::areaAround(pose->pose));
       subscribedAt = pose->pose.position;
     }
     if (pose) lastPoseAt = pose->receivedAt;

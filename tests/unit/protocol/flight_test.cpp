@@ -49,5 +49,19 @@ TEST(FlightCsv, SampleInterpolatesAndWrapsHeading) {
   EXPECT_EQ(sample(*f, 99).position.alt_m, 1100);
 }
 
+TEST(FlightFile, FormatFollowsTheExtensionInAnyCase) {
+  const std::string csv = "time_s,lat_deg,lon_deg,alt_m,yaw_deg,pitch_deg,roll_deg\n0,1,2,3,0,0,0\n1,1,2,3,0,0,0\n";
+  EXPECT_TRUE(parseFlight(csv, "dir.v2/a.CSV"));
+  // The same text as IGC has no B records: the IGC reader's error, not CSV's success.
+  EXPECT_FALSE(parseFlight(csv, "a.igc"));
+  const auto unknown = parseFlight(csv, "dir.csv/flight");
+  ASSERT_FALSE(unknown);
+  EXPECT_EQ(unknown.error().code, ErrorCode::Unsupported);
+  EXPECT_NE(unknown.error().detail.find("dir.csv/flight"), std::string::npos);
+  const auto kml = parseFlight(csv, "a.kml");
+  ASSERT_FALSE(kml);
+  EXPECT_NE(kml.error().detail.find("'.kml'"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace sky::flight

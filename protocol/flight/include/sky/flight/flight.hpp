@@ -100,6 +100,10 @@ Result<ParsedFlight> parseIgc(std::string_view text, std::string_view sourceName
 // startUtc_s is that second. Attitude is derived by deriveAttitude.
 Result<ParsedFlight> parseGpx(std::string_view text, std::string_view sourceName);
 
+// Any of the three, chosen by the extension of sourceName in any letter case
+// (.csv, .igc, .gpx); Unsupported for another extension, naming it.
+Result<ParsedFlight> parseFlight(std::string_view text, std::string_view sourceName);
+
 // Fills yaw, pitch and roll of every fix from the track alone:
 //  * yaw: geodesic azimuth of the chord through the neighbouring fixes;
 //  * pitch: climb angle atan2(climb rate, ground speed);

@@ -1,0 +1,42 @@
+// skyshell-render --replay: renders a recorded flight headless, one frame per
+// fixed step of flight time, with the weather the server streams, then writes
+// an MP4 (ffmpeg), a contact sheet and a JSON report next to the frames.
+//
+// Deterministic: frame i shows the flight at t0 + i × step and the weather at
+// clock base + i × step × rate (base: --weather-clock, else the server's clock
+// when the first snapshot arrived; rate: the server's); after every
+// re-subscription the next frame waits for the answering snapshot. So the same
+// flight, options and (unchanging) server weather give byte-identical PNGs.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "sky/render/cloud_renderer.hpp"
+
+namespace sky::app {
+
+struct ReplayOptions {
+  std::string flightPath;  // .csv, .igc or .gpx
+  double step_s = 1.0 / 30.0;           // flight seconds per frame, (0, 3600]
+  double start_s = 0;                   // offset into the flight, s
+  std::optional<double> end_s;          // offset into the flight, s (default: its end)
+  std::optional<double> weatherClock_s; // weather clock of the first frame (default: the server's)
+  std::string serverHost;
+  unsigned short serverPort = 0;
+  double weatherTimeout_s = 30;  // for the first snapshot and after each re-subscription
+  std::string outDir;
+  bool writeFloat = false;
+  bool video = true;             // MP4 through ffmpeg (skipped with a warning if ffmpeg is missing)
+  double sunAzimuth_deg = 135, sunElevation_deg = 40;
+  std::string preset = "skeleton";  // recorded in the report
+};
+
+// Runs the replay to the end (or until *stop turns true). Returns the process
+// exit code: 0 done, 2 bad input (flight file, output folder), 3 render
+// failure, 4 no weather in time.
+int runHeadlessReplay(const ReplayOptions& options, render::CloudRenderer& renderer, const std::atomic<bool>* stop);
+
+}  // namespace sky::app

@@ -1,0 +1,239 @@
+// Headless replay of a recorded flight (see headless_replay.hpp).
+#include "sky/app/headless_replay.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <set>
+#include <thread>
+
+#include <boost/asio.hpp>
+#include <nlohmann/json.hpp>
+
+#include "sky/app/area_of_interest.hpp"
+#include "sky/app/frame_writer.hpp"
+#include "sky/app/replay_outputs.hpp"
+#include "sky/app/shared_state.hpp"
+#include "sky/app/weather_client.hpp"
+#include "sky/flight/flight.hpp"
+#include "sky/sim/flight_file.hpp"
+
+namespace sky::app {
+
+namespace {
+
+namespace asio = boost::asio;
+using Clock = std::chrono::steady_clock;
+
+constexpr std::size_t kSheetColumns = 4, kSheetRows = 3;
+constexpr std::uint32_t kSheetCellWidth = 240;
+// Video frame rate: one video second per flight second (1 / step), kept to
+// what players handle.
+constexpr double kMinVideoFps = 1, kMaxVideoFps = 60;
+// Poll period while waiting for weather.
+constexpr auto kWeatherPoll = std::chrono::milliseconds(5);
+
+std::string duration(double s) {
+  char buf[32];
+  const long t = std::lround(std::max(0.0, s));
+  if (t >= 3600)
+    std::snprintf(buf, sizeof buf, "%ldh%02ldm%02lds", t / 3600, t / 60 % 60, t % 60);
+  else
+    std::snprintf(buf, sizeof buf, "%ldm%02lds", t / 60, t % 60);
+  return buf;
+}
+
+// Waits until the weather version exceeds `after` (a snapshot or delta arrived).
+bool waitForWeather(const SharedState& state, std::uint64_t after, double timeout_s, const std::atomic<bool>* stop) {
+  const auto until = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
+  while (state.weatherVersion() <= after) {
+    if ((stop && *stop) || Clock::now() > until) return false;
+    std::this_thread::sleep_for(kWeatherPoll);
+  }
+  return true;
+}
+
+}  // namespace
+
+int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, const std::atomic<bool>* stop) {
+  auto flight = sim::loadFlight(o.flightPath);
+  if (!flight) {
+    std::fprintf(stderr, "skyshell-render: %s\n", describe(flight.error()).c_str());
+    return 2;
+  }
+  for (const auto& w : flight->warnings) std::fprintf(stderr, "skyshell-render: warning: %s\n", w.c_str());
+  const double first_s = flight->fixes.front().time_s;
+  const double t0 = first_s + o.start_s;
+  const double t1 = o.end_s ? std::min(first_s + *o.end_s, flight->fixes.back().time_s) : flight->fixes.back().time_s;
+  if (!(o.step_s > 0) || !(t1 >= t0)) {
+    std::fprintf(stderr, "skyshell-render: --replay %s: nothing to render between %.3f s and %.3f s of the flight\n",
+                 o.flightPath.c_str(), t0 - first_s, t1 - first_s);
+    return 2;
+  }
+  // A tiny tolerance so that a step dividing the span exactly includes the end.
+  const auto frameCount = static_cast<std::size_t>(std::floor((t1 - t0) / o.step_s + 1e-9)) + 1;
+
+  auto writer = FrameWriter::open(o.outDir + "/frames", o.writeFloat);
+  if (!writer) {
+    std::fprintf(stderr, "skyshell-render: %s\n", describe(writer.error()).c_str());
+    return 2;
+  }
+
+  SharedState state;
+  asio::io_context io;
+  auto guard = asio::make_work_guard(io);
+  WeatherClient weather(io, state, o.serverHost, o.serverPort);
+  weather.start();
+  std::thread ioThread([&] { io.run(); });
+  struct Stopper {
+    WeatherClient& weather;
+    decltype(guard)& g;
+    std::thread& t;
+    ~Stopper() {
+      weather.stop();
+      g.reset();
+      t.join();
+    }
+  } stopper{weather, guard, ioThread};
+
+  const auto& s = renderer.settings();
+  std::printf("skyshell-render: replaying %s headless: %zu frames of %.3f s (flight %.1f-%.1f s) at %ux%u, "
+              "weather from %s:%u, output to %s\n",
+              o.flightPath.c_str(), frameCount, o.step_s, t0 - first_s, t1 - first_s, s.width, s.height,
+              o.serverHost.c_str(), o.serverPort, o.outDir.c_str());
+  std::fflush(stdout);
+
+  geo::GeodeticPose pose = flight::sample(*flight, t0);
+  weather.subscribe(areaAround(pose));
+  geo::Geodetic subscribedAt = pose.position;
+  if (!waitForWeather(state, 0, o.weatherTimeout_s, stop)) {
+    std::fprintf(stderr, "skyshell-render: no weather from %s:%u within %.0f s\n", o.serverHost.c_str(),
+                 o.serverPort, o.weatherTimeout_s);
+    return 4;
+  }
+  const WeatherView firstView = state.weather();
+  const double clockBase_s = o.weatherClock_s.value_or(firstView.clockNow(Clock::now()));
+  const double clockRate = firstView.clock.rate();
+
+  const auto picks = ContactSheet::pick(frameCount, kSheetColumns * kSheetRows);
+  ContactSheet sheet(kSheetColumns, kSheetRows, kSheetCellWidth, s.width, s.height);
+  std::size_t nextPick = 0;
+  std::vector<double> renderMs;
+  std::set<std::uint64_t> versionsSeen;
+  std::size_t nonFinite = 0;
+  const auto start = Clock::now();
+  auto lastReport = start;
+  int exitCode = 0;
+  std::size_t done = 0;
+  for (std::size_t i = 0; i < frameCount; ++i) {
+    if (stop && *stop) {
+      exitCode = 1;
+      break;
+    }
+    const double t = t0 + double(i) * o.step_s;
+    pose = flight::sample(*flight, t);
+    if (needsResubscribe(subscribedAt, pose.position)) {
+      const std::uint64_t before = state.weatherVersion();
+      weather.subscribe(areaAround(pose));
+      subscribedAt = pose.position;
+      if (!waitForWeather(state, before, o.weatherTimeout_s, stop))
+        std::fprintf(stderr, "skyshell-render: warning: frame %zu: no weather for the new area within %.0f s; "
+                             "drawing the old area's\n", i, o.weatherTimeout_s);
+    }
+    const WeatherView view = state.weather();
+    render::FrameInputs in;
+    in.camera = pose;
+    in.weather = &view.snapshot;
+    in.weatherClock_s = clockBase_s + (t - t0) * clockRate;
+    in.sunAzimuth_deg = o.sunAzimuth_deg;
+    in.sunElevation_deg = o.sunElevation_deg;
+    in.frameIndex = i;
+    const auto r0 = Clock::now();
+    auto image = renderer.render(in);
+    if (!image) {
+      std::fprintf(stderr, "skyshell-render: frame %zu: %s\n", i, describe(image.error()).c_str());
+      exitCode = 3;
+      break;
+    }
+    FrameRecord record;
+    record.frame = i;
+    record.host.pose = pose;
+    record.host.hostFrame = static_cast<std::uint32_t>(i);
+    record.host.hostTime_s = t - first_s;
+    record.source = "replay";
+    record.weatherClock_s = in.weatherClock_s;
+    record.weatherVersion = view.version;
+    record.layerCount = view.snapshot.layers.size();
+    record.stats = render::computeStats(*image);
+    record.render_ms = std::chrono::duration<double, std::milli>(Clock::now() - r0).count();
+    if (auto ok = writer->write(*image, record); !ok) {
+      std::fprintf(stderr, "skyshell-render: %s\n", describe(ok.error()).c_str());
+      exitCode = 2;
+      break;
+    }
+    renderMs.push_back(record.render_ms);
+    versionsSeen.insert(view.version);
+    nonFinite += record.stats.nonFinite;
+    if (nextPick < picks.size() && picks[nextPick] == i) {
+      sheet.add(*image);
+      ++nextPick;
+    }
+    done = i + 1;
+    const auto now = Clock::now();
+    if (now - lastReport > std::chrono::seconds(1) || done == frameCount) {
+      lastReport = now;
+      const double elapsed = std::chrono::duration<double>(now - start).count();
+      const double rate = elapsed > 0 ? double(done) / elapsed : 0;
+      std::printf("replay: frame %zu/%zu (%.0f%%), %.2f frames/s, %s elapsed, %s left\n", done, frameCount,
+                  100.0 * double(done) / double(frameCount), rate, duration(elapsed).c_str(),
+                  duration(rate > 0 ? double(frameCount - done) / rate : 0).c_str());
+      std::fflush(stdout);
+    }
+  }
+  const double wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+
+  nlohmann::json report;
+  if (done > 0) {
+    const std::string sheetPath = o.outDir + "/contact-sheet.png";
+    if (auto ok = render::writePng(sheet.image(), sheetPath); ok)
+      report["contact_sheet"] = "contact-sheet.png";
+    else
+      std::fprintf(stderr, "skyshell-render: warning: %s\n", describe(ok.error()).c_str());
+    if (o.video && exitCode == 0) {
+      const double fps = std::clamp(1.0 / o.step_s, kMinVideoFps, kMaxVideoFps);
+      if (auto ok = encodeVideo(o.outDir + "/frames", fps, o.outDir + "/replay.mp4"); ok)
+        report["video"] = "replay.mp4";
+      else
+        std::fprintf(stderr, "skyshell-render: warning: no video: %s\n", describe(ok.error()).c_str());
+    }
+  }
+  const Percentiles ms = percentiles(renderMs);
+  report["flight"] = o.flightPath;
+  report["flight_window_s"] = {t0 - first_s, t1 - first_s};
+  report["step_s"] = o.step_s;
+  report["frames"] = done;
+  report["frames_planned"] = frameCount;
+  report["complete"] = exitCode == 0 && done == frameCount;
+  report["resolution"] = {s.width, s.height};
+  report["vertical_fov_deg"] = s.verticalFov_deg;
+  report["noise_seed"] = s.noiseSeed;
+  report["preset"] = o.preset;
+  report["device"] = renderer.deviceName();
+  report["render_ms"] = {{"p50", ms.p50}, {"p90", ms.p90}, {"p99", ms.p99}, {"mean", ms.mean}, {"max", ms.max}};
+  report["wall_s"] = wall_s;
+  report["weather_server"] = o.serverHost + ":" + std::to_string(o.serverPort);
+  report["weather_clock_s"] = {clockBase_s, clockBase_s + double(frameCount - 1) * o.step_s * clockRate};
+  report["weather_clock_rate"] = clockRate;
+  report["weather_versions_seen"] = versionsSeen;
+  report["non_finite_pixels"] = nonFinite;
+  report["metadata_index"] = "frames/frames.jsonl";
+  std::ofstream(o.outDir + "/report.json", std::ios::trunc) << report.dump(2) << '\n';
+  std::printf("replay: wrote %zu frames to %s/frames in %.1f s (render p50 %.0f ms, p90 %.0f ms); "
+              "report %s/report.json\n",
+              done, o.outDir.c_str(), wall_s, ms.p50, ms.p90, o.outDir.c_str());
+  std::fflush(stdout);
+  return exitCode;
+}
+
+}  // namespace sky::app

@@ -1,0 +1,157 @@
+// skyshell-render --replay against a running skyshell-weatherd: every step of
+// the flight becomes a frame whose camera is the flight's pose at that time,
+// two runs with the same inputs give byte-identical PNGs, and the run leaves
+// a video, a contact sheet and a report that say what happened. A bad flight
+// file is refused with its line and field.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "child_process.hpp"
+#include "sky/flight/flight.hpp"
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+namespace sky::test {
+namespace {
+
+// The 6 s test flight at one frame per 1.5 s: frames at 0, 1.5, 3, 4.5, 6 s.
+constexpr double kStep_s = 1.5;
+constexpr std::size_t kFrames = 5;
+// Pinned so the two runs see the same weather clock.
+constexpr const char* kWeatherClock = "5000";
+// The metadata carries the pose in decimal JSON (shortest round-trip form):
+// compare with what the flight says to well below a millimetre.
+constexpr double kPoseTolerance_deg = 1e-9;
+constexpr double kAltTolerance_m = 1e-6;
+
+std::string readAll(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+struct ReplayRun {
+  int exitCode = -1;
+  std::string log;
+};
+
+ReplayRun replay(unsigned weatherPort, const std::string& flight, const fs::path& out,
+                 std::vector<std::string> extra = {}) {
+  std::vector<std::string> argv = {SKY_RENDER, "--headless", "--server", "127.0.0.1:" + std::to_string(weatherPort),
+                                   "--replay", flight, "--step", std::to_string(kStep_s), "--weather-clock",
+                                   kWeatherClock, "--out", out.string(), "--width", "160", "--height", "90"};
+  argv.insert(argv.end(), extra.begin(), extra.end());
+  // Leak checking off for the renderer only (as in skeleton_test.cpp): lavapipe's JIT.
+  ChildProcess render(argv, out.string() + ".log", {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
+  const auto code = render.wait(300s);
+  return {code.value_or(-1), render.log()};
+}
+
+class HeadlessReplay : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(SKY_TEST_OUTPUT_DIR) / ("replay-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    weatherd_.emplace(std::vector<std::string>{SKY_WEATHERD, "--scenario", SKY_SCENARIO_CLOUDY, "--port", "0",
+                                               "--port-file", (dir_ / "weatherd.port").string()},
+                      (dir_ / "weatherd.log").string());
+    port_ = waitForPortFile((dir_ / "weatherd.port").string(), 20s);
+    ASSERT_GT(port_, 0u) << weatherd_->log();
+  }
+  void TearDown() override {
+    if (weatherd_) {
+      EXPECT_EQ(weatherd_->stop(), 0) << weatherd_->log();
+    }
+  }
+  fs::path dir_;
+  std::optional<ChildProcess> weatherd_;
+  unsigned port_ = 0;
+};
+
+TEST_F(HeadlessReplay, FramesFollowTheFlightAreDeterministicAndReported) {
+  const ReplayRun a = replay(port_, SKY_TEST_FLIGHT, dir_ / "a");
+  ASSERT_EQ(a.exitCode, 0) << a.log;
+  const ReplayRun b = replay(port_, SKY_TEST_FLIGHT, dir_ / "b", {"--no-video"});
+  ASSERT_EQ(b.exitCode, 0) << b.log;
+  EXPECT_NE(a.log.find("replay: frame 5/5 (100%)"), std::string::npos) << "no progress line in\n" << a.log;
+
+  // The flight as the protocol reader sees it: the oracle for the camera.
+  auto flight = flight::parseCsv(readAll(SKY_TEST_FLIGHT), SKY_TEST_FLIGHT);
+  ASSERT_TRUE(flight);
+
+  std::vector<nlohmann::json> frames;
+  std::ifstream jsonl(dir_ / "a" / "frames" / "frames.jsonl");
+  for (std::string line; std::getline(jsonl, line);)
+    if (!line.empty()) frames.push_back(nlohmann::json::parse(line));
+  ASSERT_EQ(frames.size(), kFrames);
+  for (std::size_t i = 0; i < kFrames; ++i) {
+    const auto& f = frames[i];
+    const double t = double(i) * kStep_s;
+    EXPECT_EQ(f["source"], "replay");
+    EXPECT_NEAR(f["host_time_s"].get<double>(), t, 1e-9);
+    EXPECT_NEAR(f["weather_clock_s"].get<double>(), 5000.0 + t, 1e-9) << "the scenario's clock runs at x1";
+    const geo::GeodeticPose want = flight::sample(*flight, t);
+    EXPECT_NEAR(f["lat_deg"].get<double>(), want.position.lat_deg, kPoseTolerance_deg) << "frame " << i;
+    EXPECT_NEAR(f["lon_deg"].get<double>(), want.position.lon_deg, kPoseTolerance_deg) << "frame " << i;
+    EXPECT_NEAR(f["alt_m"].get<double>(), want.position.alt_m, kAltTolerance_m) << "frame " << i;
+    EXPECT_NEAR(f["yaw_deg"].get<double>(), want.yaw_deg, 1e-9);
+    EXPECT_NEAR(f["pitch_deg"].get<double>(), want.pitch_deg, 1e-9);
+    EXPECT_EQ(f["non_finite"], 0);
+    EXPECT_EQ(f["layers"], 1);
+    // Byte-identical re-render.
+    const std::string file = f["file"];
+    const std::string pngA = readAll(dir_ / "a" / "frames" / file), pngB = readAll(dir_ / "b" / "frames" / file);
+    ASSERT_GT(pngA.size(), 100u);
+    EXPECT_TRUE(pngA == pngB) << file << " differs between two runs with the same inputs";
+  }
+  // The camera moved east along the flight (55 m/s for 6 s), so the frames differ.
+  EXPECT_NE(readAll(dir_ / "a" / "frames" / "frame_000000.png"), readAll(dir_ / "a" / "frames" / "frame_000004.png"));
+
+  const auto report = nlohmann::json::parse(readAll(dir_ / "a" / "report.json"));
+  EXPECT_EQ(report["frames"], kFrames);
+  EXPECT_EQ(report["complete"], true);
+  EXPECT_EQ(report["resolution"], nlohmann::json::array({160, 90}));
+  EXPECT_EQ(report["non_finite_pixels"], 0);
+  EXPECT_EQ(report["metadata_index"], "frames/frames.jsonl");
+  EXPECT_FALSE(report["weather_versions_seen"].empty());
+  EXPECT_GT(report["render_ms"]["p50"].get<double>(), 0.0);
+  EXPECT_LE(report["render_ms"]["p50"].get<double>(), report["render_ms"]["p90"].get<double>());
+  EXPECT_EQ(report["weather_clock_s"], nlohmann::json::array({5000.0, 5006.0}));
+
+  // The contact sheet is a PNG; the video an MP4 (ISO base media: 'ftyp' box first).
+  const std::string sheet = readAll(dir_ / "a" / "contact-sheet.png");
+  ASSERT_GT(sheet.size(), 8u);
+  EXPECT_EQ(sheet.substr(1, 3), "PNG");
+  EXPECT_EQ(report["video"], "replay.mp4");
+  const std::string mp4 = readAll(dir_ / "a" / "replay.mp4");
+  ASSERT_GT(mp4.size(), 1000u) << a.log;
+  EXPECT_EQ(mp4.substr(4, 4), "ftyp");
+  EXPECT_FALSE(fs::exists(dir_ / "b" / "replay.mp4")) << "--no-video must not write one";
+}
+
+TEST_F(HeadlessReplay, BadFlightFileIsRefusedWithLineAndField) {
+  const fs::path bad = dir_ / "bad.csv";
+  std::ofstream(bad) << "time_s,lat_deg,lon_deg,alt_m,yaw_deg,pitch_deg,roll_deg\n"
+                        "0,46.2,12.8,900,90,0,0\n"
+                        "1,146.2,12.8,900,90,0,0\n";
+  const ReplayRun r = replay(port_, bad.string(), dir_ / "out");
+  EXPECT_EQ(r.exitCode, 2) << r.log;
+  EXPECT_NE(r.log.find("bad.csv:3"), std::string::npos) << r.log;
+  EXPECT_NE(r.log.find("lat_deg"), std::string::npos) << r.log;
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "frames" / "frame_000000.png"));
+
+  const ReplayRun missing = replay(port_, (dir_ / "nope.igc").string(), dir_ / "out2");
+  EXPECT_EQ(missing.exitCode, 2) << missing.log;
+  EXPECT_NE(missing.log.find("nope.igc: cannot open"), std::string::npos) << missing.log;
+}
+
+}  // namespace
+}  // namespace sky::test
