@@ -6,13 +6,17 @@
 #include <functional>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
+#include <optional>
+#include <stdexcept>
 #include <string>
 
 #include <CLI/CLI.hpp>
 #include <boost/asio.hpp>
 
 #include "sky/sim/cigi_host.hpp"
+#include "sky/sim/conditions_probe.hpp"
 #include "sky/sim/flight_file.hpp"
 
 namespace asio = boost::asio;
@@ -31,6 +35,8 @@ struct Options {
   bool loop = false;
   bool littleEndian = false;
   bool quiet = false;
+  double conditionsRate_hz = 1;  // 0: no Environmental Conditions Requests
+  std::string conditionsCsv;
 };
 
 class Replay {
@@ -43,6 +49,12 @@ class Replay {
     socket_.open(asio::ip::udp::v4());
     socket_.bind({asio::ip::make_address(o.host), 0});
     target_ = {asio::ip::make_address(o.host), static_cast<unsigned short>(o.port)};
+    if (o.conditionsRate_hz > 0) probe_.emplace(o.conditionsRate_hz);
+    if (!o.conditionsCsv.empty()) {
+      csv_.open(o.conditionsCsv, std::ios::trunc);
+      if (!csv_) throw std::runtime_error("cannot write --conditions-csv " + o.conditionsCsv);
+      csv_ << sky::sim::ConditionsProbe::csvHeader() << '\n';
+    }
     t0_ = flight_.fixes.front().time_s + o.start_s;
     t1_ = o.end_s >= 0 ? std::min(flight_.fixes.front().time_s + o.end_s, flight_.fixes.back().time_s)
                        : flight_.fixes.back().time_s;
@@ -67,7 +79,10 @@ class Replay {
       t = t0_;
     }
     if (done && !o_.loop) t = t1_;
-    const auto bytes = host_.nextFrame(sky::flight::sample(flight_, t), t - flight_.fixes.front().time_s);
+    const auto pose = sky::flight::sample(flight_, t);
+    flightTime_s_ = t - flight_.fixes.front().time_s;
+    const auto request = probe_ ? probe_->due(flightTime_s_, pose.position) : std::nullopt;
+    const auto bytes = host_.nextFrame(pose, flightTime_s_, request);
     boost::system::error_code ec;
     socket_.send_to(asio::buffer(bytes), target_, 0, ec);
     if (ec) {
@@ -113,18 +128,34 @@ class Replay {
                 wall > 0 ? host_.framesSent() / wall : 0.0,
                 static_cast<unsigned long long>(host_.startOfFramesReceived()), host_.igLagFrames(),
                 final ? ", done" : "");
+    if (probe_ && lastConditions_ && lastConditions_->weather) {
+      const auto& w = *lastConditions_->weather;
+      std::printf("replay: conditions at %.0f m: wind %.1f m/s from %.0f deg, vertical %.1f m/s",
+                  lastConditions_->position.alt_m, double(w.horizontalWind_mps), double(w.windDirection_deg),
+                  double(w.verticalWind_mps));
+      for (const auto& a : lastConditions_->aerosols)
+        std::printf(", cloud layer %u %.3f g/m3", unsigned(static_cast<std::uint8_t>(a.layerId)),
+                    double(a.concentration_gpm3));
+      std::printf(" (%llu asked, %llu answered)\n", static_cast<unsigned long long>(probe_->asked()),
+                  static_cast<unsigned long long>(probe_->answered()));
+    }
     std::fflush(stdout);
   }
 
   void finish() {
     socket_.close();
+    if (csv_.is_open()) csv_.flush();
     onDone_();
   }
 
   void receive() {
     socket_.async_receive_from(asio::buffer(rx_), from_, [this](boost::system::error_code ec, std::size_t n) {
       if (ec) return;
-      host_.onIgDatagram(std::span(rx_.data(), n));
+      if (host_.onIgDatagram(std::span(rx_.data(), n)) && probe_)
+        for (auto& row : probe_->onIgPackets(host_.lastReplies(), flightTime_s_)) {
+          if (csv_.is_open()) csv_ << sky::sim::ConditionsProbe::csvLine(row) << '\n';
+          lastConditions_ = std::move(row);
+        }
       receive();
     });
   }
@@ -137,6 +168,10 @@ class Replay {
   asio::ip::udp::endpoint target_, from_;
   sky::sim::CigiHost host_;
   std::array<std::uint8_t, 2048> rx_{};
+  std::optional<sky::sim::ConditionsProbe> probe_;
+  std::optional<sky::sim::ConditionsRow> lastConditions_;
+  std::ofstream csv_;
+  double flightTime_s_ = 0;
   double t0_ = 0, t1_ = 0;
   Clock::time_point wallStart_, lastReport_, tick0_;
   bool tick0Set_ = false;
@@ -149,7 +184,7 @@ class Replay {
 int main(int argc, char** argv) {
   Options o;
   CLI::App app{"skyshell-replay: replay a recorded flight as a CIGI 3.3 host over UDP"};
-  app.add_option("flight", o.flightPath, "flight file (.csv: time_s,lat_deg,lon_deg,alt_m,yaw_deg,pitch_deg,roll_deg)")
+  app.add_option("flight", o.flightPath, "flight file: .csv (time_s,lat_deg,lon_deg,alt_m,yaw_deg,pitch_deg,roll_deg), .igc or .gpx")
       ->required();
   app.add_option("--host", o.host, "IG (renderer) address");
   app.add_option("--port", o.port, "IG (renderer) CIGI UDP port")->check(CLI::Range(1, 65535));
@@ -160,6 +195,12 @@ int main(int argc, char** argv) {
   app.add_flag("--loop", o.loop, "start again at the end");
   app.add_flag("--little-endian", o.littleEndian, "send little-endian CIGI (default big-endian)");
   app.add_flag("--quiet", o.quiet, "no progress lines");
+  app.add_option("--conditions-rate", o.conditionsRate_hz,
+                 "Environmental Conditions Requests (weather + aerosol) at the ownship per second of flight; "
+                 "0: none")
+      ->check(CLI::Range(0.0, 60.0));
+  app.add_option("--conditions-csv", o.conditionsCsv,
+                 "write every answer (wind, temperature, cloud per layer) to this CSV file");
   CLI11_PARSE(app, argc, argv);
 
   auto flight = sky::sim::loadFlight(o.flightPath);

@@ -27,7 +27,8 @@ cigi::CelestialSphereControl celestialAt(std::int64_t utc_s) {
   return c;
 }
 
-std::vector<std::uint8_t> CigiHost::nextFrame(const geo::GeodeticPose& pose, double flightTime_s) {
+std::vector<std::uint8_t> CigiHost::nextFrame(const geo::GeodeticPose& pose, double flightTime_s,
+                                              const std::optional<cigi::EnvironmentalConditionsRequest>& request) {
   cigi::IgControl ig;
   ig.mode = cigi::IgMode::Operate;
   ig.hostFrame = hostFrame_++;
@@ -69,6 +70,7 @@ std::vector<std::uint8_t> CigiHost::nextFrame(const geo::GeodeticPose& pose, dou
       w.add(celestialAt(utc));
     }
   }
+  if (request) w.add(*request);
   return w.bytes();
 }
 
@@ -82,6 +84,7 @@ bool CigiHost::onIgDatagram(std::span<const std::uint8_t> bytes) {
   lastIgFrame_ = sof.igFrame;
   if (!lastAckedHostFrame_ || sof.lastHostFrame > *lastAckedHostFrame_) lastAckedHostFrame_ = sof.lastHostFrame;
   ++sofReceived_;
+  lastReplies_.assign(d->packets.begin() + 1, d->packets.end());
   return true;
 }
 

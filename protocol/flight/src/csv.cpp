@@ -98,6 +98,57 @@ Result<ParsedFlight> parseCsv(std::string_view text, std::string_view sourceName
   return flight;
 }
 
+namespace {
+
+// Attitude as a unit quaternion of the aerospace Z-Y-X rotation (yaw about
+// down, pitch about the new right axis, roll about the new forward axis), so
+// that interpolation follows the shortest rotation between two attitudes
+// instead of three independent angles (which wobble when bank and heading
+// change together, and break near pitch +-90).
+struct Quaternion {
+  double w, x, y, z;
+};
+struct Attitude {
+  double yaw_deg, pitch_deg, roll_deg;
+};
+constexpr double kRad = 3.14159265358979323846 / 180.0;
+
+Quaternion toQuaternion(const geo::GeodeticPose& p) {
+  const double cy = std::cos(p.yaw_deg * kRad / 2), sy = std::sin(p.yaw_deg * kRad / 2);
+  const double cp = std::cos(p.pitch_deg * kRad / 2), sp = std::sin(p.pitch_deg * kRad / 2);
+  const double cr = std::cos(p.roll_deg * kRad / 2), sr = std::sin(p.roll_deg * kRad / 2);
+  return {cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
+          cr * cp * sy - sr * sp * cy};
+}
+
+Attitude toAttitude(const Quaternion& q) {
+  const double sinPitch = std::clamp(2 * (q.w * q.y - q.z * q.x), -1.0, 1.0);
+  return {std::atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y * q.y + q.z * q.z)) / kRad,
+          std::asin(sinPitch) / kRad,
+          std::atan2(2 * (q.w * q.x + q.y * q.z), 1 - 2 * (q.x * q.x + q.y * q.y)) / kRad};
+}
+
+// Spherical linear interpolation along the shorter arc; normalised lerp when
+// the two are within ~2.6 degrees (where slerp's sin ratio loses precision).
+Quaternion slerp(const Quaternion& a, Quaternion b, double u) {
+  double d = a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z;
+  if (d < 0) {
+    b = {-b.w, -b.x, -b.y, -b.z};
+    d = -d;
+  }
+  double ka = 1 - u, kb = u;
+  if (d < 0.9995) {
+    const double theta = std::acos(d);
+    ka = std::sin((1 - u) * theta) / std::sin(theta);
+    kb = std::sin(u * theta) / std::sin(theta);
+  }
+  Quaternion q{ka * a.w + kb * b.w, ka * a.x + kb * b.x, ka * a.y + kb * b.y, ka * a.z + kb * b.z};
+  const double n = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+  return {q.w / n, q.x / n, q.y / n, q.z / n};
+}
+
+}  // namespace
+
 geo::GeodeticPose sample(const Flight& flight, double time_s) {
   const auto& fx = flight.fixes;
   if (time_s <= fx.front().time_s) return fx.front().pose;
@@ -112,10 +163,10 @@ geo::GeodeticPose sample(const Flight& flight, double time_s) {
   out.position = geo::fromEcef(pa + (pb - pa) * u);
   // ECEF lerp cuts the chord: re-impose the interpolated altitude.
   out.position.alt_m = a.pose.position.alt_m + (b.pose.position.alt_m - a.pose.position.alt_m) * u;
-  auto lerpAngle = [u](double x, double y) { return x + geo::angleDiff_deg(x, y) * u; };
-  out.yaw_deg = std::fmod(lerpAngle(a.pose.yaw_deg, b.pose.yaw_deg) + 360.0, 360.0);
-  out.pitch_deg = a.pose.pitch_deg + (b.pose.pitch_deg - a.pose.pitch_deg) * u;
-  out.roll_deg = lerpAngle(a.pose.roll_deg, b.pose.roll_deg);
+  const Attitude att = toAttitude(slerp(toQuaternion(a.pose), toQuaternion(b.pose), u));
+  out.yaw_deg = std::fmod(att.yaw_deg + 360.0, 360.0);
+  out.pitch_deg = att.pitch_deg;
+  out.roll_deg = att.roll_deg;
   return out;
 }
 

@@ -43,10 +43,58 @@ TEST(FlightCsv, SampleInterpolatesAndWrapsHeading) {
   const geo::GeodeticPose mid = sample(*f, 5);
   EXPECT_NEAR(mid.position.lon_deg, 12.005, 1e-6);
   EXPECT_NEAR(mid.position.alt_m, 1050, 1e-6);
-  EXPECT_NEAR(mid.yaw_deg, 0.0, 1e-9);  // 350 -> 10 passes through north
-  EXPECT_NEAR(mid.roll_deg, -5, 1e-9);
+  // 350 -> 10 passes through north. Heading and bank change together here, so
+  // the slerped attitude is not exactly the two half angles: for changes this
+  // small they agree to second order (0.04 and 0.09 degrees here).
+  EXPECT_NEAR(mid.yaw_deg, 0.0, 0.1);
+  EXPECT_NEAR(mid.roll_deg, -5, 0.1);
   EXPECT_EQ(sample(*f, -1).position.alt_m, 1000);
   EXPECT_EQ(sample(*f, 99).position.alt_m, 1100);
+}
+
+// Hand-worked attitudes: between two attitudes that differ by a rotation
+// about one body axis, the midpoint is the half rotation about it (exact for
+// slerp); across north and across a roll of 180 it takes the short way.
+TEST(FlightSample, AttitudeBySlerp) {
+  auto fix = [](double t, double yaw, double pitch, double roll) {
+    Fix f;
+    f.time_s = t;
+    f.pose.position = {10, 20, 1000};
+    f.pose.yaw_deg = yaw;
+    f.pose.pitch_deg = pitch;
+    f.pose.roll_deg = roll;
+    return f;
+  };
+  Flight f;
+  f.fixes = {fix(0, 350, 0, 30), fix(1, 10, 0, 30),  fix(2, 10, 0, -30), fix(3, 10, 80, -30),
+             fix(4, 10, 80, -170), fix(5, 10, 80, 170)};
+  // Heading alone, wings banked 30 throughout: yaw is the first of the three
+  // rotations, so this is one rotation about the local vertical.
+  const auto turn = sample(f, 0.5);
+  EXPECT_NEAR(std::fmod(turn.yaw_deg + 180.0, 360.0) - 180.0, 0.0, 1e-9);
+  EXPECT_NEAR(turn.pitch_deg, 0.0, 1e-9);
+  EXPECT_NEAR(turn.roll_deg, 30.0, 1e-9);
+  // Bank alone: 30 -> -30 passes through wings level.
+  const auto level = sample(f, 1.5);
+  EXPECT_NEAR(level.yaw_deg, 10.0, 1e-9);
+  EXPECT_NEAR(level.pitch_deg, 0.0, 1e-9);
+  EXPECT_NEAR(level.roll_deg, 0.0, 1e-9);
+  // Pitch alone with the wings banked: qa^-1 qb = Rx(30) Ry(80) Rx(-30), one
+  // rotation by 80 degrees, whose half lands on pitch 40 with the same bank.
+  const auto climb = sample(f, 2.5);
+  EXPECT_NEAR(climb.pitch_deg, 40.0, 1e-9);
+  EXPECT_NEAR(climb.yaw_deg, 10.0, 1e-9);
+  EXPECT_NEAR(climb.roll_deg, -30.0, 1e-9);
+  // Roll across 180: -170 -> 170 passes through 180, not through 0.
+  const auto inverted = sample(f, 4.5);
+  EXPECT_NEAR(std::abs(inverted.roll_deg), 180.0, 1e-6);
+  EXPECT_NEAR(inverted.pitch_deg, 80.0, 1e-6);
+  for (double t = 0; t <= 5; t += 0.01) {
+    const auto p = sample(f, t);
+    EXPECT_TRUE(std::isfinite(p.yaw_deg) && std::isfinite(p.pitch_deg) && std::isfinite(p.roll_deg)) << t;
+    EXPECT_GE(p.yaw_deg, 0.0);
+    EXPECT_LT(p.yaw_deg, 360.0);
+  }
 }
 
 TEST(FlightFile, FormatFollowsTheExtensionInAnyCase) {

@@ -34,11 +34,16 @@ class CigiHost {
   // flightTime_s becomes the CIGI timestamp (10 us ticks). The first frame
   // also carries View Definition; with a start date, every frame whose UTC
   // minute changed (and the first) carries Celestial Sphere Control.
-  std::vector<std::uint8_t> nextFrame(const geo::GeodeticPose& pose, double flightTime_s);
+  // `request`, when given, is appended (an Environmental Conditions Request).
+  std::vector<std::uint8_t> nextFrame(const geo::GeodeticPose& pose, double flightTime_s,
+                                      const std::optional<cigi::EnvironmentalConditionsRequest>& request = {});
 
   // Feeds one datagram received from the IG; returns whether it was a valid
   // Start of Frame. Malformed datagrams are counted, never thrown.
   bool onIgDatagram(std::span<const std::uint8_t> bytes);
+  // The packets after Start of Frame in the last valid IG datagram (answers
+  // to conditions requests, for a ConditionsProbe).
+  const std::vector<cigi::Packet>& lastReplies() const { return lastReplies_; }
 
   std::uint32_t framesSent() const { return hostFrame_; }
   // Host frames the newest Start of Frame says the IG has not seen yet.
@@ -55,6 +60,7 @@ class CigiHost {
   std::optional<std::uint32_t> lastIgFrame_;
   std::uint64_t sofReceived_ = 0;
   std::uint64_t malformed_ = 0;
+  std::vector<cigi::Packet> lastReplies_;
 };
 
 }  // namespace sky::sim
