@@ -1,0 +1,88 @@
+// A recorded flight flown as a CIGI 3.3 host over UDP, in real time (scaled):
+// IG Control + ownship Entity Control at a fixed rate on absolute deadlines,
+// Environmental Conditions Requests at their own rate, Start of Frame and the
+// IG's answers read back, progress on stdout. Runs on the caller's
+// io_context; skyshell-replay runs it alone, skyshell-scenario next to its
+// weather actions (the tick hook gives them the flight time).
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <fstream>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/udp.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include "sky/flight/flight.hpp"
+#include "sky/sim/cigi_host.hpp"
+#include "sky/sim/conditions_probe.hpp"
+
+namespace sky::sim {
+
+struct ReplayOptions {
+  std::string host = "127.0.0.1";  // the IG (renderer)
+  unsigned port = 8004;            // its CIGI UDP port
+  double rate_hz = 60;             // host frames per wall second
+  double speed = 1;                // flight seconds per wall second
+  double start_s = 0;              // offset into the flight
+  double end_s = -1;               // offset into the flight; < 0: its end
+  bool loop = false;
+  bool littleEndian = false;
+  bool quiet = false;              // no progress lines
+  double conditionsRate_hz = 1;    // 0: no Environmental Conditions Requests
+  std::string conditionsCsv;       // empty: answers are only printed
+  std::string name = "replay";     // progress line prefix
+};
+
+class ReplaySession {
+ public:
+  // Throws std::runtime_error when the socket or the CSV cannot be opened.
+  ReplaySession(boost::asio::io_context& io, ReplayOptions options, flight::Flight flight,
+                std::function<void()> onDone);
+
+  // Called on every host frame with the flight time (s from the record's
+  // start), before the frame is sent.
+  void onTick(std::function<void(double flightTime_s)> hook) { tickHook_ = std::move(hook); }
+
+  void start();
+  // Stops sending; onDone runs.
+  void stop();
+
+  int exitCode() const { return exitCode_; }
+  double flightTime_s() const { return flightTime_s_; }
+  const CigiHost& host() const { return host_; }
+  const std::optional<ConditionsProbe>& probe() const { return probe_; }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  void tick();
+  void report(double t, bool final);
+  void finish();
+  void receive();
+
+  ReplayOptions o_;
+  flight::Flight flight_;
+  std::function<void()> onDone_;
+  std::function<void(double)> tickHook_;
+  boost::asio::ip::udp::socket socket_;
+  boost::asio::steady_timer timer_;
+  boost::asio::ip::udp::endpoint target_, from_;
+  CigiHost host_;
+  std::array<std::uint8_t, 2048> rx_{};
+  std::optional<ConditionsProbe> probe_;
+  std::optional<ConditionsRow> lastConditions_;
+  std::ofstream csv_;
+  double flightTime_s_ = 0;
+  double t0_ = 0, t1_ = 0;
+  Clock::time_point wallStart_, lastReport_, tick0_;
+  std::uint64_t ticks_ = 0;
+  int exitCode_ = 0;
+  bool finished_ = false;
+};
+
+}  // namespace sky::sim

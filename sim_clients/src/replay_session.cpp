@@ -1,0 +1,139 @@
+// A recorded flight flown as a CIGI host (see replay_session.hpp).
+#include "sky/sim/replay_session.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <span>
+#include <stdexcept>
+
+#include <boost/asio/buffer.hpp>
+#include <boost/asio/ip/address.hpp>
+
+namespace sky::sim {
+
+namespace asio = boost::asio;
+
+ReplaySession::ReplaySession(asio::io_context& io, ReplayOptions o, flight::Flight flight,
+                             std::function<void()> onDone)
+    : o_(std::move(o)), flight_(std::move(flight)), onDone_(std::move(onDone)), socket_(io), timer_(io),
+      host_(HostOptions{o_.littleEndian ? cigi::ByteOrder::Little : cigi::ByteOrder::Big, 60, 16.0 / 9.0,
+                        flight_.startUtc_s}) {
+  boost::system::error_code ec;
+  const auto address = asio::ip::make_address(o_.host, ec);
+  if (ec) throw std::runtime_error("IG address '" + o_.host + "': " + ec.message());
+  socket_.open(address.is_v6() ? asio::ip::udp::v6() : asio::ip::udp::v4());
+  socket_.bind({address, 0});
+  target_ = {address, static_cast<unsigned short>(o_.port)};
+  if (o_.conditionsRate_hz > 0) probe_.emplace(o_.conditionsRate_hz);
+  if (!o_.conditionsCsv.empty()) {
+    csv_.open(o_.conditionsCsv, std::ios::trunc);
+    if (!csv_) throw std::runtime_error("cannot write conditions CSV " + o_.conditionsCsv);
+    csv_ << ConditionsProbe::csvHeader() << '\n';
+  }
+  t0_ = flight_.fixes.front().time_s + o_.start_s;
+  t1_ = o_.end_s >= 0 ? std::min(flight_.fixes.front().time_s + o_.end_s, flight_.fixes.back().time_s)
+                      : flight_.fixes.back().time_s;
+}
+
+void ReplaySession::start() {
+  wallStart_ = Clock::now();
+  tick0_ = wallStart_;
+  lastReport_ = wallStart_;
+  receive();
+  tick();
+}
+
+void ReplaySession::stop() {
+  if (finished_) return;
+  timer_.cancel();
+  finish();
+}
+
+void ReplaySession::tick() {
+  if (finished_) return;
+  const double elapsed = std::chrono::duration<double>(Clock::now() - wallStart_).count();
+  double t = t0_ + elapsed * o_.speed;
+  const bool done = t >= t1_;
+  if (done && o_.loop) {
+    wallStart_ = Clock::now();
+    t = t0_;
+  }
+  if (done && !o_.loop) t = t1_;
+  const auto pose = flight::sample(flight_, t);
+  flightTime_s_ = t - flight_.fixes.front().time_s;
+  if (tickHook_) tickHook_(flightTime_s_);
+  const auto request = probe_ ? probe_->due(flightTime_s_, pose.position) : std::nullopt;
+  const auto bytes = host_.nextFrame(pose, flightTime_s_, request);
+  boost::system::error_code ec;
+  socket_.send_to(asio::buffer(bytes), target_, 0, ec);
+  if (ec) {
+    std::fprintf(stderr, "skyshell-%s: send to %s:%u failed: %s\n", o_.name.c_str(), o_.host.c_str(), o_.port,
+                 ec.message().c_str());
+    exitCode_ = 1;
+    finish();
+    return;
+  }
+  report(t, done && !o_.loop);
+  if (done && !o_.loop) {
+    finish();
+    return;
+  }
+  // Absolute deadlines, so the rate does not drift.
+  ++ticks_;
+  timer_.expires_at(tick0_ + std::chrono::duration_cast<Clock::duration>(
+                                 std::chrono::duration<double>(double(ticks_) / o_.rate_hz)));
+  timer_.async_wait([this](boost::system::error_code e) {
+    if (!e) tick();
+  });
+}
+
+void ReplaySession::report(double t, bool final) {
+  const auto now = Clock::now();
+  if (o_.quiet || (!final && now - lastReport_ < std::chrono::seconds(1))) return;
+  lastReport_ = now;
+  const double wall = std::chrono::duration<double>(now - tick0_).count();
+  const double total = t1_ - t0_, done = t - t0_;
+  const double left_s = o_.speed > 0 ? (total - done) / o_.speed : 0;
+  std::printf("%s: flight time %.1f / %.1f s (%.0f%%, %.0f s left), %u frames sent (%.1f Hz), "
+              "%llu Start of Frame received, IG %u frames behind%s\n",
+              o_.name.c_str(), t - flight_.fixes.front().time_s, t1_ - flight_.fixes.front().time_s,
+              total > 0 ? 100.0 * done / total : 100.0, left_s, host_.framesSent(),
+              wall > 0 ? host_.framesSent() / wall : 0.0,
+              static_cast<unsigned long long>(host_.startOfFramesReceived()), host_.igLagFrames(),
+              final ? ", done" : "");
+  if (probe_ && lastConditions_ && lastConditions_->weather) {
+    const auto& w = *lastConditions_->weather;
+    std::printf("%s: conditions at %.0f m: wind %.1f m/s from %.0f deg, vertical %.1f m/s", o_.name.c_str(),
+                lastConditions_->position.alt_m, double(w.horizontalWind_mps), double(w.windDirection_deg),
+                double(w.verticalWind_mps));
+    for (const auto& a : lastConditions_->aerosols)
+      std::printf(", cloud layer %u %.3f g/m3", unsigned(static_cast<std::uint8_t>(a.layerId)),
+                  double(a.concentration_gpm3));
+    std::printf(" (%llu asked, %llu answered)\n", static_cast<unsigned long long>(probe_->asked()),
+                static_cast<unsigned long long>(probe_->answered()));
+  }
+  std::fflush(stdout);
+}
+
+void ReplaySession::finish() {
+  if (finished_) return;
+  finished_ = true;
+  boost::system::error_code ignored;
+  socket_.close(ignored);
+  if (csv_.is_open()) csv_.flush();
+  if (onDone_) onDone_();
+}
+
+void ReplaySession::receive() {
+  socket_.async_receive_from(asio::buffer(rx_), from_, [this](boost::system::error_code ec, std::size_t n) {
+    if (ec) return;
+    if (host_.onIgDatagram(std::span(rx_.data(), n)) && probe_)
+      for (auto& row : probe_->onIgPackets(host_.lastReplies(), flightTime_s_)) {
+        if (csv_.is_open()) csv_ << ConditionsProbe::csvLine(row) << '\n';
+        lastConditions_ = std::move(row);
+      }
+    receive();
+  });
+}
+
+}  // namespace sky::sim
