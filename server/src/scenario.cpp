@@ -4,86 +4,25 @@
 
 #include <cmath>
 #include <fstream>
-#include <initializer_list>
 #include <set>
 #include <sstream>
 #include <string>
 
-#include <toml++/toml.h>
+#include "sky/config/toml_fields.hpp"
 
 namespace sky::server {
 
 namespace {
 
-// Builds error details "file:line:col: field: what" for one scenario source.
-class Where {
- public:
-  explicit Where(std::string_view sourceName) : source_(sourceName) {}
-
-  tl::unexpected<Error> error(ErrorCode code, const toml::source_region& at,
-                              const std::string& field, const std::string& what) const {
-    return fail(code, source_ + ":" + std::to_string(at.begin.line) + ":" +
-                          std::to_string(at.begin.column) + ": " + field + ": " + what);
-  }
-
- private:
-  std::string source_;
-};
+// The strict field readers every TOML input shares (protocol/config).
+// (number: TOML integers are accepted where a float is expected, base_m = 1500.)
+using config::number;
+using config::onlyKeys;
+using config::required;
+using config::table;
+using config::Where;
 
 std::string singleQuoted(std::string_view s) { return "'" + std::string(s) + "'"; }
-
-std::string join(std::initializer_list<std::string_view> names) {
-  std::string out;
-  for (std::string_view n : names) out += (out.empty() ? "" : ", ") + std::string(n);
-  return out;
-}
-
-// Rejects keys outside `allowed`: a typo must never be ignored silently.
-Result<void> onlyKeys(const toml::table& table, std::initializer_list<std::string_view> allowed,
-                      const std::string& prefix, const Where& where) {
-  for (auto&& [key, node] : table) {
-    bool known = false;
-    for (std::string_view a : allowed) known = known || key.str() == a;
-    if (!known)
-      return where.error(ErrorCode::Malformed, node.source(), prefix + std::string(key.str()),
-                         "unknown key (expected one of: " + join(allowed) + ")");
-  }
-  return {};
-}
-
-Result<const toml::node*> required(const toml::table& table, std::string_view key,
-                                   const std::string& prefix, const Where& where) {
-  const toml::node* node = table.get(key);
-  if (!node)
-    return where.error(ErrorCode::Malformed, table.source(), prefix + std::string(key),
-                       "missing (required)");
-  return node;
-}
-
-// A number: TOML integers are accepted where a float is expected (base_m = 1500).
-Result<double> number(const toml::table& table, std::string_view key, const std::string& prefix,
-                      const Where& where) {
-  auto node = required(table, key, prefix, where);
-  if (!node) return tl::unexpected(node.error());
-  if (const auto* f = (*node)->as_floating_point()) {
-    if (!std::isfinite(f->get()))
-      return where.error(ErrorCode::InvalidArgument, (*node)->source(), prefix + std::string(key),
-                         "must be finite");
-    return f->get();
-  }
-  if (const auto* i = (*node)->as_integer()) return static_cast<double>(i->get());
-  return where.error(ErrorCode::Malformed, (*node)->source(), prefix + std::string(key),
-                     "must be a number");
-}
-
-Result<const toml::table*> table(const toml::table& parent, std::string_view key,
-                                 const std::string& prefix, const Where& where) {
-  auto node = required(parent, key, prefix, where);
-  if (!node) return tl::unexpected(node.error());
-  if (const auto* t = (*node)->as_table()) return t;
-  return where.error(ErrorCode::Malformed, (*node)->source(), prefix + std::string(key),
-                     "must be a table");
-}
 
 Result<ClockSettings> parseClock(const toml::table& root, const Where& where) {
   auto clock = table(root, "clock", "", where);
@@ -189,12 +128,9 @@ Result<weather::CloudLayer> parseLayer(const toml::table& t, std::size_t index,
 
 Result<Scenario> parseScenario(std::string_view text, std::string_view sourceName) {
   const Where where(sourceName);
-  toml::table root;
-  try {
-    root = toml::parse(text, sourceName);
-  } catch (const toml::parse_error& e) {
-    return where.error(ErrorCode::Malformed, e.source(), "TOML", std::string(e.description()));
-  }
+  auto parsed = config::parseText(text, where);
+  if (!parsed) return tl::unexpected(parsed.error());
+  const toml::table& root = *parsed;
   if (auto r = onlyKeys(root, {"clock", "layer"}, "", where); !r) return tl::unexpected(r.error());
 
   Scenario scenario;
