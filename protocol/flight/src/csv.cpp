@@ -128,6 +128,25 @@ Attitude toAttitude(const Quaternion& q) {
           std::atan2(2 * (q.w * q.x + q.y * q.z), 1 - 2 * (q.x * q.x + q.y * q.y)) / kRad};
 }
 
+Quaternion operator*(const Quaternion& a, const Quaternion& b) {
+  return {a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z, a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+          a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x, a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w};
+}
+
+Quaternion conjugate(const Quaternion& q) { return {q.w, -q.x, -q.y, -q.z}; }
+
+// The local north-east-down frame at a geodetic point, as a rotation from NED
+// to Earth-fixed (ECEF) axes: about z by the longitude, then about y by
+// -(latitude + 90 deg). Attitudes are interpolated in Earth-fixed axes, so
+// that a track over a pole (where heading flips from 0 to 180 in one step)
+// turns the camera no more than the aircraft turned.
+Quaternion nedToEcef(const geo::Geodetic& p) {
+  const double hl = p.lon_deg * kRad / 2, hp = (-p.lat_deg - 90.0) * kRad / 2;
+  const Quaternion z{std::cos(hl), 0, 0, std::sin(hl)};
+  const Quaternion y{std::cos(hp), 0, std::sin(hp), 0};
+  return z * y;
+}
+
 // Spherical linear interpolation along the shorter arc; normalised lerp when
 // the two are within ~2.6 degrees (where slerp's sin ratio loses precision).
 Quaternion slerp(const Quaternion& a, Quaternion b, double u) {
@@ -163,7 +182,9 @@ geo::GeodeticPose sample(const Flight& flight, double time_s) {
   out.position = geo::fromEcef(pa + (pb - pa) * u);
   // ECEF lerp cuts the chord: re-impose the interpolated altitude.
   out.position.alt_m = a.pose.position.alt_m + (b.pose.position.alt_m - a.pose.position.alt_m) * u;
-  const Attitude att = toAttitude(slerp(toQuaternion(a.pose), toQuaternion(b.pose), u));
+  const Quaternion qa = nedToEcef(a.pose.position) * toQuaternion(a.pose);
+  const Quaternion qb = nedToEcef(b.pose.position) * toQuaternion(b.pose);
+  const Attitude att = toAttitude(conjugate(nedToEcef(out.position)) * slerp(qa, qb, u));
   out.yaw_deg = std::fmod(att.yaw_deg + 360.0, 360.0);
   out.pitch_deg = att.pitch_deg;
   out.roll_deg = att.roll_deg;

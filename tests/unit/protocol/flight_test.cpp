@@ -97,6 +97,38 @@ TEST(FlightSample, AttitudeBySlerp) {
   }
 }
 
+// Over the pole the track's heading jumps from 0 (north, on 170W) to 180
+// (south, on 10E), yet the aircraft flies straight: between the two fixes the
+// camera must keep looking along the meridian plane (level, nose along the
+// track), not swing through east or west as a heading interpolation would.
+TEST(FlightSample, AttitudeIsContinuousOverThePole) {
+  Flight f;
+  Fix a, b;
+  a.time_s = 0;
+  a.pose.position = {89.99, -170.0, 10000};
+  a.pose.yaw_deg = 0;
+  b.time_s = 9;
+  b.pose.position = {89.99, 10.0, 10000};
+  b.pose.yaw_deg = 180;
+  f.fixes = {a, b};
+  // Nose direction in ECEF at each sample: consecutive samples turn little.
+  auto nose = [](const geo::GeodeticPose& p) {
+    const geo::EnuFrame e = geo::enuFrameAt(p.position);
+    const double y = p.yaw_deg * 3.14159265358979323846 / 180, c = std::cos(p.pitch_deg * 3.14159265358979323846 / 180);
+    return e.north * (std::cos(y) * c) + e.east * (std::sin(y) * c) +
+           e.up * std::sin(p.pitch_deg * 3.14159265358979323846 / 180);
+  };
+  const geo::Vec3d start = nose(sample(f, 0));
+  for (double t = 0; t <= 9; t += 0.25) {
+    const auto p = sample(f, t);
+    // Both fixes look along the same great circle (the 170W/10E meridian
+    // plane): every sample must too, within 0.01 degrees.
+    EXPECT_NEAR(geo::dot(nose(p), start), 1.0, 1e-6) << "t=" << t << " yaw " << p.yaw_deg;
+    EXPECT_NEAR(p.pitch_deg, 0.0, 0.01) << t;
+    EXPECT_NEAR(p.roll_deg, 0.0, 0.01) << t;
+  }
+}
+
 TEST(FlightFile, FormatFollowsTheExtensionInAnyCase) {
   const std::string csv = "time_s,lat_deg,lon_deg,alt_m,yaw_deg,pitch_deg,roll_deg\n0,1,2,3,0,0,0\n1,1,2,3,0,0,0\n";
   EXPECT_TRUE(parseFlight(csv, "dir.v2/a.CSV"));

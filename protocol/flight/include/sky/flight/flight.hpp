@@ -121,7 +121,9 @@ std::int64_t daysFromCivil(std::int64_t y, unsigned m, unsigned d);
 
 // The pose at time t (clamped to the record): position interpolated along the
 // ellipsoid (ECEF lerp re-projected), attitude by quaternion slerp of the
-// yaw-pitch-roll rotations (the shortest rotation between the two fixes).
+// body's rotation in Earth-fixed axes (the shortest rotation between the two
+// fixes, continuous over a pole), expressed in the local frame of the
+// interpolated position.
 // Yaw in [0, 360), pitch in [-90, 90], roll in (-180, 180].
 geo::GeodeticPose sample(const Flight& flight, double time_s);
 
