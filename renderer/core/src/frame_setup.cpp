@@ -1,6 +1,7 @@
 // Frame derivation in double precision (see frame_setup.hpp).
 #include "frame_setup.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <numeric>
@@ -106,8 +107,10 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
   // |camera ECEF|, so R_local = r - alt and heights above it are altitudes.
   const double alt_m = in.camera.position.alt_m;
   s.r_m = geo::length(enu.originEcef_m);
-  s.hGround_m = alt_m;
-  s.cGround_m2 = alt_m * (2 * s.r_m - alt_m);
+  // The ground is mean sea level (no terrain yet); a camera below it (the
+  // Dead Sea shore at -430 m) stands on the ground instead of under it.
+  s.hGround_m = std::max(alt_m, 0.0);
+  s.cGround_m2 = s.hGround_m * (2 * s.r_m - s.hGround_m);
 
   const double az = in.sunAzimuth_deg * kDegToRad, el = in.sunElevation_deg * kDegToRad;
   s.sunDir = {std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), std::sin(el)};
