@@ -16,10 +16,18 @@ SKY_CORE_CONST real kPi = 3.14159265358979323846;
 SKY_CORE_CONST real kExtinctionPerDensity_perm = 0.05;
 // Single-scattering albedo of cloud droplets in the visible (formulas.md: 0.999+).
 SKY_CORE_CONST real kAlbedo = 0.999;
-// Henyey-Greenstein asymmetry: one forward lobe standing in for Mie until the
-// Jendersie-d'Eon fit arrives (their g_HG for 10 um droplets is 0.99; 0.6 keeps
-// the side-lit cloud visible with single scattering only).
-SKY_CORE_CONST real kPhaseG = 0.6;
+// Cloud droplet diameter for the Jendersie-d'Eon fitted Mie phase function,
+// um: the fit holds for 5-50; 10 um is a typical cumulus droplet (effective
+// radius ~5-10 um), and formulas.md lists the fitted parameters there.
+SKY_CORE_CONST real kDropletDiameter_um = 10.0;
+// Wrenninge 2015 multiple-scattering octaves: octave i scales the extinction
+// towards the sun by a^i, its contribution by b^i and the phase eccentricity
+// by c^i; a <= b keeps the sum energy-conserving. a = b = c = 0.5 as in
+// formulas.md; 4 octaves (Ford uses 8; the 5th adds under 3 %).
+SKY_CORE_CONST int kScatterOctaves = 4;
+SKY_CORE_CONST real kOctaveExtinction = 0.5;
+SKY_CORE_CONST real kOctaveContribution = 0.5;
+SKY_CORE_CONST real kOctaveEccentricity = 0.5;
 // Primary samples per layer span; fixed so cost is predictable (lavapipe.md:
 // ~9.5 ns per primary step, 60-130 lookups per pixel fit a 33 ms frame).
 SKY_CORE_CONST int kPrimarySteps = 48;
@@ -175,6 +183,48 @@ real phaseHG(real cosTheta, real g) {
   return (1.0 - g * g) / (4.0 * kPi * denom * sqrt(denom));
 }
 
+// Draine's phase function (formulas.md), 1/sr: HG times (1 + alpha cos^2)
+// over its mean, (1 + alpha (1 + 2 g^2) / 3), so it integrates to 1.
+real phaseDraine(real cosTheta, real g, real alpha) {
+  real c = clamp(cosTheta, -1.0, 1.0);
+  return phaseHG(c, g) * (1.0 + alpha * c * c) / (1.0 + alpha * (1.0 + 2.0 * g * g) / 3.0);
+}
+
+// Jendersie & d'Eon 2023 fit of Mie scattering by water droplets of diameter
+// d um (5 <= d <= 50): an HG lobe and a Draine lobe mixed by w.
+struct MieFit {
+  real gHG;
+  real gD;
+  real alpha;
+  real w;
+};
+
+MieFit mieFit(real d) {
+  return MieFit(exp(-0.0990567 / (d - 1.67154)), exp(-2.20679 / (d + 3.91029) - 0.428934),
+                exp(3.62489 - 8.29288 / (d + 5.52825)), exp(-0.599085 / (d - 0.641583) - 0.664888));
+}
+
+// The fitted phase function with both eccentricities scaled by gScale (1 for
+// single scattering, c^i for Wrenninge's octave i), 1/sr.
+real phaseMie(real cosTheta, MieFit m, real gScale) {
+  return (1.0 - m.w) * phaseHG(cosTheta, m.gHG * gScale) + m.w * phaseDraine(cosTheta, m.gD * gScale, m.alpha);
+}
+
+// Sun light scattered towards the viewer at a point with optical depth tauSun
+// towards the sun, per unit sun radiance: Wrenninge's octave sum
+// sum_i b^i p(theta, c^i g) exp(-a^i tauSun), given the octaves' phase values.
+real octaveSum(real phases[kScatterOctaves], real tauSun) {
+  real sum = 0.0;
+  real a = 1.0;
+  real b = 1.0;
+  for (int i = 0; i < kScatterOctaves; ++i) {
+    sum += b * phases[i] * exp(-a * tauSun);
+    a *= kOctaveExtinction;
+    b *= kOctaveContribution;
+  }
+  return sum;
+}
+
 // Vertical profile in [0, 1] for ph = height fraction within the layer; 0
 // outside [0, 1].
 real heightProfile(real ph) {
@@ -205,7 +255,14 @@ real3 skyBackground(real3 dir, bool hitsGround) {
 MarchState marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, MarchState st) {
   CoreLayer L = f.layers[li];
   real dt = (s.t1 - s.t0) / real(kPrimarySteps);
-  real phase = phaseHG(dot(dir, f.sunDir), kPhaseG);
+  // The phase of each octave depends on the angle to the sun only: once per span.
+  MieFit mie = mieFit(kDropletDiameter_um);
+  real phases[kScatterOctaves];
+  real gScale = 1.0;
+  for (int o = 0; o < kScatterOctaves; ++o) {
+    phases[o] = phaseMie(dot(dir, f.sunDir), mie, gScale);
+    gScale *= kOctaveEccentricity;
+  }
   real lightDt = kLightMarchDistance_m / real(kLightSteps);
   for (int i = 0; i < kPrimarySteps; ++i) {
     if (st.transmittance < kMinTransmittance) break;
@@ -228,7 +285,7 @@ MarchState marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, March
     }
     real sigmaT = kExtinctionPerDensity_perm * rho;
     real ambientScale = mix(kAmbientBottomFactor, 1.0, clamp(ph, 0.0, 1.0));
-    real3 scattered = f.sunRadiance * (phase * exp(-tauSun)) + f.ambient * ambientScale;
+    real3 scattered = f.sunRadiance * octaveSum(phases, tauSun) + f.ambient * ambientScale;
     // Hillaire 2016 energy-conserving step: integral over the step of
     // sigma_s L e^{-sigma_t s} = albedo L (1 - e^{-sigma_t dt}); its limit as
     // sigma_t -> 0 is sigma_s L dt.
