@@ -10,6 +10,7 @@
 
 #include "renderer_fixture.hpp"
 #include "scenes.hpp"
+#include "sky/render/ephemeris.hpp"
 
 namespace sky::test {
 namespace {
@@ -127,6 +128,27 @@ TEST(CloudRender, FrameIsReproducibleAndCloudsDriftWithWind) {
   const Image windy = renderOk(r, in);
   EXPECT_GT(diff(a, windy).meanAbs, 1e-3) << "6 km of drift must change the view";
   EXPECT_EQ(render::computeStats(windy).nonFinite, 0u);
+}
+
+// With a UTC instant the sun comes from the ephemeris at the camera: the same
+// image as passing that direction by hand, and a different one from noon at
+// midnight.
+TEST(CloudRender, SunFromUtcIsTheEphemerisSun) {
+  SKY_RENDERER(r, 64, 36);
+  weather::WeatherSnapshot snap;
+  snap.layers.push_back(layer(1, 1500, 1000, 0.6, 1.0));
+  FrameInputs in;
+  in.camera = pose(46.2, 12.8, 900.0, 180.0, 20.0);
+  in.weather = &snap;
+  in.utc_s = 1459685800.0;  // 2016-04-03 12:16:40 UTC, the demo flight's date
+  const Image dated = renderOk(r, in);
+  const render::SkyDirection sun = render::sunDirection(*in.utc_s, 46.2, 12.8);
+  in.utc_s.reset();
+  in.sunAzimuth_deg = sun.azimuth_deg;
+  in.sunElevation_deg = sun.elevation_deg;
+  EXPECT_EQ(dated.rgba, renderOk(r, in).rgba);
+  in.utc_s = 1459685800.0 + 12 * 3600.0;  // past midnight: the sun is down
+  EXPECT_GT(diff(dated, renderOk(r, in)).meanAbs, 1e-3);
 }
 
 // A renderer of its own, created, used and destroyed while the shared ones keep

@@ -116,6 +116,8 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   const double clockBase_s = o.weatherClock_s.value_or(firstView.clockNow(Clock::now()));
   const double clockRate = firstView.clock.rate();
 
+  // The real sun when the record says when it was flown.
+  const bool sunFromDate = !o.fixedSun && flight->startUtc_s.has_value();
   const auto picks = ContactSheet::pick(frameCount, kSheetColumns * kSheetRows);
   ContactSheet sheet(kSheetColumns, kSheetRows, kSheetCellWidth, s.width, s.height);
   std::size_t nextPick = 0;
@@ -148,6 +150,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     in.weatherClock_s = clockBase_s + (t - t0) * clockRate;
     in.sunAzimuth_deg = o.sunAzimuth_deg;
     in.sunElevation_deg = o.sunElevation_deg;
+    if (sunFromDate) in.utc_s = double(*flight->startUtc_s) + (t - first_s);
     in.frameIndex = i;
     const auto r0 = Clock::now();
     auto image = renderer.render(in);
@@ -219,6 +222,12 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   report["vertical_fov_deg"] = s.verticalFov_deg;
   report["noise_seed"] = s.noiseSeed;
   report["preset"] = o.preset;
+  if (sunFromDate) {
+    report["sun"] = "ephemeris at the recorded date and time";
+    report["utc_start_s"] = double(*flight->startUtc_s) + (t0 - first_s);
+  } else {
+    report["sun"] = {{"azimuth_deg", o.sunAzimuth_deg}, {"elevation_deg", o.sunElevation_deg}};
+  }
   report["device"] = renderer.deviceName();
   report["render_ms"] = {{"p50", ms.p50}, {"p90", ms.p90}, {"p99", ms.p99}, {"mean", ms.mean}, {"max", ms.max}};
   report["wall_s"] = wall_s;

@@ -57,6 +57,7 @@ struct Options {
   double replayEnd_s = -1;
   double replayWeatherClock_s = std::numeric_limits<double>::quiet_NaN();
   bool noVideo = false;
+  bool fixedSun = false;
 };
 
 // Set by SIGINT/SIGTERM during a --replay (which runs no io_context of its own
@@ -121,6 +122,8 @@ int main(int argc, char** argv) {
                  "with --replay: weather clock of the first frame, s (default: the server's); pin it for "
                  "byte-identical re-renders");
   app.add_flag("--no-video", o.noVideo, "with --replay: skip the MP4");
+  app.add_flag("--fixed-sun", o.fixedSun,
+               "with --replay: light from --sun-azimuth/--sun-elevation even when the flight has a date");
   app.set_config("--config", "", "config file (TOML keys named like the long options)");
   CLI11_PARSE(app, argc, argv);
   spdlog::set_default_logger(spdlog::stderr_color_mt("render"));
@@ -166,6 +169,7 @@ int main(int argc, char** argv) {
     r.video = !o.noVideo;
     r.sunAzimuth_deg = o.sunAzimuth_deg;
     r.sunElevation_deg = o.sunElevation_deg;
+    r.fixedSun = o.fixedSun;
     std::signal(SIGINT, onReplaySignal);
     std::signal(SIGTERM, onReplaySignal);
     return sky::app::runHeadlessReplay(r, **renderer, &gReplayStop);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "sky/core/assert.hpp"
+#include "sky/render/ephemeris.hpp"
 #include "sky/weather/advection.hpp"
 
 namespace sky::render {
@@ -61,7 +62,7 @@ Result<void> validateInputs(const FrameInputs& in) {
   const auto& c = in.camera;
   const auto& p = c.position;
   for (double v : {p.lat_deg, p.lon_deg, p.alt_m, c.yaw_deg, c.pitch_deg, c.roll_deg, in.weatherClock_s,
-                   in.sunAzimuth_deg, in.sunElevation_deg})
+                   in.sunAzimuth_deg, in.sunElevation_deg, in.utc_s.value_or(0.0)})
     if (!std::isfinite(v)) return fail(ErrorCode::InvalidArgument, "frame inputs: non-finite value");
   if (p.lat_deg < -90 || p.lat_deg > 90)
     return fail(ErrorCode::InvalidArgument, "frame inputs: camera lat_deg " + num(p.lat_deg) + " outside [-90, 90]");
@@ -112,7 +113,9 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
   s.hGround_m = std::max(alt_m, 0.0);
   s.cGround_m2 = s.hGround_m * (2 * s.r_m - s.hGround_m);
 
-  const double az = in.sunAzimuth_deg * kDegToRad, el = in.sunElevation_deg * kDegToRad;
+  SkyDirection sun{in.sunAzimuth_deg, in.sunElevation_deg};
+  if (in.utc_s) sun = sunDirection(*in.utc_s, in.camera.position.lat_deg, in.camera.position.lon_deg);
+  const double az = sun.azimuth_deg * kDegToRad, el = sun.elevation_deg * kDegToRad;
   s.sunDir = {std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), std::sin(el)};
   s.sunRadiance = kSunIrradiance * kSunColour;
   s.ambient = kAmbientRadiance;

@@ -30,7 +30,8 @@ struct ReplayOptions {
   std::string outDir;
   bool writeFloat = false;
   bool video = true;             // MP4 through ffmpeg (skipped with a warning if ffmpeg is missing)
-  double sunAzimuth_deg = 135, sunElevation_deg = 40;
+  double sunAzimuth_deg = 135, sunElevation_deg = 40;  // when the flight has no date, or fixedSun
+  bool fixedSun = false;  // ignore the flight's recorded date (IGC, GPX) for the sun
   std::string preset = "skeleton";  // recorded in the report
 };
 

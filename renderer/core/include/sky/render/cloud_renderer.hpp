@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,9 @@ struct FrameInputs {
                                                       // density); with tiles, a missing cell is empty.
   double weatherClock_s = 0;  // clouds advect with each layer's wind by this clock
   double sunAzimuth_deg = 135, sunElevation_deg = 40;  // in the camera's local ENU frame
+  // When set (UTC, s since 1970), the sun is where it is at that instant seen
+  // from the camera (ephemeris.hpp), and the two angles above are ignored.
+  std::optional<double> utc_s;
   std::uint64_t frameIndex = 0;  // carried for reprojection; the skeleton's image does not depend on it
 };
 
