@@ -60,8 +60,20 @@ class HeadlessReplay : public ::testing::Test {
     dir_ = fs::path(SKY_TEST_OUTPUT_DIR) / ("replay-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    weatherd_.emplace(std::vector<std::string>{SKY_WEATHERD, "--scenario", SKY_SCENARIO_CLOUDY, "--port", "0",
-                                               "--port-file", (dir_ / "weatherd.port").string()},
+    // The server's weather is an input of the render: its snapshots carry
+    // the weather clock they were made at, and the renderer advects their
+    // coverage from then on. A frozen clock makes that input the same in
+    // every run; the cumulus layer (10 m/s westerly) of the bundled scenario.
+    std::ifstream cloudy(SKY_SCENARIO_CLOUDY);
+    std::ostringstream text;
+    text << cloudy.rdbuf();
+    std::string scenario = text.str();
+    const auto rate = scenario.find("rate = 1.0");
+    ASSERT_NE(rate, std::string::npos);
+    scenario.replace(rate, 10, "rate = 0.0");
+    std::ofstream(dir_ / "frozen.toml") << scenario;
+    weatherd_.emplace(std::vector<std::string>{SKY_WEATHERD, "--scenario", (dir_ / "frozen.toml").string(), "--port",
+                                               "0", "--port-file", (dir_ / "weatherd.port").string()},
                       (dir_ / "weatherd.log").string());
     port_ = waitForPortFile((dir_ / "weatherd.port").string(), 20s);
     ASSERT_GT(port_, 0u) << weatherd_->log();
@@ -97,7 +109,7 @@ TEST_F(HeadlessReplay, FramesFollowTheFlightAreDeterministicAndReported) {
     const double t = double(i) * kStep_s;
     EXPECT_EQ(f["source"], "replay");
     EXPECT_NEAR(f["host_time_s"].get<double>(), t, 1e-9);
-    EXPECT_NEAR(f["weather_clock_s"].get<double>(), 5000.0 + t, 1e-9) << "the scenario's clock runs at x1";
+    EXPECT_NEAR(f["weather_clock_s"].get<double>(), 5000.0, 1e-9) << "pinned, and the server's clock is frozen";
     const geo::GeodeticPose want = flight::sample(*flight, t);
     EXPECT_NEAR(f["lat_deg"].get<double>(), want.position.lat_deg, kPoseTolerance_deg) << "frame " << i;
     EXPECT_NEAR(f["lon_deg"].get<double>(), want.position.lon_deg, kPoseTolerance_deg) << "frame " << i;
@@ -124,7 +136,8 @@ TEST_F(HeadlessReplay, FramesFollowTheFlightAreDeterministicAndReported) {
   EXPECT_FALSE(report["weather_versions_seen"].empty());
   EXPECT_GT(report["render_ms"]["p50"].get<double>(), 0.0);
   EXPECT_LE(report["render_ms"]["p50"].get<double>(), report["render_ms"]["p90"].get<double>());
-  EXPECT_EQ(report["weather_clock_s"], nlohmann::json::array({5000.0, 5006.0}));
+  EXPECT_EQ(report["weather_clock_s"], nlohmann::json::array({5000.0, 5000.0}));
+  EXPECT_EQ(report["weather_clock_rate"], 0.0);
 
   // The contact sheet is a PNG; the video an MP4 (ISO base media: 'ftyp' box first).
   const std::string sheet = readAll(dir_ / "a" / "contact-sheet.png");
@@ -135,6 +148,26 @@ TEST_F(HeadlessReplay, FramesFollowTheFlightAreDeterministicAndReported) {
   ASSERT_GT(mp4.size(), 1000u) << a.log;
   EXPECT_EQ(mp4.substr(4, 4), "ftyp");
   EXPECT_FALSE(fs::exists(dir_ / "b" / "replay.mp4")) << "--no-video must not write one";
+}
+
+// With the server's clock running at x1, frame i's weather clock is the
+// pinned start plus the flight time it shows.
+TEST_F(HeadlessReplay, WeatherClockFollowsFlightTimeAtTheServersRate) {
+  ChildProcess live({SKY_WEATHERD, "--scenario", SKY_SCENARIO_CLOUDY, "--port", "0", "--port-file",
+                     (dir_ / "live.port").string()},
+                    (dir_ / "live.log").string());
+  const unsigned port = waitForPortFile((dir_ / "live.port").string(), 20s);
+  ASSERT_GT(port, 0u) << live.log();
+  const ReplayRun run = replay(port, SKY_TEST_FLIGHT, dir_ / "live", {"--no-video"});
+  ASSERT_EQ(run.exitCode, 0) << run.log;
+  std::ifstream jsonl(dir_ / "live" / "frames" / "frames.jsonl");
+  std::size_t n = 0;
+  for (std::string line; std::getline(jsonl, line); ++n) {
+    const auto f = nlohmann::json::parse(line);
+    EXPECT_NEAR(f["weather_clock_s"].get<double>(), 5000.0 + double(n) * kStep_s, 1e-9);
+  }
+  EXPECT_EQ(n, kFrames);
+  EXPECT_EQ(live.stop(), 0) << live.log();
 }
 
 TEST_F(HeadlessReplay, BadFlightFileIsRefusedWithLineAndField) {

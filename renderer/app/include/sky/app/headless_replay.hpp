@@ -6,7 +6,10 @@
 // clock base + i × step × rate (base: --weather-clock, else the server's clock
 // when the first snapshot arrived; rate: the server's); after every
 // re-subscription the next frame waits for the answering snapshot. So the same
-// flight, options and (unchanging) server weather give byte-identical PNGs.
+// flight, options and server weather give byte-identical PNGs. (The server's
+// snapshots carry the weather clock they were made at, and their coverage is
+// advected from it: a server whose clock runs hands out a different input at
+// every start; one with a frozen clock, or the same state, does not.)
 #pragma once
 
 #include <atomic>
