@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -91,7 +92,10 @@ PipelineRun runPipeline(const std::string& name, const std::string& scenario) {
   EXPECT_GT(cigiPort, 0u) << render.log();
   if (cigiPort == 0) return run;
 
-  ChildProcess replay({SKY_REPLAY, SKY_TEST_FLIGHT, "--port", std::to_string(cigiPort), "--rate", "60"},
+  // The replay also asks the renderer for the weather at the ownship (CIGI
+  // Environmental Conditions Request) 4 times per flight second.
+  ChildProcess replay({SKY_REPLAY, SKY_TEST_FLIGHT, "--port", std::to_string(cigiPort), "--rate", "60",
+                       "--conditions-rate", "4", "--conditions-csv", d + "/conditions.csv"},
                       d + "/replay.log");
   EXPECT_EQ(replay.wait(60s), std::optional<int>(0)) << replay.log();
   EXPECT_EQ(render.wait(120s), std::optional<int>(0)) << render.log();
@@ -119,6 +123,38 @@ std::size_t nearestFrame(const PipelineRun& run, double t) {
         std::abs(run.frames[best]["host_time_s"].get<double>() - t))
       best = i;
   return best;
+}
+
+// The host's conditions requests came back answered with the weather the
+// renderer held: the cumulus layer's wind (10 m/s from 270; the flight is
+// below the layer, where its wind applies), standard-atmosphere temperature,
+// clear air (the flight stays 500 m below the base), no cloud water.
+TEST(Skeleton, ReplayHostGetsTheWeatherAtTheOwnship) {
+  const PipelineRun cloudy = runPipeline("conditions", SKY_SCENARIO_CLOUDY);
+  std::istringstream csv(readText((cloudy.dir / "conditions.csv").string()));
+  std::string header;
+  ASSERT_TRUE(std::getline(csv, header));
+  EXPECT_EQ(header.rfind("flight_time_s,lat_deg,lon_deg,alt_m,answered_after_s,wind_mps,wind_from_deg", 0), 0u);
+  std::size_t rows = 0, answered = 0;
+  for (std::string line; std::getline(csv, line);) {
+    ++rows;
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) f.push_back(cell);
+    ASSERT_GE(f.size(), 13u) << line;
+    // Before the first weather arrived the renderer knows no layer: calm, and
+    // no cloud layer answers (empty cloud columns).
+    if (f[12].empty()) continue;
+    ++answered;
+    const double alt = std::stod(f[3]);
+    EXPECT_NEAR(std::stod(f[5]), 10.0, 0.01) << line;
+    EXPECT_NEAR(std::stod(f[6]), 270.0, 0.1) << line;
+    EXPECT_NEAR(std::stod(f[9]), 15.0 - 0.0065 * alt, 0.06) << line;  // ISA, printed to 0.1
+    EXPECT_EQ(std::stod(f[12]), 0.0) << "cloud water in clear air: " << line;
+  }
+  // 6 s of flight at 4 requests per second.
+  EXPECT_GE(rows, 20u);
+  EXPECT_GE(answered, rows / 2) << "most requests must be answered";
 }
 
 TEST(Skeleton, ThreeProcessesRenderTheStreamedWeatherAlongTheReplayedFlight) {

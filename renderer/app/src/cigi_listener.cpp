@@ -1,6 +1,10 @@
 // CIGI UDP endpoint of a renderer channel (see cigi_listener.hpp).
 #include "sky/app/cigi_listener.hpp"
 
+#include <algorithm>
+
+#include "sky/weather/query.hpp"
+
 #include <spdlog/spdlog.h>
 
 namespace sky::app {
@@ -82,8 +86,50 @@ void CigiListener::onDatagram(std::span<const std::uint8_t> bytes) {
   sof.lastHostFrame = ig->hostFrame;
   cigi::DatagramWriter w;
   w.add(sof);
+  // Environmental Conditions Requests, answered in the same datagram from the
+  // weather this channel holds, by the query every process shares.
+  for (const auto& packet : datagram->packets)
+    if (const auto* request = std::get_if<cigi::EnvironmentalConditionsRequest>(&packet))
+      for (const auto& reply : answerConditions(*request, state_.weather(), std::chrono::steady_clock::now()))
+        w.add(reply);
   boost::system::error_code ec;
   socket_.send_to(asio::buffer(w.bytes()), from_, 0, ec);
+}
+
+std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRequest& r, const WeatherView& view,
+                                          std::chrono::steady_clock::time_point now) {
+  std::vector<cigi::Packet> out;
+  const auto& layers = view.snapshot.layers;
+  const auto lookup = weather::snapshotLookup(view.snapshot, view.clockNow(now));
+  if (r.requestType & cigi::kRequestWeather) {
+    const weather::PointWeather pw = weather::weatherAt(layers, lookup, r.lat_deg, r.lon_deg, r.alt_m);
+    cigi::WeatherConditionsResponse wcr;
+    wcr.requestId = r.requestId;
+    wcr.humidity_pct = static_cast<std::uint8_t>(pw.cloudDensity > 0 ? 100 : kClearAirHumidity_pct);
+    wcr.airTemperature_c = static_cast<float>(weather::isaTemperature_c(r.alt_m));
+    // Koschmieder: visual range 3.912 / extinction.
+    const double sigma = kExtinctionPerDensity_perm * pw.cloudDensity;
+    wcr.visibility_m = static_cast<float>(sigma > 0 ? std::min(kClearVisibility_m, 3.912 / sigma) : kClearVisibility_m);
+    wcr.horizontalWind_mps = static_cast<float>(pw.wind.speed_mps);
+    wcr.verticalWind_mps = static_cast<float>(pw.wind.vertical_mps);
+    wcr.windDirection_deg = static_cast<float>(pw.wind.fromDirection_deg);
+    wcr.pressure_hpa = static_cast<float>(weather::isaPressure_hpa(r.alt_m));
+    out.push_back(wcr);
+  }
+  if (r.requestType & cigi::kRequestAerosol) {
+    // CIGI cloud layers 1-3 are our layers of those ids; their liquid water
+    // at the point, g/m^3.
+    for (const auto& l : layers) {
+      if (l.id < 1 || l.id > 3) continue;
+      const weather::PointWeather one = weather::weatherAt(std::span(&l, 1), lookup, r.lat_deg, r.lon_deg, r.alt_m);
+      cigi::AerosolConcentrationResponse a;
+      a.requestId = r.requestId;
+      a.layerId = static_cast<cigi::LayerId>(l.id);
+      a.concentration_gpm3 = static_cast<float>(kCloudLiquidWater_gpm3 * one.cloudDensity);
+      out.push_back(a);
+    }
+  }
+  return out;
 }
 
 }  // namespace sky::app

@@ -1,13 +1,15 @@
 // The renderer's CIGI 3.3 endpoint on UDP: takes the ownship pose from each
 // host datagram (IG Control + Entity Control for entity 0) into SharedState
-// and answers with Start of Frame. Malformed datagrams are dropped, counted,
-// and logged once per reason.
+// and answers with Start of Frame, plus a Weather Conditions Response and
+// Aerosol Concentration Responses for each Environmental Conditions Request.
+// Malformed datagrams are dropped, counted, and logged once per reason.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <set>
 #include <string>
+#include <vector>
 
 #include <utility>  // before asio: Boost 1.74 asio uses std::exchange without including it
 #include <boost/asio.hpp>
@@ -16,6 +18,23 @@
 #include "sky/cigi/codec.hpp"
 
 namespace sky::app {
+
+// What the weather model has no field for, in a Weather Conditions Response:
+// humidity outside cloud (50 %; 100 % in cloud), visibility in clear air
+// (50 km; in cloud the Koschmieder range of its extinction).
+inline constexpr int kClearAirHumidity_pct = 50;
+inline constexpr double kClearVisibility_m = 50000.0;
+// Extinction per unit cloud density, 1/m: the renderer's (cloud_core.glsl).
+inline constexpr double kExtinctionPerDensity_perm = 0.05;
+// Liquid water of cloud at density 1, g/m^3 (cumulus 0.3-1, formulas.md).
+inline constexpr double kCloudLiquidWater_gpm3 = 0.5;
+
+// The replies to one Environmental Conditions Request from the weather held:
+// wind, temperature and pressure (standard atmosphere), humidity and
+// visibility at the point (weather bit); each cloud layer 1-3's liquid water
+// there (aerosol bit). Pure: the clock comes in as `now`.
+std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRequest& request,
+                                          const WeatherView& view, std::chrono::steady_clock::time_point now);
 
 class CigiListener {
  public:

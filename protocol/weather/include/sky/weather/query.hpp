@@ -1,0 +1,50 @@
+// The weather at a point, as a flight model needs it (CIGI Weather Conditions
+// Response): wind, and whether and how dense cloud is there. One function for
+// every process: the renderer answers its host's Environmental Conditions
+// Requests with it from the weather it holds, so the flight model flies in
+// the wind that moves the clouds it sees.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <span>
+
+#include "sky/weather/model.hpp"
+
+namespace sky::weather {
+
+struct PointWeather {
+  LayerWind wind;                       // see weatherAt for the interpolation
+  double cloudDensity = 0;              // [0, 1]: coverage x density x vertical presence, densest layer
+  std::optional<std::uint32_t> layerId; // the layer whose cloud that is (none: clear air)
+};
+
+// Coverage (and density, type blend) of one layer at a surface point, when it
+// varies regionally; nullopt: the layer's own uniform values apply.
+using CoverageLookup = std::function<std::optional<CoverageTile>(const CloudLayer& layer, double lat_deg, double lon_deg)>;
+
+// Wind: inside a layer (base to top) that layer's; between two layers linear
+// in altitude (by components) from the top of the one below to the base of
+// the one above; below the lowest or above the highest, the nearest layer's;
+// no layers: calm. Cloud: each layer is fully present from base to top and
+// fades linearly to nothing over its transition band above and below; the
+// densest layer at the point wins.
+PointWeather weatherAt(std::span<const CloudLayer> layers, const CoverageLookup& lookup, double lat_deg,
+                       double lon_deg, double alt_m);
+
+// A lookup over a snapshot's tiles at weather clock clock_s: the tile of the
+// point's S2 cell at the snapshot's level, the point first carried back by
+// the layer's wind from clock_s to the snapshot's clock (advect). A layer
+// with tiles is empty where it has none; a layer without tiles is uniform.
+// The lookup keeps a reference to the snapshot.
+CoverageLookup snapshotLookup(const WeatherSnapshot& snapshot, double clock_s);
+
+// ICAO standard atmosphere below 20 km (altitude MSL, m): 15 C and 1013.25 hPa
+// at sea level, -6.5 K/km to the tropopause at 11 km (-56.5 C, 226.32 hPa),
+// isothermal above. For the parts of a Weather Conditions Response the
+// weather model has no field for.
+double isaTemperature_c(double alt_m);
+double isaPressure_hpa(double alt_m);
+
+}  // namespace sky::weather

@@ -1,0 +1,144 @@
+// The weather at a point (see query.hpp).
+#include "sky/weather/query.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <vector>
+
+#include "sky/weather/advection.hpp"
+#include "sky/weather/tiling.hpp"
+
+namespace sky::weather {
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// Vertical presence of a layer at an altitude, [0, 1].
+double presence(const CloudLayer& l, double alt_m) {
+  const double top = l.base_m + l.thickness_m;
+  if (alt_m >= l.base_m && alt_m <= top) return 1.0;
+  if (l.transitionBand_m <= 0) return 0.0;
+  const double outside = alt_m < l.base_m ? l.base_m - alt_m : alt_m - top;
+  return std::max(0.0, 1.0 - outside / l.transitionBand_m);
+}
+
+// Wind as (east, north) components of the air's motion, m/s.
+struct Components {
+  double east, north;
+};
+Components components(const LayerWind& w) {
+  const double to = (w.fromDirection_deg + 180.0) * kDeg;
+  return {w.speed_mps * std::sin(to), w.speed_mps * std::cos(to)};
+}
+LayerWind fromComponents(const Components& c, double vertical_mps) {
+  LayerWind w;
+  w.speed_mps = std::hypot(c.east, c.north);
+  // The direction the air comes FROM: opposite to where it goes.
+  double from = std::atan2(-c.east, -c.north) / kDeg;
+  if (from < 0) from += 360.0;
+  w.fromDirection_deg = w.speed_mps > 0 ? std::fmod(from, 360.0) : 0.0;
+  w.vertical_mps = vertical_mps;
+  return w;
+}
+
+}  // namespace
+
+PointWeather weatherAt(std::span<const CloudLayer> layers, const CoverageLookup& lookup, double lat_deg,
+                       double lon_deg, double alt_m) {
+  PointWeather out;
+  if (layers.empty()) return out;
+  std::vector<const CloudLayer*> byBase;
+  for (const auto& l : layers) byBase.push_back(&l);
+  std::sort(byBase.begin(), byBase.end(), [](const CloudLayer* a, const CloudLayer* b) { return a->base_m < b->base_m; });
+
+  // Wind.
+  const CloudLayer* inside = nullptr;
+  for (const CloudLayer* l : byBase)
+    if (alt_m >= l->base_m && alt_m <= l->base_m + l->thickness_m) inside = l;  // the highest-based wins on overlap
+  if (inside) {
+    out.wind = inside->wind;
+  } else if (alt_m < byBase.front()->base_m) {
+    out.wind = byBase.front()->wind;
+  } else {
+    // Below the first layer based above alt, above the highest top below it.
+    const CloudLayer* above = nullptr;
+    const CloudLayer* below = nullptr;
+    for (const CloudLayer* l : byBase) {
+      if (l->base_m > alt_m) {
+        if (!above) above = l;
+      } else if (!below || l->base_m + l->thickness_m > below->base_m + below->thickness_m) {
+        below = l;
+      }
+    }
+    if (!above) {
+      out.wind = below->wind;
+    } else {
+      const double z0 = below->base_m + below->thickness_m, z1 = above->base_m;
+      const double f = z1 > z0 ? std::clamp((alt_m - z0) / (z1 - z0), 0.0, 1.0) : 0.0;
+      const Components a = components(below->wind), b = components(above->wind);
+      out.wind = fromComponents({a.east + f * (b.east - a.east), a.north + f * (b.north - a.north)},
+                                below->wind.vertical_mps + f * (above->wind.vertical_mps - below->wind.vertical_mps));
+    }
+  }
+
+  // Cloud.
+  for (const auto& l : layers) {
+    const double p = presence(l, alt_m);
+    if (p <= 0) continue;
+    double coverage = l.coverage, density = l.density;
+    if (lookup) {
+      if (const auto tile = lookup(l, lat_deg, lon_deg)) {
+        coverage = tile->coverage;
+        density = tile->density;
+      }
+    }
+    const double d = coverage * density * p;
+    if (d > out.cloudDensity) {
+      out.cloudDensity = d;
+      out.layerId = l.id;
+    }
+  }
+  return out;
+}
+
+CoverageLookup snapshotLookup(const WeatherSnapshot& snapshot, double clock_s) {
+  // (layer id, cell) -> tile; layers that have tiles at all.
+  auto index = std::make_shared<std::map<std::pair<std::uint32_t, std::uint64_t>, CoverageTile>>();
+  auto tiled = std::make_shared<std::map<std::uint32_t, bool>>();
+  for (const auto& t : snapshot.tiles) {
+    (*index)[{t.layerId, t.cellId}] = t;
+    (*tiled)[t.layerId] = true;
+  }
+  const double since_s = clock_s - snapshot.weatherClock_s;
+  const int level = snapshot.tileLevel;
+  return [index, tiled, since_s, level](const CloudLayer& layer, double lat_deg,
+                                        double lon_deg) -> std::optional<CoverageTile> {
+    if (!tiled->count(layer.id)) return std::nullopt;
+    const SurfacePoint upwind = advect({lat_deg, lon_deg}, layer.wind, -since_s);
+    const auto it = index->find({layer.id, cellAt(upwind.lat_deg, upwind.lon_deg, level)});
+    if (it == index->end()) {
+      CoverageTile empty;
+      empty.layerId = layer.id;
+      empty.coverage = 0;
+      return empty;
+    }
+    return it->second;
+  };
+}
+
+double isaTemperature_c(double alt_m) {
+  const double h = std::clamp(alt_m, -1000.0, 20000.0);
+  return h <= 11000.0 ? 15.0 - 0.0065 * h : -56.5;
+}
+
+double isaPressure_hpa(double alt_m) {
+  const double h = std::clamp(alt_m, -1000.0, 20000.0);
+  if (h <= 11000.0) return 1013.25 * std::pow(1.0 - 2.25577e-5 * h, 5.25588);
+  return 226.32 * std::exp(-(h - 11000.0) / 6341.62);
+}
+
+}  // namespace sky::weather
