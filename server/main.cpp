@@ -14,6 +14,7 @@
 #include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "sky/server/http_api.hpp"
 #include "sky/server/scenario.hpp"
 #include "sky/server/server.hpp"
 #include "sky/server/weather_state.hpp"
@@ -74,6 +75,15 @@ int main(int argc, char** argv) {
   app.add_option("--heartbeat-ms", heartbeatMs, "Heartbeat period, ms")
       ->check(CLI::Range(1, 3'600'000))
       ->capture_default_str();
+  sky::server::HttpApiOptions http;
+  int httpPort = -1;
+  std::string httpPortFile, tokenFile;
+  app.add_option("--http-listen", http.listenAddress, "Address of the HTTP API")->capture_default_str();
+  app.add_option("--http-port", httpPort, "HTTP API port (0 picks a free one; default: no HTTP API)")
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--http-port-file", httpPortFile, "Write the HTTP port here once listening");
+  app.add_option("--token-file", tokenFile,
+                 "File whose first line is the token that changes need (without it the API is read-only)");
   app.add_option("--log-level", logLevel, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
@@ -118,6 +128,36 @@ int main(int argc, char** argv) {
   }
   log->info("scenario {}: {} layer(s); listening on {}:{}", scenarioPath, scenario->layers.size(),
             host, (*server)->port());
+
+  std::unique_ptr<sky::server::HttpApi> api;
+  if (httpPort >= 0) {
+    if (!tokenFile.empty()) {
+      std::ifstream in(tokenFile);
+      if (!in || !std::getline(in, http.token) || http.token.empty()) {
+        log->error("--token-file {}: cannot read a token from its first line", tokenFile);
+        return kExitBadInput;
+      }
+    }
+    http.port = static_cast<std::uint16_t>(httpPort);
+    http.log = log;
+    sky::server::Server& s = **server;
+    auto created = sky::server::HttpApi::create(
+        s.io(), http, s.weather(), {[&s] { s.weatherChanged(); }, [&s] { return s.subscribers(); }});
+    if (!created) {
+      log->error("{}", sky::describe(created.error()));
+      return kExitRuntime;
+    }
+    api = std::move(*created);
+    s.onShutdown([&api] { api->close(); });
+    std::cout << "skyshell-weatherd HTTP API on " << http.listenAddress << ":" << api->port()
+              << (http.token.empty() ? " (read-only: no --token-file)" : "") << std::endl;
+    if (!httpPortFile.empty()) {
+      if (auto r = writePortFile(httpPortFile, api->port()); !r) {
+        log->error("{}", sky::describe(r.error()));
+        return kExitRuntime;
+      }
+    }
+  }
 
   (*server)->run();
   return EXIT_SUCCESS;

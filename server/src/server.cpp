@@ -34,7 +34,12 @@ Server::Server(ServerOptions options, WeatherState state)
     : options_(std::move(options)),
       // A logger without sinks: the library stays silent unless a main asks.
       log_(options_.log ? options_.log : std::make_shared<spdlog::logger>("sky_server")),
-      state_(std::move(state)),
+      weather_(state.scenario, state.wallStart, options_.wallNow,
+               [] {
+                 return std::chrono::duration_cast<std::chrono::milliseconds>(
+                            std::chrono::system_clock::now().time_since_epoch())
+                     .count();
+               }),
       acceptor_(io_),
       acceptRetry_(io_),
       heartbeat_(io_) {}
@@ -71,8 +76,8 @@ void Server::run() {
   }
   accept();
   scheduleHeartbeat();
-  log_->info("serving {} layer(s), weather clock {:.3f} s at rate {}", state_.layers().size(),
-             clockNow(), state_.clock().rate());
+  log_->info("serving {} layer(s), weather clock {:.3f} s at rate {}", weather_.layersAt(clockNow()).size(),
+             clockNow(), weather_.clock().rate());
   io_.run();
   log_->info("stopped");
 }
@@ -90,6 +95,7 @@ void Server::shutdown() {
   heartbeat_.cancel();
   if (signals_) signals_->cancel(ignored);
   registry_.closeAll();
+  if (onShutdown_) onShutdown_();
 }
 
 void Server::accept() {
@@ -116,7 +122,7 @@ void Server::onAccept(const boost::system::error_code& ec, tcp::socket socket) {
   log_->info("session {} ({}): connected", session->id(), session->peer());
   registry_.add(session);
   const stream::Hello hello{stream::kProtocolVersion, options_.serverId, clockNow(),
-                            state_.clock().rate()};
+                            weather_.clock().rate()};
   session->start(stream::encodeFrame(stream::encodeMessage(hello)));
   accept();
 }
@@ -127,15 +133,21 @@ void Server::scheduleHeartbeat() {
     if (ec || stopped_) return;
     const Frame frame = stream::encodeFrame(stream::encodeMessage(stream::Heartbeat{clockNow()}));
     registry_.forEach([&frame](Session& s) { s.sendHeartbeat(frame); });
+    // While a change ramps, subscribers follow it at the heartbeat's pace.
+    if (weather_.changing(clockNow())) weatherChanged();
     scheduleHeartbeat();
   });
 }
 
-double Server::clockNow() const { return state_.clock().at(options_.wallNow()); }
+double Server::clockNow() const { return weather_.clock().at(options_.wallNow()); }
+
+void Server::weatherChanged() {
+  registry_.forEach([](Session& s) { s.weatherChanged(); });
+}
 
 Frame Server::snapshotFrame(const stream::Subscribe& request) {
   const weather::WeatherSnapshot snapshot =
-      buildSnapshot(request, state_.layers(), clockNow(), options_.maxCellsPerSnapshot);
+      buildSnapshot(request, weather_.layersAt(clockNow()), clockNow(), options_.maxCellsPerSnapshot);
   const std::vector<std::uint8_t> payload = stream::encodeMessage(snapshot);
   // cellBudget keeps tiles × 24 bytes under the cap; a bigger frame is our bug.
   SKY_ASSERT(payload.size() <= stream::kMaxFrameBytes);

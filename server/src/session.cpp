@@ -53,6 +53,12 @@ void Session::sendHeartbeat(const Frame& heartbeat) {
   writeNext();
 }
 
+void Session::weatherChanged() {
+  if (state_ != State::Open || !subscription_) return;
+  outbox_.requestSnapshot(*subscription_);
+  writeNext();
+}
+
 void Session::close() {
   if (state_ == State::Closed) return;
   state_ = State::Closed;
@@ -104,6 +110,7 @@ void Session::handleMessage(const stream::Message& message) {
     log_.debug("session {} ({}): subscribe lat {} lon {} radius {} m level {}", id_, peer_,
                subscribe->area.centerLat_deg, subscribe->area.centerLon_deg,
                subscribe->area.radius_m, subscribe->tileLevel);
+    subscription_ = *subscribe;
     outbox_.requestSnapshot(*subscribe);
     writeNext();
   } else if (std::holds_alternative<stream::Heartbeat>(message)) {

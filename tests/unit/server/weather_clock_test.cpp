@@ -41,19 +41,5 @@ TEST(WeatherClock, SubMillisecondWallTime) {
   EXPECT_NEAR(clock.at(kT0 + 250us), 250e-6, 1e-12);
 }
 
-TEST(WeatherState, TakesLayersAndClockFromScenario) {
-  Scenario scenario;
-  scenario.clock = {500.0, 10.0};
-  weather::CloudLayer layer;
-  layer.id = 7;
-  layer.coverage = 0.3;
-  scenario.layers.push_back(layer);
-  const WeatherState state(scenario, kT0);
-  ASSERT_EQ(state.layers().size(), 1u);
-  EXPECT_EQ(state.layers()[0].id, 7u);
-  EXPECT_DOUBLE_EQ(state.clock().rate(), 10.0);
-  EXPECT_DOUBLE_EQ(state.clock().at(kT0 + 3s), 530.0);
-}
-
 }  // namespace
 }  // namespace sky::server

@@ -20,6 +20,7 @@
 #include "sky/server/session.hpp"
 #include "sky/server/session_registry.hpp"
 #include "sky/server/snapshot_builder.hpp"
+#include "sky/server/live_weather.hpp"
 #include "sky/server/weather_state.hpp"
 
 namespace spdlog {
@@ -49,6 +50,15 @@ class Server final : private SessionHandler {
   ~Server();
 
   std::uint16_t port() const { return port_; }
+  boost::asio::io_context& io() { return io_; }
+  LiveWeather& weather() { return weather_; }
+  // Every subscriber gets a fresh Snapshot of its area (call on the io thread,
+  // after an accepted change).
+  void weatherChanged();
+  std::size_t subscribers() const { return registry_.size(); }
+  // Runs on the io thread when the server shuts down: whatever else lives on
+  // its io_context (the HTTP API) closes there too, so run() can return.
+  void onShutdown(std::function<void()> f) { onShutdown_ = std::move(f); }
 
   // Serves until stop() or a signal. Call from one thread only.
   void run();
@@ -73,7 +83,7 @@ class Server final : private SessionHandler {
   boost::asio::io_context io_;
   ServerOptions options_;
   std::shared_ptr<spdlog::logger> log_;
-  WeatherState state_;
+  LiveWeather weather_;
   boost::asio::ip::tcp::acceptor acceptor_;
   boost::asio::steady_timer acceptRetry_;
   boost::asio::steady_timer heartbeat_;
@@ -82,6 +92,7 @@ class Server final : private SessionHandler {
   std::uint16_t port_ = 0;
   std::uint64_t nextSessionId_ = 1;
   bool stopped_ = false;
+  std::function<void()> onShutdown_;
 };
 
 }  // namespace sky::server

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <boost/asio/ip/tcp.hpp>
@@ -47,6 +48,9 @@ class Session : public std::enable_shared_from_this<Session> {
   void start(Frame hello);
   // Queues a heartbeat frame, replacing one not yet sent. Ignored once closing.
   void sendHeartbeat(const Frame& heartbeat);
+  // The weather changed: a fresh Snapshot of the current subscription (if
+  // any) replaces whatever snapshot is still waiting to be sent.
+  void weatherChanged();
   // Closes the socket now, cancelling pending I/O. Idempotent.
   void close();
 
@@ -77,6 +81,7 @@ class Session : public std::enable_shared_from_this<Session> {
   spdlog::logger& log_;
   State state_ = State::Open;
   stream::FrameDecoder decoder_;
+  std::optional<stream::Subscribe> subscription_;  // the latest area asked for
   std::array<std::uint8_t, 64 * 1024> readBuffer_{};
   Outbox outbox_;
   Frame writing_;  // the frame async_write is sending; untouched until it completes

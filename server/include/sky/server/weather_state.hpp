@@ -1,30 +1,16 @@
-// The one true weather state of a server: the cloud layers and the weather
-// clock. Later sources (console, CIGI, METAR) change it; for now a scenario
-// sets it at start-up.
+// What a server starts from: a scenario and the wall time its weather clock
+// starts at. The running weather (changes, ramps) is LiveWeather.
 #pragma once
-
-#include <span>
-#include <vector>
 
 #include "sky/server/scenario.hpp"
 #include "sky/server/weather_clock.hpp"
-#include "sky/weather/model.hpp"
 
 namespace sky::server {
 
-class WeatherState {
- public:
-  // The scenario's weather, its clock starting at wallStart.
-  WeatherState(const Scenario& scenario, WallClock::time_point wallStart)
-      : layers_(scenario.layers),
-        clock_(scenario.clock.start_s, scenario.clock.rate, wallStart) {}
-
-  std::span<const weather::CloudLayer> layers() const { return layers_; }
-  const WeatherClock& clock() const { return clock_; }
-
- private:
-  std::vector<weather::CloudLayer> layers_;
-  WeatherClock clock_;
+struct WeatherState {
+  WeatherState(const Scenario& s, WallClock::time_point start) : scenario(s), wallStart(start) {}
+  Scenario scenario;
+  WallClock::time_point wallStart;
 };
 
 }  // namespace sky::server

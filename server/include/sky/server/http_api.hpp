@@ -1,0 +1,78 @@
+// The weather server's HTTP API (JSON) on the server's own io_context:
+//   GET  /healthz        "ok"
+//   GET  /metrics        Prometheus text: changes applied and rejected, subscribers
+//   GET  /api/state      the weather now (layers, pending ramps, clock)
+//   GET  /api/events?limit=N   the newest N change events
+//   POST /api/changes    a change request (api_json.hpp); needs
+//                        "Authorization: Bearer <token>"; 200 once applied,
+//                        400 {"error": ...} naming the field, 401 without the token
+// One request per connection (Connection: close); bodies over 64 KiB and
+// clients slower than 10 s are dropped. Loopback unless configured otherwise.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+
+#include "sky/core/result.hpp"
+#include "sky/server/live_weather.hpp"
+
+namespace spdlog {
+class logger;
+}
+
+namespace sky::server {
+
+struct HttpApiOptions {
+  std::string listenAddress = "127.0.0.1";
+  std::uint16_t port = 0;   // 0: ephemeral
+  std::string token;        // empty: read-only (changes are refused)
+  std::shared_ptr<spdlog::logger> log;
+};
+
+struct HttpApiHooks {
+  std::function<void()> weatherChanged;       // after an accepted change
+  std::function<std::size_t()> subscribers;   // for /metrics
+};
+
+class HttpApi {
+ public:
+  static Result<std::unique_ptr<HttpApi>> create(boost::asio::io_context& io, HttpApiOptions options,
+                                                 LiveWeather& weather, HttpApiHooks hooks);
+  ~HttpApi();
+  std::uint16_t port() const { return port_; }
+  void close();
+
+  struct Counters {
+    std::uint64_t requests = 0, applied = 0, rejected = 0, unauthorized = 0;
+  };
+  const Counters& counters() const { return counters_; }
+
+  // The response to one request (exposed for the connection class).
+  struct Reply {
+    int status = 200;
+    std::string contentType = "application/json";
+    std::string body;
+  };
+  Reply handle(const std::string& method, const std::string& target, const std::string& authorization,
+               const std::string& body);
+
+ private:
+  HttpApi(boost::asio::io_context& io, HttpApiOptions options, LiveWeather& weather, HttpApiHooks hooks);
+  void accept();
+
+  boost::asio::io_context& io_;
+  HttpApiOptions options_;
+  LiveWeather& weather_;
+  HttpApiHooks hooks_;
+  boost::asio::ip::tcp::acceptor acceptor_;
+  std::uint16_t port_ = 0;
+  Counters counters_;
+  bool closed_ = false;
+};
+
+}  // namespace sky::server

@@ -1,0 +1,71 @@
+// The weather a running server owns and changes: global layers and the weather
+// clock, changed through the WeatherService vocabulary (change.hpp) with
+// scheduled starts and ramps on the weather clock. In memory: a restart starts
+// again from the scenario (durable storage in SQLite is still to come, issue
+// 4), and regions are refused as not implemented yet.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <vector>
+
+#include "sky/server/change.hpp"
+#include "sky/server/scenario.hpp"
+#include "sky/server/weather_clock.hpp"
+
+namespace sky::server {
+
+class LiveWeather final : public WeatherService {
+ public:
+  using WallNow = std::function<WallClock::time_point()>;
+  using UnixNowMs = std::function<std::int64_t()>;
+
+  // The scenario's weather, its clock at scenario.clock.start_s at wallStart.
+  LiveWeather(const Scenario& scenario, WallClock::time_point wallStart, WallNow wallNow, UnixNowMs unixNowMs);
+
+  Result<AppliedChange> submit(const ChangeRequest& request) override;
+  WeatherView view() const override;
+  std::vector<ChangeEvent> events(std::size_t limit) const override;
+
+  double clockNow() const { return clock_.at(wallNow_()); }
+  const WeatherClock& clock() const { return clock_; }
+  // The layers as they stand at weather clock c (ramps evaluated).
+  std::vector<weather::CloudLayer> layersAt(double clock_s) const;
+  // Whether a scheduled or ramping change is still under way at clock c: the
+  // stream then refreshes its subscribers as the weather moves.
+  bool changing(double clock_s) const;
+  std::uint64_t rejected() const { return rejected_; }
+
+ private:
+  struct Ramp {
+    std::uint64_t sequence = 0;
+    std::uint32_t layerId = 0;
+    double start_s = 0, end_s = 0;
+    bool fromAbsent = false;  // a new layer: ramps in from coverage 0
+    weather::CloudLayer from, to;
+    bool removeAtEnd = false;
+    std::string summary;
+  };
+  struct State {
+    std::map<std::uint32_t, weather::CloudLayer> layers;  // settled values
+    std::vector<Ramp> ramps;                              // in submission order
+    WeatherClock clock;
+  };
+  static std::vector<weather::CloudLayer> evaluate(const State& s, double clock_s);
+  Result<std::string> apply(State& s, const WeatherChange& change, std::size_t index, double now_s,
+                            std::uint64_t sequence) const;
+  void settle(double clock_s);
+
+  WallNow wallNow_;
+  UnixNowMs unixNowMs_;
+  std::map<std::uint32_t, weather::CloudLayer> layers_;
+  std::vector<Ramp> ramps_;
+  WeatherClock clock_;
+  std::vector<ChangeEvent> events_;
+  std::uint64_t sequence_ = 0;
+  std::uint64_t version_ = 1;
+  std::uint64_t rejected_ = 0;
+};
+
+}  // namespace sky::server

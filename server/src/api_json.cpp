@@ -1,0 +1,185 @@
+// JSON of the HTTP API (see api_json.hpp).
+#include "sky/server/api_json.hpp"
+
+#include <initializer_list>
+
+namespace sky::server {
+
+namespace {
+
+using nlohmann::json;
+
+tl::unexpected<Error> bad(const std::string& path, const std::string& what) {
+  return fail(ErrorCode::Malformed, path + ": " + what);
+}
+
+Result<void> onlyKeys(const json& o, std::initializer_list<const char*> allowed, const std::string& path) {
+  for (auto it = o.begin(); it != o.end(); ++it) {
+    bool known = false;
+    for (const char* a : allowed) known = known || it.key() == a;
+    if (!known) {
+      std::string list;
+      for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+      return bad(path + (path.empty() ? "" : ".") + it.key(), "unknown key (expected one of: " + list + ")");
+    }
+  }
+  return {};
+}
+
+Result<double> number(const json& o, const char* key, const std::string& path) {
+  const std::string at = path + "." + key;
+  if (!o.contains(key)) return bad(at, "missing (required)");
+  const json& v = o.at(key);
+  if (!v.is_number()) return bad(at, "expected a number");
+  return v.get<double>();
+}
+
+Result<std::optional<double>> optionalNumber(const json& o, const char* key, const std::string& path) {
+  if (!o.contains(key)) return std::optional<double>{};
+  auto v = number(o, key, path);
+  if (!v) return tl::unexpected(v.error());
+  return std::optional<double>(*v);
+}
+
+Result<std::uint32_t> id(const json& o, const char* key, const std::string& path) {
+  const std::string at = path + "." + key;
+  if (!o.contains(key)) return bad(at, "missing (required)");
+  const json& v = o.at(key);
+  if (!v.is_number_integer() || v.get<std::int64_t>() < 0 || v.get<std::int64_t>() > 65535)
+    return bad(at, "expected an integer in [0, 65535]");
+  return static_cast<std::uint32_t>(v.get<std::int64_t>());
+}
+
+Result<Timing> timing(const json& o, const std::string& path) {
+  Timing t;
+  auto ramp = optionalNumber(o, "ramp_s", path);
+  if (!ramp) return tl::unexpected(ramp.error());
+  t.ramp_s = ramp->value_or(0.0);
+  auto at = optionalNumber(o, "at_s", path);
+  if (!at) return tl::unexpected(at.error());
+  t.at_s = *at;
+  return t;
+}
+
+Result<weather::CloudLayer> layer(const json& o, const std::string& path) {
+  if (!o.is_object()) return bad(path, "expected an object");
+  if (auto r = onlyKeys(o, {"id", "type", "base_m", "thickness_m", "transition_band_m", "coverage", "density", "wind"},
+                        path);
+      !r)
+    return tl::unexpected(r.error());
+  weather::CloudLayer l;
+  auto i = id(o, "id", path);
+  if (!i) return tl::unexpected(i.error());
+  l.id = *i;
+  if (!o.contains("type") || !o.at("type").is_string()) return bad(path + ".type", "expected a cloud type name");
+  const auto type = weather::cloudTypeFromString(o.at("type").get<std::string>());
+  if (!type) return bad(path + ".type", "'" + o.at("type").get<std::string>() + "' is not a cloud type");
+  l.type = *type;
+  struct Field {
+    const char* key;
+    double* out;
+  };
+  for (const Field& f : {Field{"base_m", &l.base_m}, Field{"thickness_m", &l.thickness_m},
+                         Field{"transition_band_m", &l.transitionBand_m}, Field{"coverage", &l.coverage},
+                         Field{"density", &l.density}}) {
+    auto v = number(o, f.key, path);
+    if (!v) return tl::unexpected(v.error());
+    *f.out = *v;
+  }
+  if (!o.contains("wind") || !o.at("wind").is_object()) return bad(path + ".wind", "expected an object");
+  const json& w = o.at("wind");
+  if (auto r = onlyKeys(w, {"speed_mps", "from_deg", "vertical_mps"}, path + ".wind"); !r) return tl::unexpected(r.error());
+  for (const Field& f : {Field{"speed_mps", &l.wind.speed_mps}, Field{"from_deg", &l.wind.fromDirection_deg},
+                         Field{"vertical_mps", &l.wind.vertical_mps}}) {
+    auto v = number(w, f.key, path + ".wind");
+    if (!v) return tl::unexpected(v.error());
+    *f.out = *v;
+  }
+  return l;
+}
+
+Result<WeatherChange> change(const json& o, const std::string& path) {
+  if (!o.is_object()) return bad(path, "expected an object");
+  if (!o.contains("op") || !o.at("op").is_string()) return bad(path + ".op", "expected set_layer, remove_layer or set_clock");
+  const std::string op = o.at("op").get<std::string>();
+  if (op == "set_layer") {
+    if (auto r = onlyKeys(o, {"op", "layer", "ramp_s", "at_s"}, path); !r) return tl::unexpected(r.error());
+    if (!o.contains("layer")) return bad(path + ".layer", "missing (required)");
+    auto l = layer(o.at("layer"), path + ".layer");
+    if (!l) return tl::unexpected(l.error());
+    auto t = timing(o, path);
+    if (!t) return tl::unexpected(t.error());
+    return SetLayer{*l, *t};
+  }
+  if (op == "remove_layer") {
+    if (auto r = onlyKeys(o, {"op", "id", "ramp_s", "at_s"}, path); !r) return tl::unexpected(r.error());
+    auto i = id(o, "id", path);
+    if (!i) return tl::unexpected(i.error());
+    auto t = timing(o, path);
+    if (!t) return tl::unexpected(t.error());
+    return RemoveLayer{*i, *t};
+  }
+  if (op == "set_clock") {
+    if (auto r = onlyKeys(o, {"op", "rate", "jump_to_s"}, path); !r) return tl::unexpected(r.error());
+    SetClock c;
+    auto rate = optionalNumber(o, "rate", path);
+    if (!rate) return tl::unexpected(rate.error());
+    auto jump = optionalNumber(o, "jump_to_s", path);
+    if (!jump) return tl::unexpected(jump.error());
+    c.rate = *rate;
+    c.jumpTo_s = *jump;
+    return c;
+  }
+  return bad(path + ".op", "'" + op + "' is not one of set_layer, remove_layer, set_clock");
+}
+
+}  // namespace
+
+Result<ChangeRequest> parseChangeRequest(std::string_view body) {
+  const json doc = json::parse(body, nullptr, false);
+  if (doc.is_discarded()) return fail(ErrorCode::Malformed, "body: not JSON");
+  if (!doc.is_object()) return bad("body", "expected an object");
+  if (auto r = onlyKeys(doc, {"author", "changes"}, ""); !r) return tl::unexpected(r.error());
+  ChangeRequest req;
+  if (doc.contains("author")) {
+    if (!doc.at("author").is_string()) return bad("author", "expected a string");
+    req.author = doc.at("author").get<std::string>().substr(0, 200);
+  }
+  if (!doc.contains("changes") || !doc.at("changes").is_array()) return bad("changes", "expected an array");
+  const json& list = doc.at("changes");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    auto c = change(list.at(i), "changes[" + std::to_string(i) + "]");
+    if (!c) return tl::unexpected(c.error());
+    req.changes.push_back(*c);
+  }
+  return req;
+}
+
+nlohmann::json toJson(const weather::CloudLayer& l) {
+  return {{"id", l.id},
+          {"type", std::string(weather::toString(l.type))},
+          {"base_m", l.base_m},
+          {"thickness_m", l.thickness_m},
+          {"transition_band_m", l.transitionBand_m},
+          {"coverage", l.coverage},
+          {"density", l.density},
+          {"wind", {{"speed_mps", l.wind.speed_mps}, {"from_deg", l.wind.fromDirection_deg},
+                    {"vertical_mps", l.wind.vertical_mps}}}};
+}
+
+nlohmann::json toJson(const WeatherView& v) {
+  json layers = json::array();
+  for (const auto& l : v.layers) layers.push_back(toJson(l));
+  json pending = json::array();
+  for (const auto& p : v.pending)
+    pending.push_back({{"sequence", p.sequence}, {"start_s", p.start_s}, {"end_s", p.end_s}, {"summary", p.summary}});
+  return {{"clock_s", v.clock_s}, {"clock_rate", v.clockRate}, {"sequence", v.lastSequence},
+          {"version", v.version}, {"layers", layers}, {"pending", pending}};
+}
+
+nlohmann::json toJson(const ChangeEvent& e) {
+  return {{"sequence", e.sequence}, {"clock_s", e.clock_s}, {"wall_time_ms", e.wallTime_ms},
+          {"author", e.author}, {"source", e.source}, {"summary", e.summary}};
+}
+
+}  // namespace sky::server

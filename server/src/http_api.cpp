@@ -1,0 +1,185 @@
+// The weather server's HTTP API (see http_api.hpp).
+#include "sky/server/http_api.hpp"
+
+#include <charconv>
+#include <chrono>
+
+#include <boost/asio/ip/address.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <spdlog/spdlog.h>
+
+#include "sky/server/api_json.hpp"
+
+namespace sky::server {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+using tcp = asio::ip::tcp;
+
+namespace {
+
+constexpr std::size_t kMaxBody = 64 * 1024;
+constexpr auto kClientDeadline = std::chrono::seconds(10);
+constexpr std::size_t kDefaultEvents = 100, kMaxEvents = 10000;
+
+class Connection : public std::enable_shared_from_this<Connection> {
+ public:
+  Connection(tcp::socket socket, HttpApi& api) : stream_(std::move(socket)), api_(api) {}
+  void start() {
+    parser_.body_limit(kMaxBody);
+    stream_.expires_after(kClientDeadline);
+    http::async_read(stream_, buffer_, parser_,
+                     [self = shared_from_this()](beast::error_code ec, std::size_t) { self->onRead(ec); });
+  }
+
+ private:
+  void onRead(beast::error_code ec) {
+    HttpApi::Reply reply;
+    if (ec == http::error::body_limit) {
+      reply = {413, "application/json", R"({"error":"body over 64 KiB"})"};
+    } else if (ec) {
+      return;  // the client went away or was too slow: nothing to answer
+    } else {
+      const auto& req = parser_.get();
+      reply = api_.handle(std::string(req.method_string()), std::string(req.target()),
+                          std::string(req[http::field::authorization]), req.body());
+    }
+    response_.result(static_cast<unsigned>(reply.status));
+    response_.version(11);
+    response_.set(http::field::content_type, reply.contentType);
+    response_.set(http::field::server, "skyshell-weatherd");
+    response_.keep_alive(false);
+    response_.body() = std::move(reply.body);
+    response_.prepare_payload();
+    http::async_write(stream_, response_, [self = shared_from_this()](beast::error_code, std::size_t) {
+      beast::error_code ignored;
+      self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+    });
+  }
+
+  beast::tcp_stream stream_;
+  beast::flat_buffer buffer_;
+  http::request_parser<http::string_body> parser_;
+  http::response<http::string_body> response_;
+  HttpApi& api_;
+};
+
+std::string errorJson(const std::string& detail) {
+  // "path: what" -> field = path, for the console to show next to the field.
+  const auto colon = detail.find(": ");
+  nlohmann::json j = {{"error", detail}};
+  if (colon != std::string::npos) j["field"] = detail.substr(0, colon);
+  return j.dump();
+}
+
+}  // namespace
+
+HttpApi::HttpApi(asio::io_context& io, HttpApiOptions options, LiveWeather& weather, HttpApiHooks hooks)
+    : io_(io), options_(std::move(options)), weather_(weather), hooks_(std::move(hooks)), acceptor_(io) {}
+
+HttpApi::~HttpApi() { close(); }
+
+Result<std::unique_ptr<HttpApi>> HttpApi::create(asio::io_context& io, HttpApiOptions options, LiveWeather& weather,
+                                                 HttpApiHooks hooks) {
+  std::unique_ptr<HttpApi> api(new HttpApi(io, std::move(options), weather, std::move(hooks)));
+  boost::system::error_code ec;
+  const auto address = asio::ip::make_address(api->options_.listenAddress, ec);
+  if (ec) return fail(ErrorCode::InvalidArgument, "HTTP listen address '" + api->options_.listenAddress + "': " + ec.message());
+  const tcp::endpoint endpoint(address, api->options_.port);
+  api->acceptor_.open(endpoint.protocol(), ec);
+  if (!ec) api->acceptor_.set_option(tcp::acceptor::reuse_address(true), ec);
+  if (!ec) api->acceptor_.bind(endpoint, ec);
+  if (!ec) api->acceptor_.listen(asio::socket_base::max_listen_connections, ec);
+  if (ec)
+    return fail(ErrorCode::Io, "HTTP API on " + api->options_.listenAddress + ":" + std::to_string(api->options_.port) +
+                                   ": " + ec.message());
+  api->port_ = api->acceptor_.local_endpoint().port();
+  api->accept();
+  return api;
+}
+
+void HttpApi::close() {
+  if (closed_) return;
+  closed_ = true;
+  boost::system::error_code ignored;
+  acceptor_.close(ignored);
+}
+
+void HttpApi::accept() {
+  acceptor_.async_accept([this](boost::system::error_code ec, tcp::socket socket) {
+    if (closed_) return;
+    if (!ec) std::make_shared<Connection>(std::move(socket), *this)->start();
+    accept();
+  });
+}
+
+HttpApi::Reply HttpApi::handle(const std::string& method, const std::string& target,
+                               const std::string& authorization, const std::string& body) {
+  ++counters_.requests;
+  const std::string path = target.substr(0, target.find('?'));
+  const std::string query = target.find('?') == std::string::npos ? "" : target.substr(target.find('?') + 1);
+  if (method == "GET" && path == "/healthz") return {200, "text/plain", "ok\n"};
+  if (method == "GET" && path == "/metrics") {
+    std::string m;
+    auto line = [&m](const char* name, const char* help, const char* type, std::uint64_t v) {
+      m += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " " + type + "\n" + name + " " +
+           std::to_string(v) + "\n";
+    };
+    line("skyshell_http_requests_total", "HTTP requests handled", "counter", counters_.requests);
+    line("skyshell_changes_applied_total", "weather changes applied", "counter", counters_.applied);
+    line("skyshell_changes_rejected_total", "weather changes refused as invalid", "counter", counters_.rejected);
+    line("skyshell_changes_unauthorized_total", "change requests without the token", "counter", counters_.unauthorized);
+    line("skyshell_subscribers", "weather stream subscribers connected", "gauge",
+         hooks_.subscribers ? hooks_.subscribers() : 0);
+    return {200, "text/plain; version=0.0.4", m};
+  }
+  if (method == "GET" && path == "/api/state") return {200, "application/json", toJson(weather_.view()).dump()};
+  if (method == "GET" && path == "/api/events") {
+    std::size_t limit = kDefaultEvents;
+    if (query.rfind("limit=", 0) == 0) {
+      const std::string v = query.substr(6);
+      std::size_t n = 0;
+      const auto [end, err] = std::from_chars(v.data(), v.data() + v.size(), n);
+      if (err != std::errc() || end != v.data() + v.size() || n == 0 || n > kMaxEvents)
+        return {400, "application/json", errorJson("limit: '" + v + "' is not in 1..10000")};
+      limit = n;
+    }
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& e : weather_.events(limit)) list.push_back(toJson(e));
+    return {200, "application/json", nlohmann::json{{"events", list}}.dump()};
+  }
+  if (path == "/api/changes") {
+    if (method != "POST") return {405, "application/json", errorJson("method: use POST")};
+    if (options_.token.empty() || authorization != "Bearer " + options_.token) {
+      ++counters_.unauthorized;
+      return {401, "application/json",
+              errorJson(std::string("authorization: ") +
+                        (options_.token.empty() ? "this server has no token: read-only" : "missing or wrong token"))};
+    }
+    auto request = parseChangeRequest(body);
+    if (!request) {
+      ++counters_.rejected;
+      return {400, "application/json", errorJson(request.error().detail)};
+    }
+    request->source = "api";
+    if (request->author.empty()) request->author = "api";
+    auto applied = weather_.submit(*request);
+    if (!applied) {
+      ++counters_.rejected;
+      if (options_.log) options_.log->info("change from {} refused: {}", request->author, applied.error().detail);
+      return {applied.error().code == ErrorCode::Unsupported ? 501 : 400, "application/json",
+              errorJson(applied.error().detail)};
+    }
+    ++counters_.applied;
+    if (options_.log) options_.log->info("change {} by {}: {}", applied->sequence, request->author, applied->summary);
+    if (hooks_.weatherChanged) hooks_.weatherChanged();
+    return {200, "application/json",
+            nlohmann::json{{"sequence", applied->sequence}, {"clock_s", applied->clock_s}, {"summary", applied->summary}}
+                .dump()};
+  }
+  return {404, "application/json", errorJson("path: no " + method + " " + path)};
+}
+
+}  // namespace sky::server

@@ -1,0 +1,24 @@
+// libFuzzer target: bodies of the weather server's POST /api/changes. The
+// parser may refuse (naming a JSON path), never crash, hang or read out of
+// bounds; what it accepts has 0..n changes whose layers' ids fit 16 bits.
+// Seeds: tests/fuzz/corpus/api_json/.
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <string_view>
+
+#include "sky/server/api_json.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string_view body(reinterpret_cast<const char*>(data), size);
+  const auto r = sky::server::parseChangeRequest(body);
+  if (!r) {
+    if (r.error().detail.empty()) std::abort();
+    return 0;
+  }
+  for (const auto& c : r->changes) {
+    if (const auto* set = std::get_if<sky::server::SetLayer>(&c))
+      if (set->layer.id > 65535) std::abort();
+  }
+  return 0;
+}

@@ -1,0 +1,151 @@
+// The weather server's HTTP API through real sockets, and a change travelling
+// from a skyshell-scenario action through the API and the weather stream into
+// a renderer's frames.
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "child_process.hpp"
+#include "sky/sim/http_client.hpp"
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+namespace sky::test {
+namespace {
+
+constexpr const char* kToken = "s3cret-test-token";
+
+struct Weatherd {
+  fs::path dir;
+  std::optional<ChildProcess> process;
+  unsigned streamPort = 0, httpPort = 0;
+
+  explicit Weatherd(const std::string& name, const std::string& scenario = SKY_SCENARIO_CLOUDY) {
+    dir = fs::path(SKY_TEST_OUTPUT_DIR) / name;
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    std::ofstream(dir / "token") << kToken << "\n";
+    process.emplace(std::vector<std::string>{SKY_WEATHERD, "--scenario", scenario, "--port", "0", "--port-file",
+                                             (dir / "weatherd.port").string(), "--http-port", "0",
+                                             "--http-port-file", (dir / "http.port").string(), "--token-file",
+                                             (dir / "token").string(), "--heartbeat-ms", "200"},
+                    (dir / "weatherd.log").string());
+    streamPort = waitForPortFile((dir / "weatherd.port").string(), 20s);
+    httpPort = waitForPortFile((dir / "http.port").string(), 20s);
+  }
+
+  sim::HttpResponse request(const std::string& method, const std::string& target, const std::string& body = "",
+                            const std::string& token = kToken) {
+    sim::HttpRequest r;
+    r.method = method;
+    r.port = static_cast<unsigned short>(httpPort);
+    r.target = target;
+    r.body = body;
+    r.bearerToken = token;
+    auto response = sim::httpRequest(r);
+    EXPECT_TRUE(response) << describe(response.error());
+    return response ? *response : sim::HttpResponse{};
+  }
+};
+
+const char* kAddStratus = R"({"author": "test", "changes": [{"op": "set_layer", "ramp_s": 0, "layer": {
+  "id": 2, "type": "stratus", "base_m": 400, "thickness_m": 300, "transition_band_m": 50, "coverage": 0.8,
+  "density": 0.7, "wind": {"speed_mps": 5, "from_deg": 200, "vertical_mps": 0}}}]})";
+
+TEST(WeatherdApi, ChangesNeedTheTokenAreCheckedAndApply) {
+  Weatherd w("weatherd-api");
+  ASSERT_GT(w.httpPort, 0u) << w.process->log();
+  EXPECT_EQ(w.request("GET", "/healthz").body, "ok\n");
+  auto state = nlohmann::json::parse(w.request("GET", "/api/state").body);
+  ASSERT_EQ(state["layers"].size(), 1u);
+  EXPECT_EQ(state["layers"][0]["coverage"], 0.6);
+
+  // Without the token: 401, nothing changes.
+  EXPECT_EQ(w.request("POST", "/api/changes", kAddStratus, "").status, 401);
+  EXPECT_EQ(w.request("POST", "/api/changes", kAddStratus, "wrong").status, 401);
+  // Invalid: 400 naming the field; a batch is all or nothing.
+  std::string bad = kAddStratus;
+  bad.replace(bad.find("\"coverage\": 0.8"), 15, "\"coverage\": 1.4");
+  const auto refused = w.request("POST", "/api/changes", bad);
+  EXPECT_EQ(refused.status, 400);
+  const auto err = nlohmann::json::parse(refused.body);
+  EXPECT_EQ(err["field"], "changes[0].layer");
+  EXPECT_NE(err["error"].get<std::string>().find("coverage 1.4"), std::string::npos) << refused.body;
+  const auto typo = w.request("POST", "/api/changes", R"({"changes": [{"op": "set_clock", "rat": 60}]})");
+  EXPECT_EQ(typo.status, 400);
+  EXPECT_EQ(nlohmann::json::parse(typo.body)["field"], "changes[0].rat");
+  EXPECT_EQ(nlohmann::json::parse(w.request("GET", "/api/state").body)["layers"].size(), 1u);
+
+  // Valid: applied, visible in the state, the event log and the metrics.
+  const auto ok = w.request("POST", "/api/changes", kAddStratus);
+  ASSERT_EQ(ok.status, 200) << ok.body;
+  EXPECT_EQ(nlohmann::json::parse(ok.body)["sequence"], 1);
+  state = nlohmann::json::parse(w.request("GET", "/api/state").body);
+  ASSERT_EQ(state["layers"].size(), 2u);
+  EXPECT_EQ(state["layers"][1]["type"], "stratus");
+  const auto events = nlohmann::json::parse(w.request("GET", "/api/events?limit=5").body)["events"];
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0]["author"], "test");
+  EXPECT_EQ(events[0]["summary"], "layer 2 (stratus) added, coverage 0.00 -> 0.80");
+  const std::string metrics = w.request("GET", "/metrics").body;
+  EXPECT_NE(metrics.find("skyshell_changes_applied_total 1\n"), std::string::npos) << metrics;
+  EXPECT_NE(metrics.find("skyshell_changes_rejected_total 2\n"), std::string::npos) << metrics;
+  EXPECT_NE(metrics.find("skyshell_changes_unauthorized_total 2\n"), std::string::npos) << metrics;
+  EXPECT_EQ(w.request("GET", "/nowhere").status, 404);
+  EXPECT_EQ(w.process->stop(), 0) << w.process->log();
+}
+
+// skyshell-scenario flies the 6 s test flight into a renderer and, 1.5 s in,
+// adds a stratus layer through the API: the renderer's frames go from one
+// layer to two, without a restart.
+TEST(WeatherdApi, ScenarioActionReachesTheRendererThroughTheStream) {
+  Weatherd w("weatherd-scenario");
+  ASSERT_GT(w.httpPort, 0u) << w.process->log();
+  const fs::path d = w.dir;
+  nlohmann::json request = nlohmann::json::parse(kAddStratus);
+  std::ofstream(d / "scenario.toml") << "[flight]\nfile = \"" << SKY_TEST_FLIGHT << "\"\n\n"
+                                     << "[[action]]\nat_s = 1.5\nwhat = \"a stratus deck forms\"\n"
+                                     << "[action.request]\nauthor = \"scenario-test\"\n"
+                                     << "[[action.request.changes]]\nop = \"set_layer\"\n"
+                                     << "layer = { id = 2, type = \"stratus\", base_m = 400, thickness_m = 300, "
+                                        "transition_band_m = 50, coverage = 0.8, density = 0.7, wind = { speed_mps = "
+                                        "5, from_deg = 200, vertical_mps = 0 } }\n";
+  ChildProcess render({SKY_RENDER, "--headless", "--server", "127.0.0.1:" + std::to_string(w.streamPort),
+                       "--cigi-port", "0", "--port-file", (d / "render.port").string(), "--out",
+                       (d / "frames").string(), "--width", "96", "--height", "54", "--idle-exit", "3",
+                       "--weather-timeout", "60"},
+                      (d / "render.log").string(), {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
+  const unsigned cigiPort = waitForPortFile((d / "render.port").string(), 60s);
+  ASSERT_GT(cigiPort, 0u) << render.log();
+  ChildProcess scenario({SKY_SCENARIO, (d / "scenario.toml").string(), "--port", std::to_string(cigiPort), "--api",
+                         "http://127.0.0.1:" + std::to_string(w.httpPort), "--token-file", (d / "token").string()},
+                        (d / "scenario.log").string());
+  EXPECT_EQ(scenario.wait(60s), std::optional<int>(0)) << scenario.log();
+  EXPECT_NE(scenario.log().find("a stratus deck forms: accepted"), std::string::npos) << scenario.log();
+  EXPECT_EQ(render.wait(120s), std::optional<int>(0)) << render.log();
+
+  std::ifstream jsonl(d / "frames" / "frames.jsonl");
+  std::vector<std::pair<double, int>> layersAt;
+  for (std::string line; std::getline(jsonl, line);) {
+    const auto f = nlohmann::json::parse(line);
+    layersAt.push_back({f["host_time_s"].get<double>(), f["layers"].get<int>()});
+  }
+  ASSERT_GE(layersAt.size(), 3u);
+  EXPECT_EQ(layersAt.front().second, 1) << "the first frames have the scenario's one layer";
+  EXPECT_EQ(layersAt.back().second, 2) << "the last frames have the stratus layer the action added";
+  for (const auto& [t, n] : layersAt)
+    if (t < 1.4) {
+      EXPECT_EQ(n, 1) << "a layer before the action at 1.5 s (frame at " << t << " s)";
+    }
+  const auto events = nlohmann::json::parse(w.request("GET", "/api/events").body)["events"];
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0]["author"], "scenario-test");
+  EXPECT_EQ(w.process->stop(), 0) << w.process->log();
+}
+
+}  // namespace
+}  // namespace sky::test
