@@ -2,10 +2,13 @@
 // skyshell-replay) and, in step with the flight's time, sends its weather
 // actions to the weather server's API (POST /api/changes). Example:
 // deploy/sim-scenarios/climb-into-sun.toml.
+
+#include <chrono>
 #include <condition_variable>
 #include <cstdio>
 #include <deque>
 #include <fstream>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -129,6 +132,10 @@ int main(int argc, char** argv) {
   app.add_option("--conditions-csv", o.conditionsCsv, "log the IG's condition answers here");
   app.add_flag("--quiet", o.quiet, "no progress lines (actions are still printed)");
   app.add_flag("--dry-run", dryRun, "check the scenario and its flight, print the actions, send nothing");
+  bool noHost = false;
+  app.add_flag("--no-host", noHost,
+               "send only the weather actions, on the flight's clock, without flying it as a CIGI host (when "
+               "a renderer replays the flight headless itself)");
   CLI11_PARSE(app, argc, argv);
 
   auto scenario = sky::sim::loadSimScenario(scenarioPath);
@@ -173,9 +180,36 @@ int main(int argc, char** argv) {
     signals.async_wait([&](boost::system::error_code ec, int) {
       if (!ec) io.stop();
     });
-    sky::sim::ReplaySession session(io, o, std::move(*flight), [&] { signals.cancel(); });
     std::size_t next = 0;
     const auto& actions = scenario->actions;
+    if (noHost) {
+      // The flight's clock alone: flight time = start + wall time x speed.
+      const double first = flight->fixes.front().time_s;
+      const double t0 = first + o.start_s;
+      const double t1 = o.end_s >= 0 ? std::min(first + o.end_s, flight->fixes.back().time_s) : flight->fixes.back().time_s;
+      const auto wall0 = std::chrono::steady_clock::now();
+      asio::steady_timer timer(io);
+      std::function<void()> tick = [&] {
+        const double t =
+            t0 + std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count() * o.speed;
+        while (next < actions.size() && actions[next].at_s <= t - first) sender.send(actions[next], t - first), ++next;
+        if (t >= t1 || next == actions.size()) {
+          signals.cancel();
+          return;
+        }
+        timer.expires_after(std::chrono::milliseconds(20));
+        timer.async_wait([&](boost::system::error_code ec) {
+          if (!ec) tick();
+        });
+      };
+      tick();
+      io.run();
+      sender.finish();
+      std::printf("scenario: done: %d of %zu actions accepted, %d refused or not sent\n", sender.accepted(),
+                  actions.size(), sender.failures());
+      return sender.failures() > 0 || next < actions.size() ? kExitActionFailed : 0;
+    }
+    sky::sim::ReplaySession session(io, o, std::move(*flight), [&] { signals.cancel(); });
     session.onTick([&](double t) {
       while (next < actions.size() && actions[next].at_s <= t) sender.send(actions[next++], t);
     });

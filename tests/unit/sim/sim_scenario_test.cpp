@@ -72,7 +72,7 @@ TEST(SimScenario, ErrorsNameLineAndField) {
 }
 
 TEST(SimScenario, BundledExamplesParse) {
-  for (const char* name : {"climb-into-sun.toml"}) {
+  for (const char* name : {"climb-into-sun.toml", "demo-live-weather.toml"}) {
     auto s = loadSimScenario(std::filesystem::path(SKY_SOURCE_DIR) / "deploy/sim-scenarios" / name);
     ASSERT_TRUE(s) << s.error().detail;
     EXPECT_TRUE(std::filesystem::exists(s->flightFile)) << s->flightFile;
