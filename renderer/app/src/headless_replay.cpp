@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "sky/app/area_of_interest.hpp"
+#include "sky/app/drawable_weather.hpp"
 #include "sky/app/frame_writer.hpp"
 #include "sky/app/replay_outputs.hpp"
 #include "sky/app/shared_state.hpp"
@@ -128,6 +129,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   auto lastReport = start;
   int exitCode = 0;
   std::size_t done = 0;
+  std::uint64_t droppedWarnedAt = 0;
   for (std::size_t i = 0; i < frameCount; ++i) {
     if (stop && *stop) {
       exitCode = 1;
@@ -144,9 +146,16 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
                              "drawing the old area's\n", i, o.weatherTimeout_s);
     }
     const WeatherView view = state.weather();
+    std::vector<std::uint32_t> dropped;
+    const auto drawable = drawableWeather(view.snapshot, render::kMaxLayers, &dropped);
+    if (!dropped.empty() && view.version != droppedWarnedAt) {
+      droppedWarnedAt = view.version;
+      std::fprintf(stderr, "skyshell-render: warning: frame %zu: weather has %zu layers, drawing the %zu with most cloud\n",
+                   i, view.snapshot.layers.size(), render::kMaxLayers);
+    }
     render::FrameInputs in;
     in.camera = pose;
-    in.weather = &view.snapshot;
+    in.weather = &drawable;
     in.weatherClock_s = clockBase_s + (t - t0) * clockRate;
     in.sunAzimuth_deg = o.sunAzimuth_deg;
     in.sunElevation_deg = o.sunElevation_deg;

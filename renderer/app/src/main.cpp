@@ -16,10 +16,12 @@
 #include <CLI/CLI.hpp>
 #include <boost/asio.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "sky/app/area_of_interest.hpp"
 #include "sky/app/cigi_listener.hpp"
+#include "sky/app/drawable_weather.hpp"
 #include "sky/app/fdm_listener.hpp"
 #include "sky/app/frame_writer.hpp"
 #include "sky/app/headless_replay.hpp"
@@ -242,7 +244,7 @@ int main(int argc, char** argv) {
                 fdm->port());
   std::fflush(stdout);
 
-  std::uint64_t frames = 0, lastSequence = 0;
+  std::uint64_t frames = 0, lastSequence = 0, droppedWarnedAt = 0;
   std::optional<sky::geo::Geodetic> subscribedAt;
   const auto start = Clock::now();
   auto lastReport = start;
@@ -286,9 +288,16 @@ int main(int argc, char** argv) {
     lastSequence = pose->sequence;
     nextFdmFrameAt = now + fdmFramePeriod;
 
+    std::vector<std::uint32_t> dropped;
+    const auto drawable = sky::app::drawableWeather(view.snapshot, sky::render::kMaxLayers, &dropped);
+    if (!dropped.empty() && view.version != droppedWarnedAt) {
+      droppedWarnedAt = view.version;
+      spdlog::warn("weather has {} layers, this channel draws {}: leaving out layer(s) {}", view.snapshot.layers.size(),
+                   sky::render::kMaxLayers, fmt::join(dropped, ", "));
+    }
     sky::render::FrameInputs in;
     in.camera = pose->pose;
-    in.weather = &view.snapshot;
+    in.weather = &drawable;
     in.weatherClock_s = view.clockNow(now);
     in.sunAzimuth_deg = o.sunAzimuth_deg;
     in.sunElevation_deg = o.sunElevation_deg;

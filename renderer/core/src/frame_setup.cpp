@@ -13,6 +13,8 @@
 
 namespace sky::render {
 
+static_assert(kMaxLayers == gpu::kMaxLayers, "cloud_renderer.hpp and sky_shared.h disagree on the layer count");
+
 namespace {
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;

@@ -16,6 +16,9 @@
 
 namespace sky::render {
 
+// Cloud layers one frame can draw (the shaders' kMaxLayers, checked there).
+inline constexpr std::size_t kMaxLayers = 4;
+
 struct RenderSettings {
   std::uint32_t width = 320, height = 180;  // pixels, [1, 8192]
   double verticalFov_deg = 60;              // (0, 179)

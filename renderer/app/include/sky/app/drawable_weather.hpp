@@ -1,0 +1,19 @@
+// The renderer draws at most render::kMaxLayers (4) cloud layers; the server
+// may hold more (an operator can add up to 32). The channel draws the layers
+// that matter most and says what it left out, instead of refusing the frame.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "sky/weather/model.hpp"
+
+namespace sky::app {
+
+// The snapshot with at most maxLayers layers: those with the most cloud
+// (coverage x density), ties by lower id; their tiles only. `dropped` gets
+// the ids left out (empty when all fit). Layer order is kept.
+weather::WeatherSnapshot drawableWeather(const weather::WeatherSnapshot& snapshot, std::size_t maxLayers,
+                                         std::vector<std::uint32_t>* dropped = nullptr);
+
+}  // namespace sky::app

@@ -1,0 +1,37 @@
+// Choosing the layers a channel draws (see drawable_weather.hpp).
+#include "sky/app/drawable_weather.hpp"
+
+#include <algorithm>
+#include <set>
+
+namespace sky::app {
+
+weather::WeatherSnapshot drawableWeather(const weather::WeatherSnapshot& s, std::size_t maxLayers,
+                                         std::vector<std::uint32_t>* dropped) {
+  if (dropped) dropped->clear();
+  if (s.layers.size() <= maxLayers) return s;
+  std::vector<const weather::CloudLayer*> ranked;
+  for (const auto& l : s.layers) ranked.push_back(&l);
+  std::stable_sort(ranked.begin(), ranked.end(), [](const weather::CloudLayer* a, const weather::CloudLayer* b) {
+    const double ca = a->coverage * a->density, cb = b->coverage * b->density;
+    return ca != cb ? ca > cb : a->id < b->id;
+  });
+  std::set<std::uint32_t> keep;
+  for (std::size_t i = 0; i < ranked.size(); ++i) {
+    if (i < maxLayers)
+      keep.insert(ranked[i]->id);
+    else if (dropped)
+      dropped->push_back(ranked[i]->id);
+  }
+  weather::WeatherSnapshot out;
+  out.weatherClock_s = s.weatherClock_s;
+  out.tileLevel = s.tileLevel;
+  for (const auto& l : s.layers)
+    if (keep.count(l.id)) out.layers.push_back(l);
+  for (const auto& t : s.tiles)
+    if (keep.count(t.layerId)) out.tiles.push_back(t);
+  if (dropped) std::sort(dropped->begin(), dropped->end());
+  return out;
+}
+
+}  // namespace sky::app
