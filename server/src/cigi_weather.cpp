@@ -1,0 +1,174 @@
+#include "sky/server/cigi_weather.hpp"
+
+#include <cmath>
+#include <string>
+#include <utility>
+
+namespace sky::server {
+namespace {
+
+bool sameLayer(const weather::CloudLayer& a, const weather::CloudLayer& b) {
+  return a.id == b.id && a.type == b.type && a.base_m == b.base_m && a.thickness_m == b.thickness_m &&
+         a.transitionBand_m == b.transitionBand_m && a.coverage == b.coverage && a.density == b.density &&
+         a.wind.speed_mps == b.wind.speed_mps && a.wind.fromDirection_deg == b.wind.fromDirection_deg &&
+         a.wind.vertical_mps == b.wind.vertical_mps;
+}
+
+bool sameRegion(const weather::Region& a, const weather::Region& b) {
+  if (a.id != b.id || a.centerLat_deg != b.centerLat_deg || a.centerLon_deg != b.centerLon_deg ||
+      a.sizeX_m != b.sizeX_m || a.sizeY_m != b.sizeY_m || a.cornerRadius_m != b.cornerRadius_m ||
+      a.rotation_deg != b.rotation_deg || a.transition_m != b.transition_m ||
+      a.layers.size() != b.layers.size())
+    return false;
+  for (std::size_t i = 0; i < a.layers.size(); ++i)
+    if (!sameLayer(a.layers[i], b.layers[i])) return false;
+  return true;
+}
+
+bool cloudLayerId(cigi::LayerId id) {
+  auto n = static_cast<std::uint8_t>(id);
+  return (n >= 1 && n <= 3) || n >= 10;
+}
+
+std::string where(std::size_t index, const char* packet) {
+  return "packet " + std::to_string(index) + " (" + packet + ")";
+}
+
+weather::Region regionWithLayers(const weather::Region& geometry,
+                                 const std::map<std::uint32_t, weather::CloudLayer>& layers) {
+  weather::Region r = geometry;
+  r.layers.clear();
+  for (const auto& [id, layer] : layers) r.layers.push_back(layer);
+  return r;
+}
+
+}  // namespace
+
+Result<std::optional<weather::CloudLayer>> cloudLayerFrom(const cigi::WeatherControl& p) {
+  if (!cloudLayerId(p.layerId)) return std::optional<weather::CloudLayer>{};
+  const std::string what = "Weather Control layer " + std::to_string(static_cast<int>(p.layerId));
+  auto bad = [&](const char* field, double v, const char* range) {
+    return fail(ErrorCode::InvalidArgument, what + ": " + field + " " + std::to_string(v) + " outside " + range);
+  };
+  if (!(p.coverage_pct >= 0 && p.coverage_pct <= 100)) return bad("coverage", p.coverage_pct, "[0, 100] %");
+  if (!(p.windDirection_deg >= -180 && p.windDirection_deg <= 360))
+    return bad("wind direction", p.windDirection_deg, "[-180, 360] deg");
+  weather::CloudLayer layer;
+  layer.id = static_cast<std::uint8_t>(p.layerId);
+  layer.type = p.cloudType;
+  layer.base_m = p.baseElevation_m;
+  layer.thickness_m = p.thickness_m;
+  layer.transitionBand_m = p.transitionBand_m;
+  layer.coverage = p.coverage_pct / 100.0;
+  layer.density = 1;
+  layer.wind.speed_mps = p.horizontalWind_mps;
+  double from = std::fmod(static_cast<double>(p.windDirection_deg), 360.0);
+  if (from < 0) from += 360;
+  layer.wind.fromDirection_deg = from;
+  layer.wind.vertical_mps = p.verticalWind_mps;
+  if (auto ok = weather::validate(layer); !ok)
+    return fail(ErrorCode::InvalidArgument, what + ": " + ok.error().detail);
+  return std::optional<weather::CloudLayer>{layer};
+}
+
+void CigiWeatherMapper::reset() {
+  globalSent_.clear();
+  regions_.clear();
+}
+
+Result<std::vector<WeatherChange>> CigiWeatherMapper::map(const cigi::Datagram& datagram) {
+  // Work on copies so a rejected datagram leaves the remembered state alone.
+  auto global = globalSent_;
+  auto regions = regions_;
+  std::size_t ignored = 0;
+  std::vector<WeatherChange> changes;
+  std::map<std::uint32_t, bool> regionTouched;
+
+  for (std::size_t i = 0; i < datagram.packets.size(); ++i) {
+    const auto& packet = datagram.packets[i];
+    if (const auto* wc = std::get_if<cigi::WeatherControl>(&packet)) {
+      if (wc->scope == cigi::WeatherScope::Entity)
+        return fail(ErrorCode::InvalidArgument,
+                    where(i, "Weather Control") + ": scope entity: no entity weather in our model");
+      auto layer = cloudLayerFrom(*wc);
+      if (!layer) return fail(ErrorCode::InvalidArgument, where(i, "Weather Control") + ": " + layer.error().detail);
+      if (!*layer) {
+        ++ignored;
+        continue;
+      }
+      const std::uint32_t id = (*layer)->id;
+      if (wc->scope == cigi::WeatherScope::Global) {
+        auto it = global.find(id);
+        if (wc->weatherEnable) {
+          if (it != global.end() && it->second && sameLayer(*it->second, **layer)) continue;
+          global[id] = **layer;
+          changes.push_back(SetLayer{**layer, {}});
+        } else {
+          // Only layers this input set are removed: a disabled layer we never
+          // enabled (hosts send all three every frame) is left alone.
+          if (it == global.end() || !it->second) continue;
+          global[id] = std::nullopt;
+          changes.push_back(RemoveLayer{id, {}});
+        }
+      } else {
+        if (wc->entityOrRegionId == 0)
+          return fail(ErrorCode::InvalidArgument, where(i, "Weather Control") + ": region id 0 outside [1, 65535]");
+        auto& region = regions[wc->entityOrRegionId];
+        if (wc->weatherEnable) region.layers[id] = **layer;
+        else region.layers.erase(id);
+        regionTouched[wc->entityOrRegionId] = true;
+      }
+    } else if (const auto* erc = std::get_if<cigi::EnvironmentalRegionControl>(&packet)) {
+      if (erc->regionId == 0)
+        return fail(ErrorCode::InvalidArgument,
+                    where(i, "Environmental Region Control") + ": region id 0 outside [1, 65535]");
+      auto& region = regions[erc->regionId];
+      if (erc->state == cigi::RegionState::Active) {
+        weather::Region geometry;
+        geometry.id = erc->regionId;
+        geometry.centerLat_deg = erc->lat_deg;
+        geometry.centerLon_deg = erc->lon_deg;
+        geometry.sizeX_m = erc->sizeX_m;
+        geometry.sizeY_m = erc->sizeY_m;
+        geometry.cornerRadius_m = erc->cornerRadius_m;
+        geometry.rotation_deg = erc->rotation_deg;
+        geometry.transition_m = erc->transitionPerimeter_m;
+        if (auto ok = weather::validate(geometry); !ok)
+          return fail(ErrorCode::InvalidArgument,
+                      where(i, "Environmental Region Control") + " region " + std::to_string(erc->regionId) +
+                          ": " + ok.error().detail);
+        region.geometry = geometry;
+        region.active = true;
+      } else {
+        region.active = false;
+        if (region.lastSent) {
+          changes.push_back(RemoveRegion{erc->regionId, {}});
+          region.lastSent.reset();
+        }
+        if (erc->state == cigi::RegionState::Destroyed) regions.erase(erc->regionId);
+        continue;
+      }
+      regionTouched[erc->regionId] = true;
+    }
+  }
+
+  // Regions whose geometry or layers were given: send them whole if active
+  // and different from what the server has.
+  for (const auto& [id, touched] : regionTouched) {
+    auto it = regions.find(id);
+    if (it == regions.end() || !it->second.active || !it->second.geometry) continue;
+    weather::Region full = regionWithLayers(*it->second.geometry, it->second.layers);
+    if (auto ok = weather::validate(full); !ok)
+      return fail(ErrorCode::InvalidArgument, "region " + std::to_string(id) + ": " + ok.error().detail);
+    if (it->second.lastSent && sameRegion(*it->second.lastSent, full)) continue;
+    it->second.lastSent = full;
+    changes.push_back(SetRegion{std::move(full), {}});
+  }
+
+  globalSent_ = std::move(global);
+  regions_ = std::move(regions);
+  ignoredLayers_ += ignored;
+  return changes;
+}
+
+}  // namespace sky::server
