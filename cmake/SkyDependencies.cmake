@@ -56,6 +56,10 @@ find_package(nlohmann_json CONFIG REQUIRED)
 add_library(sky::json INTERFACE IMPORTED)
 target_link_libraries(sky::json INTERFACE nlohmann_json::nlohmann_json)
 
+find_package(SQLite3 REQUIRED)
+add_library(sky::sqlite INTERFACE IMPORTED)
+target_link_libraries(sky::sqlite INTERFACE SQLite::SQLite3)
+
 find_package(Vulkan REQUIRED)
 find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)
 find_package(glm CONFIG REQUIRED)

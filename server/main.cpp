@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -17,6 +18,7 @@
 #include "sky/server/http_api.hpp"
 #include "sky/server/scenario.hpp"
 #include "sky/server/server.hpp"
+#include "sky/server/weather_store.hpp"
 #include "sky/server/weather_state.hpp"
 
 namespace {
@@ -84,6 +86,10 @@ int main(int argc, char** argv) {
   app.add_option("--http-port-file", httpPortFile, "Write the HTTP port here once listening");
   app.add_option("--token-file", tokenFile,
                  "File whose first line is the token that changes need (without it the API is read-only)");
+  std::string dbPath;
+  app.add_option("--db", dbPath,
+                 "SQLite file of the live weather: restored at start when it holds a state, every accepted change "
+                 "committed to it (default: none, the weather lives in memory)");
   app.add_option("--log-level", logLevel, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
@@ -128,6 +134,36 @@ int main(int argc, char** argv) {
   }
   log->info("scenario {}: {} layer(s); listening on {}:{}", scenarioPath, scenario->layers.size(),
             host, (*server)->port());
+
+  std::optional<sky::server::WeatherStore> store;
+  if (!dbPath.empty()) {
+    auto opened = sky::server::WeatherStore::open(dbPath);
+    if (!opened) {
+      log->error("{}", sky::describe(opened.error()));
+      return kExitRuntime;
+    }
+    store.emplace(std::move(*opened));
+    auto saved = store->load();
+    if (!saved) {
+      log->error("{}", sky::describe(saved.error()));
+      return kExitRuntime;
+    }
+    auto& weather = (*server)->weather();
+    if (*saved) {
+      if (auto r = weather.restore((*saved)->state, std::move((*saved)->events)); !r) {
+        log->error("{}: {}", dbPath, sky::describe(r.error()));
+        return kExitRuntime;
+      }
+      log->info("restored the weather from {}: sequence {}, {} layer(s), state hash {:016x}", dbPath,
+                weather.view().lastSequence, weather.view().layers.size(), weather.stateHash());
+    } else if (auto r = store->save(weather.toJson(), nullptr); !r) {
+      log->error("{}", sky::describe(r.error()));
+      return kExitRuntime;
+    } else {
+      log->info("new weather file {} from the scenario", dbPath);
+    }
+    weather.attachStore(&*store);
+  }
 
   std::unique_ptr<sky::server::HttpApi> api;
   if (httpPort >= 0) {

@@ -61,7 +61,7 @@ Result<Timing> timing(const json& o, const std::string& path) {
   return t;
 }
 
-Result<weather::CloudLayer> layer(const json& o, const std::string& path) {
+Result<weather::CloudLayer> parseLayer(const json& o, const std::string& path) {
   if (!o.is_object()) return bad(path, "expected an object");
   if (auto r = onlyKeys(o, {"id", "type", "base_m", "thickness_m", "transition_band_m", "coverage", "density", "wind"},
                         path);
@@ -105,7 +105,7 @@ Result<WeatherChange> change(const json& o, const std::string& path) {
   if (op == "set_layer") {
     if (auto r = onlyKeys(o, {"op", "layer", "ramp_s", "at_s"}, path); !r) return tl::unexpected(r.error());
     if (!o.contains("layer")) return bad(path + ".layer", "missing (required)");
-    auto l = layer(o.at("layer"), path + ".layer");
+    auto l = parseLayer(o.at("layer"), path + ".layer");
     if (!l) return tl::unexpected(l.error());
     auto t = timing(o, path);
     if (!t) return tl::unexpected(t.error());
@@ -153,6 +153,10 @@ Result<ChangeRequest> parseChangeRequest(std::string_view body) {
     req.changes.push_back(*c);
   }
   return req;
+}
+
+Result<weather::CloudLayer> layerFromJson(const nlohmann::json& object, const std::string& path) {
+  return parseLayer(object, path);
 }
 
 nlohmann::json toJson(const weather::CloudLayer& l) {

@@ -1,6 +1,9 @@
 // The server's live weather (see live_weather.hpp).
 #include "sky/server/live_weather.hpp"
 
+#include "sky/server/api_json.hpp"
+#include "sky/server/weather_store.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -196,12 +199,16 @@ Result<AppliedChange> LiveWeather::submit(const ChangeRequest& request) {
     }
     summary += (summary.empty() ? "" : "; ") + *one;
   }
+  ChangeEvent e{sequence_ + 1, now_s, unixNowMs_(), request.author, request.source, summary};
+  if (store_) {
+    // Commit first: only a change on disk is acknowledged and applied.
+    if (auto ok = store_->save(stateJson(next, sequence_ + 1, version_ + 1), &e); !ok) return tl::unexpected(ok.error());
+  }
   layers_ = std::move(next.layers);
   ramps_ = std::move(next.ramps);
   clock_ = next.clock;
   ++sequence_;
   ++version_;
-  ChangeEvent e{sequence_, now_s, unixNowMs_(), request.author, request.source, summary};
   events_.push_back(e);
   if (events_.size() > kMaxEvents) events_.erase(events_.begin());
   return AppliedChange{sequence_, now_s, summary};
@@ -222,6 +229,89 @@ WeatherView LiveWeather::view() const {
 std::vector<ChangeEvent> LiveWeather::events(std::size_t limit) const {
   const std::size_t n = std::min(limit, events_.size());
   return {events_.end() - static_cast<std::ptrdiff_t>(n), events_.end()};
+}
+
+namespace {
+
+nlohmann::json rampJson(std::uint64_t sequence, std::uint32_t layerId, double start_s, double end_s, bool fromAbsent,
+                        const weather::CloudLayer& from, const weather::CloudLayer& to, bool removeAtEnd,
+                        const std::string& summary) {
+  return {{"sequence", sequence}, {"layer_id", layerId},   {"start_s", start_s},          {"end_s", end_s},
+          {"from_absent", fromAbsent}, {"from", toJson(from)}, {"to", toJson(to)}, {"remove_at_end", removeAtEnd},
+          {"summary", summary}};
+}
+
+}  // namespace
+
+nlohmann::json LiveWeather::stateJson(const State& s, std::uint64_t sequence, std::uint64_t version) const {
+  nlohmann::json layers = nlohmann::json::array();
+  for (const auto& [id, l] : s.layers) layers.push_back(server::toJson(l));
+  nlohmann::json ramps = nlohmann::json::array();
+  for (const Ramp& r : s.ramps)
+    ramps.push_back(rampJson(r.sequence, r.layerId, r.start_s, r.end_s, r.fromAbsent, r.from, r.to, r.removeAtEnd,
+                             r.summary));
+  return {{"layers", layers},
+          {"ramps", ramps},
+          {"sequence", sequence},
+          {"version", version},
+          {"clock", {{"clock_s", s.clock.at(wallNow_())}, {"rate", s.clock.rate()}, {"unix_ms", unixNowMs_()}}}};
+}
+
+nlohmann::json LiveWeather::toJson() const { return stateJson(State{layers_, ramps_, clock_}, sequence_, version_); }
+
+Result<void> LiveWeather::restore(const nlohmann::json& j, std::vector<ChangeEvent> events) {
+  auto bad = [](const std::string& what) { return fail(ErrorCode::Malformed, "saved state: " + what); };
+  try {
+    std::map<std::uint32_t, weather::CloudLayer> layers;
+    for (const auto& l : j.at("layers")) {
+      auto layer = layerFromJson(l, "layers[]");
+      if (!layer) return tl::unexpected(layer.error());
+      layers[layer->id] = *layer;
+    }
+    std::vector<Ramp> ramps;
+    for (const auto& r : j.at("ramps")) {
+      Ramp ramp;
+      ramp.sequence = r.at("sequence").get<std::uint64_t>();
+      ramp.layerId = r.at("layer_id").get<std::uint32_t>();
+      ramp.start_s = r.at("start_s").get<double>();
+      ramp.end_s = r.at("end_s").get<double>();
+      ramp.fromAbsent = r.at("from_absent").get<bool>();
+      auto from = layerFromJson(r.at("from"), "ramps[].from");
+      auto to = layerFromJson(r.at("to"), "ramps[].to");
+      if (!from || !to) return bad("a ramp's layers");
+      ramp.from = *from;
+      ramp.to = *to;
+      ramp.removeAtEnd = r.at("remove_at_end").get<bool>();
+      ramp.summary = r.at("summary").get<std::string>();
+      ramps.push_back(ramp);
+    }
+    const auto& c = j.at("clock");
+    const double rate = c.at("rate").get<double>();
+    const double downtime_s = double(unixNowMs_() - c.at("unix_ms").get<std::int64_t>()) / 1000.0;
+    const double clockNow_s = c.at("clock_s").get<double>() + rate * std::max(0.0, downtime_s);
+    layers_ = std::move(layers);
+    ramps_ = std::move(ramps);
+    sequence_ = j.at("sequence").get<std::uint64_t>();
+    version_ = j.at("version").get<std::uint64_t>() + 1;
+    clock_ = WeatherClock(clockNow_s, rate, wallNow_());
+    events_ = std::move(events);
+  } catch (const nlohmann::json::exception& e) {
+    return bad(e.what());
+  }
+  return {};
+}
+
+std::uint64_t LiveWeather::stateHash() const {
+  nlohmann::json j = toJson();
+  j.erase("version");
+  j["clock"] = {{"rate", clock_.rate()}};
+  const std::string text = j.dump();
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char ch : text) {
+    h ^= ch;
+    h *= 1099511628211ull;
+  }
+  return h;
 }
 
 }  // namespace sky::server

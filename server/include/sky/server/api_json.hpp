@@ -27,6 +27,8 @@ namespace sky::server {
 Result<ChangeRequest> parseChangeRequest(std::string_view body);
 
 nlohmann::json toJson(const weather::CloudLayer& layer);
+// The LAYER object above; errors name `path`. Values are not range-checked.
+Result<weather::CloudLayer> layerFromJson(const nlohmann::json& object, const std::string& path);
 nlohmann::json toJson(const WeatherView& view);
 nlohmann::json toJson(const ChangeEvent& event);
 

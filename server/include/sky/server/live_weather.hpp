@@ -10,6 +10,8 @@
 #include <map>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "sky/server/change.hpp"
 #include "sky/server/scenario.hpp"
 #include "sky/server/weather_clock.hpp"
@@ -37,6 +39,21 @@ class LiveWeather final : public WeatherService {
   bool changing(double clock_s) const;
   std::uint64_t rejected() const { return rejected_; }
 
+  // Durability: with a store attached, every accepted change is committed to
+  // it (state and event, one transaction) before submit returns; a failed
+  // commit refuses the change (Io) and leaves the state as it was.
+  void attachStore(class WeatherStore* store) { store_ = store; }
+  // The whole state as JSON: layers, ramps in progress, sequence, version,
+  // and the clock as (clock_s, rate) at unix_ms.
+  nlohmann::json toJson() const;
+  // Replaces the state with a saved one; the weather clock goes on from the
+  // saved value at its rate for the time the server was down (the weather
+  // outside did not stop). Malformed when the JSON is not a saved state.
+  Result<void> restore(const nlohmann::json& state, std::vector<ChangeEvent> events);
+  // FNV-1a of the canonical state without the clock's position (layers,
+  // ramps, sequence, clock rate): equal before a shutdown and after restore.
+  std::uint64_t stateHash() const;
+
  private:
   struct Ramp {
     std::uint64_t sequence = 0;
@@ -56,6 +73,7 @@ class LiveWeather final : public WeatherService {
   Result<std::string> apply(State& s, const WeatherChange& change, std::size_t index, double now_s,
                             std::uint64_t sequence) const;
   void settle(double clock_s);
+  nlohmann::json stateJson(const State& s, std::uint64_t sequence, std::uint64_t version) const;
 
   WallNow wallNow_;
   UnixNowMs unixNowMs_;
@@ -66,6 +84,7 @@ class LiveWeather final : public WeatherService {
   std::uint64_t sequence_ = 0;
   std::uint64_t version_ = 1;
   std::uint64_t rejected_ = 0;
+  class WeatherStore* store_ = nullptr;
 };
 
 }  // namespace sky::server

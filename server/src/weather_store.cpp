@@ -1,0 +1,131 @@
+// SQLite persistence of the live weather (see weather_store.hpp).
+#include "sky/server/weather_store.hpp"
+
+#include <sqlite3.h>
+
+namespace sky::server {
+
+namespace {
+
+constexpr int kSchemaVersion = 1;
+
+// A prepared statement, finalised when it goes out of scope.
+class Statement {
+ public:
+  Statement(sqlite3* db, const char* sql) { rc_ = sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr); }
+  ~Statement() { sqlite3_finalize(stmt_); }
+  Statement(const Statement&) = delete;
+  Statement& operator=(const Statement&) = delete;
+  bool ok() const { return rc_ == SQLITE_OK && stmt_; }
+  sqlite3_stmt* get() const { return stmt_; }
+
+ private:
+  sqlite3_stmt* stmt_ = nullptr;
+  int rc_ = SQLITE_ERROR;
+};
+
+std::string text(sqlite3_stmt* s, int col) {
+  const auto* p = sqlite3_column_text(s, col);
+  return p ? reinterpret_cast<const char*>(p) : "";
+}
+
+}  // namespace
+
+void WeatherStore::Closer::operator()(sqlite3* db) const { sqlite3_close_v2(db); }
+
+WeatherStore::WeatherStore(std::filesystem::path path, std::unique_ptr<sqlite3, Closer> db)
+    : path_(std::move(path)), db_(std::move(db)) {}
+WeatherStore::WeatherStore(WeatherStore&&) noexcept = default;
+WeatherStore& WeatherStore::operator=(WeatherStore&&) noexcept = default;
+WeatherStore::~WeatherStore() = default;
+
+Result<void> WeatherStore::exec(const char* sql) const {
+  char* err = nullptr;
+  if (sqlite3_exec(db_.get(), sql, nullptr, nullptr, &err) != SQLITE_OK) {
+    const std::string detail = path_.string() + ": " + (err ? err : sqlite3_errmsg(db_.get()));
+    sqlite3_free(err);
+    return fail(ErrorCode::Io, detail);
+  }
+  return {};
+}
+
+Result<WeatherStore> WeatherStore::open(const std::filesystem::path& path) {
+  sqlite3* raw = nullptr;
+  const int rc = sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+  std::unique_ptr<sqlite3, Closer> db(raw);
+  if (rc != SQLITE_OK)
+    return fail(ErrorCode::Io, path.string() + ": cannot open: " + (raw ? sqlite3_errmsg(raw) : "out of memory"));
+  sqlite3_busy_timeout(raw, 5000);
+  WeatherStore store(path, std::move(db));
+  // WAL: a crash never leaves a half-written state; FULL: a commit survives
+  // the machine losing power, not only the process dying.
+  if (auto r = store.exec("PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;"); !r) return tl::unexpected(r.error());
+  if (auto r = store.exec("CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);"
+                          "CREATE TABLE IF NOT EXISTS events (sequence INTEGER PRIMARY KEY, clock_s REAL NOT NULL,"
+                          " wall_ms INTEGER NOT NULL, author TEXT NOT NULL, source TEXT NOT NULL, summary TEXT NOT NULL);");
+      !r)
+    return tl::unexpected(r.error());
+  Statement version(store.db_.get(), "SELECT value FROM meta WHERE key = 'schema'");
+  if (!version.ok()) return fail(ErrorCode::Io, path.string() + ": " + sqlite3_errmsg(store.db_.get()));
+  if (sqlite3_step(version.get()) == SQLITE_ROW) {
+    if (text(version.get(), 0) != std::to_string(kSchemaVersion))
+      return fail(ErrorCode::Unsupported, path.string() + ": schema version " + text(version.get(), 0) +
+                                              ", this server knows " + std::to_string(kSchemaVersion));
+  } else if (auto r = store.exec("INSERT INTO meta (key, value) VALUES ('schema', '1');"); !r) {
+    return tl::unexpected(r.error());
+  }
+  return store;
+}
+
+Result<std::optional<WeatherStore::Saved>> WeatherStore::load() const {
+  Statement st(db_.get(), "SELECT value FROM meta WHERE key = 'state'");
+  if (!st.ok()) return fail(ErrorCode::Io, path_.string() + ": " + sqlite3_errmsg(db_.get()));
+  if (sqlite3_step(st.get()) != SQLITE_ROW) return std::optional<Saved>{};
+  Saved saved;
+  saved.state = nlohmann::json::parse(text(st.get(), 0), nullptr, false);
+  if (saved.state.is_discarded() || !saved.state.is_object())
+    return fail(ErrorCode::Malformed, path_.string() + ": the saved state is not a JSON object");
+  Statement ev(db_.get(), "SELECT sequence, clock_s, wall_ms, author, source, summary FROM events ORDER BY sequence");
+  if (!ev.ok()) return fail(ErrorCode::Io, path_.string() + ": " + sqlite3_errmsg(db_.get()));
+  while (sqlite3_step(ev.get()) == SQLITE_ROW)
+    saved.events.push_back({static_cast<std::uint64_t>(sqlite3_column_int64(ev.get(), 0)),
+                            sqlite3_column_double(ev.get(), 1), sqlite3_column_int64(ev.get(), 2),
+                            text(ev.get(), 3), text(ev.get(), 4), text(ev.get(), 5)});
+  return std::optional<Saved>(std::move(saved));
+}
+
+Result<void> WeatherStore::save(const nlohmann::json& state, const ChangeEvent* event) {
+  if (auto r = exec("BEGIN IMMEDIATE;"); !r) return r;
+  auto rollback = [this](const std::string& what) {
+    const std::string detail = path_.string() + ": " + what + ": " + sqlite3_errmsg(db_.get());
+    (void)exec("ROLLBACK;");
+    return fail(ErrorCode::Io, detail);
+  };
+  {
+    Statement st(db_.get(), "INSERT INTO meta (key, value) VALUES ('state', ?1) "
+                            "ON CONFLICT(key) DO UPDATE SET value = excluded.value");
+    const std::string json = state.dump();
+    if (!st.ok() || sqlite3_bind_text(st.get(), 1, json.c_str(), int(json.size()), SQLITE_TRANSIENT) != SQLITE_OK ||
+        sqlite3_step(st.get()) != SQLITE_DONE)
+      return rollback("saving the state");
+  }
+  if (event) {
+    Statement st(db_.get(), "INSERT INTO events (sequence, clock_s, wall_ms, author, source, summary) "
+                            "VALUES (?1, ?2, ?3, ?4, ?5, ?6)");
+    if (!st.ok() || sqlite3_bind_int64(st.get(), 1, static_cast<sqlite3_int64>(event->sequence)) != SQLITE_OK ||
+        sqlite3_bind_double(st.get(), 2, event->clock_s) != SQLITE_OK ||
+        sqlite3_bind_int64(st.get(), 3, event->wallTime_ms) != SQLITE_OK ||
+        sqlite3_bind_text(st.get(), 4, event->author.c_str(), -1, SQLITE_TRANSIENT) != SQLITE_OK ||
+        sqlite3_bind_text(st.get(), 5, event->source.c_str(), -1, SQLITE_TRANSIENT) != SQLITE_OK ||
+        sqlite3_bind_text(st.get(), 6, event->summary.c_str(), -1, SQLITE_TRANSIENT) != SQLITE_OK ||
+        sqlite3_step(st.get()) != SQLITE_DONE)
+      return rollback("saving the event");
+  }
+  if (auto r = exec("COMMIT;"); !r) {
+    (void)exec("ROLLBACK;");
+    return r;
+  }
+  return {};
+}
+
+}  // namespace sky::server
