@@ -1,0 +1,174 @@
+// CIGI Weather Control / Environmental Region Control -> change requests.
+// Datagrams are built with the protocol encoder in both byte orders and
+// decoded by the protocol decoder, as the listener will; expected values are
+// worked out by hand from the packet fields.
+#include "sky/server/cigi_weather.hpp"
+
+#include <gtest/gtest.h>
+
+#include <variant>
+
+namespace sky::server {
+namespace {
+
+cigi::Datagram roundTrip(const std::vector<cigi::Packet>& packets, cigi::ByteOrder order) {
+  cigi::DatagramWriter w(order);
+  w.add(cigi::IgControl{});
+  for (const auto& p : packets) w.add(p);
+  auto d = cigi::decodeDatagram(w.bytes());
+  EXPECT_TRUE(d) << (d ? "" : d.error().detail);
+  return *d;
+}
+
+cigi::WeatherControl layer2() {
+  cigi::WeatherControl wc;
+  wc.layerId = cigi::LayerId::CloudLayer2;
+  wc.cloudType = weather::CloudType::Stratocumulus;
+  wc.coverage_pct = 62.5f;
+  wc.baseElevation_m = 1500;
+  wc.thickness_m = 800;
+  wc.transitionBand_m = 100;
+  wc.horizontalWind_mps = 12.5f;
+  wc.verticalWind_mps = -0.5f;
+  wc.windDirection_deg = -90;  // from the west: 270 in [0, 360)
+  return wc;
+}
+
+class CigiWeather : public ::testing::TestWithParam<cigi::ByteOrder> {};
+
+TEST_P(CigiWeather, GlobalLayerMapsEveryField) {
+  CigiWeatherMapper m;
+  auto changes = m.map(roundTrip({layer2()}, GetParam()));
+  ASSERT_TRUE(changes) << changes.error().detail;
+  ASSERT_EQ(changes->size(), 1u);
+  const auto& set = std::get<SetLayer>((*changes)[0]);
+  EXPECT_EQ(set.layer.id, 2u);
+  EXPECT_EQ(set.layer.type, weather::CloudType::Stratocumulus);
+  EXPECT_DOUBLE_EQ(set.layer.coverage, 0.625);
+  EXPECT_DOUBLE_EQ(set.layer.base_m, 1500);
+  EXPECT_DOUBLE_EQ(set.layer.thickness_m, 800);
+  EXPECT_DOUBLE_EQ(set.layer.transitionBand_m, 100);
+  EXPECT_DOUBLE_EQ(set.layer.wind.speed_mps, 12.5);
+  EXPECT_DOUBLE_EQ(set.layer.wind.fromDirection_deg, 270);
+  EXPECT_DOUBLE_EQ(set.layer.wind.vertical_mps, -0.5);
+  EXPECT_FALSE(set.timing.at_s);
+  EXPECT_EQ(set.timing.ramp_s, 0);
+}
+
+TEST_P(CigiWeather, RepeatedIdenticalPacketsProduceNoChange) {
+  CigiWeatherMapper m;
+  ASSERT_EQ(m.map(roundTrip({layer2()}, GetParam()))->size(), 1u);
+  for (int frame = 0; frame < 60; ++frame) {
+    auto again = m.map(roundTrip({layer2()}, GetParam()));
+    ASSERT_TRUE(again);
+    EXPECT_TRUE(again->empty());
+  }
+  auto moved = layer2();
+  moved.coverage_pct = 70;
+  auto changed = m.map(roundTrip({moved}, GetParam()));
+  ASSERT_EQ(changed->size(), 1u);
+  EXPECT_DOUBLE_EQ(std::get<SetLayer>((*changed)[0]).layer.coverage, 0.70);
+}
+
+TEST_P(CigiWeather, DisableRemovesOnlyALayerItEnabled) {
+  CigiWeatherMapper m;
+  auto off = layer2();
+  off.weatherEnable = false;
+  EXPECT_TRUE(m.map(roundTrip({off}, GetParam()))->empty());  // never enabled: left alone
+  ASSERT_EQ(m.map(roundTrip({layer2()}, GetParam()))->size(), 1u);
+  auto removed = m.map(roundTrip({off}, GetParam()));
+  ASSERT_EQ(removed->size(), 1u);
+  EXPECT_EQ(std::get<RemoveLayer>((*removed)[0]).layerId, 2u);
+  EXPECT_TRUE(m.map(roundTrip({off}, GetParam()))->empty());
+}
+
+TEST_P(CigiWeather, FogAndPrecipitationIgnoredIgDefinedKept) {
+  CigiWeatherMapper m;
+  auto rain = layer2();
+  rain.layerId = cigi::LayerId::Rain;
+  rain.cloudType = weather::CloudType::None;
+  auto ig = layer2();
+  ig.layerId = cigi::LayerId{12};
+  auto changes = m.map(roundTrip({rain, ig}, GetParam()));
+  ASSERT_TRUE(changes);
+  ASSERT_EQ(changes->size(), 1u);
+  EXPECT_EQ(std::get<SetLayer>((*changes)[0]).layer.id, 12u);
+  EXPECT_EQ(m.ignoredLayers(), 1u);
+}
+
+TEST_P(CigiWeather, RegionWithItsLayers) {
+  CigiWeatherMapper m;
+  cigi::EnvironmentalRegionControl erc;
+  erc.regionId = 7;
+  erc.lat_deg = 47.5;
+  erc.lon_deg = 8.25;
+  erc.sizeX_m = 20000;
+  erc.sizeY_m = 10000;
+  erc.cornerRadius_m = 2000;
+  erc.rotation_deg = 30;
+  erc.transitionPerimeter_m = 5000;
+  erc.mergeWeather = true;  // ignored
+  auto wc = layer2();
+  wc.scope = cigi::WeatherScope::Regional;
+  wc.entityOrRegionId = 7;
+  auto changes = m.map(roundTrip({erc, wc}, GetParam()));
+  ASSERT_TRUE(changes) << changes.error().detail;
+  ASSERT_EQ(changes->size(), 1u);
+  const auto& r = std::get<SetRegion>((*changes)[0]).region;
+  EXPECT_EQ(r.id, 7u);
+  EXPECT_DOUBLE_EQ(r.centerLat_deg, 47.5);
+  EXPECT_DOUBLE_EQ(r.centerLon_deg, 8.25);
+  EXPECT_DOUBLE_EQ(r.sizeX_m, 20000);
+  EXPECT_DOUBLE_EQ(r.sizeY_m, 10000);
+  EXPECT_DOUBLE_EQ(r.cornerRadius_m, 2000);
+  EXPECT_DOUBLE_EQ(r.rotation_deg, 30);
+  EXPECT_DOUBLE_EQ(r.transition_m, 5000);
+  ASSERT_EQ(r.layers.size(), 1u);
+  EXPECT_DOUBLE_EQ(r.layers[0].coverage, 0.625);
+  EXPECT_TRUE(m.map(roundTrip({erc, wc}, GetParam()))->empty());
+
+  erc.state = cigi::RegionState::Inactive;
+  auto off = m.map(roundTrip({erc}, GetParam()));
+  ASSERT_EQ(off->size(), 1u);
+  EXPECT_EQ(std::get<RemoveRegion>((*off)[0]).regionId, 7u);
+  erc.state = cigi::RegionState::Active;  // back with its remembered layer
+  auto on = m.map(roundTrip({erc}, GetParam()));
+  ASSERT_EQ(on->size(), 1u);
+  EXPECT_EQ(std::get<SetRegion>((*on)[0]).region.layers.size(), 1u);
+  erc.state = cigi::RegionState::Destroyed;
+  EXPECT_EQ(m.map(roundTrip({erc}, GetParam()))->size(), 1u);
+}
+
+TEST_P(CigiWeather, RejectsNameThePacketAndFieldAndKeepState) {
+  CigiWeatherMapper m;
+  auto thick = layer2();
+  thick.thickness_m = 0;  // our layers need thickness > 0
+  auto bad = m.map(roundTrip({layer2(), thick}, GetParam()));
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().code, ErrorCode::InvalidArgument);
+  EXPECT_NE(bad.error().detail.find("packet 2 (Weather Control)"), std::string::npos) << bad.error().detail;
+  EXPECT_NE(bad.error().detail.find("thickness_m"), std::string::npos) << bad.error().detail;
+  // Nothing remembered from the rejected datagram: layer 2 is still new.
+  EXPECT_EQ(m.map(roundTrip({layer2()}, GetParam()))->size(), 1u);
+
+  auto entity = layer2();
+  entity.scope = cigi::WeatherScope::Entity;
+  auto e = m.map(roundTrip({entity}, GetParam()));
+  ASSERT_FALSE(e);
+  EXPECT_NE(e.error().detail.find("scope entity"), std::string::npos);
+
+  cigi::EnvironmentalRegionControl erc;
+  erc.regionId = 3;
+  erc.sizeX_m = 0;  // our regions need a size > 0
+  erc.sizeY_m = 1000;
+  auto r = m.map(roundTrip({erc}, GetParam()));
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().detail.find("Environmental Region Control"), std::string::npos) << r.error().detail;
+  EXPECT_NE(r.error().detail.find("size x"), std::string::npos) << r.error().detail;
+}
+
+INSTANTIATE_TEST_SUITE_P(ByteOrders, CigiWeather,
+                         ::testing::Values(cigi::ByteOrder::Big, cigi::ByteOrder::Little));
+
+}  // namespace
+}  // namespace sky::server
