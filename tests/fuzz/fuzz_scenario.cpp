@@ -1,4 +1,4 @@
-// libFuzzer target: the weather server's scenario files (TOML) on arbitrary
+// libFuzzer target: scenario files (protocol/weather, read by the server and the headless renderer) (TOML) on arbitrary
 // bytes. The parser may refuse, never crash, hang or read out of bounds; every
 // scenario it accepts has a clock rate in range and layers that pass
 // weather::validate with unique ids. Seeds: tests/fuzz/corpus/scenario/.
@@ -8,11 +8,11 @@
 #include <set>
 #include <string_view>
 
-#include "sky/server/scenario.hpp"
+#include "sky/weather/scenario.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
-  const auto s = sky::server::parseScenario(text, "fuzz.toml");
+  const auto s = sky::weather::parseScenario(text, "fuzz.toml");
   if (!s) return 0;
   if (s->clock.rate < 0 || s->clock.rate > 3600) std::abort();
   std::set<std::uint32_t> ids;

@@ -170,6 +170,27 @@ TEST_F(HeadlessReplay, WeatherClockFollowsFlightTimeAtTheServersRate) {
   EXPECT_EQ(live.stop(), 0) << live.log();
 }
 
+// Without a server: the weather of a scenario file, the same in every run.
+TEST_F(HeadlessReplay, WeatherFileWithoutAServer) {
+  // The fixture's server is stopped first: nothing answers on its port.
+  ASSERT_EQ(weatherd_->stop(), 0) << weatherd_->log();
+  weatherd_.reset();
+  const std::vector<std::string> noServer = {"--weather-file", SKY_SCENARIO_CLOUDY, "--no-video", "--replay-end", "3"};
+  const ReplayRun a = replay(port_, SKY_TEST_FLIGHT, dir_ / "fa", noServer);
+  ASSERT_EQ(a.exitCode, 0) << a.log;
+  const ReplayRun b = replay(port_, SKY_TEST_FLIGHT, dir_ / "fb", noServer);
+  ASSERT_EQ(b.exitCode, 0) << b.log;
+  const auto report = nlohmann::json::parse(readAll(dir_ / "fa" / "report.json"));
+  EXPECT_EQ(report["weather_source"], SKY_SCENARIO_CLOUDY);
+  EXPECT_EQ(report["frames"], 3);  // 0, 1.5, 3 s
+  for (const char* f : {"frame_000000.png", "frame_000001.png", "frame_000002.png"})
+    EXPECT_TRUE(readAll(dir_ / "fa" / "frames" / f) == readAll(dir_ / "fb" / "frames" / f)) << f;
+  std::ifstream jsonl(dir_ / "fa" / "frames" / "frames.jsonl");
+  std::string line;
+  ASSERT_TRUE(std::getline(jsonl, line));
+  EXPECT_EQ(nlohmann::json::parse(line)["layers"], 1);
+}
+
 TEST_F(HeadlessReplay, BadFlightFileIsRefusedWithLineAndField) {
   const fs::path bad = dir_ / "bad.csv";
   std::ofstream(bad) << "time_s,lat_deg,lon_deg,alt_m,yaw_deg,pitch_deg,roll_deg\n"

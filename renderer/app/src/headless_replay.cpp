@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <set>
+#include <sstream>
 #include <thread>
 
 #include <boost/asio.hpp>
@@ -19,6 +21,7 @@
 #include "sky/app/weather_client.hpp"
 #include "sky/flight/flight.hpp"
 #include "sky/sim/flight_file.hpp"
+#include "sky/weather/scenario.hpp"
 
 namespace sky::app {
 
@@ -84,15 +87,38 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   SharedState state;
   asio::io_context io;
   auto guard = asio::make_work_guard(io);
-  WeatherClient weather(io, state, o.serverHost, o.serverPort);
-  weather.start();
+  // The weather: streamed by a server, or read once from a scenario file.
+  std::optional<WeatherClient> weather;
+  std::string weatherSource;
+  if (!o.weatherFile.empty()) {
+    std::ifstream in(o.weatherFile, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    auto scenario = in ? weather::parseScenario(text.str(), o.weatherFile)
+                       : Result<weather::Scenario>(fail(ErrorCode::Io, o.weatherFile + ": cannot open"));
+    if (!scenario) {
+      std::fprintf(stderr, "skyshell-render: --weather-file: %s\n", describe(scenario.error()).c_str());
+      return 2;
+    }
+    weather::WeatherSnapshot snapshot;
+    snapshot.weatherClock_s = scenario->clock.start_s;
+    snapshot.layers = scenario->layers;
+    const auto now = Clock::now();
+    state.setSnapshot(std::move(snapshot), now);
+    state.setClock(scenario->clock.start_s, scenario->clock.rate, now);
+    weatherSource = o.weatherFile;
+  } else {
+    weather.emplace(io, state, o.serverHost, o.serverPort);
+    weather->start();
+    weatherSource = o.serverHost + ":" + std::to_string(o.serverPort);
+  }
   std::thread ioThread([&] { io.run(); });
   struct Stopper {
-    WeatherClient& weather;
+    std::optional<WeatherClient>& weather;
     decltype(guard)& g;
     std::thread& t;
     ~Stopper() {
-      weather.stop();
+      if (weather) weather->stop();
       g.reset();
       t.join();
     }
@@ -100,17 +126,17 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
 
   const auto& s = renderer.settings();
   std::printf("skyshell-render: replaying %s headless: %zu frames of %.3f s (flight %.1f-%.1f s) at %ux%u, "
-              "weather from %s:%u, output to %s\n",
+              "weather from %s, output to %s\n",
               o.flightPath.c_str(), frameCount, o.step_s, t0 - first_s, t1 - first_s, s.width, s.height,
-              o.serverHost.c_str(), o.serverPort, o.outDir.c_str());
+              weatherSource.c_str(), o.outDir.c_str());
   std::fflush(stdout);
 
   geo::GeodeticPose pose = flight::sample(*flight, t0);
-  weather.subscribe(areaAround(pose));
+  if (weather) weather->subscribe(areaAround(pose));
   geo::Geodetic subscribedAt = pose.position;
   if (!waitForWeather(state, 0, o.weatherTimeout_s, stop)) {
-    std::fprintf(stderr, "skyshell-render: no weather from %s:%u within %.0f s\n", o.serverHost.c_str(),
-                 o.serverPort, o.weatherTimeout_s);
+    std::fprintf(stderr, "skyshell-render: no weather from %s within %.0f s\n", weatherSource.c_str(),
+                 o.weatherTimeout_s);
     return 4;
   }
   const WeatherView firstView = state.weather();
@@ -137,9 +163,9 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     }
     const double t = t0 + double(i) * o.step_s;
     pose = flight::sample(*flight, t);
-    if (needsResubscribe(subscribedAt, pose.position)) {
+    if (weather && needsResubscribe(subscribedAt, pose.position)) {
       const std::uint64_t before = state.weatherVersion();
-      weather.subscribe(areaAround(pose));
+      weather->subscribe(areaAround(pose));
       subscribedAt = pose.position;
       if (!waitForWeather(state, before, o.weatherTimeout_s, stop))
         std::fprintf(stderr, "skyshell-render: warning: frame %zu: no weather for the new area within %.0f s; "
@@ -240,7 +266,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   report["device"] = renderer.deviceName();
   report["render_ms"] = {{"p50", ms.p50}, {"p90", ms.p90}, {"p99", ms.p99}, {"mean", ms.mean}, {"max", ms.max}};
   report["wall_s"] = wall_s;
-  report["weather_server"] = o.serverHost + ":" + std::to_string(o.serverPort);
+  report["weather_source"] = weatherSource;
   report["weather_clock_s"] = {clockBase_s, clockBase_s + double(frameCount - 1) * o.step_s * clockRate};
   report["weather_clock_rate"] = clockRate;
   report["weather_versions_seen"] = versionsSeen;

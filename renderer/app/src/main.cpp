@@ -60,6 +60,7 @@ struct Options {
   double replayWeatherClock_s = std::numeric_limits<double>::quiet_NaN();
   bool noVideo = false;
   bool fixedSun = false;
+  std::string weatherFile;
 };
 
 // Set by SIGINT/SIGTERM during a --replay (which runs no io_context of its own
@@ -124,6 +125,9 @@ int main(int argc, char** argv) {
                  "with --replay: weather clock of the first frame, s (default: the server's); pin it for "
                  "byte-identical re-renders");
   app.add_flag("--no-video", o.noVideo, "with --replay: skip the MP4");
+  app.add_option("--weather-file", o.weatherFile,
+                 "with --replay: render the weather of this scenario file (deploy/scenarios/*.toml) instead of "
+                 "asking --server");
   app.add_flag("--fixed-sun", o.fixedSun,
                "with --replay: light from --sun-azimuth/--sun-elevation even when the flight has a date");
   app.set_config("--config", "", "config file (TOML keys named like the long options)");
@@ -172,6 +176,7 @@ int main(int argc, char** argv) {
     r.sunAzimuth_deg = o.sunAzimuth_deg;
     r.sunElevation_deg = o.sunElevation_deg;
     r.fixedSun = o.fixedSun;
+    r.weatherFile = o.weatherFile;
     std::signal(SIGINT, onReplaySignal);
     std::signal(SIGTERM, onReplaySignal);
     return sky::app::runHeadlessReplay(r, **renderer, &gReplayStop);

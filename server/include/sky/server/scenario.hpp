@@ -1,36 +1,18 @@
-// Scenario files: the weather a server starts from, as TOML (format documented
-// in deploy/scenarios/skeleton-cumulus.toml). Parsing is strict: unknown keys,
-// missing fields and values out of range are errors naming file, line and field.
+// Scenario files on the server's side: the format and parser live in
+// protocol/ (sky/weather/scenario.hpp: a headless renderer reads the same
+// files); the server reads them from disk.
 #pragma once
 
-#include <cstddef>
 #include <filesystem>
-#include <string_view>
-#include <vector>
 
-#include "sky/core/result.hpp"
-#include "sky/weather/model.hpp"
+#include "sky/weather/scenario.hpp"
 
 namespace sky::server {
 
-// Layers per scenario. Bounds one snapshot's size: every layer adds one tile
-// per S2 cell, and a snapshot must fit one stream frame.
-inline constexpr std::size_t kMaxScenarioLayers = 32;
-
-struct ClockSettings {
-  double start_s = 0;  // weather clock when the server starts, s
-  double rate = 1;     // weather seconds per wall second, [0, 3600]
-};
-
-struct Scenario {
-  ClockSettings clock;
-  std::vector<weather::CloudLayer> layers;  // validated, ids unique
-};
-
-// Parses scenario text. sourceName is used in error details ("a.toml:12:5:
-// layer[0].coverage: ..."). Errors: Malformed (TOML syntax, wrong type,
-// unknown or missing key), InvalidArgument (a value out of range).
-Result<Scenario> parseScenario(std::string_view text, std::string_view sourceName);
+using weather::ClockSettings;
+using weather::kMaxScenarioLayers;
+using weather::parseScenario;
+using weather::Scenario;
 
 // Reads and parses a scenario file. Io when the file cannot be read.
 Result<Scenario> loadScenario(const std::filesystem::path& path);

@@ -5,7 +5,8 @@
 // Deterministic: frame i shows the flight at t0 + i × step and the weather at
 // clock base + i × step × rate (base: --weather-clock, else the server's clock
 // when the first snapshot arrived; rate: the server's); after every
-// re-subscription the next frame waits for the answering snapshot. So the same
+// re-subscription the next frame waits for the answering snapshot. Without a
+// server, --weather-file renders a scenario file's layers on its clock. So the same
 // flight, options and server weather give byte-identical PNGs. (The server's
 // snapshots carry the weather clock they were made at, and their coverage is
 // advected from it: a server whose clock runs hands out a different input at
@@ -27,6 +28,7 @@ struct ReplayOptions {
   double start_s = 0;                   // offset into the flight, s
   std::optional<double> end_s;          // offset into the flight, s (default: its end)
   std::optional<double> weatherClock_s; // weather clock of the first frame (default: the server's)
+  std::string weatherFile;  // a scenario TOML instead of a server (its layers, uniform; its clock)
   std::string serverHost;
   unsigned short serverPort = 0;
   double weatherTimeout_s = 30;  // for the first snapshot and after each re-subscription

@@ -1,16 +1,14 @@
 // Scenario TOML parsing (see scenario.hpp). toml++ gives every node its source
 // position, so each error can point at the line that caused it.
-#include "sky/server/scenario.hpp"
+#include "sky/weather/scenario.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <set>
-#include <sstream>
 #include <string>
 
 #include "sky/config/toml_fields.hpp"
 
-namespace sky::server {
+namespace sky::weather {
 
 namespace {
 
@@ -54,7 +52,7 @@ std::string blamedField(const std::string& detail) {
   return detail.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
 }
 
-Result<weather::CloudLayer> parseLayer(const toml::table& t, std::size_t index,
+Result<CloudLayer> parseLayer(const toml::table& t, std::size_t index,
                                        const Where& where) {
   const std::string prefix = "layer[" + std::to_string(index) + "].";
   if (auto r = onlyKeys(t,
@@ -64,7 +62,7 @@ Result<weather::CloudLayer> parseLayer(const toml::table& t, std::size_t index,
       !r)
     return tl::unexpected(r.error());
 
-  weather::CloudLayer layer;
+  CloudLayer layer;
 
   auto idNode = required(t, "id", prefix, where);
   if (!idNode) return tl::unexpected(idNode.error());
@@ -77,12 +75,12 @@ Result<weather::CloudLayer> parseLayer(const toml::table& t, std::size_t index,
   auto typeNode = required(t, "type", prefix, where);
   if (!typeNode) return tl::unexpected(typeNode.error());
   const auto* typeName = (*typeNode)->as_string();
-  std::optional<weather::CloudType> type;
-  if (typeName) type = weather::cloudTypeFromString(typeName->get());
+  std::optional<CloudType> type;
+  if (typeName) type = cloudTypeFromString(typeName->get());
   if (!type) {
     std::string names;
-    for (std::uint8_t i = 0; i <= weather::kMaxCloudType; ++i)
-      names += (i ? ", " : "") + std::string(weather::toString(static_cast<weather::CloudType>(i)));
+    for (std::uint8_t i = 0; i <= kMaxCloudType; ++i)
+      names += (i ? ", " : "") + std::string(toString(static_cast<CloudType>(i)));
     return where.error(ErrorCode::InvalidArgument, (*typeNode)->source(), prefix + "type",
                        (typeName ? singleQuoted(typeName->get()) : std::string("value")) +
                            " is not a cloud type (one of: " + names + ")");
@@ -114,7 +112,7 @@ Result<weather::CloudLayer> parseLayer(const toml::table& t, std::size_t index,
     *f.out = *v;
   }
 
-  if (auto r = weather::validate(layer); !r) {
+  if (auto r = validate(layer); !r) {
     // Point at the value validate() blames; fall back to the layer's header.
     const std::string field = blamedField(r.error().detail);
     const toml::node* blamed = field.empty() ? nullptr : t.at_path(field).node();
@@ -163,13 +161,4 @@ Result<Scenario> parseScenario(std::string_view text, std::string_view sourceNam
   return scenario;
 }
 
-Result<Scenario> loadScenario(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return fail(ErrorCode::Io, path.string() + ": cannot open scenario file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return fail(ErrorCode::Io, path.string() + ": read failed");
-  return parseScenario(text.str(), path.string());
-}
-
-}  // namespace sky::server
+}  // namespace sky::weather
