@@ -3,6 +3,8 @@
 
 #include <initializer_list>
 
+#include "sky/weather/region.hpp"
+
 namespace sky::server {
 
 namespace {
@@ -98,9 +100,56 @@ Result<weather::CloudLayer> parseLayer(const json& o, const std::string& path) {
   return l;
 }
 
+Result<weather::Region> parseRegion(const json& o, const std::string& path, bool withPlacement) {
+  if (!o.is_object()) return bad(path, "expected an object");
+  if (auto r = withPlacement
+                   ? onlyKeys(o, {"id", "center_lat_deg", "center_lon_deg", "size_x_m", "size_y_m", "corner_radius_m",
+                                  "rotation_deg", "transition_m", "drifts_with_wind", "layers", "placed_at_clock_s"},
+                              path)
+                   : onlyKeys(o, {"id", "center_lat_deg", "center_lon_deg", "size_x_m", "size_y_m", "corner_radius_m",
+                                  "rotation_deg", "transition_m", "drifts_with_wind", "layers"},
+                              path);
+      !r)
+    return tl::unexpected(r.error());
+  weather::Region g;
+  auto i = id(o, "id", path);
+  if (!i) return tl::unexpected(i.error());
+  g.id = *i;
+  struct Field {
+    const char* key;
+    double* out;
+    bool required;
+  };
+  for (const Field& f : {Field{"center_lat_deg", &g.centerLat_deg, true}, Field{"center_lon_deg", &g.centerLon_deg, true},
+                         Field{"size_x_m", &g.sizeX_m, true}, Field{"size_y_m", &g.sizeY_m, true},
+                         Field{"corner_radius_m", &g.cornerRadius_m, false},
+                         Field{"rotation_deg", &g.rotation_deg, false}, Field{"transition_m", &g.transition_m, false},
+                         Field{"placed_at_clock_s", &g.placedAtClock_s, false}}) {
+    if (!f.required && !o.contains(f.key)) continue;
+    auto v = number(o, f.key, path);
+    if (!v) return tl::unexpected(v.error());
+    *f.out = *v;
+  }
+  if (o.contains("drifts_with_wind")) {
+    if (!o.at("drifts_with_wind").is_boolean()) return bad(path + ".drifts_with_wind", "expected true or false");
+    g.driftsWithWind = o.at("drifts_with_wind").get<bool>();
+  }
+  if (!o.contains("layers") || !o.at("layers").is_array()) return bad(path + ".layers", "expected an array of layers");
+  const json& layers = o.at("layers");
+  if (layers.size() > weather::kMaxRegionLayers)
+    return bad(path + ".layers", std::to_string(layers.size()) + " layers, at most " +
+                                     std::to_string(weather::kMaxRegionLayers));
+  for (std::size_t k = 0; k < layers.size(); ++k) {
+    auto l = parseLayer(layers.at(k), path + ".layers[" + std::to_string(k) + "]");
+    if (!l) return tl::unexpected(l.error());
+    g.layers.push_back(*l);
+  }
+  return g;
+}
+
 Result<WeatherChange> change(const json& o, const std::string& path) {
   if (!o.is_object()) return bad(path, "expected an object");
-  if (!o.contains("op") || !o.at("op").is_string()) return bad(path + ".op", "expected set_layer, remove_layer or set_clock");
+  if (!o.contains("op") || !o.at("op").is_string()) return bad(path + ".op", "expected set_layer, remove_layer, set_clock, set_region or remove_region");
   const std::string op = o.at("op").get<std::string>();
   if (op == "set_layer") {
     if (auto r = onlyKeys(o, {"op", "layer", "ramp_s", "at_s"}, path); !r) return tl::unexpected(r.error());
@@ -130,7 +179,25 @@ Result<WeatherChange> change(const json& o, const std::string& path) {
     c.jumpTo_s = *jump;
     return c;
   }
-  return bad(path + ".op", "'" + op + "' is not one of set_layer, remove_layer, set_clock");
+  if (op == "set_region") {
+    if (auto r = onlyKeys(o, {"op", "region", "ramp_s", "at_s"}, path); !r) return tl::unexpected(r.error());
+    if (!o.contains("region")) return bad(path + ".region", "missing (required)");
+    auto g = parseRegion(o.at("region"), path + ".region", false);
+    if (!g) return tl::unexpected(g.error());
+    auto t = timing(o, path);
+    if (!t) return tl::unexpected(t.error());
+    return SetRegion{*g, *t};
+  }
+  if (op == "remove_region") {
+    if (auto r = onlyKeys(o, {"op", "id", "ramp_s", "at_s"}, path); !r) return tl::unexpected(r.error());
+    auto i = id(o, "id", path);
+    if (!i) return tl::unexpected(i.error());
+    auto t = timing(o, path);
+    if (!t) return tl::unexpected(t.error());
+    return RemoveRegion{*i, *t};
+  }
+  return bad(path + ".op",
+             "'" + op + "' is not one of set_layer, remove_layer, set_clock, set_region, remove_region");
 }
 
 }  // namespace
@@ -171,14 +238,36 @@ nlohmann::json toJson(const weather::CloudLayer& l) {
                     {"vertical_mps", l.wind.vertical_mps}}}};
 }
 
+Result<weather::Region> regionFromJson(const nlohmann::json& object, const std::string& path, bool withPlacement) {
+  return parseRegion(object, path, withPlacement);
+}
+
+nlohmann::json toJson(const weather::Region& r) {
+  json layers = json::array();
+  for (const auto& l : r.layers) layers.push_back(toJson(l));
+  return {{"id", r.id},
+          {"center_lat_deg", r.centerLat_deg},
+          {"center_lon_deg", r.centerLon_deg},
+          {"size_x_m", r.sizeX_m},
+          {"size_y_m", r.sizeY_m},
+          {"corner_radius_m", r.cornerRadius_m},
+          {"rotation_deg", r.rotation_deg},
+          {"transition_m", r.transition_m},
+          {"drifts_with_wind", r.driftsWithWind},
+          {"placed_at_clock_s", r.placedAtClock_s},
+          {"layers", layers}};
+}
+
 nlohmann::json toJson(const WeatherView& v) {
   json layers = json::array();
   for (const auto& l : v.layers) layers.push_back(toJson(l));
+  json regions = json::array();
+  for (const auto& r : v.regions) regions.push_back(toJson(r));
   json pending = json::array();
   for (const auto& p : v.pending)
     pending.push_back({{"sequence", p.sequence}, {"start_s", p.start_s}, {"end_s", p.end_s}, {"summary", p.summary}});
   return {{"clock_s", v.clock_s}, {"clock_rate", v.clockRate}, {"sequence", v.lastSequence},
-          {"version", v.version}, {"layers", layers}, {"pending", pending}};
+          {"version", v.version}, {"layers", layers}, {"regions", regions}, {"pending", pending}};
 }
 
 nlohmann::json toJson(const ChangeEvent& e) {

@@ -43,25 +43,6 @@ weather::Region regionWithLayers(const weather::Region& geometry,
   return r;
 }
 
-// weather::validate(Region) is declared in the contract but not yet defined;
-// until it lands, the ranges of region.hpp checked here.
-Result<void> checkRegion(const weather::Region& r) {
-  auto bad = [&](const char* field, double v, const std::string& range) {
-    return fail(ErrorCode::InvalidArgument, std::string(field) + " " + std::to_string(v) + " outside " + range);
-  };
-  if (!(r.centerLat_deg >= -90 && r.centerLat_deg <= 90)) return bad("latitude", r.centerLat_deg, "[-90, 90]");
-  if (!std::isfinite(r.centerLon_deg)) return bad("longitude", r.centerLon_deg, "finite");
-  if (!(r.sizeX_m > 0 && r.sizeX_m <= 2e6)) return bad("size x", r.sizeX_m, "(0, 2e6] m");
-  if (!(r.sizeY_m > 0 && r.sizeY_m <= 2e6)) return bad("size y", r.sizeY_m, "(0, 2e6] m");
-  const double maxCorner = std::min(r.sizeX_m, r.sizeY_m) / 2;
-  if (!(r.cornerRadius_m >= 0 && r.cornerRadius_m <= maxCorner))
-    return bad("corner radius", r.cornerRadius_m, "[0, " + std::to_string(maxCorner) + "] m");
-  if (!(r.rotation_deg >= -180 && r.rotation_deg <= 180)) return bad("rotation", r.rotation_deg, "[-180, 180]");
-  if (!(r.transition_m >= 0 && r.transition_m <= 2e6))
-    return bad("transition perimeter", r.transition_m, "[0, 2e6] m");
-  return {};
-}
-
 }  // namespace
 
 Result<std::optional<weather::CloudLayer>> cloudLayerFrom(const cigi::WeatherControl& p) {
@@ -153,7 +134,7 @@ Result<std::vector<WeatherChange>> CigiWeatherMapper::map(const cigi::Datagram& 
         geometry.cornerRadius_m = erc->cornerRadius_m;
         geometry.rotation_deg = erc->rotation_deg;
         geometry.transition_m = erc->transitionPerimeter_m;
-        if (auto ok = checkRegion(geometry); !ok)
+        if (auto ok = weather::validate(geometry); !ok)
           return fail(ErrorCode::InvalidArgument,
                       where(i, "Environmental Region Control") + " region " + std::to_string(erc->regionId) +
                           ": " + ok.error().detail);
@@ -178,7 +159,7 @@ Result<std::vector<WeatherChange>> CigiWeatherMapper::map(const cigi::Datagram& 
     auto it = regions.find(id);
     if (it == regions.end() || !it->second.active || !it->second.geometry) continue;
     weather::Region full = regionWithLayers(*it->second.geometry, it->second.layers);
-    if (auto ok = checkRegion(full); !ok)
+    if (auto ok = weather::validate(full); !ok)
       return fail(ErrorCode::InvalidArgument, "region " + std::to_string(id) + ": " + ok.error().detail);
     if (it->second.lastSent && sameRegion(*it->second.lastSent, full)) continue;
     it->second.lastSent = full;

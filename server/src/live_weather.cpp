@@ -3,6 +3,7 @@
 
 #include "sky/server/api_json.hpp"
 #include "sky/server/weather_store.hpp"
+#include "ramp_math.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,11 +13,6 @@ namespace sky::server {
 
 namespace {
 
-// Longest ramp, weather seconds (a day).
-constexpr double kMaxRamp_s = 86400.0;
-// A start this far in the past (weather seconds) still counts as now: the
-// clock moves between a client reading it and its request arriving.
-constexpr double kPastTolerance_s = 5.0;
 // Events kept in memory for /api/events.
 constexpr std::size_t kMaxEvents = 10000;
 
@@ -24,33 +20,6 @@ std::string fmt(const char* f, double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, f, v);
   return buf;
-}
-
-weather::CloudLayer lerp(const weather::CloudLayer& a, const weather::CloudLayer& b, double f) {
-  weather::CloudLayer o = b;
-  auto mix = [f](double x, double y) { return x + f * (y - x); };
-  o.base_m = mix(a.base_m, b.base_m);
-  o.thickness_m = mix(a.thickness_m, b.thickness_m);
-  o.transitionBand_m = mix(a.transitionBand_m, b.transitionBand_m);
-  o.coverage = mix(a.coverage, b.coverage);
-  o.density = mix(a.density, b.density);
-  o.wind.speed_mps = mix(a.wind.speed_mps, b.wind.speed_mps);
-  // Direction along the shorter way round.
-  double d = std::fmod(b.wind.fromDirection_deg - a.wind.fromDirection_deg + 540.0, 360.0) - 180.0;
-  o.wind.fromDirection_deg = std::fmod(a.wind.fromDirection_deg + f * d + 360.0, 360.0);
-  o.wind.vertical_mps = mix(a.wind.vertical_mps, b.wind.vertical_mps);
-  // The type switches at once (tiles blend it); until the end of a ramp that
-  // removes the layer it keeps its own.
-  return o;
-}
-
-Result<void> checkTiming(const Timing& t, const std::string& at, double now_s) {
-  if (!std::isfinite(t.ramp_s) || t.ramp_s < 0 || t.ramp_s > kMaxRamp_s)
-    return fail(ErrorCode::InvalidArgument, at + ".ramp_s: " + fmt("%g", t.ramp_s) + " outside [0, 86400]");
-  if (t.at_s && (!std::isfinite(*t.at_s) || *t.at_s < now_s - kPastTolerance_s))
-    return fail(ErrorCode::InvalidArgument,
-                at + ".at_s: " + fmt("%.1f", *t.at_s) + " is in the past (weather clock now " + fmt("%.1f", now_s) + ")");
-  return {};
 }
 
 }  // namespace
@@ -79,7 +48,7 @@ std::vector<weather::CloudLayer> LiveWeather::evaluate(const State& s, double c)
       from = r.to;
       from.coverage = 0;
     }
-    out[r.layerId] = lerp(from, r.to, f);
+    out[r.layerId] = lerpLayer(from, r.to, f);
   }
   std::vector<weather::CloudLayer> v;
   for (auto& [id, l] : out) v.push_back(l);
@@ -87,11 +56,13 @@ std::vector<weather::CloudLayer> LiveWeather::evaluate(const State& s, double c)
 }
 
 std::vector<weather::CloudLayer> LiveWeather::layersAt(double clock_s) const {
-  return evaluate(State{layers_, ramps_, clock_}, clock_s);
+  return evaluate(state(), clock_s);
 }
 
 bool LiveWeather::changing(double clock_s) const {
   for (const Ramp& r : ramps_)
+    if (clock_s < r.end_s || (r.end_s == r.start_s && clock_s < r.start_s)) return true;
+  for (const RegionRamp& r : regionRamps_)
     if (clock_s < r.end_s || (r.end_s == r.start_s && clock_s < r.start_s)) return true;
   return false;
 }
@@ -110,6 +81,18 @@ void LiveWeather::settle(double c) {
       layers_[r.layerId] = r.to;
   }
   ramps_ = std::move(still);
+  std::vector<RegionRamp> stillRegions;
+  for (const RegionRamp& r : regionRamps_) {
+    if (c < r.end_s || c < r.start_s) {
+      stillRegions.push_back(r);
+      continue;
+    }
+    if (r.removeAtEnd)
+      regions_.erase(r.regionId);
+    else
+      regions_[r.regionId] = r.to;
+  }
+  regionRamps_ = std::move(stillRegions);
 }
 
 Result<std::string> LiveWeather::apply(State& s, const WeatherChange& change, std::size_t i, double now_s,
@@ -122,10 +105,15 @@ Result<std::string> LiveWeather::apply(State& s, const WeatherChange& change, st
     const auto current = evaluate(s, set->timing.at_s.value_or(now_s));
     const auto it = std::find_if(current.begin(), current.end(),
                                  [&](const weather::CloudLayer& l) { return l.id == set->layer.id; });
-    if (it == current.end() && current.size() >= kMaxScenarioLayers)
-      return fail(ErrorCode::InvalidArgument,
-                  at + ".layer.id: " + std::to_string(set->layer.id) + " would be layer " +
-                      std::to_string(current.size() + 1) + ", at most " + std::to_string(kMaxScenarioLayers));
+    if (it == current.end()) {
+      auto withNew = current;
+      withNew.push_back(set->layer);
+      const std::size_t ids = distinctLayerIds(withNew, evaluateRegions(s, set->timing.at_s.value_or(now_s)));
+      if (ids > kMaxScenarioLayers)
+        return fail(ErrorCode::InvalidArgument,
+                    at + ".layer.id: " + std::to_string(set->layer.id) + " would be layer " + std::to_string(ids) +
+                        " (global and regional), at most " + std::to_string(kMaxScenarioLayers));
+    }
     Ramp r;
     r.sequence = sequence;
     r.layerId = set->layer.id;
@@ -177,7 +165,7 @@ Result<std::string> LiveWeather::apply(State& s, const WeatherChange& change, st
     return std::string("weather clock ") + (clock->jumpTo_s ? "jumps to " + fmt("%.0f", start) + " s" : "") +
            (clock->jumpTo_s && clock->rate ? ", " : "") + (clock->rate ? "rate x" + fmt("%g", rate) : "");
   }
-  return fail(ErrorCode::Unsupported, at + ": regional weather is not implemented yet");
+  return applyRegion(s, change, at, now_s, sequence);
 }
 
 Result<AppliedChange> LiveWeather::submit(const ChangeRequest& request) {
@@ -189,7 +177,7 @@ Result<AppliedChange> LiveWeather::submit(const ChangeRequest& request) {
   const double now_s = clockNow();
   settle(now_s);
   // All or nothing: apply to a copy, keep it only if every change passed.
-  State next{layers_, ramps_, clock_};
+  State next = state();
   std::string summary;
   for (std::size_t i = 0; i < request.changes.size(); ++i) {
     auto one = apply(next, request.changes[i], i, now_s, sequence_ + 1);
@@ -206,6 +194,8 @@ Result<AppliedChange> LiveWeather::submit(const ChangeRequest& request) {
   }
   layers_ = std::move(next.layers);
   ramps_ = std::move(next.ramps);
+  regions_ = std::move(next.regions);
+  regionRamps_ = std::move(next.regionRamps);
   clock_ = next.clock;
   ++sequence_;
   ++version_;
@@ -219,8 +209,13 @@ WeatherView LiveWeather::view() const {
   v.clock_s = clockNow();
   v.clockRate = clock_.rate();
   v.layers = layersAt(v.clock_s);
+  v.regions = regionsAt(v.clock_s);
   for (const Ramp& r : ramps_)
     if (v.clock_s < r.end_s || v.clock_s < r.start_s) v.pending.push_back({r.sequence, r.start_s, r.end_s, r.summary});
+  for (const RegionRamp& r : regionRamps_)
+    if (v.clock_s < r.end_s || v.clock_s < r.start_s) v.pending.push_back({r.sequence, r.start_s, r.end_s, r.summary});
+  std::stable_sort(v.pending.begin(), v.pending.end(),
+                   [](const PendingChange& a, const PendingChange& b) { return a.sequence < b.sequence; });
   v.lastSequence = sequence_;
   v.version = version_;
   return v;
@@ -250,14 +245,23 @@ nlohmann::json LiveWeather::stateJson(const State& s, std::uint64_t sequence, st
   for (const Ramp& r : s.ramps)
     ramps.push_back(rampJson(r.sequence, r.layerId, r.start_s, r.end_s, r.fromAbsent, r.from, r.to, r.removeAtEnd,
                              r.summary));
+  nlohmann::json regions = nlohmann::json::array();
+  for (const auto& [id, r] : s.regions) regions.push_back(server::toJson(r));
+  nlohmann::json regionRamps = nlohmann::json::array();
+  for (const RegionRamp& r : s.regionRamps)
+    regionRamps.push_back({{"sequence", r.sequence}, {"region_id", r.regionId}, {"start_s", r.start_s},
+                           {"end_s", r.end_s}, {"from_absent", r.fromAbsent}, {"from", server::toJson(r.from)},
+                           {"to", server::toJson(r.to)}, {"remove_at_end", r.removeAtEnd}, {"summary", r.summary}});
   return {{"layers", layers},
           {"ramps", ramps},
+          {"regions", regions},
+          {"region_ramps", regionRamps},
           {"sequence", sequence},
           {"version", version},
           {"clock", {{"clock_s", s.clock.at(wallNow_())}, {"rate", s.clock.rate()}, {"unix_ms", unixNowMs_()}}}};
 }
 
-nlohmann::json LiveWeather::toJson() const { return stateJson(State{layers_, ramps_, clock_}, sequence_, version_); }
+nlohmann::json LiveWeather::toJson() const { return stateJson(state(), sequence_, version_); }
 
 Result<void> LiveWeather::restore(const nlohmann::json& j, std::vector<ChangeEvent> events) {
   auto bad = [](const std::string& what) { return fail(ErrorCode::Malformed, "saved state: " + what); };
@@ -285,12 +289,41 @@ Result<void> LiveWeather::restore(const nlohmann::json& j, std::vector<ChangeEve
       ramp.summary = r.at("summary").get<std::string>();
       ramps.push_back(ramp);
     }
+    // Regions came with format 2 of the saved state; a state saved before
+    // has none.
+    std::map<std::uint32_t, weather::Region> regions;
+    std::vector<RegionRamp> regionRamps;
+    if (j.contains("regions")) {
+      for (const auto& r : j.at("regions")) {
+        auto region = regionFromJson(r, "regions[]", true);
+        if (!region) return tl::unexpected(region.error());
+        regions[region->id] = *region;
+      }
+      for (const auto& r : j.at("region_ramps")) {
+        RegionRamp ramp;
+        ramp.sequence = r.at("sequence").get<std::uint64_t>();
+        ramp.regionId = r.at("region_id").get<std::uint32_t>();
+        ramp.start_s = r.at("start_s").get<double>();
+        ramp.end_s = r.at("end_s").get<double>();
+        ramp.fromAbsent = r.at("from_absent").get<bool>();
+        auto from = regionFromJson(r.at("from"), "region_ramps[].from", true);
+        auto to = regionFromJson(r.at("to"), "region_ramps[].to", true);
+        if (!from || !to) return bad("a region ramp's regions");
+        ramp.from = *from;
+        ramp.to = *to;
+        ramp.removeAtEnd = r.at("remove_at_end").get<bool>();
+        ramp.summary = r.at("summary").get<std::string>();
+        regionRamps.push_back(ramp);
+      }
+    }
     const auto& c = j.at("clock");
     const double rate = c.at("rate").get<double>();
     const double downtime_s = double(unixNowMs_() - c.at("unix_ms").get<std::int64_t>()) / 1000.0;
     const double clockNow_s = c.at("clock_s").get<double>() + rate * std::max(0.0, downtime_s);
     layers_ = std::move(layers);
     ramps_ = std::move(ramps);
+    regions_ = std::move(regions);
+    regionRamps_ = std::move(regionRamps);
     sequence_ = j.at("sequence").get<std::uint64_t>();
     version_ = j.at("version").get<std::uint64_t>() + 1;
     clock_ = WeatherClock(clockNow_s, rate, wallNow_());

@@ -147,7 +147,8 @@ void Server::weatherChanged() {
 
 Frame Server::snapshotFrame(const stream::Subscribe& request) {
   const weather::WeatherSnapshot snapshot =
-      buildSnapshot(request, weather_.layersAt(clockNow()), clockNow(), options_.maxCellsPerSnapshot);
+      buildSnapshot(request, weather_.layersAt(clockNow()), clockNow(), options_.maxCellsPerSnapshot,
+                    weather_.regionsAt(clockNow()));
   const std::vector<std::uint8_t> payload = stream::encodeMessage(snapshot);
   // cellBudget keeps tiles × 24 bytes under the cap; a bigger frame is our bug.
   SKY_ASSERT(payload.size() <= stream::kMaxFrameBytes);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numbers>
 
 #include "sky/core/assert.hpp"
@@ -57,27 +58,116 @@ Covering coverArea(const weather::SphericalCap& cap, int wantedLevel, std::size_
   }
 }
 
+std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLayer> layers,
+                                                std::span<const weather::Region> regions) {
+  std::vector<weather::CloudLayer> table(layers.begin(), layers.end());
+  std::map<std::uint32_t, weather::CloudLayer> regionOnly;
+  std::vector<const weather::Region*> byId;
+  for (const auto& r : regions) byId.push_back(&r);
+  std::sort(byId.begin(), byId.end(), [](const auto* a, const auto* b) { return a->id < b->id; });
+  for (const weather::Region* r : byId)
+    for (const weather::CloudLayer& l : r->layers) {
+      const bool global = std::any_of(layers.begin(), layers.end(), [&](const auto& g) { return g.id == l.id; });
+      if (!global && !regionOnly.count(l.id)) {
+        weather::CloudLayer absent = l;
+        absent.coverage = 0;
+        regionOnly[l.id] = absent;
+      }
+    }
+  for (const auto& [id, l] : regionOnly) table.push_back(l);
+  return table;
+}
+
+namespace {
+
+// Great-circle distance on the mean sphere, m: a cheap bound to skip regions
+// far from a cell before the exact geodesic measure.
+double sphereDistance_m(double lat1, double lon1, double lat2, double lon2) {
+  constexpr double d2r = std::numbers::pi / 180.0;
+  const double s1 = std::sin((lat2 - lat1) * d2r / 2), s2 = std::sin((lon2 - lon1) * d2r / 2);
+  const double h = s1 * s1 + std::cos(lat1 * d2r) * std::cos(lat2 * d2r) * s2 * s2;
+  return 2 * kMeanEarthRadius_m * std::asin(std::min(1.0, std::sqrt(h)));
+}
+
+struct Reach {
+  const weather::Region* region;
+  double reach_m;  // beyond this (sphere distance from the centre) its weight is 0
+};
+
+}  // namespace
+
 std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> cells,
-                                               std::span<const weather::CloudLayer> layers) {
+                                               std::span<const weather::CloudLayer> layers,
+                                               std::span<const weather::Region> regions) {
   std::vector<weather::CoverageTile> tiles;
   tiles.reserve(cells.size() * layers.size());
+  std::vector<Reach> reaches;
+  for (const auto& r : regions)
+    // Half diagonal plus perimeter, with 1 % and 1 km for the ellipsoid and
+    // the sphere bound's own error.
+    reaches.push_back({&r, 1.01 * (std::hypot(r.sizeX_m, r.sizeY_m) / 2 + r.transition_m) + 1000.0});
+  // Every region's weight at every cell centre (none when no region is near).
+  std::vector<std::vector<double>> weights(regions.empty() ? 0 : cells.size());
+  for (std::size_t ci = 0; ci < weights.size(); ++ci) {
+    const weather::CellCentre c = weather::cellCentre(cells[ci]);
+    std::vector<double> w(reaches.size(), 0.0);
+    bool any = false;
+    for (std::size_t k = 0; k < reaches.size(); ++k) {
+      const weather::Region& r = *reaches[k].region;
+      if (sphereDistance_m(c.lat_deg, c.lon_deg, r.centerLat_deg, r.centerLon_deg) > reaches[k].reach_m) continue;
+      w[k] = weather::regionWeight(r, c.lat_deg, c.lon_deg);
+      any = any || w[k] > 0;
+    }
+    if (any) weights[ci] = std::move(w);
+  }
   for (const weather::CloudLayer& layer : layers)
-    for (const std::uint64_t cell : cells)
-      tiles.push_back({cell, layer.id, static_cast<float>(layer.coverage),
-                       static_cast<float>(layer.density)});
+    for (std::size_t ci = 0; ci < cells.size(); ++ci) {
+      weather::CoverageTile t{cells[ci], layer.id, static_cast<float>(layer.coverage),
+                              static_cast<float>(layer.density)};
+      if (ci < weights.size() && !weights[ci].empty()) {
+        double sumW = 0, coverage = 0, density = 0, heaviest = 0;
+        weather::CloudType heaviestType = layer.type;
+        for (std::size_t k = 0; k < reaches.size(); ++k) {
+          const double w = weights[ci][k];
+          if (w <= 0) continue;
+          for (const weather::CloudLayer& rl : reaches[k].region->layers) {
+            if (rl.id != layer.id) continue;
+            sumW += w;
+            coverage += w * rl.coverage;
+            density += w * rl.density;
+            if (w > heaviest) {
+              heaviest = w;
+              heaviestType = rl.type;
+            }
+          }
+        }
+        if (sumW > 0) {
+          const double w = std::min(sumW, 1.0);
+          t.coverage = static_cast<float>(layer.coverage + w * (coverage / sumW - layer.coverage));
+          t.density = static_cast<float>(layer.density + w * (density / sumW - layer.density));
+          if (heaviestType != layer.type) {
+            t.blendType = heaviestType;
+            t.blend = static_cast<float>(w);
+          }
+        }
+      }
+      tiles.push_back(t);
+    }
   return tiles;
 }
 
 weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,
                                        std::span<const weather::CloudLayer> layers,
-                                       double clock_s, std::size_t maxCells) {
+                                       double clock_s, std::size_t maxCells,
+                                       std::span<const weather::Region> regions) {
+  const std::vector<weather::CloudLayer> table = snapshotLayers(layers, regions);
   const Covering covering =
-      coverArea(request.area, request.tileLevel, cellBudget(maxCells, layers.size()));
+      coverArea(request.area, request.tileLevel, cellBudget(maxCells, table.size()));
   weather::WeatherSnapshot snapshot;
   snapshot.weatherClock_s = clock_s;
-  snapshot.layers.assign(layers.begin(), layers.end());
+  snapshot.layers = table;
   snapshot.tileLevel = covering.level;
-  snapshot.tiles = deriveTiles(covering.cells, layers);
+  snapshot.tiles = deriveTiles(covering.cells, table, regions);
   return snapshot;
 }
 

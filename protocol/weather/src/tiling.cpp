@@ -39,6 +39,11 @@ std::uint64_t cellAt(double lat_deg, double lon_deg, int level) {
   return S2CellId(S2LatLng::FromDegrees(lat_deg, lon_deg).Normalized()).parent(level).id();
 }
 
+CellCentre cellCentre(std::uint64_t id) {
+  const S2LatLng c(S2CellId(id).ToPoint());
+  return {c.lat().degrees(), c.lng().degrees()};
+}
+
 double averageCellEdge_m(int level) {
   return S2::kAvgEdge.GetValue(level) * kMeanEarthRadius_m;
 }

@@ -2,6 +2,7 @@
 #include "sky/app/drawable_weather.hpp"
 
 #include <algorithm>
+#include <map>
 #include <set>
 
 namespace sky::app {
@@ -10,10 +11,18 @@ weather::WeatherSnapshot drawableWeather(const weather::WeatherSnapshot& s, std:
                                          std::vector<std::uint32_t>* dropped) {
   if (dropped) dropped->clear();
   if (s.layers.size() <= maxLayers) return s;
+  // How much cloud a layer has anywhere in the snapshot: its own value, or
+  // more in some tile (a layer only a storm region has is 0 globally).
+  std::map<std::uint32_t, double> most;
+  for (const auto& l : s.layers) most[l.id] = l.coverage * l.density;
+  for (const auto& t : s.tiles) {
+    auto it = most.find(t.layerId);
+    if (it != most.end()) it->second = std::max(it->second, double(t.coverage) * double(t.density));
+  }
   std::vector<const weather::CloudLayer*> ranked;
   for (const auto& l : s.layers) ranked.push_back(&l);
-  std::stable_sort(ranked.begin(), ranked.end(), [](const weather::CloudLayer* a, const weather::CloudLayer* b) {
-    const double ca = a->coverage * a->density, cb = b->coverage * b->density;
+  std::stable_sort(ranked.begin(), ranked.end(), [&](const weather::CloudLayer* a, const weather::CloudLayer* b) {
+    const double ca = most[a->id], cb = most[b->id];
     return ca != cb ? ca > cb : a->id < b->id;
   });
   std::set<std::uint32_t> keep;

@@ -17,7 +17,7 @@ TEST(DrawableWeather, KeepsTheLayersWithMostCloud) {
     l.coverage = cover[i];
     l.density = 1;
     s.layers.push_back(l);
-    s.tiles.push_back({100 + i, i + 1, 0.5f, 1.0f});
+    s.tiles.push_back({100 + i, i + 1, static_cast<float>(cover[i]), 1.0f});
   }
   std::vector<std::uint32_t> dropped;
   const auto d = drawableWeather(s, 4, &dropped);
@@ -35,6 +35,25 @@ TEST(DrawableWeather, KeepsTheLayersWithMostCloud) {
   s.layers.resize(3);
   EXPECT_EQ(drawableWeather(s, 4, &dropped).layers.size(), 3u);
   EXPECT_TRUE(dropped.empty());
+}
+
+TEST(DrawableWeather, ALayerOnlyARegionHasRanksByItsTiles) {
+  // Layer 9 is a storm cell's: absent globally (coverage 0) but dense in its
+  // tiles; it outranks the thin global layers.
+  weather::WeatherSnapshot s;
+  s.tileLevel = 13;
+  for (std::uint32_t id : {1u, 2u, 3u, 4u, 9u}) {
+    weather::CloudLayer l;
+    l.id = id;
+    l.coverage = id == 9 ? 0.0 : 0.1 * id;
+    s.layers.push_back(l);
+    s.tiles.push_back({500, id, static_cast<float>(l.coverage), 1.0f});
+  }
+  s.tiles.push_back({501, 9, 1.0f, 1.0f});
+  std::vector<std::uint32_t> dropped;
+  const auto d = drawableWeather(s, 4, &dropped);
+  EXPECT_EQ(dropped, (std::vector<std::uint32_t>{1}));
+  EXPECT_EQ(d.layers.back().id, 9u);
 }
 
 }  // namespace

@@ -164,7 +164,7 @@ TEST_P(CigiWeather, RejectsNameThePacketAndFieldAndKeepState) {
   auto r = m.map(roundTrip({erc}, GetParam()));
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().detail.find("Environmental Region Control"), std::string::npos) << r.error().detail;
-  EXPECT_NE(r.error().detail.find("size x"), std::string::npos) << r.error().detail;
+  EXPECT_NE(r.error().detail.find("size_x_m"), std::string::npos) << r.error().detail;
 }
 
 INSTANTIATE_TEST_SUITE_P(ByteOrders, CigiWeather,

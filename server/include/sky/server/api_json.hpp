@@ -7,10 +7,20 @@
 //    "changes": [                        1..256, applied all or nothing
 //      {"op": "set_layer", "layer": LAYER, "ramp_s": 120, "at_s": 5000},   ramp_s, at_s optional
 //      {"op": "remove_layer", "id": 2, "ramp_s": 60, "at_s": 5000},        ramp_s, at_s optional
-//      {"op": "set_clock", "rate": 60, "jump_to_s": 43200}]}               either or both
+//      {"op": "set_clock", "rate": 60, "jump_to_s": 43200},                either or both
+//      {"op": "set_region", "region": REGION, "ramp_s": 300, "at_s": 5000}, ramp_s, at_s optional
+//      {"op": "remove_region", "id": 7, "ramp_s": 120, "at_s": 5000}]}      ramp_s, at_s optional
 //   LAYER: {"id", "type" (cumulus, stratus, ...), "base_m", "thickness_m",
 //           "transition_band_m", "coverage" (0..1), "density" (0..1),
 //           "wind": {"speed_mps", "from_deg", "vertical_mps"}}
+//   REGION: {"id" (1..65535), "center_lat_deg", "center_lon_deg", "size_x_m",
+//            "size_y_m", "corner_radius_m" (0), "rotation_deg" (0),
+//            "transition_m" (0), "drifts_with_wind" (false),
+//            "layers": [LAYER, ...]}   (defaults in brackets when left out)
+//            A region's layer replaces the global layer of the same id inside
+//            the region and blends into it across the transition perimeter;
+//            a new id is a layer only the region has. A drifting region moves
+//            with its first layer's wind from where it was placed.
 #pragma once
 
 #include <string_view>
@@ -29,6 +39,10 @@ Result<ChangeRequest> parseChangeRequest(std::string_view body);
 nlohmann::json toJson(const weather::CloudLayer& layer);
 // The LAYER object above; errors name `path`. Values are not range-checked.
 Result<weather::CloudLayer> layerFromJson(const nlohmann::json& object, const std::string& path);
+nlohmann::json toJson(const weather::Region& region);  // with "placed_at_clock_s"
+// The REGION object above; errors name `path`. With withPlacement the saved
+// form's "placed_at_clock_s" is read too (the API sets it itself).
+Result<weather::Region> regionFromJson(const nlohmann::json& object, const std::string& path, bool withPlacement);
 nlohmann::json toJson(const WeatherView& view);
 nlohmann::json toJson(const ChangeEvent& event);
 

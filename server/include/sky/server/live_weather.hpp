@@ -1,8 +1,8 @@
-// The weather a running server owns and changes: global layers and the weather
+// The weather a running server owns and changes: global layers, regions (with
+// their own layers, optionally drifting with their wind) and the weather
 // clock, changed through the WeatherService vocabulary (change.hpp) with
-// scheduled starts and ramps on the weather clock. In memory: a restart starts
-// again from the scenario (durable storage in SQLite is still to come, issue
-// 4), and regions are refused as not implemented yet.
+// scheduled starts and ramps on the weather clock. With a WeatherStore
+// attached every accepted change is on disk before it is acknowledged.
 #pragma once
 
 #include <cstdint>
@@ -34,6 +34,9 @@ class LiveWeather final : public WeatherService {
   const WeatherClock& clock() const { return clock_; }
   // The layers as they stand at weather clock c (ramps evaluated).
   std::vector<weather::CloudLayer> layersAt(double clock_s) const;
+  // The regions as they stand at weather clock c (ramps evaluated, drifting
+  // regions carried by their wind to c), by id.
+  std::vector<weather::Region> regionsAt(double clock_s) const;
   // Whether a scheduled or ramping change is still under way at clock c: the
   // stream then refreshes its subscribers as the weather moves.
   bool changing(double clock_s) const;
@@ -64,12 +67,29 @@ class LiveWeather final : public WeatherService {
     bool removeAtEnd = false;
     std::string summary;
   };
+  // A region appearing, changing or going: geometry and layers interpolate
+  // from `from` (a new region grows from zero size) to `to`.
+  struct RegionRamp {
+    std::uint64_t sequence = 0;
+    std::uint32_t regionId = 0;
+    double start_s = 0, end_s = 0;
+    bool fromAbsent = false;
+    weather::Region from, to;  // placed (placedAtClock_s) where they drift from
+    bool removeAtEnd = false;
+    std::string summary;
+  };
   struct State {
     std::map<std::uint32_t, weather::CloudLayer> layers;  // settled values
     std::vector<Ramp> ramps;                              // in submission order
+    std::map<std::uint32_t, weather::Region> regions;     // settled
+    std::vector<RegionRamp> regionRamps;                  // in submission order
     WeatherClock clock;
   };
+  State state() const { return State{layers_, ramps_, regions_, regionRamps_, clock_}; }
   static std::vector<weather::CloudLayer> evaluate(const State& s, double clock_s);
+  static std::vector<weather::Region> evaluateRegions(const State& s, double clock_s);
+  Result<std::string> applyRegion(State& s, const WeatherChange& change, const std::string& at, double now_s,
+                                  std::uint64_t sequence) const;
   Result<std::string> apply(State& s, const WeatherChange& change, std::size_t index, double now_s,
                             std::uint64_t sequence) const;
   void settle(double clock_s);
@@ -79,6 +99,8 @@ class LiveWeather final : public WeatherService {
   UnixNowMs unixNowMs_;
   std::map<std::uint32_t, weather::CloudLayer> layers_;
   std::vector<Ramp> ramps_;
+  std::map<std::uint32_t, weather::Region> regions_;
+  std::vector<RegionRamp> regionRamps_;
   WeatherClock clock_;
   std::vector<ChangeEvent> events_;
   std::uint64_t sequence_ = 0;

@@ -10,6 +10,7 @@
 
 #include "sky/stream/messages.hpp"
 #include "sky/weather/model.hpp"
+#include "sky/weather/region.hpp"
 #include "sky/weather/tiling.hpp"
 
 namespace sky::server {
@@ -37,14 +38,27 @@ struct Covering {
 // that does not.
 Covering coverArea(const weather::SphericalCap& cap, int wantedLevel, std::size_t maxCells);
 
-// One tile per (cell, layer). Layers are global in this version, so each tile
-// carries its layer's coverage and density; regional weather replaces this.
+// The layer table of a snapshot: the global layers, then each layer id only
+// regions have (taken from the lowest region id that has it) with coverage 0,
+// since outside its regions there is none of it.
+std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLayer> layers,
+                                                std::span<const weather::Region> regions);
+
+// One tile per (cell, table layer). At the cell's centre every region weighs
+// in by weather::regionWeight (1 inside, smooth to 0 across its transition
+// perimeter) for the layers it has: the tile is the global value blended
+// towards the weighted mean of the regions' values by the summed weight
+// (capped at 1); the type blend is the heaviest region's type when it differs
+// from the layer's. `regions` must be as they stand at the snapshot's clock
+// (weather::regionAt), and `layers` the table from snapshotLayers.
 std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> cells,
-                                               std::span<const weather::CloudLayer> layers);
+                                               std::span<const weather::CloudLayer> layers,
+                                               std::span<const weather::Region> regions = {});
 
 // The snapshot answering `request` at weather clock clock_s.
 weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,
                                        std::span<const weather::CloudLayer> layers,
-                                       double clock_s, std::size_t maxCells);
+                                       double clock_s, std::size_t maxCells,
+                                       std::span<const weather::Region> regions = {});
 
 }  // namespace sky::server

@@ -22,6 +22,13 @@ std::vector<std::uint64_t> coverCap(const SphericalCap& cap, int level, std::siz
 // The S2 cell of `level` containing a point.
 std::uint64_t cellAt(double lat_deg, double lon_deg, int level);
 
+// Centre of an S2 cell (a valid id), degrees.
+struct CellCentre {
+  double lat_deg = 0;
+  double lon_deg = 0;
+};
+CellCentre cellCentre(std::uint64_t id);
+
 // Mean edge length of a cell at `level`, m (S2's average, for choosing levels).
 double averageCellEdge_m(int level);
 
