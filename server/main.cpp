@@ -15,6 +15,7 @@
 #include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "sky/server/cigi_weather_input.hpp"
 #include "sky/server/http_api.hpp"
 #include "sky/server/scenario.hpp"
 #include "sky/server/server.hpp"
@@ -90,6 +91,14 @@ int main(int argc, char** argv) {
   app.add_option("--db", dbPath,
                  "SQLite file of the live weather: restored at start when it holds a state, every accepted change "
                  "committed to it (default: none, the weather lives in memory)");
+  std::string cigiListen = "127.0.0.1", cigiPortFile;
+  int cigiPort = -1;
+  app.add_option("--cigi-listen", cigiListen, "Address of the CIGI weather input (UDP)")->capture_default_str();
+  app.add_option("--cigi-port", cigiPort,
+                 "UDP port taking CIGI 3.3 Weather Control and Environmental Region Control from a host "
+                 "(0 picks a free one; default: no CIGI input)")
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--cigi-port-file", cigiPortFile, "Write the CIGI UDP port here once listening");
   app.add_option("--log-level", logLevel, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
@@ -165,6 +174,11 @@ int main(int argc, char** argv) {
     weather.attachStore(&*store);
   }
 
+  sky::server::Server& s = **server;
+  std::unique_ptr<sky::server::CigiWeatherInput> cigi;
+  // Every accepted change from any input reaches every subscriber at once.
+  auto weatherChanged = [&s] { s.weatherChanged(); };
+
   std::unique_ptr<sky::server::HttpApi> api;
   if (httpPort >= 0) {
     if (!tokenFile.empty()) {
@@ -176,9 +190,22 @@ int main(int argc, char** argv) {
     }
     http.port = static_cast<std::uint16_t>(httpPort);
     http.log = log;
-    sky::server::Server& s = **server;
-    auto created = sky::server::HttpApi::create(
-        s.io(), http, s.weather(), {[&s] { s.weatherChanged(); }, [&s] { return s.subscribers(); }});
+    auto cigiMetrics = [&cigi]() -> std::string {
+      if (!cigi) return {};
+      std::string m;
+      auto line = [&m](const char* name, const char* help, std::uint64_t v) {
+        m += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " counter\n" + name + " " +
+             std::to_string(v) + "\n";
+      };
+      const auto& c = cigi->counters();
+      line("skyshell_cigi_datagrams_total", "CIGI weather datagrams received", c.datagrams);
+      line("skyshell_cigi_malformed_total", "CIGI weather datagrams dropped as malformed", c.malformed);
+      line("skyshell_cigi_rejected_total", "CIGI weather refused by the model", c.rejected);
+      line("skyshell_cigi_applied_total", "CIGI weather datagrams that changed the weather", c.applied);
+      return m;
+    };
+    auto created = sky::server::HttpApi::create(s.io(), http, s.weather(),
+                                                {weatherChanged, [&s] { return s.subscribers(); }, cigiMetrics});
     if (!created) {
       log->error("{}", sky::describe(created.error()));
       return kExitRuntime;
@@ -189,6 +216,24 @@ int main(int argc, char** argv) {
               << (http.token.empty() ? " (read-only: no --token-file)" : "") << std::endl;
     if (!httpPortFile.empty()) {
       if (auto r = writePortFile(httpPortFile, api->port()); !r) {
+        log->error("{}", sky::describe(r.error()));
+        return kExitRuntime;
+      }
+    }
+  }
+
+  if (cigiPort >= 0) {
+    auto created = sky::server::CigiWeatherInput::create(s.io(), cigiListen, static_cast<std::uint16_t>(cigiPort),
+                                                         s.weather(), weatherChanged, log);
+    if (!created) {
+      log->error("{}", sky::describe(created.error()));
+      return kExitRuntime;
+    }
+    cigi = std::move(*created);
+    s.onShutdown([&cigi] { cigi->close(); });
+    std::cout << "skyshell-weatherd CIGI weather input on udp " << cigiListen << ":" << cigi->port() << std::endl;
+    if (!cigiPortFile.empty()) {
+      if (auto r = writePortFile(cigiPortFile, cigi->port()); !r) {
         log->error("{}", sky::describe(r.error()));
         return kExitRuntime;
       }

@@ -84,6 +84,7 @@ Result<std::vector<WeatherChange>> CigiWeatherMapper::map(const cigi::Datagram& 
   std::size_t ignored = 0;
   std::vector<WeatherChange> changes;
   std::map<std::uint32_t, bool> regionTouched;
+  std::map<std::uint32_t, std::optional<weather::CloudLayer>> wantedGlobal;  // none: disabled
 
   for (std::size_t i = 0; i < datagram.packets.size(); ++i) {
     const auto& packet = datagram.packets[i];
@@ -99,18 +100,8 @@ Result<std::vector<WeatherChange>> CigiWeatherMapper::map(const cigi::Datagram& 
       }
       const std::uint32_t id = (*layer)->id;
       if (wc->scope == cigi::WeatherScope::Global) {
-        auto it = global.find(id);
-        if (wc->weatherEnable) {
-          if (it != global.end() && it->second && sameLayer(*it->second, **layer)) continue;
-          global[id] = **layer;
-          changes.push_back(SetLayer{**layer, {}});
-        } else {
-          // Only layers this input set are removed: a disabled layer we never
-          // enabled (hosts send all three every frame) is left alone.
-          if (it == global.end() || !it->second) continue;
-          global[id] = std::nullopt;
-          changes.push_back(RemoveLayer{id, {}});
-        }
+        // The last packet for a layer in the datagram is what the host wants.
+        wantedGlobal[id] = wc->weatherEnable ? std::optional<weather::CloudLayer>(**layer) : std::nullopt;
       } else {
         if (wc->entityOrRegionId == 0)
           return fail(ErrorCode::InvalidArgument, where(i, "Weather Control") + ": region id 0 outside [1, 65535]");
@@ -142,22 +133,46 @@ Result<std::vector<WeatherChange>> CigiWeatherMapper::map(const cigi::Datagram& 
         region.active = true;
       } else {
         region.active = false;
-        if (region.lastSent) {
-          changes.push_back(RemoveRegion{erc->regionId, {}});
-          region.lastSent.reset();
+        if (erc->state == cigi::RegionState::Destroyed) {
+          // Forgotten, but what the server has must still go.
+          const auto sent = region.lastSent;
+          region = RegionState{};
+          region.lastSent = sent;
         }
-        if (erc->state == cigi::RegionState::Destroyed) regions.erase(erc->regionId);
-        continue;
       }
       regionTouched[erc->regionId] = true;
     }
   }
 
-  // Regions whose geometry or layers were given: send them whole if active
-  // and different from what the server has.
+  // Global layers: the datagram's net effect against what this input set.
+  for (const auto& [id, want] : wantedGlobal) {
+    auto it = global.find(id);
+    if (want) {
+      if (it != global.end() && it->second && sameLayer(*it->second, *want)) continue;
+      global[id] = *want;
+      changes.push_back(SetLayer{*want, {}});
+    } else {
+      // Only layers this input set are removed: a disabled layer we never
+      // enabled (hosts send all three every frame) is left alone.
+      if (it == global.end() || !it->second) continue;
+      global[id] = std::nullopt;
+      changes.push_back(RemoveLayer{id, {}});
+    }
+  }
+
+  // Regions whose state, geometry or layers were given: removed if no longer
+  // active, else sent whole when different from what the server has.
   for (const auto& [id, touched] : regionTouched) {
     auto it = regions.find(id);
-    if (it == regions.end() || !it->second.active || !it->second.geometry) continue;
+    if (it == regions.end()) continue;
+    if (!it->second.active || !it->second.geometry) {
+      if (!it->second.active && it->second.lastSent) {
+        changes.push_back(RemoveRegion{id, {}});
+        it->second.lastSent.reset();
+      }
+      if (!it->second.active && !it->second.geometry && it->second.layers.empty()) regions.erase(it);
+      continue;
+    }
     weather::Region full = regionWithLayers(*it->second.geometry, it->second.layers);
     if (auto ok = weather::validate(full); !ok)
       return fail(ErrorCode::InvalidArgument, "region " + std::to_string(id) + ": " + ok.error().detail);

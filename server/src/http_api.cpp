@@ -133,6 +133,7 @@ HttpApi::Reply HttpApi::handle(const std::string& method, const std::string& tar
     line("skyshell_changes_unauthorized_total", "change requests without the token", "counter", counters_.unauthorized);
     line("skyshell_subscribers", "weather stream subscribers connected", "gauge",
          hooks_.subscribers ? hooks_.subscribers() : 0);
+    if (hooks_.extraMetrics) m += hooks_.extraMetrics();
     return {200, "text/plain; version=0.0.4", m};
   }
   if (method == "GET" && path == "/api/state") return {200, "application/json", toJson(weather_.view()).dump()};

@@ -95,7 +95,7 @@ void Server::shutdown() {
   heartbeat_.cancel();
   if (signals_) signals_->cancel(ignored);
   registry_.closeAll();
-  if (onShutdown_) onShutdown_();
+  for (const auto& f : onShutdown_) f();
 }
 
 void Server::accept() {

@@ -1,14 +1,22 @@
 // The weather server's HTTP API through real sockets, and a change travelling
 // from a skyshell-scenario action through the API and the weather stream into
 // a renderer's frames.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <span>
+#include <thread>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "child_process.hpp"
+#include "sky/cigi/codec.hpp"
 #include "sky/sim/http_client.hpp"
 
 namespace fs = std::filesystem;
@@ -22,20 +30,22 @@ constexpr const char* kToken = "s3cret-test-token";
 struct Weatherd {
   fs::path dir;
   std::optional<ChildProcess> process;
-  unsigned streamPort = 0, httpPort = 0;
+  unsigned streamPort = 0, httpPort = 0, cigiPort = 0;
 
-  explicit Weatherd(const std::string& name, const std::string& scenario = SKY_SCENARIO_CLOUDY) {
+  explicit Weatherd(const std::string& name, const std::string& scenario = SKY_SCENARIO_CLOUDY, bool cigi = false) {
     dir = fs::path(SKY_TEST_OUTPUT_DIR) / name;
     fs::remove_all(dir);
     fs::create_directories(dir);
     std::ofstream(dir / "token") << kToken << "\n";
-    process.emplace(std::vector<std::string>{SKY_WEATHERD, "--scenario", scenario, "--port", "0", "--port-file",
-                                             (dir / "weatherd.port").string(), "--http-port", "0",
-                                             "--http-port-file", (dir / "http.port").string(), "--token-file",
-                                             (dir / "token").string(), "--heartbeat-ms", "200"},
-                    (dir / "weatherd.log").string());
+    std::vector<std::string> args{SKY_WEATHERD, "--scenario", scenario, "--port", "0", "--port-file",
+                                  (dir / "weatherd.port").string(), "--http-port", "0",
+                                  "--http-port-file", (dir / "http.port").string(), "--token-file",
+                                  (dir / "token").string(), "--heartbeat-ms", "200"};
+    if (cigi) args.insert(args.end(), {"--cigi-port", "0", "--cigi-port-file", (dir / "cigi.port").string()});
+    process.emplace(args, (dir / "weatherd.log").string());
     streamPort = waitForPortFile((dir / "weatherd.port").string(), 20s);
     httpPort = waitForPortFile((dir / "http.port").string(), 20s);
+    if (cigi) cigiPort = waitForPortFile((dir / "cigi.port").string(), 20s);
   }
 
   sim::HttpResponse request(const std::string& method, const std::string& target, const std::string& body = "",
@@ -144,6 +154,134 @@ TEST(WeatherdApi, ScenarioActionReachesTheRendererThroughTheStream) {
   const auto events = nlohmann::json::parse(w.request("GET", "/api/events").body)["events"];
   ASSERT_EQ(events.size(), 1u);
   EXPECT_EQ(events[0]["author"], "scenario-test");
+  EXPECT_EQ(w.process->stop(), 0) << w.process->log();
+}
+
+}  // namespace
+}  // namespace sky::test
+
+namespace sky::test {
+namespace {
+
+// One UDP datagram to 127.0.0.1:port from a fixed local socket (one "host").
+class UdpHost {
+ public:
+  UdpHost() : fd_(::socket(AF_INET, SOCK_DGRAM, 0)) {}
+  ~UdpHost() { ::close(fd_); }
+  void send(unsigned port, std::span<const std::uint8_t> bytes) {
+    sockaddr_in to{};
+    to.sin_family = AF_INET;
+    to.sin_port = htons(static_cast<std::uint16_t>(port));
+    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ASSERT_EQ(::sendto(fd_, bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to),
+              static_cast<ssize_t>(bytes.size()));
+  }
+
+ private:
+  int fd_;
+};
+
+std::vector<std::uint8_t> hostDatagram(const std::vector<cigi::Packet>& packets) {
+  cigi::DatagramWriter w(cigi::ByteOrder::Big);
+  w.add(cigi::IgControl{});
+  for (const auto& p : packets) w.add(p);
+  return w.bytes();
+}
+
+cigi::WeatherControl cloudLayer1(float coverage_pct) {
+  cigi::WeatherControl wc;
+  wc.layerId = cigi::LayerId::CloudLayer1;
+  wc.cloudType = weather::CloudType::Stratocumulus;
+  wc.coverage_pct = coverage_pct;
+  wc.baseElevation_m = 1200;
+  wc.thickness_m = 800;
+  wc.transitionBand_m = 100;
+  wc.horizontalWind_mps = 8;
+  wc.windDirection_deg = 240;
+  return wc;
+}
+
+// Polls GET /api/state until pred holds (the UDP input is asynchronous).
+template <typename Pred>
+nlohmann::json waitForState(Weatherd& w, Pred pred) {
+  nlohmann::json state;
+  for (int i = 0; i < 100; ++i) {
+    state = nlohmann::json::parse(w.request("GET", "/api/state").body);
+    if (pred(state)) break;
+    std::this_thread::sleep_for(50ms);
+  }
+  return state;
+}
+
+std::uint64_t metric(Weatherd& w, const std::string& name) {
+  const std::string m = w.request("GET", "/metrics").body;
+  const auto at = m.find("\n" + name + " ");
+  return at == std::string::npos ? ~0ull : std::stoull(m.substr(at + name.size() + 2));
+}
+
+// A CIGI host drives the weather: Weather Control changes the global layer,
+// Environmental Region Control plus a regional Weather Control place a storm
+// cell; 20 identical resends change nothing; a malformed datagram is dropped
+// and counted; an out-of-range layer is refused and leaves the state alone.
+TEST(WeatherdCigi, AHostDrivesTheWeatherOverUdp) {
+  Weatherd w("weatherd-cigi", SKY_SCENARIO_CLOUDY, true);
+  ASSERT_GT(w.cigiPort, 0u) << w.process->log();
+  UdpHost host;
+  cigi::EnvironmentalRegionControl erc;
+  erc.regionId = 5;
+  erc.state = cigi::RegionState::Active;
+  erc.lat_deg = 46.1;
+  erc.lon_deg = 13.2;
+  erc.sizeX_m = 8000;
+  erc.sizeY_m = 6000;
+  erc.transitionPerimeter_m = 2000;
+  cigi::WeatherControl storm = cloudLayer1(90);
+  storm.layerId = cigi::LayerId::CloudLayer2;
+  storm.cloudType = weather::CloudType::Cumulonimbus;
+  storm.scope = cigi::WeatherScope::Regional;
+  storm.entityOrRegionId = 5;
+  storm.thickness_m = 7000;
+  const auto weatherDatagram = hostDatagram({cloudLayer1(70), erc, storm});
+  host.send(w.cigiPort, weatherDatagram);
+  auto state = waitForState(w, [](const nlohmann::json& s) { return s["regions"].size() == 1; });
+  ASSERT_EQ(state["regions"].size(), 1u) << state.dump() << w.process->log();
+  ASSERT_EQ(state["layers"].size(), 1u);
+  EXPECT_EQ(state["layers"][0]["type"], "stratocumulus");
+  EXPECT_NEAR(state["layers"][0]["coverage"].get<double>(), 0.70, 1e-6);
+  EXPECT_NEAR(state["layers"][0]["wind"]["from_deg"].get<double>(), 240, 1e-6);
+  const auto& region = state["regions"][0];
+  EXPECT_EQ(region["id"], 5);
+  EXPECT_NEAR(region["center_lat_deg"].get<double>(), 46.1, 1e-9);
+  EXPECT_NEAR(region["size_x_m"].get<double>(), 8000, 1e-6);
+  ASSERT_EQ(region["layers"].size(), 1u);
+  EXPECT_EQ(region["layers"][0]["type"], "cumulonimbus");
+  const auto events = nlohmann::json::parse(w.request("GET", "/api/events?limit=10").body)["events"];
+  ASSERT_EQ(events.size(), 1u) << "one datagram, one change request";
+  EXPECT_EQ(events[0]["source"], "cigi");
+  EXPECT_EQ(events[0]["author"].get<std::string>().rfind("cigi:127.0.0.1:", 0), 0u) << events[0].dump();
+
+  // A host resends its weather every frame: nothing new.
+  for (int frame = 0; frame < 20; ++frame) host.send(w.cigiPort, weatherDatagram);
+  // Malformed: the Weather Control's size byte cut short.
+  auto broken = weatherDatagram;
+  broken.resize(broken.size() - 10);
+  host.send(w.cigiPort, broken);
+  // Refused: a layer with no thickness.
+  auto flat = cloudLayer1(70);
+  flat.thickness_m = 0;
+  host.send(w.cigiPort, hostDatagram({flat}));
+  // Then a real change, which also proves everything before it was handled.
+  host.send(w.cigiPort, hostDatagram({cloudLayer1(30)}));
+  state = waitForState(w, [](const nlohmann::json& s) {
+    return std::abs(s["layers"][0]["coverage"].get<double>() - 0.3) < 1e-6;
+  });
+  EXPECT_NEAR(state["layers"][0]["coverage"].get<double>(), 0.30, 1e-6);
+  EXPECT_EQ(state["regions"].size(), 1u);
+  EXPECT_EQ(state["sequence"], 2) << "the resends and the refused layer added no change";
+  EXPECT_EQ(metric(w, "skyshell_cigi_datagrams_total"), 24u);
+  EXPECT_EQ(metric(w, "skyshell_cigi_malformed_total"), 1u);
+  EXPECT_EQ(metric(w, "skyshell_cigi_rejected_total"), 1u);
+  EXPECT_EQ(metric(w, "skyshell_cigi_applied_total"), 2u);
   EXPECT_EQ(w.process->stop(), 0) << w.process->log();
 }
 

@@ -167,6 +167,43 @@ TEST_P(CigiWeather, RejectsNameThePacketAndFieldAndKeepState) {
   EXPECT_NE(r.error().detail.find("size_x_m"), std::string::npos) << r.error().detail;
 }
 
+// Found by fuzz_cigi_weather: a datagram that enables and then disables the
+// same layer (or activates and deactivates a region) must have one net
+// effect, so resending it changes nothing.
+TEST_P(CigiWeather, OneDatagramHasOneNetEffectPerLayerAndRegion) {
+  CigiWeatherMapper m;
+  auto off = layer2();
+  off.weatherEnable = false;
+  auto onThenOff = m.map(roundTrip({layer2(), off}, GetParam()));
+  ASSERT_TRUE(onThenOff);
+  EXPECT_TRUE(onThenOff->empty()) << "never enabled before, disabled at the end: nothing";
+  auto offThenOn = m.map(roundTrip({off, layer2()}, GetParam()));
+  ASSERT_EQ(offThenOn->size(), 1u);
+  EXPECT_TRUE(std::holds_alternative<SetLayer>((*offThenOn)[0]));
+  for (int frame = 0; frame < 3; ++frame) EXPECT_TRUE(m.map(roundTrip({off, layer2()}, GetParam()))->empty());
+
+  cigi::EnvironmentalRegionControl active;
+  active.regionId = 4;
+  active.lat_deg = 10;
+  active.lon_deg = 20;
+  active.sizeX_m = 5000;
+  active.sizeY_m = 5000;
+  auto inactive = active;
+  inactive.state = cigi::RegionState::Inactive;
+  auto wc = layer2();
+  wc.scope = cigi::WeatherScope::Regional;
+  wc.entityOrRegionId = 4;
+  auto placed = m.map(roundTrip({inactive, active, wc}, GetParam()));
+  ASSERT_EQ(placed->size(), 1u);
+  EXPECT_TRUE(std::holds_alternative<SetRegion>((*placed)[0]));
+  for (int frame = 0; frame < 3; ++frame)
+    EXPECT_TRUE(m.map(roundTrip({inactive, active, wc}, GetParam()))->empty());
+  auto gone = m.map(roundTrip({active, wc, inactive}, GetParam()));
+  ASSERT_EQ(gone->size(), 1u);
+  EXPECT_TRUE(std::holds_alternative<RemoveRegion>((*gone)[0]));
+  EXPECT_TRUE(m.map(roundTrip({active, wc, inactive}, GetParam()))->empty());
+}
+
 INSTANTIATE_TEST_SUITE_P(ByteOrders, CigiWeather,
                          ::testing::Values(cigi::ByteOrder::Big, cigi::ByteOrder::Little));
 

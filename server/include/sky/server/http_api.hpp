@@ -37,6 +37,7 @@ struct HttpApiOptions {
 struct HttpApiHooks {
   std::function<void()> weatherChanged;       // after an accepted change
   std::function<std::size_t()> subscribers;   // for /metrics
+  std::function<std::string()> extraMetrics;  // more Prometheus text for /metrics (other inputs)
 };
 
 class HttpApi {

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <vector>
 #include <memory>
 #include <optional>
 #include <string>
@@ -57,8 +58,9 @@ class Server final : private SessionHandler {
   void weatherChanged();
   std::size_t subscribers() const { return registry_.size(); }
   // Runs on the io thread when the server shuts down: whatever else lives on
-  // its io_context (the HTTP API) closes there too, so run() can return.
-  void onShutdown(std::function<void()> f) { onShutdown_ = std::move(f); }
+  // its io_context (the HTTP API, the CIGI input) closes there too, so run()
+  // can return. Every function added runs, in the order added.
+  void onShutdown(std::function<void()> f) { onShutdown_.push_back(std::move(f)); }
 
   // Serves until stop() or a signal. Call from one thread only.
   void run();
@@ -92,7 +94,7 @@ class Server final : private SessionHandler {
   std::uint16_t port_ = 0;
   std::uint64_t nextSessionId_ = 1;
   bool stopped_ = false;
-  std::function<void()> onShutdown_;
+  std::vector<std::function<void()>> onShutdown_;  // in the order added
 };
 
 }  // namespace sky::server

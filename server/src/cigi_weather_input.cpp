@@ -1,0 +1,110 @@
+// CIGI weather input on UDP (see cigi_weather_input.hpp).
+#include "sky/server/cigi_weather_input.hpp"
+
+#include <boost/asio/ip/address.hpp>
+#include <spdlog/spdlog.h>
+
+#include "sky/cigi/codec.hpp"
+
+namespace sky::server {
+
+namespace asio = boost::asio;
+using asio::ip::udp;
+
+namespace {
+
+// The kind of a reason, for logging each kind once: its text up to the first
+// digit (packet indices and values differ between occurrences).
+std::string kindOf(const std::string& reason) {
+  const auto digit = reason.find_first_of("0123456789");
+  return reason.substr(0, digit == std::string::npos ? reason.size() : digit);
+}
+
+}  // namespace
+
+CigiWeatherInput::CigiWeatherInput(asio::io_context& io, WeatherService& weather,
+                                   std::function<void()> weatherChanged, std::shared_ptr<spdlog::logger> log)
+    : socket_(io), weather_(weather), weatherChanged_(std::move(weatherChanged)), log_(std::move(log)) {}
+
+Result<std::unique_ptr<CigiWeatherInput>> CigiWeatherInput::create(asio::io_context& io, const std::string& address,
+                                                                   std::uint16_t port, WeatherService& weather,
+                                                                   std::function<void()> weatherChanged,
+                                                                   std::shared_ptr<spdlog::logger> log) {
+  std::unique_ptr<CigiWeatherInput> in(
+      new CigiWeatherInput(io, weather, std::move(weatherChanged), log ? log : spdlog::default_logger()));
+  boost::system::error_code ec;
+  const auto ip = asio::ip::make_address(address, ec);
+  if (ec) return fail(ErrorCode::InvalidArgument, "--cigi-listen " + address + ": not an IP address");
+  const udp::endpoint at(ip, port);
+  in->socket_.open(at.protocol(), ec);
+  if (!ec) in->socket_.bind(at, ec);
+  if (ec)
+    return fail(ErrorCode::Io, "CIGI weather input: cannot bind UDP " + address + ":" + std::to_string(port) + ": " +
+                                   ec.message());
+  in->port_ = in->socket_.local_endpoint().port();
+  in->receive();
+  return in;
+}
+
+void CigiWeatherInput::close() {
+  boost::system::error_code ec;
+  socket_.close(ec);
+}
+
+void CigiWeatherInput::receive() {
+  socket_.async_receive_from(asio::buffer(buffer_), from_, [this](boost::system::error_code ec, std::size_t n) {
+    if (ec == asio::error::operation_aborted || !socket_.is_open()) return;
+    if (!ec)
+      onDatagram(std::span<const std::uint8_t>(buffer_.data(), n),
+                 from_.address().to_string() + ":" + std::to_string(from_.port()));
+    receive();
+  });
+}
+
+void CigiWeatherInput::logOnce(const std::string& kind, const std::string& message) {
+  if (logged_.insert(kind).second) log_->warn("{} (further ones of this kind are only counted)", message);
+}
+
+void CigiWeatherInput::onDatagram(std::span<const std::uint8_t> bytes, const std::string& sender) {
+  ++counters_.datagrams;
+  auto datagram = cigi::decodeDatagram(bytes);
+  if (!datagram) {
+    ++counters_.malformed;
+    logOnce("malformed " + kindOf(datagram.error().detail),
+            "CIGI weather from " + sender + ": dropped a datagram: " + datagram.error().detail);
+    return;
+  }
+  if (datagram->direction != cigi::Direction::HostToIg) {
+    ++counters_.malformed;
+    logOnce("direction", "CIGI weather from " + sender + ": dropped a datagram: it starts with Start of Frame, "
+                         "the weather input takes host datagrams only");
+    return;
+  }
+  CigiWeatherMapper& mapper = mappers_[sender];
+  auto changes = mapper.map(*datagram);
+  if (!changes) {
+    ++counters_.rejected;
+    logOnce("refused " + kindOf(changes.error().detail),
+            "CIGI weather from " + sender + ": refused: " + changes.error().detail);
+    return;
+  }
+  if (changes->empty()) {
+    ++counters_.unchanged;
+    return;
+  }
+  auto applied = weather_.submit(ChangeRequest{std::move(*changes), "cigi:" + sender, "cigi"});
+  if (!applied) {
+    ++counters_.rejected;
+    // The mapper remembered these as sent; forget, so the next resend is
+    // mapped (and judged) again.
+    mapper.reset();
+    logOnce("refused " + kindOf(applied.error().detail),
+            "CIGI weather from " + sender + ": refused: " + applied.error().detail);
+    return;
+  }
+  ++counters_.applied;
+  log_->info("CIGI weather from {}: change {}: {}", sender, applied->sequence, applied->summary);
+  if (weatherChanged_) weatherChanged_();
+}
+
+}  // namespace sky::server
