@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iostream>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -17,6 +18,7 @@
 
 #include "sky/server/cigi_weather_input.hpp"
 #include "sky/server/http_api.hpp"
+#include "sky/server/metar_changes.hpp"
 #include "sky/server/scenario.hpp"
 #include "sky/server/server.hpp"
 #include "sky/server/weather_store.hpp"
@@ -87,6 +89,10 @@ int main(int argc, char** argv) {
   app.add_option("--http-port-file", httpPortFile, "Write the HTTP port here once listening");
   app.add_option("--token-file", tokenFile,
                  "File whose first line is the token that changes need (without it the API is read-only)");
+  std::string stationsPath;
+  app.add_option("--metar-stations", stationsPath,
+                 "METAR station table for POST /api/metar: CSV icao,lat_deg,lon_deg,elevation_m "
+                 "(deploy/metar/stations.csv); requests may also bring their own");
   std::string dbPath;
   app.add_option("--db", dbPath,
                  "SQLite file of the live weather: restored at start when it holds a state, every accepted change "
@@ -187,6 +193,22 @@ int main(int argc, char** argv) {
         log->error("--token-file {}: cannot read a token from its first line", tokenFile);
         return kExitBadInput;
       }
+    }
+    if (!stationsPath.empty()) {
+      std::ifstream in(stationsPath);
+      std::stringstream text;
+      text << in.rdbuf();
+      if (!in) {
+        log->error("--metar-stations {}: cannot read", stationsPath);
+        return kExitBadInput;
+      }
+      auto table = sky::server::parseStationTable(text.str(), stationsPath);
+      if (!table) {
+        log->error("{}", sky::describe(table.error()));
+        return kExitBadInput;
+      }
+      http.stations = std::move(*table);
+      log->info("METAR station table {}: {} stations", stationsPath, http.stations.size());
     }
     http.port = static_cast<std::uint16_t>(httpPort);
     http.log = log;

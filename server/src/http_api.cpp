@@ -10,6 +10,7 @@
 #include <spdlog/spdlog.h>
 
 #include "sky/server/api_json.hpp"
+#include "sky/server/metar_api.hpp"
 
 namespace sky::server {
 
@@ -179,6 +180,30 @@ HttpApi::Reply HttpApi::handle(const std::string& method, const std::string& tar
     return {200, "application/json",
             nlohmann::json{{"sequence", applied->sequence}, {"clock_s", applied->clock_s}, {"summary", applied->summary}}
                 .dump()};
+  }
+  if (path == "/api/metar") {
+    if (method != "POST") return {405, "application/json", errorJson("method: use POST")};
+    auto request = parseMetarRequest(body);
+    if (!request) {
+      ++counters_.rejected;
+      return {400, "application/json", errorJson(request.error().detail)};
+    }
+    // A preview reads; applying changes the weather and needs the token.
+    if (request->apply && (options_.token.empty() || authorization != "Bearer " + options_.token)) {
+      ++counters_.unauthorized;
+      return {401, "application/json", errorJson("authorization: applying METAR needs the token")};
+    }
+    const MetarReply reply = handleMetar(*request, options_.stations, weather_);
+    if (request->apply) {
+      if (reply.status == 200) {
+        ++counters_.applied;
+        if (options_.log) options_.log->info("METAR batch applied: {}", reply.body["applied"]["summary"].get<std::string>());
+        if (hooks_.weatherChanged) hooks_.weatherChanged();
+      } else {
+        ++counters_.rejected;
+      }
+    }
+    return {reply.status, "application/json", reply.body.dump()};
   }
   return {404, "application/json", errorJson("path: no " + method + " " + path)};
 }

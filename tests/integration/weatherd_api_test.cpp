@@ -287,3 +287,43 @@ TEST(WeatherdCigi, AHostDrivesTheWeatherOverUdp) {
 
 }  // namespace
 }  // namespace sky::test
+
+namespace sky::test {
+namespace {
+
+// METAR through the API: a preview (no token) lists each report's layers and
+// the one that does not parse with its group, and changes nothing; applying
+// needs the token and puts a region at each station that mapped.
+TEST(WeatherdApi, MetarPreviewThenApply) {
+  Weatherd w("weatherd-metar");
+  const std::string body = R"({"reports": ["METAR LIPQ 221150Z 09012KT 9999 BKN020 15/10 Q1015",
+      "METAR LJLJ 221150Z 27005KT 9999 BKN0x5 12/05 Q1018"],
+      "stations": [{"icao": "LIPQ", "lat_deg": 45.8275, "lon_deg": 13.4722, "elevation_m": 12},
+                   {"icao": "LJLJ", "lat_deg": 46.2237, "lon_deg": 14.4576, "elevation_m": 388}])";
+  const auto preview = w.request("POST", "/api/metar", body + ", \"apply\": false}", "");
+  ASSERT_EQ(preview.status, 200) << preview.body;
+  const auto p = nlohmann::json::parse(preview.body);
+  ASSERT_EQ(p["reports"].size(), 2u);
+  EXPECT_EQ(p["reports"][0]["ok"], true);
+  EXPECT_EQ(p["reports"][0]["layers"][0]["type"], "stratocumulus");
+  EXPECT_EQ(p["reports"][1]["ok"], false);
+  EXPECT_NE(p["reports"][1]["error"].get<std::string>().find("'BKN0x5'"), std::string::npos) << preview.body;
+  ASSERT_EQ(p["changes"].size(), 1u);
+  EXPECT_TRUE(p["applied"].is_null());
+  EXPECT_TRUE(nlohmann::json::parse(w.request("GET", "/api/state").body)["regions"].empty());
+
+  EXPECT_EQ(w.request("POST", "/api/metar", body + ", \"apply\": true}", "").status, 401);
+  const auto applied = w.request("POST", "/api/metar", body + ", \"apply\": true}");
+  ASSERT_EQ(applied.status, 200) << applied.body;
+  EXPECT_EQ(nlohmann::json::parse(applied.body)["applied"]["sequence"], 1);
+  const auto state = nlohmann::json::parse(w.request("GET", "/api/state").body);
+  ASSERT_EQ(state["regions"].size(), 1u);
+  EXPECT_NEAR(state["regions"][0]["center_lat_deg"].get<double>(), 45.8275, 1e-9);
+  const auto events = nlohmann::json::parse(w.request("GET", "/api/events").body)["events"];
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0]["source"], "metar");
+  EXPECT_EQ(w.process->stop(), 0) << w.process->log();
+}
+
+}  // namespace
+}  // namespace sky::test

@@ -6,6 +6,8 @@
 //   POST /api/changes    a change request (api_json.hpp); needs
 //                        "Authorization: Bearer <token>"; 200 once applied,
 //                        400 {"error": ...} naming the field, 401 without the token
+//   POST /api/metar      METAR reports previewed, or applied with the token
+//                        (metar_api.hpp)
 // One request per connection (Connection: close); bodies over 64 KiB and
 // clients slower than 10 s are dropped. Loopback unless configured otherwise.
 #pragma once
@@ -20,6 +22,7 @@
 
 #include "sky/core/result.hpp"
 #include "sky/server/live_weather.hpp"
+#include "sky/server/metar.hpp"
 
 namespace spdlog {
 class logger;
@@ -31,6 +34,7 @@ struct HttpApiOptions {
   std::string listenAddress = "127.0.0.1";
   std::uint16_t port = 0;   // 0: ephemeral
   std::string token;        // empty: read-only (changes are refused)
+  std::vector<Station> stations;  // METAR station table for POST /api/metar
   std::shared_ptr<spdlog::logger> log;
 };
 
