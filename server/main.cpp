@@ -212,9 +212,9 @@ int main(int argc, char** argv) {
     }
     http.port = static_cast<std::uint16_t>(httpPort);
     http.log = log;
-    auto cigiMetrics = [&cigi]() -> std::string {
-      if (!cigi) return {};
-      std::string m;
+    auto moreMetrics = [&cigi, &s]() -> std::string {
+      std::string m = s.streamMetrics();
+      if (!cigi) return m;
       auto line = [&m](const char* name, const char* help, std::uint64_t v) {
         m += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " counter\n" + name + " " +
              std::to_string(v) + "\n";
@@ -227,7 +227,7 @@ int main(int argc, char** argv) {
       return m;
     };
     auto created = sky::server::HttpApi::create(s.io(), http, s.weather(),
-                                                {weatherChanged, [&s] { return s.subscribers(); }, cigiMetrics});
+                                                {weatherChanged, [&s] { return s.subscribers(); }, moreMetrics});
     if (!created) {
       log->error("{}", sky::describe(created.error()));
       return kExitRuntime;

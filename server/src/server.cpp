@@ -118,7 +118,7 @@ void Server::onAccept(const boost::system::error_code& ec, tcp::socket socket) {
   // Frames are whole messages: send each as soon as it is written.
   socket.set_option(tcp::no_delay(true), ignored);
   auto session = std::make_shared<Session>(std::move(socket), nextSessionId_++,
-                                           static_cast<SessionHandler&>(*this), *log_);
+                                           static_cast<SessionHandler&>(*this), *log_, options_.stallTimeout);
   log_->info("session {} ({}): connected", session->id(), session->peer());
   registry_.add(session);
   const stream::Hello hello{stream::kProtocolVersion, options_.serverId, clockNow(),
@@ -155,6 +155,26 @@ Frame Server::snapshotFrame(const stream::Subscribe& request) {
   log_->debug("snapshot: level {} (asked {}), {} tiles, {} bytes", snapshot.tileLevel,
               request.tileLevel, snapshot.tiles.size(), payload.size());
   return stream::encodeFrame(payload);
+}
+
+void Server::frameSent(std::size_t bytes) {
+  streamCounters_.frames.fetch_add(1, std::memory_order_relaxed);
+  streamCounters_.bytes.fetch_add(bytes, std::memory_order_relaxed);
+}
+
+void Server::sessionStalled(Session&) { streamCounters_.stalledDropped.fetch_add(1, std::memory_order_relaxed); }
+
+std::string Server::streamMetrics() const {
+  std::string m;
+  auto line = [&m](const char* name, const char* help, std::uint64_t v) {
+    m += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " counter\n" + name + " " +
+         std::to_string(v) + "\n";
+  };
+  line("skyshell_stream_frames_total", "weather stream frames sent", streamCounters_.frames.load());
+  line("skyshell_stream_bytes_total", "weather stream bytes sent", streamCounters_.bytes.load());
+  line("skyshell_subscribers_dropped_total", "subscribers dropped for not reading",
+       streamCounters_.stalledDropped.load());
+  return m;
 }
 
 void Server::sessionClosed(Session& session) {

@@ -30,9 +30,11 @@ Frame encodeErrorFrame(const Error& error) {
 }  // namespace
 
 Session::Session(asio::ip::tcp::socket socket, std::uint64_t id, SessionHandler& handler,
-                 spdlog::logger& log)
+                 spdlog::logger& log, std::chrono::milliseconds stallTimeout)
     : socket_(std::move(socket)),
       drainTimer_(socket_.get_executor()),
+      stallTimer_(socket_.get_executor()),
+      stallTimeout_(stallTimeout),
       id_(id),
       handler_(handler),
       log_(log) {
@@ -65,6 +67,7 @@ void Session::close() {
   boost::system::error_code ignored;
   socket_.close(ignored);
   drainTimer_.cancel();
+  stallTimer_.cancel();
   handler_.sessionClosed(*this);
 }
 
@@ -149,20 +152,33 @@ void Session::writeNext() {
       },
       std::move(*item));
   writeInFlight_ = true;
+  const std::uint64_t generation = ++writeGeneration_;
   asio::async_write(socket_, asio::buffer(writing_),
                     [self = shared_from_this()](const boost::system::error_code& ec, std::size_t) {
                       self->onWritten(ec);
                     });
+  stallTimer_.expires_after(stallTimeout_);
+  stallTimer_.async_wait([self = shared_from_this(), generation](const boost::system::error_code& ec) {
+    // Cancelled, superseded by a later write, or that write has completed.
+    if (ec || generation != self->writeGeneration_ || !self->writeInFlight_ || self->state_ == State::Closed)
+      return;
+    self->log_.warn("session {} ({}): not reading: a {}-byte frame has not gone out in {} ms; dropped", self->id_,
+                    self->peer_, self->writing_.size(), self->stallTimeout_.count());
+    self->handler_.sessionStalled(*self);
+    self->close();
+  });
 }
 
 void Session::onWritten(const boost::system::error_code& ec) {
   writeInFlight_ = false;
+  stallTimer_.cancel();
   if (state_ == State::Closed) return;
   if (ec) {
     log_.info("session {} ({}): write failed: {}", id_, peer_, ec.message());
     close();
     return;
   }
+  handler_.frameSent(writing_.size());
   writeNext();
 }
 

@@ -105,6 +105,8 @@ TEST(WeatherdApi, ChangesNeedTheTokenAreCheckedAndApply) {
   EXPECT_NE(metrics.find("skyshell_changes_applied_total 1\n"), std::string::npos) << metrics;
   EXPECT_NE(metrics.find("skyshell_changes_rejected_total 2\n"), std::string::npos) << metrics;
   EXPECT_NE(metrics.find("skyshell_changes_unauthorized_total 2\n"), std::string::npos) << metrics;
+  EXPECT_NE(metrics.find("skyshell_stream_frames_total "), std::string::npos) << metrics;
+  EXPECT_NE(metrics.find("skyshell_subscribers_dropped_total 0\n"), std::string::npos) << metrics;
   EXPECT_EQ(w.request("GET", "/nowhere").status, 404);
   EXPECT_EQ(w.process->stop(), 0) << w.process->log();
 }

@@ -265,6 +265,45 @@ TEST_F(ServerFixture, StopsWithClientsConnected) {
   }
 }
 
+// A subscriber that stops reading is dropped after the stall bound (300 ms
+// here) while the server pushes snapshots at it; another subscriber keeps
+// getting its weather all along, and the drop is counted.
+TEST(Server, ASubscriberThatStopsReadingIsDroppedOthersGoOn) {
+  auto scenario = loadScenario(SKY_SOURCE_DIR "/deploy/scenarios/skeleton-cumulus.toml");
+  ASSERT_TRUE(scenario);
+  const WallClock::time_point t0{std::chrono::seconds(1)};
+  ServerOptions options;
+  options.heartbeatInterval = 50ms;
+  options.handleSignals = false;
+  options.wallNow = [t0] { return t0; };
+  options.stallTimeout = 300ms;
+  auto created = Server::create(options, WeatherState(*scenario, t0));
+  ASSERT_TRUE(created);
+  std::unique_ptr<Server> server = std::move(*created);
+  std::thread thread([&] { server->run(); });
+
+  TestClient good(server->port());
+  ASSERT_TRUE(good.readNext<stream::Hello>());
+  expectServing(good, 47.0);
+  TestClient slow(server->port());
+  ASSERT_TRUE(slow.readNext<stream::Hello>());
+  // ~20000 cells at ~1 km: a ~0.5 MB snapshot per change, never read.
+  slow.send(subscribe(46.0, 13.0, 80'000, 13));
+  const auto start = std::chrono::steady_clock::now();
+  while (server->streamCounters().stalledDropped.load() == 0 && std::chrono::steady_clock::now() - start < 20s) {
+    asio::post(server->io(), [&] { server->weatherChanged(); });
+    std::this_thread::sleep_for(20ms);
+  }
+  EXPECT_EQ(server->streamCounters().stalledDropped.load(), 1u);
+  EXPECT_GT(server->streamCounters().bytes.load(), 1'000'000u) << "the buffers filled before the stall";
+  // The good subscriber was served throughout and still is.
+  expectServing(good, 48.0);
+  for (int i = 0; i < 50 && server->subscribers() != 1; ++i) std::this_thread::sleep_for(20ms);
+  EXPECT_EQ(server->subscribers(), 1u);
+  server->stop();
+  thread.join();
+}
+
 TEST(Server, BadListenAddressIsAnError) {
   Scenario scenario;
   ServerOptions options;

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <atomic>
 #include <functional>
 #include <vector>
 #include <memory>
@@ -37,6 +38,9 @@ struct ServerOptions {
   std::string serverId = "skyshell-weatherd";         // sent in Hello
   std::size_t maxCellsPerSnapshot = kDefaultMaxCells;
   bool handleSignals = true;  // SIGINT/SIGTERM stop the server (off in tests)
+  // A subscriber whose frame has not gone out in this long has stopped
+  // reading and is dropped (its weather was coalesced until then).
+  std::chrono::milliseconds stallTimeout{10000};
   std::function<WallClock::time_point()> wallNow = [] { return WallClock::now(); };
   std::shared_ptr<spdlog::logger> log;  // null: log nothing
 };
@@ -57,6 +61,13 @@ class Server final : private SessionHandler {
   // after an accepted change).
   void weatherChanged();
   std::size_t subscribers() const { return registry_.size(); }
+  // Stream counters (readable from any thread, for /metrics and tests).
+  struct StreamCounters {
+    std::atomic<std::uint64_t> frames{0}, bytes{0}, stalledDropped{0};
+  };
+  const StreamCounters& streamCounters() const { return streamCounters_; }
+  // Prometheus text of the stream counters.
+  std::string streamMetrics() const;
   // Runs on the io thread when the server shuts down: whatever else lives on
   // its io_context (the HTTP API, the CIGI input) closes there too, so run()
   // can return. Every function added runs, in the order added.
@@ -79,6 +90,8 @@ class Server final : private SessionHandler {
 
   Frame snapshotFrame(const stream::Subscribe& request) override;
   void sessionClosed(Session& session) override;
+  void frameSent(std::size_t bytes) override;
+  void sessionStalled(Session& session) override;
 
   // Member order is destruction order in reverse: the io_context goes last,
   // destroying handlers (and the sessions they keep alive) after the rest.
@@ -91,6 +104,7 @@ class Server final : private SessionHandler {
   boost::asio::steady_timer heartbeat_;
   std::optional<boost::asio::signal_set> signals_;
   SessionRegistry registry_;
+  StreamCounters streamCounters_;
   std::uint16_t port_ = 0;
   std::uint64_t nextSessionId_ = 1;
   bool stopped_ = false;

@@ -33,6 +33,11 @@ class SessionHandler {
   virtual Frame snapshotFrame(const stream::Subscribe& request) = 0;
   // The session has closed its socket and will do no more work.
   virtual void sessionClosed(Session& session) = 0;
+  // A frame of `bytes` bytes went out completely.
+  virtual void frameSent(std::size_t bytes) = 0;
+  // The session is being dropped: its peer stopped reading (a write did not
+  // complete within the stall bound).
+  virtual void sessionStalled(Session& session) = 0;
 
  protected:
   ~SessionHandler() = default;
@@ -41,8 +46,11 @@ class SessionHandler {
 class Session : public std::enable_shared_from_this<Session> {
  public:
   // handler and log must outlive every call into the session.
+  // A write that does not complete within stallTimeout drops the session:
+  // the weather it missed is coalesced until then (outbox.hpp), and nobody
+  // else waits for it.
   Session(boost::asio::ip::tcp::socket socket, std::uint64_t id, SessionHandler& handler,
-          spdlog::logger& log);
+          spdlog::logger& log, std::chrono::milliseconds stallTimeout);
 
   // Sends `hello` (an encoded frame) first and starts reading.
   void start(Frame hello);
@@ -75,6 +83,9 @@ class Session : public std::enable_shared_from_this<Session> {
 
   boost::asio::ip::tcp::socket socket_;
   boost::asio::steady_timer drainTimer_;
+  boost::asio::steady_timer stallTimer_;
+  std::chrono::milliseconds stallTimeout_;
+  std::uint64_t writeGeneration_ = 0;  // which write the stall timer is watching
   std::uint64_t id_;
   std::string peer_;
   SessionHandler& handler_;
