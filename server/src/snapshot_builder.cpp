@@ -120,7 +120,10 @@ std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> ce
     }
     if (any) weights[ci] = std::move(w);
   }
-  for (const weather::CloudLayer& layer : layers)
+  std::vector<weather::CoverageTile> layerTiles;
+  for (const weather::CloudLayer& layer : layers) {
+    layerTiles.clear();
+    bool varies = false;
     for (std::size_t ci = 0; ci < cells.size(); ++ci) {
       weather::CoverageTile t{cells[ci], layer.id, static_cast<float>(layer.coverage),
                               static_cast<float>(layer.density)};
@@ -151,8 +154,14 @@ std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> ce
           }
         }
       }
-      tiles.push_back(t);
+      varies = varies || t.coverage != static_cast<float>(layer.coverage) ||
+               t.density != static_cast<float>(layer.density) || t.blendType != weather::CloudType::None;
+      layerTiles.push_back(t);
     }
+    // A layer the same everywhere in the area needs no tiles: a renderer
+    // takes a layer without tiles as uniform (its own coverage and density).
+    if (varies) tiles.insert(tiles.end(), layerTiles.begin(), layerTiles.end());
+  }
   return tiles;
 }
 

@@ -88,6 +88,21 @@ class TestClient {
   tcp::socket socket_;
 };
 
+// A region over the test areas (46-49 N, 8.5 E) that thins the scenario's
+// layer 1: without one the weather is uniform and snapshots carry no tiles.
+void addRegion(Server& server) {
+  weather::Region r;
+  r.id = 1;
+  r.centerLat_deg = 47.5;
+  r.centerLon_deg = 10.0;
+  r.sizeX_m = r.sizeY_m = 600'000;
+  weather::CloudLayer l = server.weather().view().layers.at(0);
+  l.coverage = 0.25;
+  r.layers = {l};
+  auto ok = server.weather().submit({{SetRegion{r, Timing{}}}, "test", "api"});
+  ASSERT_TRUE(ok) << ok.error().detail;
+}
+
 // A server on an ephemeral loopback port, run on its own thread; the weather
 // clock is frozen at a known wall time so every clock on the wire is exact.
 class ServerFixture : public ::testing::Test {
@@ -109,6 +124,7 @@ class ServerFixture : public ::testing::Test {
     ASSERT_TRUE(server) << server.error().detail;
     server_ = std::move(*server);
     ASSERT_NE(server_->port(), 0);
+    addRegion(*server_);
     thread_ = std::thread([this] { server_->run(); });
   }
 
@@ -157,7 +173,7 @@ TEST_F(ServerFixture, HelloSubscribeSnapshotHeartbeat) {
   ASSERT_FALSE(snapshot->tiles.empty());
   for (const auto& t : snapshot->tiles) {
     EXPECT_EQ(t.layerId, 1u);
-    EXPECT_FLOAT_EQ(t.coverage, 0.6f);
+    EXPECT_NEAR(t.coverage, 0.25f, 0.5f / 255) << "the region's coverage, quantised to 1/255";
   }
 
   auto heartbeat = client.readNext<stream::Heartbeat>();
@@ -169,7 +185,10 @@ TEST_F(ServerFixture, HelloSubscribeSnapshotHeartbeat) {
   auto again = client.readNext<weather::WeatherSnapshot>();
   ASSERT_TRUE(again) << again.error().detail;
   EXPECT_EQ(again->tileLevel, 11);
-  EXPECT_NE(again->tiles.front().cellId, snapshot->tiles.front().cellId);
+  // Far from the region: uniform weather, no tiles, only the layer table.
+  EXPECT_TRUE(again->tiles.empty());
+  ASSERT_EQ(again->layers.size(), 1u);
+  EXPECT_NEAR(again->layers[0].coverage, 0.6, 1e-6);
 }
 
 TEST_F(ServerFixture, TooFineALevelIsLoweredAndReported) {
@@ -226,7 +245,7 @@ TEST_F(ServerFixture, ServerOnlyMessagesFromAClientAreRejected) {
   }
   TestClient good(server_->port());
   ASSERT_TRUE(good.readNext<stream::Hello>());
-  expectServing(good, 10.0);
+  expectServing(good, 47.2);
 }
 
 TEST_F(ServerFixture, SubscribeOfAnotherProtocolVersionGetsErrorAndClose) {
@@ -280,6 +299,7 @@ TEST(Server, ASubscriberThatStopsReadingIsDroppedOthersGoOn) {
   auto created = Server::create(options, WeatherState(*scenario, t0));
   ASSERT_TRUE(created);
   std::unique_ptr<Server> server = std::move(*created);
+  addRegion(*server);
   std::thread thread([&] { server->run(); });
 
   TestClient good(server->port());

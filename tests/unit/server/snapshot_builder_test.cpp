@@ -15,6 +15,8 @@
 
 #include "sky/server/snapshot_builder.hpp"
 #include "sky/stream/framing.hpp"
+#include "sky/weather/region.hpp"
+#include "sky/weather/tiling.hpp"
 
 namespace sky::server {
 namespace {
@@ -148,37 +150,56 @@ TEST(CellBudget, KeepsEveryTileInOneFrame) {
   EXPECT_EQ(cellBudget(kDefaultMaxCells, 1), kDefaultMaxCells);
 }
 
-TEST(DeriveTiles, OneTilePerCellAndLayerWithTheLayersValues) {
+TEST(DeriveTiles, UniformLayersGetNoTilesAVaryingOneOnePerCell) {
   const std::vector<std::uint64_t> cells = {S2CellId::FromFace(0).child_begin(2).id(),
                                             S2CellId::FromFace(1).child_begin(2).id()};
   const std::vector<weather::CloudLayer> layers = {layer(1, 0.6, 1.0), layer(5, 0.2, 0.5)};
-  const auto tiles = deriveTiles(cells, layers);
-  ASSERT_EQ(tiles.size(), 4u);
-  std::set<std::pair<std::uint64_t, std::uint32_t>> seen;
+  EXPECT_TRUE(deriveTiles(cells, layers).empty()) << "uniform weather is its layer table";
+  // A region on the first cell's centre changes layer 5 there only.
+  const weather::CellCentre c = weather::cellCentre(cells[0]);
+  weather::Region r;
+  r.id = 1;
+  r.centerLat_deg = c.lat_deg;
+  r.centerLon_deg = c.lon_deg;
+  r.sizeX_m = r.sizeY_m = 100'000;
+  r.layers = {layer(5, 0.9, 0.5)};
+  const std::vector<weather::Region> regions = {r};
+  const auto tiles = deriveTiles(cells, layers, regions);
+  ASSERT_EQ(tiles.size(), 2u) << "layer 5 on both cells, layer 1 still none";
   for (const auto& t : tiles) {
-    seen.insert({t.cellId, t.layerId});
-    const weather::CloudLayer& l = t.layerId == 1 ? layers[0] : layers[1];
-    EXPECT_FLOAT_EQ(t.coverage, static_cast<float>(l.coverage));
-    EXPECT_FLOAT_EQ(t.density, static_cast<float>(l.density));
+    EXPECT_EQ(t.layerId, 5u);
+    EXPECT_FLOAT_EQ(t.coverage, t.cellId == cells[0] ? 0.9f : 0.2f);
+    EXPECT_FLOAT_EQ(t.density, 0.5f);
   }
-  EXPECT_EQ(seen.size(), 4u);
 }
 
+// A clearing 20 km across at the pole: every cell of the cap gets a tile of
+// layer 1, the global 0.6 outside and down to 0.1 inside.
 TEST(BuildSnapshot, CarriesLayersClockAndTilesOverTheCap) {
   const std::vector<weather::CloudLayer> layers = {layer(1, 0.6, 1.0)};
+  weather::Region clearing;
+  clearing.id = 2;
+  clearing.centerLat_deg = 90;
+  clearing.sizeX_m = clearing.sizeY_m = 20'000;
+  clearing.layers = {layer(1, 0.1, 1.0)};
+  const std::vector<weather::Region> regions = {clearing};
   const stream::Subscribe req = request(90.0, 0.0, 50'000, 10);
-  const weather::WeatherSnapshot s = buildSnapshot(req, layers, 1234.5, kDefaultMaxCells);
+  const weather::WeatherSnapshot s = buildSnapshot(req, layers, 1234.5, kDefaultMaxCells, regions);
   EXPECT_DOUBLE_EQ(s.weatherClock_s, 1234.5);
   ASSERT_EQ(s.layers.size(), 1u);
   EXPECT_EQ(s.layers[0].id, 1u);
   EXPECT_EQ(s.tileLevel, 10);
   std::vector<std::uint64_t> cells;
+  std::size_t cleared = 0;
   for (const auto& t : s.tiles) {
     EXPECT_EQ(t.layerId, 1u);
-    EXPECT_FLOAT_EQ(t.coverage, 0.6f);
+    EXPECT_TRUE(t.coverage == 0.6f || t.coverage == 0.1f) << t.coverage;
+    cleared += t.coverage == 0.1f;
     EXPECT_FLOAT_EQ(t.density, 1.0f);
     cells.push_back(t.cellId);
   }
+  EXPECT_GT(cleared, 0u);
+  EXPECT_LT(cleared, cells.size());
   expectCovers(req.area, s.tileLevel, cells);
 }
 
@@ -192,8 +213,18 @@ TEST(BuildSnapshot, NoLayersMeansNoTiles) {
 TEST(BuildSnapshot, ManyLayersOverALargeCapStillFitOneFrame) {
   std::vector<weather::CloudLayer> layers;
   for (std::uint32_t i = 0; i < 32; ++i) layers.push_back(layer(i, 0.5, 0.5));
+  // Two regions vary all 32 layers over part of the cap, so every layer has tiles.
+  std::vector<weather::Region> regions(2);
+  for (std::uint32_t k = 0; k < 2; ++k) {
+    regions[k].id = k + 1;
+    regions[k].centerLat_deg = 45;
+    regions[k].centerLon_deg = 10;
+    regions[k].sizeX_m = regions[k].sizeY_m = 100'000;
+    for (std::uint32_t i = 16 * k; i < 16 * k + 16; ++i) regions[k].layers.push_back(layer(i, 0.9, 0.5));
+  }
   const weather::WeatherSnapshot s =
-      buildSnapshot(request(45, 10, 500'000, 12), layers, 0.0, kDefaultMaxCells);
+      buildSnapshot(request(45, 10, 500'000, 12), layers, 0.0, kDefaultMaxCells, regions);
+  EXPECT_GT(s.tiles.size(), 32u * 6);
   const auto payload = stream::encodeMessage(s);
   EXPECT_LE(payload.size(), stream::kMaxFrameBytes);
   auto decoded = stream::decodeMessage(payload);

@@ -44,8 +44,11 @@ Covering coverArea(const weather::SphericalCap& cap, int wantedLevel, std::size_
 std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLayer> layers,
                                                 std::span<const weather::Region> regions);
 
-// One tile per (cell, table layer). At the cell's centre every region weighs
-// in by weather::regionWeight (1 inside, smooth to 0 across its transition
+// One tile per (cell, table layer) for each layer that varies over the
+// cells; a layer that is the same everywhere there gets none (a renderer then
+// takes the layer's own values: the snapshot of uniform weather is just its
+// layer table, and a change to it costs a few hundred bytes). At the cell's
+// centre every region weighs in by weather::regionWeight (1 inside, smooth to 0 across its transition
 // perimeter) for the layers it has: the tile is the global value blended
 // towards the weighted mean of the regions' values by the summed weight
 // (capped at 1); the type blend is the heaviest region's type when it differs

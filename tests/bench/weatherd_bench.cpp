@@ -1,0 +1,301 @@
+// Weather server benchmark (issue 4): many subscribers on loopback, each with
+// its own area, under a storm of changes; not a timed test (ctest only runs
+// it briefly, label bench), the numbers come from running it by hand:
+//   build/release/tests/bench/sky_weatherd_bench --subscribers 64 --rate 50 --seconds 10
+// It measures
+// * change-to-delivery latency: from submitting a change on the server's io
+//   thread to a subscriber holding a frame that has it (p50 / p99 over every
+//   delivery; a subscriber that is behind gets the newest state, so changes
+//   it never saw are counted as coalesced, not as deliveries);
+// * the server thread's CPU time at idle (heartbeats only) and in the storm,
+//   as a percentage of one core;
+// * frames and bytes sent, and the size of one snapshot for a 300 km wide
+//   area with 3 layers, and of the frame one layer's coverage change costs.
+// The server runs in this process on its own thread (real TCP sockets on
+// loopback); the subscribers share one client thread.
+#include <pthread.h>
+#include <time.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <utility>  // before asio: Boost 1.74 asio uses std::exchange without including it
+#include <boost/asio.hpp>
+#include <nlohmann/json.hpp>
+
+#include "sky/server/server.hpp"
+#include "sky/server/snapshot_builder.hpp"
+#include "sky/stream/framing.hpp"
+#include "sky/stream/messages.hpp"
+#include "sky/weather/tiling.hpp"
+
+namespace asio = boost::asio;
+using asio::ip::tcp;
+using Clock = std::chrono::steady_clock;
+using namespace std::chrono_literals;
+
+namespace {
+
+struct Options {
+  int subscribers = 64;
+  double rate = 50;           // changes per second
+  double seconds = 10;        // storm length
+  double idleSeconds = 5;     // idle measurement
+  double radius_m = 120000;   // each subscriber's area (the renderer's)
+  std::size_t maxTiles = 4096;  // the renderer's tile budget (levelForRadius)
+  std::string json;
+};
+
+std::vector<sky::weather::CloudLayer> threeLayers() {
+  std::vector<sky::weather::CloudLayer> layers;
+  const sky::weather::CloudType types[] = {sky::weather::CloudType::Cumulus, sky::weather::CloudType::Altostratus,
+                                           sky::weather::CloudType::Cirrus};
+  for (std::uint32_t i = 0; i < 3; ++i) {
+    sky::weather::CloudLayer l;
+    l.id = i + 1;
+    l.type = types[i];
+    l.base_m = 600 + 4000.0 * i;  // layer 1 below kMarkerBase: the first marker is change 0
+    l.thickness_m = 800;
+    l.coverage = 0.5;
+    l.density = 0.8;
+    l.wind = {10.0 + 10 * i, 250, 0};
+    layers.push_back(l);
+  }
+  return layers;
+}
+
+double threadCpu_s(pthread_t thread) {
+  clockid_t id;
+  if (pthread_getcpuclockid(thread, &id) != 0) return 0;
+  timespec ts{};
+  clock_gettime(id, &ts);
+  return double(ts.tv_sec) + double(ts.tv_nsec) * 1e-9;
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const std::size_t i = std::min(v.size() - 1, static_cast<std::size_t>(p / 100.0 * double(v.size() - 1) + 0.5));
+  return v[i];
+}
+
+// Submit times by marker (layer 1's base_m = kMarkerBase + index).
+constexpr double kMarkerBase = 1000;
+
+struct Shared {
+  std::mutex mutex;
+  std::vector<Clock::time_point> submitted;  // by change index
+  std::vector<double> latencies_ms;
+  std::uint64_t deliveries = 0, coalesced = 0, snapshots = 0;
+};
+
+class Subscriber : public std::enable_shared_from_this<Subscriber> {
+ public:
+  Subscriber(asio::io_context& io, Shared& shared) : socket_(io), shared_(shared) {}
+
+  void start(std::uint16_t port, const sky::stream::Subscribe& subscribe) {
+    socket_.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+    socket_.set_option(tcp::no_delay(true));
+    const auto frame = sky::stream::encodeFrame(sky::stream::encodeMessage(subscribe));
+    asio::write(socket_, asio::buffer(frame));
+    read();
+  }
+  bool ready() const { return ready_.load(); }
+  void close() {
+    boost::system::error_code ec;
+    socket_.close(ec);
+  }
+
+ private:
+  void read() {
+    socket_.async_read_some(asio::buffer(buffer_), [self = shared_from_this()](boost::system::error_code ec,
+                                                                               std::size_t n) {
+      if (ec) return;
+      self->decoder_.append(std::span<const std::uint8_t>(self->buffer_.data(), n));
+      for (;;) {
+        auto payload = self->decoder_.next();
+        if (!payload || !*payload) break;
+        auto message = sky::stream::decodeMessage(**payload);
+        if (message) self->onMessage(*message);
+      }
+      self->read();
+    });
+  }
+
+  void onMessage(const sky::stream::Message& m) {
+    const auto* s = std::get_if<sky::weather::WeatherSnapshot>(&m);
+    if (!s) return;
+    ready_ = true;
+    const auto now = Clock::now();
+    std::lock_guard lock(shared_.mutex);
+    ++shared_.snapshots;
+    for (const auto& l : s->layers) {
+      if (l.id != 1 || l.base_m < kMarkerBase) continue;
+      const auto index = static_cast<std::size_t>(l.base_m - kMarkerBase + 0.5);
+      if (index >= shared_.submitted.size() || shared_.submitted[index] == Clock::time_point{} ||
+          (lastIndex_ && index <= *lastIndex_))
+        continue;
+      shared_.latencies_ms.push_back(std::chrono::duration<double, std::milli>(now - shared_.submitted[index]).count());
+      ++shared_.deliveries;
+      if (lastIndex_) shared_.coalesced += index - *lastIndex_ - 1;
+      lastIndex_ = index;
+    }
+  }
+
+  tcp::socket socket_;
+  Shared& shared_;
+  std::array<std::uint8_t, 256 * 1024> buffer_{};
+  sky::stream::FrameDecoder decoder_;
+  std::atomic<bool> ready_{false};
+  std::optional<std::size_t> lastIndex_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string k = argv[i], v = argv[i + 1];
+    if (k == "--subscribers") o.subscribers = std::stoi(v);
+    else if (k == "--rate") o.rate = std::stod(v);
+    else if (k == "--seconds") o.seconds = std::stod(v);
+    else if (k == "--idle-seconds") o.idleSeconds = std::stod(v);
+    else if (k == "--radius-m") o.radius_m = std::stod(v);
+    else if (k == "--json") o.json = v;
+    else {
+      std::fprintf(stderr, "unknown option %s\n", k.c_str());
+      return 2;
+    }
+  }
+  if (argc % 2 == 0) {
+    std::fprintf(stderr, "usage: sky_weatherd_bench [--subscribers N] [--rate HZ] [--seconds S] [--idle-seconds S] "
+                         "[--radius-m M] [--json FILE]\n");
+    return 2;
+  }
+  const auto layers = threeLayers();
+
+  // Sizes, without sockets: a 300 km wide area (150 km radius) at ~1 km
+  // tiles, 3 layers; and the frame a one-layer coverage change costs a
+  // renderer's subscription today (a whole Snapshot: Delta is not sent yet).
+  sky::stream::Subscribe wide;
+  wide.area = {46.0, 13.0, 150000};
+  wide.tileLevel = 13;
+  const auto wideSnapshot = sky::server::buildSnapshot(wide, layers, 0, sky::server::kDefaultMaxCells);
+  const std::size_t wideBytes = sky::stream::encodeFrame(sky::stream::encodeMessage(wideSnapshot)).size();
+  sky::stream::Subscribe renderer;
+  renderer.area = {46.0, 13.0, o.radius_m};
+  renderer.tileLevel = sky::weather::levelForRadius(o.radius_m, o.maxTiles);
+  const auto rendererSnapshot = sky::server::buildSnapshot(renderer, layers, 0, sky::server::kDefaultMaxCells);
+  const std::size_t changeBytes = sky::stream::encodeFrame(sky::stream::encodeMessage(rendererSnapshot)).size();
+
+  sky::server::Scenario scenario;
+  scenario.layers = layers;
+  sky::server::ServerOptions options;
+  options.handleSignals = false;
+  options.heartbeatInterval = 1000ms;
+  auto created = sky::server::Server::create(options, sky::server::WeatherState(scenario, Clock::now()));
+  if (!created) {
+    std::fprintf(stderr, "server: %s\n", created.error().detail.c_str());
+    return 1;
+  }
+  std::unique_ptr<sky::server::Server> server = std::move(*created);
+  std::thread serverThread([&] { server->run(); });
+
+  Shared shared;
+  const std::size_t changes = static_cast<std::size_t>(o.rate * o.seconds);
+  shared.submitted.resize(changes);
+  asio::io_context clientIo;
+  auto guard = asio::make_work_guard(clientIo);
+  std::vector<std::shared_ptr<Subscriber>> subs;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> jitter(-2.0, 2.0);
+  for (int i = 0; i < o.subscribers; ++i) {
+    auto s = std::make_shared<Subscriber>(clientIo, shared);
+    sky::stream::Subscribe area = renderer;
+    area.area.centerLat_deg = 46.0 + jitter(rng);
+    area.area.centerLon_deg = 13.0 + jitter(rng);
+    s->start(server->port(), area);
+    subs.push_back(s);
+  }
+  std::thread clientThread([&] { clientIo.run(); });
+  const auto waitStart = Clock::now();
+  while (Clock::now() - waitStart < 30s &&
+         !std::all_of(subs.begin(), subs.end(), [](const auto& s) { return s->ready(); }))
+    std::this_thread::sleep_for(10ms);
+
+  // Idle: heartbeats only.
+  const pthread_t st = serverThread.native_handle();
+  double cpu0 = threadCpu_s(st);
+  std::this_thread::sleep_for(std::chrono::duration<double>(o.idleSeconds));
+  const double idlePct = 100.0 * (threadCpu_s(st) - cpu0) / o.idleSeconds;
+  const auto bytes0 = server->streamCounters().bytes.load();
+  const auto frames0 = server->streamCounters().frames.load();
+
+  // The storm: one change every 1/rate s, each moving layer 1's base (the
+  // marker) and its coverage.
+  cpu0 = threadCpu_s(st);
+  const auto stormStart = Clock::now();
+  for (std::size_t i = 0; i < changes; ++i) {
+    std::this_thread::sleep_until(stormStart + std::chrono::duration_cast<Clock::duration>(
+                                                   std::chrono::duration<double>(double(i) / o.rate)));
+    asio::post(server->io(), [&, i] {
+      auto layer = layers[0];
+      layer.base_m = kMarkerBase + double(i);
+      layer.coverage = 0.2 + 0.6 * double(i % 10) / 10;
+      {
+        std::lock_guard lock(shared.mutex);
+        shared.submitted[i] = Clock::now();
+      }
+      auto ok = server->weather().submit({{sky::server::SetLayer{layer, {}}}, "bench", "api"});
+      if (ok) server->weatherChanged();
+    });
+  }
+  std::this_thread::sleep_for(1s);  // let the last deliveries land
+  const double stormWall_s = std::chrono::duration<double>(Clock::now() - stormStart).count();
+  const double stormPct = 100.0 * (threadCpu_s(st) - cpu0) / stormWall_s;
+  const auto bytes = server->streamCounters().bytes.load() - bytes0;
+  const auto frames = server->streamCounters().frames.load() - frames0;
+
+  for (auto& s : subs) asio::post(clientIo, [s] { s->close(); });
+  guard.reset();
+  clientThread.join();
+  server->stop();
+  serverThread.join();
+
+  std::lock_guard lock(shared.mutex);
+  const double p50 = percentile(shared.latencies_ms, 50), p99 = percentile(shared.latencies_ms, 99);
+  const double expected = double(changes) * o.subscribers;
+  std::printf("weatherd bench: %d subscribers (radius %.0f km, level %d), %zu changes at %.0f/s\n", o.subscribers,
+              o.radius_m / 1000, renderer.tileLevel, changes, o.rate);
+  std::printf("  change-to-delivery latency  p50 %.2f ms  p99 %.2f ms  (%llu deliveries, %llu coalesced of %.0f)\n",
+              p50, p99, static_cast<unsigned long long>(shared.deliveries),
+              static_cast<unsigned long long>(shared.coalesced), expected);
+  std::printf("  server CPU                  idle %.2f %% of a core, storm %.1f %%\n", idlePct, stormPct);
+  std::printf("  storm traffic               %llu frames, %.1f MB\n", static_cast<unsigned long long>(frames),
+              double(bytes) / 1e6);
+  std::printf("  snapshot 300 km wide, 3 layers: %zu bytes (level %d, %zu tiles)\n", wideBytes,
+              wideSnapshot.tileLevel, wideSnapshot.tiles.size());
+  std::printf("  one layer's coverage change: %zu bytes per subscriber (a whole snapshot, level %d, %zu tiles)\n",
+              changeBytes, rendererSnapshot.tileLevel, rendererSnapshot.tiles.size());
+  if (!o.json.empty()) {
+    const nlohmann::json j = {{"subscribers", o.subscribers}, {"rate_hz", o.rate}, {"changes", changes},
+                              {"latency_p50_ms", p50}, {"latency_p99_ms", p99}, {"deliveries", shared.deliveries},
+                              {"coalesced", shared.coalesced}, {"cpu_idle_pct", idlePct}, {"cpu_storm_pct", stormPct},
+                              {"frames", frames}, {"bytes", bytes}, {"snapshot_300km_3layers_bytes", wideBytes},
+                              {"change_frame_bytes", changeBytes}};
+    std::ofstream(o.json) << j.dump(2) << "\n";
+  }
+  // Every subscriber must have received the weather at all.
+  return shared.deliveries > 0 && shared.snapshots >= static_cast<std::uint64_t>(o.subscribers) ? 0 : 1;
+}
