@@ -94,6 +94,12 @@ struct Reach {
   double reach_m;  // beyond this (sphere distance from the centre) its weight is 0
 };
 
+// Half diagonal plus perimeter, with 1 % and 1 km for the ellipsoid and the
+// sphere bound's own error.
+double reachOf(const weather::Region& r) {
+  return 1.01 * (std::hypot(r.sizeX_m, r.sizeY_m) / 2 + r.transition_m) + 1000.0;
+}
+
 }  // namespace
 
 std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> cells,
@@ -102,10 +108,7 @@ std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> ce
   std::vector<weather::CoverageTile> tiles;
   tiles.reserve(cells.size() * layers.size());
   std::vector<Reach> reaches;
-  for (const auto& r : regions)
-    // Half diagonal plus perimeter, with 1 % and 1 km for the ellipsoid and
-    // the sphere bound's own error.
-    reaches.push_back({&r, 1.01 * (std::hypot(r.sizeX_m, r.sizeY_m) / 2 + r.transition_m) + 1000.0});
+  for (const auto& r : regions) reaches.push_back({&r, reachOf(r)});
   // Every region's weight at every cell centre (none when no region is near).
   std::vector<std::vector<double>> weights(regions.empty() ? 0 : cells.size());
   for (std::size_t ci = 0; ci < weights.size(); ++ci) {
@@ -170,11 +173,24 @@ weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,
                                        double clock_s, std::size_t maxCells,
                                        std::span<const weather::Region> regions) {
   const std::vector<weather::CloudLayer> table = snapshotLayers(layers, regions);
-  const Covering covering =
-      coverArea(request.area, request.tileLevel, cellBudget(maxCells, table.size()));
+  const std::size_t budget = cellBudget(maxCells, table.size());
   weather::WeatherSnapshot snapshot;
   snapshot.weatherClock_s = clock_s;
   snapshot.layers = table;
+  // No region reaches the area: the weather there is uniform and needs no
+  // tiles, so no covering either (the level is the one the budget allows).
+  const auto& cap = request.area;
+  const bool regional = std::any_of(regions.begin(), regions.end(), [&](const weather::Region& r) {
+    return sphereDistance_m(cap.centerLat_deg, cap.centerLon_deg, r.centerLat_deg, r.centerLon_deg) <=
+           cap.radius_m + reachOf(r);
+  });
+  if (!regional) {
+    int level = request.tileLevel;
+    while (level > 0 && estimatedCells(cap, level) > static_cast<double>(budget)) --level;
+    snapshot.tileLevel = level;
+    return snapshot;
+  }
+  const Covering covering = coverArea(cap, request.tileLevel, budget);
   snapshot.tileLevel = covering.level;
   snapshot.tiles = deriveTiles(covering.cells, table, regions);
   return snapshot;

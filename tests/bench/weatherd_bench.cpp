@@ -54,6 +54,7 @@ struct Options {
   double idleSeconds = 5;     // idle measurement
   double radius_m = 120000;   // each subscriber's area (the renderer's)
   std::size_t maxTiles = 4096;  // the renderer's tile budget (levelForRadius)
+  bool regional = false;  // the storm's weather has a region over every subscriber's area
   std::string json;
 };
 
@@ -173,6 +174,7 @@ int main(int argc, char** argv) {
     else if (k == "--idle-seconds") o.idleSeconds = std::stod(v);
     else if (k == "--radius-m") o.radius_m = std::stod(v);
     else if (k == "--json") o.json = v;
+    else if (k == "--regional") o.regional = v == "1";
     else {
       std::fprintf(stderr, "unknown option %s\n", k.c_str());
       return 2;
@@ -180,24 +182,44 @@ int main(int argc, char** argv) {
   }
   if (argc % 2 == 0) {
     std::fprintf(stderr, "usage: sky_weatherd_bench [--subscribers N] [--rate HZ] [--seconds S] [--idle-seconds S] "
-                         "[--radius-m M] [--json FILE]\n");
+                         "[--radius-m M] [--regional 0|1] [--json FILE]\n");
     return 2;
   }
   const auto layers = threeLayers();
 
   // Sizes, without sockets: a 300 km wide area (150 km radius) at ~1 km
-  // tiles, 3 layers; and the frame a one-layer coverage change costs a
-  // renderer's subscription today (a whole Snapshot: Delta is not sent yet).
+  // tiles, 3 layers all varying (a region 200 km across changes each), so
+  // every layer carries tiles; and the frame one layer's coverage change
+  // costs a renderer's subscription, with uniform weather (just the layer
+  // table) and with that region in its area (the whole snapshot: the server
+  // does not send Deltas yet).
+  sky::weather::Region region;
+  region.id = 1;
+  region.centerLat_deg = 46.0;
+  region.centerLon_deg = 13.0;
+  region.sizeX_m = region.sizeY_m = 200000;
+  region.transition_m = 20000;
+  for (auto l : layers) {
+    l.coverage = 0.9;
+    region.layers.push_back(l);
+  }
+  const std::vector<sky::weather::Region> regions = {region};
+  auto frameBytes = [](const sky::weather::WeatherSnapshot& s) {
+    return sky::stream::encodeFrame(sky::stream::encodeMessage(s)).size();
+  };
   sky::stream::Subscribe wide;
   wide.area = {46.0, 13.0, 150000};
   wide.tileLevel = 13;
-  const auto wideSnapshot = sky::server::buildSnapshot(wide, layers, 0, sky::server::kDefaultMaxCells);
-  const std::size_t wideBytes = sky::stream::encodeFrame(sky::stream::encodeMessage(wideSnapshot)).size();
+  const auto wideSnapshot = sky::server::buildSnapshot(wide, layers, 0, sky::server::kDefaultMaxCells, regions);
+  const std::size_t wideBytes = frameBytes(wideSnapshot);
   sky::stream::Subscribe renderer;
   renderer.area = {46.0, 13.0, o.radius_m};
   renderer.tileLevel = sky::weather::levelForRadius(o.radius_m, o.maxTiles);
-  const auto rendererSnapshot = sky::server::buildSnapshot(renderer, layers, 0, sky::server::kDefaultMaxCells);
-  const std::size_t changeBytes = sky::stream::encodeFrame(sky::stream::encodeMessage(rendererSnapshot)).size();
+  const auto uniformSnapshot = sky::server::buildSnapshot(renderer, layers, 0, sky::server::kDefaultMaxCells);
+  const std::size_t changeBytes = frameBytes(uniformSnapshot);
+  const auto regionalSnapshot =
+      sky::server::buildSnapshot(renderer, layers, 0, sky::server::kDefaultMaxCells, regions);
+  const std::size_t regionalChangeBytes = frameBytes(regionalSnapshot);
 
   sky::server::Scenario scenario;
   scenario.layers = layers;
@@ -210,6 +232,17 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::unique_ptr<sky::server::Server> server = std::move(*created);
+  if (o.regional) {
+    // A region 800 km across over every subscriber's area: every snapshot
+    // carries tiles for all 3 layers, and every change resends them.
+    sky::weather::Region everywhere = region;
+    everywhere.sizeX_m = everywhere.sizeY_m = 800000;
+    auto ok = server->weather().submit({{sky::server::SetRegion{everywhere, {}}}, "bench", "api"});
+    if (!ok) {
+      std::fprintf(stderr, "region: %s\n", ok.error().detail.c_str());
+      return 1;
+    }
+  }
   std::thread serverThread([&] { server->run(); });
 
   Shared shared;
@@ -276,24 +309,26 @@ int main(int argc, char** argv) {
   std::lock_guard lock(shared.mutex);
   const double p50 = percentile(shared.latencies_ms, 50), p99 = percentile(shared.latencies_ms, 99);
   const double expected = double(changes) * o.subscribers;
-  std::printf("weatherd bench: %d subscribers (radius %.0f km, level %d), %zu changes at %.0f/s\n", o.subscribers,
-              o.radius_m / 1000, renderer.tileLevel, changes, o.rate);
+  std::printf("weatherd bench: %d subscribers (radius %.0f km, level %d), %zu changes at %.0f/s, %s weather\n",
+              o.subscribers, o.radius_m / 1000, renderer.tileLevel, changes, o.rate,
+              o.regional ? "regional (tiles in every snapshot)" : "uniform (layer tables only)");
   std::printf("  change-to-delivery latency  p50 %.2f ms  p99 %.2f ms  (%llu deliveries, %llu coalesced of %.0f)\n",
               p50, p99, static_cast<unsigned long long>(shared.deliveries),
               static_cast<unsigned long long>(shared.coalesced), expected);
   std::printf("  server CPU                  idle %.2f %% of a core, storm %.1f %%\n", idlePct, stormPct);
   std::printf("  storm traffic               %llu frames, %.1f MB\n", static_cast<unsigned long long>(frames),
               double(bytes) / 1e6);
-  std::printf("  snapshot 300 km wide, 3 layers: %zu bytes (level %d, %zu tiles)\n", wideBytes,
+  std::printf("  snapshot 300 km wide, 3 varying layers: %zu bytes (level %d, %zu tiles)\n", wideBytes,
               wideSnapshot.tileLevel, wideSnapshot.tiles.size());
-  std::printf("  one layer's coverage change: %zu bytes per subscriber (a whole snapshot, level %d, %zu tiles)\n",
-              changeBytes, rendererSnapshot.tileLevel, rendererSnapshot.tiles.size());
+  std::printf("  one layer's coverage change, per subscriber: %zu bytes with uniform weather (layer table), "
+              "%zu bytes with a region in its area (whole snapshot, level %d, %zu tiles)\n",
+              changeBytes, regionalChangeBytes, regionalSnapshot.tileLevel, regionalSnapshot.tiles.size());
   if (!o.json.empty()) {
-    const nlohmann::json j = {{"subscribers", o.subscribers}, {"rate_hz", o.rate}, {"changes", changes},
+    const nlohmann::json j = {{"subscribers", o.subscribers}, {"rate_hz", o.rate}, {"regional", o.regional}, {"changes", changes},
                               {"latency_p50_ms", p50}, {"latency_p99_ms", p99}, {"deliveries", shared.deliveries},
                               {"coalesced", shared.coalesced}, {"cpu_idle_pct", idlePct}, {"cpu_storm_pct", stormPct},
                               {"frames", frames}, {"bytes", bytes}, {"snapshot_300km_3layers_bytes", wideBytes},
-                              {"change_frame_bytes", changeBytes}};
+                              {"change_frame_bytes_uniform", changeBytes}, {"change_frame_bytes_regional", regionalChangeBytes}};
     std::ofstream(o.json) << j.dump(2) << "\n";
   }
   // Every subscriber must have received the weather at all.
