@@ -145,16 +145,13 @@ void Server::weatherChanged() {
   registry_.forEach([](Session& s) { s.weatherChanged(); });
 }
 
-Frame Server::snapshotFrame(const stream::Subscribe& request) {
-  const weather::WeatherSnapshot snapshot =
+weather::WeatherSnapshot Server::snapshotFor(const stream::Subscribe& request) {
+  weather::WeatherSnapshot snapshot =
       buildSnapshot(request, weather_.layersAt(clockNow()), clockNow(), options_.maxCellsPerSnapshot,
                     weather_.regionsAt(clockNow()));
-  const std::vector<std::uint8_t> payload = stream::encodeMessage(snapshot);
-  // cellBudget keeps tiles × 24 bytes under the cap; a bigger frame is our bug.
-  SKY_ASSERT(payload.size() <= stream::kMaxFrameBytes);
-  log_->debug("snapshot: level {} (asked {}), {} tiles, {} bytes", snapshot.tileLevel,
-              request.tileLevel, snapshot.tiles.size(), payload.size());
-  return stream::encodeFrame(payload);
+  log_->debug("snapshot: level {} (asked {}), {} tiles", snapshot.tileLevel, request.tileLevel,
+              snapshot.tiles.size());
+  return snapshot;
 }
 
 void Server::frameSent(std::size_t bytes) {

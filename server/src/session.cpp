@@ -27,6 +27,12 @@ Frame encodeErrorFrame(const Error& error) {
   return stream::encodeFrame(stream::encodeMessage(message));
 }
 
+bool sameArea(const stream::Subscribe& a, const stream::Subscribe& b) {
+  return a.area.centerLat_deg == b.area.centerLat_deg && a.area.centerLon_deg == b.area.centerLon_deg &&
+         a.area.radius_m == b.area.radius_m && a.altMin_m == b.altMin_m && a.altMax_m == b.altMax_m &&
+         a.tileLevel == b.tileLevel;
+}
+
 }  // namespace
 
 Session::Session(asio::ip::tcp::socket socket, std::uint64_t id, SessionHandler& handler,
@@ -146,7 +152,7 @@ void Session::writeNext() {
   std::visit(
       [this](auto&& next) {
         if constexpr (std::is_same_v<std::decay_t<decltype(next)>, stream::Subscribe>)
-          writing_ = handler_.snapshotFrame(next);
+          writing_ = weatherFrame(next);
         else
           writing_ = std::move(next);
       },
@@ -167,6 +173,22 @@ void Session::writeNext() {
     self->handler_.sessionStalled(*self);
     self->close();
   });
+}
+
+Frame Session::weatherFrame(const stream::Subscribe& request) {
+  weather::WeatherSnapshot snapshot = handler_.snapshotFor(request);
+  std::optional<Frame> frame;
+  if (peerHolds_ && peerHoldsFor_ && sameArea(*peerHoldsFor_, request)) {
+    if (auto delta = weather::diffSnapshots(*peerHolds_, snapshot)) {
+      Frame d = stream::encodeFrame(stream::encodeMessage(*delta));
+      // A delta that resends most tiles is no better than the snapshot.
+      if (d.size() < 3 * stream::encodeFrame(stream::encodeMessage(snapshot)).size() / 4) frame = std::move(d);
+    }
+  }
+  if (!frame) frame = stream::encodeFrame(stream::encodeMessage(snapshot));
+  peerHolds_ = std::move(snapshot);
+  peerHoldsFor_ = request;
+  return std::move(*frame);
 }
 
 void Session::onWritten(const boost::system::error_code& ec) {

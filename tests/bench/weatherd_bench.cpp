@@ -9,7 +9,8 @@
 //   it never saw are counted as coalesced, not as deliveries);
 // * the server thread's CPU time at idle (heartbeats only) and in the storm,
 //   as a percentage of one core;
-// * frames and bytes sent, and the size of one snapshot for a 300 km wide
+// * frames and bytes sent (a change goes out as a Delta when that is smaller
+//   than a snapshot), and the size of one snapshot for a 300 km wide
 //   area with 3 layers, and of the frame one layer's coverage change costs.
 // The server runs in this process on its own thread (real TCP sockets on
 // loopback); the subscribers share one client thread.
@@ -135,14 +136,17 @@ class Subscriber : public std::enable_shared_from_this<Subscriber> {
   }
 
   void onMessage(const sky::stream::Message& m) {
-    const auto* s = std::get_if<sky::weather::WeatherSnapshot>(&m);
-    if (!s) return;
+    // The layers this frame brings: a snapshot's table, or a delta's changed ones.
+    const std::vector<sky::weather::CloudLayer>* layers = nullptr;
+    if (const auto* s = std::get_if<sky::weather::WeatherSnapshot>(&m)) layers = &s->layers;
+    if (const auto* d = std::get_if<sky::weather::WeatherDelta>(&m)) layers = &d->layers;
+    if (!layers) return;
     ready_ = true;
     const auto now = Clock::now();
     std::lock_guard lock(shared_.mutex);
     ++shared_.snapshots;
-    for (const auto& l : s->layers) {
-      if (l.id != 1 || l.base_m < kMarkerBase) continue;
+    for (const auto& l : *layers) {
+      if ((l.id != 1 && l.id != 9) || l.base_m < kMarkerBase) continue;
       const auto index = static_cast<std::size_t>(l.base_m - kMarkerBase + 0.5);
       if (index >= shared_.submitted.size() || shared_.submitted[index] == Clock::time_point{} ||
           (lastIndex_ && index <= *lastIndex_))
@@ -234,7 +238,7 @@ int main(int argc, char** argv) {
   std::unique_ptr<sky::server::Server> server = std::move(*created);
   if (o.regional) {
     // A region 800 km across over every subscriber's area: every snapshot
-    // carries tiles for all 3 layers, and every change resends them.
+    // carries tiles for all 3 layers; the storm is a cell moving inside it.
     sky::weather::Region everywhere = region;
     everywhere.sizeX_m = everywhere.sizeY_m = 800000;
     auto ok = server->weather().submit({{sky::server::SetRegion{everywhere, {}}}, "bench", "api"});
@@ -283,14 +287,37 @@ int main(int argc, char** argv) {
     std::this_thread::sleep_until(stormStart + std::chrono::duration_cast<Clock::duration>(
                                                    std::chrono::duration<double>(double(i) / o.rate)));
     asio::post(server->io(), [&, i] {
-      auto layer = layers[0];
-      layer.base_m = kMarkerBase + double(i);
-      layer.coverage = 0.2 + 0.6 * double(i % 10) / 10;
       {
         std::lock_guard lock(shared.mutex);
         shared.submitted[i] = Clock::now();
       }
-      auto ok = server->weather().submit({{sky::server::SetLayer{layer, {}}}, "bench", "api"});
+      sky::server::WeatherChange change;
+      if (!o.regional) {
+        auto layer = layers[0];
+        layer.base_m = kMarkerBase + double(i);
+        layer.coverage = 0.2 + 0.6 * double(i % 10) / 10;
+        change = sky::server::SetLayer{layer, {}};
+      } else {
+        // A storm cell 60 km across moving east 300 m per change: the tiles
+        // about its edge change for the subscribers near it; its layer
+        // (in every snapshot's table) carries the marker.
+        sky::weather::Region storm;
+        storm.id = 9;
+        storm.centerLat_deg = 46.0;
+        storm.centerLon_deg = 12.0 + 0.004 * double(i);
+        storm.sizeX_m = storm.sizeY_m = 60000;
+        storm.cornerRadius_m = 30000;
+        storm.transition_m = 5000;
+        auto cell = layers[0];
+        cell.id = 9;
+        cell.type = sky::weather::CloudType::Cumulonimbus;
+        cell.base_m = kMarkerBase + double(i);
+        cell.thickness_m = 8000;
+        cell.coverage = 0.9;
+        storm.layers = {cell};
+        change = sky::server::SetRegion{storm, {}};
+      }
+      auto ok = server->weather().submit({{change}, "bench", "api"});
       if (ok) server->weatherChanged();
     });
   }
@@ -311,7 +338,7 @@ int main(int argc, char** argv) {
   const double expected = double(changes) * o.subscribers;
   std::printf("weatherd bench: %d subscribers (radius %.0f km, level %d), %zu changes at %.0f/s, %s weather\n",
               o.subscribers, o.radius_m / 1000, renderer.tileLevel, changes, o.rate,
-              o.regional ? "regional (tiles in every snapshot)" : "uniform (layer tables only)");
+              o.regional ? "regional (tiles in every snapshot; a storm cell moves)" : "uniform (layer tables only)");
   std::printf("  change-to-delivery latency  p50 %.2f ms  p99 %.2f ms  (%llu deliveries, %llu coalesced of %.0f)\n",
               p50, p99, static_cast<unsigned long long>(shared.deliveries),
               static_cast<unsigned long long>(shared.coalesced), expected);

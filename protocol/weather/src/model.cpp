@@ -104,4 +104,58 @@ Result<void> applyDelta(WeatherSnapshot& snapshot, const WeatherDelta& delta) {
   return {};
 }
 
+std::optional<WeatherDelta> diffSnapshots(const WeatherSnapshot& before, const WeatherSnapshot& after) {
+  WeatherDelta d;
+  d.weatherClock_s = after.weatherClock_s;
+  d.tileLevel = after.tileLevel;
+  if (!before.tiles.empty() && !after.tiles.empty() && before.tileLevel != after.tileLevel) return std::nullopt;
+  // Layers: the ones kept must stay in their order, new ones come last.
+  std::vector<std::uint32_t> kept;
+  for (const CloudLayer& b : before.layers) {
+    const auto it = std::find_if(after.layers.begin(), after.layers.end(),
+                                 [&](const CloudLayer& l) { return l.id == b.id; });
+    if (it == after.layers.end())
+      d.removedLayerIds.push_back(b.id);
+    else
+      kept.push_back(b.id);
+  }
+  for (std::size_t i = 0; i < after.layers.size(); ++i) {
+    const CloudLayer& a = after.layers[i];
+    if (i < kept.size()) {
+      if (a.id != kept[i]) return std::nullopt;  // reordered
+      const auto b = std::find_if(before.layers.begin(), before.layers.end(),
+                                  [&](const CloudLayer& l) { return l.id == a.id; });
+      const bool same = b->type == a.type && b->base_m == a.base_m && b->thickness_m == a.thickness_m &&
+                        b->transitionBand_m == a.transitionBand_m && b->coverage == a.coverage &&
+                        b->density == a.density && b->wind.speed_mps == a.wind.speed_mps &&
+                        b->wind.fromDirection_deg == a.wind.fromDirection_deg &&
+                        b->wind.vertical_mps == a.wind.vertical_mps;
+      if (!same) d.layers.push_back(a);
+    } else {
+      d.layers.push_back(a);
+    }
+  }
+  // Tiles: every kept (cell, layer) must still be there; changed and new ones go.
+  std::map<std::pair<std::uint64_t, std::uint32_t>, const CoverageTile*> was;
+  for (const CoverageTile& t : before.tiles) was[{t.cellId, t.layerId}] = &t;
+  std::size_t matched = 0;
+  for (const CoverageTile& t : after.tiles) {
+    const auto it = was.find({t.cellId, t.layerId});
+    if (it == was.end()) {
+      d.tiles.push_back(t);
+      continue;
+    }
+    ++matched;
+    if (!(*it->second == t)) d.tiles.push_back(t);
+  }
+  std::size_t keptTiles = 0;  // tiles of `before` whose layer is not removed
+  for (const CoverageTile& t : before.tiles)
+    if (std::find(d.removedLayerIds.begin(), d.removedLayerIds.end(), t.layerId) == d.removedLayerIds.end())
+      ++keptTiles;
+  if (matched != keptTiles) return std::nullopt;  // a tile (or a layer's tiles) went away
+  // With no tiles the delta cannot move the snapshot's level.
+  if (d.tiles.empty() && before.tileLevel != after.tileLevel) return std::nullopt;
+  return d;
+}
+
 }  // namespace sky::weather

@@ -1,5 +1,6 @@
 // Weather model: validation names the bad field; tiling covers caps at the
 // poles and across the antimeridian; advection moves air downwind.
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <set>
@@ -155,6 +156,74 @@ TEST(Advection, MovesDownwindBySpeedTimesTime) {
   // Across the antimeridian the longitude wraps.
   const SurfacePoint q = advect({0, 179.99}, {10, 270, 0}, 10000);
   EXPECT_LT(q.lon_deg, -179.0);
+}
+
+}  // namespace
+}  // namespace sky::weather
+
+namespace sky::weather {
+namespace {
+
+// diffSnapshots against applyDelta on random pairs: whenever it gives a
+// delta, applying it to `before` yields `after` exactly; it refuses what a
+// delta cannot say; an unchanged snapshot gives an empty delta.
+TEST(Delta, DiffThenApplyIsTheNewSnapshot) {
+  std::mt19937 rng(11);
+  auto makeLayer = [&](std::uint32_t id) {
+    CloudLayer l;
+    l.id = id;
+    l.thickness_m = 500;
+    l.coverage = std::uniform_int_distribution<int>(0, 4)(rng) / 4.0;
+    return l;
+  };
+  const std::uint64_t cells[] = {cellAt(0, 0, 10), cellAt(1, 1, 10), cellAt(2, 2, 10), cellAt(3, 3, 10)};
+  auto makeSnapshot = [&] {
+    WeatherSnapshot s;
+    s.tileLevel = 10;
+    for (std::uint32_t id = 1; id <= 4; ++id) {
+      if (rng() % 4 == 0) continue;
+      s.layers.push_back(makeLayer(id));
+      if (rng() % 2)
+        for (std::uint64_t c : cells)
+          s.tiles.push_back({c, id, float(std::uniform_int_distribution<int>(0, 2)(rng)) / 2, 1.0f});
+    }
+    return s;
+  };
+  int deltas = 0, refused = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const WeatherSnapshot before = makeSnapshot();
+    WeatherSnapshot after = rng() % 3 == 0 ? before : makeSnapshot();
+    after.weatherClock_s = 5;
+    const auto d = diffSnapshots(before, after);
+    if (!d) {
+      ++refused;
+      continue;
+    }
+    ++deltas;
+    WeatherSnapshot applied = before;
+    ASSERT_TRUE(applyDelta(applied, *d));
+    ASSERT_EQ(applied.layers.size(), after.layers.size()) << i;
+    for (std::size_t k = 0; k < after.layers.size(); ++k) {
+      EXPECT_EQ(applied.layers[k].id, after.layers[k].id) << i;
+      EXPECT_EQ(applied.layers[k].coverage, after.layers[k].coverage) << i;
+    }
+    auto sorted = [](std::vector<CoverageTile> t) {
+      std::sort(t.begin(), t.end(), [](const auto& a, const auto& b) {
+        return std::pair{a.cellId, a.layerId} < std::pair{b.cellId, b.layerId};
+      });
+      return t;
+    };
+    EXPECT_EQ(sorted(applied.tiles), sorted(after.tiles)) << i;
+    EXPECT_EQ(applied.tileLevel, after.tileLevel) << i;
+    EXPECT_EQ(applied.weatherClock_s, 5);
+  }
+  EXPECT_GT(deltas, 500);
+  EXPECT_GT(refused, 100);  // tiles dropped, reorders: snapshots then
+  // Unchanged: nothing but the clock.
+  const WeatherSnapshot s = makeSnapshot();
+  const auto same = diffSnapshots(s, s);
+  ASSERT_TRUE(same);
+  EXPECT_TRUE(same->layers.empty() && same->tiles.empty() && same->removedLayerIds.empty());
 }
 
 }  // namespace

@@ -71,14 +71,15 @@ class TestClient {
     return stream::decodeMessage(payload);
   }
 
-  // The next message of type T, skipping heartbeats (unless T is Heartbeat).
+  // The next message of type T, skipping heartbeats and deltas (unless T is one).
   template <class T>
   Result<T> readNext() {
     for (;;) {
       auto m = read();
       if (!m) return tl::unexpected(m.error());
       if (auto* t = std::get_if<T>(&*m)) return *t;
-      if (!std::holds_alternative<stream::Heartbeat>(*m))
+      // Heartbeats, and deltas of weather changes, come between the others.
+      if (!std::holds_alternative<stream::Heartbeat>(*m) && !std::holds_alternative<weather::WeatherDelta>(*m))
         return fail(ErrorCode::Malformed, std::string("unexpected ") + stream::kindName(*m));
     }
   }
@@ -90,14 +91,14 @@ class TestClient {
 
 // A region over the test areas (46-49 N, 8.5 E) that thins the scenario's
 // layer 1: without one the weather is uniform and snapshots carry no tiles.
-void addRegion(Server& server) {
+void addRegion(Server& server, double coverage = 0.25) {
   weather::Region r;
   r.id = 1;
   r.centerLat_deg = 47.5;
   r.centerLon_deg = 10.0;
   r.sizeX_m = r.sizeY_m = 600'000;
   weather::CloudLayer l = server.weather().view().layers.at(0);
-  l.coverage = 0.25;
+  l.coverage = coverage;
   r.layers = {l};
   auto ok = server.weather().submit({{SetRegion{r, Timing{}}}, "test", "api"});
   ASSERT_TRUE(ok) << ok.error().detail;
@@ -189,6 +190,49 @@ TEST_F(ServerFixture, HelloSubscribeSnapshotHeartbeat) {
   EXPECT_TRUE(again->tiles.empty());
   ASSERT_EQ(again->layers.size(), 1u);
   EXPECT_NEAR(again->layers[0].coverage, 0.6, 1e-6);
+}
+
+// A change in a subscriber's area goes out as a Delta from the snapshot it
+// holds when that is smaller; applied, it equals what a fresh subscription
+// gets. Here the global layer changes while the region (covering the whole
+// area) keeps its tiles: the delta is the one layer and no tiles.
+TEST_F(ServerFixture, AChangeArrivesAsADeltaThatEqualsAFreshSnapshot) {
+  TestClient client(server_->port());
+  ASSERT_TRUE(client.readNext<stream::Hello>());
+  client.send(subscribe(47.4, 8.5, 30'000, 10));
+  auto held = client.readNext<weather::WeatherSnapshot>();
+  ASSERT_TRUE(held) << held.error().detail;
+  ASSERT_FALSE(held->tiles.empty());
+  asio::post(server_->io(), [this] {
+    weather::CloudLayer l = server_->weather().view().layers.at(0);
+    l.coverage = 0.7;
+    ASSERT_TRUE(server_->weather().submit({{SetLayer{l, Timing{}}}, "test", "api"}));
+    server_->weatherChanged();
+  });
+  auto delta = client.readNext<weather::WeatherDelta>();
+  ASSERT_TRUE(delta) << delta.error().detail;
+  ASSERT_EQ(delta->layers.size(), 1u);
+  EXPECT_NEAR(delta->layers[0].coverage, 0.7, 1e-6);
+  EXPECT_TRUE(delta->tiles.empty()) << "inside the region the tiles did not change";
+  ASSERT_TRUE(weather::applyDelta(*held, *delta));
+  TestClient fresh(server_->port());
+  ASSERT_TRUE(fresh.readNext<stream::Hello>());
+  fresh.send(subscribe(47.4, 8.5, 30'000, 10));
+  auto expected = fresh.readNext<weather::WeatherSnapshot>();
+  ASSERT_TRUE(expected);
+  ASSERT_EQ(held->layers.size(), expected->layers.size());
+  EXPECT_NEAR(held->layers[0].coverage, expected->layers[0].coverage, 1e-6);
+  EXPECT_EQ(held->tiles, expected->tiles);
+  // The region itself changes: every tile is new, so a whole Snapshot comes.
+  asio::post(server_->io(), [this] {
+    addRegion(*server_, 0.8);
+    server_->weatherChanged();
+  });
+  auto m = client.read();
+  while (m && std::holds_alternative<stream::Heartbeat>(*m)) m = client.read();
+  ASSERT_TRUE(m);
+  ASSERT_TRUE(std::holds_alternative<weather::WeatherSnapshot>(*m)) << stream::kindName(*m);
+  for (const auto& t : std::get<weather::WeatherSnapshot>(*m).tiles) EXPECT_NEAR(t.coverage, 0.8f, 0.5f / 255);
 }
 
 TEST_F(ServerFixture, TooFineALevelIsLoweredAndReported) {
@@ -310,8 +354,14 @@ TEST(Server, ASubscriberThatStopsReadingIsDroppedOthersGoOn) {
   // ~20000 cells at ~1 km: a ~0.5 MB snapshot per change, never read.
   slow.send(subscribe(46.0, 13.0, 80'000, 13));
   const auto start = std::chrono::steady_clock::now();
+  // Each change moves the region's coverage: every tile changes, so each
+  // update is about a whole snapshot.
+  int step = 0;
   while (server->streamCounters().stalledDropped.load() == 0 && std::chrono::steady_clock::now() - start < 20s) {
-    asio::post(server->io(), [&] { server->weatherChanged(); });
+    asio::post(server->io(), [&server, coverage = 0.1 + 0.1 * (step++ % 5)] {
+      addRegion(*server, coverage);
+      server->weatherChanged();
+    });
     std::this_thread::sleep_for(20ms);
   }
   EXPECT_EQ(server->streamCounters().stalledDropped.load(), 1u);

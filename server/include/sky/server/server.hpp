@@ -88,7 +88,7 @@ class Server final : private SessionHandler {
   void shutdown();
   double clockNow() const;
 
-  Frame snapshotFrame(const stream::Subscribe& request) override;
+  weather::WeatherSnapshot snapshotFor(const stream::Subscribe& request) override;
   void sessionClosed(Session& session) override;
   void frameSent(std::size_t bytes) override;
   void sessionStalled(Session& session) override;

@@ -29,8 +29,8 @@ class Session;
 // What a session needs from its owner. Called on the io_context's thread.
 class SessionHandler {
  public:
-  // The snapshot frame answering `request`, at the weather clock of now.
-  virtual Frame snapshotFrame(const stream::Subscribe& request) = 0;
+  // The snapshot answering `request`, at the weather clock of now.
+  virtual weather::WeatherSnapshot snapshotFor(const stream::Subscribe& request) = 0;
   // The session has closed its socket and will do no more work.
   virtual void sessionClosed(Session& session) = 0;
   // A frame of `bytes` bytes went out completely.
@@ -56,8 +56,9 @@ class Session : public std::enable_shared_from_this<Session> {
   void start(Frame hello);
   // Queues a heartbeat frame, replacing one not yet sent. Ignored once closing.
   void sendHeartbeat(const Frame& heartbeat);
-  // The weather changed: a fresh Snapshot of the current subscription (if
-  // any) replaces whatever snapshot is still waiting to be sent.
+  // The weather changed: fresh weather for the current subscription (if any)
+  // replaces whatever is still waiting to be sent; it goes out as a Delta
+  // from what the peer holds when it can, else as a Snapshot.
   void weatherChanged();
   // Closes the socket now, cancelling pending I/O. Idempotent.
   void close();
@@ -78,6 +79,7 @@ class Session : public std::enable_shared_from_this<Session> {
   void handleMessage(const stream::Message& message);
   void protocolError(const Error& error);
   void writeNext();
+  Frame weatherFrame(const stream::Subscribe& request);
   void onWritten(const boost::system::error_code& ec);
   void beginDrain();
 
@@ -93,6 +95,11 @@ class Session : public std::enable_shared_from_this<Session> {
   State state_ = State::Open;
   stream::FrameDecoder decoder_;
   std::optional<stream::Subscribe> subscription_;  // the latest area asked for
+  // What the peer holds: the last snapshot sent (or reached by deltas), and
+  // the subscription it answered. A new snapshot of the same subscription
+  // goes out as the Delta from it when a delta can say it and is smaller.
+  std::optional<weather::WeatherSnapshot> peerHolds_;
+  std::optional<stream::Subscribe> peerHoldsFor_;
   std::array<std::uint8_t, 64 * 1024> readBuffer_{};
   Outbox outbox_;
   Frame writing_;  // the frame async_write is sending; untouched until it completes

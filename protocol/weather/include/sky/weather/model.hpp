@@ -86,6 +86,14 @@ struct WeatherDelta {
 // layer) the snapshot is left exactly as it was.
 Result<void> applyDelta(WeatherSnapshot& snapshot, const WeatherDelta& delta);
 
+// The delta that takes `before` to `after` (applyDelta(before, delta) gives
+// after exactly: same layers in the same order, same tiles by (cell, layer)):
+// changed and new layers, removed layers, and the tiles that differ. None when
+// a delta cannot say it: a different tile level, a layer losing tiles it had
+// (a delta only upserts tiles), a tile gone, or layers reordered; the caller
+// then sends a snapshot.
+std::optional<WeatherDelta> diffSnapshots(const WeatherSnapshot& before, const WeatherSnapshot& after);
+
 // Fractions on the wire: [0, 1] -> 0..255, rounding to nearest; NaN -> 0.
 std::uint8_t quantizeUnit(double v);
 inline float dequantizeUnit(std::uint8_t q) { return static_cast<float>(q) / 255.0f; }
