@@ -148,7 +148,7 @@ void Server::weatherChanged() {
 weather::WeatherSnapshot Server::snapshotFor(const stream::Subscribe& request) {
   weather::WeatherSnapshot snapshot =
       buildSnapshot(request, weather_.layersAt(clockNow()), clockNow(), options_.maxCellsPerSnapshot,
-                    weather_.regionsAt(clockNow()));
+                    weather_.regionsAt(clockNow()), &tileCache_);
   log_->debug("snapshot: level {} (asked {}), {} tiles", snapshot.tileLevel, request.tileLevel,
               snapshot.tiles.size());
   return snapshot;

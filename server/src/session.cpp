@@ -179,11 +179,11 @@ Frame Session::weatherFrame(const stream::Subscribe& request) {
   weather::WeatherSnapshot snapshot = handler_.snapshotFor(request);
   std::optional<Frame> frame;
   if (peerHolds_ && peerHoldsFor_ && sameArea(*peerHoldsFor_, request)) {
-    if (auto delta = weather::diffSnapshots(*peerHolds_, snapshot)) {
-      Frame d = stream::encodeFrame(stream::encodeMessage(*delta));
-      // A delta that resends most tiles is no better than the snapshot.
-      if (d.size() < 3 * stream::encodeFrame(stream::encodeMessage(snapshot)).size() / 4) frame = std::move(d);
-    }
+    // A delta that resends most tiles is no better than the snapshot (tiles
+    // are nearly all of either's size).
+    if (auto delta = weather::diffSnapshots(*peerHolds_, snapshot);
+        delta && (delta->tiles.empty() || 4 * delta->tiles.size() < 3 * snapshot.tiles.size()))
+      frame = stream::encodeFrame(stream::encodeMessage(*delta));
   }
   if (!frame) frame = stream::encodeFrame(stream::encodeMessage(snapshot));
   peerHolds_ = std::move(snapshot);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <numbers>
 
@@ -102,9 +103,57 @@ double reachOf(const weather::Region& r) {
 
 }  // namespace
 
+namespace {
+
+std::uint64_t shapeKey(const weather::Region& r) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (double v : {r.centerLat_deg, r.centerLon_deg, r.sizeX_m, r.sizeY_m, r.cornerRadius_m, r.rotation_deg,
+                   r.transition_m}) {
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &v, sizeof bits);
+    for (int i = 0; i < 8; ++i) {
+      h ^= (bits >> (8 * i)) & 0xffu;
+      h *= 1099511628211ull;
+    }
+  }
+  return h;
+}
+
+// Bounds of the cache: areas (renderers re-subscribe as they move) and
+// region shapes (a drifting region has a new shape at every change).
+constexpr std::size_t kMaxCachedCoverings = 256;
+constexpr std::size_t kMaxCachedShapes = 64;
+
+}  // namespace
+
+const TileCache::Entry& TileCache::covering(const weather::SphericalCap& cap, int wantedLevel,
+                                            std::size_t maxCells) {
+  const auto key = std::tuple{cap.centerLat_deg, cap.centerLon_deg, cap.radius_m, wantedLevel, maxCells};
+  if (auto it = coverings_.find(key); it != coverings_.end()) return it->second;
+  if (coverings_.size() >= kMaxCachedCoverings) coverings_.clear();
+  Entry e{coverArea(cap, wantedLevel, maxCells), {}};
+  e.centres.reserve(e.covering.cells.size());
+  for (std::uint64_t c : e.covering.cells) e.centres.push_back(weather::cellCentre(c));
+  return coverings_.emplace(key, std::move(e)).first->second;
+}
+
+double TileCache::weight(const weather::Region& region, std::uint64_t cell, const weather::CellCentre& centre) {
+  const std::uint64_t key = shapeKey(region);
+  auto shape = weights_.find(key);
+  if (shape == weights_.end()) {
+    if (weights_.size() >= kMaxCachedShapes) weights_.clear();
+    shape = weights_.emplace(key, std::unordered_map<std::uint64_t, double>{}).first;
+  }
+  if (auto it = shape->second.find(cell); it != shape->second.end()) return it->second;
+  const double w = weather::regionWeight(region, centre.lat_deg, centre.lon_deg);
+  shape->second.emplace(cell, w);
+  return w;
+}
+
 std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> cells,
                                                std::span<const weather::CloudLayer> layers,
-                                               std::span<const weather::Region> regions) {
+                                               std::span<const weather::Region> regions, TileCache* cache,
+                                               std::span<const weather::CellCentre> centres) {
   std::vector<weather::CoverageTile> tiles;
   tiles.reserve(cells.size() * layers.size());
   std::vector<Reach> reaches;
@@ -112,13 +161,13 @@ std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> ce
   // Every region's weight at every cell centre (none when no region is near).
   std::vector<std::vector<double>> weights(regions.empty() ? 0 : cells.size());
   for (std::size_t ci = 0; ci < weights.size(); ++ci) {
-    const weather::CellCentre c = weather::cellCentre(cells[ci]);
+    const weather::CellCentre c = ci < centres.size() ? centres[ci] : weather::cellCentre(cells[ci]);
     std::vector<double> w(reaches.size(), 0.0);
     bool any = false;
     for (std::size_t k = 0; k < reaches.size(); ++k) {
       const weather::Region& r = *reaches[k].region;
       if (sphereDistance_m(c.lat_deg, c.lon_deg, r.centerLat_deg, r.centerLon_deg) > reaches[k].reach_m) continue;
-      w[k] = weather::regionWeight(r, c.lat_deg, c.lon_deg);
+      w[k] = cache ? cache->weight(r, cells[ci], c) : weather::regionWeight(r, c.lat_deg, c.lon_deg);
       any = any || w[k] > 0;
     }
     if (any) weights[ci] = std::move(w);
@@ -171,7 +220,7 @@ std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> ce
 weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,
                                        std::span<const weather::CloudLayer> layers,
                                        double clock_s, std::size_t maxCells,
-                                       std::span<const weather::Region> regions) {
+                                       std::span<const weather::Region> regions, TileCache* cache) {
   const std::vector<weather::CloudLayer> table = snapshotLayers(layers, regions);
   const std::size_t budget = cellBudget(maxCells, table.size());
   weather::WeatherSnapshot snapshot;
@@ -188,6 +237,12 @@ weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,
     int level = request.tileLevel;
     while (level > 0 && estimatedCells(cap, level) > static_cast<double>(budget)) --level;
     snapshot.tileLevel = level;
+    return snapshot;
+  }
+  if (cache) {
+    const TileCache::Entry& e = cache->covering(cap, request.tileLevel, budget);
+    snapshot.tileLevel = e.covering.level;
+    snapshot.tiles = deriveTiles(e.covering.cells, table, regions, cache, e.centres);
     return snapshot;
   }
   const Covering covering = coverArea(cap, request.tileLevel, budget);

@@ -135,7 +135,19 @@ std::optional<WeatherDelta> diffSnapshots(const WeatherSnapshot& before, const W
       d.layers.push_back(a);
     }
   }
-  // Tiles: every kept (cell, layer) must still be there; changed and new ones go.
+  // Tiles: every kept (cell, layer) must still be there; changed and new ones
+  // go. Fast path: the same tiles in the same order (one area, one covering).
+  const bool sameOrder = before.tiles.size() == after.tiles.size() && d.removedLayerIds.empty() &&
+                         std::equal(before.tiles.begin(), before.tiles.end(), after.tiles.begin(),
+                                    [](const CoverageTile& a, const CoverageTile& b) {
+                                      return a.cellId == b.cellId && a.layerId == b.layerId;
+                                    });
+  if (sameOrder) {
+    for (std::size_t i = 0; i < after.tiles.size(); ++i)
+      if (!(before.tiles[i] == after.tiles[i])) d.tiles.push_back(after.tiles[i]);
+    if (d.tiles.empty() && before.tileLevel != after.tileLevel) return std::nullopt;
+    return d;
+  }
   std::map<std::pair<std::uint64_t, std::uint32_t>, const CoverageTile*> was;
   for (const CoverageTile& t : before.tiles) was[{t.cellId, t.layerId}] = &t;
   std::size_t matched = 0;

@@ -133,6 +133,22 @@ TEST(Regions, AnotherTypeInARegionBlendsIntoTheLayer) {
   EXPECT_NEAR(edge->coverage, 0.5 + edge->blend * 0.4, 1e-5) << "coverage and type blend by the same weight";
 }
 
+TEST(Regions, TheTileCacheGivesTheSameSnapshots) {
+  const std::vector<weather::CloudLayer> global = {layer(1, weather::CloudType::Cumulus, 0.8)};
+  std::vector<weather::Region> regions = {
+      cell(1, 46, 13, 20000, 10000, {layer(1, weather::CloudType::Cumulus, 0.0)}),
+      cell(2, 46, 13.39, 8000, 4000, {layer(6, weather::CloudType::Cumulonimbus, 1.0)})};
+  TileCache cache;
+  for (int round = 0; round < 3; ++round) {  // the first fills the cache, the others read it
+    regions[1].centerLon_deg = 13.39 + 0.01 * (round == 2);  // the storm moves in the last round
+    const auto plain = buildSnapshot(around(46, 13.2, 60000), global, 0.0, kDefaultMaxCells, regions);
+    const auto cached = buildSnapshot(around(46, 13.2, 60000), global, 0.0, kDefaultMaxCells, regions, &cache);
+    EXPECT_EQ(cached.tileLevel, plain.tileLevel);
+    EXPECT_EQ(cached.tiles, plain.tiles) << round;
+  }
+  EXPECT_EQ(cache.coverings(), 1u);
+}
+
 TEST(Regions, OverlappingRegionsAverageByWeight) {
   const std::vector<weather::CloudLayer> global = {layer(1, weather::CloudType::Cumulus, 0.5)};
   const std::vector<weather::Region> regions = {cell(1, 0, 0, 20000, 0, {layer(1, weather::CloudType::Cumulus, 0.2)}),

@@ -105,6 +105,7 @@ class Server final : private SessionHandler {
   std::optional<boost::asio::signal_set> signals_;
   SessionRegistry registry_;
   StreamCounters streamCounters_;
+  TileCache tileCache_;
   std::uint16_t port_ = 0;
   std::uint64_t nextSessionId_ = 1;
   bool stopped_ = false;

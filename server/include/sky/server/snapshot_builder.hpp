@@ -5,6 +5,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <map>
+#include <tuple>
+#include <unordered_map>
 #include <span>
 #include <vector>
 
@@ -44,6 +47,26 @@ Covering coverArea(const weather::SphericalCap& cap, int wantedLevel, std::size_
 std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLayer> layers,
                                                 std::span<const weather::Region> regions);
 
+// What snapshots of the same areas share from one change to the next: the
+// S2 coverings (with their cell centres) by area, level and budget, and each
+// region shape's weight at each cell. Bounded: a table that grows past its
+// limit starts again. Used on the server's io thread only.
+class TileCache {
+ public:
+  struct Entry {
+    Covering covering;
+    std::vector<weather::CellCentre> centres;  // of covering.cells
+  };
+  const Entry& covering(const weather::SphericalCap& cap, int wantedLevel, std::size_t maxCells);
+  // regionWeight(region, centre) of `cell`, remembered by the region's shape.
+  double weight(const weather::Region& region, std::uint64_t cell, const weather::CellCentre& centre);
+  std::size_t coverings() const { return coverings_.size(); }
+
+ private:
+  std::map<std::tuple<double, double, double, int, std::size_t>, Entry> coverings_;
+  std::unordered_map<std::uint64_t, std::unordered_map<std::uint64_t, double>> weights_;  // shape -> cell -> weight
+};
+
 // One tile per (cell, table layer) for each layer that varies over the
 // cells; a layer that is the same everywhere there gets none (a renderer then
 // takes the layer's own values: the snapshot of uniform weather is just its
@@ -56,12 +79,15 @@ std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLa
 // (weather::regionAt), and `layers` the table from snapshotLayers.
 std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> cells,
                                                std::span<const weather::CloudLayer> layers,
-                                               std::span<const weather::Region> regions = {});
+                                               std::span<const weather::Region> regions = {},
+                                               TileCache* cache = nullptr,
+                                               std::span<const weather::CellCentre> centres = {});
 
 // The snapshot answering `request` at weather clock clock_s.
 weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,
                                        std::span<const weather::CloudLayer> layers,
                                        double clock_s, std::size_t maxCells,
-                                       std::span<const weather::Region> regions = {});
+                                       std::span<const weather::Region> regions = {},
+                                       TileCache* cache = nullptr);
 
 }  // namespace sky::server
