@@ -214,6 +214,13 @@ int main(int argc, char** argv) {
     http.log = log;
     auto moreMetrics = [&cigi, &s]() -> std::string {
       std::string m = s.streamMetrics();
+      const auto& commits = s.weather().commitStats();
+      m += "# HELP skyshell_commit_seconds time to commit an accepted change to SQLite before acknowledging it\n"
+           "# TYPE skyshell_commit_seconds summary\n"
+           "skyshell_commit_seconds_sum " + std::to_string(commits.total_s) + "\n"
+           "skyshell_commit_seconds_count " + std::to_string(commits.count) + "\n"
+           "# HELP skyshell_commit_seconds_max longest commit so far\n# TYPE skyshell_commit_seconds_max gauge\n"
+           "skyshell_commit_seconds_max " + std::to_string(commits.max_s) + "\n";
       if (!cigi) return m;
       auto line = [&m](const char* name, const char* help, std::uint64_t v) {
         m += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " counter\n" + name + " " +

@@ -6,6 +6,7 @@
 #include "ramp_math.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -190,7 +191,13 @@ Result<AppliedChange> LiveWeather::submit(const ChangeRequest& request) {
   ChangeEvent e{sequence_ + 1, now_s, unixNowMs_(), request.author, request.source, summary};
   if (store_) {
     // Commit first: only a change on disk is acknowledged and applied.
-    if (auto ok = store_->save(stateJson(next, sequence_ + 1, version_ + 1), &e); !ok) return tl::unexpected(ok.error());
+    const auto started = std::chrono::steady_clock::now();
+    auto ok = store_->save(stateJson(next, sequence_ + 1, version_ + 1), &e);
+    const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    ++commitStats_.count;
+    commitStats_.total_s += took_s;
+    commitStats_.max_s = std::max(commitStats_.max_s, took_s);
+    if (!ok) return tl::unexpected(ok.error());
   }
   layers_ = std::move(next.layers);
   ramps_ = std::move(next.ramps);

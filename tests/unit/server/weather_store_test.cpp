@@ -63,6 +63,10 @@ TEST(WeatherStore, RestartRestoresTheSameStateAndGoesOn) {
     unixMs += 100'000;
     hash = w.stateHash();
     EXPECT_NEAR(w.layersAt(w.clockNow())[0].coverage, 0.4, 1e-12);  // 100 s into 0.3 -> 0.9 over 600 s
+    // One commit: the refused change never reached the store.
+    EXPECT_EQ(w.commitStats().count, 1u);
+    EXPECT_GT(w.commitStats().max_s, 0.0);
+    EXPECT_LE(w.commitStats().max_s, w.commitStats().total_s);
   }
   // Down for 50 s, then a new process restores.
   unixMs += 50'000;

@@ -41,6 +41,12 @@ class LiveWeather final : public WeatherService {
   // stream then refreshes its subscribers as the weather moves.
   bool changing(double clock_s) const;
   std::uint64_t rejected() const { return rejected_; }
+  // Commits to the store: how many, and their total and longest duration.
+  struct CommitStats {
+    std::uint64_t count = 0;
+    double total_s = 0, max_s = 0;
+  };
+  const CommitStats& commitStats() const { return commitStats_; }
 
   // Durability: with a store attached, every accepted change is committed to
   // it (state and event, one transaction) before submit returns; a failed
@@ -106,6 +112,7 @@ class LiveWeather final : public WeatherService {
   std::uint64_t sequence_ = 0;
   std::uint64_t version_ = 1;
   std::uint64_t rejected_ = 0;
+  CommitStats commitStats_;
   class WeatherStore* store_ = nullptr;
 };
 
