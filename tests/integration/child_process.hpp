@@ -81,6 +81,13 @@ class ChildProcess {
     return wait(std::chrono::seconds(5)).value_or(-1);
   }
 
+  // SIGKILL now (a crash: no shutdown code runs), then reap it.
+  int killNow() {
+    if (exitCode_) return *exitCode_;
+    kill(pid_, SIGKILL);
+    return wait(std::chrono::seconds(5)).value_or(-1);
+  }
+
   std::string log() const {
     std::ifstream f(logPath_);
     std::stringstream s;
