@@ -162,6 +162,9 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
       break;
     }
     const double t = t0 + double(i) * o.step_s;
+    if (o.pace > 0)
+      std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
+                                                std::chrono::duration<double>((t - t0) / o.pace)));
     pose = flight::sample(*flight, t);
     if (weather && needsResubscribe(subscribedAt, pose.position)) {
       const std::uint64_t before = state.weatherVersion();

@@ -55,6 +55,7 @@ struct Options {
   // --replay: headless replay of a flight file instead of listening to a host.
   std::string replayFlight;
   double replayStep_s = 1.0 / 30.0;
+  double replayPace = 0;
   double replayStart_s = 0;
   double replayEnd_s = -1;
   double replayWeatherClock_s = std::numeric_limits<double>::quiet_NaN();
@@ -117,6 +118,10 @@ int main(int argc, char** argv) {
                  "render this flight file (.csv, .igc, .gpx) headless, one frame per --step of flight time, "
                  "then write a video, a contact sheet and report.json into --out");
   app.add_option("--step", o.replayStep_s, "with --replay: flight seconds per frame")->check(CLI::Range(1e-3, 3600.0));
+  app.add_option("--replay-pace", o.replayPace,
+                 "with --replay: flight seconds per wall second; no frame is rendered before its time "
+                 "(default 0: as fast as it renders)")
+      ->check(CLI::Range(0.0, 3600.0));
   app.add_option("--replay-start", o.replayStart_s, "with --replay: start offset into the flight, s")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--replay-end", o.replayEnd_s, "with --replay: end offset into the flight, s (default: its end)")
@@ -164,6 +169,7 @@ int main(int argc, char** argv) {
     sky::app::ReplayOptions r;
     r.flightPath = o.replayFlight;
     r.step_s = o.replayStep_s;
+    r.pace = o.replayPace;
     r.start_s = o.replayStart_s;
     if (o.replayEnd_s >= 0) r.end_s = o.replayEnd_s;
     if (std::isfinite(o.replayWeatherClock_s)) r.weatherClock_s = o.replayWeatherClock_s;

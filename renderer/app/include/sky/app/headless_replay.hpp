@@ -38,6 +38,10 @@ struct ReplayOptions {
   double sunAzimuth_deg = 135, sunElevation_deg = 40;  // when the flight has no date, or fixedSun
   bool fixedSun = false;  // ignore the flight's recorded date (IGC, GPX) for the sun
   std::string preset = "skeleton";  // recorded in the report
+  // Flight seconds per wall second: a frame is not rendered before its time
+  // (so a weather change timed in flight seconds lands on the frames it
+  // should). 0: as fast as the renderer goes.
+  double pace = 0;
 };
 
 // Runs the replay to the end (or until *stop turns true). Returns the process
