@@ -1,6 +1,7 @@
 // IGC flight reader (FAI Technical Specification for IGC-approved GNSS flight
 // recorders, Appendix A): H date, I extensions, B fixes. Lenient by design:
 // a bad line is skipped with a warning (see flight.hpp for every rule).
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -24,6 +25,7 @@ constexpr double kMidnightJump_s = kSecondsPerDay / 2;
 // B record layout, 0-based byte offsets (spec A4.1).
 constexpr std::size_t kBMinLength = 35;
 constexpr std::size_t kBFirstExtensionByte = 36;  // 1-based, as I records count
+constexpr std::size_t kMaxExtraDigits = 9;        // LAD/LOD digits that still matter
 
 struct Date {
   std::int64_t y;
@@ -96,8 +98,13 @@ std::optional<double> angle(std::string_view deg, std::string_view minutesMilli,
   const long long d = digitsValue(deg), mm = digitsValue(minutesMilli);
   if (d < 0 || mm < 0 || mm >= 60000) return std::nullopt;
   double minutes = static_cast<double>(mm) / 1000.0;
-  const long long x = digitsValue(extra);
-  if (x >= 0) minutes += static_cast<double>(x) / (1000.0 * std::pow(10.0, static_cast<double>(extra.size())));
+  // An I record may declare a wide LAD/LOD; past 9 extra digits (1e-12
+  // minutes, a micrometre) nothing is left to refine, so the rest only has to
+  // be digits. Without the cut a long run overflowed the value.
+  const bool extraIsDigits = std::all_of(extra.begin(), extra.end(), detail::isDigit);
+  const std::string_view used = extra.substr(0, std::min<std::size_t>(extra.size(), kMaxExtraDigits));
+  const long long x = extraIsDigits ? digitsValue(used) : -1;
+  if (x >= 0) minutes += static_cast<double>(x) / (1000.0 * std::pow(10.0, static_cast<double>(used.size())));
   return static_cast<double>(d) + minutes / 60.0;
 }
 

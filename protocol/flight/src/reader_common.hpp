@@ -23,9 +23,14 @@ constexpr std::string_view sub(std::string_view s, std::size_t pos, std::size_t 
   return pos > s.size() ? std::string_view() : s.substr(pos, n);
 }
 
-// Value of s (all digits, non-empty) or -1.
+// Most digits digitsValue reads: 18 always fit a long long.
+constexpr std::size_t kMaxValueDigits = 18;
+
+// Value of s (all digits, non-empty, at most kMaxValueDigits) or -1. Longer
+// runs are refused rather than overflowing: no fixed-width field we read is
+// that wide, so such a run is junk.
 constexpr long long digitsValue(std::string_view s) {
-  if (s.empty()) return -1;
+  if (s.empty() || s.size() > kMaxValueDigits) return -1;
   long long v = 0;
   for (char c : s) {
     if (!isDigit(c)) return -1;

@@ -89,6 +89,22 @@ TEST(FlightIgc, IRecordExtensionsAreSkippedAndLadLodRefine) {
   EXPECT_TRUE(f->warnings.empty()) << allWarnings(*f);
 }
 
+TEST(FlightIgc, WideLadExtensionUsesItsFirstNineDigitsAndDoesNotOverflow) {
+  // LAD declared over bytes 36-63 (28 digits): the value would overflow a
+  // 64-bit integer (the fuzzer found this); the first nine digits refine the
+  // minutes, the rest must only be digits. A non-digit in the run leaves the
+  // minutes unrefined.
+  const std::string digits28 = "7" + std::string(27, '3');
+  const std::string text = kHeader + "I013663LAD\r\n" +
+                           b("120000", 'A', 950, 1000, "4612584N01249706E", digits28) +
+                           b("120001", 'A', 950, 1000, "4612584N01249706E", "7" + std::string(20, '3') + "x333333");
+  auto f = parseIgc(text, "w.igc");
+  ASSERT_TRUE(f) << f.error().detail;
+  ASSERT_EQ(f->fixes.size(), 2u);
+  EXPECT_NEAR(f->fixes[0].pose.position.lat_deg, 46 + (12.584 + 0.000733333333) / 60, 1e-14);
+  EXPECT_NEAR(f->fixes[1].pose.position.lat_deg, 46 + 12.584 / 60, 1e-14);
+}
+
 TEST(FlightIgc, BadIRecordIgnoresExtensionsWithAWarning) {
   auto f = parseIgc(kHeader + "I02363XLAD\r\n" + b("120000") + b("120001"), "i.igc");
   ASSERT_TRUE(f);
