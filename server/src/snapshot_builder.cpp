@@ -2,8 +2,8 @@
 #include "sky/server/snapshot_builder.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
-#include <cstring>
 #include <map>
 #include <numbers>
 
@@ -81,139 +81,270 @@ std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLa
 
 namespace {
 
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+
 // Great-circle distance on the mean sphere, m: a cheap bound to skip regions
-// far from a cell before the exact geodesic measure.
+// far from an area before the exact geodesic measure.
 double sphereDistance_m(double lat1, double lon1, double lat2, double lon2) {
-  constexpr double d2r = std::numbers::pi / 180.0;
-  const double s1 = std::sin((lat2 - lat1) * d2r / 2), s2 = std::sin((lon2 - lon1) * d2r / 2);
-  const double h = s1 * s1 + std::cos(lat1 * d2r) * std::cos(lat2 * d2r) * s2 * s2;
+  const double s1 = std::sin((lat2 - lat1) * kDegToRad / 2), s2 = std::sin((lon2 - lon1) * kDegToRad / 2);
+  const double h = s1 * s1 + std::cos(lat1 * kDegToRad) * std::cos(lat2 * kDegToRad) * s2 * s2;
   return 2 * kMeanEarthRadius_m * std::asin(std::min(1.0, std::sqrt(h)));
 }
 
-struct Reach {
-  const weather::Region* region;
-  double reach_m;  // beyond this (sphere distance from the centre) its weight is 0
-};
-
 // Half diagonal plus perimeter, with 1 % and 1 km for the ellipsoid and the
-// sphere bound's own error.
+// sphere bound's own error: beyond this (sphere distance from the centre) a
+// region's weight is 0.
 double reachOf(const weather::Region& r) {
   return 1.01 * (std::hypot(r.sizeX_m, r.sizeY_m) / 2 + r.transition_m) + 1000.0;
 }
 
-}  // namespace
+// A region's reach as a bound on the dot product of unit vectors: a cell
+// whose centre has dot(centre, region centre) below it is out of reach.
+struct ReachBound {
+  UnitVector centre;
+  double minDot = -2;  // a reach past the antipode reaches everything
+};
 
-namespace {
-
-std::uint64_t shapeKey(const weather::Region& r) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (double v : {r.centerLat_deg, r.centerLon_deg, r.sizeX_m, r.sizeY_m, r.cornerRadius_m, r.rotation_deg,
-                   r.transition_m}) {
-    std::uint64_t bits = 0;
-    std::memcpy(&bits, &v, sizeof bits);
-    for (int i = 0; i < 8; ++i) {
-      h ^= (bits >> (8 * i)) & 0xffu;
-      h *= 1099511628211ull;
-    }
-  }
-  return h;
+ReachBound reachBound(const weather::Region& r) {
+  const double angle_rad = reachOf(r) / kMeanEarthRadius_m;
+  return {unitVector(r.centerLat_deg, r.centerLon_deg), angle_rad >= std::numbers::pi ? -2.0 : std::cos(angle_rad)};
 }
 
-// Bounds of the cache: areas (renderers re-subscribe as they move) and
-// region shapes (a drifting region has a new shape at every change).
+double dot(const UnitVector& a, const UnitVector& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+std::uint64_t bitsOf(double v) { return std::bit_cast<std::uint64_t>(v); }
+
+TileCache::ShapeKey shapeKey(const weather::Region& r) {
+  return {bitsOf(r.centerLat_deg), bitsOf(r.centerLon_deg), bitsOf(r.sizeX_m), bitsOf(r.sizeY_m),
+          bitsOf(r.cornerRadius_m), bitsOf(r.rotation_deg), bitsOf(r.transition_m)};
+}
+
+// Bounds of the cache: areas (renderers re-subscribe as they move), region
+// shapes (a drifting or moving region has a new shape at every change) across
+// coverings, and shapes per covering.
 constexpr std::size_t kMaxCachedCoverings = 256;
 constexpr std::size_t kMaxCachedShapes = 64;
+// Cell weights kept across coverings, ~60 bytes each in the hash maps: 1M is
+// ~60 MB, and a storm cell 60 km across reaches ~400 cells of each of 64
+// subscribers' level 11 coverings (the bench), mostly the same ones.
+constexpr std::size_t kMaxCachedCellWeights = 1'000'000;
+constexpr std::size_t kMaxShapesPerCovering = 8;
+
+// A region's layer of the layer being derived, with that region's weight at
+// every cell (0 where it does not reach).
+struct Contribution {
+  const std::vector<double>* weights;
+  const weather::CloudLayer* layer;
+};
+
+// One layer's tiles over `cells`: the global value blended towards the
+// weighted mean of the contributing regions' values; none when the layer
+// comes out the same everywhere.
+std::vector<weather::CoverageTile> layerTiles(std::span<const std::uint64_t> cells, const weather::CloudLayer& layer,
+                                              std::span<const Contribution> contributions) {
+  std::vector<weather::CoverageTile> tiles;
+  if (contributions.empty()) return tiles;
+  tiles.reserve(cells.size());
+  bool varies = false;
+  const auto coverage = static_cast<float>(layer.coverage), density = static_cast<float>(layer.density);
+  for (std::size_t ci = 0; ci < cells.size(); ++ci) {
+    weather::CoverageTile t{cells[ci], layer.id, coverage, density};
+    double sumW = 0, cov = 0, den = 0, heaviest = 0;
+    weather::CloudType heaviestType = layer.type;
+    for (const Contribution& c : contributions) {
+      const double w = (*c.weights)[ci];
+      if (w <= 0) continue;
+      sumW += w;
+      cov += w * c.layer->coverage;
+      den += w * c.layer->density;
+      if (w > heaviest) {
+        heaviest = w;
+        heaviestType = c.layer->type;
+      }
+    }
+    if (sumW > 0) {
+      const double w = std::min(sumW, 1.0);
+      t.coverage = static_cast<float>(layer.coverage + w * (cov / sumW - layer.coverage));
+      t.density = static_cast<float>(layer.density + w * (den / sumW - layer.density));
+      if (heaviestType != layer.type) {
+        t.blendType = heaviestType;
+        t.blend = static_cast<float>(w);
+      }
+      varies = varies || t.coverage != coverage || t.density != density || t.blendType != weather::CloudType::None;
+    }
+    tiles.push_back(t);
+  }
+  // A layer the same everywhere in the area needs no tiles: a renderer takes
+  // a layer without tiles as uniform (its own coverage and density).
+  if (!varies) tiles.clear();
+  return tiles;
+}
+
+// A region's layer of this id, if it has one (a region's layer ids are distinct).
+const weather::CloudLayer* layerOf(const weather::Region& r, std::uint32_t id) {
+  for (const auto& l : r.layers)
+    if (l.id == id) return &l;
+  return nullptr;
+}
+
+// Every layer's tiles from every region's weight per cell (weights[k] for
+// region k; null where it reaches no cell).
+std::vector<weather::CoverageTile> tilesFromWeights(std::span<const std::uint64_t> cells,
+                                                    std::span<const weather::CloudLayer> layers,
+                                                    std::span<const weather::Region> regions,
+                                                    std::span<const std::vector<double>* const> weights) {
+  std::vector<weather::CoverageTile> tiles;
+  std::vector<Contribution> contributions;
+  for (const weather::CloudLayer& layer : layers) {
+    contributions.clear();
+    for (std::size_t k = 0; k < regions.size(); ++k)
+      if (const auto* rl = layerOf(regions[k], layer.id); rl && weights[k]) contributions.push_back({weights[k], rl});
+    const auto t = layerTiles(cells, layer, contributions);
+    tiles.insert(tiles.end(), t.begin(), t.end());
+  }
+  return tiles;
+}
 
 }  // namespace
 
-const TileCache::Entry& TileCache::covering(const weather::SphericalCap& cap, int wantedLevel,
-                                            std::size_t maxCells) {
+UnitVector unitVector(double lat_deg, double lon_deg) {
+  const double lat = lat_deg * kDegToRad, lon = lon_deg * kDegToRad;
+  return {std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon), std::sin(lat)};
+}
+
+TileCache::Entry& TileCache::covering(const weather::SphericalCap& cap, int wantedLevel, std::size_t maxCells) {
   const auto key = std::tuple{cap.centerLat_deg, cap.centerLon_deg, cap.radius_m, wantedLevel, maxCells};
   if (auto it = coverings_.find(key); it != coverings_.end()) return it->second;
   if (coverings_.size() >= kMaxCachedCoverings) coverings_.clear();
-  Entry e{coverArea(cap, wantedLevel, maxCells), {}};
+  Entry e;
+  e.cap = cap;
+  e.covering = coverArea(cap, wantedLevel, maxCells);
   e.centres.reserve(e.covering.cells.size());
-  for (std::uint64_t c : e.covering.cells) e.centres.push_back(weather::cellCentre(c));
+  e.units.reserve(e.covering.cells.size());
+  for (std::uint64_t c : e.covering.cells) {
+    e.centres.push_back(weather::cellCentre(c));
+    e.units.push_back(unitVector(e.centres.back().lat_deg, e.centres.back().lon_deg));
+  }
   return coverings_.emplace(key, std::move(e)).first->second;
 }
 
-double TileCache::weight(const weather::Region& region, std::uint64_t cell, const weather::CellCentre& centre) {
-  const std::uint64_t key = shapeKey(region);
-  auto shape = weights_.find(key);
-  if (shape == weights_.end()) {
-    if (weights_.size() >= kMaxCachedShapes) weights_.clear();
-    shape = weights_.emplace(key, std::unordered_map<std::uint64_t, double>{}).first;
+std::size_t TileCache::ShapeKeyHash::operator()(const ShapeKey& k) const {
+  std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the words
+  for (std::uint64_t v : k) {
+    h ^= v;
+    h *= 1099511628211ull;
   }
-  if (auto it = shape->second.find(cell); it != shape->second.end()) return it->second;
+  return static_cast<std::size_t>(h ^ (h >> 32));
+}
+
+double TileCache::cellWeight(const ShapeKey& shape, const weather::Region& region, std::uint64_t cell,
+                             const weather::CellCentre& centre) {
+  auto it = cellWeights_.find(shape);
+  if (it == cellWeights_.end() || cellWeightCount_ >= kMaxCachedCellWeights) {
+    if (cellWeights_.size() >= kMaxCachedShapes || cellWeightCount_ >= kMaxCachedCellWeights) {
+      cellWeights_.clear();
+      cellWeightCount_ = 0;
+    }
+    it = cellWeights_.try_emplace(shape).first;
+  }
+  auto& cells = it->second;
+  if (auto w = cells.find(cell); w != cells.end()) return w->second;
   const double w = weather::regionWeight(region, centre.lat_deg, centre.lon_deg);
-  shape->second.emplace(cell, w);
+  cells.emplace(cell, w);
+  ++cellWeightCount_;
   return w;
+}
+
+const std::vector<double>& TileCache::weights(Entry& entry, const weather::Region& region) {
+  // (Never erases: the caller bounds entry.shapeWeights before asking.)
+  const ShapeKey shape = shapeKey(region);
+  if (auto it = entry.shapeWeights.find(shape); it != entry.shapeWeights.end()) return it->second;
+  std::vector<double> w(entry.covering.cells.size(), 0.0);
+  const ReachBound reach = reachBound(region);
+  for (std::size_t ci = 0; ci < w.size(); ++ci)
+    if (dot(entry.units[ci], reach.centre) >= reach.minDot)
+      w[ci] = cellWeight(shape, region, entry.covering.cells[ci], entry.centres[ci]);
+  return entry.shapeWeights.emplace(shape, std::move(w)).first->second;
 }
 
 std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> cells,
                                                std::span<const weather::CloudLayer> layers,
-                                               std::span<const weather::Region> regions, TileCache* cache,
-                                               std::span<const weather::CellCentre> centres) {
-  std::vector<weather::CoverageTile> tiles;
-  tiles.reserve(cells.size() * layers.size());
-  std::vector<Reach> reaches;
-  for (const auto& r : regions) reaches.push_back({&r, reachOf(r)});
-  // Every region's weight at every cell centre (none when no region is near).
-  std::vector<std::vector<double>> weights(regions.empty() ? 0 : cells.size());
-  for (std::size_t ci = 0; ci < weights.size(); ++ci) {
-    const weather::CellCentre c = ci < centres.size() ? centres[ci] : weather::cellCentre(cells[ci]);
-    std::vector<double> w(reaches.size(), 0.0);
+                                               std::span<const weather::Region> regions) {
+  std::vector<std::vector<double>> weights(regions.size());
+  std::vector<const std::vector<double>*> byRegion(regions.size(), nullptr);
+  std::vector<UnitVector> units;
+  if (!regions.empty()) {
+    units.reserve(cells.size());
+    for (std::uint64_t c : cells) {
+      const weather::CellCentre centre = weather::cellCentre(c);
+      units.push_back(unitVector(centre.lat_deg, centre.lon_deg));
+    }
+  }
+  for (std::size_t k = 0; k < regions.size(); ++k) {
+    const ReachBound reach = reachBound(regions[k]);
+    weights[k].assign(cells.size(), 0.0);
     bool any = false;
-    for (std::size_t k = 0; k < reaches.size(); ++k) {
-      const weather::Region& r = *reaches[k].region;
-      if (sphereDistance_m(c.lat_deg, c.lon_deg, r.centerLat_deg, r.centerLon_deg) > reaches[k].reach_m) continue;
-      w[k] = cache ? cache->weight(r, cells[ci], c) : weather::regionWeight(r, c.lat_deg, c.lon_deg);
-      any = any || w[k] > 0;
-    }
-    if (any) weights[ci] = std::move(w);
-  }
-  std::vector<weather::CoverageTile> layerTiles;
-  for (const weather::CloudLayer& layer : layers) {
-    layerTiles.clear();
-    bool varies = false;
     for (std::size_t ci = 0; ci < cells.size(); ++ci) {
-      weather::CoverageTile t{cells[ci], layer.id, static_cast<float>(layer.coverage),
-                              static_cast<float>(layer.density)};
-      if (ci < weights.size() && !weights[ci].empty()) {
-        double sumW = 0, coverage = 0, density = 0, heaviest = 0;
-        weather::CloudType heaviestType = layer.type;
-        for (std::size_t k = 0; k < reaches.size(); ++k) {
-          const double w = weights[ci][k];
-          if (w <= 0) continue;
-          for (const weather::CloudLayer& rl : reaches[k].region->layers) {
-            if (rl.id != layer.id) continue;
-            sumW += w;
-            coverage += w * rl.coverage;
-            density += w * rl.density;
-            if (w > heaviest) {
-              heaviest = w;
-              heaviestType = rl.type;
-            }
-          }
-        }
-        if (sumW > 0) {
-          const double w = std::min(sumW, 1.0);
-          t.coverage = static_cast<float>(layer.coverage + w * (coverage / sumW - layer.coverage));
-          t.density = static_cast<float>(layer.density + w * (density / sumW - layer.density));
-          if (heaviestType != layer.type) {
-            t.blendType = heaviestType;
-            t.blend = static_cast<float>(w);
-          }
-        }
-      }
-      varies = varies || t.coverage != static_cast<float>(layer.coverage) ||
-               t.density != static_cast<float>(layer.density) || t.blendType != weather::CloudType::None;
-      layerTiles.push_back(t);
+      if (dot(units[ci], reach.centre) < reach.minDot) continue;
+      const weather::CellCentre centre = weather::cellCentre(cells[ci]);
+      weights[k][ci] = weather::regionWeight(regions[k], centre.lat_deg, centre.lon_deg);
+      any = any || weights[k][ci] > 0;
     }
-    // A layer the same everywhere in the area needs no tiles: a renderer
-    // takes a layer without tiles as uniform (its own coverage and density).
-    if (varies) tiles.insert(tiles.end(), layerTiles.begin(), layerTiles.end());
+    if (any) byRegion[k] = &weights[k];
   }
+  return tilesFromWeights(cells, layers, regions, byRegion);
+}
+
+std::vector<weather::CoverageTile> deriveTiles(TileCache& cache, TileCache::Entry& entry,
+                                               std::span<const weather::CloudLayer> layers,
+                                               std::span<const weather::Region> regions) {
+  // Room for every region's weights first: the pointers below must stay valid.
+  if (entry.shapeWeights.size() + regions.size() > kMaxShapesPerCovering) entry.shapeWeights.clear();
+  // The regions that can reach a cell of this covering (its cells reach past
+  // the cap by up to a cell: S2 cells are at most about twice the average
+  // edge across); the others change nothing here.
+  const auto& cap = entry.cap;
+  const double margin_m = 2 * weather::averageCellEdge_m(entry.covering.level);
+  std::vector<bool> reaches(regions.size());
+  for (std::size_t k = 0; k < regions.size(); ++k)
+    reaches[k] = sphereDistance_m(cap.centerLat_deg, cap.centerLon_deg, regions[k].centerLat_deg,
+                                  regions[k].centerLon_deg) <= cap.radius_m + reachOf(regions[k]) + margin_m;
+  std::vector<weather::CoverageTile> tiles;
+  std::vector<Contribution> contributions;
+  std::vector<std::uint64_t> inputs;
+  for (const weather::CloudLayer& layer : layers) {
+    // A layer's tiles depend on its own values and, for each region that
+    // reaches here and has it (in order: the sums run in it), that region's
+    // shape and layer values: equal inputs give equal tiles (their bit
+    // patterns compared exactly, not hashed).
+    inputs = {static_cast<std::uint64_t>(layer.type), bitsOf(layer.coverage), bitsOf(layer.density)};
+    for (std::size_t k = 0; k < regions.size(); ++k) {
+      const auto* rl = reaches[k] ? layerOf(regions[k], layer.id) : nullptr;
+      if (!rl) continue;
+      const TileCache::ShapeKey shape = shapeKey(regions[k]);
+      inputs.push_back(k);
+      inputs.insert(inputs.end(), shape.begin(), shape.end());
+      inputs.insert(inputs.end(), {static_cast<std::uint64_t>(rl->type), bitsOf(rl->coverage), bitsOf(rl->density)});
+    }
+    TileCache::LayerMemo& memo = entry.layers[layer.id];
+    const bool hit = memo.valid && memo.inputs == inputs;
+    cache.countTiles(hit);
+    if (!hit) {
+      contributions.clear();
+      for (std::size_t k = 0; k < regions.size(); ++k)
+        if (const auto* rl = reaches[k] ? layerOf(regions[k], layer.id) : nullptr)
+          contributions.push_back({&cache.weights(entry, regions[k]), rl});
+      memo.tiles = layerTiles(entry.covering.cells, layer, contributions);
+      memo.inputs = inputs;
+      memo.valid = true;
+    }
+    tiles.insert(tiles.end(), memo.tiles.begin(), memo.tiles.end());
+  }
+  // Layers gone from the table take their memo with them.
+  for (auto it = entry.layers.begin(); it != entry.layers.end();)
+    it = std::any_of(layers.begin(), layers.end(), [&](const auto& l) { return l.id == it->first; })
+             ? std::next(it)
+             : entry.layers.erase(it);
   return tiles;
 }
 
@@ -240,9 +371,9 @@ weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,
     return snapshot;
   }
   if (cache) {
-    const TileCache::Entry& e = cache->covering(cap, request.tileLevel, budget);
+    TileCache::Entry& e = cache->covering(cap, request.tileLevel, budget);
     snapshot.tileLevel = e.covering.level;
-    snapshot.tiles = deriveTiles(e.covering.cells, table, regions, cache, e.centres);
+    snapshot.tiles = deriveTiles(*cache, e, table, regions);
     return snapshot;
   }
   const Covering covering = coverArea(cap, request.tileLevel, budget);

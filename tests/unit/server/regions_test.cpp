@@ -147,6 +147,21 @@ TEST(Regions, TheTileCacheGivesTheSameSnapshots) {
     EXPECT_EQ(cached.tiles, plain.tiles) << round;
   }
   EXPECT_EQ(cache.coverings(), 1u);
+  // Counted per layer (1 and 6): round 1 changed nothing, round 2 moved only
+  // the storm, which has no layer 1.
+  EXPECT_EQ(cache.tileHits(), 3u) << "round 1's layers and round 2's layer 1 came back from the memo";
+  EXPECT_EQ(cache.tileMisses(), 3u);
+  // A storm far from the area moves: the area's tiles come back as they were,
+  // and equal what deriving them gives.
+  regions.push_back(cell(3, 10, 60, 8000, 4000, {layer(6, weather::CloudType::Cumulonimbus, 1.0)}));
+  for (int round = 0; round < 3; ++round) {
+    regions[2].centerLon_deg = 60 + 0.5 * round;
+    const auto plain = buildSnapshot(around(46, 13.2, 60000), global, 0.0, kDefaultMaxCells, regions);
+    const auto cached = buildSnapshot(around(46, 13.2, 60000), global, 0.0, kDefaultMaxCells, regions, &cache);
+    EXPECT_EQ(cached.tiles, plain.tiles) << round;
+  }
+  EXPECT_EQ(cache.tileHits(), 9u) << "adding the far storm and moving it changed nothing here";
+  EXPECT_EQ(cache.tileMisses(), 3u);
 }
 
 TEST(Regions, OverlappingRegionsAverageByWeight) {

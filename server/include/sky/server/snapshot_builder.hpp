@@ -3,6 +3,7 @@
 // so the frame) stays bounded.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <map>
@@ -47,24 +48,65 @@ Covering coverArea(const weather::SphericalCap& cap, int wantedLevel, std::size_
 std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLayer> layers,
                                                 std::span<const weather::Region> regions);
 
+// A unit vector on the mean sphere (x towards 0 N 0 E, z towards the north
+// pole): the cheap "is this cell within reach of that region" test is a dot
+// product, with no trigonometry per cell.
+struct UnitVector {
+  double x = 0, y = 0, z = 1;
+};
+UnitVector unitVector(double lat_deg, double lon_deg);
+
 // What snapshots of the same areas share from one change to the next: the
-// S2 coverings (with their cell centres) by area, level and budget, and each
-// region shape's weight at each cell. Bounded: a table that grows past its
-// limit starts again. Used on the server's io thread only.
+// S2 coverings by area, level and budget, with their cells' centres; per
+// covering, each region shape's weight at every cell; each shape's weight
+// per cell across coverings (renderers' areas overlap); and per covering and
+// layer the tiles derived last with the inputs they came from, so a layer no
+// change touched in an area gets its tiles back without deriving them (a
+// storm cell moving changes its own layer's tiles, and only near it). Bounded: a table that
+// grows past its limit starts again. Used on the server's io thread only.
 class TileCache {
  public:
+  // A region's shape (centre, sizes, corner radius, rotation, transition) as
+  // the bit patterns of its values: equal keys are equal shapes, exactly.
+  using ShapeKey = std::array<std::uint64_t, 7>;
+  struct ShapeKeyHash {
+    std::size_t operator()(const ShapeKey& k) const;
+  };
+  // One layer's tiles as derived last for a covering, and the bit patterns of
+  // what they were derived from (see deriveTiles).
+  struct LayerMemo {
+    std::vector<std::uint64_t> inputs;
+    std::vector<weather::CoverageTile> tiles;  // empty: the layer is uniform there
+    bool valid = false;
+  };
   struct Entry {
+    weather::SphericalCap cap;
     Covering covering;
     std::vector<weather::CellCentre> centres;  // of covering.cells
+    std::vector<UnitVector> units;             // of centres
+    std::unordered_map<ShapeKey, std::vector<double>, ShapeKeyHash> shapeWeights;  // weight per cell
+    std::map<std::uint32_t, LayerMemo> layers;  // by layer id
   };
-  const Entry& covering(const weather::SphericalCap& cap, int wantedLevel, std::size_t maxCells);
-  // regionWeight(region, centre) of `cell`, remembered by the region's shape.
-  double weight(const weather::Region& region, std::uint64_t cell, const weather::CellCentre& centre);
+  Entry& covering(const weather::SphericalCap& cap, int wantedLevel, std::size_t maxCells);
+  // regionWeight(region, cell centre) of every cell of `entry` (0 where the
+  // region cannot reach), remembered by the region's shape. The reference
+  // stays valid until entry.shapeWeights is cleared (deriveTiles bounds it).
+  const std::vector<double>& weights(Entry& entry, const weather::Region& region);
   std::size_t coverings() const { return coverings_.size(); }
+  // Layers of snapshots whose tiles came back from the memo / were derived.
+  std::uint64_t tileHits() const { return tileHits_; }
+  std::uint64_t tileMisses() const { return tileMisses_; }
+  void countTiles(bool hit) { ++(hit ? tileHits_ : tileMisses_); }
 
  private:
+  double cellWeight(const ShapeKey& shape, const weather::Region& region, std::uint64_t cell,
+                    const weather::CellCentre& centre);
+
   std::map<std::tuple<double, double, double, int, std::size_t>, Entry> coverings_;
-  std::unordered_map<std::uint64_t, std::unordered_map<std::uint64_t, double>> weights_;  // shape -> cell -> weight
+  // Shape -> cell -> weight, shared by coverings; cellWeightCount_ entries in all.
+  std::unordered_map<ShapeKey, std::unordered_map<std::uint64_t, double>, ShapeKeyHash> cellWeights_;
+  std::size_t cellWeightCount_ = 0;
+  std::uint64_t tileHits_ = 0, tileMisses_ = 0;
 };
 
 // One tile per (cell, table layer) for each layer that varies over the
@@ -79,9 +121,11 @@ class TileCache {
 // (weather::regionAt), and `layers` the table from snapshotLayers.
 std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> cells,
                                                std::span<const weather::CloudLayer> layers,
-                                               std::span<const weather::Region> regions = {},
-                                               TileCache* cache = nullptr,
-                                               std::span<const weather::CellCentre> centres = {});
+                                               std::span<const weather::Region> regions = {});
+// The same, for the cells of a cached covering (their weights from the cache).
+std::vector<weather::CoverageTile> deriveTiles(TileCache& cache, TileCache::Entry& entry,
+                                               std::span<const weather::CloudLayer> layers,
+                                               std::span<const weather::Region> regions);
 
 // The snapshot answering `request` at weather clock clock_s.
 weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,

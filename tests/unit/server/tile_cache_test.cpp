@@ -1,0 +1,200 @@
+// The server's TileCache never hands back stale tiles: after a layer changes
+// (globally or in a region), a region moves, grows, turns, is removed or
+// reordered, or many regions share an area, a snapshot built through the
+// cache equals one built from scratch without it (the plain deriveTiles path,
+// which keeps nothing between calls); and the memo is really used (layers no
+// change touched come back as hits), so these comparisons test it.
+#include <gtest/gtest.h>
+
+#include "sky/server/snapshot_builder.hpp"
+
+namespace sky::server {
+namespace {
+
+weather::CloudLayer layer(std::uint32_t id, weather::CloudType type, double coverage) {
+  weather::CloudLayer l;
+  l.id = id;
+  l.type = type;
+  l.base_m = 1500.0 + 2000.0 * id;
+  l.thickness_m = 1000;
+  l.coverage = coverage;
+  l.density = 0.8;
+  l.wind = {10, 270, 0};
+  return l;
+}
+
+weather::Region region(std::uint32_t id, double lat, double lon, double size_m, double transition_m,
+                       std::vector<weather::CloudLayer> layers) {
+  weather::Region r;
+  r.id = id;
+  r.centerLat_deg = lat;
+  r.centerLon_deg = lon;
+  r.sizeX_m = size_m;
+  r.sizeY_m = size_m;
+  r.transition_m = transition_m;
+  r.layers = std::move(layers);
+  return r;
+}
+
+stream::Subscribe around(double lat, double lon, double radius_m, int level = 13) {
+  stream::Subscribe s;
+  s.area = {lat, lon, radius_m};
+  s.tileLevel = level;
+  return s;
+}
+
+std::vector<weather::CoverageTile> tilesOf(const weather::WeatherSnapshot& s, std::uint32_t layerId) {
+  std::vector<weather::CoverageTile> out;
+  for (const auto& t : s.tiles)
+    if (t.layerId == layerId) out.push_back(t);
+  return out;
+}
+
+// The snapshot through the cache, after checking it against one from scratch.
+weather::WeatherSnapshot checked(TileCache& cache, const stream::Subscribe& area,
+                                 const std::vector<weather::CloudLayer>& global,
+                                 const std::vector<weather::Region>& regions, const std::string& step) {
+  const auto plain = buildSnapshot(area, global, 0.0, kDefaultMaxCells, regions);
+  auto cached = buildSnapshot(area, global, 0.0, kDefaultMaxCells, regions, &cache);
+  EXPECT_EQ(cached.tileLevel, plain.tileLevel) << step;
+  EXPECT_EQ(cached.layers.size(), plain.layers.size()) << step;
+  EXPECT_EQ(cached.tiles.size(), plain.tiles.size()) << step;
+  EXPECT_TRUE(cached.tiles == plain.tiles) << step << ": the cache gave other tiles than deriving them";
+  return cached;
+}
+
+class TileCacheTest : public ::testing::Test {
+ protected:
+  // Three global layers; a clearing of layer 1 that thickens layer 2 over
+  // the area's centre, and a storm cell of a layer only it has, east of it.
+  std::vector<weather::CloudLayer> global = {layer(1, weather::CloudType::Cumulus, 0.8),
+                                             layer(2, weather::CloudType::Altostratus, 0.5),
+                                             layer(3, weather::CloudType::Cirrus, 0.3)};
+  std::vector<weather::Region> regions = {
+      region(1, 46, 13.1, 30000, 10000,
+             {layer(1, weather::CloudType::Cumulus, 0.0), layer(2, weather::CloudType::Altostratus, 0.9)}),
+      region(2, 46, 13.39, 8000, 4000, {layer(6, weather::CloudType::Cumulonimbus, 1.0)})};
+  const stream::Subscribe area = around(46, 13.2, 60000);
+  TileCache cache;
+};
+
+TEST_F(TileCacheTest, AChangedLayerIsDerivedAgain) {
+  const auto before = checked(cache, area, global, regions, "first");
+  ASSERT_FALSE(tilesOf(before, 1).empty());
+  ASSERT_FALSE(tilesOf(before, 2).empty());
+  ASSERT_FALSE(tilesOf(before, 6).empty());
+
+  // The global layer 2 thins: its tiles change, layer 1's and 6's come back.
+  global[1].coverage = 0.4;
+  auto hits = cache.tileHits();
+  const auto thinner = checked(cache, area, global, regions, "global layer 2 coverage");
+  EXPECT_NE(tilesOf(thinner, 2), tilesOf(before, 2)) << "the change shows in its layer's tiles";
+  EXPECT_EQ(tilesOf(thinner, 1), tilesOf(before, 1));
+  EXPECT_GE(cache.tileHits(), hits + 2) << "layers 1 and 6 (and 3, uniform) were not touched";
+
+  // The region's own layer 1 changes its coverage, then its density.
+  regions[0].layers[0].coverage = 0.4;
+  const auto regional = checked(cache, area, global, regions, "region layer 1 coverage");
+  EXPECT_NE(tilesOf(regional, 1), tilesOf(before, 1));
+  regions[0].layers[0].density = 0.2;
+  checked(cache, area, global, regions, "region layer 1 density");
+
+  // Types alone: the blend type tiles carry.
+  regions[0].layers[1].type = weather::CloudType::Stratus;
+  const auto stratus = checked(cache, area, global, regions, "region layer 2 type");
+  EXPECT_NE(tilesOf(stratus, 2), tilesOf(thinner, 2));
+  global[0].type = weather::CloudType::Stratocumulus;
+  checked(cache, area, global, regions, "global layer 1 type");
+  regions[1].layers[0].coverage = 0.5;  // the storm's own layer
+  checked(cache, area, global, regions, "storm layer coverage");
+
+  // A uniform layer changes: still no tiles for it, and the others' hold.
+  global[2].density = 0.1;
+  hits = cache.tileHits();
+  checked(cache, area, global, regions, "global layer 3 density");
+  EXPECT_GE(cache.tileHits(), hits + 3);
+
+  // Layer 2 leaves the global table (the region's layer 2 then blends from
+  // coverage 0), then returns: its memo must not outlive it.
+  const auto layer2 = global[1];
+  global.erase(global.begin() + 1);
+  const auto without = checked(cache, area, global, regions, "global layer 2 removed");
+  EXPECT_NE(tilesOf(without, 2), tilesOf(stratus, 2));
+  global.insert(global.begin() + 1, layer2);
+  checked(cache, area, global, regions, "global layer 2 back");
+
+  // The same values again after all that: equal tiles to the very first.
+  global = {layer(1, weather::CloudType::Cumulus, 0.8), layer(2, weather::CloudType::Altostratus, 0.5),
+            layer(3, weather::CloudType::Cirrus, 0.3)};
+  regions[0].layers = {layer(1, weather::CloudType::Cumulus, 0.0), layer(2, weather::CloudType::Altostratus, 0.9)};
+  regions[1].layers[0].coverage = 1.0;
+  EXPECT_EQ(checked(cache, area, global, regions, "back to the start").tiles, before.tiles);
+}
+
+TEST_F(TileCacheTest, AMovedRegionIsDerivedAgain) {
+  const auto before = checked(cache, area, global, regions, "first");
+
+  // The clearing moves by less than a cell (1 km cells): the tiles along its
+  // transition change.
+  regions[0].centerLon_deg += 0.004;
+  const auto nudged = checked(cache, area, global, regions, "moved 300 m east");
+  EXPECT_NE(tilesOf(nudged, 1), tilesOf(before, 1));
+  regions[0].centerLat_deg -= 0.05;
+  checked(cache, area, global, regions, "moved 5 km south");
+
+  // Its shape, one field at a time.
+  regions[0].sizeX_m = 40000;
+  checked(cache, area, global, regions, "size x");
+  regions[0].sizeY_m = 20000;
+  checked(cache, area, global, regions, "size y");
+  regions[0].rotation_deg = 30;
+  const auto turned = checked(cache, area, global, regions, "rotation");
+  EXPECT_NE(tilesOf(turned, 1), tilesOf(nudged, 1));
+  regions[0].cornerRadius_m = 8000;
+  checked(cache, area, global, regions, "corner radius");
+  regions[0].transition_m = 2000;
+  checked(cache, area, global, regions, "transition");
+
+  // Order and count: regions swap places, the first goes, comes back.
+  std::swap(regions[0], regions[1]);
+  checked(cache, area, global, regions, "swapped");
+  const auto clearing = regions[1];
+  regions.erase(regions.begin() + 1);
+  const auto gone = checked(cache, area, global, regions, "clearing removed");
+  EXPECT_TRUE(tilesOf(gone, 1).empty()) << "layer 1 is uniform without the clearing";
+  regions.insert(regions.begin(), clearing);
+  checked(cache, area, global, regions, "clearing back, first");
+
+  // The storm leaves the area for good (no region reaches it: no tiles, no
+  // covering), then comes back from the other side.
+  regions[1].centerLon_deg = 20;
+  regions[0].centerLon_deg = 25;
+  EXPECT_TRUE(checked(cache, area, global, regions, "both far").tiles.empty());
+  regions[1].centerLon_deg = 12.9;
+  regions[0].centerLon_deg = 13.1;
+  checked(cache, area, global, regions, "both back");
+}
+
+TEST_F(TileCacheTest, OverlappingAreasAndManyRegions) {
+  // Two areas that share cells (weights are shared across coverings by
+  // cell), one at a coarser level (other cells), and more regions than a
+  // covering keeps shapes for.
+  const stream::Subscribe east = around(46, 13.35, 50000), coarse = around(46, 13.2, 60000, 11);
+  for (int i = 0; i < 12; ++i)
+    regions.push_back(region(10 + i, 45.8 + 0.035 * i, 12.9 + 0.05 * i, 6000, 3000,
+                             {layer(7 + i % 3, weather::CloudType::Cumulonimbus, 0.3 + 0.05 * i)}));
+  for (int round = 0; round < 6; ++round) {
+    const std::string step = "round " + std::to_string(round);
+    checked(cache, area, global, regions, step + " area");
+    checked(cache, east, global, regions, step + " east");
+    checked(cache, coarse, global, regions, step + " coarse");
+    // One storm moves a cell's width, one changes, one stays.
+    regions[2 + round].centerLon_deg += 0.015;
+    regions[3 + 2 * round % 12].layers[0].coverage = 0.95;
+  }
+  EXPECT_EQ(cache.coverings(), 3u);
+  EXPECT_GT(cache.tileHits(), 0u);
+}
+
+}  // namespace
+}  // namespace sky::server
