@@ -199,13 +199,13 @@ void Server::weatherChanged() {
   registry_.forEach([](Session& s) { s.weatherChanged(); });
 }
 
-weather::WeatherSnapshot Server::snapshotFor(const stream::Subscribe& request) {
-  weather::WeatherSnapshot snapshot =
-      buildSnapshot(request, weather_.layersAt(clockNow()), clockNow(), options_.maxCellsPerSnapshot,
-                    weather_.regionsAt(clockNow()), &tileCache_);
-  log_->debug("event=snapshot level={} asked={} tiles={}", snapshot.tileLevel, request.tileLevel,
-              snapshot.tiles.size());
-  return snapshot;
+BuiltSnapshot Server::snapshotFor(const stream::Subscribe& request) {
+  BuiltSnapshot built =
+      buildSnapshotWithGenerations(request, weather_.layersAt(clockNow()), clockNow(), options_.maxCellsPerSnapshot,
+                                   weather_.regionsAt(clockNow()), &tileCache_);
+  log_->debug("event=snapshot level={} asked={} tiles={}", built.snapshot.tileLevel, request.tileLevel,
+              built.snapshot.tiles.size());
+  return built;
 }
 
 void Server::frameSent(std::size_t bytes) {

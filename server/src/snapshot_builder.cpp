@@ -297,7 +297,8 @@ std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> ce
 
 std::vector<weather::CoverageTile> deriveTiles(TileCache& cache, TileCache::Entry& entry,
                                                std::span<const weather::CloudLayer> layers,
-                                               std::span<const weather::Region> regions) {
+                                               std::span<const weather::Region> regions,
+                                               std::vector<LayerRun>* runs) {
   // Room for every region's weights first: the pointers below must stay valid.
   if (entry.shapeWeights.size() + regions.size() > kMaxShapesPerCovering) entry.shapeWeights.clear();
   // The regions that can reach a cell of this covering (its cells reach past
@@ -336,9 +337,18 @@ std::vector<weather::CoverageTile> deriveTiles(TileCache& cache, TileCache::Entr
           contributions.push_back({&cache.weights(entry, regions[k]), rl});
       memo.tiles = layerTiles(entry.covering.cells, layer, contributions);
       memo.inputs = inputs;
+      memo.generation = cache.nextGeneration();
       memo.valid = true;
     }
-    tiles.insert(tiles.end(), memo.tiles.begin(), memo.tiles.end());
+    if (runs) runs->push_back({memo.generation, memo.tiles.size()});
+  }
+  // Copied once all are known: one allocation for the snapshot's tiles.
+  std::size_t count = 0;
+  for (const weather::CloudLayer& layer : layers) count += entry.layers[layer.id].tiles.size();
+  tiles.reserve(count);
+  for (const weather::CloudLayer& layer : layers) {
+    const auto& t = entry.layers[layer.id].tiles;
+    tiles.insert(tiles.end(), t.begin(), t.end());
   }
   // Layers gone from the table take their memo with them.
   for (auto it = entry.layers.begin(); it != entry.layers.end();)
@@ -348,13 +358,14 @@ std::vector<weather::CoverageTile> deriveTiles(TileCache& cache, TileCache::Entr
   return tiles;
 }
 
-weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,
-                                       std::span<const weather::CloudLayer> layers,
-                                       double clock_s, std::size_t maxCells,
-                                       std::span<const weather::Region> regions, TileCache* cache) {
+BuiltSnapshot buildSnapshotWithGenerations(const stream::Subscribe& request,
+                                           std::span<const weather::CloudLayer> layers, double clock_s,
+                                           std::size_t maxCells, std::span<const weather::Region> regions,
+                                           TileCache* cache) {
   const std::vector<weather::CloudLayer> table = snapshotLayers(layers, regions);
   const std::size_t budget = cellBudget(maxCells, table.size());
-  weather::WeatherSnapshot snapshot;
+  BuiltSnapshot built;
+  weather::WeatherSnapshot& snapshot = built.snapshot;
   snapshot.weatherClock_s = clock_s;
   snapshot.layers = table;
   // No region reaches the area: the weather there is uniform and needs no
@@ -368,18 +379,69 @@ weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,
     int level = request.tileLevel;
     while (level > 0 && estimatedCells(cap, level) > static_cast<double>(budget)) --level;
     snapshot.tileLevel = level;
-    return snapshot;
+    built.runs.assign(table.size(), LayerRun{});
+    return built;
   }
   if (cache) {
     TileCache::Entry& e = cache->covering(cap, request.tileLevel, budget);
     snapshot.tileLevel = e.covering.level;
-    snapshot.tiles = deriveTiles(*cache, e, table, regions);
-    return snapshot;
+    built.runs.reserve(table.size());
+    snapshot.tiles = deriveTiles(*cache, e, table, regions, &built.runs);
+    return built;
   }
   const Covering covering = coverArea(cap, request.tileLevel, budget);
   snapshot.tileLevel = covering.level;
   snapshot.tiles = deriveTiles(covering.cells, table, regions);
-  return snapshot;
+  return built;  // runs not known
+}
+
+weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,
+                                       std::span<const weather::CloudLayer> layers,
+                                       double clock_s, std::size_t maxCells,
+                                       std::span<const weather::Region> regions, TileCache* cache) {
+  return buildSnapshotWithGenerations(request, layers, clock_s, maxCells, regions, cache).snapshot;
+}
+
+namespace {
+
+// Whether `runs` describe `s`: one run per layer, adding up to its tiles.
+bool runsCover(const BuiltSnapshot& s) {
+  if (s.runs.size() != s.snapshot.layers.size()) return false;
+  std::size_t n = 0;
+  for (const LayerRun& r : s.runs) n += r.tiles;
+  return n == s.snapshot.tiles.size();
+}
+
+}  // namespace
+
+std::optional<weather::WeatherDelta> diffBuilt(const BuiltSnapshot& before, const BuiltSnapshot& after) {
+  const auto& b = before.snapshot;
+  const auto& a = after.snapshot;
+  // Layers whose tiles are known to be the same (same generation, same level).
+  std::vector<std::uint32_t> same;
+  if (b.tileLevel == a.tileLevel && runsCover(before) && runsCover(after))
+    for (std::size_t i = 0; i < a.layers.size(); ++i) {
+      const std::uint64_t g = after.runs[i].generation;
+      for (std::size_t j = 0; g != 0 && j < b.layers.size(); ++j)
+        if (b.layers[j].id == a.layers[i].id && before.runs[j].generation == g) same.push_back(a.layers[i].id);
+    }
+  if (same.empty()) return weather::diffSnapshots(b, a);
+  // Those layers' tiles are equal in both, so the diff without them is the
+  // same diff: their layers are still compared, their tiles never differ.
+  auto without = [&](const BuiltSnapshot& s) {
+    weather::WeatherSnapshot r;
+    r.weatherClock_s = s.snapshot.weatherClock_s;
+    r.layers = s.snapshot.layers;
+    r.tileLevel = s.snapshot.tileLevel;
+    auto from = s.snapshot.tiles.begin();
+    for (std::size_t i = 0; i < s.runs.size(); ++i) {
+      const auto n = static_cast<std::ptrdiff_t>(s.runs[i].tiles);
+      if (std::find(same.begin(), same.end(), r.layers[i].id) == same.end()) r.tiles.insert(r.tiles.end(), from, from + n);
+      from += n;
+    }
+    return r;
+  };
+  return weather::diffSnapshots(without(before), without(after));
 }
 
 }  // namespace sky::server

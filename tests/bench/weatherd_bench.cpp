@@ -193,10 +193,10 @@ int main(int argc, char** argv) {
 
   // Sizes, without sockets: a 300 km wide area (150 km radius) at ~1 km
   // tiles, 3 layers all varying (a region 200 km across changes each), so
-  // every layer carries tiles; and the frame one layer's coverage change
-  // costs a renderer's subscription, with uniform weather (just the layer
-  // table) and with that region in its area (the whole snapshot: the server
-  // does not send Deltas yet).
+  // every layer carries tiles; and the Delta one layer's coverage change
+  // costs a renderer's subscription (what the server sends, see Session),
+  // with uniform weather (a layer in the table) and with that region in its
+  // area (that layer's tiles that change, outside the region's core).
   sky::weather::Region region;
   region.id = 1;
   region.centerLat_deg = 46.0;
@@ -219,11 +219,22 @@ int main(int argc, char** argv) {
   sky::stream::Subscribe renderer;
   renderer.area = {46.0, 13.0, o.radius_m};
   renderer.tileLevel = sky::weather::levelForRadius(o.radius_m, o.maxTiles);
-  const auto uniformSnapshot = sky::server::buildSnapshot(renderer, layers, 0, sky::server::kDefaultMaxCells);
-  const std::size_t changeBytes = frameBytes(uniformSnapshot);
-  const auto regionalSnapshot =
-      sky::server::buildSnapshot(renderer, layers, 0, sky::server::kDefaultMaxCells, regions);
-  const std::size_t regionalChangeBytes = frameBytes(regionalSnapshot);
+  auto changed = layers;
+  changed[1].coverage = 0.6;
+  auto deltaBytes = [&](std::span<const sky::weather::Region> rs, sky::weather::WeatherSnapshot& before,
+                        std::size_t& tiles) -> std::size_t {
+    before = sky::server::buildSnapshot(renderer, layers, 0, sky::server::kDefaultMaxCells, rs);
+    const auto after = sky::server::buildSnapshot(renderer, changed, 0, sky::server::kDefaultMaxCells, rs);
+    const auto delta = sky::weather::diffSnapshots(before, after);
+    if (!delta) return 0;
+    tiles = delta->tiles.size();
+    return sky::stream::encodeFrame(sky::stream::encodeMessage(*delta)).size();
+  };
+  sky::weather::WeatherSnapshot uniformSnapshot, regionalSnapshot;
+  std::size_t uniformDeltaTiles = 0, regionalDeltaTiles = 0;
+  const std::size_t changeBytes = deltaBytes({}, uniformSnapshot, uniformDeltaTiles);
+  const std::size_t regionalChangeBytes = deltaBytes(regions, regionalSnapshot, regionalDeltaTiles);
+  const std::size_t regionalSnapshotBytes = frameBytes(regionalSnapshot);
 
   sky::server::Scenario scenario;
   scenario.layers = layers;
@@ -347,15 +358,18 @@ int main(int argc, char** argv) {
               double(bytes) / 1e6);
   std::printf("  snapshot 300 km wide, 3 varying layers: %zu bytes (level %d, %zu tiles)\n", wideBytes,
               wideSnapshot.tileLevel, wideSnapshot.tiles.size());
-  std::printf("  one layer's coverage change, per subscriber: %zu bytes with uniform weather (layer table), "
-              "%zu bytes with a region in its area (whole snapshot, level %d, %zu tiles)\n",
-              changeBytes, regionalChangeBytes, regionalSnapshot.tileLevel, regionalSnapshot.tiles.size());
+  std::printf("  one layer's coverage change, per subscriber: Delta %zu bytes with uniform weather (layer "
+              "table), Delta %zu bytes (%zu tiles) with a region in its area (its snapshot: %zu bytes, level %d, "
+              "%zu tiles)\n",
+              changeBytes, regionalChangeBytes, regionalDeltaTiles, regionalSnapshotBytes, regionalSnapshot.tileLevel,
+              regionalSnapshot.tiles.size());
   if (!o.json.empty()) {
     const nlohmann::json j = {{"subscribers", o.subscribers}, {"rate_hz", o.rate}, {"regional", o.regional}, {"changes", changes},
                               {"latency_p50_ms", p50}, {"latency_p99_ms", p99}, {"deliveries", shared.deliveries},
                               {"coalesced", shared.coalesced}, {"cpu_idle_pct", idlePct}, {"cpu_storm_pct", stormPct},
                               {"frames", frames}, {"bytes", bytes}, {"snapshot_300km_3layers_bytes", wideBytes},
-                              {"change_frame_bytes_uniform", changeBytes}, {"change_frame_bytes_regional", regionalChangeBytes}};
+                              {"change_delta_bytes_uniform", changeBytes}, {"change_delta_bytes_regional", regionalChangeBytes},
+                              {"regional_snapshot_bytes", regionalSnapshotBytes}};
     std::ofstream(o.json) << j.dump(2) << "\n";
   }
   // Every subscriber must have received the weather at all.

@@ -4,6 +4,8 @@
 // cache equals one built from scratch without it (the plain deriveTiles path,
 // which keeps nothing between calls); and the memo is really used (layers no
 // change touched come back as hits), so these comparisons test it.
+#include <functional>
+
 #include <gtest/gtest.h>
 
 #include "sky/server/snapshot_builder.hpp"
@@ -194,6 +196,52 @@ TEST_F(TileCacheTest, OverlappingAreasAndManyRegions) {
   }
   EXPECT_EQ(cache.coverings(), 3u);
   EXPECT_GT(cache.tileHits(), 0u);
+}
+
+// diffBuilt skips the tiles of layers whose generation both snapshots share:
+// its delta must be diffSnapshots' on the whole snapshots, at every step.
+TEST_F(TileCacheTest, DiffBuiltIsTheDiffOfTheWholeSnapshots) {
+  auto build = [&] { return buildSnapshotWithGenerations(area, global, 0.0, kDefaultMaxCells, regions, &cache); };
+  std::vector<std::function<void()>> steps = {
+      [&] {},                                                        // nothing changed
+      [&] { global[1].coverage = 0.4; },                             // one layer
+      [&] { regions[1].centerLon_deg += 0.01; },                     // the storm moves
+      [&] { regions[0].layers[0].coverage = 0.3; },                  // a region's layer
+      [&] { global[2].base_m += 100; },                              // a uniform layer's table entry
+      [&] { regions[1].centerLon_deg = 30; },                        // the storm leaves: its tiles go
+      [&] { regions[1].centerLon_deg = 13.3; },                      // and comes back
+      [&] { global.erase(global.begin() + 2); },                     // a layer removed
+      [&] { regions.erase(regions.begin()); },                       // the clearing removed
+      [&] { regions[0].centerLon_deg = 40; },                        // no region near: no tiles
+  };
+  BuiltSnapshot before = build();
+  int skipped = 0;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    steps[i]();
+    const BuiltSnapshot after = build();
+    ASSERT_EQ(after.runs.size(), after.snapshot.layers.size()) << i;
+    for (std::size_t k = 0; k < after.runs.size(); ++k)
+      for (std::size_t j = 0; j < before.runs.size(); ++j)
+        skipped += after.runs[k].generation != 0 && after.snapshot.layers[k].id == before.snapshot.layers[j].id &&
+                   after.runs[k].generation == before.runs[j].generation;
+    const auto fast = diffBuilt(before, after);
+    const auto whole = weather::diffSnapshots(before.snapshot, after.snapshot);
+    ASSERT_EQ(fast.has_value(), whole.has_value()) << "step " << i;
+    if (whole) {
+      EXPECT_EQ(fast->tileLevel, whole->tileLevel) << "step " << i;
+      EXPECT_EQ(fast->removedLayerIds, whole->removedLayerIds) << "step " << i;
+      ASSERT_EQ(fast->layers.size(), whole->layers.size()) << "step " << i;
+      for (std::size_t k = 0; k < whole->layers.size(); ++k) EXPECT_EQ(fast->layers[k].id, whole->layers[k].id);
+      EXPECT_TRUE(fast->tiles == whole->tiles) << "step " << i << ": " << fast->tiles.size() << " tiles, not "
+                                               << whole->tiles.size();
+      // And it takes the peer to the new snapshot.
+      weather::WeatherSnapshot held = before.snapshot;
+      ASSERT_TRUE(weather::applyDelta(held, *fast)) << "step " << i;
+      EXPECT_TRUE(held.tiles == after.snapshot.tiles) << "step " << i;
+    }
+    before = after;
+  }
+  EXPECT_GE(skipped, 8) << "untouched layers kept their generation, so their tiles were skipped";
 }
 
 }  // namespace

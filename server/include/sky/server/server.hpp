@@ -102,7 +102,7 @@ class Server final : private SessionHandler {
   void shutdown();
   double clockNow() const;
 
-  weather::WeatherSnapshot snapshotFor(const stream::Subscribe& request) override;
+  BuiltSnapshot snapshotFor(const stream::Subscribe& request) override;
   void sessionClosed(Session& session) override;
   void frameSent(std::size_t bytes) override;
   void sessionStalled(Session& session) override;

@@ -16,6 +16,7 @@
 #include "sky/core/result.hpp"
 #include "sky/server/outbox.hpp"
 #include "sky/server/renderer_info.hpp"
+#include "sky/server/snapshot_builder.hpp"
 #include "sky/stream/framing.hpp"
 #include "sky/stream/messages.hpp"
 
@@ -31,7 +32,7 @@ class Session;
 class SessionHandler {
  public:
   // The snapshot answering `request`, at the weather clock of now.
-  virtual weather::WeatherSnapshot snapshotFor(const stream::Subscribe& request) = 0;
+  virtual BuiltSnapshot snapshotFor(const stream::Subscribe& request) = 0;
   // The session has closed its socket and will do no more work.
   virtual void sessionClosed(Session& session) = 0;
   // A frame of `bytes` bytes went out completely.
@@ -106,7 +107,7 @@ class Session : public std::enable_shared_from_this<Session> {
   // What the peer holds: the last snapshot sent (or reached by deltas), and
   // the subscription it answered. A new snapshot of the same subscription
   // goes out as the Delta from it when a delta can say it and is smaller.
-  std::optional<weather::WeatherSnapshot> peerHolds_;
+  std::optional<BuiltSnapshot> peerHolds_;
   std::optional<stream::Subscribe> peerHoldsFor_;
   // The newest CameraReport and when it arrived (reports replace each other).
   std::optional<stream::CameraReport> report_;

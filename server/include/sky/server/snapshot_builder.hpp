@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <tuple>
 #include <unordered_map>
 #include <span>
@@ -77,6 +78,7 @@ class TileCache {
   struct LayerMemo {
     std::vector<std::uint64_t> inputs;
     std::vector<weather::CoverageTile> tiles;  // empty: the layer is uniform there
+    std::uint64_t generation = 0;              // of these tiles (0: none derived yet)
     bool valid = false;
   };
   struct Entry {
@@ -97,6 +99,8 @@ class TileCache {
   std::uint64_t tileHits() const { return tileHits_; }
   std::uint64_t tileMisses() const { return tileMisses_; }
   void countTiles(bool hit) { ++(hit ? tileHits_ : tileMisses_); }
+  // A number no tiles derived before had: equal generations, equal tiles.
+  std::uint64_t nextGeneration() { return ++generations_; }
 
  private:
   double cellWeight(const ShapeKey& shape, const weather::Region& region, std::uint64_t cell,
@@ -107,6 +111,7 @@ class TileCache {
   std::unordered_map<ShapeKey, std::unordered_map<std::uint64_t, double>, ShapeKeyHash> cellWeights_;
   std::size_t cellWeightCount_ = 0;
   std::uint64_t tileHits_ = 0, tileMisses_ = 0;
+  std::uint64_t generations_ = 0;
 };
 
 // One tile per (cell, table layer) for each layer that varies over the
@@ -122,10 +127,34 @@ class TileCache {
 std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> cells,
                                                std::span<const weather::CloudLayer> layers,
                                                std::span<const weather::Region> regions = {});
-// The same, for the cells of a cached covering (their weights from the cache).
+// One layer's run of tiles in a snapshot (its tiles are consecutive, in the
+// order of the layer table) and the generation of those tiles in the
+// TileCache that derived them: two runs from one cache with the same non-zero
+// generation are the very same tiles (0: not known).
+struct LayerRun {
+  std::uint64_t generation = 0;
+  std::size_t tiles = 0;
+};
+
+// The same, for the cells of a cached covering (their weights from the cache);
+// runs, when given, gets each layer's run (by index of `layers`).
 std::vector<weather::CoverageTile> deriveTiles(TileCache& cache, TileCache::Entry& entry,
                                                std::span<const weather::CloudLayer> layers,
-                                               std::span<const weather::Region> regions);
+                                               std::span<const weather::Region> regions,
+                                               std::vector<LayerRun>* runs = nullptr);
+
+// A snapshot with its layers' runs of tiles (by index of snapshot.layers;
+// empty when not known).
+struct BuiltSnapshot {
+  weather::WeatherSnapshot snapshot;
+  std::vector<LayerRun> runs;
+};
+
+// weather::diffSnapshots(before.snapshot, after.snapshot), without reading
+// the tiles of layers whose generation both share (a delta leaves those out
+// anyway): what a change costs a subscriber grows with the tiles it changed,
+// not with the tiles of its area.
+std::optional<weather::WeatherDelta> diffBuilt(const BuiltSnapshot& before, const BuiltSnapshot& after);
 
 // The snapshot answering `request` at weather clock clock_s.
 weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,
@@ -133,5 +162,10 @@ weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,
                                        double clock_s, std::size_t maxCells,
                                        std::span<const weather::Region> regions = {},
                                        TileCache* cache = nullptr);
+// The same, with its runs of tiles (see LayerRun; generations 0 without a cache).
+BuiltSnapshot buildSnapshotWithGenerations(const stream::Subscribe& request,
+                                           std::span<const weather::CloudLayer> layers, double clock_s,
+                                           std::size_t maxCells, std::span<const weather::Region> regions,
+                                           TileCache* cache);
 
 }  // namespace sky::server
