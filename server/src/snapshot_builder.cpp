@@ -131,52 +131,81 @@ constexpr std::size_t kMaxCachedCellWeights = 1'000'000;
 constexpr std::size_t kMaxShapesPerCovering = 8;
 
 // A region's layer of the layer being derived, with that region's weight at
-// every cell (0 where it does not reach).
+// the cells it reaches.
 struct Contribution {
-  const std::vector<double>* weights;
+  const TileCache::Weights* weights;
   const weather::CloudLayer* layer;
 };
 
+// The weights kept: every one not <= 0 (a NaN too, as the sums below would
+// take it).
+void keepWeight(TileCache::Weights& out, std::size_t cell, double w) {
+  if (w <= 0) return;
+  out.cells.push_back(static_cast<std::uint32_t>(cell));
+  out.weights.push_back(w);
+}
+
 // One layer's tiles over `cells`: the global value blended towards the
 // weighted mean of the contributing regions' values; none when the layer
-// comes out the same everywhere.
+// comes out the same everywhere. Only the cells a region reaches are
+// blended (a storm cell reaches a few hundred of an area's thousands).
 std::vector<weather::CoverageTile> layerTiles(std::span<const std::uint64_t> cells, const weather::CloudLayer& layer,
                                               std::span<const Contribution> contributions) {
   std::vector<weather::CoverageTile> tiles;
   if (contributions.empty()) return tiles;
-  tiles.reserve(cells.size());
-  bool varies = false;
+  // Per reached cell, the sums over the contributions in their order.
+  struct Sum {
+    std::uint32_t cell;
+    double w = 0, cov = 0, den = 0, heaviest = 0;
+    weather::CloudType heaviestType;
+  };
+  std::vector<Sum> sums;
+  constexpr std::uint32_t kNone = ~0u;
+  std::vector<std::uint32_t> slot(contributions.size() > 1 ? cells.size() : 0, kNone);  // cell -> sums index
+  for (const Contribution& c : contributions) {
+    const auto& ws = *c.weights;
+    for (std::size_t n = 0; n < ws.cells.size(); ++n) {
+      const std::uint32_t ci = ws.cells[n];
+      const double w = ws.weights[n];
+      std::size_t at = sums.size();
+      if (slot.empty() || slot[ci] == kNone) {
+        if (!slot.empty()) slot[ci] = static_cast<std::uint32_t>(at);
+        sums.push_back({ci, 0, 0, 0, 0, layer.type});
+      } else {
+        at = slot[ci];
+      }
+      Sum& s = sums[at];
+      s.w += w;
+      s.cov += w * c.layer->coverage;
+      s.den += w * c.layer->density;
+      if (w > s.heaviest) {
+        s.heaviest = w;
+        s.heaviestType = c.layer->type;
+      }
+    }
+  }
   const auto coverage = static_cast<float>(layer.coverage), density = static_cast<float>(layer.density);
-  for (std::size_t ci = 0; ci < cells.size(); ++ci) {
-    weather::CoverageTile t{cells[ci], layer.id, coverage, density};
-    double sumW = 0, cov = 0, den = 0, heaviest = 0;
-    weather::CloudType heaviestType = layer.type;
-    for (const Contribution& c : contributions) {
-      const double w = (*c.weights)[ci];
-      if (w <= 0) continue;
-      sumW += w;
-      cov += w * c.layer->coverage;
-      den += w * c.layer->density;
-      if (w > heaviest) {
-        heaviest = w;
-        heaviestType = c.layer->type;
-      }
+  std::vector<std::pair<std::uint32_t, weather::CoverageTile>> blended;
+  bool varies = false;
+  for (const Sum& s : sums) {
+    if (!(s.w > 0)) continue;
+    weather::CoverageTile t{cells[s.cell], layer.id, coverage, density};
+    const double w = std::min(s.w, 1.0);
+    t.coverage = static_cast<float>(layer.coverage + w * (s.cov / s.w - layer.coverage));
+    t.density = static_cast<float>(layer.density + w * (s.den / s.w - layer.density));
+    if (s.heaviestType != layer.type) {
+      t.blendType = s.heaviestType;
+      t.blend = static_cast<float>(w);
     }
-    if (sumW > 0) {
-      const double w = std::min(sumW, 1.0);
-      t.coverage = static_cast<float>(layer.coverage + w * (cov / sumW - layer.coverage));
-      t.density = static_cast<float>(layer.density + w * (den / sumW - layer.density));
-      if (heaviestType != layer.type) {
-        t.blendType = heaviestType;
-        t.blend = static_cast<float>(w);
-      }
-      varies = varies || t.coverage != coverage || t.density != density || t.blendType != weather::CloudType::None;
-    }
-    tiles.push_back(t);
+    varies = varies || t.coverage != coverage || t.density != density || t.blendType != weather::CloudType::None;
+    blended.emplace_back(s.cell, t);
   }
   // A layer the same everywhere in the area needs no tiles: a renderer takes
   // a layer without tiles as uniform (its own coverage and density).
-  if (!varies) tiles.clear();
+  if (!varies) return tiles;
+  tiles.reserve(cells.size());
+  for (std::uint64_t cell : cells) tiles.push_back({cell, layer.id, coverage, density});
+  for (const auto& [ci, t] : blended) tiles[ci] = t;
   return tiles;
 }
 
@@ -192,7 +221,7 @@ const weather::CloudLayer* layerOf(const weather::Region& r, std::uint32_t id) {
 std::vector<weather::CoverageTile> tilesFromWeights(std::span<const std::uint64_t> cells,
                                                     std::span<const weather::CloudLayer> layers,
                                                     std::span<const weather::Region> regions,
-                                                    std::span<const std::vector<double>* const> weights) {
+                                                    std::span<const TileCache::Weights* const> weights) {
   std::vector<weather::CoverageTile> tiles;
   std::vector<Contribution> contributions;
   for (const weather::CloudLayer& layer : layers) {
@@ -255,23 +284,23 @@ double TileCache::cellWeight(const ShapeKey& shape, const weather::Region& regio
   return w;
 }
 
-const std::vector<double>& TileCache::weights(Entry& entry, const weather::Region& region) {
+const TileCache::Weights& TileCache::weights(Entry& entry, const weather::Region& region) {
   // (Never erases: the caller bounds entry.shapeWeights before asking.)
   const ShapeKey shape = shapeKey(region);
   if (auto it = entry.shapeWeights.find(shape); it != entry.shapeWeights.end()) return it->second;
-  std::vector<double> w(entry.covering.cells.size(), 0.0);
+  Weights w;
   const ReachBound reach = reachBound(region);
-  for (std::size_t ci = 0; ci < w.size(); ++ci)
+  for (std::size_t ci = 0; ci < entry.covering.cells.size(); ++ci)
     if (dot(entry.units[ci], reach.centre) >= reach.minDot)
-      w[ci] = cellWeight(shape, region, entry.covering.cells[ci], entry.centres[ci]);
+      keepWeight(w, ci, cellWeight(shape, region, entry.covering.cells[ci], entry.centres[ci]));
   return entry.shapeWeights.emplace(shape, std::move(w)).first->second;
 }
 
 std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> cells,
                                                std::span<const weather::CloudLayer> layers,
                                                std::span<const weather::Region> regions) {
-  std::vector<std::vector<double>> weights(regions.size());
-  std::vector<const std::vector<double>*> byRegion(regions.size(), nullptr);
+  std::vector<TileCache::Weights> weights(regions.size());
+  std::vector<const TileCache::Weights*> byRegion(regions.size(), nullptr);
   std::vector<UnitVector> units;
   if (!regions.empty()) {
     units.reserve(cells.size());
@@ -282,15 +311,12 @@ std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> ce
   }
   for (std::size_t k = 0; k < regions.size(); ++k) {
     const ReachBound reach = reachBound(regions[k]);
-    weights[k].assign(cells.size(), 0.0);
-    bool any = false;
     for (std::size_t ci = 0; ci < cells.size(); ++ci) {
       if (dot(units[ci], reach.centre) < reach.minDot) continue;
       const weather::CellCentre centre = weather::cellCentre(cells[ci]);
-      weights[k][ci] = weather::regionWeight(regions[k], centre.lat_deg, centre.lon_deg);
-      any = any || weights[k][ci] > 0;
+      keepWeight(weights[k], ci, weather::regionWeight(regions[k], centre.lat_deg, centre.lon_deg));
     }
-    if (any) byRegion[k] = &weights[k];
+    if (!weights[k].cells.empty()) byRegion[k] = &weights[k];
   }
   return tilesFromWeights(cells, layers, regions, byRegion);
 }

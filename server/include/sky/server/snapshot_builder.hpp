@@ -81,19 +81,25 @@ class TileCache {
     std::uint64_t generation = 0;              // of these tiles (0: none derived yet)
     bool valid = false;
   };
+  // A region's weight at the cells of a covering it reaches, by index into
+  // the covering's cells; cells left out have weight 0.
+  struct Weights {
+    std::vector<std::uint32_t> cells;
+    std::vector<double> weights;
+  };
   struct Entry {
     weather::SphericalCap cap;
     Covering covering;
     std::vector<weather::CellCentre> centres;  // of covering.cells
     std::vector<UnitVector> units;             // of centres
-    std::unordered_map<ShapeKey, std::vector<double>, ShapeKeyHash> shapeWeights;  // weight per cell
+    std::unordered_map<ShapeKey, Weights, ShapeKeyHash> shapeWeights;
     std::map<std::uint32_t, LayerMemo> layers;  // by layer id
   };
   Entry& covering(const weather::SphericalCap& cap, int wantedLevel, std::size_t maxCells);
-  // regionWeight(region, cell centre) of every cell of `entry` (0 where the
-  // region cannot reach), remembered by the region's shape. The reference
-  // stays valid until entry.shapeWeights is cleared (deriveTiles bounds it).
-  const std::vector<double>& weights(Entry& entry, const weather::Region& region);
+  // regionWeight(region, cell centre) of the cells of `entry` where it is
+  // not 0, remembered by the region's shape. The reference stays valid until
+  // entry.shapeWeights is cleared (deriveTiles bounds it).
+  const Weights& weights(Entry& entry, const weather::Region& region);
   std::size_t coverings() const { return coverings_.size(); }
   // Layers of snapshots whose tiles came back from the memo / were derived.
   std::uint64_t tileHits() const { return tileHits_; }
