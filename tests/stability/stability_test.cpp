@@ -24,10 +24,13 @@ namespace sky::test {
 namespace {
 
 // GPU against the CPU reference, as in tests/gpu/gpu_vs_cpu_test.cpp: RMSE
-// over rgb relative to the reference's mean luminance, and the relative
-// difference of the means. The extremes get the same bounds as ordinary
-// scenes: a float-precision failure (cancellation at Earth-radius magnitudes,
-// a degenerate frame at a pole) shows up as a pattern error far above them.
+// over rgb of the displayed value x / (1 + x) relative to the reference's mean
+// displayed value (a cloud edge in the sun's forward lobe reaches radiance
+// ~800 here, antimeridian_east: linearly those few pixels would be the whole
+// error), and the relative difference of the linear means. The extremes get
+// the same bounds as ordinary scenes: a float-precision failure (cancellation
+// at Earth-radius magnitudes, a degenerate frame at a pole) shows up as a
+// pattern error far above them.
 constexpr double kRelativeRmseTolerance = 0.05;
 constexpr double kRelativeMeanTolerance = 0.01;
 constexpr std::uint32_t kW = 64, kH = 36;
@@ -60,6 +63,8 @@ render::FrameInputs inputsFor(const Extreme& s, weather::WeatherSnapshot& snap) 
 
 TEST(Stability, ExtremesAreFiniteAndMatchTheCpuReference) {
   SKY_RENDERER(r, kW, kH);
+  auto reference = render::CpuReference::create(r.settings());
+  ASSERT_TRUE(reference) << describe(reference.error());
   std::vector<Extreme> scenes = {
       {"north_pole_exact", pose(90, 0, 800, 0, 20)},
       {"south_pole_exact", pose(-90, 0, 800, 137, 20)},
@@ -92,7 +97,7 @@ TEST(Stability, ExtremesAreFiniteAndMatchTheCpuReference) {
     const render::FrameInputs in = inputsFor(s, snap);
     auto gpu = r.render(in);
     ASSERT_TRUE(gpu) << describe(gpu.error());
-    auto cpu = render::renderCpuReference(r.settings(), in);
+    auto cpu = reference->render(in);
     ASSERT_TRUE(cpu) << describe(cpu.error());
     savePng(*gpu, std::string("stability_") + s.name);
     EXPECT_EQ(render::computeStats(*gpu).nonFinite, 0u);
@@ -100,8 +105,8 @@ TEST(Stability, ExtremesAreFiniteAndMatchTheCpuReference) {
     const Diff d = diff(*gpu, *cpu);
     const double mean = render::computeStats(*cpu).meanLuminance;
     const double meanError = std::abs(render::computeStats(*gpu).meanLuminance - mean) / mean;
-    std::printf("[ extreme  ] %-24s mean %.4f (gpu %+.3f %%) rmse %.2f %%\n", s.name, mean, 100 * meanError,
-                100 * d.rmse / mean);
+    std::printf("[ extreme  ] %-24s mean %.4g (gpu %+.3f %%) displayed rmse %.2f %% (linear %.2f %%)\n", s.name, mean,
+                100 * meanError, 100 * d.displayedRmse / d.displayedMean, 100 * d.rmse / mean);
     EXPECT_GT(mean, 0.0);
     // Every camera here sees the sky above the horizon (pitch up to level),
     // except those looking down from above: the top row is not ground.
@@ -114,7 +119,7 @@ TEST(Stability, ExtremesAreFiniteAndMatchTheCpuReference) {
       EXPECT_NE(top, bottom) << "the whole view is one colour: no sky";
     }
     EXPECT_LT(meanError, kRelativeMeanTolerance);
-    EXPECT_LT(d.rmse, kRelativeRmseTolerance * mean);
+    EXPECT_LT(d.displayedRmse, kRelativeRmseTolerance * d.displayedMean);
   }
 }
 

@@ -1,10 +1,12 @@
 // The cloud pass: one compute dispatch over the image (shaders/clouds.comp)
-// with its uniform block, shape-noise texture, samplers, output buffer,
-// descriptor set and command buffer. Blocking: run() returns the read-back image.
+// with its frame block, shape and detail noise, the atmosphere's
+// transmittance table, samplers, output buffer, descriptor set and command
+// buffer. Blocking: run() returns the read-back image.
 #pragma once
 
 #include <cstdint>
 
+#include "atmosphere_tables.hpp"
 #include "compute_pipeline.hpp"
 #include "gpu_context.hpp"
 #include "gpu_memory.hpp"
@@ -18,10 +20,11 @@ namespace sky::render {
 class CloudPass {
  public:
   // weather must outlive the pass (its image view is bound once here).
-  // Errors: Io/Malformed for the SPIR-V, Device from the noise upload; other
-  // Vulkan failures throw.
+  // Errors: Io/Malformed for the SPIR-V, Device from the texture uploads;
+  // other Vulkan failures throw.
   static Result<CloudPass> create(const GpuContext& ctx, std::uint32_t width, std::uint32_t height,
-                                  const NoiseVolume& noise, const WeatherTexture& weather);
+                                  const NoiseVolume& shape, const NoiseVolume& detail,
+                                  const AtmosphereTables& atmosphere, const WeatherTexture& weather);
 
   // Dispatches one frame and reads it back. Errors: Timeout, Device.
   Result<Image> run(const GpuContext& ctx, const gpu::SkyFrame& frame);
@@ -35,8 +38,11 @@ class CloudPass {
   ComputePipeline pipeline_;
   vk::raii::Sampler noiseSampler_{nullptr};
   vk::raii::Sampler weatherSampler_{nullptr};
-  GpuImage noise_;
-  GpuBuffer uniforms_;
+  vk::raii::Sampler tableSampler_{nullptr};
+  GpuImage shape_;
+  GpuImage detail_;
+  GpuImage transmittance_;
+  GpuBuffer uniforms_;  // the frame block (a storage buffer, see clouds.comp)
   GpuBuffer output_;
   vk::raii::DescriptorPool descriptorPool_{nullptr};
   vk::raii::DescriptorSet descriptorSet_{nullptr};

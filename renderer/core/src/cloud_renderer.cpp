@@ -7,6 +7,7 @@
 
 #include "sky/core/assert.hpp"
 
+#include "atmosphere_tables.hpp"
 #include "cloud_pass.hpp"
 #include "frame_setup.hpp"
 #include "gpu_context.hpp"
@@ -22,6 +23,7 @@ struct CloudRenderer::Impl {
   WeatherTexture weather;
   CloudPass pass;
   RenderSettings settings;
+  AtmosphereTables atmosphere;  // CPU copy: the frame setup's sky light reads it
 };
 
 namespace {
@@ -51,10 +53,13 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
     if (!ctx) return tl::unexpected(ctx.error());
     auto weather = WeatherTexture::create(**ctx);
     if (!weather) return tl::unexpected(weather.error());
-    const NoiseVolume noise = makeShapeNoise(kNoiseSize, settings.noiseSeed);
-    auto pass = CloudPass::create(**ctx, settings.width, settings.height, noise, *weather);
+    const NoiseVolume shape = makeShapeNoise(kShapeNoiseSize, settings.noiseSeed);
+    const NoiseVolume detail = makeDetailNoise(kDetailNoiseSize, settings.noiseSeed);
+    AtmosphereTables atmosphere = buildAtmosphereTables();
+    auto pass = CloudPass::create(**ctx, settings.width, settings.height, shape, detail, atmosphere, *weather);
     if (!pass) return tl::unexpected(pass.error());
-    auto impl = std::make_unique<Impl>(Impl{std::move(*ctx), std::move(*weather), std::move(*pass), settings});
+    auto impl = std::make_unique<Impl>(
+        Impl{std::move(*ctx), std::move(*weather), std::move(*pass), settings, std::move(atmosphere)});
     return std::unique_ptr<CloudRenderer>(new CloudRenderer(std::move(impl)));
   });
 }
@@ -64,7 +69,7 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
   if (auto ok = validateInputs(inputs); !ok) return tl::unexpected(ok.error());
   return atVulkanEdge("CloudRenderer::render", [&]() -> Result<Image> {
     if (auto ok = impl_->weather.update(*impl_->ctx, inputs); !ok) return tl::unexpected(ok.error());
-    const FrameSetup setup = prepareFrame(impl_->settings, inputs, impl_->weather.field());
+    const FrameSetup setup = prepareFrame(impl_->settings, inputs, impl_->weather.field(), impl_->atmosphere);
     return impl_->pass.run(*impl_->ctx, packFrame(setup));
   });
 }

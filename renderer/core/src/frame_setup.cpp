@@ -20,13 +20,19 @@ namespace {
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 // Largest image edge, pixels: keeps buffers and the tile permutation in range.
 constexpr std::uint32_t kMaxImageEdge = 8192;
-// Sun irradiance at the clouds and the ambient radiance inside them, linear
-// units shared with the sky colours in cloud_core.glsl. Chosen by eye so a
-// sunlit cloud top is white (~1 after exposure) and a shadowed base is grey,
-// until the atmosphere model supplies physical values.
-constexpr double kSunIrradiance = 9.0;
-const glm::dvec3 kSunColour(1.0, 0.96, 0.90);
-const glm::dvec3 kAmbientRadiance(0.42, 0.46, 0.55);
+// Sun irradiance at the top of the atmosphere, linear units (white: the
+// atmosphere colours it). The units are the PNG's (exposure 1): this puts a
+// clear noon zenith near 0.3-0.5 and a sunlit cloud top near 1-2, the tones
+// the tonemap maps to mid and upper grey.
+constexpr double kSunIrradiance = 20.0;
+// Secondary march towards the sun: half the layer's thickness (Haggstrom 2018
+// sec. 4.2, "half the layer thickness"), at least 100 m (a thin layer's light
+// still crosses a few cells' edges) and at most 2 km (4 steps of 500 m keep
+// a cumulonimbus tower's self-shadowing).
+constexpr double kLightMarchFraction = 0.5;
+constexpr double kMinLightDistance_m = 100.0;
+constexpr double kMaxLightDistance_m = 2000.0;
+
 // Tile permutation stride as a fraction of the tile count (golden ratio
 // conjugate, lavapipe.md): any stride coprime to n permutes the tiles.
 constexpr double kStrideFraction = 0.618;
@@ -86,7 +92,8 @@ Result<void> validateInputs(const FrameInputs& in) {
   return {};
 }
 
-FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, const WeatherField& field) {
+FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, const WeatherField& field,
+                        const AtmosphereTables& tables) {
   FrameSetup s;
   s.width = settings.width;
   s.height = settings.height;
@@ -114,19 +121,37 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
   // Dead Sea shore at -430 m) stands on the ground instead of under it.
   s.hGround_m = std::max(alt_m, 0.0);
   s.cGround_m2 = s.hGround_m * (2 * s.r_m - s.hGround_m);
+  const double hAboveTop_m = s.hGround_m - atmosphereHeight_m();
+  s.cAtmosphereTop_m2 = hAboveTop_m * (2 * s.r_m - hAboveTop_m);
+  const double groundRadius_m = s.r_m - s.hGround_m;
 
   SkyDirection sun{in.sunAzimuth_deg, in.sunElevation_deg};
   if (in.utc_s) sun = sunDirection(*in.utc_s, in.camera.position.lat_deg, in.camera.position.lon_deg);
   const double az = sun.azimuth_deg * kDegToRad, el = sun.elevation_deg * kDegToRad;
   s.sunDir = {std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), std::sin(el)};
-  s.sunRadiance = kSunIrradiance * kSunColour;
-  s.ambient = kAmbientRadiance;
+  s.sunIrradiance = glm::dvec3(kSunIrradiance);
+  s.groundIrradiance = skyLightAt(tables, 0.0, groundRadius_m, s.sunDir, s.sunIrradiance).irradiance;
 
   if (in.weather == nullptr) return s;
   const double sinceSnapshot_s = in.weatherClock_s - in.weather->weatherClock_s;
-  for (const auto& layer : in.weather->layers) {
+  for (std::size_t slice = 0; slice < in.weather->layers.size(); ++slice) {
+    const weather::CloudLayer& layer = in.weather->layers[slice];
     LayerSetup l;
     l.thickness_m = layer.thickness_m;
+    l.lightDistance_m = std::clamp(kLightMarchFraction * layer.thickness_m, kMinLightDistance_m, kMaxLightDistance_m);
+    l.primary = cloudTypeParams(layer.type);
+    l.blends = field.blendType[slice] != weather::CloudType::None;
+    l.secondary = l.blends ? cloudTypeParams(field.blendType[slice]) : l.primary;
+    l.shapePeriod_m = l.primary.shapePeriod_m;
+    l.detailPeriod_m = l.primary.detailPeriod_m;
+    l.cloudMapPeriod_m = kCloudMapPeriodFactor * l.primary.shapePeriod_m;
+    // The diffuse light the layer's top receives, over the camera: the sky,
+    // and the sun through the air (cloud_core.glsl's diffuseLight).
+    const double top_m = std::max(layer.base_m + layer.thickness_m, 0.0);
+    l.skyTop = skyLightAt(tables, top_m, groundRadius_m, s.sunDir, s.sunIrradiance).meanRadiance;
+    l.sunCosine = std::max(s.sunDir.z, 0.0);
+    l.sunDiffuseTop = s.sunIrradiance * sunTransmittanceAt(tables, top_m, s.sunDir.z, groundRadius_m) *
+                      (l.sunCosine / std::numbers::pi);
     l.hBase_m = alt_m - layer.base_m;
     l.hTop_m = alt_m - (layer.base_m + layer.thickness_m);
     l.cBase_m2 = l.hBase_m * (2 * s.r_m - l.hBase_m);
@@ -148,8 +173,9 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
       }
       return out;
     };
-    l.noiseOrigin = inPeriods(kNoisePeriod_m);
-    l.cloudMapOrigin = inPeriods(kCloudMapPeriod_m);
+    l.shapeOrigin = inPeriods(l.shapePeriod_m);
+    l.detailOrigin = inPeriods(l.detailPeriod_m);
+    l.cloudMapOrigin = inPeriods(l.cloudMapPeriod_m);
     // The coverage tiles are the server's field at the snapshot's clock; the
     // air over the camera now was, then, where the shared advection formula
     // (weather::advect, the one the server moves its regions with) says: the
@@ -158,7 +184,10 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
         {in.camera.position.lat_deg, in.camera.position.lon_deg}, layer.wind, -sinceSnapshot_s);
     const geo::Vec3d upwindEcef = geo::toEcef({upwind.lat_deg, upwind.lon_deg, alt_m});
     const glm::dvec3 drift = inFrame(enu, enu.originEcef_m - upwindEcef);
-    l.coverageShift_m = glm::dvec2(drift.x, drift.y);
+    // A uniform layer is the same everywhere: it does not drift off the map
+    // (an hour-old snapshot in a 150 m/s wind would otherwise be 540 km away,
+    // past the map's 100 km, and empty).
+    l.coverageShift_m = field.tiled[slice] ? glm::dvec2(drift.x, drift.y) : glm::dvec2(0.0);
     s.layers.push_back(l);
   }
   return s;
@@ -176,12 +205,11 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
     f.camToAnchor[row] = v4(glm::dvec3(s.camToAnchor[0][row], s.camToAnchor[1][row], s.camToAnchor[2][row]));
   }
   f.camInAnchor = v4(s.camInAnchor_m, s.anchorRadius_m);
-  f.weatherMap = gpu::vec4(float(1.0 / (2 * s.mapHalfExtent_m)), float(s.layers.size()),
-                           float(1.0 / kNoisePeriod_m), float(1.0 / kCloudMapPeriod_m));
-  f.earth = gpu::vec4(float(s.r_m), float(s.hGround_m), float(s.cGround_m2), 0.0f);
+  f.weatherMap = gpu::vec4(float(1.0 / (2 * s.mapHalfExtent_m)), float(s.layers.size()), 0.0f, 0.0f);
+  f.earth = gpu::vec4(float(s.r_m), float(s.hGround_m), float(s.cGround_m2), float(s.cAtmosphereTop_m2));
   f.sunDir = v4(s.sunDir);
-  f.sunRadiance = v4(s.sunRadiance);
-  f.ambient = v4(s.ambient);
+  f.sunIrradiance = v4(s.sunIrradiance);
+  f.groundIrradiance = v4(s.groundIrradiance);
 
   const std::uint32_t tilesX = (s.width + gpu::kLocalSize - 1) / gpu::kLocalSize;
   const std::uint32_t n = tileCount(s.width, s.height);
@@ -197,13 +225,22 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
     const LayerSetup& l = s.layers[i];
     gpu::SkyLayer& g = f.layers[i];
     g.heights = gpu::vec4(glm::dvec4(l.hBase_m, l.hTop_m, l.cBase_m2, l.cTop_m2));
-    g.shape = gpu::vec4(float(l.thickness_m), float(i), 0.0f, 0.0f);
-    g.noiseOrigin = v4(l.noiseOrigin);
-    g.cloudMapOrigin = v4(l.cloudMapOrigin);
+    g.shape = gpu::vec4(float(l.thickness_m), float(i), float(l.lightDistance_m), l.blends ? 1.0f : 0.0f);
+    g.shapeOrigin = v4(l.shapeOrigin, 1.0 / l.shapePeriod_m);
+    g.detailOrigin = v4(l.detailOrigin, 1.0 / l.detailPeriod_m);
+    g.cloudMapOrigin = v4(l.cloudMapOrigin, 1.0 / l.cloudMapPeriod_m);
     g.coverageShift = gpu::vec4(float(l.coverageShift_m.x), float(l.coverageShift_m.y), 0.0f, 0.0f);
+    g.ambient = v4(l.skyTop);
+    g.sunDiffuse = v4(l.sunDiffuseTop, l.sunCosine);
+    g.primary = packCloudType(l.primary);
+    g.secondary = packCloudType(l.secondary);
   }
-  // Unused slots keep a positive thickness so the shader's per-layer setup never divides by 0.
-  for (std::size_t i = s.layers.size(); i < gpu::kMaxLayers; ++i) f.layers[i].shape.x = 1.0f;
+  // Unused slots keep a positive thickness and valid types so the shader's
+  // per-layer setup never divides by 0.
+  for (std::size_t i = s.layers.size(); i < gpu::kMaxLayers; ++i) {
+    f.layers[i].shape = gpu::vec4(1.0f, float(i), 1.0f, 0.0f);
+    f.layers[i].primary = f.layers[i].secondary = packCloudType(cloudTypeParams(weather::CloudType::Cumulus));
+  }
   return f;
 }
 

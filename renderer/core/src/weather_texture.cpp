@@ -9,7 +9,7 @@ namespace sky::render {
 
 Result<WeatherTexture> WeatherTexture::create(const GpuContext& ctx) {
   WeatherTexture t;
-  t.image_ = createSampledImage(ctx, vk::ImageType::e2D, vk::Format::eR16G16Sfloat,
+  t.image_ = createSampledImage(ctx, vk::ImageType::e2D, vk::Format::eR8G8B8A8Unorm,
                                 vk::Extent3D(kWeatherMapSize, kWeatherMapSize, 1), gpu::kMaxLayers, "sky.weatherMap");
   t.field_ = buildWeatherField(nullptr, geo::Geodetic{});
   if (auto ok = t.upload(ctx); !ok) return tl::unexpected(ok.error());

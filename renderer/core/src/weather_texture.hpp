@@ -1,4 +1,4 @@
-// The weather map on the GPU: a fixed-size RG16F 2D array (one slice per cloud
+// The weather map on the GPU: a fixed-size RGBA8 2D array (one slice per cloud
 // layer) and the CPU field it was uploaded from. Rebuilt and re-uploaded only
 // when the snapshot's content changes or the camera leaves the anchor's
 // neighbourhood (kWeatherRecentre_m).

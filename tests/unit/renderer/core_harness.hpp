@@ -1,0 +1,47 @@
+// The shared cloud model (shaders/include/cloud_core.glsl) compiled as C++ in
+// double precision inside a class whose texture hooks return what a test
+// sets (a uniform field, no air extinction unless a table is given), for the
+// closed-form tests of the core.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+#include <glm/glm.hpp>
+
+#include "sky_shared.h"
+
+namespace sky::test {
+
+using namespace glm;
+using gpu::kMaxLayers;
+
+class Core {
+ public:
+  using real = double;
+  using real2 = glm::dvec2;
+  using real3 = glm::dvec3;
+  using real4 = glm::dvec4;
+  using uint = std::uint32_t;
+
+  real coverage = 1.0, density = 1.0, blend = 0.0, noise = 1.0, detail = 0.5;
+  real2 cloudMap = real2(0.5, 1.0);
+  // Transmittance table lookup; unset: clear air transmits everything.
+  std::function<real3(real2)> table;
+
+  real3 sampleWeather(int, real3) const { return real3(coverage, density, blend); }
+  real2 sampleCloudMap(int, real3) const { return cloudMap; }
+  real2 sampleShape(int, real3) const { return real2(noise, noise); }
+  real sampleDetail(int, real3) const { return detail; }
+  real3 sampleTransmittanceLut(real2 uv) const { return table ? table(uv) : real3(1.0); }
+
+#define SKY_CORE_CONST static constexpr
+#include "cloud_core.glsl"
+#undef SKY_CORE_CONST
+
+  CoreLayer layers[kMaxLayers]{};
+};
+
+inline Core::CoreLayer Core::layerAt(int li) { return layers[li]; }
+
+}  // namespace sky::test
