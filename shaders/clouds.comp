@@ -10,11 +10,13 @@
 layout(local_size_x = kLocalSize, local_size_y = kLocalSize) in;
 
 // The frame's numbers in a read-only storage buffer, not a uniform block:
-// lavapipe specialises a shader on the values of uniform-block members that
-// decide branches (camera and layer heights here) and compiles a new variant
-// whenever they change, ~1.5 s per frame under ASan with a moving camera
-// (measured with MESA_SHADER_CACHE_DISABLE=true); storage buffers it leaves
-// alone. std430 and std140 agree on this vec4-only layout.
+// lavapipe specialises a shader on uniform-block values that decide branches
+// and compiles a new variant whenever they change (with a moving camera ~1.5
+// s per frame under ASan, measured with MESA_SHADER_CACHE_DISABLE=true);
+// storage buffers it leaves alone. std430 and std140 agree on this vec4-only
+// layout. Storage loads are gathers on lavapipe, so what a sample needs is
+// read once: the frame's into the globals below, a layer's into its
+// CoreLayer (layerAt, once per span).
 layout(std430, set = 0, binding = kBindingFrame) readonly buffer FrameBlock { SkyFrame frame; };
 layout(set = 0, binding = kBindingShape) uniform sampler3D shapeTex;
 layout(set = 0, binding = kBindingWeather) uniform sampler2DArray weatherTex;
@@ -28,45 +30,48 @@ layout(set = 0, binding = kBindingTransmittance) uniform sampler2D transmittance
 #define real4 vec4
 #define SKY_CORE_CONST const
 
-// Weather map lookup: camera-local point -> weather anchor frame -> gnomonic
-// plane of the anchor sphere (x = R q.x / q.z) -> texture coordinates.
-vec3 sampleWeather(int layer, vec3 p) {
-  vec3 q = vec3(dot(frame.camToAnchor[0].xyz, p), dot(frame.camToAnchor[1].xyz, p),
-                dot(frame.camToAnchor[2].xyz, p)) + frame.camInAnchor.xyz;
-  if (q.z <= 0.0) return vec3(0.0);
-  vec2 plane = q.xy * (frame.camInAnchor.w / q.z) - frame.layers[layer].coverageShift.xy;
-  vec2 uv = plane * frame.weatherMap.x + 0.5;
-  return textureLod(weatherTex, vec3(uv, frame.layers[layer].shape.y), 0.0).xyz;
-}
-
-// Earth-fixed noise coordinates: rotate to ECEF axes, scale by the period and
-// add the origin (camera ECEF minus wind drift, modulo the period, computed in
-// double on the CPU).
-vec3 noiseCoord(vec4 origin, vec3 p) {
-  vec3 e = vec3(dot(frame.localToEcef[0].xyz, p), dot(frame.localToEcef[1].xyz, p),
-                dot(frame.localToEcef[2].xyz, p));
-  return origin.xyz + e * origin.w;
-}
-
-vec2 sampleShape(int layer, vec3 p) {
-  return textureLod(shapeTex, noiseCoord(frame.layers[layer].shapeOrigin, p), 0.0).rg;
-}
-
-float sampleDetail(int layer, vec3 p) {
-  return textureLod(detailTex, noiseCoord(frame.layers[layer].detailOrigin, p), 0.0).r;
-}
-
-// Large-scale cloud map: the shape texture's smooth and Worley channels at a
-// larger, incommensurate period.
-vec2 sampleCloudMap(int layer, vec3 p) {
-  return textureLod(shapeTex, noiseCoord(frame.layers[layer].cloudMapOrigin, p), 0.0).ba;
-}
+// Copies of the frame's sampling numbers, set at the start of main.
+mat3 gCamToAnchor;     // camera-local -> weather-anchor-local
+vec4 gCamInAnchor;     // xyz: camera in the anchor frame (m); w: anchor sphere radius (m)
+float gMapScale;       // 1 / (2 half extent) of the weather map (1/m)
+mat3 gLocalToEcef;     // camera-local -> ECEF axes
 
 vec3 sampleTransmittanceLut(vec2 uv) {
   return textureLod(transmittanceTex, uv, 0.0).rgb;
 }
 
 #include "cloud_core.glsl"
+
+// Weather map lookup: camera-local point -> weather anchor frame -> gnomonic
+// plane of the anchor sphere (x = R q.x / q.z) -> texture coordinates.
+vec3 sampleWeather(LayerSampling s, vec3 p) {
+  vec3 q = gCamToAnchor * p + gCamInAnchor.xyz;
+  if (q.z <= 0.0) return vec3(0.0);
+  vec2 plane = q.xy * (gCamInAnchor.w / q.z) - s.coverageShift.xy;
+  vec2 uv = plane * gMapScale + 0.5;
+  return textureLod(weatherTex, vec3(uv, s.coverageShift.z), 0.0).xyz;
+}
+
+// Earth-fixed noise coordinates: rotate to ECEF axes, scale by the period and
+// add the origin (camera ECEF minus wind drift, modulo the period, computed in
+// double on the CPU).
+vec3 noiseCoord(vec4 origin, vec3 p) {
+  return origin.xyz + (gLocalToEcef * p) * origin.w;
+}
+
+vec2 sampleShape(LayerSampling s, vec3 p) {
+  return textureLod(shapeTex, noiseCoord(s.shapeOrigin, p), 0.0).rg;
+}
+
+float sampleDetail(LayerSampling s, vec3 p) {
+  return textureLod(detailTex, noiseCoord(s.detailOrigin, p), 0.0).r;
+}
+
+// Large-scale cloud map: the shape texture's smooth and Worley channels at a
+// larger, incommensurate period.
+vec2 sampleCloudMap(LayerSampling s, vec3 p) {
+  return textureLod(shapeTex, noiseCoord(s.cloudMapOrigin, p), 0.0).ba;
+}
 
 CloudType unpackType(SkyCloudType t) {
   CloudType c;
@@ -91,9 +96,11 @@ CloudType unpackType(SkyCloudType t) {
 
 CoreLayer layerAt(int li) {
   SkyLayer l = frame.layers[li];
+  LayerSampling s = LayerSampling(l.shapeOrigin, l.detailOrigin, l.cloudMapOrigin,
+                                  vec3(l.coverageShift.xy, l.shape.y));
   return CoreLayer(l.heights.x, l.heights.y, l.heights.z, l.heights.w, l.shape.x, l.shape.z, l.shape.w > 0.5,
                    unpackType(l.primary), unpackType(l.secondary), l.ambient.rgb, l.sunDiffuse.rgb,
-                   l.sunDiffuse.w);
+                   l.sunDiffuse.w, s);
 }
 
 void main() {
@@ -103,6 +110,12 @@ void main() {
   uint tile = (gl_WorkGroupID.x * frame.dispatch.x) % frame.image.w;
   uvec2 px = uvec2(tile % frame.image.z, tile / frame.image.z) * kLocalSize + gl_LocalInvocationID.xy;
   if (px.x >= frame.image.x || px.y >= frame.image.y) return;
+
+  // GLSL's mat3(a, b, c) takes columns; the frame holds rows.
+  gCamToAnchor = transpose(mat3(frame.camToAnchor[0].xyz, frame.camToAnchor[1].xyz, frame.camToAnchor[2].xyz));
+  gLocalToEcef = transpose(mat3(frame.localToEcef[0].xyz, frame.localToEcef[1].xyz, frame.localToEcef[2].xyz));
+  gCamInAnchor = frame.camInAnchor;
+  gMapScale = frame.weatherMap.x;
 
   CoreFrame f;
   f.air = AirFrame(frame.earth.x, frame.earth.y, frame.earth.z, frame.earth.w, frame.sunDir.xyz,

@@ -6,14 +6,13 @@
 // shaders/clouds.comp (real = float) and, inside a class body, by
 // renderer/core/src/cpu_reference.cpp (real = double).
 // The includer defines real, real2, real3, real4, uint, SKY_CORE_CONST,
-// kMaxLayers and the texture hooks before including this file, and defines
-// the layer hook (declared below) after it:
-//   CoreLayer layerAt(int li)                     // layer li of the frame
-//   real3 sampleWeather(int layer, real3 pLocal)  // (coverage, density, blend), 0 outside the map
-//   real2 sampleCloudMap(int layer, real3 pLocal) // (coverage modulation, peak height) in [0, 1]
-//   real2 sampleShape(int layer, real3 pLocal)    // (billowy, fibrous) shape noise in [0, 1]
-//   real  sampleDetail(int layer, real3 pLocal)   // Worley detail noise in [0, 1]
-//   real3 sampleTransmittanceLut(real2 uv)        // atmosphere_core.glsl
+// kMaxLayers and sampleTransmittanceLut (atmosphere_core.glsl) before
+// including this file, and defines the hooks declared below after it:
+//   CoreLayer layerAt(int li)                            // layer li of the frame
+//   real3 sampleWeather(LayerSampling s, real3 pLocal)   // (coverage, density, blend), 0 outside the map
+//   real2 sampleCloudMap(LayerSampling s, real3 pLocal)  // (coverage modulation, peak height) in [0, 1]
+//   real2 sampleShape(LayerSampling s, real3 pLocal)     // (billowy, fibrous) shape noise in [0, 1]
+//   real  sampleDetail(LayerSampling s, real3 pLocal)    // Worley detail noise in [0, 1]
 // pLocal is camera-relative, local frame: x east, y north, z up (m).
 
 #include "core_common.glsl"
@@ -67,6 +66,15 @@ SKY_CORE_CONST real kMinSunCosine = 0.02;
 // Lambertian ground albedo (no terrain yet): 0.1, a mix of vegetation and
 // soil, as Bruneton 2017's reference ground.
 SKY_CORE_CONST real kGroundAlbedo = 0.1;
+// Where a layer's textures are read (the hooks' per-layer inputs, carried
+// in the layer so a sample reads no frame data).
+struct LayerSampling {
+  real4 shapeOrigin;     // xyz: (camera ECEF - wind drift) mod period, in periods; w: 1 / period (1/m)
+  real4 detailOrigin;    // the same for the detail noise
+  real4 cloudMapOrigin;  // the same for the cloud map
+  real3 coverageShift;   // xy: coverage drift east/north (m); z: weather-map slice
+};
+
 struct CoreLayer {
   real hBase;      // camera height above the layer base, m (negative below)
   real hTop;       // camera height above the layer top, m
@@ -80,6 +88,7 @@ struct CoreLayer {
   real3 skyTop;        // mean sky radiance at the layer top, linear units
   real3 sunDiffuseTop; // sunlight at the layer top as a diffuse radiance, E T mu / pi
   real sunCosine;      // mu of the sun at the layer top (>= 0)
+  LayerSampling sampling;
 };
 
 // The layers are read through this hook, not carried in CoreFrame: a frame
@@ -87,6 +96,10 @@ struct CoreLayer {
 // and indexed by a run-time layer number, is copied per sample by lavapipe
 // (measured: 3x the frame time of reading the one layer a span needs).
 CoreLayer layerAt(int li);
+real3 sampleWeather(LayerSampling s, real3 pLocal);
+real2 sampleCloudMap(LayerSampling s, real3 pLocal);
+real2 sampleShape(LayerSampling s, real3 pLocal);
+real sampleDetail(LayerSampling s, real3 pLocal);
 
 struct CoreFrame {
   AirFrame air;
@@ -118,24 +131,21 @@ struct PixelResult {
 Span layerSpan(CoreFrame f, CoreLayer L, real mu, real tGround) {
   Roots base = intersectSphere(f.air.r, L.cBase, mu);
   Roots top = intersectSphere(f.air.r, L.cTop, mu);
-  real t0 = 0.0;
-  real t1 = 0.0;
-  if (L.hBase < 0.0) {
-    // Below: inside both spheres, so both are hit; leave the base, then the top.
-    t0 = base.t1;
-    t1 = top.t1;
-  } else if (L.hTop < 0.0) {
-    // Inside: until the top, or the base if the ray reaches it first.
-    t1 = top.t1;
-    if (base.hit && base.t0 >= 0.0) t1 = min(t1, base.t0);
-  } else if (top.hit && top.t1 > 0.0) {
-    // Above: from the top down to the base, or out through the top again.
-    t0 = max(top.t0, 0.0);
-    t1 = (base.hit && base.t0 >= 0.0) ? base.t0 : top.t1;
-  }
+  // The three cases as selects, not branches: a branch on the layer heights
+  // alone (uniform values) makes lavapipe compile a shader variant for each
+  // camera altitude (it inlines uniforms that decide an `if`).
+  bool below = L.hBase < 0.0;
+  bool inside = !below && L.hTop < 0.0;
+  bool aboveHit = !below && !inside && top.hit && top.t1 > 0.0;
+  // Below: inside both spheres, so both are hit; leave the base, then the top.
+  // Inside: until the top, or the base if the ray reaches it first.
+  // Above: from the top down to the base, or out through the top again.
+  real baseFirst = (base.hit && base.t0 >= 0.0) ? base.t0 : top.t1;
+  real t0 = below ? base.t1 : (aboveHit ? max(top.t0, 0.0) : 0.0);
+  real t1 = below ? top.t1 : (inside ? min(top.t1, baseFirst) : (aboveHit ? baseFirst : 0.0));
   t1 = min(t1, tGround);
   t1 = min(t1, t0 + kMaxSpan_m);
-  if (t0 > kMaxViewDistance_m) t1 = t0;
+  t1 = t0 > kMaxViewDistance_m ? t0 : t1;
   return Span(t0, t1);
 }
 
@@ -212,8 +222,8 @@ real octaveSum(real4 phases, real tauSun) {
 // there is no density: lavapipe runs every branch for all lanes of a
 // subgroup, but leaves a loop once no lane is in it, so a zero trip count is
 // what skips the march.
-real lightOpticalDepth(real3 sunDir, real muSun, real thickness, real lightDistance, int li, CloudType t, real3 p,
-                       real ph, real c, real peakNoise, real densityScale, int steps) {
+real lightOpticalDepth(real3 sunDir, real muSun, real thickness, real lightDistance, LayerSampling ls, CloudType t,
+                       real3 p, real ph, real c, real peakNoise, real densityScale, int steps) {
   real lightDt = lightDistance / real(kLightSteps);
   real dph = lightDt * muSun / thickness;
   real tau = 0.0;
@@ -221,7 +231,7 @@ real lightOpticalDepth(real3 sunDir, real muSun, real thickness, real lightDista
     real3 q = p + sunDir * ((real(j) + 0.5) * lightDt);
     real qh = ph + (real(j) + 0.5) * dph;
     real sa = shapeProfile(t, qh, c, peakNoise);
-    tau += cloudShape(t, sampleShape(li, q), c, sa) * densityProfile(t, qh);
+    tau += cloudShape(t, sampleShape(ls, q), c, sa) * densityProfile(t, qh);
   }
   return tau * t.extinction_perm * densityScale * lightDt;
 }
@@ -271,24 +281,24 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
     real h = heightAboveCameraSphere(p, f.air.r);
     real ph = (h + L.hBase) / L.thickness;
     if (ph <= 0.0 || ph >= 1.0) continue;
-    real3 weather = sampleWeather(li, p);
+    real3 weather = sampleWeather(L.sampling, p);
     if (weather.x <= 0.0) continue;
     real blend = L.blends ? weather.z : 0.0;
     CloudType ct = blend > 0.0 ? mixCloudType(L.primary, L.secondary, blend) : L.primary;
-    real2 map = sampleCloudMap(li, p);
+    real2 map = sampleCloudMap(L.sampling, p);
     real c = anvilCoverage(ct, ph, weather.x < 1.0 ? mappedCoverage(weather.x, map.x) : 1.0);
     real sa = shapeProfile(ct, ph, c, map.y);
     if (sa <= 0.0) continue;
-    real shape = cloudShape(ct, sampleShape(li, p), c, sa);
+    real shape = cloudShape(ct, sampleShape(L.sampling, p), c, sa);
     if (shape <= 0.0) continue;
     real da = densityProfile(ct, ph) * weather.y;
     if (da <= 0.0) continue;
     // Erosion leaves a full shape (1) full: the detail fetch only at the edges.
-    real rho = (shape < 1.0 ? erodeShape(ct, shape, sampleDetail(li, p), c, ph) : 1.0) * da;
+    real rho = (shape < 1.0 ? erodeShape(ct, shape, sampleDetail(L.sampling, p), c, ph) : 1.0) * da;
     if (rho <= 0.0) continue;
     real u = (real(i) + jitter) / real(kPrimarySteps);
-    real tauSun = lightOpticalDepth(f.air.sunDir, mix(muStart, muEnd, u), L.thickness, L.lightDistance, li, ct, p, ph,
-                                    c, map.y, weather.y, rho > 0.0 ? kLightSteps : 0);
+    real tauSun = lightOpticalDepth(f.air.sunDir, mix(muStart, muEnd, u), L.thickness, L.lightDistance, L.sampling, ct,
+                                    p, ph, c, map.y, weather.y, rho > 0.0 ? kLightSteps : 0);
     // Sunlight at p through the clear air above it (reddened at low sun,
     // none in the Earth's shadow), and the sky's light from all around.
     real3 sun = mix(mix(sunBaseStart, sunTopStart, ph), mix(sunBaseEnd, sunTopEnd, ph), u);

@@ -41,33 +41,6 @@ class CpuCore {
           const AtmosphereTables& atmosphere, const WeatherField& weather)
       : setup_(setup), shape_(shape), detail_(detail), atmosphere_(atmosphere), weather_(weather) {}
 
-  // Mirrors sampleWeather in shaders/clouds.comp.
-  real3 sampleWeather(int layer, real3 p) const {
-    const real3 q = setup_.camToAnchor * p + setup_.camInAnchor_m;
-    if (q.z <= 0.0) return real3(0.0);
-    const real2 plane =
-        real2(q.x, q.y) * (setup_.anchorRadius_m / q.z) - setup_.layers[std::size_t(layer)].coverageShift_m;
-    return weather_.sample(std::uint32_t(layer), plane.x, plane.y);
-  }
-
-  // Mirrors sampleShape, sampleDetail and sampleCloudMap in shaders/clouds.comp.
-  real2 sampleShape(int layer, real3 p) const {
-    const LayerSetup& l = setup_.layers[std::size_t(layer)];
-    const real4 v = shape_.sample(l.shapeOrigin + (setup_.localToEcef * p) / l.shapePeriod_m);
-    return real2(v.x, v.y);
-  }
-
-  real sampleDetail(int layer, real3 p) const {
-    const LayerSetup& l = setup_.layers[std::size_t(layer)];
-    return detail_.sample(l.detailOrigin + (setup_.localToEcef * p) / l.detailPeriod_m).x;
-  }
-
-  real2 sampleCloudMap(int layer, real3 p) const {
-    const LayerSetup& l = setup_.layers[std::size_t(layer)];
-    const real4 v = shape_.sample(l.cloudMapOrigin + (setup_.localToEcef * p) / l.cloudMapPeriod_m);
-    return real2(v.z, v.w);
-  }
-
   real3 sampleTransmittanceLut(real2 uv) const { return atmosphere_.sampleTransmittance(uv); }
 
 #define SKY_CORE_CONST static constexpr
@@ -111,9 +84,13 @@ class CpuCore {
       if (i < setup_.layers.size()) {
         const LayerSetup& l = setup_.layers[i];
         c = CoreLayer{l.hBase_m, l.hTop_m, l.cBase_m2, l.cTop_m2, l.thickness_m, l.lightDistance_m, l.blends,
-                      coreType(l.primary), coreType(l.secondary), l.skyTop, l.sunDiffuseTop, l.sunCosine};
+                      coreType(l.primary), coreType(l.secondary), l.skyTop, l.sunDiffuseTop, l.sunCosine,
+                      LayerSampling{real4(l.shapeOrigin, 1.0 / l.shapePeriod_m), real4(l.detailOrigin, 1.0 / l.detailPeriod_m),
+                                    real4(l.cloudMapOrigin, 1.0 / l.cloudMapPeriod_m),
+                                    real3(l.coverageShift_m, double(i))}};
       } else {
-        c = CoreLayer{0.0, 0.0, 0.0, 0.0, 1.0, 1.0, false, cumulus, cumulus, real3(0.0), real3(0.0), 0.0};
+        c = CoreLayer{0.0, 0.0, 0.0, 0.0, 1.0, 1.0, false, cumulus, cumulus, real3(0.0), real3(0.0), 0.0,
+                      LayerSampling{real4(0.0), real4(0.0), real4(0.0), real3(0.0, 0.0, double(i))}};
       }
     }
     return f;
@@ -135,6 +112,29 @@ class CpuCore {
 };
 
 CpuCore::CoreLayer CpuCore::layerAt(int li) { return layers_[li]; }
+
+// The hooks mirror those of shaders/clouds.comp.
+CpuCore::real3 CpuCore::sampleWeather(LayerSampling s, real3 p) {
+  const real3 q = setup_.camToAnchor * p + setup_.camInAnchor_m;
+  if (q.z <= 0.0) return real3(0.0);
+  const real2 plane = real2(q.x, q.y) * (setup_.anchorRadius_m / q.z) - real2(s.coverageShift.x, s.coverageShift.y);
+  return weather_.sample(std::uint32_t(s.coverageShift.z), plane.x, plane.y);
+}
+
+CpuCore::real2 CpuCore::sampleShape(LayerSampling s, real3 p) {
+  const real4 v = shape_.sample(real3(s.shapeOrigin) + (setup_.localToEcef * p) * s.shapeOrigin.w);
+  return real2(v.x, v.y);
+}
+
+CpuCore::real CpuCore::sampleDetail(LayerSampling s, real3 p) {
+  return detail_.sample(real3(s.detailOrigin) + (setup_.localToEcef * p) * s.detailOrigin.w).x;
+}
+
+// The cloud map: the shape texture's smooth and Worley channels at its own period.
+CpuCore::real2 CpuCore::sampleCloudMap(LayerSampling s, real3 p) {
+  const real4 v = shape_.sample(real3(s.cloudMapOrigin) + (setup_.localToEcef * p) * s.cloudMapOrigin.w);
+  return real2(v.z, v.w);
+}
 
 }  // namespace
 

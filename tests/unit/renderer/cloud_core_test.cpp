@@ -86,7 +86,7 @@ Core::CoreFrame frameAt(Core& c, double R, double alt, double base, double thick
   const double hBase = alt - base, hTop = alt - (base + thickness);
   Core::CoreLayer& L = c.layers[0];
   L = Core::CoreLayer{hBase, hTop, hBase * (2 * f.air.r - hBase), hTop * (2 * f.air.r - hTop), thickness,
-                      0.5 * thickness, false, type, type, Core::real3(0), Core::real3(0), 1.0};
+                      0.5 * thickness, false, type, type, Core::real3(0), Core::real3(0), 1.0, Core::LayerSampling{}};
   return f;
 }
 

@@ -29,10 +29,6 @@ class Core {
   // Transmittance table lookup; unset: clear air transmits everything.
   std::function<real3(real2)> table;
 
-  real3 sampleWeather(int, real3) const { return real3(coverage, density, blend); }
-  real2 sampleCloudMap(int, real3) const { return cloudMap; }
-  real2 sampleShape(int, real3) const { return real2(noise, noise); }
-  real sampleDetail(int, real3) const { return detail; }
   real3 sampleTransmittanceLut(real2 uv) const { return table ? table(uv) : real3(1.0); }
 
 #define SKY_CORE_CONST static constexpr
@@ -43,5 +39,9 @@ class Core {
 };
 
 inline Core::CoreLayer Core::layerAt(int li) { return layers[li]; }
+inline Core::real3 Core::sampleWeather(LayerSampling, real3) { return real3(coverage, density, blend); }
+inline Core::real2 Core::sampleCloudMap(LayerSampling, real3) { return cloudMap; }
+inline Core::real2 Core::sampleShape(LayerSampling, real3) { return real2(noise, noise); }
+inline Core::real Core::sampleDetail(LayerSampling, real3) { return detail; }
 
 }  // namespace sky::test
