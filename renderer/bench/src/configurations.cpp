@@ -13,13 +13,13 @@ std::vector<Configuration> builtInConfigurations() {
   // (steps, light steps) is fixed in shaders/include/cloud_core.glsl. So today
   // `reference` is simply the renderer as it is, and the other entries trade
   // resolution only. When presets land, each becomes one entry here
-  // ({"medium", "...", 1.0, render::presetSettings(Preset::Medium)} or the
-  // like), `reference` takes the reference preset, and the seeds'
+  // ({"medium", "...", 1.0, true, render::presetSettings(Preset::Medium)}
+  // or the like), `reference` takes the reference preset, and the seeds'
   // configurations (Haggstrom's and Ford's final settings) become entries too.
   std::vector<Configuration> all;
-  all.push_back({kReferenceName, "the renderer's only quality today: full resolution, fixed march", 1.0, {}});
-  all.push_back({"half-res", "renders at 1/2 the width and height, bilinear upscale (bench-side)", 0.5, {}});
-  all.push_back({"quarter-res", "renders at 1/4 the width and height, bilinear upscale (bench-side)", 0.25, {}});
+  all.push_back({kReferenceName, "the renderer's only quality today: full resolution, fixed march", 1.0, false, {}});
+  all.push_back({"half-res", "renders at 1/2 the width and height, bilinear upscale (bench-side)", 0.5, false, {}});
+  all.push_back({"quarter-res", "renders at 1/4 the width and height, bilinear upscale (bench-side)", 0.25, false, {}});
   return all;
 }
 

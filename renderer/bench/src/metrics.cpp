@@ -184,13 +184,17 @@ Result<double> ssim(const Srgb8Image& a, const Srgb8Image& b) {
   return ssimGray(luma(a), luma(b));
 }
 
-Result<TemporalError> temporalError(std::span<const Srgb8Image> test, std::span<const Srgb8Image> reference) {
-  if (test.size() != reference.size())
-    return fail(ErrorCode::InvalidArgument, "temporalError: " + std::to_string(test.size()) + " test frames and " +
-                                                std::to_string(reference.size()) + " reference frames");
+Result<TemporalError> temporalError(std::span<const Srgb8Image> test, std::span<const Srgb8Image> reference,
+                                    std::span<const Srgb8Image> baseline) {
+  if (baseline.empty()) baseline = reference;
+  if (test.size() != reference.size() || test.size() != baseline.size())
+    return fail(ErrorCode::InvalidArgument, "temporalError: " + std::to_string(test.size()) + " test frames, " +
+                                                std::to_string(reference.size()) + " reference frames and " +
+                                                std::to_string(baseline.size()) + " baseline frames");
   if (test.size() < 2) return fail(ErrorCode::InvalidArgument, "temporalError: a path needs at least two frames");
   for (std::size_t t = 0; t < test.size(); ++t) {
     if (auto ok = comparable(test[t], reference[t], "temporalError"); !ok) return tl::unexpected(ok.error());
+    if (auto ok = comparable(test[t], baseline[t], "temporalError"); !ok) return tl::unexpected(ok.error());
     if (auto ok = comparable(test[t], test[0], "temporalError"); !ok) return tl::unexpected(ok.error());
   }
   TemporalError out;
@@ -202,9 +206,10 @@ Result<TemporalError> temporalError(std::span<const Srgb8Image> test, std::span<
     for (std::size_t i = 0; i < n; ++i) {
       const double eNow = double(test[t].rgb[i]) - double(reference[t].rgb[i]);
       const double ePrev = double(test[t - 1].rgb[i]) - double(reference[t - 1].rgb[i]);
-      const double d = double(reference[t - 1].rgb[i]) - double(reference[t].rgb[i]);
+      const double lag = double(test[t].rgb[i]) - double(baseline[t].rgb[i]);
+      const double d = double(baseline[t - 1].rgb[i]) - double(baseline[t].rgb[i]);
       flickerSum += (eNow - ePrev) * (eNow - ePrev);
-      ed += eNow * d;
+      ed += lag * d;
       dd += d * d;
     }
     const double flicker = std::sqrt(flickerSum / double(n));

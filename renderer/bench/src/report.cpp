@@ -191,7 +191,8 @@ std::string reportMarkdown(const BenchReport& report) {
     md << "\n";
   }
   md << "Flicker: RMS change of the error between consecutive frames (8-bit levels); ghosting: share of the previous "
-        "reference frame left in a frame (0 none, 1 all). Definitions: renderer/bench/include/sky/bench/metrics.hpp.\n";
+        "frame left in a frame (0 none, 1 all), against the configuration's own history-free frames (0 for "
+        "configurations that reuse no history). Definitions: renderer/bench/include/sky/bench/metrics.hpp.\n";
   return md.str();
 }
 

@@ -148,7 +148,12 @@ Result<CaseResult> runCase(const LoadedScene& ls, const Configuration& config, c
   cr.error.psnr_dB = mse == 0 ? std::numeric_limits<double>::infinity() : 10 * std::log10(255.0 * 255.0 / mse);
   if (!cr.path) cr.worst = cr.error;
   if (cr.path) {
-    auto te = temporalError(kept.srgb, reference.srgb);
+    // temporalBaseline: a configuration without history is its own baseline;
+    // one with history is compared with reference until the renderer can draw
+    // it history-free (metrics.hpp, ghosting).
+    const std::span<const Srgb8Image> baseline =
+        config.reusesHistory ? std::span<const Srgb8Image>(reference.srgb) : std::span<const Srgb8Image>(kept.srgb);
+    auto te = temporalError(kept.srgb, reference.srgb, baseline);
     if (!te) return tl::unexpected(te.error());
     cr.temporal = std::move(*te);
   }

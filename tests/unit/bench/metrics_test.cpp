@@ -200,6 +200,27 @@ TEST(Temporal, GhostingIsTheBlendOfThePreviousFrame) {
   }
 }
 
+TEST(Temporal, GhostingAgainstABaselineIgnoresSpatialError) {
+  // The test is its baseline (a blurry, biased rendering far from the
+  // reference) blended with the baseline's previous frame: ghosting is the
+  // blend, whatever the reference holds; with the test as its own baseline it is 0.
+  const double alpha = 0.4;
+  const std::vector<Srgb8Image> ref{random8(40, 30, 0, 255, 41), random8(40, 30, 0, 255, 42)};
+  const std::vector<Srgb8Image> base{random8(40, 30, 0, 255, 43), random8(40, 30, 0, 255, 44)};
+  Srgb8Image blended = base[1];
+  for (std::size_t i = 0; i < blended.rgb.size(); ++i)
+    blended.rgb[i] = std::uint8_t(std::lround((1 - alpha) * base[1].rgb[i] + alpha * base[0].rgb[i]));
+  const std::vector<Srgb8Image> test{base[0], blended};
+  auto te = temporalError(test, ref, base);
+  ASSERT_TRUE(te);
+  EXPECT_NEAR(*te->ghosting[0], alpha, 0.01);
+  auto self = temporalError(test, ref, test);
+  ASSERT_TRUE(self);
+  EXPECT_DOUBLE_EQ(*self->ghosting[0], 0.0);
+  const std::vector<Srgb8Image> shortBase{base[0]};
+  EXPECT_FALSE(temporalError(test, ref, shortBase));
+}
+
 TEST(Temporal, NoGhostingWithoutMotion) {
   const Srgb8Image still = random8(20, 20, 0, 255, 30);
   const std::vector<Srgb8Image> ref{still, still}, test{still, constant8(20, 20, 0)};

@@ -23,6 +23,13 @@ struct Configuration {
   // (display.hpp). The renderer has no render scale of its own yet; when it
   // does, a preset sets it in RenderSettings and this stays 1. (0, 1].
   double renderScale = 1.0;
+  // Whether frames reuse earlier frames (reprojection, temporal
+  // accumulation). Only such a configuration can ghost: for the others the
+  // bench measures ghosting against the configuration's own frames (0). For
+  // one that does, it measures against reference until the renderer can draw
+  // the same configuration without history (then that is the baseline:
+  // runner.cpp, temporalBaseline).
+  bool reusesHistory = false;
   // The renderer's settings for this configuration; width, height and
   // verticalFov_deg are overwritten per scene and resolution by settingsFor.
   render::RenderSettings settings;

@@ -80,12 +80,16 @@ Result<double> ssim(const Srgb8Image& a, const Srgb8Image& b);
 //  * flicker: RMS over pixels and rgb of e_t - e_{t-1}, where e = test -
 //    reference; an error that stays put (a bias) costs nothing, an error that
 //    changes from frame to frame (noise, shimmering, popping) does.
-//  * ghosting: how much of the previous reference frame the test frame still
-//    holds: the least-squares alpha in e_t = alpha (ref_{t-1} - ref_t) (0 = no
-//    lag, 1 = shows the previous frame; test_t = (1 - a) ref_t + a ref_{t-1}
-//    gives exactly a). Absent where the reference barely changes between the
-//    two frames (RMS change under kGhostingMinChange levels): no motion, no
-//    ghost to see.
+//  * ghosting: how much of the previous frame the test frame still holds,
+//    measured against a baseline B: the least-squares alpha in test_t - B_t =
+//    alpha (B_{t-1} - B_t) (0 = no lag, 1 = shows the previous frame; test_t =
+//    (1 - a) B_t + a B_{t-1} gives exactly a). B should be what the same
+//    configuration shows without history: then spatial error cannot pass for
+//    lag (a blurred frame resembles an average of shifted ones, so against the
+//    reference a plain lower-resolution render of a moving view scores ~0.1-0.2).
+//    Without a baseline, B is the reference. Absent where B barely changes
+//    between the two frames (RMS change under kGhostingMinChange levels): no
+//    motion, no ghost to see.
 inline constexpr double kGhostingMinChange = 0.5;  // 8-bit levels: under half a level, no visible motion
 struct TemporalError {
   std::vector<double> flicker;                 // per frame pair, levels
@@ -93,9 +97,10 @@ struct TemporalError {
   double meanFlicker = 0, maxFlicker = 0;
   std::optional<double> meanGhosting, maxGhosting;  // over the pairs where it is defined
 };
-// Errors: InvalidArgument when the sequences differ in length or frame size,
-// or hold fewer than two frames.
-Result<TemporalError> temporalError(std::span<const Srgb8Image> test, std::span<const Srgb8Image> reference);
+// Errors: InvalidArgument when the sequences (baseline: when given) differ in
+// length or frame size, or hold fewer than two frames.
+Result<TemporalError> temporalError(std::span<const Srgb8Image> test, std::span<const Srgb8Image> reference,
+                                    std::span<const Srgb8Image> baseline = {});
 
 // Error heat map: per pixel the RMS over rgb of the 8-bit difference, mapped
 // from 0 (black) through blue, magenta, orange and yellow to white at
