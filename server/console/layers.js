@@ -20,12 +20,6 @@ export const DEFAULT_LAYER = {
   wind: { speed_mps: 10, from_deg: 270, vertical_mps: 0 },
 };
 
-// "60 % · 4.8 ok"
-export const coverageText = (c) => `${fmt(c * 100)} % · ${fmt(c * OKTAS, 1)} ok`;
-export const heightText = (m) => `${fmt(m)} m · ${fmt(ftFromM(m))} ft`;
-export const windText = (w) => `${fmt(w.speed_mps, 1)} m/s · ${fmt(ktFromMps(w.speed_mps))} kt from ${fmt(w.from_deg)}°` +
-  (w.vertical_mps ? `, ${w.vertical_mps > 0 ? "+" : ""}${fmt(w.vertical_mps, 1)} m/s` : "");
-
 export class LayerPanel {
   // app: {clockNow(), submit(changes, form, keys, noteEl), onSelect(id)}
   constructor(root, app) {
@@ -59,14 +53,20 @@ export class LayerPanel {
       const m = /^layer (\d+)/.exec(p.summary);
       if (m) ramping.add(Number(m[1]));
     }
+    // Each value in both units, one above the other.
+    const two = (a, b) => el("td", { class: "num" }, el("div", {}, a), el("div", { class: "muted" }, b));
     this.tbody.replaceChildren(...state.layers.map((l) => el("tr", {
       class: l.id === this.selectedId ? "selected" : "", dataset: { id: String(l.id) },
       onclick: () => this.select(l.id),
     },
     el("td", {}, String(l.id), ramping.has(l.id) ? el("span", { class: "badge", title: "a change is ramping or scheduled" }, "ramp") : ""),
-    el("td", {}, l.type), el("td", { class: "num" }, coverageText(l.coverage)),
-    el("td", { class: "num" }, heightText(l.base_m)), el("td", { class: "num" }, heightText(l.base_m + l.thickness_m)),
-    el("td", { class: "num" }, fmt(l.density, 2)), el("td", { class: "num" }, windText(l.wind)))));
+    el("td", {}, l.type),
+    two(`${fmt(l.coverage * 100)} %`, `${fmt(l.coverage * OKTAS, 1)} oktas`),
+    two(`${fmt(l.base_m)} m`, `${fmt(ftFromM(l.base_m))} ft`),
+    two(`${fmt(l.base_m + l.thickness_m)} m`, `${fmt(ftFromM(l.base_m + l.thickness_m))} ft`),
+    el("td", { class: "num" }, fmt(l.density, 2)),
+    two(`${fmt(l.wind.speed_mps, 1)} m/s · ${fmt(ktFromMps(l.wind.speed_mps))} kt`,
+      `from ${fmt(l.wind.from_deg)}°${l.wind.vertical_mps ? `, ${l.wind.vertical_mps > 0 ? "+" : ""}${fmt(l.wind.vertical_mps, 1)} m/s` : ""}`))));
     if (!state.layers.length) this.tbody.append(el("tr", {}, el("td", { colspan: 7, class: "muted" }, "no global layers: clear sky")));
     if (!this.initialized) {
       this.initialized = true;

@@ -6,7 +6,7 @@
 // position and heading. Drag pans, the wheel zooms; in a placing mode a click
 // (or a drag, for its size) puts a storm cell or a clearing there.
 import { coverageAt, regionEdgeDistance_m, regionOutline, regionPoint, regionWeight } from "./coverage.js";
-import { Projection } from "./geo.js";
+import { direct, Projection } from "./geo.js";
 import { fmt, ftFromM } from "./units.js";
 
 // Coverage is sampled on a grid this coarse (CSS px) and smoothed up: the
@@ -22,6 +22,8 @@ const CLICK_SLOP_PX = 4;
 const HANDLE_GRAB_PX = 9;
 // A renderer whose last report is older than this is drawn as stale.
 const STALE_AFTER_S = 5;
+// Least distance between two longitude labels (CSS px): "12.45°" is ~40 px wide.
+const LABEL_GAP_PX = 56;
 // Graticule spacings to choose from (degrees).
 const GRID_STEPS_DEG = [0.01, 0.02, 0.05, 0.1, 0.2, 0.25, 0.5, 1, 2, 5, 10, 15, 30];
 
@@ -270,6 +272,7 @@ export class MapView {
       if (l.y > 12 && l.y < this.h - 4) g.fillText(`${fmt(lat, 2)}°`, 4, l.y - 3);
     }
     const lonStart = Math.ceil((lonMin - lonStep) / lonStep) * lonStep;
+    let lastLabel_px = -Infinity;  // labels closer than LABEL_GAP_PX are left out
     for (let lon = lonStart; lon <= lonMax + lonStep; lon += lonStep) {
       g.beginPath();
       for (let k = 0; k <= n; ++k) {
@@ -279,7 +282,10 @@ export class MapView {
       g.stroke();
       const b = this.toScreen(this.toSurface(this.w / 2, this.h - 4).lat_deg, lon);
       const shown = ((lon + 540) % 360) - 180;
-      if (b.x > 30 && b.x < this.w - 30) g.fillText(`${fmt(shown, 2)}°`, b.x + 3, this.h - 6);
+      if (b.x > 30 && b.x < this.w - 30 && b.x - lastLabel_px >= LABEL_GAP_PX) {
+        g.fillText(`${fmt(shown, 2)}°`, b.x + 3, this.h - 6);
+        lastLabel_px = b.x;
+      }
     }
     g.restore();
   }
@@ -393,6 +399,19 @@ export class MapView {
 
   drawRenderers(renderers) {
     const g = this.ctx;
+    // Each renderer's area of interest (the spherical cap it subscribed).
+    g.save();
+    g.strokeStyle = "rgba(255, 225, 77, 0.35)";
+    g.setLineDash([2, 4]);
+    for (const r of renderers) {
+      const a = r.area;
+      if (!a || !(a.radius_m > 0) || !Number.isFinite(a.center_lat_deg)) continue;
+      const ring = [];
+      for (let k = 0; k < 72; ++k) ring.push(direct(a.center_lat_deg, a.center_lon_deg, k * 5, a.radius_m));
+      this.path(ring);
+      g.stroke();
+    }
+    g.restore();
     for (const r of renderers) {
       if (r.lat_deg === null || r.lon_deg === null || r.lat_deg === undefined) continue;
       const p = this.toScreen(r.lat_deg, r.lon_deg);

@@ -7,7 +7,7 @@ import { execFileSync } from "node:child_process";
 import fs from "node:fs";
 import path from "node:path";
 import {
-  assert, config, launch, near, openConsole, run, skip, TOKEN, until, Weatherd, withoutWebSocketAllowances,
+  assert, child, config, launch, near, openConsole, run, skip, TOKEN, until, Weatherd, withoutWebSocketAllowances,
 } from "./harness.mjs";
 
 const R = 6371008.8;  // the console's sphere (mean Earth radius)
@@ -275,6 +275,60 @@ const cases = {
     assert(fs.statSync(shot).size > 50000, "a screenshot with something in it");
     noProblems(a.problems);
   },
+};
+
+// A real renderer channel (skyshell-render, headless) flown by
+// skyshell-replay over CIGI appears in the renderer list and as an aircraft
+// on the map where the flight is.
+cases.renderers = async (cleanup) => {
+  const { w, hasWs, browser } = await setup("renderers", cleanup);
+  if ((await w.api("GET", "/api/renderers")).status === 404)
+    skip("this skyshell-weatherd has no GET /api/renderers yet (it comes with the WebSocket)");
+  if (!config.render || !config.replay || !config.flight) throw new Error("SKY_RENDER, SKY_REPLAY, SKY_TEST_FLIGHT must be set");
+  // lavapipe's JIT leaves allocations no suppression can name: no leak
+  // check for the renderer process (as in tests/integration).
+  const render = child(w.dir, "render", config.render, ["--headless", "--server", `127.0.0.1:${w.streamPort}`,
+    "--cigi-port", "0", "--port-file", path.join(w.dir, "render.port"), "--out", path.join(w.dir, "frames"),
+    "--width", "32", "--height", "18", "--weather-timeout", "60"], { ASAN_OPTIONS: "detect_leaks=0:abort_on_error=1" });
+  cleanup(() => render.stop());
+  const cigiPort = await until("the renderer's CIGI port", async () => {
+    const f = path.join(w.dir, "render.port");
+    return fs.existsSync(f) ? Number(fs.readFileSync(f, "utf8")) : 0;
+  }, 60000);
+  const replay = child(w.dir, "replay", config.replay, [config.flight, "--port", String(cigiPort), "--loop", "--quiet"]);
+  cleanup(() => replay.stop());
+  // The flight: level, heading east at 900 m near 46.2 N 12.8 E.
+  const listed = await until("the renderer in GET /api/renderers", async () => {
+    const list = (await w.api("GET", "/api/renderers")).json;
+    const arr = Array.isArray(list) ? list : list && list.renderers;
+    return arr && arr.find((r) => r.lat_deg !== null && Math.abs(r.lat_deg - 46.2) < 0.01);
+  }, 90000, 500);
+  near(listed.lon_deg, 12.8, 0.02, "renderer longitude");
+  near(listed.heading_deg, 90, 2, "renderer heading");
+  const lat0 = 46.2, lon0 = 12.8, scale = 20;
+  const a = await openConsole(browser, w, { allowed: withoutWebSocketAllowances(hasWs), name: "A",
+    hash: `#focus=${lat0},${lon0}&scale=${scale}` });
+  await until("the renderer row", async () => /46\.2/.test(await a.page.textContent("#renderers tbody")), 30000);
+  // The aircraft symbol is yellow (#ffe14d): look for it where the flight is
+  // on a flat local frame (the replay moves ~55 m/s east: up to 20 px here).
+  const found = await until("a yellow aircraft on the map", async () => {
+    const r = (await w.api("GET", "/api/renderers")).json;
+    const pose = (Array.isArray(r) ? r : r.renderers).find((x) => x.lat_deg !== null);
+    const x = ((pose.lon_deg - lon0) * D2R * R * Math.cos(lat0 * D2R)) / scale;
+    const y = (-(pose.lat_deg - lat0) * D2R * R) / scale;
+    return a.page.evaluate(([dx, dy]) => {
+      const c = document.querySelector("#map");
+      const g = c.getContext("2d");
+      const k = c.width / c.getBoundingClientRect().width;
+      const cx = (c.width / 2 + dx * k) | 0, cy = (c.height / 2 + dy * k) | 0, half = (30 * k) | 0;
+      const img = g.getImageData(cx - half, cy - half, 2 * half, 2 * half).data;
+      let yellow = 0;
+      for (let i = 0; i < img.length; i += 4) if (img[i] > 230 && img[i + 1] > 200 && img[i + 2] < 120) ++yellow;
+      return yellow > 10;
+    }, [x, y]);
+  }, 30000, 500);
+  assert(found, "the aircraft is drawn");
+  noProblems(a.problems);
 };
 
 // Installed (cmake --install into a fresh prefix), skyshell-weatherd finds

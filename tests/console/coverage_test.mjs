@@ -5,15 +5,15 @@
 // snapshot_builder.cpp: the weighted blend into the global layer).
 import { assert, near, run, skip } from "./harness.mjs";
 
-// The console's files are ES modules in a folder without a package.json:
-// Node.js reads them as such from 20 on (syntax detection).
-if (Number(process.versions.node.split(".")[0]) < 20) skip(`Node.js 20 or newer needed, this is ${process.version}`);
-const { coverageAt, regionEdgeDistance_m, regionOutline, regionWeight } = await import("../../server/console/coverage.js");
-const { direct, EARTH_RADIUS_M, inverse, Projection } = await import("../../server/console/geo.js");
 
 const smoothstep = (t) => t * t * (3 - 2 * t);
 
 run("coverage", async () => {
+  // The console's files are ES modules in a folder without a package.json:
+  // Node.js reads them as such from 20 on (syntax detection).
+  if (Number(process.versions.node.split(".")[0]) < 20) skip(`Node.js 20 or newer needed, this is ${process.version}`);
+  const { coverageAt, regionEdgeDistance_m, regionOutline, regionWeight } = await import("../../server/console/coverage.js");
+  const { direct, EARTH_RADIUS_M, inverse, Projection } = await import("../../server/console/geo.js");
   // A degree of the equator, due east.
   const eq = inverse(0, 0, 0, 1);
   near(eq.distance_m, (EARTH_RADIUS_M * Math.PI) / 180, 1e-6, "one degree of the equator");

@@ -11,20 +11,35 @@ import http from "node:http";
 import path from "node:path";
 
 export const SKIP = 77;  // ctest SKIP_RETURN_CODE
+
+// Every process a test starts, killed when this one exits however it exits
+// (a failed assertion, an exception, SIGTERM/SIGINT), so none outlives it.
+const children = new Set();
+process.on("exit", () => { for (const p of children) if (p.exitCode === null && p.signalCode === null) p.kill("SIGKILL"); });
+for (const signal of ["SIGTERM", "SIGINT"]) process.on(signal, () => process.exit(1));
+function track(proc) {
+  children.add(proc);
+  proc.on("exit", () => children.delete(proc));
+  return proc;
+}
 export const TOKEN = "console-test-token";
 
 const env = (name, fallback) => process.env[name] || fallback;
 export const config = {
   weatherd: env("SKY_WEATHERD"),
+  render: env("SKY_RENDER"),
+  replay: env("SKY_REPLAY"),
+  flight: env("SKY_TEST_FLIGHT"),
   scenario: env("SKY_SCENARIO"),
   stations: env("SKY_METAR_STATIONS"),
   out: env("SKY_CONSOLE_OUTPUT_DIR", path.resolve("console-output")),
   chromium: env("SKY_CHROMIUM", "/usr/bin/chromium"),
 };
 
+// Thrown to end a test as skipped; run() stops what the test started first.
+class Skipped extends Error {}
 export function skip(reason) {
-  console.log(`SKIPPED: ${reason}`);
-  process.exit(SKIP);
+  throw new Skipped(reason);
 }
 
 // The flags Chromium needs on this machine (.library/env/machines/cpp.md):
@@ -78,13 +93,15 @@ export class Weatherd {
 
   async start() {
     const portFile = path.join(this.dir, "http.port");
+    const streamPortFile = path.join(this.dir, "stream.port");
     fs.rmSync(portFile, { force: true });
-    const args = ["--scenario", config.scenario, "--port", "0", "--http-port", String(this.httpPort),
+    const args = ["--scenario", config.scenario, "--port", "0", "--port-file", streamPortFile,
+      "--http-port", String(this.httpPort),
       "--http-port-file", portFile, "--token-file", path.join(this.dir, "token"), "--heartbeat-ms", "200"];
     if (config.stations) args.push("--metar-stations", config.stations);
     if (this.db) args.push("--db", this.db);
     const log = fs.openSync(path.join(this.dir, `weatherd-${++this.starts}.log`), "w");
-    this.proc = spawn(config.weatherd, args, { stdio: ["ignore", log, log] });
+    this.proc = track(spawn(config.weatherd, args, { stdio: ["ignore", log, log] }));
     this.exited = new Promise((resolve) => this.proc.on("exit", (code, signal) => resolve({ code, signal })));
     const port = await until("the HTTP port file", async () => {
       const r = await Promise.race([this.exited.then((e) => ({ exit: e })), new Promise((res) => setTimeout(res, 50))]);
@@ -92,6 +109,7 @@ export class Weatherd {
       return fs.existsSync(portFile) ? Number(fs.readFileSync(portFile, "utf8")) : 0;
     }, 30000, 50).catch((e) => { throw new Error(`${e.message}\n${this.log()}`); });
     this.httpPort = port;
+    this.streamPort = Number(fs.readFileSync(streamPortFile, "utf8"));
     this.base = `http://127.0.0.1:${port}`;
     return this;
   }
@@ -138,6 +156,24 @@ export class Weatherd {
       req.end();
     });
   }
+}
+
+// A child process with its output in `dir`/`name`.log, stopped by stop().
+export function child(dir, name, file, args, extraEnv = {}) {
+  const log = fs.openSync(path.join(dir, `${name}.log`), "w");
+  const proc = track(spawn(file, args, { stdio: ["ignore", log, log], env: { ...process.env, ...extraEnv } }));
+  const exited = new Promise((resolve) => proc.on("exit", (code, signal) => resolve({ code, signal })));
+  return {
+    proc, exited,
+    log: () => fs.readFileSync(path.join(dir, `${name}.log`), "utf8"),
+    async stop() {
+      if (proc.exitCode !== null || proc.signalCode !== null) return;
+      proc.kill("SIGTERM");
+      const timer = setTimeout(() => proc.kill("SIGKILL"), 10000);
+      await exited;
+      clearTimeout(timer);
+    },
+  };
 }
 
 // Watches a page: console errors and uncaught exceptions are failures unless
@@ -192,6 +228,10 @@ export async function run(name, body) {
   }
   for (const fn of cleanups.reverse()) {
     try { await fn(); } catch (e) { if (!failed) failed = e; }
+  }
+  if (failed instanceof Skipped) {
+    console.log(`SKIPPED: ${failed.message}`);
+    process.exit(SKIP);
   }
   if (failed) {
     console.log(`FAILED ${name}: ${failed.stack || failed}`);
