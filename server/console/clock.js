@@ -61,7 +61,7 @@ export class ClockPanel {
         style: { left: pct(p.start_s), width: `max(3px, calc(${pct(p.end_s)} - ${pct(p.start_s)}))`, top: `${(i % 4) * 9 + 2}px` },
       })),
       el("span", { class: "tick", style: { left: "0" } }, "now"),
-      el("span", { class: "tick", style: { left: "50%" } }, clockText(now + span / 2)),
+      el("span", { class: "tick mid", style: { left: "50%" } }, clockText(now + span / 2)),
       el("span", { class: "tick end" }, clockText(end)));
     const list = $("#timeline-list", this.root);
     const key = JSON.stringify(pending.map((p) => [p.sequence, p.start_s <= now]));

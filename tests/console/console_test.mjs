@@ -143,6 +143,61 @@ const cases = {
     near(r.center_lon_deg, lon0 + (dx * scale) / (R * Math.cos(lat0 * D2R)) / D2R, 0.0015, "centre longitude");
     near(r.size_x_m, 16000, 300, "width after dragging the handle");
     assert(r.layers.length === 1 && r.layers[0].type === "cumulonimbus", "a storm cell's layer");
+    // The transition handle: the default 4 km perimeter ends 40 px beyond the
+    // 80 px edge; dragged out to 150 px it becomes 7 km.
+    await a.page.mouse.move(cx + dx + 120, cy + dy);
+    await a.page.mouse.down();
+    await a.page.mouse.move(cx + dx + 135, cy + dy, { steps: 4 });
+    await a.page.mouse.move(cx + dx + 150, cy + dy, { steps: 4 });
+    await a.page.mouse.up();
+    await a.page.click("#region-apply");
+    await until("the perimeter applied", async () => {
+      const g = (await w.state()).regions[0];
+      return g && Math.abs(g.transition_m - 7000) < 300;
+    });
+    // A clearing placed by press and drag: 60 px from its centre is a 12 km
+    // hole, every global layer at coverage 0 inside.
+    await a.page.click("#mode-clearing");
+    await a.page.mouse.move(cx - 150, cy + 100);
+    await a.page.mouse.down();
+    await a.page.mouse.move(cx - 120, cy + 100, { steps: 4 });
+    await a.page.mouse.move(cx - 90, cy + 100, { steps: 4 });
+    await a.page.mouse.up();
+    await a.page.click("#region-apply");
+    const clearing = await until("the clearing in the API", async () => (await w.state()).regions.find((g) => g.id !== r.id));
+    near(clearing.size_x_m, 12000, 300, "clearing size from the drag");
+    assert(clearing.layers.length === 1 && clearing.layers[0].id === 1 && clearing.layers[0].coverage === 0,
+      `a clearing of layer 1: ${JSON.stringify(clearing.layers)}`);
+    noProblems(a.problems);
+  },
+
+  // The weather clock: pause, a jump, a rate; a layer change scheduled as a
+  // ramp shows on the timeline and in the API's pending changes.
+  async clock(cleanup) {
+    const { w, hasWs, browser } = await setup("clock", cleanup);
+    const a = await openConsole(browser, w, { token: TOKEN, allowed: withoutWebSocketAllowances(hasWs), name: "A" });
+    await a.page.click('[data-rate="0"]');
+    await until("paused", async () => (await w.state()).clock_rate === 0);
+    await until("the page says paused", async () => /paused/.test(await a.page.textContent("#clock-rate")));
+    await a.page.fill('[name="jump"]', "12:00");
+    await a.page.click("#clock-jump-form button");
+    await until("the jump", async () => Math.abs((await w.state()).clock_s - 43200) < 1e-6);
+    await until("the page's clock", async () => (await a.page.textContent("#clock-now")) === "12:00:00");
+    // Coverage 0.6 -> 0.9 from 12:10 over 10 minutes.
+    await a.page.click('#layer-table tbody tr[data-id="1"]');
+    await a.page.fill('[name="coverage_oktas"]', "7.2");
+    assert((await a.page.inputValue('[name="coverage_pct"]')) === "90", "7.2 oktas is 90 %");
+    await a.page.fill('[name="ramp"]', "600");
+    await a.page.fill('[name="at"]', "12:10:00");
+    await a.page.click("#layer-apply");
+    await until("applied", async () => /applied #/.test(await a.page.textContent("#layers .note")));
+    const s = await w.state();
+    assert(s.pending.length === 1 && s.pending[0].start_s === 43800 && s.pending[0].end_s === 44400,
+      `pending: ${JSON.stringify(s.pending)}`);
+    near(s.layers[0].coverage, 0.6, 1e-12, "not yet started");
+    await until("the timeline entry", async () => /at 12:10:00, in 00:10:00/.test(await a.page.textContent("#timeline-list")));
+    await a.page.click('[data-rate="60"]');
+    await until("x60", async () => (await w.state()).clock_rate === 60);
     noProblems(a.problems);
   },
 
