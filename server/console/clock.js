@@ -1,8 +1,10 @@
 // The weather clock and the timeline: the clock now (extrapolated between
-// states at its rate), pause and rates x1/x10/x60, a jump to a time, and what
-// is scheduled or ramping next (the state's pending changes) on a bar
-// timeline and as a list.
-import { $, el, showErrors } from "./dom.js";
+// states at its rate), pause and rates x1/x10/x60, a jump to a time, loading a
+// scenario file (POST /api/scenario: its start replaces the weather, its
+// timeline is scheduled), and what is scheduled or ramping next (the state's
+// pending changes) on a bar timeline and as a list.
+import { request, session } from "./api.js";
+import { $, el, note, showErrors } from "./dom.js";
 import { clockText, parseClock } from "./units.js";
 
 const RATES = [0, 1, 10, 60];
@@ -20,6 +22,7 @@ export class ClockPanel {
       b.addEventListener("click", () => this.setRate(rate));
     }
     $("#clock-jump-form", root).addEventListener("submit", (e) => { e.preventDefault(); this.jump(); });
+    $("#scenario-form", root).addEventListener("submit", (e) => { e.preventDefault(); this.loadScenario(); });
     setInterval(() => this.tick(), 250);
   }
 
@@ -37,6 +40,40 @@ export class ClockPanel {
     }
     showErrors(form, {});
     await this.app.submit([{ op: "set_clock", jump_to_s: t }], form, { jump_to_s: "jump" }, $(".note", this.root));
+  }
+
+  // Reads the chosen TOML file in the browser (no upload of anything but its
+  // text) and asks the server to load it; its refusal names file and line.
+  async loadScenario() {
+    const form = $("#scenario-form", this.root);
+    const errors = $("#scenario-error", this.root);
+    const noteEl = $(".note", this.root);
+    const file = $('[name="scenario"]', form).files[0];
+    const refuse = (text) => {
+      errors.textContent = text;
+      $('[name="scenario"]', form).setAttribute("aria-invalid", "true");
+      note(noteEl, "scenario not loaded: nothing changed", "bad");
+    };
+    errors.textContent = "";
+    $('[name="scenario"]', form).removeAttribute("aria-invalid");
+    if (!file) return refuse("choose a scenario file (.toml) first");
+    if (file.size > 1 << 20) return refuse(`${file.name}: ${file.size} bytes, at most 1 MiB`);
+    if (!this.app.canEdit()) return note(noteEl, "read-only: enter the token first", "bad");
+    note(noteEl, `loading ${file.name}…`, "busy");
+    const r = await request("POST", "/api/scenario", { toml: await file.text(), name: file.name, author: session.author() },
+      { auth: true });
+    if (r.ok) {
+      note(noteEl, `loaded ${file.name} (#${r.body.sequence}): ${r.body.layers} layer(s), ` +
+        `${r.body.timeline} timeline entr${r.body.timeline === 1 ? "y" : "ies"}`, "ok");
+      this.app.changed(r);
+    } else if (r.status === 401) {
+      this.app.tokenRefused();
+      note(noteEl, "the server refused the token: read-only now; nothing applied", "bad");
+    } else if (r.status === 404) {
+      refuse("this server cannot load scenarios (no POST /api/scenario)");
+    } else {
+      refuse(r.body.error || `HTTP ${r.status}`);
+    }
   }
 
   tick() {
@@ -72,7 +109,8 @@ export class ClockPanel {
     }
     this.listKey = key;
     list.replaceChildren(...(pending.length ? pending.map((p) => el("li", {},
-      el("span", { class: "when" }, this.when(p, now)), ` #${p.sequence} ${p.summary}`))
+      el("span", { class: "when" }, this.when(p, now)), p.kind === "timeline" ? el("span", { class: "badge" }, "scenario") : "",
+      ` #${p.sequence} ${p.summary}`))
       : [el("li", { class: "muted" }, "nothing scheduled")]));
   }
 

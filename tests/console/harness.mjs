@@ -126,11 +126,13 @@ export class Weatherd {
     clearTimeout(timer);
   }
 
-  // A JSON request to the API from outside the browser (the independent view).
+  // A request to the API from outside the browser (the independent view):
+  // an object body goes as JSON, a string as it is.
   async api(method, target, body, token = TOKEN) {
-    const headers = { "Content-Type": "application/json" };
+    const headers = { "Content-Type": typeof body === "string" ? "text/plain" : "application/json" };
     if (token) headers.Authorization = `Bearer ${token}`;
-    const r = await fetch(this.base + target, { method, headers, body: body === undefined ? undefined : JSON.stringify(body) });
+    const r = await fetch(this.base + target, { method, headers,
+      body: body === undefined ? undefined : typeof body === "string" ? body : JSON.stringify(body) });
     const text = await r.text();
     let json = null;
     try { json = JSON.parse(text); } catch { /* not JSON */ }
