@@ -165,7 +165,11 @@ function updateEditable() {
 }
 
 const link = new LiveLink({
-  hello: (m) => { $("#server-id").textContent = m.server_id; },
+  hello: (m) => {
+    // This page speaks version 1 of the feed; a newer server is named so an
+    // odd display has an explanation.
+    $("#server-id").textContent = m.server_id + (m.api_version > 1 ? ` (feed v${m.api_version}; this console reads v1)` : "");
+  },
   state: (s) => {
     app.stateValue = s;
     app.stateAt_ms = performance.now();
