@@ -164,14 +164,14 @@ std::string reportMarkdown(const BenchReport& report) {
      << "* " << report.timingSource << "\n"
      << "* " << report.warmup << " warm-up frames per case, then " << report.repeats << " timed renders of each still, "
      << report.pathRepeats << " timed run(s) of each camera path; error against `reference` at the same resolution "
-     << "(paths: mean over frames, worst frame in the contact sheet)\n\n";
+     << "(paths: mean over frames; a path's contact sheet shows its last frame with that frame's SSIM and PSNR)\n\n";
   std::set<std::pair<std::uint32_t, std::uint32_t>> sizes;
   for (const CaseResult& c : report.cases) sizes.insert({c.width, c.height});
   for (const auto& [w, h] : sizes) {
     md << "## " << w << "x" << h << "\n\n"
-       << "| scene | configuration | wall ms median [min, max] | GPU ms | cores | speed-up | RMSE linear | PSNR dB | "
-          "SSIM | flicker | ghosting | contact sheet |\n"
-       << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+       << "| scene | configuration | wall ms median [min, max] | GPU ms | cores | M lookups/s | speed-up | RMSE linear | "
+          "PSNR dB | SSIM | flicker | ghosting | contact sheet |\n"
+       << "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const CaseResult& c : report.cases) {
       if (c.width != w || c.height != h) continue;
       md << "| " << c.scene << (c.path ? " (path)" : "") << " | " << c.configuration
@@ -180,7 +180,7 @@ std::string reportMarkdown(const BenchReport& report) {
          << " | " << fixed(c.wall_ms.median, 2) << " [" << fixed(c.wall_ms.min, 2) << ", " << fixed(c.wall_ms.max, 2)
          << "] | " << (c.gpu_ms ? fixed(c.gpu_ms->median, 2) : "n/a") << " | "
          << fixed(c.wall_ms.median > 0 ? c.cpu_ms.median / c.wall_ms.median : NAN, 2) << " | "
-         << fixed(speedup(refs, c), 2) << "x | " << fixed(c.error.rmseLinear, 4) << " | " << fixed(c.error.psnr_dB, 2)
+         << (c.lookupsPerSecond ? fixed(*c.lookupsPerSecond * 1e-6, 1) : "n/a") << " | " << fixed(speedup(refs, c), 2) << "x | " << fixed(c.error.rmseLinear, 4) << " | " << fixed(c.error.psnr_dB, 2)
          << " | " << fixed(c.error.ssim, 4) << " | "
          << (c.temporal ? fixed(c.temporal->meanFlicker, 2) : "") << " | "
          << (c.temporal ? fixed(c.temporal->meanGhosting, 3) : "") << " | [sheet](" << c.contactSheet << ") |";

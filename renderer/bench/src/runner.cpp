@@ -199,11 +199,14 @@ Result<std::string> writeSceneImages(const std::string& stem, const std::vector<
       continue;
     }
     auto map = errorHeatMap(img, ref);
-    if (!map) return tl::unexpected(map.error());
+    auto shownSsim = ssim(img, ref);
+    auto shownPsnr = psnr(img, ref);
+    if (!map || !shownSsim || !shownPsnr) return fail(ErrorCode::InvalidArgument, stem + ": cannot compare images");
     heat[i] = std::move(*map);
+    // The metrics of the frame shown (a path's last), not of the whole path.
     rows.push_back({{&img, timeLabel},
                     {&ref, "REFERENCE"},
-                    {&heat[i], "SSIM " + fixed(cases[i].worst.ssim, 3) + " PSNR " + fixed(cases[i].worst.psnr_dB, 1)}});
+                    {&heat[i], "SSIM " + fixed(*shownSsim, 3) + " PSNR " + fixed(*shownPsnr, 1)}});
   }
   const std::string title = stem + (cases.front().path ? " (LAST FRAME)" : "") + " - ERROR 0 TO " +
                             fixed(kHeatMapFullScale, 0) + " LEVELS, BLACK TO WHITE";
