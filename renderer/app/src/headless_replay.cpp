@@ -197,6 +197,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
       exitCode = 3;
       break;
     }
+    if (weather) weather->reportCamera(pose, i, view.version, in.weatherClock_s);
     FrameRecord record;
     record.frame = i;
     record.host.pose = pose;

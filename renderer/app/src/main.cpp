@@ -62,6 +62,7 @@ struct Options {
   bool noVideo = false;
   bool fixedSun = false;
   std::string weatherFile;
+  std::string channel;  // name in the operator console; empty: render@<host>
 };
 
 // Set by SIGINT/SIGTERM during a --replay (which runs no io_context of its own
@@ -88,6 +89,8 @@ int main(int argc, char** argv) {
   Options o;
   CLI::App app{"skyshell-render: a Skyshell image generator channel"};
   app.add_option("--server", o.server, "weather server HOST:PORT");
+  app.add_option("--channel", o.channel,
+                 "this channel's name in the operator console (at most 64 bytes; default render@<host>)");
   app.add_option("--cigi-address", o.cigiAddress, "address to receive CIGI on");
   app.add_option("--cigi-port", o.cigiPort, "UDP port to receive CIGI on (0 = any free port)")
       ->check(CLI::Range(0, 65535));
@@ -223,7 +226,7 @@ int main(int argc, char** argv) {
     }
     fdm->start();
   }
-  sky::app::WeatherClient weather(io, state, serverHost, static_cast<unsigned short>(serverPort));
+  sky::app::WeatherClient weather(io, state, serverHost, static_cast<unsigned short>(serverPort), o.channel);
   weather.start();
   std::thread ioThread([&] { io.run(); });
   auto shutdown = [&] {
@@ -330,6 +333,7 @@ int main(int argc, char** argv) {
     record.layerCount = view.snapshot.layers.size();
     record.stats = sky::render::computeStats(*image);
     record.render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    weather.reportCamera(pose->pose, frames, view.version, in.weatherClock_s);
     if (auto ok = writer->write(*image, record); !ok) {
       std::fprintf(stderr, "skyshell-render: %s\n", sky::describe(ok.error()).c_str());
       exitCode = 2;
