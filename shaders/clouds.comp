@@ -23,6 +23,7 @@ layout(set = 0, binding = kBindingWeather) uniform sampler2DArray weatherTex;
 layout(std430, set = 0, binding = kBindingOutput) writeonly buffer OutputBlock { vec4 pixels[]; };
 layout(set = 0, binding = kBindingDetail) uniform sampler3D detailTex;
 layout(set = 0, binding = kBindingTransmittance) uniform sampler2D transmittanceTex;
+layout(set = 0, binding = kBindingMultipleScattering) uniform sampler2D multipleScatteringTex;
 
 #define real float
 #define real2 vec2
@@ -38,6 +39,10 @@ mat3 gLocalToEcef;     // camera-local -> ECEF axes
 
 vec3 sampleTransmittanceLut(vec2 uv) {
   return textureLod(transmittanceTex, uv, 0.0).rgb;
+}
+
+vec3 sampleMultipleScatteringLut(vec2 uv) {
+  return textureLod(multipleScatteringTex, uv, 0.0).rgb;
 }
 
 #include "cloud_core.glsl"
@@ -59,8 +64,12 @@ vec3 noiseCoord(vec4 origin, vec3 p) {
   return origin.xyz + (gLocalToEcef * p) * origin.w;
 }
 
+// The shape noise, stretched along ECEF z for streaky types (the origin is
+// stretched the same way on the CPU, so the pattern stays Earth-fixed).
 vec2 sampleShape(LayerSampling s, vec3 p) {
-  return textureLod(shapeTex, noiseCoord(s.shapeOrigin, p), 0.0).rg;
+  vec3 e = gLocalToEcef * p;
+  e.z *= s.shapeStretchZ;
+  return textureLod(shapeTex, s.shapeOrigin.xyz + e * s.shapeOrigin.w, 0.0).rg;
 }
 
 float sampleDetail(LayerSampling s, vec3 p) {
@@ -97,7 +106,7 @@ CloudType unpackType(SkyCloudType t) {
 CoreLayer layerAt(int li) {
   SkyLayer l = frame.layers[li];
   LayerSampling s = LayerSampling(l.shapeOrigin, l.detailOrigin, l.cloudMapOrigin,
-                                  vec3(l.coverageShift.xy, l.shape.y));
+                                  vec3(l.coverageShift.xy, l.shape.y), l.coverageShift.w);
   return CoreLayer(l.heights.x, l.heights.y, l.heights.z, l.heights.w, l.shape.x, l.shape.z, l.shape.w > 0.5,
                    unpackType(l.primary), unpackType(l.secondary), l.ambient.rgb, l.sunDiffuse.rgb,
                    l.sunDiffuse.w, s);

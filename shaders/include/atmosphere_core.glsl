@@ -6,8 +6,10 @@
 // atmosphere rendering technique"; values in reference/formulas.md), the
 // transmittance-table parametrisation, sunlight with the Earth's shadow, and
 // single scattering marched along a view ray with queries at cloud depths
-// (aerial perspective). Needs core_common.glsl, and one texture hook:
-//   real3 sampleTransmittanceLut(real2 uv)  // transmittance to the top, bilinear
+// (aerial perspective), with Hillaire 2020's multiple-scattering term.
+// Needs core_common.glsl, and two texture hooks:
+//   real3 sampleTransmittanceLut(real2 uv)        // transmittance to the top, bilinear
+//   real3 sampleMultipleScatteringLut(real2 uv)   // multiple-scattering radiance, bilinear
 // Heights are above the local ground sphere (m); mu is the cosine of the
 // angle from the local vertical.
 
@@ -47,6 +49,16 @@ SKY_CORE_CONST int kTransmittanceLutHeight = 64;
 // ~1 % of a 2000-step integral above the horizon (atmosphere_test.cpp) at
 // ~15 % of a 320x180 frame on lavapipe.
 SKY_CORE_CONST int kAirSteps = 16;
+// Multiple-scattering table (Hillaire 2020, sec. 5.5): 32 x 32 over (sun
+// cosine, height), each texel from 16 x 16 equal-solid-angle directions of
+// 20 steps (Hillaire's 64 directions are up to 18 % off a fine integral of
+// the same definition at low sun, 256 within 8 %: atmosphere_test.cpp).
+SKY_CORE_CONST int kMultipleScatteringLutSize = 32;
+SKY_CORE_CONST int kMultipleScatteringSide = 16;  // directions: side x side
+SKY_CORE_CONST int kMultipleScatteringDirections = kMultipleScatteringSide * kMultipleScatteringSide;
+SKY_CORE_CONST int kMultipleScatteringSteps = 20;
+// Ground albedo the multiple scattering sees (the renderer's ground, 0.1).
+SKY_CORE_CONST real kAirGroundAlbedo = 0.1;
 // Distances a view ray reports the air's in-scattering and transmittance at:
 // one per cloud layer plus the end of the ray.
 SKY_CORE_CONST int kAirQueries = 5;
@@ -170,7 +182,68 @@ real3 sunTransmittance(real h, real muSun, real groundRadius) {
   return sampleTransmittanceLut(transmittanceUv(h, clamp(muSun, -1.0, 1.0))) * vis;
 }
 
-// Single scattering of sunlight by the air along dir from the camera, with
+// Texture coordinates of (sun cosine, height) in the multiple-scattering
+// table, on texel centres (Hillaire 2020: u = 0.5 + 0.5 muS, v = h / H).
+real2 multipleScatteringUv(real h, real muSun) {
+  real n = real(kMultipleScatteringLutSize);
+  real u = clamp(0.5 + 0.5 * muSun, 0.0, 1.0);
+  real v = clamp(h / kAtmosphereHeight_m, 0.0, 1.0);
+  return real2(0.5 / n + u * (1.0 - 1.0 / n), 0.5 / n + v * (1.0 - 1.0 / n));
+}
+
+// Hillaire 2020's multiple scattering at height h for the sun at cosine
+// muSun, per unit sun irradiance: the second-order radiance L2 (sunlight
+// scattered once, isotropically, from all around, plus the lit ground) over
+// 1 - f, f the fraction of isotropic light the surrounding air scatters back
+// (the sum of all further orders, L2 (1 + f + f^2 + ...)). Built into a table
+// on the CPU; the sky march adds sigma_s times it. Directions: a grid of
+// equal solid angle, uniform in mu and phi.
+real3 multipleScattering(real h, real muSun) {
+  real R = kAtmosphereBottomRadius_m;
+  real r = R + h;
+  real3 sunDir = real3(sqrt(max(1.0 - muSun * muSun, 0.0)), 0.0, muSun);
+  real3 L2 = real3(0.0);
+  real3 f = real3(0.0);
+  int side = kMultipleScatteringSide;
+  for (int k = 0; k < kMultipleScatteringDirections; ++k) {
+    real mu = 1.0 - 2.0 * (real(k / side) + 0.5) / real(side);
+    real phi = 2.0 * kPi * (real(k - (k / side) * side) + 0.5) / real(side);
+    real s = sqrt(max(1.0 - mu * mu, 0.0));
+    real3 dir = real3(s * cos(phi), s * sin(phi), mu);
+    // To the ground (if the ray meets it: downwards, inside its horizon; at
+    // h = 0 at once) or the top. Never through the Earth.
+    real cGround = h * (2.0 * r - h);
+    Roots ground = intersectSphere(r, cGround, mu);
+    bool hitsGround = mu < 0.0 && ground.hit;
+    real tMax = hitsGround ? max(ground.t0, 0.0) : distanceToAtmosphereTop(h, mu);
+    real dt = tMax / real(kMultipleScatteringSteps);
+    real3 transmittance = real3(1.0);
+    real3 Li = real3(0.0);
+    real3 fi = real3(0.0);
+    for (int j = 0; j < kMultipleScatteringSteps; ++j) {
+      real3 x = real3(0.0, 0.0, r) + dir * ((real(j) + 0.5) * dt);
+      real rx = length(x);
+      real hx = rx - R;
+      real3 sigmaS = rayleighScattering(hx) + real3(kMieScattering_perm * mieDensity(hx));
+      real3 sigmaT = airExtinction(hx);
+      real3 sun = sunTransmittance(hx, dot(x / rx, sunDir), R);
+      real3 part = scatterFraction3(sigmaT * dt) * dt;  // (1 - e^{-sigma dt}) / sigma
+      Li += transmittance * sigmaS * sun * part / (4.0 * kPi);
+      fi += transmittance * sigmaS * part;
+      transmittance *= exp(-sigmaT * dt);
+    }
+    if (hitsGround) {
+      real3 g = real3(0.0, 0.0, r) + dir * tMax;
+      real muGround = dot(normalize(g), sunDir);
+      Li += transmittance * sunTransmittance(0.0, muGround, R) * max(muGround, 0.0) * (kAirGroundAlbedo / kPi);
+    }
+    L2 += Li / real(kMultipleScatteringDirections);
+    f += fi / real(kMultipleScatteringDirections);
+  }
+  return L2 / (real3(1.0) - f);
+}
+
+// Sunlight scattered by the air along dir from the camera, with
 // the camera's air to distance tEnd (the ground, or past the atmosphere),
 // reported at the queried distances q[0..count) (ascending, any values: a
 // query before the air starts reports nothing yet, past tEnd the whole path).
@@ -208,9 +281,15 @@ AirPath marchAir(AirFrame a, real3 dir, real tEnd, real q[kAirQueries], int coun
     real3 p = dir * tm;
     real h = heightAboveCameraSphere(p, a.r) + a.h;
     real3 sigmaT = airExtinction(h);
-    real3 sun = a.sunIrradiance * sunTransmittance(h, dot(upAt(p, a.r), a.sunDir), groundRadius);
-    // Source per unit length: sigma_s p E_sun T_sun for both scatterers.
-    real3 source = (rayleighScattering(h) * pR + real3(kMieScattering_perm * mieDensity(h) * pM)) * sun;
+    real muSun = dot(upAt(p, a.r), a.sunDir);
+    real3 sun = a.sunIrradiance * sunTransmittance(h, muSun, groundRadius);
+    // Source per unit length: sigma_s p E_sun T_sun for both scatterers, and
+    // sigma_s times the multiple-scattering radiance (Hillaire 2020, eq. 11).
+    real3 rayleigh = rayleighScattering(h);
+    real mie = kMieScattering_perm * mieDensity(h);
+    real3 source = (rayleigh * pR + real3(mie * pM)) * sun +
+                   (rayleigh + real3(mie)) * sampleMultipleScatteringLut(multipleScatteringUv(h, muSun)) *
+                       a.sunIrradiance;
     // Queries inside this step: the exact part of the step up to each.
     while (next < count && q[next] < s1) {
       real d = q[next] - s0;

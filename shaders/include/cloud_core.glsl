@@ -73,6 +73,7 @@ struct LayerSampling {
   real4 detailOrigin;    // the same for the detail noise
   real4 cloudMapOrigin;  // the same for the cloud map
   real3 coverageShift;   // xy: coverage drift east/north (m); z: weather-map slice
+  real shapeStretchZ;    // the shape noise's ECEF z scale: < 1 draws streaks along the Earth's axis
 };
 
 struct CoreLayer {
@@ -318,13 +319,45 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
   return res;
 }
 
-// Lambertian ground at distance t along dir: sunlight through the air
-// (no cloud shadows yet) and the sky's irradiance.
+// Transmission of sunlight and sky light down through every layer to the
+// ground point p (camera-relative): each layer's coverage and density where
+// the sun ray crosses its middle, its type's mean column depth, and the same
+// two-stream split as diffuseLight (direct e^(-tau/mu), the rest diffused
+// by t(tau)). x: direct sun factor, y: diffuse factor for the sun's
+// scattered part and the sky. Shadows at the weather map's scale (~1 km),
+// without the noise's shapes.
+real2 groundShadow(CoreFrame f, real3 p, real muSun) {
+  real direct = 1.0;
+  real diffuse = 1.0;
+  real mu = max(muSun, kMinSunCosine);
+  real groundRadius = f.air.r - f.air.h;
+  for (int k = 0; k < f.layerCount; ++k) {
+    CoreLayer L = layerAt(k);
+    // Height of the layer's middle above the ground, and the distance to it
+    // along the sun from the ground (stable sphere root).
+    real hMid = max(f.air.h - 0.5 * (L.hBase + L.hTop), 0.0);
+    real c2 = hMid * (2.0 * groundRadius + hMid);
+    real d = c2 / (groundRadius * mu + sqrt(groundRadius * groundRadius * mu * mu + c2));
+    real3 weather = sampleWeather(L.sampling, p + f.air.sunDir * d);
+    CloudType t = L.blends ? mixCloudType(L.primary, L.secondary, weather.z) : L.primary;
+    real tau = t.extinction_perm * weather.y * weather.x * t.columnFill * L.thickness;
+    real beam = exp(-tau / mu);
+    real spread = 1.0 / (1.0 + 0.75 * (1.0 - kDiffuseAsymmetry) * tau);
+    direct *= beam;
+    diffuse *= spread;
+  }
+  return real2(direct, diffuse);
+}
+
+// Lambertian ground at distance t along dir: sunlight and sky light through
+// the air and the cloud layers above it.
 real3 groundRadiance(CoreFrame f, real3 dir, real t) {
   real3 p = dir * t;
   real muSun = dot(upAt(p, f.air.r), f.air.sunDir);
   real3 sun = f.air.sunIrradiance * sunTransmittance(0.0, muSun, f.air.r - f.air.h) * max(muSun, 0.0);
-  return (sun + f.groundIrradiance) * (kGroundAlbedo / kPi);
+  real2 shadow = groundShadow(f, p, muSun);
+  real3 light = sun * (shadow.x + (1.0 - shadow.x) * shadow.y) + f.groundIrradiance * shadow.y;
+  return light * (kGroundAlbedo / kPi);
 }
 
 // Radiance along dir (unit, local frame): the layers front to back, each seen

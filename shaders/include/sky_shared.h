@@ -26,6 +26,7 @@ SKY_SHARED_CONST kBindingWeather = 2u;        // sampler2DArray, RGBA8 = coverag
 SKY_SHARED_CONST kBindingOutput = 3u;         // storage buffer of vec4 radiance (rgb) + transmittance (a)
 SKY_SHARED_CONST kBindingDetail = 4u;         // sampler3D, tileable Worley detail noise (R8, repeat)
 SKY_SHARED_CONST kBindingTransmittance = 5u;  // sampler2D, atmosphere transmittance table (RGBA16F, clamp)
+SKY_SHARED_CONST kBindingMultipleScattering = 6u;  // sampler2D, atmosphere multiple scattering (RGBA16F, clamp)
 
 // Workgroup edge of the cloud pass, pixels (8x8 = 64 invocations = 8 lavapipe
 // subgroups of 8 lanes).
@@ -53,7 +54,8 @@ struct SkyLayer {
                        // w: 1 / shape period (1/m)
   vec4 detailOrigin;   // the same for the detail noise and its period
   vec4 cloudMapOrigin; // the same for the cloud map (the shape texture at a larger period)
-  vec4 coverageShift;  // xy: coverage drift east/north in the weather map plane (m), zw: unused
+  vec4 coverageShift;  // xy: coverage drift east/north in the weather map plane (m), z: unused,
+                       // w: the shape noise's ECEF z scale (1, or < 1 for streaks)
   vec4 ambient;        // rgb: mean sky radiance at the layer top (linear units); w: unused
   vec4 sunDiffuse;     // rgb: sunlight at the layer top as diffuse radiance, E T mu / pi; w: mu of the sun
   SkyCloudType primary;    // the layer's own type

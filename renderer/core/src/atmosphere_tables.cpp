@@ -30,6 +30,7 @@ class AirCore {
   explicit AirCore(const AtmosphereTables* tables) : tables_(tables) {}
 
   real3 sampleTransmittanceLut(real2 uv) const { return tables_->sampleTransmittance(uv); }
+  real3 sampleMultipleScatteringLut(real2 uv) const { return tables_->sampleMultipleScattering(uv); }
 
 #define SKY_CORE_CONST static constexpr
 #include "core_common.glsl"
@@ -46,8 +47,8 @@ constexpr int kSkyAzimuths = 16;
 
 }  // namespace
 
-glm::dvec3 AtmosphereTables::sampleTransmittance(const glm::dvec2& uv) const {
-  SKY_ASSERT(width > 0 && height > 0 && transmittance.size() == std::size_t(width) * height * 4);
+glm::dvec3 AtmosphereTable::sample(const glm::dvec2& uv) const {
+  SKY_ASSERT(width > 0 && height > 0 && texels.size() == std::size_t(width) * height * 4);
   const double tx = std::clamp(uv.x, 0.0, 1.0) * width - 0.5;
   const double ty = std::clamp(uv.y, 0.0, 1.0) * height - 0.5;
   const double fx = std::floor(tx), fy = std::floor(ty);
@@ -60,38 +61,56 @@ glm::dvec3 AtmosphereTables::sampleTransmittance(const glm::dvec2& uv) const {
       const int j = std::clamp(j0 + dj, 0, int(height) - 1);
       const std::size_t idx = (std::size_t(j) * width + std::size_t(i)) * 4;
       const double w = (di ? ax : 1 - ax) * (dj ? ay : 1 - ay);
-      sum += w * glm::dvec3(glm::unpackHalf1x16(transmittance[idx]), glm::unpackHalf1x16(transmittance[idx + 1]),
-                            glm::unpackHalf1x16(transmittance[idx + 2]));
+      sum += w * glm::dvec3(glm::unpackHalf1x16(texels[idx]), glm::unpackHalf1x16(texels[idx + 1]),
+                            glm::unpackHalf1x16(texels[idx + 2]));
     }
   return sum;
 }
 
 double atmosphereHeight_m() { return AirCore::kAtmosphereHeight_m; }
 
+namespace {
+
+void store(AtmosphereTable& table, std::uint32_t i, std::uint32_t j, const glm::dvec3& v) {
+  const std::size_t idx = (std::size_t(j) * table.width + i) * 4;
+  for (int c = 0; c < 3; ++c) table.texels[idx + std::size_t(c)] = glm::packHalf1x16(float(v[c]));
+  table.texels[idx + 3] = glm::packHalf1x16(1.0f);
+}
+
+}  // namespace
+
 AtmosphereTables buildAtmosphereTables() {
   using C = AirCore;
   AtmosphereTables tables;
-  tables.width = std::uint32_t(C::kTransmittanceLutWidth);
-  tables.height = std::uint32_t(C::kTransmittanceLutHeight);
-  tables.transmittance.resize(std::size_t(tables.width) * tables.height * 4);
-  AirCore core(nullptr);
+  AtmosphereTable& t = tables.transmittance;
+  t.width = std::uint32_t(C::kTransmittanceLutWidth);
+  t.height = std::uint32_t(C::kTransmittanceLutHeight);
+  t.texels.resize(std::size_t(t.width) * t.height * 4);
+  AirCore core(&tables);
   const double R = C::kAtmosphereBottomRadius_m, H = C::kAtmosphereHeight_m;
   const double rhoTop = std::sqrt(H * (2 * R + H));
-  for (std::uint32_t j = 0; j < tables.height; ++j)
-    for (std::uint32_t i = 0; i < tables.width; ++i) {
+  for (std::uint32_t j = 0; j < t.height; ++j)
+    for (std::uint32_t i = 0; i < t.width; ++i) {
       // Inverse of transmittanceUv at the texel centre (Bruneton 2017 sec. 4).
-      const double xMu = double(i) / double(tables.width - 1);
-      const double xR = double(j) / double(tables.height - 1);
+      const double xMu = double(i) / double(t.width - 1);
+      const double xR = double(j) / double(t.height - 1);
       const double rho = rhoTop * xR;
       const double r = std::sqrt(rho * rho + R * R);
       const double h = rho * rho / (r + R);  // r - R without cancellation
       const double dMin = H - h, dMax = rho + rhoTop;
       const double d = dMin + xMu * (dMax - dMin);
       const double mu = d <= 0 ? 1.0 : std::clamp((rhoTop * rhoTop - rho * rho - d * d) / (2 * r * d), -1.0, 1.0);
-      const glm::dvec3 t = core.transmittanceToTop(h, mu, kTransmittanceTableSteps);
-      const std::size_t idx = (std::size_t(j) * tables.width + i) * 4;
-      for (int c = 0; c < 3; ++c) tables.transmittance[idx + std::size_t(c)] = glm::packHalf1x16(float(t[c]));
-      tables.transmittance[idx + 3] = glm::packHalf1x16(1.0f);
+      store(t, i, j, core.transmittanceToTop(h, mu, kTransmittanceTableSteps));
+    }
+  // The multiple scattering reads the transmittance table just built.
+  AtmosphereTable& m = tables.multipleScattering;
+  m.width = m.height = std::uint32_t(C::kMultipleScatteringLutSize);
+  m.texels.resize(std::size_t(m.width) * m.height * 4);
+  for (std::uint32_t j = 0; j < m.height; ++j)
+    for (std::uint32_t i = 0; i < m.width; ++i) {
+      const double muSun = 2.0 * double(i) / double(m.width - 1) - 1.0;
+      const double h = H * double(j) / double(m.height - 1);
+      store(m, i, j, core.multipleScattering(h, muSun));
     }
   return tables;
 }

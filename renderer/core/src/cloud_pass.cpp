@@ -37,6 +37,7 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
       .binding(gpu::kBindingOutput, vk::DescriptorType::eStorageBuffer)
       .binding(gpu::kBindingDetail, vk::DescriptorType::eCombinedImageSampler)
       .binding(gpu::kBindingTransmittance, vk::DescriptorType::eCombinedImageSampler)
+      .binding(gpu::kBindingMultipleScattering, vk::DescriptorType::eCombinedImageSampler)
       .shader("clouds.comp.spv");
   auto pipeline = builder.build(ctx);
   if (!pipeline) return tl::unexpected(pipeline.error());
@@ -56,10 +57,16 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
   pass.detail_ = noiseImage(detail, "sky.detailNoise");
   if (auto ok = uploadImage(ctx, pass.detail_, std::as_bytes(std::span(detail.texels))); !ok)
     return tl::unexpected(ok.error());
-  pass.transmittance_ = createSampledImage(ctx, vk::ImageType::e2D, vk::Format::eR16G16B16A16Sfloat,
-                                           vk::Extent3D(atmosphere.width, atmosphere.height, 1), 1,
-                                           "sky.transmittanceTable");
-  if (auto ok = uploadImage(ctx, pass.transmittance_, std::as_bytes(std::span(atmosphere.transmittance))); !ok)
+  auto tableImage = [&](const AtmosphereTable& t, const char* name) {
+    return createSampledImage(ctx, vk::ImageType::e2D, vk::Format::eR16G16B16A16Sfloat,
+                              vk::Extent3D(t.width, t.height, 1), 1, name);
+  };
+  pass.transmittance_ = tableImage(atmosphere.transmittance, "sky.transmittanceTable");
+  if (auto ok = uploadImage(ctx, pass.transmittance_, std::as_bytes(std::span(atmosphere.transmittance.texels))); !ok)
+    return tl::unexpected(ok.error());
+  pass.multipleScattering_ = tableImage(atmosphere.multipleScattering, "sky.multipleScatteringTable");
+  if (auto ok = uploadImage(ctx, pass.multipleScattering_, std::as_bytes(std::span(atmosphere.multipleScattering.texels)));
+      !ok)
     return tl::unexpected(ok.error());
 
   // A storage buffer, not a uniform buffer: see clouds.comp's FrameBlock.
@@ -67,7 +74,7 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
   pass.output_ = createHostBuffer(ctx, vk::DeviceSize(width) * height * 4 * sizeof(float),
                                   vk::BufferUsageFlagBits::eStorageBuffer, "sky.cloudOutput");
 
-  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eCombinedImageSampler, 4),
+  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eCombinedImageSampler, 5),
                              vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 2)};
   pass.descriptorPool_ = vk::raii::DescriptorPool(
       device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSizes));
@@ -83,6 +90,8 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
   const vk::DescriptorImageInfo detailInfo(*pass.noiseSampler_, *pass.detail_.view, vk::ImageLayout::eShaderReadOnlyOptimal);
   const vk::DescriptorImageInfo tableInfo(*pass.tableSampler_, *pass.transmittance_.view,
                                           vk::ImageLayout::eShaderReadOnlyOptimal);
+  const vk::DescriptorImageInfo msInfo(*pass.tableSampler_, *pass.multipleScattering_.view,
+                                       vk::ImageLayout::eShaderReadOnlyOptimal);
   const vk::DescriptorImageInfo weatherInfo(*pass.weatherSampler_, *weather.image().view,
                                             vk::ImageLayout::eShaderReadOnlyOptimal);
   const vk::DescriptorSet set = *pass.descriptorSet_;
@@ -91,6 +100,7 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
       vk::WriteDescriptorSet(set, gpu::kBindingShape, 0, vk::DescriptorType::eCombinedImageSampler, shapeInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingDetail, 0, vk::DescriptorType::eCombinedImageSampler, detailInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingTransmittance, 0, vk::DescriptorType::eCombinedImageSampler, tableInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingMultipleScattering, 0, vk::DescriptorType::eCombinedImageSampler, msInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingWeather, 0, vk::DescriptorType::eCombinedImageSampler, weatherInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingOutput, 0, vk::DescriptorType::eStorageBuffer, {}, outputInfo)};
   device.updateDescriptorSets(writes, {});

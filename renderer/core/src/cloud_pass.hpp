@@ -1,6 +1,6 @@
 // The cloud pass: one compute dispatch over the image (shaders/clouds.comp)
 // with its frame block, shape and detail noise, the atmosphere's
-// transmittance table, samplers, output buffer, descriptor set and command
+// transmittance and multiple-scattering tables, samplers, output buffer, descriptor set and command
 // buffer. Blocking: run() returns the read-back image.
 #pragma once
 
@@ -42,6 +42,7 @@ class CloudPass {
   GpuImage shape_;
   GpuImage detail_;
   GpuImage transmittance_;
+  GpuImage multipleScattering_;
   GpuBuffer uniforms_;  // the frame block (a storage buffer, see clouds.comp)
   GpuBuffer output_;
   vk::raii::DescriptorPool descriptorPool_{nullptr};

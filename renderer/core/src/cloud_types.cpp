@@ -17,6 +17,8 @@
 //  * column fill: the mean density over a column through a cloud (the
 //    profiles' mean, about 0.5 for the growing cumulus profile, more for the
 //    sheets, less for the wispy ice), for the depth the diffuse light crosses.
+//  * streak: cirrus "in the form of filaments, strands or hooks" (Haggstrom
+//    sec. 2.1.2.3): shape features 4x longer than wide, cirrostratus 2x.
 //  * noise periods: cumulus' 5 km shape period puts ~1.2 km cells (4 Worley
 //    cells per period), fair-weather cumulus size; the others scale that by
 //    their cell size (stratocumulus ~2 km, altocumulus ~0.6 km, cirrocumulus
@@ -33,7 +35,7 @@ namespace {
 
 using weather::CloudType;
 
-//                 ext     d_um  bRnd  tRnd  peak  pVar  anvl  grad  dBas  dTop  edge  fibr  eros  wisp  fill  shape_m  detail_m
+//                 ext     d_um  bRnd  tRnd  peak  pVar  anvl  grad  dBas  dTop  edge  fibr  eros  wisp  fill  shape_m  detail_m  streak
 constexpr CloudTypeParams kCumulus{
     0.06,   14.0, 0.07, 0.20, 1.00, 0.50, 0.0,  1.00, 0.15, 0.10, 0.25, 0.0,  0.35, 0.20, 0.50, 5000.0,  1000.0};
 constexpr CloudTypeParams kStratocumulus{
@@ -49,9 +51,9 @@ constexpr CloudTypeParams kAltocumulus{
 constexpr CloudTypeParams kAltostratus{
     0.02,   10.0, 0.15, 0.70, 1.00, 0.10, 0.0,  0.20, 0.20, 0.20, 0.50, 0.0,  0.20, 0.30, 0.80, 14000.0, 2000.0};
 constexpr CloudTypeParams kCirrus{
-    5.0e-4, 0.0,  0.20, 0.30, 1.00, 0.50, 0.0,  0.30, 0.30, 0.30, 0.40, 1.0,  0.50, 0.50, 0.30, 10000.0, 1500.0};
+    5.0e-4, 0.0,  0.20, 0.30, 1.00, 0.50, 0.0,  0.30, 0.30, 0.30, 0.40, 1.0,  0.50, 0.50, 0.30, 10000.0, 1500.0, 4.0};
 constexpr CloudTypeParams kCirrostratus{
-    3.0e-4, 0.0,  0.30, 0.60, 1.00, 0.20, 0.0,  0.20, 0.30, 0.30, 0.60, 0.5,  0.30, 0.50, 0.60, 16000.0, 2000.0};
+    3.0e-4, 0.0,  0.30, 0.60, 1.00, 0.20, 0.0,  0.20, 0.30, 0.30, 0.60, 0.5,  0.30, 0.50, 0.60, 16000.0, 2000.0, 2.0};
 constexpr CloudTypeParams kCirrocumulus{
     1.0e-3, 0.0,  0.20, 0.40, 1.00, 0.30, 0.0,  0.50, 0.30, 0.30, 0.25, 0.0,  0.40, 0.30, 0.40, 1200.0,  400.0};
 

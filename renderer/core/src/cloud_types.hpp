@@ -30,6 +30,7 @@ struct CloudTypeParams {
   // Placement of the noise textures.
   double shapePeriod_m = 0;   // world size of one period of the shape noise
   double detailPeriod_m = 0;  // of the detail noise
+  double streak = 1;          // length of shape features along the Earth's axis over their width (>= 1)
 };
 
 // The numbers of a type; None (no type given) draws as cumulus.

@@ -42,6 +42,7 @@ class CpuCore {
       : setup_(setup), shape_(shape), detail_(detail), atmosphere_(atmosphere), weather_(weather) {}
 
   real3 sampleTransmittanceLut(real2 uv) const { return atmosphere_.sampleTransmittance(uv); }
+  real3 sampleMultipleScatteringLut(real2 uv) const { return atmosphere_.sampleMultipleScattering(uv); }
 
 #define SKY_CORE_CONST static constexpr
 #include "cloud_core.glsl"
@@ -87,10 +88,10 @@ class CpuCore {
                       coreType(l.primary), coreType(l.secondary), l.skyTop, l.sunDiffuseTop, l.sunCosine,
                       LayerSampling{real4(l.shapeOrigin, 1.0 / l.shapePeriod_m), real4(l.detailOrigin, 1.0 / l.detailPeriod_m),
                                     real4(l.cloudMapOrigin, 1.0 / l.cloudMapPeriod_m),
-                                    real3(l.coverageShift_m, double(i))}};
+                                    real3(l.coverageShift_m, double(i)), l.shapeStretchZ}};
       } else {
         c = CoreLayer{0.0, 0.0, 0.0, 0.0, 1.0, 1.0, false, cumulus, cumulus, real3(0.0), real3(0.0), 0.0,
-                      LayerSampling{real4(0.0), real4(0.0), real4(0.0), real3(0.0, 0.0, double(i))}};
+                      LayerSampling{real4(0.0), real4(0.0), real4(0.0), real3(0.0, 0.0, double(i)), 1.0}};
       }
     }
     return f;
@@ -122,7 +123,9 @@ CpuCore::real3 CpuCore::sampleWeather(LayerSampling s, real3 p) {
 }
 
 CpuCore::real2 CpuCore::sampleShape(LayerSampling s, real3 p) {
-  const real4 v = shape_.sample(real3(s.shapeOrigin) + (setup_.localToEcef * p) * s.shapeOrigin.w);
+  real3 e = setup_.localToEcef * p;
+  e.z *= s.shapeStretchZ;
+  const real4 v = shape_.sample(real3(s.shapeOrigin) + e * s.shapeOrigin.w);
   return real2(v.x, v.y);
 }
 

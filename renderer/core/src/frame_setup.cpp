@@ -145,6 +145,7 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
     l.shapePeriod_m = l.primary.shapePeriod_m;
     l.detailPeriod_m = l.primary.detailPeriod_m;
     l.cloudMapPeriod_m = kCloudMapPeriodFactor * l.primary.shapePeriod_m;
+    l.shapeStretchZ = 1.0 / l.primary.streak;
     // The diffuse light the layer's top receives, over the camera: the sky,
     // and the sun through the air (cloud_core.glsl's diffuseLight).
     const double top_m = std::max(layer.base_m + layer.thickness_m, 0.0);
@@ -165,17 +166,22 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
     // (~1 degree per 100 km) as the camera travels; per-point advection comes
     // with the full model.
     const glm::dvec3 origin = toGlm(enu.originEcef_m) - s.localToEcef * windEnu_mps * in.weatherClock_s;
-    auto inPeriods = [&](double period_m) {
+    auto inPeriods = [&](double period_m, double stretchZ) {
       glm::dvec3 out;
       for (int k = 0; k < 3; ++k) {
-        const double m = std::fmod(origin[k], period_m);
+        const double m = std::fmod(origin[k] * (k == 2 ? stretchZ : 1.0), period_m);
         out[k] = (m < 0 ? m + period_m : m) / period_m;
       }
       return out;
     };
-    l.shapeOrigin = inPeriods(l.shapePeriod_m);
-    l.detailOrigin = inPeriods(l.detailPeriod_m);
-    l.cloudMapOrigin = inPeriods(l.cloudMapPeriod_m);
+    // Streaky types stretch the shape noise along the Earth's axis: a fixed
+    // ECEF axis keeps the pattern Earth-fixed (a stretch along the local wind
+    // would turn with the camera's position and slide the clouds). Streaks
+    // run north-south, foreshortened towards the poles, where they end as
+    // plain fibres.
+    l.shapeOrigin = inPeriods(l.shapePeriod_m, l.shapeStretchZ);
+    l.detailOrigin = inPeriods(l.detailPeriod_m, 1.0);
+    l.cloudMapOrigin = inPeriods(l.cloudMapPeriod_m, 1.0);
     // The coverage tiles are the server's field at the snapshot's clock; the
     // air over the camera now was, then, where the shared advection formula
     // (weather::advect, the one the server moves its regions with) says: the
@@ -229,7 +235,7 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
     g.shapeOrigin = v4(l.shapeOrigin, 1.0 / l.shapePeriod_m);
     g.detailOrigin = v4(l.detailOrigin, 1.0 / l.detailPeriod_m);
     g.cloudMapOrigin = v4(l.cloudMapOrigin, 1.0 / l.cloudMapPeriod_m);
-    g.coverageShift = gpu::vec4(float(l.coverageShift_m.x), float(l.coverageShift_m.y), 0.0f, 0.0f);
+    g.coverageShift = gpu::vec4(float(l.coverageShift_m.x), float(l.coverageShift_m.y), 0.0f, float(l.shapeStretchZ));
     g.ambient = v4(l.skyTop);
     g.sunDiffuse = v4(l.sunDiffuseTop, l.sunCosine);
     g.primary = packCloudType(l.primary);
@@ -239,6 +245,7 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   // per-layer setup never divides by 0.
   for (std::size_t i = s.layers.size(); i < gpu::kMaxLayers; ++i) {
     f.layers[i].shape = gpu::vec4(1.0f, float(i), 1.0f, 0.0f);
+    f.layers[i].coverageShift.w = 1.0f;
     f.layers[i].primary = f.layers[i].secondary = packCloudType(cloudTypeParams(weather::CloudType::Cumulus));
   }
   return f;

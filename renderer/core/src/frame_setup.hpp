@@ -36,6 +36,7 @@ struct LayerSetup {
   CloudTypeParams secondary;       // the type its tiles blend towards (= primary when none)
   bool blends = false;             // tiles carry a blend towards `secondary`
   double shapePeriod_m = 0, detailPeriod_m = 0, cloudMapPeriod_m = 0;
+  double shapeStretchZ = 1;        // the shape noise's ECEF z scale (1 / the type's streak length)
   glm::dvec3 shapeOrigin{0};       // (camera ECEF - wind drift) mod shape period, in periods
   glm::dvec3 detailOrigin{0};      // the same for the detail period
   glm::dvec3 cloudMapOrigin{0};    // the same for the cloud-map period

@@ -7,7 +7,8 @@
 // (a conservative slab in a uniform radiance field leaves it uniform) and
 // has its sigma -> 0 limit; Haggstrom's height functions and anvils at
 // hand-computed points; the diffuse light's two-stream depth; ray-shell
-// distances for vertical, horizontal and grazing rays.
+// distances for vertical, horizontal and grazing rays; cloud shadows on the
+// ground by the layers' two-stream depth.
 #include <cmath>
 #include <cstdint>
 
@@ -86,7 +87,8 @@ Core::CoreFrame frameAt(Core& c, double R, double alt, double base, double thick
   const double hBase = alt - base, hTop = alt - (base + thickness);
   Core::CoreLayer& L = c.layers[0];
   L = Core::CoreLayer{hBase, hTop, hBase * (2 * f.air.r - hBase), hTop * (2 * f.air.r - hTop), thickness,
-                      0.5 * thickness, false, type, type, Core::real3(0), Core::real3(0), 1.0, Core::LayerSampling{}};
+                      0.5 * thickness, false, type, type, Core::real3(0), Core::real3(0), 1.0,
+                      Core::LayerSampling{Core::real4(0.0), Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), 1.0}};
   return f;
 }
 
@@ -290,6 +292,57 @@ TEST(CloudCore, DiffuseLightFollowsTheTwoStreamDepth) {
   EXPECT_NEAR(c.diffuseLight(L, cu, 0.0, 1.0, 1.0).x, expected, 1e-12);
   // Less cover above lets more through.
   EXPECT_GT(c.diffuseLight(L, cu, 0.0, 0.3, 1.0).x / (0.3 + 4.0), c.diffuseLight(L, cu, 0.0, 1.0, 1.0).x / (0.3 + 4.0));
+}
+
+// Cloud shadows on the ground: each layer's optical depth where the sun
+// ray crosses it, tau = extinction x density x coverage x column fill x
+// thickness; the beam e^(-tau / mu) and the diffuse part 1 / (1 + 0.75 (1 -
+// g) tau), multiplied over the layers; no cloud, no shadow; and the
+// ground's radiance from them by hand.
+TEST(CloudCore, GroundShadowIsTheTwoStreamDepthOfTheLayersAbove) {
+  Core c;
+  const double R = 6371000, alt = 500;
+  Core::CloudType st = uniformType(0.01);
+  st.columnFill = 0.8;
+  Core::CoreFrame f = frameAt(c, R, alt, 1500, 1000, st);
+  const double mu = 0.5;
+  f.air.sunDir = Core::real3(std::sqrt(1 - mu * mu), 0, mu);
+  const Core::real3 ground(0, 0, -alt);  // the ground point under the camera
+  c.coverage = 0.9;
+  c.density = 0.7;
+  const double tau = 0.01 * 0.7 * 0.9 * 0.8 * 1000;
+  const double beam = std::exp(-tau / mu), spread = 1 / (1 + 0.75 * (1 - 0.85) * tau);
+  Core::real2 s = c.groundShadow(f, ground, mu);
+  EXPECT_NEAR(s.x, beam, 1e-12);
+  EXPECT_NEAR(s.y, spread, 1e-12);
+  // A second, thinner layer higher up: the factors multiply.
+  Core::CloudType ci = uniformType(5e-4);
+  ci.columnFill = 0.3;
+  c.layers[1] = c.layers[0];
+  const double hB = alt - 8000, hT = alt - 9000;
+  c.layers[1].hBase = hB;
+  c.layers[1].hTop = hT;
+  c.layers[1].cBase = hB * (2 * f.air.r - hB);
+  c.layers[1].cTop = hT * (2 * f.air.r - hT);
+  c.layers[1].primary = c.layers[1].secondary = ci;
+  f.layerCount = 2;
+  const double tau2 = 5e-4 * 0.7 * 0.9 * 0.3 * 1000;
+  s = c.groundShadow(f, ground, mu);
+  EXPECT_NEAR(s.x, beam * std::exp(-tau2 / mu), 1e-12);
+  EXPECT_NEAR(s.y, spread / (1 + 0.75 * (1 - 0.85) * tau2), 1e-12);
+  // The ground's radiance: albedo / pi x (sun mu T (beam + (1 - beam)
+  // spread) + sky spread), clear air (no table: T = 1).
+  f.air.sunIrradiance = Core::real3(2.0);
+  f.groundIrradiance = Core::real3(0.4);
+  const double b2 = beam * std::exp(-tau2 / mu), s2 = spread / (1 + 0.75 * (1 - 0.85) * tau2);
+  const double expected = 0.1 / kPi * (2.0 * mu * (b2 + (1 - b2) * s2) + 0.4 * s2);
+  EXPECT_NEAR(c.groundRadiance(f, Core::real3(0, 0, -1), alt).x, expected, 1e-9);
+  // No cloud: the sun and the sky reach the ground whole.
+  c.coverage = 0.0;
+  s = c.groundShadow(f, ground, mu);
+  EXPECT_EQ(s.x, 1.0);
+  EXPECT_EQ(s.y, 1.0);
+  EXPECT_NEAR(c.groundRadiance(f, Core::real3(0, 0, -1), alt).x, 0.1 / kPi * (2.0 * mu + 0.4), 1e-9);
 }
 
 TEST(CloudCore, RayShellDistancesMatchHandComputedOnes) {

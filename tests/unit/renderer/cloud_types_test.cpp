@@ -52,10 +52,12 @@ TEST(CloudTypes, EveryTypeIsInsideTheModelsRanges) {
     }
     EXPECT_LT(p.erosion, 1.0) << "erodeShape divides by 1 - erosion";
     EXPECT_GT(p.shapePeriod_m, p.detailPeriod_m);
+    EXPECT_GE(p.streak, 1.0);
     EXPECT_EQ(p.anvil, t == CloudType::Cumulonimbus ? 1.0 : 0.0);
   }
   // The look of the ice clouds: cirrus fibrous, cirrocumulus small cells.
   EXPECT_EQ(cloudTypeParams(CloudType::Cirrus).fibrous, 1.0);
+  EXPECT_GT(cloudTypeParams(CloudType::Cirrus).streak, 1.0) << "filaments";
   EXPECT_LT(cloudTypeParams(CloudType::Cirrocumulus).shapePeriod_m, cloudTypeParams(CloudType::Altocumulus).shapePeriod_m);
   EXPECT_LT(cloudTypeParams(CloudType::Altocumulus).shapePeriod_m, cloudTypeParams(CloudType::Cumulus).shapePeriod_m);
   // No type given draws as cumulus.

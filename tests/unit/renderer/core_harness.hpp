@@ -28,8 +28,13 @@ class Core {
   real2 cloudMap = real2(0.5, 1.0);
   // Transmittance table lookup; unset: clear air transmits everything.
   std::function<real3(real2)> table;
+  // Multiple-scattering table lookup; unset: none.
+  std::function<real3(real2)> multipleScatteringTable;
 
   real3 sampleTransmittanceLut(real2 uv) const { return table ? table(uv) : real3(1.0); }
+  real3 sampleMultipleScatteringLut(real2 uv) const {
+    return multipleScatteringTable ? multipleScatteringTable(uv) : real3(0.0);
+  }
 
 #define SKY_CORE_CONST static constexpr
 #include "cloud_core.glsl"
