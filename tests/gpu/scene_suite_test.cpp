@@ -3,7 +3,8 @@
 // cumulonimbus, cirrus over cumulus) rendered on the GPU and compared with
 // the double-precision CPU reference on sampled pixels; no NaN or Inf; and a
 // contact sheet of the six at 320x180 (output/scenes.png, the picture in
-// docs/images/scenes.png).
+// docs/images/scenes.png); and a moonlit night, against the CPU reference
+// and against the renderer's linearity in its light (output/moonlit_night.png).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include "scenes.hpp"
 #include "sky/app/replay_outputs.hpp"
 #include "sky/render/cpu_reference.hpp"
+#include "sky/render/ephemeris.hpp"
 
 namespace sky::test {
 namespace {
@@ -154,6 +156,91 @@ TEST(Scenes, LookAndContactSheet) {
   }
   savePng(sheet.image(), "scenes");
   std::printf("[ sheet    ] %s/scenes.png\n", SKY_GPU_TEST_OUTPUT_DIR);
+}
+
+// A moonlit night: the midday cumulus under a full moon 45 deg up, the sun
+// 30 deg below the horizon. Radiances are the moon's ~2.5e-6 of the day's,
+// so the comparisons look at them exposed by 1 / that ratio (a night
+// photograph's exposure). Checked (1) against the CPU reference on sampled
+// pixels with the day scenes' tolerances, and (2) against the renderer's
+// linearity in its light: the model is affine in the key light's irradiance
+// E (L = E A + F, F the night-sky floor), so the moonlit image must be
+// ratio x (the same view with the sun where the moon is, minus F) + F, F
+// from a new-moon night; no tolerance but the day scenes' displayed RMSE.
+TEST(Scenes, MoonlitNight) {
+  SKY_RENDERER(r, kW, kH);
+  const Scene scene = issueScenes()[0];
+  render::FrameInputs in = scene.inputs();
+  in.sunAzimuth_deg = 315;
+  in.sunElevation_deg = -30;
+  in.moonAzimuth_deg = 135;
+  in.moonElevation_deg = 45;
+  in.moonPhaseAngle_deg = 0;
+  const double exposure = 1.0 / render::moonToSunIlluminance(0.0);
+  auto night = r.render(in);
+  ASSERT_TRUE(night) << describe(night.error());
+  EXPECT_EQ(render::computeStats(*night).nonFinite, 0u);
+  // (1) The CPU reference.
+  auto reference = render::CpuReference::create(r.settings());
+  ASSERT_TRUE(reference) << describe(reference.error());
+  const auto pixels = samplePixels();
+  auto cpu = reference->renderPixels(in, pixels);
+  ASSERT_TRUE(cpu) << describe(cpu.error());
+  double sum2 = 0, meanCompressed = 0, meanGpu = 0, meanCpu = 0;
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    const float* g = &night->rgba[(std::size_t(pixels[i].y) * kW + pixels[i].x) * 4];
+    const float* c = (*cpu)[i].data();
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_TRUE(std::isfinite(c[k]));
+      const double e = compressed(float(g[k] * exposure)) - compressed(float(c[k] * exposure));
+      sum2 += e * e;
+      meanCompressed += compressed(float(c[k] * exposure));
+    }
+    meanGpu += luminance(g);
+    meanCpu += luminance(c);
+  }
+  const double n = double(pixels.size());
+  meanCompressed /= 3 * n;
+  const double rmse = std::sqrt(sum2 / (3 * n));
+  std::printf("[ moonlit  ] mean %.3e (x exposure %.3f, gpu %+.3f %%) displayed rmse %.2f %%\n", meanCpu / n,
+              meanCpu / n * exposure, 100 * (meanGpu - meanCpu) / meanCpu, 100 * rmse / meanCompressed);
+  EXPECT_LT(std::abs(meanGpu - meanCpu) / meanCpu, kRelativeMeanTolerance);
+  EXPECT_LT(rmse, kRelativeRmseTolerance * meanCompressed);
+  // (2) Linearity: the sun where the moon is, and a new-moon night.
+  render::FrameInputs day = in;
+  day.moonElevation_deg = -90;
+  day.sunAzimuth_deg = in.moonAzimuth_deg;
+  day.sunElevation_deg = in.moonElevation_deg;
+  render::FrameInputs dark = in;
+  dark.moonPhaseAngle_deg = 180;
+  auto sunlit = r.render(day);
+  auto floor = r.render(dark);
+  ASSERT_TRUE(sunlit && floor);
+  const double ratio = render::moonToSunIlluminance(0.0);
+  double lin2 = 0, linMean = 0;
+  for (std::size_t i = 0; i < night->rgba.size(); ++i) {
+    if (i % 4 == 3) {
+      EXPECT_NEAR(night->rgba[i], sunlit->rgba[i], 1e-6) << "cloud transmittance does not depend on the light";
+      continue;
+    }
+    const double f = floor->rgba[i];
+    const double predicted = (double(sunlit->rgba[i]) - f) * ratio + f;
+    const double e = compressed(float(night->rgba[i] * exposure)) - compressed(float(predicted * exposure));
+    lin2 += e * e;
+    linMean += compressed(float(predicted * exposure));
+  }
+  const double m = double(night->rgba.size() / 4 * 3);
+  std::printf("[ moonlit  ] against ratio x the sunlit view + the floor: displayed rmse %.3f %%\n",
+              100 * std::sqrt(lin2 / m) / (linMean / m));
+  EXPECT_LT(std::sqrt(lin2 / m), kRelativeRmseTolerance * linMean / m);
+  // The picture, exposed, at 320x180.
+  SKY_RENDERER(big, 320, 180);
+  auto picture = big.render(in);
+  ASSERT_TRUE(picture) << describe(picture.error());
+  for (std::size_t i = 0; i < picture->rgba.size(); ++i)
+    if (i % 4 != 3) picture->rgba[i] = float(picture->rgba[i] * exposure);
+  savePng(*picture, "moonlit_night");
+  std::printf("[ moonlit  ] %s/moonlit_night.png (x %.0f)\n", SKY_GPU_TEST_OUTPUT_DIR, exposure);
 }
 
 }  // namespace

@@ -70,8 +70,12 @@ Result<void> validateInputs(const FrameInputs& in) {
   const auto& c = in.camera;
   const auto& p = c.position;
   for (double v : {p.lat_deg, p.lon_deg, p.alt_m, c.yaw_deg, c.pitch_deg, c.roll_deg, in.weatherClock_s,
-                   in.sunAzimuth_deg, in.sunElevation_deg, in.utc_s.value_or(0.0)})
+                   in.sunAzimuth_deg, in.sunElevation_deg, in.utc_s.value_or(0.0), in.moonAzimuth_deg,
+                   in.moonElevation_deg, in.moonPhaseAngle_deg})
     if (!std::isfinite(v)) return fail(ErrorCode::InvalidArgument, "frame inputs: non-finite value");
+  if (in.moonPhaseAngle_deg < 0 || in.moonPhaseAngle_deg > 180)
+    return fail(ErrorCode::InvalidArgument,
+                "frame inputs: moonPhaseAngle_deg " + num(in.moonPhaseAngle_deg) + " outside [0, 180]");
   if (p.lat_deg < -90 || p.lat_deg > 90)
     return fail(ErrorCode::InvalidArgument, "frame inputs: camera lat_deg " + num(p.lat_deg) + " outside [-90, 90]");
   if (p.alt_m < -1000 || p.alt_m > 1e6)
@@ -125,12 +129,42 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
   s.cAtmosphereTop_m2 = hAboveTop_m * (2 * s.r_m - hAboveTop_m);
   const double groundRadius_m = s.r_m - s.hGround_m;
 
-  SkyDirection sun{in.sunAzimuth_deg, in.sunElevation_deg};
-  if (in.utc_s) sun = sunDirection(*in.utc_s, in.camera.position.lat_deg, in.camera.position.lon_deg);
-  const double az = sun.azimuth_deg * kDegToRad, el = sun.elevation_deg * kDegToRad;
-  s.sunDir = {std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), std::sin(el)};
+  SkyDirection sun{in.sunAzimuth_deg, in.sunElevation_deg}, moon{in.moonAzimuth_deg, in.moonElevation_deg};
+  double moonPhase_deg = in.moonPhaseAngle_deg;
+  if (in.utc_s) {
+    const double lat = in.camera.position.lat_deg, lon = in.camera.position.lon_deg;
+    sun = sunDirection(*in.utc_s, lat, lon);
+    moon = moonDirection(*in.utc_s, lat, lon);
+    moonPhase_deg = moonPhaseAngle_deg(*in.utc_s);
+  }
+  auto towards = [](const SkyDirection& d) {
+    const double az = d.azimuth_deg * kDegToRad, el = d.elevation_deg * kDegToRad;
+    return glm::dvec3(std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), std::sin(el));
+  };
+  s.sunDir = towards(sun);
   s.sunIrradiance = glm::dvec3(kSunIrradiance);
   s.groundIrradiance = skyLightAt(tables, 0.0, groundRadius_m, s.sunDir, s.sunIrradiance).irradiance;
+  // One key light for the clouds, the air and the ground: the moon instead
+  // of the sun when it puts more light on the ground (direct and through the
+  // sky, by luminance): with a full moon from about the end of nautical
+  // twilight. Its light is the sun's spectrum scaled by the illuminance
+  // ratio of its phase (the moon's albedo is nearly grey; ~10 % redder,
+  // ignored); twilight's glow goes when the moon takes over.
+  if (sun.elevation_deg < 0 && moon.elevation_deg > -1) {
+    const glm::dvec3 moonDir = towards(moon);
+    const glm::dvec3 moonIrradiance(kSunIrradiance * moonToSunIlluminance(moonPhase_deg));
+    const glm::dvec3 moonSky = skyLightAt(tables, 0.0, groundRadius_m, moonDir, moonIrradiance).irradiance;
+    auto onGround = [&](const glm::dvec3& dir, const glm::dvec3& e, const glm::dvec3& sky) {
+      const glm::dvec3 v = e * sunTransmittanceAt(tables, 0.0, dir.z, groundRadius_m) * std::max(dir.z, 0.0) + sky;
+      return 0.2126 * v.r + 0.7152 * v.g + 0.0722 * v.b;
+    };
+    if (onGround(moonDir, moonIrradiance, moonSky) > onGround(s.sunDir, s.sunIrradiance, s.groundIrradiance)) {
+      s.sunDir = moonDir;
+      s.sunIrradiance = moonIrradiance;
+      s.groundIrradiance = moonSky;
+      s.moonLit = true;
+    }
+  }
 
   if (in.weather == nullptr) return s;
   const double sinceSnapshot_s = in.weatherClock_s - in.weather->weatherClock_s;

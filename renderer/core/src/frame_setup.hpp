@@ -59,8 +59,10 @@ struct FrameSetup {
   double hGround_m = 0;        // camera height above the ground sphere = altitude
   double cGround_m2 = 0;
   double cAtmosphereTop_m2 = 0;  // the same for the top of the atmosphere
+  // The key light (the sun, or the moon at night: moonLit); the model calls it the sun.
   glm::dvec3 sunDir{0, 0, 1};
   glm::dvec3 sunIrradiance{0};     // at the top of the atmosphere, linear units
+  bool moonLit = false;
   glm::dvec3 groundIrradiance{0};  // sky irradiance on the ground, linear units
   std::vector<LayerSetup> layers;
 };

@@ -5,7 +5,8 @@
 // integral; the zenith sky is blue at noon and the light reddens at low sun;
 // the air's in-scattering never exceeds what it removes times the largest
 // source (energy); aerial-perspective queries are consistent with the whole
-// path; the Earth's shadow and the sky light of the frame setup.
+// path; the Earth's shadow and the sky light of the frame setup; the moon as
+// the key light at night.
 #include <algorithm>
 #include <utility>
 #include <cstdio>
@@ -16,6 +17,9 @@
 #include <gtest/gtest.h>
 
 #include "atmosphere_tables.hpp"
+#include "frame_setup.hpp"
+#include "sky/render/ephemeris.hpp"
+#include "weather_field.hpp"
 
 namespace sky::render {
 namespace {
@@ -367,6 +371,63 @@ TEST(Atmosphere, SkyLightOfTheFrameSetup) {
   const SkyLight night = skyLightAt(tables(), 0, kEarth_m, normalize(glm::dvec3(0, 1, -0.35)), glm::dvec3(20.0));
   EXPECT_GT(night.meanRadiance.b, 0.0);
   EXPECT_LE(night.meanRadiance.b, Air::kNightSkyRadiance);
+}
+
+// The frame's key light: by day the sun; on a full-moon night the moon where
+// the ephemeris puts it, with the sun's irradiance times the moon's
+// illuminance ratio for its phase; across twilight the sun until the sky it
+// lights is darker than the full moon's light: published illuminances on the
+// ground are ~3 lux at civil dusk (sun -6), ~0.01 lux at nautical dusk
+// (-12) and ~0.1-0.3 lux under a high full moon, so the moon takes over
+// between -6 and -12.
+TEST(Atmosphere, TheMoonIsTheKeyLightOnAMoonlitNight) {
+  render::RenderSettings settings;
+  render::FrameInputs in;
+  in.camera.position = {47.0, 8.0, 500.0};
+  const WeatherField field = buildWeatherField(nullptr, in.camera.position);
+  // 2024-01-25 23:30 UTC, 5.6 h after full moon: the moon ~60 deg up over Switzerland.
+  in.utc_s = 1706225400.0;
+  const SkyDirection moon = moonDirection(*in.utc_s, 47.0, 8.0);
+  ASSERT_GT(moon.elevation_deg, 45.0);
+  FrameSetup s = prepareFrame(settings, in, field, tables());
+  EXPECT_TRUE(s.moonLit);
+  EXPECT_NEAR(s.sunDir.z, std::sin(moon.elevation_deg * kDeg), 1e-12);
+  EXPECT_NEAR(std::atan2(s.sunDir.x, s.sunDir.y) / kDeg + (s.sunDir.x < 0 ? 360.0 : 0.0), moon.azimuth_deg, 1e-9);
+  const double ratio = moonToSunIlluminance(moonPhaseAngle_deg(*in.utc_s));
+  EXPECT_NEAR(s.sunIrradiance.g, 20.0 * ratio, 1e-15);
+  EXPECT_GT(ratio, 2.0e-6);
+  // Noon the same day: the sun.
+  in.utc_s = 1706183400.0;  // 11:50 UTC
+  s = prepareFrame(settings, in, field, tables());
+  EXPECT_FALSE(s.moonLit);
+  EXPECT_EQ(s.sunIrradiance.g, 20.0);
+  // Twilight, a full moon 40 deg up opposite the sun.
+  in.utc_s.reset();
+  in.sunAzimuth_deg = 270;
+  in.moonAzimuth_deg = 90;
+  in.moonElevation_deg = 40;
+  in.moonPhaseAngle_deg = 0;
+  double handover = 0;
+  for (double el = 0; el >= -18; el -= 0.5) {
+    in.sunElevation_deg = el;
+    if (prepareFrame(settings, in, field, tables()).moonLit) {
+      handover = el;
+      break;
+    }
+  }
+  std::printf("[ moon     ] a full moon 40 deg up takes over at sun elevation %.1f deg\n", handover);
+  EXPECT_LT(handover, -6.0);
+  EXPECT_GT(handover, -12.0);
+  // A new moon never outshines even the night sky's floor by much: the sun
+  // stays the key light (a dark night).
+  in.moonPhaseAngle_deg = 180;
+  in.sunElevation_deg = -8;
+  EXPECT_FALSE(prepareFrame(settings, in, field, tables()).moonLit);
+  // Validation names the field.
+  in.moonPhaseAngle_deg = 200;
+  auto bad = validateInputs(in);
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().detail.find("moonPhaseAngle_deg"), std::string::npos);
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
 // The headless cloud renderer's public face: settings, one frame's inputs (a
-// CIGI camera pose, the weather, the weather clock, the sun), the linear image
+// CIGI camera pose, the weather, the weather clock, the sun and the moon), the linear image
 // it returns, and PNG output. The Vulkan machinery stays behind a pimpl.
 #pragma once
 
@@ -36,6 +36,11 @@ struct FrameInputs {
   // When set (UTC, s since 1970), the sun is where it is at that instant seen
   // from the camera (ephemeris.hpp), and the two angles above are ignored.
   std::optional<double> utc_s;
+  // The moon, when utc_s is unset (with utc_s the ephemeris places it and
+  // gives its phase): direction in the camera's local ENU frame and phase
+  // angle, 0 full to 180 new. The clouds are lit by one key light: the sun,
+  // or the moon when it lights the ground more (frame_setup.cpp).
+  double moonAzimuth_deg = 0, moonElevation_deg = -90, moonPhaseAngle_deg = 180;
   std::uint64_t frameIndex = 0;  // carried for reprojection; the skeleton's image does not depend on it
 };
 
