@@ -1,6 +1,7 @@
 // Cloud pass: one invocation per pixel marches every cloud layer along the
 // view ray (model in include/cloud_core.glsl) and writes linear radiance and
-// transmittance to a storage buffer. Uniform layout: include/sky_shared.h.
+// transmittance to one storage buffer, the cloud depth to a second one.
+// Uniform layout: include/sky_shared.h.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
@@ -12,6 +13,7 @@ layout(std140, set = 0, binding = kBindingFrame) uniform FrameBlock { SkyFrame f
 layout(set = 0, binding = kBindingNoise) uniform sampler3D noiseTex;
 layout(set = 0, binding = kBindingWeather) uniform sampler2DArray weatherTex;
 layout(std430, set = 0, binding = kBindingOutput) writeonly buffer OutputBlock { vec4 pixels[]; };
+layout(std430, set = 0, binding = kBindingDepth) writeonly buffer DepthBlock { float depths[]; };
 
 #define real float
 #define real2 vec2
@@ -69,4 +71,5 @@ void main() {
                        frame.camDown.w, float(px.x), float(px.y), float(frame.image.x), float(frame.image.y));
   PixelResult r = shadePixel(f, dir, pixelJitter(px.x, px.y));
   pixels[px.y * frame.image.x + px.x] = vec4(r.radiance, r.transmittance);
+  depths[px.y * frame.image.x + px.x] = r.depth;
 }

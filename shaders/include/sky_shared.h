@@ -22,6 +22,7 @@ SKY_SHARED_CONST kBindingFrame = 0u;    // uniform SkyFrame
 SKY_SHARED_CONST kBindingNoise = 1u;    // sampler3D, tileable shape noise (R8, repeat)
 SKY_SHARED_CONST kBindingWeather = 2u;  // sampler2DArray, RG = coverage, density; one slice per layer
 SKY_SHARED_CONST kBindingOutput = 3u;   // storage buffer of vec4 radiance (rgb) + transmittance (a)
+SKY_SHARED_CONST kBindingDepth = 4u;    // storage buffer of float cloud depth (m, 0 = no cloud) per pixel
 
 // Workgroup edge of the cloud pass, pixels (8x8 = 64 invocations = 8 lavapipe
 // subgroups of 8 lanes).
