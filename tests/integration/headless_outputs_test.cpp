@@ -5,7 +5,7 @@
 // everywhere; cloud: depth exactly where light was taken); and a metadata
 // line per frame in frames.jsonl with the pose, weather clock and version,
 // sun, preset, settings, seeds, resolution and GPU time per pass, summed up
-// per pass in report.json.
+// per pass in report.json; and the noise cache across starts of the process.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -105,19 +105,22 @@ struct ReplayResult {
   fs::path dir;
   std::vector<nlohmann::json> frames;
   nlohmann::json report;
+  std::string log;
 };
 
-ReplayResult replay(const std::string& name, const std::string& scenario) {
+ReplayResult replay(const std::string& name, const std::string& scenario, std::vector<std::string> extra = {}) {
   ReplayResult run;
   run.dir = fs::path(SKY_TEST_OUTPUT_DIR) / ("outputs-" + name);
   fs::remove_all(run.dir);
   fs::create_directories(run.dir);
-  ChildProcess render({SKY_RENDER, "--headless", "--replay", SKY_TEST_FLIGHT, "--weather-file", scenario, "--step", "2",
-                       "--out", run.dir.string(), "--width", std::to_string(kWidth), "--height",
-                       std::to_string(kHeight), "--write-float", "--no-video"},
-                      run.dir.string() + ".log", {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
+  std::vector<std::string> argv = {SKY_RENDER, "--headless", "--replay", SKY_TEST_FLIGHT, "--weather-file", scenario,
+                                   "--step", "2", "--out", run.dir.string(), "--width", std::to_string(kWidth),
+                                   "--height", std::to_string(kHeight), "--write-float", "--no-video"};
+  argv.insert(argv.end(), extra.begin(), extra.end());
+  ChildProcess render(argv, run.dir.string() + ".log", {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
   const auto code = render.wait(300s);
-  EXPECT_EQ(code.value_or(-1), 0) << render.log();
+  run.log = render.log();
+  EXPECT_EQ(code.value_or(-1), 0) << run.log;
   std::ifstream jsonl(run.dir / "frames" / "frames.jsonl");
   for (std::string line; std::getline(jsonl, line);)
     if (!line.empty()) run.frames.push_back(nlohmann::json::parse(line));
@@ -224,6 +227,40 @@ TEST(HeadlessOutputs, MetadataDescribesEachFrameAndTheReportSumsGpuTimes) {
   EXPECT_LE(gpu["clouds"]["p50"].get<double>(), gpu["clouds"]["p90"].get<double>());
   EXPECT_EQ(gpu["weather_upload"]["frames"], 1);
   EXPECT_EQ(run.report["preset"], "default");
+}
+
+// The shape noise through skyshell-render's --cache-dir: the first start
+// generates and writes it, the second loads it (and draws the same bytes),
+// a damaged cache file is detected and regenerated (the same image again).
+TEST(HeadlessOutputs, NoiseCacheIsLoadedOnTheSecondStartAndRegeneratedWhenDamaged) {
+  const fs::path cache = fs::path(SKY_TEST_OUTPUT_DIR) / "noise-cache";
+  fs::remove_all(cache);
+  const std::vector<std::string> args = {"--cache-dir", cache.string(), "--replay-end", "0", "--no-exr"};
+  const ReplayResult first = replay("cache-1", SKY_SCENARIO_CLOUDY, args);
+  EXPECT_NE(first.log.find("shape noise 64^3 seed 1: generated into " + cache.string()), std::string::npos)
+      << first.log;
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(cache)) files.push_back(e.path());
+  ASSERT_EQ(files.size(), 1u);
+  EXPECT_EQ(files[0].extension(), ".noise");
+  const auto cachedBytes = readAll(files[0]);
+  EXPECT_GT(cachedBytes.size(), std::size_t(64 * 64 * 64)) << "the 64^3 texels and a header";
+
+  const ReplayResult second = replay("cache-2", SKY_SCENARIO_CLOUDY, args);
+  EXPECT_NE(second.log.find("loaded from " + files[0].string()), std::string::npos) << second.log;
+  EXPECT_EQ(second.log.find("generated"), std::string::npos) << second.log;
+  EXPECT_EQ(readAll(files[0]), cachedBytes);
+  const std::string png = "frames/frame_000000.png";
+  EXPECT_TRUE(readAll(first.dir / png) == readAll(second.dir / png)) << "cached noise must draw the same clouds";
+
+  std::string damaged = cachedBytes;
+  damaged[damaged.size() / 2] = char(damaged[damaged.size() / 2] ^ 0x40);
+  std::ofstream(files[0], std::ios::binary | std::ios::trunc) << damaged;
+  const ReplayResult third = replay("cache-3", SKY_SCENARIO_CLOUDY, args);
+  EXPECT_NE(third.log.find("regenerated into " + files[0].string()), std::string::npos) << third.log;
+  EXPECT_NE(third.log.find("checksum"), std::string::npos) << third.log;
+  EXPECT_EQ(readAll(files[0]), cachedBytes) << "the damaged file is rewritten whole";
+  EXPECT_TRUE(readAll(first.dir / png) == readAll(third.dir / png));
 }
 
 }  // namespace
