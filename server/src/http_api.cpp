@@ -10,6 +10,7 @@
 #include <spdlog/spdlog.h>
 
 #include "sky/server/api_json.hpp"
+#include "sky/server/console_files.hpp"
 #include "sky/server/metar_api.hpp"
 
 namespace sky::server {
@@ -205,6 +206,8 @@ HttpApi::Reply HttpApi::handle(const std::string& method, const std::string& tar
     }
     return {reply.status, "application/json", reply.body.dump()};
   }
+  if (method == "GET" && options_.console)
+    if (const ConsoleFile* f = options_.console->find(path)) return {200, f->contentType, f->body};
   return {404, "application/json", errorJson("path: no " + method + " " + path)};
 }
 

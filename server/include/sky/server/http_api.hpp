@@ -8,6 +8,8 @@
 //                        400 {"error": ...} naming the field, 401 without the token
 //   POST /api/metar      METAR reports previewed, or applied with the token
 //                        (metar_api.hpp)
+//   GET  /, /console/*   the operator console's files, when options.console is set
+//                        (console_files.hpp)
 // One request per connection (Connection: close); bodies over 64 KiB and
 // clients slower than 10 s are dropped. Loopback unless configured otherwise.
 #pragma once
@@ -30,11 +32,14 @@ class logger;
 
 namespace sky::server {
 
+class ConsoleFiles;
+
 struct HttpApiOptions {
   std::string listenAddress = "127.0.0.1";
   std::uint16_t port = 0;   // 0: ephemeral
   std::string token;        // empty: read-only (changes are refused)
   std::vector<Station> stations;  // METAR station table for POST /api/metar
+  std::shared_ptr<const ConsoleFiles> console;  // null: no console pages
   std::shared_ptr<spdlog::logger> log;
 };
 
