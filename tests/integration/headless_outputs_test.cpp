@@ -235,7 +235,10 @@ TEST(HeadlessOutputs, MetadataDescribesEachFrameAndTheReportSumsGpuTimes) {
 TEST(HeadlessOutputs, NoiseCacheIsLoadedOnTheSecondStartAndRegeneratedWhenDamaged) {
   const fs::path cache = fs::path(SKY_TEST_OUTPUT_DIR) / "noise-cache";
   fs::remove_all(cache);
-  const std::vector<std::string> args = {"--cache-dir", cache.string(), "--replay-end", "0", "--no-exr"};
+  // The weather clock pinned: the scenario's runs with the wall clock, and the
+  // same clouds need the same clock.
+  const std::vector<std::string> args = {"--cache-dir", cache.string(), "--replay-end", "0", "--no-exr",
+                                         "--weather-clock", "0"};
   const ReplayResult first = replay("cache-1", SKY_SCENARIO_CLOUDY, args);
   EXPECT_NE(first.log.find("shape noise 64^3 seed 1: generated into " + cache.string()), std::string::npos)
       << first.log;
