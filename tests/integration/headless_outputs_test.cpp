@@ -266,5 +266,16 @@ TEST(HeadlessOutputs, NoiseCacheIsLoadedOnTheSecondStartAndRegeneratedWhenDamage
   EXPECT_TRUE(readAll(first.dir / png) == readAll(third.dir / png));
 }
 
+// The headless passes (weather upload, cloud pass, timestamps, readback)
+// under Khronos validation, on a scenario with several layers.
+TEST(HeadlessOutputs, NoValidationErrors) {
+  if (!fs::exists("/usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json"))
+    GTEST_SKIP() << "no Vulkan validation layer (Debian: vulkan-validationlayers)";
+  const ReplayResult run = replay("validation", SKY_SCENARIO_LAYERED,
+                                  {"--vulkan-validation"});
+  EXPECT_EQ(run.frames.size(), kFrames);
+  EXPECT_NE(run.log.find("vulkan validation: 0 errors, 0 warnings"), std::string::npos) << run.log;
+}
+
 }  // namespace
 }  // namespace sky::test
