@@ -13,7 +13,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   // The key the seeds were written for: a 4^3 "shape" volume.
-  const sky::render::NoiseKey key{"shape", 1, 1, 4, 0x0123456789abcdefull};
+  const sky::render::NoiseKey key{"shape", 1, 1, 4, 1, 0x0123456789abcdefull};
   const auto bytes = std::span(data, size);
   const auto texels = sky::render::decodeNoiseFile(bytes, key);
   if (!texels) return 0;

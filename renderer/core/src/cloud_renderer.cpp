@@ -44,21 +44,30 @@ auto atVulkanEdge(const char* what, F&& body) -> decltype(body()) {
   }
 }
 
-// Shape noise for these settings, from the cache when it holds it.
-NoiseVolume shapeNoise(const RenderSettings& settings, std::string* report) {
-  NoiseKey key{"shape", kShapeNoiseGeneratorVersion, settings.noiseSeed, kNoiseSize, 0};
-  key.fingerprint = fnv1a64(makeShapeNoise(kNoiseFingerprintSize, settings.noiseSeed).texels);
+// A noise texture for these settings from the cache when it holds it, else
+// from generate(size, seed); *report says which. The fingerprint is the
+// generator's output at fingerprintSize; its bytes per texel give the
+// channel count.
+NoiseVolume cachedNoise(const RenderSettings& settings, const char* kind, std::uint32_t generatorVersion,
+                        std::uint32_t size, std::uint32_t fingerprintSize,
+                        NoiseVolume (*generate)(std::uint32_t, std::uint32_t), std::string* report) {
+  const NoiseVolume tiny = generate(fingerprintSize, settings.noiseSeed);
+  const std::size_t tinyTexels = std::size_t(fingerprintSize) * fingerprintSize * fingerprintSize;
+  SKY_ASSERT(tinyTexels > 0 && tiny.texels.size() % tinyTexels == 0);
+  const NoiseKey key{kind, generatorVersion, settings.noiseSeed, size,
+                     static_cast<std::uint32_t>(tiny.texels.size() / tinyTexels), fnv1a64(tiny.texels)};
   CachedNoise cached = loadOrGenerateNoise(settings.noiseCacheDir, key, [&] {
-    return makeShapeNoise(kNoiseSize, settings.noiseSeed).texels;
+    return generate(size, settings.noiseSeed).texels;
   });
   const char* how = cached.source == NoiseSource::Loaded        ? "loaded from "
                     : cached.source == NoiseSource::Regenerated ? "regenerated into "
                     : cached.path.empty()                       ? "generated (no cache)"
                                                                 : "generated into ";
-  *report = "shape noise " + std::to_string(kNoiseSize) + "^3 seed " + std::to_string(settings.noiseSeed) + ": " + how +
-            cached.path.string() + (cached.note.empty() ? "" : " (" + cached.note + ")");
+  *report += std::string(report->empty() ? "" : "; ") + kind + " noise " + std::to_string(size) + "^3 seed " +
+             std::to_string(settings.noiseSeed) + ": " + how + cached.path.string() +
+             (cached.note.empty() ? "" : " (" + cached.note + ")");
   NoiseVolume volume;
-  volume.size = kNoiseSize;
+  volume.size = size;
   volume.texels = std::move(cached.texels);
   return volume;
 }
@@ -78,7 +87,8 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
     auto weather = WeatherTexture::create(**ctx);
     if (!weather) return tl::unexpected(weather.error());
     std::string noiseReport;
-    const NoiseVolume noise = shapeNoise(settings, &noiseReport);
+    const NoiseVolume noise = cachedNoise(settings, "shape", kShapeNoiseGeneratorVersion, kNoiseSize,
+                                          kNoiseFingerprintSize, makeShapeNoise, &noiseReport);
     auto pass = CloudPass::create(**ctx, settings.width, settings.height, noise, *weather);
     if (!pass) return tl::unexpected(pass.error());
     std::optional<Presenter> presenter;

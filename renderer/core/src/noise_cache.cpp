@@ -20,10 +20,11 @@ namespace {
 
 constexpr std::array<std::uint8_t, 8> kMagic = {'S', 'K', 'Y', 'N', 'O', 'I', 'S', 'E'};
 // Bumped when the file layout changes.
-constexpr std::uint32_t kFormatVersion = 1;
+constexpr std::uint32_t kFormatVersion = 2;
 // Largest cube edge a cache file may claim: 512^3 = 128 MiB, far above the
 // renderer's textures, so a damaged length cannot ask for gigabytes.
 constexpr std::uint32_t kMaxNoiseSize = 512;
+constexpr std::uint32_t kMaxChannels = 4;
 
 void putU32(std::vector<std::uint8_t>& out, std::uint32_t v) {
   for (int i = 0; i < 4; ++i) out.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
@@ -111,7 +112,7 @@ std::uint64_t fnv1a64(std::span<const std::uint8_t> bytes) {
 
 std::string noiseFileName(const NoiseKey& k) {
   return k.kind + "-g" + std::to_string(k.generatorVersion) + "-s" + std::to_string(k.seed) + "-n" +
-         std::to_string(k.size) + "-" + hex64(k.fingerprint) + ".noise";
+         std::to_string(k.size) + "-c" + std::to_string(k.channels) + "-" + hex64(k.fingerprint) + ".noise";
 }
 
 std::vector<std::uint8_t> encodeNoiseFile(const NoiseKey& k, std::span<const std::uint8_t> texels) {
@@ -120,6 +121,7 @@ std::vector<std::uint8_t> encodeNoiseFile(const NoiseKey& k, std::span<const std
   putU32(out, k.generatorVersion);
   putU32(out, k.seed);
   putU32(out, k.size);
+  putU32(out, k.channels);
   putU64(out, k.fingerprint);
   putU64(out, texels.size());
   putU64(out, fnv1a64(texels));
@@ -134,13 +136,14 @@ Result<std::vector<std::uint8_t>> decodeNoiseFile(std::span<const std::uint8_t> 
   std::span<const std::uint8_t> magic;
   if (!r.bytes(kMagic.size(), magic) || !std::equal(magic.begin(), magic.end(), kMagic.begin()))
     return fail(ErrorCode::Malformed, "not a Skyshell noise file (bad magic)");
-  std::uint32_t format = 0, version = 0, seed = 0, size = 0;
+  std::uint32_t format = 0, version = 0, seed = 0, size = 0, channels = 0;
   std::uint64_t fingerprint = 0, length = 0, checksum = 0;
   if (!r.u32(format)) return fail(ErrorCode::Malformed, "truncated header");
   if (format != kFormatVersion)
     return fail(ErrorCode::Malformed, "format version " + std::to_string(format) + ", expected " +
                                           std::to_string(kFormatVersion));
-  if (!r.u32(version) || !r.u32(seed) || !r.u32(size) || !r.u64(fingerprint) || !r.u64(length) || !r.u64(checksum))
+  if (!r.u32(version) || !r.u32(seed) || !r.u32(size) || !r.u32(channels) || !r.u64(fingerprint) || !r.u64(length) ||
+      !r.u64(checksum))
     return fail(ErrorCode::Malformed, "truncated header");
   std::span<const std::uint8_t> kindLength, kind;
   if (!r.bytes(1, kindLength) || !r.bytes(kindLength[0], kind)) return fail(ErrorCode::Malformed, "truncated header");
@@ -152,11 +155,14 @@ Result<std::vector<std::uint8_t>> decodeNoiseFile(std::span<const std::uint8_t> 
                                                                std::to_string(want.seed));
   if (size != want.size || size == 0 || size > kMaxNoiseSize)
     return fail(ErrorCode::Malformed, "size " + std::to_string(size) + ", expected " + std::to_string(want.size));
+  if (channels != want.channels || channels == 0 || channels > kMaxChannels)
+    return fail(ErrorCode::Malformed, "channels " + std::to_string(channels) + ", expected " +
+                                          std::to_string(want.channels));
   if (fingerprint != want.fingerprint) return fail(ErrorCode::Malformed, "generator fingerprint differs");
-  const std::uint64_t texels = std::uint64_t(size) * size * size;
+  const std::uint64_t texels = std::uint64_t(size) * size * size * channels;
   if (length != texels)
     return fail(ErrorCode::Malformed, "payload length " + std::to_string(length) + " for a " + std::to_string(size) +
-                                          "^3 volume");
+                                          "^3 volume of " + std::to_string(channels) + " channel(s)");
   if (r.left() != texels)
     return fail(ErrorCode::Malformed, "payload is " + std::to_string(r.left()) + " bytes, expected " +
                                           std::to_string(texels) + " (truncated or padded file)");

@@ -34,7 +34,7 @@ struct Generator {
   }
 };
 
-NoiseKey keyFor(const Generator& g) { return NoiseKey{"test", 1, g.seed, g.size, 0xabcdef}; }
+NoiseKey keyFor(const Generator& g) { return NoiseKey{"test", 1, g.seed, g.size, 1, 0xabcdef}; }
 
 std::vector<std::uint8_t> readBytes(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -113,16 +113,22 @@ TEST_F(NoiseCacheTest, EveryPartOfTheKeySelectsItsOwnFile) {
   Generator g;
   const CachedNoise base = get(g);
   NoiseKey k = keyFor(g);
-  std::vector<NoiseKey> others(5, k);
+  std::vector<NoiseKey> others(6, k);
   others[0].seed = 8;
   others[1].size = 32;
   others[2].generatorVersion = 2;
   others[3].fingerprint = 0x123;  // the generator changed without a version bump
   others[4].kind = "detail";
+  others[5].channels = 4;  // RGBA8 texels
   for (const auto& o : others) {
     EXPECT_NE(noiseFileName(o), noiseFileName(k));
     Generator og{o.size, o.seed};
-    const CachedNoise c = loadOrGenerateNoise(dir_, o, std::ref(og));
+    auto generate = [&] {
+      auto v = og();
+      v.resize(v.size() * o.channels, 7);
+      return v;
+    };
+    const CachedNoise c = loadOrGenerateNoise(dir_, o, generate);
     EXPECT_EQ(c.source, NoiseSource::Generated) << noiseFileName(o);
     EXPECT_EQ(og.calls, 1);
   }
@@ -154,7 +160,7 @@ TEST_F(NoiseCacheTest, EmptyFolderTurnsCachingOff) {
 }
 
 TEST(NoiseCacheFile, DecoderNamesWhatIsWrong) {
-  const NoiseKey k{"shape", 3, 11, 2, 99};
+  const NoiseKey k{"shape", 3, 11, 2, 1, 99};
   const std::vector<std::uint8_t> texels = {1, 2, 3, 4, 5, 6, 7, 8};
   const auto file = encodeNoiseFile(k, texels);
   auto ok = decodeNoiseFile(file, k);
@@ -172,6 +178,17 @@ TEST(NoiseCacheFile, DecoderNamesWhatIsWrong) {
   auto h = decodeNoiseFile(encodeNoiseFile(huge, texels), huge);
   ASSERT_FALSE(h);
   EXPECT_NE(h.error().detail.find("size"), std::string::npos) << h.error().detail;
+  // Four channels: four bytes per texel.
+  NoiseKey rgba = k;
+  rgba.channels = 4;
+  std::vector<std::uint8_t> rgbaTexels(32, 9);
+  auto four = decodeNoiseFile(encodeNoiseFile(rgba, rgbaTexels), rgba);
+  ASSERT_TRUE(four) << describe(four.error());
+  EXPECT_EQ(four->size(), 32u);
+  auto wrongChannels = decodeNoiseFile(encodeNoiseFile(rgba, rgbaTexels), k);
+  ASSERT_FALSE(wrongChannels);
+  EXPECT_NE(wrongChannels.error().detail.find("channels 4, expected 1"), std::string::npos)
+      << wrongChannels.error().detail;
   // Every prefix of a good file is refused, none crashes.
   for (std::size_t n = 0; n < file.size(); ++n)
     EXPECT_FALSE(decodeNoiseFile(std::span(file.data(), n), k)) << n << " bytes";

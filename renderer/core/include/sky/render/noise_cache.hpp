@@ -23,19 +23,20 @@ struct NoiseKey {
   std::uint32_t generatorVersion = 0;   // bumped whenever the generator's output changes
   std::uint32_t seed = 0;
   std::uint32_t size = 0;               // texels per edge of a cube
-  std::uint64_t fingerprint = 0;        // noiseFingerprint() of the generator at a tiny size
+  std::uint32_t channels = 1;           // bytes per texel, [1, 4] (R8 ... RGBA8)
+  std::uint64_t fingerprint = 0;        // fnv1a64 of the generator's output at a tiny size
 };
 
 // FNV-1a (64 bit) of the bytes: the file checksum and the fingerprint hash.
 std::uint64_t fnv1a64(std::span<const std::uint8_t> bytes);
 
-// The file name for a key: <kind>-g<version>-s<seed>-n<size>-<fingerprint hex>.noise
+// The file name for a key: <kind>-g<version>-s<seed>-n<size>-c<channels>-<fingerprint hex>.noise
 std::string noiseFileName(const NoiseKey& key);
 
 // File layout (little-endian): "SKYNOISE", u32 format version, u32 generator
-// version, u32 seed, u32 size, u64 fingerprint, u64 payload length, u64
-// FNV-1a of the payload, u8 kind length, the kind, then the payload
-// (size^3 texels, one byte each).
+// version, u32 seed, u32 size, u32 channels, u64 fingerprint, u64 payload
+// length, u64 FNV-1a of the payload, u8 kind length, the kind, then the
+// payload (size^3 texels of `channels` bytes).
 std::vector<std::uint8_t> encodeNoiseFile(const NoiseKey& key, std::span<const std::uint8_t> texels);
 // The payload of a file that holds exactly this key. Errors: Malformed with
 // what is wrong (magic, format version, key field, length, checksum).
@@ -55,7 +56,7 @@ struct CachedNoise {
 };
 
 // The texels for key from directory, or from generate() (which must return
-// key.size^3 texels) when the file is missing or bad; a generated volume is
+// key.size^3 * key.channels bytes) when the file is missing or bad; a generated volume is
 // written to the cache. Never fails: a cache that cannot be read or written
 // costs a regeneration and says so in note. An empty directory turns caching
 // off.
