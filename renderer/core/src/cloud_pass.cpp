@@ -30,7 +30,9 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
   const auto& device = ctx.device();
 
   ComputePipelineBuilder builder("sky.clouds");
-  builder.binding(gpu::kBindingFrame, vk::DescriptorType::eUniformBuffer)
+  // The frame block is a storage buffer: lavapipe recompiles the shader for
+  // every new value of a uniform block that decides a branch (clouds.comp).
+  builder.binding(gpu::kBindingFrame, vk::DescriptorType::eStorageBuffer)
       .binding(gpu::kBindingNoise, vk::DescriptorType::eCombinedImageSampler)
       .binding(gpu::kBindingWeather, vk::DescriptorType::eCombinedImageSampler)
       .binding(gpu::kBindingOutput, vk::DescriptorType::eStorageBuffer)
@@ -48,15 +50,14 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
   if (auto ok = uploadImage(ctx, pass.noise_, std::as_bytes(std::span(noise.texels))); !ok)
     return tl::unexpected(ok.error());
 
-  pass.uniforms_ = createHostBuffer(ctx, sizeof(gpu::SkyFrame), vk::BufferUsageFlagBits::eUniformBuffer, "sky.frameUniforms");
+  pass.uniforms_ = createHostBuffer(ctx, sizeof(gpu::SkyFrame), vk::BufferUsageFlagBits::eStorageBuffer, "sky.frameUniforms");
   pass.output_ = createHostBuffer(ctx, vk::DeviceSize(width) * height * 4 * sizeof(float),
                                   vk::BufferUsageFlagBits::eStorageBuffer, "sky.cloudOutput");
   pass.depth_ = createHostBuffer(ctx, vk::DeviceSize(width) * height * sizeof(float),
                                  vk::BufferUsageFlagBits::eStorageBuffer, "sky.cloudDepth");
 
-  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eUniformBuffer, 1),
-                             vk::DescriptorPoolSize(vk::DescriptorType::eCombinedImageSampler, 2),
-                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 2)};
+  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eCombinedImageSampler, 2),
+                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 3)};
   pass.descriptorPool_ = vk::raii::DescriptorPool(
       device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSizes));
   ctx.name(pass.descriptorPool_, "sky.clouds.descriptorPool");
@@ -73,7 +74,7 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
                                             vk::ImageLayout::eShaderReadOnlyOptimal);
   const vk::DescriptorSet set = *pass.descriptorSet_;
   const std::array writes{
-      vk::WriteDescriptorSet(set, gpu::kBindingFrame, 0, vk::DescriptorType::eUniformBuffer, {}, uniformInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingFrame, 0, vk::DescriptorType::eStorageBuffer, {}, uniformInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingNoise, 0, vk::DescriptorType::eCombinedImageSampler, noiseInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingWeather, 0, vk::DescriptorType::eCombinedImageSampler, weatherInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingOutput, 0, vk::DescriptorType::eStorageBuffer, {}, outputInfo),
