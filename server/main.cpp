@@ -127,10 +127,13 @@ int main(int argc, char** argv) {
       "weatherd", std::make_shared<spdlog::sinks::stderr_sink_mt>());
   log->set_level(spdlog::level::from_str(logLevel));
   log->flush_on(spdlog::level::info);
+  // Structured lines: a timestamp, the level, then "event=... key=value"
+  // fields (strings that may hold spaces are quoted), for grep and log shippers.
+  log->set_pattern("%Y-%m-%dT%H:%M:%S.%e%z level=%l %v");
 
   auto scenario = sky::server::loadScenario(scenarioPath);
   if (!scenario) {
-    log->error("bad scenario: {}", sky::describe(scenario.error()));
+    log->error("event=bad_scenario detail={:?}", sky::describe(scenario.error()));
     return kExitBadInput;
   }
 
@@ -153,8 +156,19 @@ int main(int argc, char** argv) {
       return kExitRuntime;
     }
   }
-  log->info("scenario {}: {} layer(s); listening on {}:{}", scenarioPath, scenario->layers.size(),
+  log->info("event=listening scenario={:?} layers={} stream={}:{}", scenarioPath, scenario->layers.size(),
             host, (*server)->port());
+
+  // The scenario's timeline, checked against the weather it will meet (a
+  // weather file restored below replaces it with the one it saved).
+  if (auto r = (*server)->weather().scheduleTimeline(*scenario, std::filesystem::path(scenarioPath).filename().string());
+      !r) {
+    log->error("event=bad_scenario detail={:?}", sky::describe(r.error()));
+    return kExitBadInput;
+  }
+  if (!scenario->timeline.empty())
+    log->info("event=timeline_scheduled scenario={:?} entries={} first_at_s={:.0f}", scenarioPath, scenario->timeline.size(),
+              scenario->timeline.front().at_s);
 
   std::optional<sky::server::WeatherStore> store;
   if (!dbPath.empty()) {
@@ -175,21 +189,21 @@ int main(int argc, char** argv) {
         log->error("{}: {}", dbPath, sky::describe(r.error()));
         return kExitRuntime;
       }
-      log->info("restored the weather from {}: sequence {}, {} layer(s), state hash {:016x}", dbPath,
+      log->info("event=restored db={:?} sequence={} layers={} state_hash={:016x}", dbPath,
                 weather.view().lastSequence, weather.view().layers.size(), weather.stateHash());
     } else if (auto r = store->save(weather.toJson(), nullptr); !r) {
       log->error("{}", sky::describe(r.error()));
       return kExitRuntime;
     } else {
-      log->info("new weather file {} from the scenario", dbPath);
+      log->info("event=new_db db={:?}", dbPath);
     }
     weather.attachStore(&*store);
   }
 
   sky::server::Server& s = **server;
   std::unique_ptr<sky::server::CigiWeatherInput> cigi;
-  // Every accepted change from any input reaches every subscriber at once.
-  auto weatherChanged = [&s] { s.weatherChanged(); };
+  // (Every accepted change from any input reaches every subscriber and the
+  // console through the LiveWeather's listeners.)
 
   std::unique_ptr<sky::server::HttpApi> api;
   if (httpPort >= 0) {
@@ -214,7 +228,7 @@ int main(int argc, char** argv) {
         return kExitBadInput;
       }
       http.stations = std::move(*table);
-      log->info("METAR station table {}: {} stations", stationsPath, http.stations.size());
+      log->info("event=metar_stations file={:?} stations={}", stationsPath, http.stations.size());
     }
     // The console is optional for the API: a missing default folder is a
     // warning, a folder named on the command line that cannot be read is not.
@@ -231,6 +245,7 @@ int main(int argc, char** argv) {
       log->warn("no console pages: {}", sky::describe(files.error()));
     }
     http.port = static_cast<std::uint16_t>(httpPort);
+    http.serverId = options.serverId;
     http.log = log;
     auto moreMetrics = [&cigi, &s]() -> std::string {
       std::string m = s.streamMetrics();
@@ -253,14 +268,19 @@ int main(int argc, char** argv) {
       line("skyshell_cigi_applied_total", "CIGI weather datagrams that changed the weather", c.applied);
       return m;
     };
-    auto created = sky::server::HttpApi::create(s.io(), http, s.weather(),
-                                                {weatherChanged, [&s] { return s.subscribers(); }, moreMetrics});
+    sky::server::HttpApiHooks hooks;
+    hooks.subscribers = [&s] { return s.subscribers(); };
+    hooks.extraMetrics = moreMetrics;
+    hooks.renderers = [&s] { return sky::server::renderersJson(s.renderers()); };
+    hooks.rejections = &s.rejections();
+    auto created = sky::server::HttpApi::create(s.io(), http, s.weather(), std::move(hooks));
     if (!created) {
       log->error("{}", sky::describe(created.error()));
       return kExitRuntime;
     }
     api = std::move(*created);
     s.onShutdown([&api] { api->close(); });
+    s.onRenderersChanged([&api] { api->renderersChanged(); });
     std::cout << "skyshell-weatherd HTTP API on " << http.listenAddress << ":" << api->port()
               << (http.token.empty() ? " (read-only: no --token-file)" : "") << std::endl;
     if (http.console)
@@ -278,7 +298,7 @@ int main(int argc, char** argv) {
 
   if (cigiPort >= 0) {
     auto created = sky::server::CigiWeatherInput::create(s.io(), cigiListen, static_cast<std::uint16_t>(cigiPort),
-                                                         s.weather(), weatherChanged, log);
+                                                         s.weather(), &s.rejections(), log);
     if (!created) {
       log->error("{}", sky::describe(created.error()));
       return kExitRuntime;

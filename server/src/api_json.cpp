@@ -222,6 +222,32 @@ Result<ChangeRequest> parseChangeRequest(std::string_view body) {
   return req;
 }
 
+Result<WeatherChange> changeFromJson(const nlohmann::json& object, const std::string& path) {
+  return change(object, path);
+}
+
+nlohmann::json toJson(const WeatherChange& c) {
+  auto timed = [](json j, const Timing& t) {
+    if (t.ramp_s != 0) j["ramp_s"] = t.ramp_s;
+    if (t.at_s) j["at_s"] = *t.at_s;
+    return j;
+  };
+  if (const auto* s = std::get_if<SetLayer>(&c)) return timed({{"op", "set_layer"}, {"layer", toJson(s->layer)}}, s->timing);
+  if (const auto* r = std::get_if<RemoveLayer>(&c)) return timed({{"op", "remove_layer"}, {"id", r->layerId}}, r->timing);
+  if (const auto* s = std::get_if<SetRegion>(&c)) {
+    json region = toJson(s->region);
+    region.erase("placed_at_clock_s");  // the server places a region when it applies it
+    return timed({{"op", "set_region"}, {"region", region}}, s->timing);
+  }
+  if (const auto* r = std::get_if<RemoveRegion>(&c))
+    return timed({{"op", "remove_region"}, {"id", r->regionId}}, r->timing);
+  const auto& k = std::get<SetClock>(c);
+  json j = {{"op", "set_clock"}};
+  if (k.rate) j["rate"] = *k.rate;
+  if (k.jumpTo_s) j["jump_to_s"] = *k.jumpTo_s;
+  return j;
+}
+
 Result<weather::CloudLayer> layerFromJson(const nlohmann::json& object, const std::string& path) {
   return parseLayer(object, path);
 }
@@ -265,7 +291,8 @@ nlohmann::json toJson(const WeatherView& v) {
   for (const auto& r : v.regions) regions.push_back(toJson(r));
   json pending = json::array();
   for (const auto& p : v.pending)
-    pending.push_back({{"sequence", p.sequence}, {"start_s", p.start_s}, {"end_s", p.end_s}, {"summary", p.summary}});
+    pending.push_back({{"sequence", p.sequence}, {"start_s", p.start_s}, {"end_s", p.end_s}, {"summary", p.summary},
+                       {"kind", p.kind}});
   return {{"clock_s", v.clock_s}, {"clock_rate", v.clockRate}, {"sequence", v.lastSequence},
           {"version", v.version}, {"layers", layers}, {"regions", regions}, {"pending", pending}};
 }

@@ -23,15 +23,15 @@ std::string kindOf(const std::string& reason) {
 }  // namespace
 
 CigiWeatherInput::CigiWeatherInput(asio::io_context& io, WeatherService& weather,
-                                   std::function<void()> weatherChanged, std::shared_ptr<spdlog::logger> log)
-    : socket_(io), weather_(weather), weatherChanged_(std::move(weatherChanged)), log_(std::move(log)) {}
+                                   Rejections* rejections, std::shared_ptr<spdlog::logger> log)
+    : socket_(io), weather_(weather), rejections_(rejections), log_(std::move(log)) {}
 
 Result<std::unique_ptr<CigiWeatherInput>> CigiWeatherInput::create(asio::io_context& io, const std::string& address,
                                                                    std::uint16_t port, WeatherService& weather,
-                                                                   std::function<void()> weatherChanged,
+                                                                   Rejections* rejections,
                                                                    std::shared_ptr<spdlog::logger> log) {
   std::unique_ptr<CigiWeatherInput> in(
-      new CigiWeatherInput(io, weather, std::move(weatherChanged), log ? log : spdlog::default_logger()));
+      new CigiWeatherInput(io, weather, rejections, log ? log : spdlog::default_logger()));
   boost::system::error_code ec;
   const auto ip = asio::ip::make_address(address, ec);
   if (ec) return fail(ErrorCode::InvalidArgument, "--cigi-listen " + address + ": not an IP address");
@@ -62,7 +62,8 @@ void CigiWeatherInput::receive() {
 }
 
 void CigiWeatherInput::logOnce(const std::string& kind, const std::string& message) {
-  if (logged_.insert(kind).second) log_->warn("{} (further ones of this kind are only counted)", message);
+  if (logged_.insert(kind).second)
+    log_->warn("event=cigi_dropped kind={:?} detail={:?} (further ones of this kind are only counted)", kind, message);
 }
 
 void CigiWeatherInput::onDatagram(std::span<const std::uint8_t> bytes, const std::string& sender) {
@@ -70,12 +71,14 @@ void CigiWeatherInput::onDatagram(std::span<const std::uint8_t> bytes, const std
   auto datagram = cigi::decodeDatagram(bytes);
   if (!datagram) {
     ++counters_.malformed;
+    if (rejections_) rejections_->count(RejectReason::CigiMalformed);
     logOnce("malformed " + kindOf(datagram.error().detail),
             "CIGI weather from " + sender + ": dropped a datagram: " + datagram.error().detail);
     return;
   }
   if (datagram->direction != cigi::Direction::HostToIg) {
     ++counters_.malformed;
+    if (rejections_) rejections_->count(RejectReason::CigiMalformed);
     logOnce("direction", "CIGI weather from " + sender + ": dropped a datagram: it starts with Start of Frame, "
                          "the weather input takes host datagrams only");
     return;
@@ -84,6 +87,7 @@ void CigiWeatherInput::onDatagram(std::span<const std::uint8_t> bytes, const std
   auto changes = mapper.map(*datagram);
   if (!changes) {
     ++counters_.rejected;
+    if (rejections_) rejections_->count(RejectReason::CigiRefused);
     logOnce("refused " + kindOf(changes.error().detail),
             "CIGI weather from " + sender + ": refused: " + changes.error().detail);
     return;
@@ -95,6 +99,7 @@ void CigiWeatherInput::onDatagram(std::span<const std::uint8_t> bytes, const std
   auto applied = weather_.submit(ChangeRequest{std::move(*changes), "cigi:" + sender, "cigi"});
   if (!applied) {
     ++counters_.rejected;
+    if (rejections_) rejections_->count(RejectReason::CigiRefused);
     // The mapper remembered these as sent; forget, so the next resend is
     // mapped (and judged) again.
     mapper.reset();
@@ -103,8 +108,8 @@ void CigiWeatherInput::onDatagram(std::span<const std::uint8_t> bytes, const std
     return;
   }
   ++counters_.applied;
-  log_->info("CIGI weather from {}: change {}: {}", sender, applied->sequence, applied->summary);
-  if (weatherChanged_) weatherChanged_();
+  log_->info("event=change_applied source=cigi sender={} sequence={} summary={:?}", sender, applied->sequence,
+             applied->summary);
 }
 
 }  // namespace sky::server

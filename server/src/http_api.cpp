@@ -7,11 +7,13 @@
 #include <boost/asio/ip/address.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
+#include <boost/beast/websocket/rfc6455.hpp>
 #include <spdlog/spdlog.h>
 
 #include "sky/server/api_json.hpp"
 #include "sky/server/console_files.hpp"
 #include "sky/server/metar_api.hpp"
+#include "sky/server/scenario_api.hpp"
 
 namespace sky::server {
 
@@ -23,6 +25,8 @@ using tcp = asio::ip::tcp;
 namespace {
 
 constexpr std::size_t kMaxBody = 64 * 1024;
+// A scenario may carry up to 1024 timeline entries of a few hundred bytes.
+constexpr std::size_t kMaxScenarioBody = 1024 * 1024;
 constexpr auto kClientDeadline = std::chrono::seconds(10);
 constexpr std::size_t kDefaultEvents = 100, kMaxEvents = 10000;
 
@@ -30,19 +34,38 @@ class Connection : public std::enable_shared_from_this<Connection> {
  public:
   Connection(tcp::socket socket, HttpApi& api) : stream_(std::move(socket)), api_(api) {}
   void start() {
-    parser_.body_limit(kMaxBody);
     stream_.expires_after(kClientDeadline);
-    http::async_read(stream_, buffer_, parser_,
-                     [self = shared_from_this()](beast::error_code ec, std::size_t) { self->onRead(ec); });
+    // The header first: the body limit depends on the path.
+    http::async_read_header(stream_, buffer_, parser_,
+                            [self = shared_from_this()](beast::error_code ec, std::size_t) { self->onHeader(ec); });
   }
 
  private:
+  void onHeader(beast::error_code ec) {
+    if (ec) return;  // the client went away, was too slow or sent no HTTP
+    const std::string_view target(parser_.get().target().data(), parser_.get().target().size());
+    bodyLimit_ = target.substr(0, target.find('?')) == "/api/scenario" ? kMaxScenarioBody : kMaxBody;
+    parser_.body_limit(bodyLimit_);
+    http::async_read(stream_, buffer_, parser_,
+                     [self = shared_from_this()](beast::error_code e, std::size_t) { self->onRead(e); });
+  }
+
   void onRead(beast::error_code ec) {
     HttpApi::Reply reply;
     if (ec == http::error::body_limit) {
-      reply = {413, "application/json", R"({"error":"body over 64 KiB"})"};
+      reply = {413, "application/json",
+               nlohmann::json{{"error", "body: over " + std::to_string(bodyLimit_ / 1024) + " KiB"}, {"field", "body"}}
+                   .dump()};
     } else if (ec) {
       return;  // the client went away or was too slow: nothing to answer
+    } else if (isFeedUpgrade(parser_.get())) {
+      if (!api_.feed().full()) {
+        // The console's WebSocket takes the connection over.
+        stream_.expires_never();
+        api_.feed().accept(stream_.release_socket(), parser_.release());
+        return;
+      }
+      reply = api_.refuseFeed();
     } else {
       const auto& req = parser_.get();
       reply = api_.handle(std::string(req.method_string()), std::string(req.target()),
@@ -61,9 +84,15 @@ class Connection : public std::enable_shared_from_this<Connection> {
     });
   }
 
+  static bool isFeedUpgrade(const http::request<http::string_body>& req) {
+    const std::string_view target(req.target().data(), req.target().size());
+    return beast::websocket::is_upgrade(req) && target.substr(0, target.find('?')) == "/api/ws";
+  }
+
   beast::tcp_stream stream_;
   beast::flat_buffer buffer_;
   http::request_parser<http::string_body> parser_;
+  std::size_t bodyLimit_ = kMaxBody;
   http::response<http::string_body> response_;
   HttpApi& api_;
 };
@@ -79,9 +108,42 @@ std::string errorJson(const std::string& detail) {
 }  // namespace
 
 HttpApi::HttpApi(asio::io_context& io, HttpApiOptions options, LiveWeather& weather, HttpApiHooks hooks)
-    : io_(io), options_(std::move(options)), weather_(weather), hooks_(std::move(hooks)), acceptor_(io) {}
+    : io_(io),
+      options_(std::move(options)),
+      weather_(weather),
+      hooks_(std::move(hooks)),
+      feed_(io, options_.feed,
+            ConsoleFeedSource{options_.serverId, [this] { return toJson(weather_.view()); },
+                              [this] { return hooks_.renderers ? hooks_.renderers() : nlohmann::json::array(); },
+                              [this] { return healthJson(); },
+                              [this] {
+                                const double now = weather_.clockNow();
+                                return weather_.rampRunning(now) || weather_.drifting(now);
+                              }},
+            options_.log),
+      acceptor_(io) {
+  // Every accepted change, from whichever input, goes to the console.
+  weatherListener_ = weather_.addListener([this](const ChangeEvent& e) { feed_.changeAccepted(e); });
+}
 
-HttpApi::~HttpApi() { close(); }
+HttpApi::~HttpApi() {
+  close();
+  weather_.removeListener(weatherListener_);
+}
+
+HttpApi::Reply HttpApi::refuseFeed() {
+  ++counters_.requests;
+  reject(RejectReason::WsRefused);
+  return {503, "application/json",
+          errorJson("ws: " + std::to_string(feed_.clients()) + " console clients connected, at most " +
+                    std::to_string(options_.feed.maxClients))};
+}
+
+nlohmann::json HttpApi::healthJson() const {
+  return {{"subscribers", hooks_.subscribers ? hooks_.subscribers() : 0},
+          {"changes_applied", weather_.accepted()},
+          {"rejected", hooks_.rejections ? hooks_.rejections->json() : nlohmann::json::object()}};
+}
 
 Result<std::unique_ptr<HttpApi>> HttpApi::create(asio::io_context& io, HttpApiOptions options, LiveWeather& weather,
                                                  HttpApiHooks hooks) {
@@ -107,6 +169,7 @@ void HttpApi::close() {
   closed_ = true;
   boost::system::error_code ignored;
   acceptor_.close(ignored);
+  feed_.close();
 }
 
 void HttpApi::accept() {
@@ -130,15 +193,26 @@ HttpApi::Reply HttpApi::handle(const std::string& method, const std::string& tar
            std::to_string(v) + "\n";
     };
     line("skyshell_http_requests_total", "HTTP requests handled", "counter", counters_.requests);
-    line("skyshell_changes_applied_total", "weather changes applied", "counter", counters_.applied);
+    line("skyshell_changes_applied_total", "weather changes applied (every input)", "counter", weather_.accepted());
     line("skyshell_changes_rejected_total", "weather changes refused as invalid", "counter", counters_.rejected);
     line("skyshell_changes_unauthorized_total", "change requests without the token", "counter", counters_.unauthorized);
     line("skyshell_subscribers", "weather stream subscribers connected", "gauge",
          hooks_.subscribers ? hooks_.subscribers() : 0);
+    line("skyshell_ws_clients", "console WebSocket clients connected", "gauge", feed_.clients());
+    line("skyshell_ws_clients_dropped_total", "console WebSocket clients dropped for not reading", "counter",
+         feed_.dropped());
+    if (hooks_.rejections) m += hooks_.rejections->metrics();
     if (hooks_.extraMetrics) m += hooks_.extraMetrics();
     return {200, "text/plain; version=0.0.4", m};
   }
   if (method == "GET" && path == "/api/state") return {200, "application/json", toJson(weather_.view()).dump()};
+  if (method == "GET" && path == "/api/renderers") {
+    const nlohmann::json list = hooks_.renderers ? hooks_.renderers() : nlohmann::json::array();
+    return {200, "application/json",
+            nlohmann::json{{"renderers", list}}.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)};
+  }
+  if (path == "/api/ws")
+    return {426, "application/json", errorJson("upgrade: GET /api/ws is a WebSocket (send Upgrade: websocket)")};
   if (method == "GET" && path == "/api/events") {
     std::size_t limit = kDefaultEvents;
     if (query.rfind("limit=", 0) == 0) {
@@ -157,6 +231,7 @@ HttpApi::Reply HttpApi::handle(const std::string& method, const std::string& tar
     if (method != "POST") return {405, "application/json", errorJson("method: use POST")};
     if (options_.token.empty() || authorization != "Bearer " + options_.token) {
       ++counters_.unauthorized;
+      reject(RejectReason::Unauthorized);
       return {401, "application/json",
               errorJson(std::string("authorization: ") +
                         (options_.token.empty() ? "this server has no token: read-only" : "missing or wrong token"))};
@@ -164,6 +239,7 @@ HttpApi::Reply HttpApi::handle(const std::string& method, const std::string& tar
     auto request = parseChangeRequest(body);
     if (!request) {
       ++counters_.rejected;
+      reject(RejectReason::HttpInvalid);
       return {400, "application/json", errorJson(request.error().detail)};
     }
     request->source = "api";
@@ -171,15 +247,52 @@ HttpApi::Reply HttpApi::handle(const std::string& method, const std::string& tar
     auto applied = weather_.submit(*request);
     if (!applied) {
       ++counters_.rejected;
-      if (options_.log) options_.log->info("change from {} refused: {}", request->author, applied.error().detail);
+      reject(RejectReason::HttpInvalid);
+      if (options_.log)
+        options_.log->info("event=change_refused source=api author={:?} detail={:?}", request->author,
+                           applied.error().detail);
       return {applied.error().code == ErrorCode::Unsupported ? 501 : 400, "application/json",
               errorJson(applied.error().detail)};
     }
     ++counters_.applied;
-    if (options_.log) options_.log->info("change {} by {}: {}", applied->sequence, request->author, applied->summary);
-    if (hooks_.weatherChanged) hooks_.weatherChanged();
+    if (options_.log)
+      options_.log->info("event=change_applied source=api sequence={} author={:?} summary={:?}", applied->sequence,
+                         request->author, applied->summary);
     return {200, "application/json",
             nlohmann::json{{"sequence", applied->sequence}, {"clock_s", applied->clock_s}, {"summary", applied->summary}}
+                .dump()};
+  }
+  if (path == "/api/scenario") {
+    if (method != "POST") return {405, "application/json", errorJson("method: use POST")};
+    if (options_.token.empty() || authorization != "Bearer " + options_.token) {
+      ++counters_.unauthorized;
+      reject(RejectReason::Unauthorized);
+      return {401, "application/json", errorJson("authorization: loading a scenario needs the token")};
+    }
+    auto upload = parseScenarioUpload(body);
+    if (!upload) {
+      reject(RejectReason::ScenarioInvalid);
+      return {400, "application/json", errorJson(upload.error().detail)};
+    }
+    auto scenario = parseScenario(upload->toml, upload->name);
+    Result<AppliedChange> applied =
+        scenario ? weather_.loadScenario(*scenario, upload->name, upload->author.empty() ? "api" : upload->author)
+                 : Result<AppliedChange>(tl::unexpected(scenario.error()));
+    if (!applied) {
+      reject(RejectReason::ScenarioInvalid);
+      if (options_.log)
+        options_.log->info("event=scenario_refused name={:?} detail={:?}", upload->name, applied.error().detail);
+      return {400, "application/json", scenarioErrorJson(applied.error().detail, upload->name).dump()};
+    }
+    if (options_.log)
+      options_.log->info("event=change_applied source=scenario sequence={} author={:?} summary={:?}", applied->sequence,
+                         upload->author, applied->summary);
+    return {200, "application/json",
+            nlohmann::json{{"sequence", applied->sequence},
+                           {"clock_s", applied->clock_s},
+                           {"summary", applied->summary},
+                           {"layers", scenario->layers.size()},
+                           {"timeline", scenario->timeline.size()}}
                 .dump()};
   }
   if (path == "/api/metar") {
@@ -187,21 +300,29 @@ HttpApi::Reply HttpApi::handle(const std::string& method, const std::string& tar
     auto request = parseMetarRequest(body);
     if (!request) {
       ++counters_.rejected;
+      reject(RejectReason::HttpInvalid);
       return {400, "application/json", errorJson(request.error().detail)};
     }
     // A preview reads; applying changes the weather and needs the token.
     if (request->apply && (options_.token.empty() || authorization != "Bearer " + options_.token)) {
       ++counters_.unauthorized;
+      reject(RejectReason::Unauthorized);
       return {401, "application/json", errorJson("authorization: applying METAR needs the token")};
     }
     const MetarReply reply = handleMetar(*request, options_.stations, weather_);
+    if (reply.body.contains("reports"))
+      for (const auto& r : reply.body["reports"])
+        if (r.value("ok", true) == false) reject(RejectReason::MetarUnparsed);
     if (request->apply) {
       if (reply.status == 200) {
         ++counters_.applied;
-        if (options_.log) options_.log->info("METAR batch applied: {}", reply.body["applied"]["summary"].get<std::string>());
-        if (hooks_.weatherChanged) hooks_.weatherChanged();
+        if (options_.log)
+          options_.log->info("event=change_applied source=metar sequence={} summary={:?}",
+                             reply.body["applied"]["sequence"].get<std::uint64_t>(),
+                             reply.body["applied"]["summary"].get<std::string>());
       } else {
         ++counters_.rejected;
+        reject(RejectReason::HttpInvalid);
       }
     }
     return {reply.status, "application/json", reply.body.dump()};

@@ -96,9 +96,8 @@ void LiveWeather::settle(double c) {
   regionRamps_ = std::move(stillRegions);
 }
 
-Result<std::string> LiveWeather::apply(State& s, const WeatherChange& change, std::size_t i, double now_s,
+Result<std::string> LiveWeather::apply(State& s, const WeatherChange& change, const std::string& at, double now_s,
                                        std::uint64_t sequence) const {
-  const std::string at = "changes[" + std::to_string(i) + "]";
   if (const auto* set = std::get_if<SetLayer>(&change)) {
     if (auto ok = checkTiming(set->timing, at, now_s); !ok) return tl::unexpected(ok.error());
     if (auto ok = weather::validate(set->layer); !ok)
@@ -181,18 +180,23 @@ Result<AppliedChange> LiveWeather::submit(const ChangeRequest& request) {
   State next = state();
   std::string summary;
   for (std::size_t i = 0; i < request.changes.size(); ++i) {
-    auto one = apply(next, request.changes[i], i, now_s, sequence_ + 1);
+    auto one = apply(next, request.changes[i], "changes[" + std::to_string(i) + "]", now_s, sequence_ + 1);
     if (!one) {
       ++rejected_;
       return tl::unexpected(one.error());
     }
     summary += (summary.empty() ? "" : "; ") + *one;
   }
-  ChangeEvent e{sequence_ + 1, now_s, unixNowMs_(), request.author, request.source, summary};
+  return commit(std::move(next), timeline_, request.author, request.source, summary, now_s);
+}
+
+Result<AppliedChange> LiveWeather::commit(State next, std::vector<TimelineItem> timeline, const std::string& author,
+                                          const std::string& source, const std::string& summary, double now_s) {
+  ChangeEvent e{sequence_ + 1, now_s, unixNowMs_(), author, source, summary};
   if (store_) {
     // Commit first: only a change on disk is acknowledged and applied.
     const auto started = std::chrono::steady_clock::now();
-    auto ok = store_->save(stateJson(next, sequence_ + 1, version_ + 1), &e);
+    auto ok = store_->save(stateJson(next, timeline, sequence_ + 1, version_ + 1), &e);
     const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     ++commitStats_.count;
     commitStats_.total_s += took_s;
@@ -204,11 +208,38 @@ Result<AppliedChange> LiveWeather::submit(const ChangeRequest& request) {
   regions_ = std::move(next.regions);
   regionRamps_ = std::move(next.regionRamps);
   clock_ = next.clock;
+  timeline_ = std::move(timeline);
   ++sequence_;
   ++version_;
   events_.push_back(e);
   if (events_.size() > kMaxEvents) events_.erase(events_.begin());
+  ++accepted_;
+  // A copy: a listener may add or remove listeners.
+  const auto listeners = listeners_;
+  for (const auto& [id, f] : listeners) f(e);
   return AppliedChange{sequence_, now_s, summary};
+}
+
+std::size_t LiveWeather::addListener(Listener listener) {
+  listeners_[nextListenerId_] = std::move(listener);
+  return nextListenerId_++;
+}
+
+void LiveWeather::removeListener(std::size_t id) { listeners_.erase(id); }
+
+bool LiveWeather::rampRunning(double c) const {
+  for (const Ramp& r : ramps_)
+    if (c >= r.start_s && c < r.end_s) return true;
+  for (const RegionRamp& r : regionRamps_)
+    if (c >= r.start_s && c < r.end_s) return true;
+  return false;
+}
+
+bool LiveWeather::drifting(double c) const {
+  if (clock_.rate() == 0) return false;
+  for (const auto& r : regionsAt(c))
+    if (r.driftsWithWind && !r.layers.empty() && r.layers.front().wind.speed_mps > 0) return true;
+  return false;
 }
 
 WeatherView LiveWeather::view() const {
@@ -223,6 +254,9 @@ WeatherView LiveWeather::view() const {
     if (v.clock_s < r.end_s || v.clock_s < r.start_s) v.pending.push_back({r.sequence, r.start_s, r.end_s, r.summary});
   std::stable_sort(v.pending.begin(), v.pending.end(),
                    [](const PendingChange& a, const PendingChange& b) { return a.sequence < b.sequence; });
+  // Then what the timeline will do, soonest first (not accepted yet: sequence 0).
+  for (const TimelineItem& t : timeline_)
+    v.pending.push_back({0, t.at_s, t.at_s + rampOf(t.change), t.summary, "timeline"});
   v.lastSequence = sequence_;
   v.version = version_;
   return v;
@@ -245,7 +279,8 @@ nlohmann::json rampJson(std::uint64_t sequence, std::uint32_t layerId, double st
 
 }  // namespace
 
-nlohmann::json LiveWeather::stateJson(const State& s, std::uint64_t sequence, std::uint64_t version) const {
+nlohmann::json LiveWeather::stateJson(const State& s, const std::vector<TimelineItem>& timeline, std::uint64_t sequence,
+                                      std::uint64_t version) const {
   nlohmann::json layers = nlohmann::json::array();
   for (const auto& [id, l] : s.layers) layers.push_back(server::toJson(l));
   nlohmann::json ramps = nlohmann::json::array();
@@ -263,12 +298,13 @@ nlohmann::json LiveWeather::stateJson(const State& s, std::uint64_t sequence, st
           {"ramps", ramps},
           {"regions", regions},
           {"region_ramps", regionRamps},
+          {"timeline", timelineJson(timeline)},
           {"sequence", sequence},
           {"version", version},
           {"clock", {{"clock_s", s.clock.at(wallNow_())}, {"rate", s.clock.rate()}, {"unix_ms", unixNowMs_()}}}};
 }
 
-nlohmann::json LiveWeather::toJson() const { return stateJson(state(), sequence_, version_); }
+nlohmann::json LiveWeather::toJson() const { return stateJson(state(), timeline_, sequence_, version_); }
 
 Result<void> LiveWeather::restore(const nlohmann::json& j, std::vector<ChangeEvent> events) {
   auto bad = [](const std::string& what) { return fail(ErrorCode::Malformed, "saved state: " + what); };
@@ -323,6 +359,13 @@ Result<void> LiveWeather::restore(const nlohmann::json& j, std::vector<ChangeEve
         regionRamps.push_back(ramp);
       }
     }
+    // The timeline came with format 3 of the saved state.
+    std::vector<TimelineItem> timeline;
+    if (j.contains("timeline")) {
+      auto t = timelineFromJson(j.at("timeline"));
+      if (!t) return tl::unexpected(t.error());
+      timeline = std::move(*t);
+    }
     const auto& c = j.at("clock");
     const double rate = c.at("rate").get<double>();
     const double downtime_s = double(unixNowMs_() - c.at("unix_ms").get<std::int64_t>()) / 1000.0;
@@ -331,6 +374,7 @@ Result<void> LiveWeather::restore(const nlohmann::json& j, std::vector<ChangeEve
     ramps_ = std::move(ramps);
     regions_ = std::move(regions);
     regionRamps_ = std::move(regionRamps);
+    timeline_ = std::move(timeline);
     sequence_ = j.at("sequence").get<std::uint64_t>();
     version_ = j.at("version").get<std::uint64_t>() + 1;
     clock_ = WeatherClock(clockNow_s, rate, wallNow_());

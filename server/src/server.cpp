@@ -1,6 +1,7 @@
 // The weather stream server (see server.hpp).
 #include "sky/server/server.hpp"
 
+#include <algorithm>
 #include <csignal>
 #include <utility>
 
@@ -20,6 +21,9 @@ namespace {
 // Pause before accepting again after a failed accept (e.g. out of file
 // descriptors), so a persistent failure does not spin the loop.
 constexpr std::chrono::milliseconds kAcceptRetryDelay{100};
+// Longest sleep of the timeline timer: the weather clock is re-read at least
+// this often, so an entry is never late by more than the timer's own slack.
+constexpr std::chrono::seconds kMaxTimelineSleep{60};
 
 }  // namespace
 
@@ -42,7 +46,15 @@ Server::Server(ServerOptions options, WeatherState state)
                }),
       acceptor_(io_),
       acceptRetry_(io_),
-      heartbeat_(io_) {}
+      heartbeat_(io_),
+      timelineTimer_(io_) {
+  // Every accepted change, from whichever input, reaches every subscriber;
+  // it may have moved the clock or brought a new timeline.
+  weather_.addListener([this](const ChangeEvent&) {
+    weatherChanged();
+    armTimeline();
+  });
+}
 
 Server::~Server() = default;
 
@@ -70,16 +82,17 @@ void Server::run() {
     signals_.emplace(io_, SIGINT, SIGTERM);
     signals_->async_wait([this](const boost::system::error_code& ec, int signal) {
       if (ec) return;
-      log_->info("signal {}: shutting down", signal);
+      log_->info("event=shutdown signal={}", signal);
       shutdown();
     });
   }
   accept();
   scheduleHeartbeat();
-  log_->info("serving {} layer(s), weather clock {:.3f} s at rate {}", weather_.layersAt(clockNow()).size(),
+  armTimeline();
+  log_->info("event=serving layers={} clock_s={:.3f} rate={}", weather_.layersAt(clockNow()).size(),
              clockNow(), weather_.clock().rate());
   io_.run();
-  log_->info("stopped");
+  log_->info("event=stopped");
 }
 
 void Server::stop() {
@@ -93,6 +106,7 @@ void Server::shutdown() {
   acceptor_.close(ignored);
   acceptRetry_.cancel();
   heartbeat_.cancel();
+  timelineTimer_.cancel();
   if (signals_) signals_->cancel(ignored);
   registry_.closeAll();
   for (const auto& f : onShutdown_) f();
@@ -107,7 +121,7 @@ void Server::accept() {
 void Server::onAccept(const boost::system::error_code& ec, tcp::socket socket) {
   if (stopped_) return;
   if (ec) {
-    log_->warn("accept failed: {}; retrying", ec.message());
+    log_->warn("event=accept_failed error={:?}; retrying", ec.message());
     acceptRetry_.expires_after(kAcceptRetryDelay);
     acceptRetry_.async_wait([this](const boost::system::error_code& e) {
       if (!e && !stopped_) accept();
@@ -119,11 +133,13 @@ void Server::onAccept(const boost::system::error_code& ec, tcp::socket socket) {
   socket.set_option(tcp::no_delay(true), ignored);
   auto session = std::make_shared<Session>(std::move(socket), nextSessionId_++,
                                            static_cast<SessionHandler&>(*this), *log_, options_.stallTimeout);
-  log_->info("session {} ({}): connected", session->id(), session->peer());
+  log_->info("event=session_connected session={} peer={} subscribers={}", session->id(), session->peer(),
+             registry_.size() + 1);
   registry_.add(session);
-  const stream::Hello hello{stream::kProtocolVersion, options_.serverId, clockNow(),
-                            weather_.clock().rate()};
+  const stream::Hello hello{stream::kProtocolVersion, options_.serverId, clockNow(), weather_.clock().rate(),
+                            stream::kFeatureCameraReports};
   session->start(stream::encodeFrame(stream::encodeMessage(hello)));
+  renderersChanged();
   accept();
 }
 
@@ -139,6 +155,44 @@ void Server::scheduleHeartbeat() {
   });
 }
 
+void Server::armTimeline() {
+  if (stopped_) return;
+  const auto next = weather_.nextTimelineAt();
+  if (!next) {
+    timelineTimer_.cancel();
+    return;
+  }
+  const double now = clockNow(), rate = weather_.clock().rate();
+  std::chrono::steady_clock::duration wait = std::chrono::steady_clock::duration::zero();
+  if (*next > now) {
+    if (rate <= 0) {
+      timelineTimer_.cancel();  // frozen: a clock change arms it again
+      return;
+    }
+    wait = std::min<std::chrono::steady_clock::duration>(
+        std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>((*next - now) / rate)),
+        kMaxTimelineSleep);
+  }
+  timelineTimer_.expires_after(wait);
+  timelineTimer_.async_wait([this](const boost::system::error_code& ec) {
+    if (!ec && !stopped_) fireTimeline();
+  });
+}
+
+void Server::fireTimeline() {
+  for (const auto& o : weather_.runTimeline()) {
+    if (o.result) {
+      log_->info("event=change_applied source=timeline sequence={} at_s={:.1f} summary={:?}", o.result->sequence,
+                 o.at_s, o.result->summary);
+    } else {
+      rejections_.count(RejectReason::TimelineRefused);
+      log_->warn("event=timeline_refused at_s={:.1f} detail={:?} (dropped)", o.at_s,
+                 o.result.error().detail);
+    }
+  }
+  armTimeline();
+}
+
 double Server::clockNow() const { return weather_.clock().at(options_.wallNow()); }
 
 void Server::weatherChanged() {
@@ -149,7 +203,7 @@ weather::WeatherSnapshot Server::snapshotFor(const stream::Subscribe& request) {
   weather::WeatherSnapshot snapshot =
       buildSnapshot(request, weather_.layersAt(clockNow()), clockNow(), options_.maxCellsPerSnapshot,
                     weather_.regionsAt(clockNow()), &tileCache_);
-  log_->debug("snapshot: level {} (asked {}), {} tiles", snapshot.tileLevel, request.tileLevel,
+  log_->debug("event=snapshot level={} asked={} tiles={}", snapshot.tileLevel, request.tileLevel,
               snapshot.tiles.size());
   return snapshot;
 }
@@ -175,8 +229,27 @@ std::string Server::streamMetrics() const {
 }
 
 void Server::sessionClosed(Session& session) {
-  log_->info("session {} ({}): closed", session.id(), session.peer());
+  log_->info("event=session_closed session={} peer={} subscribers={}", session.id(), session.peer(),
+             registry_.size() - 1);
   registry_.remove(session);
+  renderersChanged();
+}
+
+void Server::rendererChanged(Session&) { renderersChanged(); }
+
+void Server::protocolRejected(Session&, const Error&) { rejections_.count(RejectReason::StreamMalformed); }
+
+void Server::renderersChanged() {
+  // Not while shutting down: the listeners' owners may be closing too.
+  if (stopped_) return;
+  for (const auto& f : onRenderersChanged_) f();
+}
+
+std::vector<RendererInfo> Server::renderers() const {
+  std::vector<RendererInfo> out;
+  const auto now = std::chrono::steady_clock::now();
+  registry_.forEachConst([&](const Session& s) { out.push_back(s.info(now)); });
+  return out;
 }
 
 }  // namespace sky::server

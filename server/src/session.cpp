@@ -1,6 +1,7 @@
 // A subscriber's connection (see session.hpp).
 #include "sky/server/session.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <span>
 #include <type_traits>
@@ -87,9 +88,9 @@ void Session::onRead(const boost::system::error_code& ec, std::size_t bytes) {
   if (state_ == State::Closed) return;
   if (ec) {
     if (ec == asio::error::eof)
-      log_.info("session {} ({}): peer closed", id_, peer_);
+      log_.info("event=session_eof session={} peer={}", id_, peer_);
     else
-      log_.info("session {} ({}): read failed: {}", id_, peer_, ec.message());
+      log_.info("event=session_read_failed session={} peer={} error={:?}", id_, peer_, ec.message());
     close();
     return;
   }
@@ -116,16 +117,27 @@ void Session::onRead(const boost::system::error_code& ec, std::size_t bytes) {
 
 void Session::handleMessage(const stream::Message& message) {
   if (const auto* subscribe = std::get_if<stream::Subscribe>(&message)) {
-    log_.debug("session {} ({}): subscribe lat {} lon {} radius {} m level {}", id_, peer_,
+    log_.debug("event=subscribe session={} peer={} lat_deg={} lon_deg={} radius_m={} level={}", id_, peer_,
                subscribe->area.centerLat_deg, subscribe->area.centerLon_deg,
                subscribe->area.radius_m, subscribe->tileLevel);
     subscription_ = *subscribe;
     outbox_.requestSnapshot(*subscribe);
     writeNext();
+    handler_.rendererChanged(*this);
+  } else if (const auto* report = std::get_if<stream::CameraReport>(&message)) {
+    report_ = *report;
+    reportAt_ = std::chrono::steady_clock::now();
+    handler_.rendererChanged(*this);
+  } else if (const auto* unknown = std::get_if<stream::UnknownKind>(&message)) {
+    // A newer client of our major version: what we do not know, we ignore.
+    if (!unknownKindLogged_)
+      log_.info("event=unknown_kind_ignored session={} peer={} body_type={}", id_, peer_,
+                unknown->bodyType);
+    unknownKindLogged_ = true;
   } else if (std::holds_alternative<stream::Heartbeat>(message)) {
     // A client's keep-alive: nothing to answer.
   } else if (const auto* error = std::get_if<stream::StreamError>(&message)) {
-    log_.info("session {} ({}): client reported error {}: {}; closing", id_, peer_, error->code,
+    log_.info("event=client_error session={} peer={} code={} detail={:?}; closing", id_, peer_, error->code,
               error->detail);
     close();
   } else {
@@ -134,8 +146,17 @@ void Session::handleMessage(const stream::Message& message) {
   }
 }
 
+RendererInfo Session::info(std::chrono::steady_clock::time_point now) const {
+  RendererInfo out{id_, peer_, std::nullopt, report_, 0};
+  if (subscription_) out.area = subscription_->area;
+  if (report_) out.lastReportAge_s = std::max(0.0, std::chrono::duration<double>(now - reportAt_).count());
+  return out;
+}
+
 void Session::protocolError(const Error& error) {
-  log_.warn("session {} ({}): {}; sending Error and closing", id_, peer_, describe(error));
+  log_.warn("event=stream_malformed session={} peer={} detail={:?}; sending Error and closing", id_, peer_,
+            describe(error));
+  handler_.protocolRejected(*this, error);
   state_ = State::ErrorQueued;
   outbox_.dropWeather();
   outbox_.pushControl(encodeErrorFrame(error));
@@ -168,7 +189,7 @@ void Session::writeNext() {
     // Cancelled, superseded by a later write, or that write has completed.
     if (ec || generation != self->writeGeneration_ || !self->writeInFlight_ || self->state_ == State::Closed)
       return;
-    self->log_.warn("session {} ({}): not reading: a {}-byte frame has not gone out in {} ms; dropped", self->id_,
+    self->log_.warn("event=subscriber_stalled session={} peer={} frame_bytes={} stall_ms={}; dropped", self->id_,
                     self->peer_, self->writing_.size(), self->stallTimeout_.count());
     self->handler_.sessionStalled(*self);
     self->close();
@@ -196,7 +217,7 @@ void Session::onWritten(const boost::system::error_code& ec) {
   stallTimer_.cancel();
   if (state_ == State::Closed) return;
   if (ec) {
-    log_.info("session {} ({}): write failed: {}", id_, peer_, ec.message());
+    log_.info("event=session_write_failed session={} peer={} error={:?}", id_, peer_, ec.message());
     close();
     return;
   }

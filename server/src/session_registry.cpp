@@ -24,6 +24,10 @@ void SessionRegistry::forEach(const std::function<void(Session&)>& f) {
   for (const auto& s : sessions) f(*s);
 }
 
+void SessionRegistry::forEachConst(const std::function<void(const Session&)>& f) const {
+  for (const auto& [id, s] : sessions_) f(*s);
+}
+
 void SessionRegistry::closeAll() {
   forEach([](Session& s) { s.close(); });
   SKY_ASSERT(sessions_.empty());

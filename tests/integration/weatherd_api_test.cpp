@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "child_process.hpp"
+#include "weatherd_process.hpp"
 #include "sky/cigi/codec.hpp"
 #include "sky/sim/http_client.hpp"
 
@@ -24,43 +25,6 @@ using namespace std::chrono_literals;
 
 namespace sky::test {
 namespace {
-
-constexpr const char* kToken = "s3cret-test-token";
-
-struct Weatherd {
-  fs::path dir;
-  std::optional<ChildProcess> process;
-  unsigned streamPort = 0, httpPort = 0, cigiPort = 0;
-
-  explicit Weatherd(const std::string& name, const std::string& scenario = SKY_SCENARIO_CLOUDY, bool cigi = false) {
-    dir = fs::path(SKY_TEST_OUTPUT_DIR) / name;
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    std::ofstream(dir / "token") << kToken << "\n";
-    std::vector<std::string> args{SKY_WEATHERD, "--scenario", scenario, "--port", "0", "--port-file",
-                                  (dir / "weatherd.port").string(), "--http-port", "0",
-                                  "--http-port-file", (dir / "http.port").string(), "--token-file",
-                                  (dir / "token").string(), "--heartbeat-ms", "200"};
-    if (cigi) args.insert(args.end(), {"--cigi-port", "0", "--cigi-port-file", (dir / "cigi.port").string()});
-    process.emplace(args, (dir / "weatherd.log").string());
-    streamPort = waitForPortFile((dir / "weatherd.port").string(), 20s);
-    httpPort = waitForPortFile((dir / "http.port").string(), 20s);
-    if (cigi) cigiPort = waitForPortFile((dir / "cigi.port").string(), 20s);
-  }
-
-  sim::HttpResponse request(const std::string& method, const std::string& target, const std::string& body = "",
-                            const std::string& token = kToken) {
-    sim::HttpRequest r;
-    r.method = method;
-    r.port = static_cast<unsigned short>(httpPort);
-    r.target = target;
-    r.body = body;
-    r.bearerToken = token;
-    auto response = sim::httpRequest(r);
-    EXPECT_TRUE(response) << describe(response.error());
-    return response ? *response : sim::HttpResponse{};
-  }
-};
 
 const char* kAddStratus = R"({"author": "test", "changes": [{"op": "set_layer", "ramp_s": 0, "layer": {
   "id": 2, "type": "stratus", "base_m": 400, "thickness_m": 300, "transition_band_m": 50, "coverage": 0.8,
@@ -129,13 +93,31 @@ TEST(WeatherdApi, ScenarioActionReachesTheRendererThroughTheStream) {
   ChildProcess render({SKY_RENDER, "--headless", "--server", "127.0.0.1:" + std::to_string(w.streamPort),
                        "--cigi-port", "0", "--port-file", (d / "render.port").string(), "--out",
                        (d / "frames").string(), "--width", "96", "--height", "54", "--idle-exit", "3",
-                       "--weather-timeout", "60"},
+                       "--weather-timeout", "60", "--channel", "left-seat"},
                       (d / "render.log").string(), {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
   const unsigned cigiPort = waitForPortFile((d / "render.port").string(), 60s);
   ASSERT_GT(cigiPort, 0u) << render.log();
   ChildProcess scenario({SKY_SCENARIO, (d / "scenario.toml").string(), "--port", std::to_string(cigiPort), "--api",
                          "http://127.0.0.1:" + std::to_string(w.httpPort), "--token-file", (d / "token").string()},
                         (d / "scenario.log").string());
+  // While it flies, the renderer reports its camera: the console's list
+  // shows the channel at the flight's position (46.2 N, 12.80-12.81 E, 900-930 m).
+  nlohmann::json channel;
+  for (int i = 0; i < 600 && channel.is_null(); ++i) {
+    const auto list = nlohmann::json::parse(w.request("GET", "/api/renderers").body)["renderers"];
+    for (const auto& r : list)
+      if (!r["lat_deg"].is_null()) channel = r;
+    if (channel.is_null()) std::this_thread::sleep_for(100ms);
+  }
+  ASSERT_FALSE(channel.is_null()) << "no camera report from the renderer\n" << render.log();
+  EXPECT_EQ(channel["channel"], "left-seat");
+  EXPECT_NEAR(channel["lat_deg"].get<double>(), 46.2, 1e-3);
+  EXPECT_NEAR(channel["lon_deg"].get<double>(), 12.802, 0.003);
+  EXPECT_NEAR(channel["alt_m"].get<double>(), 915, 20);
+  EXPECT_NEAR(channel["heading_deg"].get<double>(), 92, 4);
+  EXPECT_NEAR(channel["pitch_deg"].get<double>(), 15, 0.5);
+  EXPECT_GE(channel["weather_version"].get<int>(), 1);
+  EXPECT_NEAR(channel["area"]["center_lat_deg"].get<double>(), 46.2, 0.01) << "the area it subscribed to";
   EXPECT_EQ(scenario.wait(60s), std::optional<int>(0)) << scenario.log();
   EXPECT_NE(scenario.log().find("a stratus deck forms: accepted"), std::string::npos) << scenario.log();
   EXPECT_EQ(render.wait(120s), std::optional<int>(0)) << render.log();

@@ -50,6 +50,7 @@ Result<Message> decodeHello(const fbs::Hello& h) {
   out.serverId = h.server_id() ? h.server_id()->str() : std::string();
   out.weatherClock_s = h.weather_clock_s();
   out.clockRate = h.clock_rate();
+  out.features = h.features();
   if (auto r = checkFinite("Hello", "weather_clock_s", out.weatherClock_s); !r)
     return tl::unexpected(r.error());
   if (auto r = checkRange("Hello", "clock_rate", out.clockRate, 0, 3600); !r)
@@ -177,6 +178,66 @@ Result<Message> decodeDelta(const fbs::Delta& d) {
   return Message(std::move(out));
 }
 
+// Well-formed UTF-8 (no overlong forms, surrogates or code points past
+// U+10FFFF) without ASCII control characters: a channel name is shown in logs
+// and JSON as it is.
+bool printableUtf8(std::string_view s) {
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    if (c < 0x80) {
+      if (c < 0x20 || c == 0x7f) return false;
+      ++i;
+      continue;
+    }
+    std::size_t n = 0;
+    std::uint32_t cp = 0, min = 0;
+    if ((c & 0xe0) == 0xc0) n = 1, cp = c & 0x1f, min = 0x80;
+    else if ((c & 0xf0) == 0xe0) n = 2, cp = c & 0x0f, min = 0x800;
+    else if ((c & 0xf8) == 0xf0) n = 3, cp = c & 0x07, min = 0x10000;
+    else return false;
+    if (n >= s.size() - i) return false;  // the sequence runs past the end
+    for (std::size_t k = 1; k <= n; ++k) {
+      const auto cc = static_cast<unsigned char>(s[i + k]);
+      if ((cc & 0xc0) != 0x80) return false;
+      cp = (cp << 6) | (cc & 0x3f);
+    }
+    if (cp < min || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff)) return false;
+    i += n + 1;
+  }
+  return true;
+}
+
+Result<Message> decodeCameraReport(const fbs::CameraReport& r) {
+  CameraReport out;
+  if (r.channel()) {
+    if (r.channel()->size() > kMaxChannelBytes)
+      return fail(ErrorCode::InvalidArgument, "CameraReport.channel: " + std::to_string(r.channel()->size()) +
+                                                  " bytes, at most " + std::to_string(kMaxChannelBytes));
+    out.channel = r.channel()->str();
+    if (!printableUtf8(out.channel))
+      return fail(ErrorCode::InvalidArgument, "CameraReport.channel: not UTF-8 text without control characters");
+  }
+  out.lat_deg = r.lat_deg();
+  out.lon_deg = r.lon_deg();
+  out.alt_m = r.alt_m();
+  out.heading_deg = r.heading_deg();
+  out.pitch_deg = r.pitch_deg();
+  out.roll_deg = r.roll_deg();
+  out.frame = r.frame();
+  out.weatherVersion = r.weather_version();
+  out.weatherClock_s = r.weather_clock_s();
+  for (auto c : {checkRange("CameraReport", "lat_deg", out.lat_deg, -90, 90),
+                 checkRange("CameraReport", "lon_deg", out.lon_deg, -180, 180),
+                 checkRange("CameraReport", "alt_m", out.alt_m, -1000, 1.0e6),
+                 checkRange("CameraReport", "heading_deg", out.heading_deg, 0, 360),
+                 checkRange("CameraReport", "pitch_deg", out.pitch_deg, -90, 90),
+                 checkRange("CameraReport", "roll_deg", out.roll_deg, -180, 180),
+                 checkFinite("CameraReport", "weather_clock_s", out.weatherClock_s)})
+    if (!c) return tl::unexpected(c.error());
+  return Message(std::move(out));
+}
+
 std::vector<fbs::Tile> encodeTiles(const std::vector<weather::CoverageTile>& tiles) {
   std::vector<fbs::Tile> out;
   out.reserve(tiles.size());
@@ -198,7 +259,7 @@ std::vector<std::uint8_t> encodeMessage(const Message& message) {
           [&](const Hello& h) {
             return std::pair{fbs::Body::Hello,
                              fbs::CreateHelloDirect(b, h.protocolVersion, h.serverId.c_str(),
-                                                    h.weatherClock_s, h.clockRate)
+                                                    h.weatherClock_s, h.clockRate, h.features)
                                  .Union()};
           },
           [&](const Subscribe& s) {
@@ -232,6 +293,23 @@ std::vector<std::uint8_t> encodeMessage(const Message& message) {
                              fbs::CreateDeltaDirect(b, d.weatherClock_s, &layers, &d.removedLayerIds,
                                                     static_cast<std::uint8_t>(d.tileLevel), &tiles)
                                  .Union()};
+          },
+          [&](const CameraReport& r) {
+            // CreateString takes the length: the channel goes out as it is
+            // (an embedded NUL too, which the decoder then refuses).
+            const auto channel = b.CreateString(r.channel);
+            return std::pair{fbs::Body::CameraReport,
+                             fbs::CreateCameraReport(
+                                 b, channel, r.lat_deg, r.lon_deg, r.alt_m, static_cast<float>(r.heading_deg),
+                                 static_cast<float>(r.pitch_deg), static_cast<float>(r.roll_deg), r.frame,
+                                 r.weatherVersion, r.weatherClock_s)
+                                 .Union()};
+          },
+          [&](const UnknownKind& u) {
+            // An empty table under a type byte we do not define: what a newer
+            // peer's message looks like to this build.
+            const auto start = b.StartTable();
+            return std::pair{static_cast<fbs::Body>(u.bodyType), flatbuffers::Offset<void>(b.EndTable(start))};
           }},
       message);
   b.Finish(fbs::CreateMessage(b, type, body));
@@ -273,10 +351,12 @@ Result<Message> decodeMessage(std::span<const std::uint8_t> payload) {
       return Message(StreamError{e->code(), e->detail() ? e->detail()->str() : std::string()});
     }
     case fbs::Body::Delta: return decodeDelta(*m->body_as_Delta());
-    case fbs::Body::NONE: break;
+    case fbs::Body::CameraReport: return decodeCameraReport(*m->body_as_CameraReport());
+    case fbs::Body::NONE: return fail(ErrorCode::Malformed, "message has no body");
   }
-  return fail(ErrorCode::Malformed,
-              "message body type " + std::to_string(static_cast<int>(m->body_type())) + " unknown");
+  // A kind appended to the schema after this build: the verifier could not
+  // look inside it, and nothing here reads it.
+  return Message(UnknownKind{static_cast<std::uint8_t>(m->body_type())});
 }
 
 const char* kindName(const Message& message) {
@@ -285,7 +365,9 @@ const char* kindName(const Message& message) {
                                [](const weather::WeatherSnapshot&) { return "Snapshot"; },
                                [](const Heartbeat&) { return "Heartbeat"; },
                                [](const StreamError&) { return "Error"; },
-                               [](const weather::WeatherDelta&) { return "Delta"; }},
+                               [](const weather::WeatherDelta&) { return "Delta"; },
+                               [](const CameraReport&) { return "CameraReport"; },
+                               [](const UnknownKind&) { return "an unknown kind"; }},
                     message);
 }
 

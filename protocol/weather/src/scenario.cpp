@@ -6,6 +6,7 @@
 #include <set>
 #include <string>
 
+#include "scenario_parts.hpp"
 #include "sky/config/toml_fields.hpp"
 
 namespace sky::weather {
@@ -43,6 +44,10 @@ Result<ClockSettings> parseClock(const toml::table& root, const Where& where) {
   return out;
 }
 
+}  // namespace
+
+namespace detail {
+
 // The field validate() blames: its detail reads "layer <id>: <field> <value> ...".
 std::string blamedField(const std::string& detail) {
   const auto colon = detail.find(": ");
@@ -52,9 +57,7 @@ std::string blamedField(const std::string& detail) {
   return detail.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
 }
 
-Result<CloudLayer> parseLayer(const toml::table& t, std::size_t index,
-                                       const Where& where) {
-  const std::string prefix = "layer[" + std::to_string(index) + "].";
+Result<CloudLayer> parseLayer(const toml::table& t, const std::string& prefix, const Where& where) {
   if (auto r = onlyKeys(t,
                         {"id", "type", "base_m", "thickness_m", "transition_band_m", "coverage",
                          "density", "wind"},
@@ -122,14 +125,14 @@ Result<CloudLayer> parseLayer(const toml::table& t, std::size_t index,
   return layer;
 }
 
-}  // namespace
+}  // namespace detail
 
 Result<Scenario> parseScenario(std::string_view text, std::string_view sourceName) {
   const Where where(sourceName);
   auto parsed = config::parseText(text, where);
   if (!parsed) return tl::unexpected(parsed.error());
   const toml::table& root = *parsed;
-  if (auto r = onlyKeys(root, {"clock", "layer"}, "", where); !r) return tl::unexpected(r.error());
+  if (auto r = onlyKeys(root, {"clock", "layer", "timeline"}, "", where); !r) return tl::unexpected(r.error());
 
   Scenario scenario;
   auto clock = parseClock(root, where);
@@ -149,7 +152,7 @@ Result<Scenario> parseScenario(std::string_view text, std::string_view sourceNam
     std::set<std::uint32_t> ids;
     for (std::size_t i = 0; i < layers->size(); ++i) {
       const toml::table& t = *(*layers)[i].as_table();
-      auto layer = parseLayer(t, i, where);
+      auto layer = detail::parseLayer(t, "layer[" + std::to_string(i) + "].", where);
       if (!layer) return tl::unexpected(layer.error());
       if (!ids.insert(layer->id).second)
         return where.error(ErrorCode::InvalidArgument, t.get("id")->source(),
@@ -158,6 +161,9 @@ Result<Scenario> parseScenario(std::string_view text, std::string_view sourceNam
       scenario.layers.push_back(*layer);
     }
   }
+  auto timeline = detail::parseTimeline(root.get("timeline"), scenario.clock.start_s, where);
+  if (!timeline) return tl::unexpected(timeline.error());
+  scenario.timeline = std::move(*timeline);
   return scenario;
 }
 

@@ -224,6 +224,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
         if (pass.pass == "present") record.gpu.push_back(pass);
     }
     logValidationMessages(renderer);
+    if (weather) weather->reportCamera(pose, i, view.version, in.weatherClock_s);
     record.frame = i;
     record.host.pose = pose;
     record.host.hostFrame = static_cast<std::uint32_t>(i);

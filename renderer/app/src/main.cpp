@@ -72,6 +72,7 @@ struct Options {
   bool noVideo = false;
   bool fixedSun = false;
   std::string weatherFile;
+  std::string channel;  // name in the operator console; empty: render@<host>
 };
 
 // Set by SIGINT/SIGTERM during a --replay (which runs no io_context of its own
@@ -98,6 +99,8 @@ int main(int argc, char** argv) {
   Options o;
   CLI::App app{"skyshell-render: a Skyshell image generator channel"};
   app.add_option("--server", o.server, "weather server HOST:PORT");
+  app.add_option("--channel", o.channel,
+                 "this channel's name in the operator console (at most 64 bytes; default render@<host>)");
   app.add_option("--cigi-address", o.cigiAddress, "address to receive CIGI on");
   app.add_option("--cigi-port", o.cigiPort, "UDP port to receive CIGI on (0 = any free port)")
       ->check(CLI::Range(0, 65535));
@@ -277,7 +280,7 @@ int main(int argc, char** argv) {
     }
     fdm->start();
   }
-  sky::app::WeatherClient weather(io, state, serverHost, static_cast<unsigned short>(serverPort));
+  sky::app::WeatherClient weather(io, state, serverHost, static_cast<unsigned short>(serverPort), o.channel);
   weather.start();
   std::thread ioThread([&] { io.run(); });
   auto shutdown = [&] {
@@ -401,7 +404,9 @@ int main(int argc, char** argv) {
       for (const auto& pass : (*renderer)->lastPassTimes())
         if (pass.pass == "present") record.gpu.push_back(pass);
     }
-    sky::app::logValidationMessages(**renderer);    if (auto ok = writer->write(*image, record); !ok) {
+    sky::app::logValidationMessages(**renderer);
+    weather.reportCamera(pose->pose, frames, view.version, in.weatherClock_s);
+    if (auto ok = writer->write(*image, record); !ok) {
       std::fprintf(stderr, "skyshell-render: %s\n", sky::describe(ok.error()).c_str());
       exitCode = 2;
       break;

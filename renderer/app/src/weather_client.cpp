@@ -1,6 +1,11 @@
 // Weather stream client (see weather_client.hpp).
 #include "sky/app/weather_client.hpp"
 
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+
 #include <spdlog/spdlog.h>
 
 #include "sky/core/overloaded.hpp"
@@ -14,11 +19,33 @@ namespace {
 // Reconnect backoff grows to this cap: short enough that a restarted server
 // is picked up within seconds, long enough not to spin on a dead one.
 constexpr std::chrono::milliseconds kMaxBackoff{2000};
+
+std::string defaultChannel() {
+  char name[256] = {};
+  if (::gethostname(name, sizeof name - 1) != 0) return "render";
+  return std::string("render@") + name;
+}
+
+// At most `max` bytes, cut at a UTF-8 character boundary.
+std::string cutUtf8(std::string s, std::size_t max) {
+  if (s.size() <= max) return s;
+  std::size_t n = max;
+  while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xc0) == 0x80) --n;
+  s.resize(n);
+  return s;
+}
+
 }  // namespace
 
-WeatherClient::WeatherClient(asio::io_context& io, SharedState& state, std::string host,
-                             unsigned short port)
-    : io_(io), state_(state), host_(std::move(host)), port_(port), socket_(io), retryTimer_(io) {}
+WeatherClient::WeatherClient(asio::io_context& io, SharedState& state, std::string host, unsigned short port,
+                             std::string channel)
+    : io_(io),
+      state_(state),
+      host_(std::move(host)),
+      port_(port),
+      socket_(io),
+      retryTimer_(io),
+      channel_(cutUtf8(channel.empty() ? defaultChannel() : std::move(channel), stream::kMaxChannelBytes)) {}
 
 void WeatherClient::start() {
   asio::post(io_, [this] { connect(); });
@@ -58,7 +85,9 @@ void WeatherClient::connect() {
     backoff_ = std::chrono::milliseconds(250);
     decoder_ = stream::FrameDecoder();
     inFlight_.clear();
-    pending_.reset();
+    pendingSubscribe_.reset();
+    pendingReport_.reset();
+    serverTakesReports_ = false;  // until this server's Hello says so
     state_.setConnected(true);
     if (area_) send(*area_);
     read();
@@ -66,6 +95,7 @@ void WeatherClient::connect() {
 }
 
 void WeatherClient::scheduleReconnect() {
+  serverTakesReports_ = false;
   if (stopped_) return;
   state_.setConnected(false);
   boost::system::error_code ec;
@@ -112,8 +142,12 @@ void WeatherClient::onFrame(std::span<const std::uint8_t> payload) {
                  [&](const stream::Hello& h) {
                    clockRate_ = h.clockRate;
                    state_.setClock(h.weatherClock_s, h.clockRate, now);
-                   spdlog::info("weather server '{}' protocol {} clock {:.1f} s x{}", h.serverId,
-                                h.protocolVersion, h.weatherClock_s, h.clockRate);
+                   const bool reports = (h.features & stream::kFeatureCameraReports) != 0;
+                   serverTakesReports_ = reports;
+                   reportNow_ = reports;
+                   spdlog::info("weather server '{}' protocol {} clock {:.1f} s x{}{}", h.serverId,
+                                h.protocolVersion, h.weatherClock_s, h.clockRate,
+                                reports ? "; reporting the camera as '" + channel_ + "'" : "");
                  },
                  [&](const weather::WeatherSnapshot& s) {
                    spdlog::info("weather snapshot: {} layers, {} tiles at S2 level {}", s.layers.size(),
@@ -134,14 +168,71 @@ void WeatherClient::onFrame(std::span<const std::uint8_t> payload) {
                  [&](const stream::Subscribe&) {
                    ++malformed_;
                    spdlog::warn("weather stream: a server must not send Subscribe; dropped");
+                 },
+                 [&](const stream::CameraReport&) {
+                   ++malformed_;
+                   spdlog::warn("weather stream: a server must not send CameraReport; dropped");
+                 },
+                 [&](const stream::UnknownKind&) {
+                   // A newer server of our major version: ignore what we do not know.
                  }},
              *message);
+}
+
+void WeatherClient::reportCamera(const geo::GeodeticPose& pose, std::uint64_t frame, std::uint64_t weatherVersion,
+                                 double weatherClock_s) {
+  if (!serverTakesReports_) return;
+  stream::CameraReport r;
+  r.channel = channel_;
+  // Into the ranges the stream checks: a pose from a host may carry any
+  // longitude or heading, and a report out of range would close the stream.
+  r.lat_deg = std::clamp(pose.position.lat_deg, -90.0, 90.0);
+  r.lon_deg = geo::normalizeLon_deg(pose.position.lon_deg);
+  r.alt_m = std::clamp(pose.position.alt_m, -1000.0, 1.0e6);
+  r.heading_deg = std::fmod(geo::normalizeLon_deg(pose.yaw_deg) + 360.0, 360.0);
+  r.pitch_deg = std::clamp(pose.pitch_deg, -90.0, 90.0);
+  r.roll_deg = geo::normalizeLon_deg(pose.roll_deg);
+  r.frame = frame;
+  r.weatherVersion = weatherVersion;
+  r.weatherClock_s = weatherClock_s;
+  for (double v : {r.lat_deg, r.lon_deg, r.alt_m, r.heading_deg, r.pitch_deg, r.roll_deg, r.weatherClock_s})
+    if (!std::isfinite(v)) return;
+  if (!reportWorthSending(r, Clock::now())) return;
+  asio::post(io_, [this, r = std::move(r)] {
+    if (!socket_.is_open() || !serverTakesReports_) return;
+    send(r);
+    ++reportsSent_;
+  });
+}
+
+bool WeatherClient::reportWorthSending(const stream::CameraReport& r, Clock::time_point now) {
+  std::lock_guard lock(reportMutex_);
+  const bool forced = reportNow_.exchange(false);
+  if (lastReport_ && !forced) {
+    const auto since = now - lastReportAt_;
+    if (since < kMinReportInterval) return false;
+    const stream::CameraReport& last = *lastReport_;
+    const bool moved =
+        geo::geodesicDistance_m(last.lat_deg, last.lon_deg, r.lat_deg, r.lon_deg) > kReportMove_m ||
+        std::abs(r.alt_m - last.alt_m) > kReportMove_m ||
+        std::abs(geo::angleDiff_deg(last.heading_deg, r.heading_deg)) > kReportTurn_deg ||
+        std::abs(r.pitch_deg - last.pitch_deg) > kReportTurn_deg ||
+        std::abs(geo::angleDiff_deg(last.roll_deg, r.roll_deg)) > kReportTurn_deg;
+    if (!moved && r.weatherVersion == last.weatherVersion && since < kReportKeepAlive) return false;
+  }
+  lastReport_ = r;
+  lastReportAt_ = now;
+  return true;
 }
 
 void WeatherClient::send(const stream::Message& message) {
   auto bytes = stream::encodeFrame(stream::encodeMessage(message));
   if (!inFlight_.empty()) {
-    pending_ = std::move(bytes);  // coalesce: only the newest request matters
+    // Coalesce: only the newest request and the newest report matter.
+    if (std::holds_alternative<stream::CameraReport>(message))
+      pendingReport_ = std::move(bytes);
+    else
+      pendingSubscribe_ = std::move(bytes);
     return;
   }
   inFlight_ = std::move(bytes);
@@ -152,10 +243,12 @@ void WeatherClient::flushWrite() {
   asio::async_write(socket_, asio::buffer(inFlight_), [this](boost::system::error_code ec, std::size_t) {
     inFlight_.clear();
     if (ec) return;  // the read side notices and reconnects
-    if (pending_) {
-      inFlight_ = std::move(*pending_);
-      pending_.reset();
+    for (auto* pending : {&pendingSubscribe_, &pendingReport_}) {
+      if (!*pending) continue;
+      inFlight_ = std::move(**pending);
+      pending->reset();
       flushWrite();
+      return;
     }
   });
 }

@@ -238,3 +238,124 @@ TEST(Messages, UnionTypeWithoutBodyIsRejected) {
 
 }  // namespace
 }  // namespace sky::stream
+
+namespace sky::stream {
+namespace {
+
+CameraReport sampleReport() {
+  CameraReport r;
+  r.channel = "cockpit-2 centre";
+  r.lat_deg = 46.123456789;
+  r.lon_deg = -179.5;
+  r.alt_m = 1834.25;
+  r.heading_deg = 359.5;
+  r.pitch_deg = -12.5;
+  r.roll_deg = 30.25;
+  r.frame = 1234567890123ull;
+  r.weatherVersion = 77;
+  r.weatherClock_s = 43200.5;
+  return r;
+}
+
+TEST(CameraReports, RoundTrip) {
+  auto m = decodeMessage(encodeMessage(sampleReport()));
+  ASSERT_TRUE(m) << m.error().detail;
+  const auto& r = std::get<CameraReport>(*m);
+  EXPECT_EQ(r.channel, "cockpit-2 centre");
+  EXPECT_EQ(r.lat_deg, 46.123456789) << "positions travel as doubles";
+  EXPECT_EQ(r.lon_deg, -179.5);
+  EXPECT_EQ(r.alt_m, 1834.25);
+  // Angles travel as floats: these values are exact in a float.
+  EXPECT_EQ(r.heading_deg, 359.5);
+  EXPECT_EQ(r.pitch_deg, -12.5);
+  EXPECT_EQ(r.roll_deg, 30.25);
+  EXPECT_EQ(r.frame, 1234567890123ull);
+  EXPECT_EQ(r.weatherVersion, 77u);
+  EXPECT_EQ(r.weatherClock_s, 43200.5);
+  EXPECT_STREQ(kindName(*m), "CameraReport");
+}
+
+TEST(CameraReports, EveryFieldIsRangeChecked) {
+  struct Case {
+    const char* field;
+    void (*spoil)(CameraReport&);
+  };
+  const Case cases[] = {
+      {"lat_deg", [](CameraReport& r) { r.lat_deg = 90.5; }},
+      {"lat_deg", [](CameraReport& r) { r.lat_deg = std::nan(""); }},
+      {"lon_deg", [](CameraReport& r) { r.lon_deg = 180.5; }},
+      {"alt_m", [](CameraReport& r) { r.alt_m = -1001; }},
+      {"alt_m", [](CameraReport& r) { r.alt_m = INFINITY; }},
+      {"heading_deg", [](CameraReport& r) { r.heading_deg = -1; }},
+      {"heading_deg", [](CameraReport& r) { r.heading_deg = 360.5; }},
+      {"pitch_deg", [](CameraReport& r) { r.pitch_deg = 90.5; }},
+      {"roll_deg", [](CameraReport& r) { r.roll_deg = -181; }},
+      {"weather_clock_s", [](CameraReport& r) { r.weatherClock_s = std::nan(""); }},
+  };
+  for (const Case& c : cases) {
+    CameraReport r = sampleReport();
+    c.spoil(r);
+    auto m = decodeMessage(encodeMessage(r));
+    ASSERT_FALSE(m) << c.field;
+    EXPECT_NE(m.error().detail.find(std::string("CameraReport.") + c.field), std::string::npos) << m.error().detail;
+  }
+  // The edges themselves are in range.
+  CameraReport edge = sampleReport();
+  edge.lat_deg = -90;
+  edge.lon_deg = 180;
+  edge.heading_deg = 0;
+  edge.pitch_deg = 90;
+  edge.roll_deg = -180;
+  EXPECT_TRUE(decodeMessage(encodeMessage(edge)));
+}
+
+TEST(CameraReports, TheChannelIsBoundedPrintableUtf8) {
+  auto decodeChannel = [](const std::string& channel) {
+    CameraReport r = sampleReport();
+    r.channel = channel;
+    return decodeMessage(encodeMessage(r));
+  };
+  EXPECT_TRUE(decodeChannel(""));
+  EXPECT_TRUE(decodeChannel(std::string(kMaxChannelBytes, 'x')));
+  EXPECT_TRUE(decodeChannel("Kanal S\xc3\xbc" "d \xe2\x9c\x88 \xf0\x9f\x9b\xa9"));  // 2-, 3- and 4-byte UTF-8
+  for (const std::string& bad : {std::string(kMaxChannelBytes + 1, 'x'), std::string("tab\there"),
+                                 std::string("del\x7f"), std::string("\xff"), std::string("cut \xc3"),
+                                 std::string("overlong \xc0\xaf"), std::string("surrogate \xed\xa0\x80"),
+                                 std::string("past U+10FFFF \xf4\x90\x80\x80"), std::string("nul\0in", 6)}) {
+    auto m = decodeChannel(bad);
+    ASSERT_FALSE(m) << bad;
+    EXPECT_NE(m.error().detail.find("CameraReport.channel"), std::string::npos) << m.error().detail;
+  }
+}
+
+// Kinds appended to the schema after a build reach it as UnknownKind, which
+// the receiver ignores; only a missing body is malformed.
+TEST(Messages, AKindThisBuildDoesNotKnowDecodesAsUnknown) {
+  auto m = decodeMessage(encodeMessage(UnknownKind{200}));
+  ASSERT_TRUE(m) << m.error().detail;
+  ASSERT_TRUE(std::holds_alternative<UnknownKind>(*m));
+  EXPECT_EQ(std::get<UnknownKind>(*m).bodyType, 200);
+  m = decodeMessage(encodeMessage(UnknownKind{0}));  // body type NONE
+  ASSERT_FALSE(m);
+  EXPECT_EQ(m.error().code, ErrorCode::Malformed);
+}
+
+// Hello.features came later: FlatBuffers leaves a field at its default out of
+// the buffer, so a Hello without features is byte for byte what a server from
+// before the field sends, and reads as 0.
+TEST(Messages, HelloFeatures) {
+  Hello h{kProtocolVersion, "weatherd-test", 42.0, 10.0};
+  const auto without = encodeMessage(h);
+  auto m = decodeMessage(without);
+  ASSERT_TRUE(m);
+  EXPECT_EQ(std::get<Hello>(*m).features, 0u);
+  h.features = kFeatureCameraReports;
+  const auto with = encodeMessage(h);
+  EXPECT_GT(with.size(), without.size());
+  m = decodeMessage(with);
+  ASSERT_TRUE(m);
+  EXPECT_EQ(std::get<Hello>(*m).features, kFeatureCameraReports);
+}
+
+}  // namespace
+}  // namespace sky::stream

@@ -3,91 +3,15 @@
 // a close while another client keeps being served.
 #include <gtest/gtest.h>
 
-#include <array>
 #include <chrono>
 #include <thread>
 
-#include <boost/asio/connect.hpp>
-#include <boost/asio/io_context.hpp>
-#include <boost/asio/ip/tcp.hpp>
-#include <boost/asio/read.hpp>
-#include <boost/asio/write.hpp>
-
 #include "sky/server/scenario.hpp"
 #include "sky/server/server.hpp"
-#include "sky/stream/framing.hpp"
-#include "sky/stream/messages.hpp"
+#include "stream_test_client.hpp"
 
 namespace sky::server {
 namespace {
-
-namespace asio = boost::asio;
-using asio::ip::tcp;
-using namespace std::chrono_literals;
-
-constexpr auto kTimeout = 5s;
-
-// A blocking-style client with a deadline on every read, so a server bug fails
-// the test instead of hanging it.
-class TestClient {
- public:
-  explicit TestClient(std::uint16_t port) : socket_(io_) {
-    socket_.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
-  }
-
-  void sendBytes(const std::vector<std::uint8_t>& bytes) { asio::write(socket_, asio::buffer(bytes)); }
-  void send(const stream::Message& m) { sendBytes(stream::encodeFrame(stream::encodeMessage(m))); }
-
-  // The next message; fails with Io "eof" when the server closed the stream.
-  Result<stream::Message> read(std::chrono::milliseconds timeout = kTimeout) {
-    std::array<std::uint8_t, stream::kFrameHeaderBytes> header{};
-    std::vector<std::uint8_t> payload;
-    bool done = false;
-    boost::system::error_code error;
-    asio::async_read(socket_, asio::buffer(header), [&](const boost::system::error_code& ec, std::size_t) {
-      if (ec) {
-        error = ec;
-        done = true;
-        return;
-      }
-      const std::size_t n = (std::size_t{header[0]} << 24) | (std::size_t{header[1]} << 16) |
-                            (std::size_t{header[2]} << 8) | header[3];
-      payload.resize(n);
-      asio::async_read(socket_, asio::buffer(payload), [&](const boost::system::error_code& ec2, std::size_t) {
-        error = ec2;
-        done = true;
-      });
-    });
-    io_.restart();
-    io_.run_for(timeout);
-    if (!done) {
-      socket_.cancel();
-      io_.restart();
-      io_.run();
-      return fail(ErrorCode::Timeout, "no message within the deadline");
-    }
-    if (error == asio::error::eof) return fail(ErrorCode::Io, "eof");
-    if (error) return fail(ErrorCode::Io, error.message());
-    return stream::decodeMessage(payload);
-  }
-
-  // The next message of type T, skipping heartbeats and deltas (unless T is one).
-  template <class T>
-  Result<T> readNext() {
-    for (;;) {
-      auto m = read();
-      if (!m) return tl::unexpected(m.error());
-      if (auto* t = std::get_if<T>(&*m)) return *t;
-      // Heartbeats, and deltas of weather changes, come between the others.
-      if (!std::holds_alternative<stream::Heartbeat>(*m) && !std::holds_alternative<weather::WeatherDelta>(*m))
-        return fail(ErrorCode::Malformed, std::string("unexpected ") + stream::kindName(*m));
-    }
-  }
-
- private:
-  asio::io_context io_;
-  tcp::socket socket_;
-};
 
 // A region over the test areas (46-49 N, 8.5 E) that thins the scenario's
 // layer 1: without one the weather is uniform and snapshots carry no tiles.
@@ -207,7 +131,6 @@ TEST_F(ServerFixture, AChangeArrivesAsADeltaThatEqualsAFreshSnapshot) {
     weather::CloudLayer l = server_->weather().view().layers.at(0);
     l.coverage = 0.7;
     ASSERT_TRUE(server_->weather().submit({{SetLayer{l, Timing{}}}, "test", "api"}));
-    server_->weatherChanged();
   });
   auto delta = client.readNext<weather::WeatherDelta>();
   ASSERT_TRUE(delta) << delta.error().detail;
@@ -226,7 +149,6 @@ TEST_F(ServerFixture, AChangeArrivesAsADeltaThatEqualsAFreshSnapshot) {
   // The region itself changes: every tile is new, so a whole Snapshot comes.
   asio::post(server_->io(), [this] {
     addRegion(*server_, 0.8);
-    server_->weatherChanged();
   });
   auto m = client.read();
   while (m && std::holds_alternative<stream::Heartbeat>(*m)) m = client.read();
@@ -360,7 +282,6 @@ TEST(Server, ASubscriberThatStopsReadingIsDroppedOthersGoOn) {
   while (server->streamCounters().stalledDropped.load() == 0 && std::chrono::steady_clock::now() - start < 20s) {
     asio::post(server->io(), [&server, coverage = 0.1 + 0.1 * (step++ % 5)] {
       addRegion(*server, coverage);
-      server->weatherChanged();
     });
     std::this_thread::sleep_for(20ms);
   }

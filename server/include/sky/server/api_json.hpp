@@ -44,6 +44,10 @@ nlohmann::json toJson(const weather::Region& region);  // with "placed_at_clock_
 // form's "placed_at_clock_s" is read too (the API sets it itself).
 Result<weather::Region> regionFromJson(const nlohmann::json& object, const std::string& path, bool withPlacement);
 nlohmann::json toJson(const WeatherView& view);
+// One element of "changes" above, both ways (a scenario timeline is saved in
+// this form). Errors name `path`; ranges are not checked.
+nlohmann::json toJson(const WeatherChange& change);
+Result<WeatherChange> changeFromJson(const nlohmann::json& object, const std::string& path);
 nlohmann::json toJson(const ChangeEvent& event);
 
 }  // namespace sky::server

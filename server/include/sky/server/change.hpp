@@ -69,11 +69,13 @@ struct AppliedChange {
   std::string summary;         // one line for the event log: "layer 2 coverage 0.30 -> 0.90 over 600 s"
 };
 
-// A change accepted but not finished: scheduled for later, or ramping.
+// A change accepted but not finished (scheduled for later, or ramping), or
+// one a scenario's timeline will make.
 struct PendingChange {
-  std::uint64_t sequence = 0;
+  std::uint64_t sequence = 0;     // 0 for a timeline entry (not accepted yet)
   double start_s = 0, end_s = 0;  // weather clock
   std::string summary;
+  std::string kind = "ramp";      // "ramp": accepted; "timeline": a scenario will submit it at start_s
 };
 
 // One line of the event log.

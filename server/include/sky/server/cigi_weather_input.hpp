@@ -29,6 +29,7 @@
 #include "sky/core/result.hpp"
 #include "sky/server/cigi_weather.hpp"
 #include "sky/server/change.hpp"
+#include "sky/server/rejections.hpp"
 
 namespace spdlog {
 class logger;
@@ -46,11 +47,12 @@ class CigiWeatherInput {
     std::uint64_t unchanged = 0;   // decoded, nothing differed from before
   };
 
-  // Binds UDP address:port (0: ephemeral); weatherChanged is called after
-  // every accepted change, on the io thread.
+  // Binds UDP address:port (0: ephemeral). Refused datagrams are counted in
+  // `rejections` too (cigi_malformed, cigi_refused) when it is given. Accepted
+  // changes reach the subscribers through the WeatherService's listeners.
   static Result<std::unique_ptr<CigiWeatherInput>> create(boost::asio::io_context& io, const std::string& address,
                                                           std::uint16_t port, WeatherService& weather,
-                                                          std::function<void()> weatherChanged,
+                                                          Rejections* rejections,
                                                           std::shared_ptr<spdlog::logger> log);
   std::uint16_t port() const { return port_; }
   void close();
@@ -60,7 +62,7 @@ class CigiWeatherInput {
   void onDatagram(std::span<const std::uint8_t> bytes, const std::string& sender);
 
  private:
-  CigiWeatherInput(boost::asio::io_context& io, WeatherService& weather, std::function<void()> weatherChanged,
+  CigiWeatherInput(boost::asio::io_context& io, WeatherService& weather, Rejections* rejections,
                    std::shared_ptr<spdlog::logger> log);
   void receive();
   void logOnce(const std::string& kind, const std::string& message);
@@ -69,7 +71,7 @@ class CigiWeatherInput {
   boost::asio::ip::udp::endpoint from_;
   std::array<std::uint8_t, 65536> buffer_{};
   WeatherService& weather_;
-  std::function<void()> weatherChanged_;
+  Rejections* rejections_;
   std::shared_ptr<spdlog::logger> log_;
   std::map<std::string, CigiWeatherMapper> mappers_;  // by sender "address:port"
   std::set<std::string> logged_;

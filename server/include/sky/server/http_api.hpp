@@ -10,6 +10,9 @@
 //                        (metar_api.hpp)
 //   GET  /, /console/*   the operator console's files, when options.console is set
 //                        (console_files.hpp)
+//   GET  /api/renderers  the weather-stream subscribers and their cameras
+//   GET  /api/ws         WebSocket upgrade: the console's live feed (console_feed.hpp)
+// Every endpoint, with its JSON, is in server/API.md.
 // One request per connection (Connection: close); bodies over 64 KiB and
 // clients slower than 10 s are dropped. Loopback unless configured otherwise.
 #pragma once
@@ -23,8 +26,10 @@
 #include <boost/asio/ip/tcp.hpp>
 
 #include "sky/core/result.hpp"
+#include "sky/server/console_feed.hpp"
 #include "sky/server/live_weather.hpp"
 #include "sky/server/metar.hpp"
+#include "sky/server/rejections.hpp"
 
 namespace spdlog {
 class logger;
@@ -40,13 +45,18 @@ struct HttpApiOptions {
   std::string token;        // empty: read-only (changes are refused)
   std::vector<Station> stations;  // METAR station table for POST /api/metar
   std::shared_ptr<const ConsoleFiles> console;  // null: no console pages
+  std::string serverId = "skyshell-weatherd";  // in the WebSocket hello
+  ConsoleFeedOptions feed;
   std::shared_ptr<spdlog::logger> log;
 };
 
+// What the API reads from the rest of the server (all called on the io
+// thread). Accepted changes reach the stream through LiveWeather's listeners.
 struct HttpApiHooks {
-  std::function<void()> weatherChanged;       // after an accepted change
-  std::function<std::size_t()> subscribers;   // for /metrics
-  std::function<std::string()> extraMetrics;  // more Prometheus text for /metrics (other inputs)
+  std::function<std::size_t()> subscribers;      // for /metrics and the console's health
+  std::function<std::string()> extraMetrics;     // more Prometheus text for /metrics (other inputs)
+  std::function<nlohmann::json()> renderers;     // GET /api/renderers: the array
+  Rejections* rejections = nullptr;              // counted here, shown in /metrics and health
 };
 
 class HttpApi {
@@ -55,7 +65,11 @@ class HttpApi {
                                                  LiveWeather& weather, HttpApiHooks hooks);
   ~HttpApi();
   std::uint16_t port() const { return port_; }
+  // Stops accepting and closes the console's WebSocket clients.
   void close();
+  // The renderer list changed (a subscriber came, went or reported).
+  void renderersChanged() { feed_.renderersChanged(); }
+  ConsoleFeed& feed() { return feed_; }
 
   struct Counters {
     std::uint64_t requests = 0, applied = 0, rejected = 0, unauthorized = 0;
@@ -70,15 +84,23 @@ class HttpApi {
   };
   Reply handle(const std::string& method, const std::string& target, const std::string& authorization,
                const std::string& body);
+  // The answer to a WebSocket upgrade while the feed is full (503).
+  Reply refuseFeed();
 
  private:
   HttpApi(boost::asio::io_context& io, HttpApiOptions options, LiveWeather& weather, HttpApiHooks hooks);
   void accept();
+  void reject(RejectReason reason) {
+    if (hooks_.rejections) hooks_.rejections->count(reason);
+  }
+  nlohmann::json healthJson() const;
 
   boost::asio::io_context& io_;
   HttpApiOptions options_;
   LiveWeather& weather_;
   HttpApiHooks hooks_;
+  ConsoleFeed feed_;
+  std::size_t weatherListener_ = 0;
   boost::asio::ip::tcp::acceptor acceptor_;
   std::uint16_t port_ = 0;
   Counters counters_;

@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -28,6 +30,41 @@ class LiveWeather final : public WeatherService {
 
   Result<AppliedChange> submit(const ChangeRequest& request) override;
   WeatherView view() const override;
+
+  // Scenario timelines (live_timeline.cpp). An entry waits here until the
+  // weather clock reaches its at_s, then is submitted like any change.
+  struct TimelineItem {
+    double at_s = 0;       // weather clock
+    WeatherChange change;  // timing: no at_s (it starts when made), the entry's ramp_s
+    std::string where;     // "file:line:col: timeline[i]"
+    std::string scenario;  // the scenario's name (its file, or what POST /api/scenario named it)
+    std::string summary;   // what it will do, for GET /api/state's pending list
+  };
+  // Replaces the weather with the scenario's start (its layers and no
+  // others, no regions, the clock at clock.start_s and its rate) and its
+  // timeline, as one accepted change, all or nothing. Each timeline entry is
+  // first tried against the weather it would meet at its time if nothing
+  // else changed meanwhile: one the model would refuse refuses the scenario
+  // (InvalidArgument naming the entry's file, line and field).
+  Result<AppliedChange> loadScenario(const Scenario& scenario, const std::string& name, const std::string& author);
+  // At start, for the scenario the constructor was given: its timeline,
+  // checked the same way. Not a change (no event); with a store, the caller
+  // saves the initial state after this.
+  Result<void> scheduleTimeline(const Scenario& scenario, const std::string& name);
+  // When the next timeline entry is due (weather clock), if one waits.
+  std::optional<double> nextTimelineAt() const;
+  struct TimelineOutcome {
+    double at_s = 0;
+    std::string where;
+    Result<AppliedChange> result;  // what submitting it gave
+  };
+  // Submits every due entry (at_s reached) in order, the entries of one
+  // at_s as one batch (source "scenario", author "scenario:<name>"), each
+  // removed from the timeline in the same commit. A batch the model refuses
+  // now (the weather moved on since it was checked) is dropped: its outcome
+  // says why.
+  std::vector<TimelineOutcome> runTimeline();
+  const std::vector<TimelineItem>& timeline() const { return timeline_; }
   std::vector<ChangeEvent> events(std::size_t limit) const override;
 
   double clockNow() const { return clock_.at(wallNow_()); }
@@ -40,7 +77,21 @@ class LiveWeather final : public WeatherService {
   // Whether a scheduled or ramping change is still under way at clock c: the
   // stream then refreshes its subscribers as the weather moves.
   bool changing(double clock_s) const;
+  // Whether a ramp is running at clock c (started, not ended): the weather
+  // moves continuously, and the console's state follows it.
+  bool rampRunning(double clock_s) const;
+  // Whether a region drifts with a wind while the clock runs: its position
+  // in the state moves continuously.
+  bool drifting(double clock_s) const;
   std::uint64_t rejected() const { return rejected_; }
+  // Changes accepted since this object was made (every input).
+  std::uint64_t accepted() const { return accepted_; }
+
+  // Called on the io thread after every accepted change from any input, once
+  // it is committed and applied: the stream and the console push it on.
+  using Listener = std::function<void(const ChangeEvent&)>;
+  std::size_t addListener(Listener listener);  // returns an id for removeListener
+  void removeListener(std::size_t id);
   // Commits to the store: how many, and their total and longest duration.
   struct CommitStats {
     std::uint64_t count = 0;
@@ -96,10 +147,21 @@ class LiveWeather final : public WeatherService {
   static std::vector<weather::Region> evaluateRegions(const State& s, double clock_s);
   Result<std::string> applyRegion(State& s, const WeatherChange& change, const std::string& at, double now_s,
                                   std::uint64_t sequence) const;
-  Result<std::string> apply(State& s, const WeatherChange& change, std::size_t index, double now_s,
+  // `at` names the change in errors ("changes[2]").
+  Result<std::string> apply(State& s, const WeatherChange& change, const std::string& at, double now_s,
                             std::uint64_t sequence) const;
   void settle(double clock_s);
-  nlohmann::json stateJson(const State& s, std::uint64_t sequence, std::uint64_t version) const;
+  // Commits `next` (with `timeline` as the timeline to come) and its event,
+  // then makes it the weather and tells the listeners.
+  Result<AppliedChange> commit(State next, std::vector<TimelineItem> timeline, const std::string& author,
+                               const std::string& source, const std::string& summary, double now_s);
+  Result<void> dryRun(State s, const std::vector<TimelineItem>& items) const;
+  static std::vector<TimelineItem> timelineItems(const Scenario& scenario, const std::string& name);
+  static nlohmann::json timelineJson(const std::vector<TimelineItem>& timeline);
+  static Result<std::vector<TimelineItem>> timelineFromJson(const nlohmann::json& j);
+  static double rampOf(const WeatherChange& change);
+  nlohmann::json stateJson(const State& s, const std::vector<TimelineItem>& timeline, std::uint64_t sequence,
+                           std::uint64_t version) const;
 
   WallNow wallNow_;
   UnixNowMs unixNowMs_;
@@ -108,10 +170,14 @@ class LiveWeather final : public WeatherService {
   std::map<std::uint32_t, weather::Region> regions_;
   std::vector<RegionRamp> regionRamps_;
   WeatherClock clock_;
+  std::vector<TimelineItem> timeline_;  // by at_s
   std::vector<ChangeEvent> events_;
   std::uint64_t sequence_ = 0;
   std::uint64_t version_ = 1;
   std::uint64_t rejected_ = 0;
+  std::uint64_t accepted_ = 0;
+  std::map<std::size_t, Listener> listeners_;  // by id, called in id order
+  std::size_t nextListenerId_ = 1;
   CommitStats commitStats_;
   class WeatherStore* store_ = nullptr;
 };

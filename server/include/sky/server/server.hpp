@@ -23,6 +23,7 @@
 #include "sky/server/session_registry.hpp"
 #include "sky/server/snapshot_builder.hpp"
 #include "sky/server/live_weather.hpp"
+#include "sky/server/rejections.hpp"
 #include "sky/server/weather_state.hpp"
 
 namespace spdlog {
@@ -57,10 +58,19 @@ class Server final : private SessionHandler {
   std::uint16_t port() const { return port_; }
   boost::asio::io_context& io() { return io_; }
   LiveWeather& weather() { return weather_; }
-  // Every subscriber gets a fresh Snapshot of its area (call on the io thread,
-  // after an accepted change).
+  // Every subscriber gets fresh weather for its area (call on the io
+  // thread). Every change the LiveWeather accepts does this already.
   void weatherChanged();
   std::size_t subscribers() const { return registry_.size(); }
+  // Every subscriber as the console sees it (area, last camera report), by
+  // session id. Call on the io thread.
+  std::vector<RendererInfo> renderers() const;
+  // Runs on the io thread whenever a subscriber connects, subscribes, reports
+  // its camera or goes away (the console coalesces these).
+  void onRenderersChanged(std::function<void()> f) { onRenderersChanged_.push_back(std::move(f)); }
+  // Refused inputs by reason, shared by every input of this server.
+  Rejections& rejections() { return rejections_; }
+  const Rejections& rejections() const { return rejections_; }
   // Stream counters (readable from any thread, for /metrics and tests).
   struct StreamCounters {
     std::atomic<std::uint64_t> frames{0}, bytes{0}, stalledDropped{0};
@@ -85,6 +95,10 @@ class Server final : private SessionHandler {
   void accept();
   void onAccept(const boost::system::error_code& ec, boost::asio::ip::tcp::socket socket);
   void scheduleHeartbeat();
+  // Sets the timeline timer for the next scenario timeline entry, by the
+  // weather clock's rate (a frozen clock waits for the next clock change).
+  void armTimeline();
+  void fireTimeline();
   void shutdown();
   double clockNow() const;
 
@@ -92,6 +106,9 @@ class Server final : private SessionHandler {
   void sessionClosed(Session& session) override;
   void frameSent(std::size_t bytes) override;
   void sessionStalled(Session& session) override;
+  void rendererChanged(Session& session) override;
+  void protocolRejected(Session& session, const Error& error) override;
+  void renderersChanged();
 
   // Member order is destruction order in reverse: the io_context goes last,
   // destroying handlers (and the sessions they keep alive) after the rest.
@@ -102,9 +119,12 @@ class Server final : private SessionHandler {
   boost::asio::ip::tcp::acceptor acceptor_;
   boost::asio::steady_timer acceptRetry_;
   boost::asio::steady_timer heartbeat_;
+  boost::asio::steady_timer timelineTimer_;
   std::optional<boost::asio::signal_set> signals_;
   SessionRegistry registry_;
   StreamCounters streamCounters_;
+  Rejections rejections_;
+  std::vector<std::function<void()>> onRenderersChanged_;
   TileCache tileCache_;
   std::uint16_t port_ = 0;
   std::uint64_t nextSessionId_ = 1;

@@ -15,6 +15,7 @@
 
 #include "sky/core/result.hpp"
 #include "sky/server/outbox.hpp"
+#include "sky/server/renderer_info.hpp"
 #include "sky/stream/framing.hpp"
 #include "sky/stream/messages.hpp"
 
@@ -38,6 +39,11 @@ class SessionHandler {
   // The session is being dropped: its peer stopped reading (a write did not
   // complete within the stall bound).
   virtual void sessionStalled(Session& session) = 0;
+  // The session's area or camera report changed.
+  virtual void rendererChanged(Session& session) = 0;
+  // The peer sent something the stream refuses (a bad frame or message, or a
+  // kind clients must not send); the session is closing.
+  virtual void protocolRejected(Session& session, const Error& error) = 0;
 
  protected:
   ~SessionHandler() = default;
@@ -65,6 +71,8 @@ class Session : public std::enable_shared_from_this<Session> {
 
   std::uint64_t id() const { return id_; }
   const std::string& peer() const { return peer_; }
+  // The console's view of this subscriber at wall time `now`.
+  RendererInfo info(std::chrono::steady_clock::time_point now) const;
 
  private:
   enum class State {
@@ -100,6 +108,10 @@ class Session : public std::enable_shared_from_this<Session> {
   // goes out as the Delta from it when a delta can say it and is smaller.
   std::optional<weather::WeatherSnapshot> peerHolds_;
   std::optional<stream::Subscribe> peerHoldsFor_;
+  // The newest CameraReport and when it arrived (reports replace each other).
+  std::optional<stream::CameraReport> report_;
+  std::chrono::steady_clock::time_point reportAt_{};
+  bool unknownKindLogged_ = false;
   std::array<std::uint8_t, 64 * 1024> readBuffer_{};
   Outbox outbox_;
   Frame writing_;  // the frame async_write is sending; untouched until it completes

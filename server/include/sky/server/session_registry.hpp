@@ -18,6 +18,8 @@ class SessionRegistry {
   void remove(const Session& session);
   // Calls f on every registered session; f may close (and so remove) sessions.
   void forEach(const std::function<void(Session&)>& f);
+  // Calls f on every registered session, in id order; f must not close any.
+  void forEachConst(const std::function<void(const Session&)>& f) const;
   // Closes every session (cancelling their I/O): part of server shutdown.
   void closeAll();
   std::size_t size() const { return sessions_.size(); }

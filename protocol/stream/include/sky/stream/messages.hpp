@@ -3,6 +3,7 @@
 // range, so a caller only ever sees values inside the documented ranges.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -23,11 +24,16 @@ inline constexpr std::uint16_t kProtocolVersion = 2;
 // for budgeting tiles against kMaxFrameBytes.
 inline constexpr std::size_t kTileWireBytes = 16;
 
+// Bits of Hello::features: what a server takes beyond the base protocol of
+// its major version. A server from before the field sends 0.
+inline constexpr std::uint32_t kFeatureCameraReports = 1u << 0;  // takes CameraReport
+
 struct Hello {
   std::uint16_t protocolVersion = kProtocolVersion;
   std::string serverId;
   double weatherClock_s = 0;
   double clockRate = 1;  // weather seconds per wall second, [0, 3600]
+  std::uint32_t features = 0;  // kFeature* bits
 };
 
 struct Subscribe {
@@ -47,16 +53,43 @@ struct StreamError {
   std::string detail;
 };
 
+// Longest CameraReport::channel, bytes: a display name ("left", "cockpit-2
+// center"), bounded so a report stays a few hundred bytes.
+inline constexpr std::size_t kMaxChannelBytes = 64;
+
+// Renderer to server: the camera a channel renders from, for the console.
+struct CameraReport {
+  std::string channel;        // UTF-8, no control characters, <= kMaxChannelBytes
+  double lat_deg = 0;         // geodetic, [-90, 90]
+  double lon_deg = 0;         // [-180, 180]
+  double alt_m = 0;           // the pose's height (WGS84 ellipsoid), [-1000, 1e6] (as Subscribe's band)
+  double heading_deg = 0;     // true, [0, 360]
+  double pitch_deg = 0;       // nose up +, [-90, 90]
+  double roll_deg = 0;        // right wing down +, [-180, 180]
+  std::uint64_t frame = 0;    // the renderer's frame index
+  std::uint64_t weatherVersion = 0;  // snapshots and deltas the renderer has applied
+  double weatherClock_s = 0;  // weather clock of that frame, finite
+};
+
+// A message of a kind this build does not know (a newer peer of the same
+// major version sent it): decoded so the receiver can ignore it. Encoding one
+// writes an empty table of that kind (for tests of that rule).
+struct UnknownKind {
+  std::uint8_t bodyType = 0;  // the union type byte, not one of ours
+};
+
 using Message = std::variant<Hello, Subscribe, weather::WeatherSnapshot, Heartbeat, StreamError,
-                             weather::WeatherDelta>;
+                             weather::WeatherDelta, CameraReport, UnknownKind>;
 
 std::vector<std::uint8_t> encodeMessage(const Message& message);
 
 // Verifies and range-checks one frame's payload: finite numbers, fractions in
 // [0, 1], latitudes, longitudes and altitudes in range, every tile a valid S2
 // cell of the stated level, every Snapshot tile of a layer the Snapshot has,
-// layer ids unique. A Hello or Subscribe of another protocol version is an
-// Unsupported error that says both versions.
+// layer ids unique, a CameraReport's pose in range and its channel valid
+// UTF-8. A Hello or Subscribe of another protocol version is an Unsupported
+// error that says both versions. A body of a kind we do not know is an
+// UnknownKind (to ignore), not an error; a missing body is Malformed.
 Result<Message> decodeMessage(std::span<const std::uint8_t> payload);
 
 // Name of the message kind, for logs ("Hello", "Snapshot", ...).

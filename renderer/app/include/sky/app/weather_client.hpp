@@ -1,11 +1,15 @@
 // The renderer's connection to skyshell-weatherd: connects, subscribes for the
 // camera's area, keeps the latest snapshot and the weather clock in
 // SharedState, and reconnects with backoff when the server goes away (the
-// last weather stays in SharedState meanwhile).
+// last weather stays in SharedState meanwhile). It also tells a server that
+// takes them (Hello's kFeatureCameraReports) where this channel's camera is,
+// for the operator console: a CameraReport at most 2 Hz.
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <chrono>
+#include <mutex>
 #include <optional>
 #include <string>
 
@@ -13,6 +17,7 @@
 #include <boost/asio.hpp>
 
 #include "sky/app/shared_state.hpp"
+#include "sky/geo/geodetic.hpp"
 #include "sky/stream/framing.hpp"
 #include "sky/stream/messages.hpp"
 
@@ -20,12 +25,33 @@ namespace sky::app {
 
 class WeatherClient {
  public:
-  WeatherClient(boost::asio::io_context& io, SharedState& state, std::string host, unsigned short port);
+  // channel: this channel's name in the console (at most
+  // stream::kMaxChannelBytes of UTF-8; longer is cut); empty: "render@<host>".
+  WeatherClient(boost::asio::io_context& io, SharedState& state, std::string host, unsigned short port,
+                std::string channel = {});
 
   void start();
   void stop();
   // Thread-safe: asks for weather around a new area (posted to the io thread).
   void subscribe(const stream::Subscribe& area);
+  // Thread-safe, cheap enough to call every frame: the pose this channel
+  // rendered frame `frame` from, with the weather version it held and the
+  // weather clock it drew. Sent as a CameraReport when the server takes them,
+  // at most every kMinReportInterval, and then only when the pose moved
+  // materially, the weather version changed, or kReportKeepAlive passed.
+  void reportCamera(const geo::GeodeticPose& pose, std::uint64_t frame, std::uint64_t weatherVersion,
+                    double weatherClock_s);
+
+  // 2 Hz: the console's renderer list refreshes at that rate.
+  static constexpr std::chrono::milliseconds kMinReportInterval{500};
+  // A still camera is still reported this often, so the console sees it alive.
+  static constexpr std::chrono::milliseconds kReportKeepAlive{5000};
+  // "Moved materially": a tenth of the smallest tile (~1 km, S2 level 13) in
+  // position, and a degree in attitude (what a map marker can show).
+  static constexpr double kReportMove_m = 100;
+  static constexpr double kReportTurn_deg = 1;
+
+  std::uint64_t reportsSent() const { return reportsSent_.load(); }
 
   std::uint64_t malformedFrames() const { return malformed_; }
 
@@ -36,6 +62,7 @@ class WeatherClient {
   void onFrame(std::span<const std::uint8_t> payload);
   void send(const stream::Message& message);
   void flushWrite();
+  bool reportWorthSending(const stream::CameraReport& r, std::chrono::steady_clock::time_point now);
 
   boost::asio::io_context& io_;
   SharedState& state_;
@@ -47,9 +74,19 @@ class WeatherClient {
   stream::FrameDecoder decoder_;
   std::array<std::uint8_t, 16384> rx_{};
   std::optional<stream::Subscribe> area_;
-  // Bounded outbound: one frame in flight, and only the newest Subscribe waits.
+  // Bounded outbound: one frame in flight; waiting, only the newest Subscribe
+  // and the newest CameraReport (the Subscribe goes first).
   std::vector<std::uint8_t> inFlight_;
-  std::optional<std::vector<std::uint8_t>> pending_;
+  std::optional<std::vector<std::uint8_t>> pendingSubscribe_, pendingReport_;
+  std::string channel_;
+  // Set from the io thread on the server's Hello; read by reportCamera.
+  std::atomic<bool> serverTakesReports_{false};
+  std::atomic<bool> reportNow_{false};  // after a (re)connect: the next call reports
+  std::atomic<std::uint64_t> reportsSent_{0};
+  // reportCamera's throttle, on the caller's thread.
+  std::mutex reportMutex_;
+  std::optional<stream::CameraReport> lastReport_;
+  std::chrono::steady_clock::time_point lastReportAt_{};
   double clockRate_ = 1;
   std::uint64_t malformed_ = 0;
   bool stopped_ = false;
