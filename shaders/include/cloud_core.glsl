@@ -100,11 +100,17 @@ struct Span {
 struct MarchState {
   real3 inscatter;
   real transmittance;
+  // Cloud depth output (not part of the light): sum over steps of the
+  // distance times the light the step removed from the view ray, and the sum
+  // of those weights; depth = depthSum / depthWeight.
+  real depthSum;
+  real depthWeight;
 };
 
 struct PixelResult {
   real3 radiance;
   real transmittance;
+  real depth;  // transmittance-weighted distance to the cloud, m; 0 when no cloud was met
 };
 
 // PCG hash (Jarzynski & Olano 2020, "Hash Functions for GPU Rendering", pcg).
@@ -293,6 +299,9 @@ MarchState marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, March
     real3 gained = sigmaT * dt > kSmallOpticalDepth ? scattered * (kAlbedo * (1.0 - stepT))
                                                     : scattered * (kAlbedo * sigmaT * dt);
     st.inscatter += gained * st.transmittance;
+    real removed = st.transmittance * (1.0 - stepT);
+    st.depthSum += removed * (s.t0 + (real(i) + jitter) * dt);
+    st.depthWeight += removed;
     st.transmittance *= stepT;
   }
   return st;
@@ -320,10 +329,11 @@ PixelResult shadePixel(CoreFrame f, real3 dir, real jitter) {
       order[j - 1] = tmp;
     }
   }
-  MarchState st = MarchState(real3(0.0), 1.0);
+  MarchState st = MarchState(real3(0.0), 1.0, 0.0, 0.0);
   for (int k = 0; k < f.layerCount; ++k) {
     Span s = spans[order[k]];
     if (s.t1 > s.t0) st = marchLayer(f, order[k], dir, s, jitter, st);
   }
-  return PixelResult(skyBackground(dir, hitsGround) * st.transmittance + st.inscatter, st.transmittance);
+  real depth = st.depthWeight > 0.0 ? st.depthSum / st.depthWeight : 0.0;
+  return PixelResult(skyBackground(dir, hitsGround) * st.transmittance + st.inscatter, st.transmittance, depth);
 }

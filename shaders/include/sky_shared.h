@@ -1,7 +1,7 @@
-// Layout of the cloud pass's uniform block and its binding numbers, shared by
+// Layout of the cloud pass's frame block and its binding numbers, shared by
 // C++ (renderer/core) and GLSL (shaders/clouds.comp). Only vec4/uvec4 members,
-// so std140 and C++ agree without hidden padding; the C++ side pins sizes and
-// offsets with static_assert below.
+// so std140/std430 and C++ agree without hidden padding; the C++ side pins
+// sizes and offsets with static_assert below.
 #ifndef SKY_SHARED_H
 #define SKY_SHARED_H
 
@@ -18,10 +18,11 @@ using uvec4 = glm::uvec4;
 #endif
 
 // Descriptor set 0 bindings of the cloud pass.
-SKY_SHARED_CONST kBindingFrame = 0u;    // uniform SkyFrame
+SKY_SHARED_CONST kBindingFrame = 0u;    // SkyFrame, a read-only storage buffer (std430; see clouds.comp)
 SKY_SHARED_CONST kBindingNoise = 1u;    // sampler3D, tileable shape noise (R8, repeat)
 SKY_SHARED_CONST kBindingWeather = 2u;  // sampler2DArray, RG = coverage, density; one slice per layer
 SKY_SHARED_CONST kBindingOutput = 3u;   // storage buffer of vec4 radiance (rgb) + transmittance (a)
+SKY_SHARED_CONST kBindingDepth = 4u;    // storage buffer of float cloud depth (m, 0 = no cloud) per pixel
 
 // Workgroup edge of the cloud pass, pixels (8x8 = 64 invocations = 8 lavapipe
 // subgroups of 8 lanes).

@@ -1,6 +1,6 @@
 // The cloud pass: one compute dispatch over the image (shaders/clouds.comp)
-// with its uniform block, shape-noise texture, samplers, output buffer,
-// descriptor set and command buffer. Blocking: run() returns the read-back image.
+// with its uniform block, shape-noise texture, samplers, output buffers
+// (radiance + transmittance, cloud depth), descriptor set and command buffer. Blocking: run() returns the read-back image.
 #pragma once
 
 #include <cstdint>
@@ -8,6 +8,7 @@
 #include "compute_pipeline.hpp"
 #include "gpu_context.hpp"
 #include "gpu_memory.hpp"
+#include "gpu_timer.hpp"
 #include "noise_volume.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky_shared.h"
@@ -25,6 +26,8 @@ class CloudPass {
 
   // Dispatches one frame and reads it back. Errors: Timeout, Device.
   Result<Image> run(const GpuContext& ctx, const gpu::SkyFrame& frame);
+  // GPU time of the last run's dispatch ("clouds").
+  std::vector<PassTime> lastTimes() const { return timer_.results(); }
 
  private:
   CloudPass() = default;
@@ -38,8 +41,10 @@ class CloudPass {
   GpuImage noise_;
   GpuBuffer uniforms_;
   GpuBuffer output_;
+  GpuBuffer depth_;
   vk::raii::DescriptorPool descriptorPool_{nullptr};
   vk::raii::DescriptorSet descriptorSet_{nullptr};
+  GpuTimer timer_;
   vk::raii::CommandBuffer commands_{nullptr};
   vk::raii::Fence fence_{nullptr};
   std::uint32_t width_ = 0, height_ = 0;

@@ -100,6 +100,7 @@ Result<Image> renderCpuReference(const RenderSettings& settings, const FrameInpu
   image.width = settings.width;
   image.height = settings.height;
   image.rgba.resize(std::size_t(settings.width) * settings.height * 4);
+  image.cloudDepth_m.resize(std::size_t(settings.width) * settings.height);
   for (std::uint32_t y = 0; y < settings.height; ++y)
     for (std::uint32_t x = 0; x < settings.width; ++x) {
       const auto r = core.shade(x, y, frame);
@@ -108,6 +109,7 @@ Result<Image> renderCpuReference(const RenderSettings& settings, const FrameInpu
       out[1] = float(r.radiance.y);
       out[2] = float(r.radiance.z);
       out[3] = float(r.transmittance);
+      image.cloudDepth_m[std::size_t(y) * settings.width + x] = float(r.depth);
     }
   return image;
 }

@@ -23,6 +23,14 @@ struct NoiseVolume {
 // the renderer's 5 km period; enough for the skeleton's single shape octave.
 inline constexpr std::uint32_t kNoiseSize = 64;
 
+// Version of makeShapeNoise's output, part of its cache key (noise_cache.hpp):
+// bump it with any change that alters the texels. (A change that forgets is
+// still caught by the cache's fingerprint: the noise at kNoiseFingerprintSize.)
+inline constexpr std::uint32_t kShapeNoiseGeneratorVersion = 1;
+// Edge of the fingerprint volume: the smallest size the generator accepts
+// (its finest Worley octave has 16 cells), 4096 texels, about 1 ms.
+inline constexpr std::uint32_t kNoiseFingerprintSize = 16;
+
 // Worley (inverted F1, three octaves) blended with value-noise fBm, then
 // histogram-equalised so the values are uniform in [0, 1]: the fraction of
 // volume with noise > 1 - c is c, which makes "coverage" an area fraction.

@@ -130,7 +130,7 @@ TEST(CloudCore, SlabTransmittanceIsBeerLambert) {
     const Core::Span span = c.layerSpan(f, f.layers[0], 1.0, 1e12);
     EXPECT_NEAR(span.t0, base - 500, 1e-6);
     EXPECT_NEAR(span.t1, base + H - 500, 1e-6);
-    Core::MarchState st{Core::real3(0), 1.0};
+    Core::MarchState st{Core::real3(0), 1.0, 0.0, 0.0};
     st = c.marchLayer(f, 0, up, span, 0.5, st);
     const double tau = Core::kExtinctionPerDensity_perm * density * profileIntegral;
     // Midpoint steps of dt = H/48 are exact on the profile's linear pieces;
@@ -149,7 +149,7 @@ TEST(CloudCore, SlabTransmittanceIsBeerLambert) {
   c.density = 1e-30;
   Core::CoreFrame f = frameAt(c, R, 500, base, H);
   f.sunRadiance = Core::real3(1);
-  Core::MarchState st{Core::real3(0), 1.0};
+  Core::MarchState st{Core::real3(0), 1.0, 0.0, 0.0};
   st = c.marchLayer(f, 0, Core::real3(0, 0, 1), c.layerSpan(f, f.layers[0], 1.0, 1e12), 0.5, st);
   EXPECT_EQ(st.transmittance, 1.0);
   EXPECT_TRUE(std::isfinite(st.inscatter.x));
