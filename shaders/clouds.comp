@@ -1,7 +1,7 @@
 // Cloud pass: one invocation per pixel marches every cloud layer and the
 // clear air along the view ray (model in include/cloud_core.glsl) and writes
-// linear radiance and cloud transmittance to a storage buffer. Uniform
-// layout: include/sky_shared.h.
+// linear radiance and cloud transmittance to one storage buffer, the cloud
+// depth to a second one. Frame layout: include/sky_shared.h.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
@@ -24,6 +24,7 @@ layout(std430, set = 0, binding = kBindingOutput) writeonly buffer OutputBlock {
 layout(set = 0, binding = kBindingDetail) uniform sampler3D detailTex;
 layout(set = 0, binding = kBindingTransmittance) uniform sampler2D transmittanceTex;
 layout(set = 0, binding = kBindingMultipleScattering) uniform sampler2D multipleScatteringTex;
+layout(std430, set = 0, binding = kBindingDepth) writeonly buffer DepthBlock { float depths[]; };
 
 #define real float
 #define real2 vec2
@@ -135,4 +136,5 @@ void main() {
                        frame.camDown.w, float(px.x), float(px.y), float(frame.image.x), float(frame.image.y));
   PixelResult r = shadePixel(f, dir, pixelJitter(px.x, px.y));
   pixels[px.y * frame.image.x + px.x] = vec4(r.radiance, r.transmittance);
+  depths[px.y * frame.image.x + px.x] = r.depth;
 }

@@ -125,6 +125,7 @@ struct LayerResult {
 struct PixelResult {
   real3 radiance;
   real transmittance;  // through the clouds only
+  real depth;          // light-weighted mean distance to the clouds, m; 0 when no cloud was met
 };
 
 // Part of the ray inside one layer's shell, clipped by the ground and the
@@ -403,17 +404,23 @@ PixelResult shadePixel(CoreFrame f, real3 dir, real jitter) {
   q[n] = tEnd;
   AirPath air = marchAir(f.air, dir, tEnd, q, n + 1);
 
+  // Cloud depth (an output, not part of the light): each layer's mean depth
+  // weighted by the light it takes out of the view ray, Tbefore (1 - T), so
+  // the pixel's depth is the mean distance at which the clouds remove light.
   real3 radiance = real3(0.0);
   real3 airBefore = real3(0.0);
   real transmittance = 1.0;
+  real depthSum = 0.0;
   for (int k = 0; k < n; ++k) {
     radiance += (air.inscatter[k] - airBefore) * transmittance;
     radiance += layers[k].inscatter * air.transmittance[k] * transmittance;
+    depthSum += transmittance * (1.0 - layers[k].transmittance) * layers[k].depth;
     transmittance *= layers[k].transmittance;
     airBefore = air.inscatter[k];
   }
   radiance += (air.inscatter[n] - airBefore) * transmittance;
   real3 background = hitsGround ? groundRadiance(f, dir, tGround) : real3(kNightSkyRadiance);
   radiance += background * air.transmittance[n] * transmittance;
-  return PixelResult(radiance, transmittance);
+  real depth = transmittance < 1.0 ? depthSum / (1.0 - transmittance) : 0.0;
+  return PixelResult(radiance, transmittance, depth);
 }

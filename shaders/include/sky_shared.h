@@ -27,6 +27,7 @@ SKY_SHARED_CONST kBindingOutput = 3u;         // storage buffer of vec4 radiance
 SKY_SHARED_CONST kBindingDetail = 4u;         // sampler3D, tileable Worley detail noise (R8, repeat)
 SKY_SHARED_CONST kBindingTransmittance = 5u;  // sampler2D, atmosphere transmittance table (RGBA16F, clamp)
 SKY_SHARED_CONST kBindingMultipleScattering = 6u;  // sampler2D, atmosphere multiple scattering (RGBA16F, clamp)
+SKY_SHARED_CONST kBindingDepth = 7u;               // storage buffer of float cloud depth (m, 0 = no cloud) per pixel
 
 // Workgroup edge of the cloud pass, pixels (8x8 = 64 invocations = 8 lavapipe
 // subgroups of 8 lanes).

@@ -38,6 +38,7 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
       .binding(gpu::kBindingDetail, vk::DescriptorType::eCombinedImageSampler)
       .binding(gpu::kBindingTransmittance, vk::DescriptorType::eCombinedImageSampler)
       .binding(gpu::kBindingMultipleScattering, vk::DescriptorType::eCombinedImageSampler)
+      .binding(gpu::kBindingDepth, vk::DescriptorType::eStorageBuffer)
       .shader("clouds.comp.spv");
   auto pipeline = builder.build(ctx);
   if (!pipeline) return tl::unexpected(pipeline.error());
@@ -73,9 +74,11 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
   pass.uniforms_ = createHostBuffer(ctx, sizeof(gpu::SkyFrame), vk::BufferUsageFlagBits::eStorageBuffer, "sky.frameBlock");
   pass.output_ = createHostBuffer(ctx, vk::DeviceSize(width) * height * 4 * sizeof(float),
                                   vk::BufferUsageFlagBits::eStorageBuffer, "sky.cloudOutput");
+  pass.depth_ = createHostBuffer(ctx, vk::DeviceSize(width) * height * sizeof(float),
+                                 vk::BufferUsageFlagBits::eStorageBuffer, "sky.cloudDepth");
 
   const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eCombinedImageSampler, 5),
-                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 2)};
+                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 3)};
   pass.descriptorPool_ = vk::raii::DescriptorPool(
       device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSizes));
   ctx.name(pass.descriptorPool_, "sky.clouds.descriptorPool");
@@ -86,6 +89,7 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
 
   const vk::DescriptorBufferInfo uniformInfo(*pass.uniforms_.buffer, 0, pass.uniforms_.size);
   const vk::DescriptorBufferInfo outputInfo(*pass.output_.buffer, 0, pass.output_.size);
+  const vk::DescriptorBufferInfo depthInfo(*pass.depth_.buffer, 0, pass.depth_.size);
   const vk::DescriptorImageInfo shapeInfo(*pass.noiseSampler_, *pass.shape_.view, vk::ImageLayout::eShaderReadOnlyOptimal);
   const vk::DescriptorImageInfo detailInfo(*pass.noiseSampler_, *pass.detail_.view, vk::ImageLayout::eShaderReadOnlyOptimal);
   const vk::DescriptorImageInfo tableInfo(*pass.tableSampler_, *pass.transmittance_.view,
@@ -102,9 +106,11 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
       vk::WriteDescriptorSet(set, gpu::kBindingTransmittance, 0, vk::DescriptorType::eCombinedImageSampler, tableInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingMultipleScattering, 0, vk::DescriptorType::eCombinedImageSampler, msInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingWeather, 0, vk::DescriptorType::eCombinedImageSampler, weatherInfo),
-      vk::WriteDescriptorSet(set, gpu::kBindingOutput, 0, vk::DescriptorType::eStorageBuffer, {}, outputInfo)};
+      vk::WriteDescriptorSet(set, gpu::kBindingOutput, 0, vk::DescriptorType::eStorageBuffer, {}, outputInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingDepth, 0, vk::DescriptorType::eStorageBuffer, {}, depthInfo)};
   device.updateDescriptorSets(writes, {});
 
+  pass.timer_ = GpuTimer(ctx, 1, "sky.clouds.timer");
   pass.commands_ = ctx.allocateCommandBuffer();
   ctx.name(pass.commands_, "sky.clouds.commands");
   pass.fence_ = vk::raii::Fence(device, vk::FenceCreateInfo());
@@ -117,14 +123,20 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame) 
 
   commands_.reset();
   commands_.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
-  commands_.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_.pipeline);
-  commands_.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *descriptorSet_, {});
-  // One workgroup per 8x8 tile, in a 1D grid: the shader maps ids to tiles
-  // through the permutation in frame.dispatch.
-  commands_.dispatch(tileCount(width_, height_), 1, 1);
-  const vk::BufferMemoryBarrier toHost(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead,
-                                       VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *output_.buffer, 0,
-                                       VK_WHOLE_SIZE);
+  timer_.begin(commands_);
+  {
+    const auto timed = timer_.section(commands_, "clouds");
+    commands_.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_.pipeline);
+    commands_.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *descriptorSet_, {});
+    // One workgroup per 8x8 tile, in a 1D grid: the shader maps ids to tiles
+    // through the permutation in frame.dispatch.
+    commands_.dispatch(tileCount(width_, height_), 1, 1);
+  }
+  const std::array toHost{
+      vk::BufferMemoryBarrier(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead, VK_QUEUE_FAMILY_IGNORED,
+                              VK_QUEUE_FAMILY_IGNORED, *output_.buffer, 0, VK_WHOLE_SIZE),
+      vk::BufferMemoryBarrier(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead, VK_QUEUE_FAMILY_IGNORED,
+                              VK_QUEUE_FAMILY_IGNORED, *depth_.buffer, 0, VK_WHOLE_SIZE)};
   commands_.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, {},
                             toHost, {});
   commands_.end();
@@ -135,6 +147,8 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame) 
   image.height = height_;
   image.rgba.resize(std::size_t(width_) * height_ * 4);
   std::memcpy(image.rgba.data(), output_.mapped, image.rgba.size() * sizeof(float));
+  image.cloudDepth_m.resize(std::size_t(width_) * height_);
+  std::memcpy(image.cloudDepth_m.data(), depth_.mapped, image.cloudDepth_m.size() * sizeof(float));
   return image;
 }
 

@@ -1,7 +1,8 @@
 // The cloud pass: one compute dispatch over the image (shaders/clouds.comp)
 // with its frame block, shape and detail noise, the atmosphere's
-// transmittance and multiple-scattering tables, samplers, output buffer, descriptor set and command
-// buffer. Blocking: run() returns the read-back image.
+// transmittance and multiple-scattering tables, samplers, output buffers
+// (radiance + transmittance, cloud depth), descriptor set, timestamps and
+// command buffer. Blocking: run() returns the read-back image.
 #pragma once
 
 #include <cstdint>
@@ -10,6 +11,7 @@
 #include "compute_pipeline.hpp"
 #include "gpu_context.hpp"
 #include "gpu_memory.hpp"
+#include "gpu_timer.hpp"
 #include "noise_volume.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky_shared.h"
@@ -28,6 +30,8 @@ class CloudPass {
 
   // Dispatches one frame and reads it back. Errors: Timeout, Device.
   Result<Image> run(const GpuContext& ctx, const gpu::SkyFrame& frame);
+  // GPU time of the last run's dispatch ("clouds").
+  std::vector<PassTime> lastTimes() const { return timer_.results(); }
 
  private:
   CloudPass() = default;
@@ -45,8 +49,10 @@ class CloudPass {
   GpuImage multipleScattering_;
   GpuBuffer uniforms_;  // the frame block (a storage buffer, see clouds.comp)
   GpuBuffer output_;
+  GpuBuffer depth_;
   vk::raii::DescriptorPool descriptorPool_{nullptr};
   vk::raii::DescriptorSet descriptorSet_{nullptr};
+  GpuTimer timer_;
   vk::raii::CommandBuffer commands_{nullptr};
   vk::raii::Fence fence_{nullptr};
   std::uint32_t width_ = 0, height_ = 0;

@@ -174,18 +174,27 @@ Result<std::vector<std::array<float, 4>>> CpuReference::renderPixels(const Frame
 }
 
 Result<Image> CpuReference::render(const FrameInputs& inputs) const {
-  std::vector<PixelCoord> all;
-  all.reserve(std::size_t(settings_.width) * settings_.height);
-  for (std::uint32_t y = 0; y < settings_.height; ++y)
-    for (std::uint32_t x = 0; x < settings_.width; ++x) all.push_back({x, y});
-  auto pixels = renderPixels(inputs, all);
-  if (!pixels) return tl::unexpected(pixels.error());
+  if (auto ok = validateInputs(inputs); !ok) return tl::unexpected(ok.error());
+  const WeatherField field = buildWeatherField(inputs.weather, inputs.camera.position);
+  const FrameSetup setup = prepareFrame(settings_, inputs, field, tables_->atmosphere);
+  CpuCore core(setup, tables_->shape, tables_->detail, tables_->atmosphere, field);
+  const auto frame = core.coreFrame();
   Image image;
   image.width = settings_.width;
   image.height = settings_.height;
-  image.rgba.resize(all.size() * 4);
-  for (std::size_t i = 0; i < all.size(); ++i)
-    for (int c = 0; c < 4; ++c) image.rgba[i * 4 + std::size_t(c)] = (*pixels)[i][std::size_t(c)];
+  image.rgba.resize(std::size_t(settings_.width) * settings_.height * 4);
+  image.cloudDepth_m.resize(std::size_t(settings_.width) * settings_.height);
+  for (std::uint32_t y = 0; y < settings_.height; ++y)
+    for (std::uint32_t x = 0; x < settings_.width; ++x) {
+      const auto r = core.shade(x, y, frame);
+      const std::size_t i = std::size_t(y) * settings_.width + x;
+      float* out = &image.rgba[i * 4];
+      out[0] = float(r.radiance.x);
+      out[1] = float(r.radiance.y);
+      out[2] = float(r.radiance.z);
+      out[3] = float(r.transmittance);
+      image.cloudDepth_m[i] = float(r.depth);
+    }
   return image;
 }
 

@@ -30,6 +30,19 @@ inline constexpr std::uint32_t kShapeNoiseSize = 64;
 // ~31 m per texel at cumulus' 1 km detail period.
 inline constexpr std::uint32_t kDetailNoiseSize = 32;
 
+// Versions of makeShapeNoise's and makeDetailNoise's output, part of their
+// cache keys (noise_cache.hpp): bump one with any change that alters its
+// texels. (A change that forgets is still caught by the cache's fingerprint:
+// the noise at the fingerprint size.) Shape 2: the cloud model's RGBA8
+// Perlin-Worley (1 was the skeleton's R8 noise).
+inline constexpr std::uint32_t kShapeNoiseGeneratorVersion = 2;
+inline constexpr std::uint32_t kDetailNoiseGeneratorVersion = 1;
+// Edges of the fingerprint volumes: the smallest sizes the generators accept
+// (the shape's finest Worley octave has 32 cells, the detail's 8): the shape
+// fingerprint costs 1/8 of generating the full texture.
+inline constexpr std::uint32_t kShapeNoiseFingerprintSize = 32;
+inline constexpr std::uint32_t kDetailNoiseFingerprintSize = 8;
+
 // Shape noise, each channel histogram-equalised so its values are uniform in
 // [0, 1] (then the fraction of volume with noise > 1 - c is c, which makes
 // "coverage" an area fraction):

@@ -1,7 +1,7 @@
 // What the renderer measures about its own frame, read through its public
 // API. The one place the bench asks the renderer for GPU time and lookup
-// counts: today the public API (cloud_renderer.hpp) offers neither, so both
-// are absent and the bench reports wall time only; fill these in when it does.
+// counts: GPU time comes from its per-pass timestamps; lookup counts are not
+// in the public API (cloud_renderer.hpp) yet, so they stay absent.
 #pragma once
 
 #include <cstdint>
