@@ -290,6 +290,42 @@ const cases = {
     noProblems(a.problems);
   },
 
+  // Every control can be clicked where it is drawn: at the usual instructor
+  // station sizes no card spills over another (a wide row under the next
+  // card takes its clicks: the scenario Load button once sat under the
+  // renderer list). Hit-tests the centre of each visible control.
+  async layout(cleanup) {
+    const { w, hasWs, browser } = await setup("layout", cleanup);
+    for (const viewport of [{ width: 1920, height: 1080 }, { width: 1600, height: 1000 }, { width: 1366, height: 768 },
+      { width: 1280, height: 800 }, { width: 1024, height: 768 }]) {
+      const a = await openConsole(browser, w, { token: TOKEN, allowed: withoutWebSocketAllowances(hasWs),
+        name: `${viewport.width}x${viewport.height}`, viewport });
+      const controls = await a.page.$$("button, input, select, textarea");
+      let checked = 0;
+      const covered = [];
+      for (const c of controls) {
+        if (!(await c.isVisible())) continue;
+        await c.scrollIntoViewIfNeeded();
+        const hit = await c.evaluate((el) => {
+          const r = el.getBoundingClientRect();
+          const x = r.left + r.width / 2, y = r.top + r.height / 2;
+          const top = document.elementFromPoint(x, y);
+          const label = el.closest("label");
+          const ok = top !== null && (el === top || el.contains(top) || (label !== null && label.contains(top)));
+          return { ok, what: el.id || el.name || el.textContent.trim().slice(0, 20) || el.tagName,
+            over: top ? (top.closest("section") || top).id || top.tagName : "nothing" };
+        });
+        checked += 1;
+        if (!hit.ok) covered.push(`${hit.what} (under ${hit.over})`);
+      }
+      assert(checked > 20, `${viewport.width}x${viewport.height}: only ${checked} visible controls`);
+      assert(covered.length === 0, `${viewport.width}x${viewport.height}: covered controls: ${covered.join(", ")}`);
+      console.log(`  ${viewport.width}x${viewport.height}: ${checked} controls, all clickable`);
+      noProblems(a.problems);
+      await a.context.close();
+    }
+  },
+
   // A screenshot of a busy console: the artefact in the build tree (and
   // docs/images/console.png when SKY_CONSOLE_DOCS_SCREENSHOT names it).
   async screenshot(cleanup) {
