@@ -68,6 +68,18 @@ find_path(STB_INCLUDE_DIR stb_image_write.h PATH_SUFFIXES stb REQUIRED)
 add_library(sky::stb INTERFACE IMPORTED)
 target_include_directories(sky::stb SYSTEM INTERFACE ${STB_INCLUDE_DIR})
 
+# EXR frames (DESIGN.md: tinyexr or OpenEXR): Debian's libtinyexr-dev ships a
+# compiled library with a CMake config (target tinyexr::tinyexr).
+find_package(tinyexr CONFIG REQUIRED)
+add_library(sky::tinyexr INTERFACE IMPORTED)
+target_link_libraries(sky::tinyexr INTERFACE tinyexr::tinyexr)
+
+# The windowed renderer's window (DESIGN.md: GLFW); libglfw3-dev's CMake
+# config names the target glfw.
+find_package(glfw3 CONFIG REQUIRED)
+add_library(sky::glfw INTERFACE IMPORTED)
+target_link_libraries(sky::glfw INTERFACE glfw)
+
 if(SKY_BUILD_TESTS)
   find_package(GTest REQUIRED)
 endif()

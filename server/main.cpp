@@ -17,6 +17,7 @@
 #include <spdlog/spdlog.h>
 
 #include "sky/server/cigi_weather_input.hpp"
+#include "sky/server/console_files.hpp"
 #include "sky/server/http_api.hpp"
 #include "sky/server/metar_changes.hpp"
 #include "sky/server/scenario.hpp"
@@ -93,6 +94,11 @@ int main(int argc, char** argv) {
   app.add_option("--metar-stations", stationsPath,
                  "METAR station table for POST /api/metar: CSV icao,lat_deg,lon_deg,elevation_m "
                  "(deploy/metar/stations.csv); requests may also bring their own");
+  std::string consoleDir;
+  auto* consoleOption = app.add_option(
+      "--console-dir", consoleDir,
+      "Folder of the operator console's files, served at http://<http-listen>:<http-port>/ (default: "
+      "<executable's folder>/" SKY_CONSOLE_RELATIVE_DIR ", where the build and the install put it)");
   std::string dbPath;
   app.add_option("--db", dbPath,
                  "SQLite file of the live weather: restored at start when it holds a state, every accepted change "
@@ -224,6 +230,20 @@ int main(int argc, char** argv) {
       http.stations = std::move(*table);
       log->info("event=metar_stations file={:?} stations={}", stationsPath, http.stations.size());
     }
+    // The console is optional for the API: a missing default folder is a
+    // warning, a folder named on the command line that cannot be read is not.
+    const bool consoleGiven = consoleOption->count() > 0;
+    const std::filesystem::path consolePath =
+        consoleGiven ? std::filesystem::path(consoleDir) : sky::server::defaultConsoleDir(SKY_CONSOLE_RELATIVE_DIR);
+    if (auto files = sky::server::ConsoleFiles::load(consolePath); files) {
+      log->info("console: {} files from {}", files->size(), consolePath.string());
+      http.console = std::make_shared<const sky::server::ConsoleFiles>(std::move(*files));
+    } else if (consoleGiven) {
+      log->error("--console-dir: {}", sky::describe(files.error()));
+      return kExitBadInput;
+    } else {
+      log->warn("no console pages: {}", sky::describe(files.error()));
+    }
     http.port = static_cast<std::uint16_t>(httpPort);
     http.serverId = options.serverId;
     http.log = log;
@@ -263,6 +283,11 @@ int main(int argc, char** argv) {
     s.onRenderersChanged([&api] { api->renderersChanged(); });
     std::cout << "skyshell-weatherd HTTP API on " << http.listenAddress << ":" << api->port()
               << (http.token.empty() ? " (read-only: no --token-file)" : "") << std::endl;
+    if (http.console)
+      std::cout << "skyshell-weatherd console on http://"
+                << (http.listenAddress.find(':') != std::string::npos ? "[" + http.listenAddress + "]"
+                                                                      : http.listenAddress)
+                << ":" << api->port() << "/" << std::endl;
     if (!httpPortFile.empty()) {
       if (auto r = writePortFile(httpPortFile, api->port()); !r) {
         log->error("{}", sky::describe(r.error()));

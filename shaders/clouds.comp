@@ -1,6 +1,7 @@
-// Cloud pass: one invocation per pixel marches every cloud layer along the
-// view ray (model in include/cloud_core.glsl) and writes linear radiance and
-// transmittance to a storage buffer. Uniform layout: include/sky_shared.h.
+// Cloud pass: one invocation per pixel marches every cloud layer and the
+// clear air along the view ray (model in include/cloud_core.glsl) and writes
+// linear radiance and cloud transmittance to one storage buffer, the cloud
+// depth to a second one. Frame layout: include/sky_shared.h.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
@@ -8,43 +9,109 @@
 
 layout(local_size_x = kLocalSize, local_size_y = kLocalSize) in;
 
-layout(std140, set = 0, binding = kBindingFrame) uniform FrameBlock { SkyFrame frame; };
-layout(set = 0, binding = kBindingNoise) uniform sampler3D noiseTex;
+// The frame's numbers in a read-only storage buffer, not a uniform block:
+// lavapipe specialises a shader on uniform-block values that decide branches
+// and compiles a new variant whenever they change (with a moving camera ~1.5
+// s per frame under ASan, measured with MESA_SHADER_CACHE_DISABLE=true);
+// storage buffers it leaves alone. std430 and std140 agree on this vec4-only
+// layout. Storage loads are gathers on lavapipe, so what a sample needs is
+// read once: the frame's into the globals below, a layer's into its
+// CoreLayer (layerAt, once per span).
+layout(std430, set = 0, binding = kBindingFrame) readonly buffer FrameBlock { SkyFrame frame; };
+layout(set = 0, binding = kBindingShape) uniform sampler3D shapeTex;
 layout(set = 0, binding = kBindingWeather) uniform sampler2DArray weatherTex;
 layout(std430, set = 0, binding = kBindingOutput) writeonly buffer OutputBlock { vec4 pixels[]; };
+layout(set = 0, binding = kBindingDetail) uniform sampler3D detailTex;
+layout(set = 0, binding = kBindingTransmittance) uniform sampler2D transmittanceTex;
+layout(set = 0, binding = kBindingMultipleScattering) uniform sampler2D multipleScatteringTex;
+layout(std430, set = 0, binding = kBindingDepth) writeonly buffer DepthBlock { float depths[]; };
 
 #define real float
 #define real2 vec2
 #define real3 vec3
+#define real4 vec4
 #define SKY_CORE_CONST const
 
-// Weather map lookup: camera-local point -> weather anchor frame -> gnomonic
-// plane of the anchor sphere (x = R q.x / q.z) -> texture coordinates.
-vec2 sampleWeather(int layer, vec3 p) {
-  vec3 q = vec3(dot(frame.camToAnchor[0].xyz, p), dot(frame.camToAnchor[1].xyz, p),
-                dot(frame.camToAnchor[2].xyz, p)) + frame.camInAnchor.xyz;
-  if (q.z <= 0.0) return vec2(0.0);
-  vec2 plane = q.xy * (frame.camInAnchor.w / q.z) - frame.layers[layer].coverageShift.xy;
-  vec2 uv = plane * frame.weatherMap.x + 0.5;
-  return textureLod(weatherTex, vec3(uv, frame.layers[layer].shape.y), 0.0).xy;
+// Copies of the frame's sampling numbers, set at the start of main.
+mat3 gCamToAnchor;     // camera-local -> weather-anchor-local
+vec4 gCamInAnchor;     // xyz: camera in the anchor frame (m); w: anchor sphere radius (m)
+float gMapScale;       // 1 / (2 half extent) of the weather map (1/m)
+mat3 gLocalToEcef;     // camera-local -> ECEF axes
+
+vec3 sampleTransmittanceLut(vec2 uv) {
+  return textureLod(transmittanceTex, uv, 0.0).rgb;
 }
 
-// Earth-fixed noise: rotate to ECEF axes and add the layer's origin (camera
-// ECEF minus wind drift, modulo the period, computed in double on the CPU).
-float sampleNoise(int layer, vec3 p) {
-  vec3 e = vec3(dot(frame.localToEcef[0].xyz, p), dot(frame.localToEcef[1].xyz, p),
-                dot(frame.localToEcef[2].xyz, p));
-  return textureLod(noiseTex, frame.layers[layer].noiseOrigin.xyz + e * frame.weatherMap.z, 0.0).r;
-}
-
-// Large-scale modulation of coverage: the same noise, its own origin and period.
-float sampleCloudMap(int layer, vec3 p) {
-  vec3 e = vec3(dot(frame.localToEcef[0].xyz, p), dot(frame.localToEcef[1].xyz, p),
-                dot(frame.localToEcef[2].xyz, p));
-  return textureLod(noiseTex, frame.layers[layer].cloudMapOrigin.xyz + e * frame.weatherMap.w, 0.0).r;
+vec3 sampleMultipleScatteringLut(vec2 uv) {
+  return textureLod(multipleScatteringTex, uv, 0.0).rgb;
 }
 
 #include "cloud_core.glsl"
+
+// Weather map lookup: camera-local point -> weather anchor frame -> gnomonic
+// plane of the anchor sphere (x = R q.x / q.z) -> texture coordinates.
+vec3 sampleWeather(LayerSampling s, vec3 p) {
+  vec3 q = gCamToAnchor * p + gCamInAnchor.xyz;
+  if (q.z <= 0.0) return vec3(0.0);
+  vec2 plane = q.xy * (gCamInAnchor.w / q.z) - s.coverageShift.xy;
+  vec2 uv = plane * gMapScale + 0.5;
+  return textureLod(weatherTex, vec3(uv, s.coverageShift.z), 0.0).xyz;
+}
+
+// Earth-fixed noise coordinates: rotate to ECEF axes, scale by the period and
+// add the origin (camera ECEF minus wind drift, modulo the period, computed in
+// double on the CPU).
+vec3 noiseCoord(vec4 origin, vec3 p) {
+  return origin.xyz + (gLocalToEcef * p) * origin.w;
+}
+
+// The shape noise, stretched along ECEF z for streaky types (the origin is
+// stretched the same way on the CPU, so the pattern stays Earth-fixed).
+vec2 sampleShape(LayerSampling s, vec3 p) {
+  vec3 e = gLocalToEcef * p;
+  e.z *= s.shapeStretchZ;
+  return textureLod(shapeTex, s.shapeOrigin.xyz + e * s.shapeOrigin.w, 0.0).rg;
+}
+
+float sampleDetail(LayerSampling s, vec3 p) {
+  return textureLod(detailTex, noiseCoord(s.detailOrigin, p), 0.0).r;
+}
+
+// Large-scale cloud map: the shape texture's smooth and Worley channels at a
+// larger, incommensurate period.
+vec2 sampleCloudMap(LayerSampling s, vec3 p) {
+  return textureLod(shapeTex, noiseCoord(s.cloudMapOrigin, p), 0.0).ba;
+}
+
+CloudType unpackType(SkyCloudType t) {
+  CloudType c;
+  c.extinction_perm = t.a.x;
+  c.dropletDiameter_um = t.a.y;
+  c.baseRound = t.a.z;
+  c.topRoundStart = t.a.w;
+  c.peak = t.b.x;
+  c.peakVariation = t.b.y;
+  c.anvil = t.b.z;
+  c.densityGradient = t.b.w;
+  c.densityBaseFade = t.c.x;
+  c.densityTopFade = t.c.y;
+  c.coverageEdge = t.c.z;
+  c.fibrous = t.c.w;
+  c.erosion = t.d.x;
+  c.wispyHeight = t.d.y;
+  c.columnFill = t.d.z;
+  c.unused = 0.0;
+  return c;
+}
+
+CoreLayer layerAt(int li) {
+  SkyLayer l = frame.layers[li];
+  LayerSampling s = LayerSampling(l.shapeOrigin, l.detailOrigin, l.cloudMapOrigin,
+                                  vec3(l.coverageShift.xy, l.shape.y), l.coverageShift.w);
+  return CoreLayer(l.heights.x, l.heights.y, l.heights.z, l.heights.w, l.shape.x, l.shape.z, l.shape.w > 0.5,
+                   unpackType(l.primary), unpackType(l.secondary), l.ambient.rgb, l.sunDiffuse.rgb,
+                   l.sunDiffuse.w, s);
+}
 
 void main() {
   // Workgroup i draws tile (i * stride) mod n: lavapipe hands each thread a
@@ -54,19 +121,20 @@ void main() {
   uvec2 px = uvec2(tile % frame.image.z, tile / frame.image.z) * kLocalSize + gl_LocalInvocationID.xy;
   if (px.x >= frame.image.x || px.y >= frame.image.y) return;
 
+  // GLSL's mat3(a, b, c) takes columns; the frame holds rows.
+  gCamToAnchor = transpose(mat3(frame.camToAnchor[0].xyz, frame.camToAnchor[1].xyz, frame.camToAnchor[2].xyz));
+  gLocalToEcef = transpose(mat3(frame.localToEcef[0].xyz, frame.localToEcef[1].xyz, frame.localToEcef[2].xyz));
+  gCamInAnchor = frame.camInAnchor;
+  gMapScale = frame.weatherMap.x;
+
   CoreFrame f;
-  f.r = frame.earth.x;
-  f.cGround = frame.earth.z;
-  f.sunDir = frame.sunDir.xyz;
-  f.sunRadiance = frame.sunRadiance.xyz;
-  f.ambient = frame.ambient.xyz;
+  f.air = AirFrame(frame.earth.x, frame.earth.y, frame.earth.z, frame.earth.w, frame.sunDir.xyz,
+                   frame.sunIrradiance.rgb);
+  f.groundIrradiance = frame.groundIrradiance.rgb;
   f.layerCount = int(frame.weatherMap.y);
-  for (int i = 0; i < int(kMaxLayers); ++i) {
-    SkyLayer l = frame.layers[i];
-    f.layers[i] = CoreLayer(l.heights.x, l.heights.y, l.heights.z, l.heights.w, l.shape.x);
-  }
   vec3 dir = cameraRay(frame.camForward.xyz, frame.camRight.xyz, frame.camDown.xyz, frame.camRight.w,
                        frame.camDown.w, float(px.x), float(px.y), float(frame.image.x), float(frame.image.y));
   PixelResult r = shadePixel(f, dir, pixelJitter(px.x, px.y));
   pixels[px.y * frame.image.x + px.x] = vec4(r.radiance, r.transmittance);
+  depths[px.y * frame.image.x + px.x] = r.depth;
 }

@@ -11,6 +11,8 @@
 #include <spdlog/spdlog.h>
 
 #include "sky/server/api_json.hpp"
+#include "sky/server/conditions_api.hpp"
+#include "sky/server/console_files.hpp"
 #include "sky/server/metar_api.hpp"
 #include "sky/server/scenario_api.hpp"
 
@@ -210,6 +212,11 @@ HttpApi::Reply HttpApi::handle(const std::string& method, const std::string& tar
     return {200, "application/json",
             nlohmann::json{{"renderers", list}}.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)};
   }
+  if (method == "GET" && path == "/api/conditions") {
+    auto q = parseConditionsQuery(query);
+    if (!q) return {400, "application/json", errorJson(q.error().detail)};
+    return {200, "application/json", conditionsJson(weather_, *q).dump()};
+  }
   if (path == "/api/ws")
     return {426, "application/json", errorJson("upgrade: GET /api/ws is a WebSocket (send Upgrade: websocket)")};
   if (method == "GET" && path == "/api/events") {
@@ -326,6 +333,8 @@ HttpApi::Reply HttpApi::handle(const std::string& method, const std::string& tar
     }
     return {reply.status, "application/json", reply.body.dump()};
   }
+  if (method == "GET" && options_.console)
+    if (const ConsoleFile* f = options_.console->find(path)) return {200, f->contentType, f->body};
   return {404, "application/json", errorJson("path: no " + method + " " + path)};
 }
 

@@ -1,29 +1,38 @@
-// The cloud model, written once in the subset GLSL and C++ share: camera rays,
-// ray-shell spans, density, phase function, the per-step integration and the
-// march. Included by shaders/clouds.comp (real = float) and, inside a class
-// body, by renderer/core/src/cpu_reference.cpp (real = double).
-// The includer defines real, real2, real3, uint, SKY_CORE_CONST, kMaxLayers and
-// the two texture hooks before including this file:
-//   real2 sampleWeather(int layer, real3 pLocal)  // (coverage, density), 0 outside the map
-//   real  sampleNoise(int layer, real3 pLocal)    // tileable shape noise in [0, 1]
-//   real  sampleCloudMap(int layer, real3 pLocal) // the same noise at a larger, incommensurate period
+// The cloud and sky model, written once in the subset GLSL and C++ share:
+// per-layer ray-shell spans, the light (Beer-Lambert, Jendersie-d'Eon phase,
+// Wrenninge octaves, a secondary march towards the sun, sky ambient,
+// Hillaire's energy-conserving steps), the clear-sky atmosphere behind and
+// between the layers (aerial perspective) and the ground. Included by
+// shaders/clouds.comp (real = float) and, inside a class body, by
+// renderer/core/src/cpu_reference.cpp (real = double).
+// The includer defines real, real2, real3, real4, uint, SKY_CORE_CONST,
+// kMaxLayers and sampleTransmittanceLut (atmosphere_core.glsl) before
+// including this file, and defines the hooks declared below after it:
+//   CoreLayer layerAt(int li)                            // layer li of the frame
+//   real3 sampleWeather(LayerSampling s, real3 pLocal)   // (coverage, density, blend), 0 outside the map
+//   real2 sampleCloudMap(LayerSampling s, real3 pLocal)  // (coverage modulation, peak height) in [0, 1]
+//   real2 sampleShape(LayerSampling s, real3 pLocal)     // (billowy, fibrous) shape noise in [0, 1]
+//   real  sampleDetail(LayerSampling s, real3 pLocal)    // Worley detail noise in [0, 1]
 // pLocal is camera-relative, local frame: x east, y north, z up (m).
 
-SKY_CORE_CONST real kPi = 3.14159265358979323846;
+#include "core_common.glsl"
+#include "atmosphere_core.glsl"
+#include "cloud_density.glsl"
 
-// Extinction per unit density, 1/m. formulas.md: cumulus sigma_t ~ 0.05-0.15,
-// stratus 0.01-0.05; the low end keeps a 48-step march from aliasing edges.
-SKY_CORE_CONST real kExtinctionPerDensity_perm = 0.05;
-// Single-scattering albedo of cloud droplets in the visible (formulas.md: 0.999+).
+// Single-scattering albedo of cloud droplets and ice in the visible
+// (formulas.md: 0.999+).
 SKY_CORE_CONST real kAlbedo = 0.999;
-// Cloud droplet diameter for the Jendersie-d'Eon fitted Mie phase function,
-// um: the fit holds for 5-50; 10 um is a typical cumulus droplet (effective
-// radius ~5-10 um), and formulas.md lists the fitted parameters there.
-SKY_CORE_CONST real kDropletDiameter_um = 10.0;
+// Asymmetry of the Henyey-Greenstein phase function for ice crystals (the
+// Mie fit holds for droplets only): g ~ 0.75-0.8 for cirrus in the visible
+// (Baum et al. 2005, "Bulk scattering properties for the remote sensing of
+// ice clouds"); halos are not modelled.
+SKY_CORE_CONST real kIceAsymmetry = 0.75;
 // Wrenninge 2015 multiple-scattering octaves: octave i scales the extinction
 // towards the sun by a^i, its contribution by b^i and the phase eccentricity
 // by c^i; a <= b keeps the sum energy-conserving. a = b = c = 0.5 as in
-// formulas.md; 4 octaves (Ford uses 8; the 5th adds under 3 %).
+// formulas.md; 4 octaves, one per lane of a real4 (Ford uses 8; the 5th adds
+// under 3 %; arrays of per-octave values cost lavapipe a memory round trip
+// per sample, a real4 does not).
 SKY_CORE_CONST int kScatterOctaves = 4;
 SKY_CORE_CONST real kOctaveExtinction = 0.5;
 SKY_CORE_CONST real kOctaveContribution = 0.5;
@@ -31,42 +40,41 @@ SKY_CORE_CONST real kOctaveEccentricity = 0.5;
 // Primary samples per layer span; fixed so cost is predictable (lavapipe.md:
 // ~9.5 ns per primary step, 60-130 lookups per pixel fit a 33 ms frame).
 SKY_CORE_CONST int kPrimarySteps = 48;
-// Light samples towards the sun (Haggstrom 2018: 4 was the best trade).
+// Light samples towards the sun (Haggstrom 2018: 4 was the best trade); the
+// distance they cover is per layer (LayerSetup::lightDistance_m).
 SKY_CORE_CONST int kLightSteps = 4;
-// Distance the light march covers, m (Haggstrom: about half a cumulus layer).
-SKY_CORE_CONST real kLightMarchDistance_m = 500.0;
 // Longest span marched through one layer, m: beyond this a grazing ray's
 // samples would be more than ~1.2 km apart and only add noise.
 SKY_CORE_CONST real kMaxSpan_m = 60000.0;
 // Spans starting farther than this are not marched, m: the weather map reaches
-// 100 km (gnomonic half extent), its corners about 141 km.
+// 100 km (gnomonic half extent), its corners about 141 km; aerial perspective
+// has faded clouds there to a few percent of their contrast.
 SKY_CORE_CONST real kMaxViewDistance_m = 150000.0;
 // Early exit once the view ray keeps less than 1 % of the background.
 SKY_CORE_CONST real kMinTransmittance = 0.01;
-// Width of the soft coverage threshold in noise units: density ramps from 0 at
-// noise = 1 - coverage to full at 1 - coverage + kCoverageEdge, so coverage 0 is
-// exactly empty and coverage 1 is nearly solid.
-SKY_CORE_CONST real kCoverageEdge = 0.25;
-// Height profile inside a layer (fractions of the thickness): rounded base and
-// a thinner top, the shape of Haggstrom's SA term without the weather inputs.
-SKY_CORE_CONST real kProfileBottomFade = 0.1;
-SKY_CORE_CONST real kProfileTopFade = 0.2;
-// How far the cloud map moves partial coverage (Schneider's low-frequency
-// weather channel): c' = c + A (m - 0.5) 4c(1 - c), so coverage 0 and 1 stay
-// exact and 0.5 spans [0.2, 0.8]; breaks up the noise's 5 km repetition.
-SKY_CORE_CONST real kCloudMapAmplitude = 0.6;
-// Ambient light at a layer's base relative to its top (the base sees the dark
-// ground and is shadowed by the cloud above it).
-SKY_CORE_CONST real kAmbientBottomFactor = 0.3;
-// Optical depth below which a step uses the sigma_t -> 0 limit of its integral.
-SKY_CORE_CONST real kSmallOpticalDepth = 1e-4;
-// 2^-24: maps the top 24 bits of a hash to [0, 1) exactly in float.
-SKY_CORE_CONST real kInv2Pow24 = 5.9604644775390625e-8;
-// Background radiances (linear, arbitrary units shared with the sun): a plain
-// zenith-to-horizon gradient and a darker ground until the atmosphere arrives.
-SKY_CORE_CONST real kSkyZenithR = 0.20, kSkyZenithG = 0.38, kSkyZenithB = 0.80;
-SKY_CORE_CONST real kSkyHorizonR = 0.62, kSkyHorizonG = 0.72, kSkyHorizonB = 0.85;
-SKY_CORE_CONST real kGroundR = 0.16, kGroundG = 0.15, kGroundB = 0.12;
+// Diffuse light inside a layer: the sky's light and the sunlight scattered
+// out of the direct beam above a point reach it as diffuse light, transmitted
+// through the optical depth tau above as by a conservatively scattering slab
+// in the Eddington two-stream approximation, t = 1 / (1 + 3/4 (1 - g) tau)
+// (e.g. Bohren & Clothiaux 2006, "Fundamentals of Atmospheric Radiation",
+// ch. 6). g = 0.85 is the asymmetry of cloud droplets in the visible (the Mie
+// fit's mean cosine at 10-20 um). Wrenninge's octaves carry sunlight a few
+// optical depths in; this carries it through an overcast deck.
+SKY_CORE_CONST real kDiffuseAsymmetry = 0.85;
+// Smallest sun cosine for the direct beam's slant depth (sun at the horizon).
+SKY_CORE_CONST real kMinSunCosine = 0.02;
+// Lambertian ground albedo (no terrain yet): 0.1, a mix of vegetation and
+// soil, as Bruneton 2017's reference ground.
+SKY_CORE_CONST real kGroundAlbedo = 0.1;
+// Where a layer's textures are read (the hooks' per-layer inputs, carried
+// in the layer so a sample reads no frame data).
+struct LayerSampling {
+  real4 shapeOrigin;     // xyz: (camera ECEF - wind drift) mod period, in periods; w: 1 / period (1/m)
+  real4 detailOrigin;    // the same for the detail noise
+  real4 cloudMapOrigin;  // the same for the cloud map
+  real3 coverageShift;   // xy: coverage drift east/north (m); z: weather-map slice
+  real shapeStretchZ;    // the shape noise's ECEF z scale: < 1 draws streaks along the Earth's axis
+};
 
 struct CoreLayer {
   real hBase;      // camera height above the layer base, m (negative below)
@@ -74,22 +82,30 @@ struct CoreLayer {
   real cBase;      // hBase (2r - hBase), m^2
   real cTop;       // hTop (2r - hTop), m^2
   real thickness;  // m, > 0
+  real lightDistance;  // m the secondary march covers towards the sun, > 0
+  bool blends;     // tiles blend towards `secondary` by the weather map's blend
+  CloudType primary;
+  CloudType secondary;
+  real3 skyTop;        // mean sky radiance at the layer top, linear units
+  real3 sunDiffuseTop; // sunlight at the layer top as a diffuse radiance, E T mu / pi
+  real sunCosine;      // mu of the sun at the layer top (>= 0)
+  LayerSampling sampling;
 };
+
+// The layers are read through this hook, not carried in CoreFrame: a frame
+// holding every layer's numbers, passed by value into per-sample functions
+// and indexed by a run-time layer number, is copied per sample by lavapipe
+// (measured: 3x the frame time of reading the one layer a span needs).
+CoreLayer layerAt(int li);
+real3 sampleWeather(LayerSampling s, real3 pLocal);
+real2 sampleCloudMap(LayerSampling s, real3 pLocal);
+real2 sampleShape(LayerSampling s, real3 pLocal);
+real sampleDetail(LayerSampling s, real3 pLocal);
 
 struct CoreFrame {
-  real r;        // camera distance from the (local) Earth centre, m
-  real cGround;  // hGround (2r - hGround), m^2; hGround = camera altitude
-  real3 sunDir;  // unit, local frame
-  real3 sunRadiance;
-  real3 ambient;
+  AirFrame air;
+  real3 groundIrradiance;  // sky irradiance on horizontal ground, linear units
   int layerCount;
-  CoreLayer layers[kMaxLayers];
-};
-
-struct Roots {
-  bool hit;
-  real t0;  // t0 <= t1
-  real t1;
 };
 
 struct Span {
@@ -97,82 +113,41 @@ struct Span {
   real t1;
 };
 
-struct MarchState {
+// One layer's contribution along a ray, alone: in-scattered radiance (not yet
+// attenuated by what lies in front), transmittance, and its
+// opacity-weighted mean depth (where aerial perspective is applied).
+struct LayerResult {
   real3 inscatter;
   real transmittance;
+  real depth;
 };
 
 struct PixelResult {
   real3 radiance;
-  real transmittance;
+  real transmittance;  // through the clouds only
+  real depth;          // light-weighted mean distance to the clouds, m; 0 when no cloud was met
 };
-
-// PCG hash (Jarzynski & Olano 2020, "Hash Functions for GPU Rendering", pcg).
-uint hashPcg(uint x) {
-  uint state = x * 747796405u + 2891336453u;
-  uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-  return (word >> 22u) ^ word;
-}
-
-// Per-pixel sample offset in [0, 1): depends on the pixel only, so a frame is
-// reproducible (no frame index, no clock).
-real pixelJitter(uint px, uint py) {
-  return real(hashPcg(px + hashPcg(py)) >> 8u) * kInv2Pow24;
-}
-
-// View ray through the centre of pixel (px, py), top row first; camera axes in
-// the local frame, tanHalfFov of the vertical field of view, aspect = w / h.
-real3 cameraRay(real3 forward, real3 right, real3 down, real tanHalfFov, real aspect,
-                real px, real py, real width, real height) {
-  real sx = ((px + 0.5) / width * 2.0 - 1.0) * tanHalfFov * aspect;
-  real sy = (1.0 - (py + 0.5) / height * 2.0) * tanHalfFov;
-  return normalize(forward + right * sx - down * sy);
-}
-
-// Ray from a point at distance r from the centre against the sphere with
-// c = h (2r - h) (h = height above it, exact from altitudes); mu = cos zenith.
-// Stable (citardauq) form, as protocol/geo/src/shell.cpp.
-Roots intersectSphere(real r, real c, real mu) {
-  real b = r * mu;
-  real disc = b * b - c;
-  if (disc < 0.0) return Roots(false, 0.0, 0.0);
-  real s = sqrt(disc);
-  real q = -(b + (b >= 0.0 ? s : -s));
-  real ta = q;
-  real tb = q != 0.0 ? c / q : 0.0;
-  return Roots(true, min(ta, tb), max(ta, tb));
-}
-
-// Height of p above the sphere through the camera, m, without forming
-// |p - centre| - r from two Earth-sized numbers: (|q|^2 - r^2) / (|q| + r).
-real heightAboveCameraSphere(real3 p, real r) {
-  real num = 2.0 * r * p.z + dot(p, p);
-  return num / (sqrt(max(r * r + num, 0.0)) + r);
-}
 
 // Part of the ray inside one layer's shell, clipped by the ground and the
 // march limits. Handles cameras below, inside and above the layer.
 Span layerSpan(CoreFrame f, CoreLayer L, real mu, real tGround) {
-  Roots base = intersectSphere(f.r, L.cBase, mu);
-  Roots top = intersectSphere(f.r, L.cTop, mu);
-  real t0 = 0.0;
-  real t1 = 0.0;
-  if (L.hBase < 0.0) {
-    // Below: inside both spheres, so both are hit; leave the base, then the top.
-    t0 = base.t1;
-    t1 = top.t1;
-  } else if (L.hTop < 0.0) {
-    // Inside: until the top, or the base if the ray reaches it first.
-    t1 = top.t1;
-    if (base.hit && base.t0 >= 0.0) t1 = min(t1, base.t0);
-  } else if (top.hit && top.t1 > 0.0) {
-    // Above: from the top down to the base, or out through the top again.
-    t0 = max(top.t0, 0.0);
-    t1 = (base.hit && base.t0 >= 0.0) ? base.t0 : top.t1;
-  }
+  Roots base = intersectSphere(f.air.r, L.cBase, mu);
+  Roots top = intersectSphere(f.air.r, L.cTop, mu);
+  // The three cases as selects, not branches: a branch on the layer heights
+  // alone (uniform values) makes lavapipe compile a shader variant for each
+  // camera altitude (it inlines uniforms that decide an `if`).
+  bool below = L.hBase < 0.0;
+  bool inside = !below && L.hTop < 0.0;
+  bool aboveHit = !below && !inside && top.hit && top.t1 > 0.0;
+  // Below: inside both spheres, so both are hit; leave the base, then the top.
+  // Inside: until the top, or the base if the ray reaches it first.
+  // Above: from the top down to the base, or out through the top again.
+  real baseFirst = (base.hit && base.t0 >= 0.0) ? base.t0 : top.t1;
+  real t0 = below ? base.t1 : (aboveHit ? max(top.t0, 0.0) : 0.0);
+  real t1 = below ? top.t1 : (inside ? min(top.t1, baseFirst) : (aboveHit ? baseFirst : 0.0));
   t1 = min(t1, tGround);
   t1 = min(t1, t0 + kMaxSpan_m);
-  if (t0 > kMaxViewDistance_m) t1 = t0;
+  t1 = t0 > kMaxViewDistance_m ? t0 : t1;
   return Span(t0, t1);
 }
 
@@ -210,106 +185,198 @@ real phaseMie(real cosTheta, MieFit m, real gScale) {
   return (1.0 - m.w) * phaseHG(cosTheta, m.gHG * gScale) + m.w * phaseDraine(cosTheta, m.gD * gScale, m.alpha);
 }
 
+// A cloud type's phase function for octave eccentricity scale gScale: the
+// Mie fit for its droplet diameter, or HG for ice.
+real phaseCloud(real cosTheta, CloudType t, real gScale) {
+  if (t.dropletDiameter_um <= 0.0) return phaseHG(cosTheta, kIceAsymmetry * gScale);
+  return phaseMie(cosTheta, mieFit(t.dropletDiameter_um), gScale);
+}
+
+// The four octaves' phase values for the angle to the sun (cosTheta): octave
+// i uses eccentricity c^i.
+real4 octavePhases(real cosTheta, CloudType t) {
+  real c1 = kOctaveEccentricity;
+  real c2 = c1 * kOctaveEccentricity;
+  real c3 = c2 * kOctaveEccentricity;
+  return real4(phaseCloud(cosTheta, t, 1.0), phaseCloud(cosTheta, t, c1), phaseCloud(cosTheta, t, c2),
+               phaseCloud(cosTheta, t, c3));
+}
+
 // Sun light scattered towards the viewer at a point with optical depth tauSun
 // towards the sun, per unit sun radiance: Wrenninge's octave sum
 // sum_i b^i p(theta, c^i g) exp(-a^i tauSun), given the octaves' phase values.
-real octaveSum(real phases[kScatterOctaves], real tauSun) {
-  real sum = 0.0;
-  real a = 1.0;
-  real b = 1.0;
-  for (int i = 0; i < kScatterOctaves; ++i) {
-    sum += b * phases[i] * exp(-a * tauSun);
-    a *= kOctaveExtinction;
-    b *= kOctaveContribution;
+real octaveSum(real4 phases, real tauSun) {
+  real a1 = kOctaveExtinction;
+  real a2 = a1 * kOctaveExtinction;
+  real a3 = a2 * kOctaveExtinction;
+  real b1 = kOctaveContribution;
+  real b2 = b1 * kOctaveContribution;
+  real b3 = b2 * kOctaveContribution;
+  return dot(phases * real4(1.0, b1, b2, b3), exp(-real4(1.0, a1, a2, a3) * tauSun));
+}
+
+// Optical depth towards the sun from p over the layer's light distance
+// (Haggstrom's secondary march, sec. 3.2): shape noise only (no erosion,
+// the cheap sample), with the coverage, type and cloud map of the primary
+// sample standing for the path (a few hundred metres; map texels ~780 m).
+// Heights along it rise by muSun per metre (the sun's cosine at p; the
+// curvature over <= 2 km is under 0.4 m). `steps` is kLightSteps, or 0 where
+// there is no density: lavapipe runs every branch for all lanes of a
+// subgroup, but leaves a loop once no lane is in it, so a zero trip count is
+// what skips the march.
+real lightOpticalDepth(real3 sunDir, real muSun, real thickness, real lightDistance, LayerSampling ls, CloudType t,
+                       real3 p, real ph, real c, real peakNoise, real densityScale, int steps) {
+  real lightDt = lightDistance / real(kLightSteps);
+  real dph = lightDt * muSun / thickness;
+  real tau = 0.0;
+  for (int j = 0; j < steps; ++j) {
+    real3 q = p + sunDir * ((real(j) + 0.5) * lightDt);
+    real qh = ph + (real(j) + 0.5) * dph;
+    real sa = shapeProfile(t, qh, c, peakNoise);
+    tau += cloudShape(t, sampleShape(ls, q), c, sa) * densityProfile(t, qh);
   }
-  return sum;
+  return tau * t.extinction_perm * densityScale * lightDt;
 }
 
-// Vertical profile in [0, 1] for ph = height fraction within the layer; 0
-// outside [0, 1].
-real heightProfile(real ph) {
-  return clamp(ph / kProfileBottomFade, 0.0, 1.0) * clamp((1.0 - ph) / kProfileTopFade, 0.0, 1.0);
+// Diffuse radiance in-scattered at height fraction ph of layer L (isotropic,
+// so per unit phase it is the radiance itself): the sky's light and the
+// sunlight scattered out of the beam above, both through the depth above.
+// The depth above is the type's mean column density (columnFill) times
+// coverage c and the weather density over the rest of the layer.
+real3 diffuseLight(CoreLayer L, CloudType t, real ph, real c, real densityScale) {
+  real tauAbove = t.extinction_perm * densityScale * c * t.columnFill * (1.0 - ph) * L.thickness;
+  real transmitted = 1.0 / (1.0 + 0.75 * (1.0 - kDiffuseAsymmetry) * tauAbove);
+  real scatteredOut = 1.0 - exp(-tauAbove / max(L.sunCosine, kMinSunCosine));
+  return (L.skyTop + L.sunDiffuseTop * scatteredOut) * transmitted;
 }
 
-// Coverage in [0, 1] after the cloud map m in [0, 1] moved it; 0 and 1 are fixed points.
-real mappedCoverage(real coverage, real m) {
-  return clamp(coverage + kCloudMapAmplitude * (m - 0.5) * 4.0 * coverage * (1.0 - coverage), 0.0, 1.0);
-}
-
-// Density in [0, 1] from shape noise n in [0, 1], coverage in [0, 1], the
-// layer's density multiplier and the height fraction ph. Coverage 0 gives
-// exactly 0 (n <= 1); the remap follows Ford's N - (1 - coverage).
-real cloudDensity(real n, real coverage, real density, real ph) {
-  if (coverage <= 0.0) return 0.0;
-  real shaped = clamp((n - (1.0 - coverage)) / kCoverageEdge, 0.0, 1.0);
-  return shaped * heightProfile(ph) * density;
-}
-
-real3 skyBackground(real3 dir, bool hitsGround) {
-  if (hitsGround) return real3(kGroundR, kGroundG, kGroundB);
-  real t = sqrt(clamp(dir.z, 0.0, 1.0));
-  return mix(real3(kSkyHorizonR, kSkyHorizonG, kSkyHorizonB), real3(kSkyZenithR, kSkyZenithG, kSkyZenithB), t);
-}
-
-// Marches one layer's span front to back, continuing state st.
-MarchState marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, MarchState st) {
-  CoreLayer L = f.layers[li];
+// Marches one layer's span front to back; transmittanceBefore (what the
+// layers in front left) only decides the early exit.
+LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real transmittanceBefore) {
+  CoreLayer L = layerAt(li);
   real dt = (s.t1 - s.t0) / real(kPrimarySteps);
-  // The phase of each octave depends on the angle to the sun only: once per span.
-  MieFit mie = mieFit(kDropletDiameter_um);
-  real phases[kScatterOctaves];
-  real gScale = 1.0;
-  for (int o = 0; o < kScatterOctaves; ++o) {
-    phases[o] = phaseMie(dot(dir, f.sunDir), mie, gScale);
-    gScale *= kOctaveEccentricity;
-  }
-  real lightDt = kLightMarchDistance_m / real(kLightSteps);
+  // The phase of each octave depends on the angle to the sun only: once per
+  // span for each of the layer's two types.
+  real nu = dot(dir, f.air.sunDir);
+  real4 phases1 = octavePhases(nu, L.primary);
+  real4 phases2 = L.blends ? octavePhases(nu, L.secondary) : phases1;
+  // Sunlight through the clear air at the span's two ends, at the layer's
+  // base and top: per sample it is interpolated (the table varies over
+  // kilometres of height and degrees of sun angle; a span spans 0.5 degrees
+  // of Earth at most), which saves a table lookup per sample.
+  real groundRadius = f.air.r - f.air.h;
+  real baseHeight = f.air.h - L.hBase;
+  real topHeight = f.air.h - L.hTop;
+  real muStart = dot(upAt(dir * s.t0, f.air.r), f.air.sunDir);
+  real muEnd = dot(upAt(dir * s.t1, f.air.r), f.air.sunDir);
+  real3 sunBaseStart = f.air.sunIrradiance * sunTransmittance(baseHeight, muStart, groundRadius);
+  real3 sunTopStart = f.air.sunIrradiance * sunTransmittance(topHeight, muStart, groundRadius);
+  real3 sunBaseEnd = f.air.sunIrradiance * sunTransmittance(baseHeight, muEnd, groundRadius);
+  real3 sunTopEnd = f.air.sunIrradiance * sunTransmittance(topHeight, muEnd, groundRadius);
+  LayerResult res = LayerResult(real3(0.0), 1.0, 0.5 * (s.t0 + s.t1));
+  real depthSum = 0.0;
+  real weightSum = 0.0;
   for (int i = 0; i < kPrimarySteps; ++i) {
-    if (st.transmittance < kMinTransmittance) break;
-    real3 p = dir * (s.t0 + (real(i) + jitter) * dt);
-    real ph = (heightAboveCameraSphere(p, f.r) + L.hBase) / L.thickness;
-    if (heightProfile(ph) <= 0.0) continue;
-    real2 weather = sampleWeather(li, p);
+    if (transmittanceBefore * res.transmittance < kMinTransmittance) break;
+    real t = s.t0 + (real(i) + jitter) * dt;
+    real3 p = dir * t;
+    real h = heightAboveCameraSphere(p, f.air.r);
+    real ph = (h + L.hBase) / L.thickness;
+    if (ph <= 0.0 || ph >= 1.0) continue;
+    real3 weather = sampleWeather(L.sampling, p);
     if (weather.x <= 0.0) continue;
-    if (weather.x < 1.0) weather.x = mappedCoverage(weather.x, sampleCloudMap(li, p));
-    real rho = cloudDensity(sampleNoise(li, p), weather.x, weather.y, ph);
+    real blend = L.blends ? weather.z : 0.0;
+    CloudType ct = blend > 0.0 ? mixCloudType(L.primary, L.secondary, blend) : L.primary;
+    real2 map = sampleCloudMap(L.sampling, p);
+    real c = anvilCoverage(ct, ph, weather.x < 1.0 ? mappedCoverage(weather.x, map.x) : 1.0);
+    real sa = shapeProfile(ct, ph, c, map.y);
+    if (sa <= 0.0) continue;
+    real shape = cloudShape(ct, sampleShape(L.sampling, p), c, sa);
+    if (shape <= 0.0) continue;
+    real da = densityProfile(ct, ph) * weather.y;
+    if (da <= 0.0) continue;
+    // Erosion leaves a full shape (1) full: the detail fetch only at the edges.
+    real rho = (shape < 1.0 ? erodeShape(ct, shape, sampleDetail(L.sampling, p), c, ph) : 1.0) * da;
     if (rho <= 0.0) continue;
-    // Optical depth towards the sun; the coverage of the primary sample stands
-    // for the light path (it is a few hundred metres, the map's texel ~780 m).
-    real tauSun = 0.0;
-    for (int j = 0; j < kLightSteps; ++j) {
-      real3 q = p + f.sunDir * ((real(j) + 0.5) * lightDt);
-      real qh = (heightAboveCameraSphere(q, f.r) + L.hBase) / L.thickness;
-      if (heightProfile(qh) <= 0.0) continue;
-      tauSun += kExtinctionPerDensity_perm * cloudDensity(sampleNoise(li, q), weather.x, weather.y, qh) * lightDt;
-    }
-    real sigmaT = kExtinctionPerDensity_perm * rho;
-    real ambientScale = mix(kAmbientBottomFactor, 1.0, clamp(ph, 0.0, 1.0));
-    real3 scattered = f.sunRadiance * octaveSum(phases, tauSun) + f.ambient * ambientScale;
+    real u = (real(i) + jitter) / real(kPrimarySteps);
+    real tauSun = lightOpticalDepth(f.air.sunDir, mix(muStart, muEnd, u), L.thickness, L.lightDistance, L.sampling, ct,
+                                    p, ph, c, map.y, weather.y, rho > 0.0 ? kLightSteps : 0);
+    // Sunlight at p through the clear air above it (reddened at low sun,
+    // none in the Earth's shadow), and the sky's light from all around.
+    real3 sun = mix(mix(sunBaseStart, sunTopStart, ph), mix(sunBaseEnd, sunTopEnd, ph), u);
+    real3 scattered = sun * octaveSum(mix(phases1, phases2, blend), tauSun) + diffuseLight(L, ct, ph, c, weather.y);
     // Hillaire 2016 energy-conserving step: integral over the step of
     // sigma_s L e^{-sigma_t s} = albedo L (1 - e^{-sigma_t dt}); its limit as
-    // sigma_t -> 0 is sigma_s L dt.
-    real stepT = exp(-sigmaT * dt);
-    real3 gained = sigmaT * dt > kSmallOpticalDepth ? scattered * (kAlbedo * (1.0 - stepT))
-                                                    : scattered * (kAlbedo * sigmaT * dt);
-    st.inscatter += gained * st.transmittance;
-    st.transmittance *= stepT;
+    // sigma_t -> 0 is sigma_s L dt (scatterFraction).
+    real x = ct.extinction_perm * rho * dt;
+    real absorbed = x * scatterFraction(x);  // 1 - e^{-x}, exact near 0
+    res.inscatter += scattered * (kAlbedo * absorbed) * res.transmittance;
+    real weight = res.transmittance * absorbed;
+    depthSum += weight * t;
+    weightSum += weight;
+    res.transmittance *= 1.0 - absorbed;
   }
-  return st;
+  if (weightSum > 0.0) res.depth = depthSum / weightSum;
+  return res;
 }
 
-// Radiance along dir (unit, local frame): background times transmittance plus
-// what the layers scatter in (Patapom's premultiplied form).
+// Transmission of sunlight and sky light down through every layer to the
+// ground point p (camera-relative): each layer's coverage and density where
+// the sun ray crosses its middle, its type's mean column depth, and the same
+// two-stream split as diffuseLight (direct e^(-tau/mu), the rest diffused
+// by t(tau)). x: direct sun factor, y: diffuse factor for the sun's
+// scattered part and the sky. Shadows at the weather map's scale (~1 km),
+// without the noise's shapes.
+real2 groundShadow(CoreFrame f, real3 p, real muSun) {
+  real direct = 1.0;
+  real diffuse = 1.0;
+  real mu = max(muSun, kMinSunCosine);
+  real groundRadius = f.air.r - f.air.h;
+  for (int k = 0; k < f.layerCount; ++k) {
+    CoreLayer L = layerAt(k);
+    // Height of the layer's middle above the ground, and the distance to it
+    // along the sun from the ground (stable sphere root).
+    real hMid = max(f.air.h - 0.5 * (L.hBase + L.hTop), 0.0);
+    real c2 = hMid * (2.0 * groundRadius + hMid);
+    real d = c2 / (groundRadius * mu + sqrt(groundRadius * groundRadius * mu * mu + c2));
+    real3 weather = sampleWeather(L.sampling, p + f.air.sunDir * d);
+    CloudType t = L.blends ? mixCloudType(L.primary, L.secondary, weather.z) : L.primary;
+    real tau = t.extinction_perm * weather.y * weather.x * t.columnFill * L.thickness;
+    real beam = exp(-tau / mu);
+    real spread = 1.0 / (1.0 + 0.75 * (1.0 - kDiffuseAsymmetry) * tau);
+    direct *= beam;
+    diffuse *= spread;
+  }
+  return real2(direct, diffuse);
+}
+
+// Lambertian ground at distance t along dir: sunlight and sky light through
+// the air and the cloud layers above it.
+real3 groundRadiance(CoreFrame f, real3 dir, real t) {
+  real3 p = dir * t;
+  real muSun = dot(upAt(p, f.air.r), f.air.sunDir);
+  real3 sun = f.air.sunIrradiance * sunTransmittance(0.0, muSun, f.air.r - f.air.h) * max(muSun, 0.0);
+  real2 shadow = groundShadow(f, p, muSun);
+  real3 light = sun * (shadow.x + (1.0 - shadow.x) * shadow.y) + f.groundIrradiance * shadow.y;
+  return light * (kGroundAlbedo / kPi);
+}
+
+// Radiance along dir (unit, local frame): the layers front to back, each seen
+// through the air in front of it (aerial perspective at the layer's depth),
+// the air's own light between them, and the ground or space behind
+// (Patapom's premultiplied compositing: background times transmittance plus
+// in-scattering).
 PixelResult shadePixel(CoreFrame f, real3 dir, real jitter) {
   real mu = dir.z;
-  Roots ground = intersectSphere(f.r, f.cGround, mu);
+  Roots ground = intersectSphere(f.air.r, f.air.cGround, mu);
   bool hitsGround = ground.hit && ground.t1 > 0.0;
   real tGround = hitsGround ? max(ground.t0, 0.0) : kMaxViewDistance_m + kMaxSpan_m;
+  real tEnd = hitsGround ? tGround : kFarAway_m;
 
   Span spans[kMaxLayers];
   int order[kMaxLayers];
   for (int i = 0; i < int(kMaxLayers); ++i) {
-    spans[i] = i < f.layerCount ? layerSpan(f, f.layers[i], mu, tGround) : Span(0.0, 0.0);
+    spans[i] = i < f.layerCount ? layerSpan(f, layerAt(i), mu, tGround) : Span(0.0, 0.0);
     order[i] = i;
   }
   // Insertion sort by entry distance, so layers composite front to back.
@@ -320,10 +387,40 @@ PixelResult shadePixel(CoreFrame f, real3 dir, real jitter) {
       order[j - 1] = tmp;
     }
   }
-  MarchState st = MarchState(real3(0.0), 1.0);
+  LayerResult layers[kMaxLayers];
+  real q[kAirQueries];
+  int n = 0;
+  real cloudT = 1.0;
   for (int k = 0; k < f.layerCount; ++k) {
     Span s = spans[order[k]];
-    if (s.t1 > s.t0) st = marchLayer(f, order[k], dir, s, jitter, st);
+    if (s.t1 <= s.t0 || cloudT < kMinTransmittance) continue;
+    LayerResult r = marchLayer(f, order[k], dir, s, jitter, cloudT);
+    if (r.transmittance >= 1.0) continue;  // met no cloud
+    layers[n] = r;
+    q[n] = n > 0 ? max(r.depth, q[n - 1]) : r.depth;
+    cloudT *= r.transmittance;
+    ++n;
   }
-  return PixelResult(skyBackground(dir, hitsGround) * st.transmittance + st.inscatter, st.transmittance);
+  q[n] = tEnd;
+  AirPath air = marchAir(f.air, dir, tEnd, q, n + 1);
+
+  // Cloud depth (an output, not part of the light): each layer's mean depth
+  // weighted by the light it takes out of the view ray, Tbefore (1 - T), so
+  // the pixel's depth is the mean distance at which the clouds remove light.
+  real3 radiance = real3(0.0);
+  real3 airBefore = real3(0.0);
+  real transmittance = 1.0;
+  real depthSum = 0.0;
+  for (int k = 0; k < n; ++k) {
+    radiance += (air.inscatter[k] - airBefore) * transmittance;
+    radiance += layers[k].inscatter * air.transmittance[k] * transmittance;
+    depthSum += transmittance * (1.0 - layers[k].transmittance) * layers[k].depth;
+    transmittance *= layers[k].transmittance;
+    airBefore = air.inscatter[k];
+  }
+  radiance += (air.inscatter[n] - airBefore) * transmittance;
+  real3 background = hitsGround ? groundRadiance(f, dir, tGround) : real3(kNightSkyRadiance);
+  radiance += background * air.transmittance[n] * transmittance;
+  real depth = transmittance < 1.0 ? depthSum / (1.0 - transmittance) : 0.0;
+  return PixelResult(radiance, transmittance, depth);
 }

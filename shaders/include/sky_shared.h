@@ -1,7 +1,7 @@
-// Layout of the cloud pass's uniform block and its binding numbers, shared by
+// Layout of the cloud pass's frame block and its binding numbers, shared by
 // C++ (renderer/core) and GLSL (shaders/clouds.comp). Only vec4/uvec4 members,
-// so std140 and C++ agree without hidden padding; the C++ side pins sizes and
-// offsets with static_assert below.
+// so std430, std140 and C++ agree without hidden padding; the C++ side pins
+// sizes and offsets with static_assert below.
 #ifndef SKY_SHARED_H
 #define SKY_SHARED_H
 
@@ -18,10 +18,16 @@ using uvec4 = glm::uvec4;
 #endif
 
 // Descriptor set 0 bindings of the cloud pass.
-SKY_SHARED_CONST kBindingFrame = 0u;    // uniform SkyFrame
-SKY_SHARED_CONST kBindingNoise = 1u;    // sampler3D, tileable shape noise (R8, repeat)
-SKY_SHARED_CONST kBindingWeather = 2u;  // sampler2DArray, RG = coverage, density; one slice per layer
-SKY_SHARED_CONST kBindingOutput = 3u;   // storage buffer of vec4 radiance (rgb) + transmittance (a)
+SKY_SHARED_CONST kBindingFrame = 0u;          // read-only storage buffer holding one SkyFrame
+SKY_SHARED_CONST kBindingShape = 1u;          // sampler3D, tileable shape noise (RGBA8, repeat):
+                                              // billowy Perlin-Worley, fibrous, smooth fBm, Worley
+SKY_SHARED_CONST kBindingWeather = 2u;        // sampler2DArray, RGBA8 = coverage, density, type blend;
+                                              // one slice per layer
+SKY_SHARED_CONST kBindingOutput = 3u;         // storage buffer of vec4 radiance (rgb) + transmittance (a)
+SKY_SHARED_CONST kBindingDetail = 4u;         // sampler3D, tileable Worley detail noise (R8, repeat)
+SKY_SHARED_CONST kBindingTransmittance = 5u;  // sampler2D, atmosphere transmittance table (RGBA16F, clamp)
+SKY_SHARED_CONST kBindingMultipleScattering = 6u;  // sampler2D, atmosphere multiple scattering (RGBA16F, clamp)
+SKY_SHARED_CONST kBindingDepth = 7u;               // storage buffer of float cloud depth (m, 0 = no cloud) per pixel
 
 // Workgroup edge of the cloud pass, pixels (8x8 = 64 invocations = 8 lavapipe
 // subgroups of 8 lanes).
@@ -29,15 +35,32 @@ SKY_SHARED_CONST kLocalSize = 8u;
 // Cloud layers the pass draws; also the slice count of the weather texture.
 SKY_SHARED_CONST kMaxLayers = 4u;
 
+// A cloud type's 15 numbers (cloud_density.glsl's CloudType, in its order,
+// four per vec4; the last one unused).
+struct SkyCloudType {
+  vec4 a;  // extinction (1/m), droplet diameter (um, <= 0 ice), baseRound, topRoundStart
+  vec4 b;  // peak, peakVariation, anvil, densityGradient
+  vec4 c;  // densityBaseFade, densityTopFade, coverageEdge, fibrous
+  vec4 d;  // erosion, wispyHeight, columnFill, unused
+};
+
 // One cloud layer as the GPU sees it. Heights are computed on the CPU in double
 // from altitudes, because r - R of two Earth-sized radii cancels in float.
 struct SkyLayer {
   vec4 heights;        // x: camera height above base (m), y: camera height above top (m),
                        // z: hBase (2r - hBase), w: hTop (2r - hTop) (m^2, r = camera radius)
-  vec4 shape;          // x: thickness (m), y: weather slice index, zw: unused
-  vec4 noiseOrigin;    // xyz: camera ECEF minus wind drift, modulo the noise period, in periods
-  vec4 coverageShift;  // xy: coverage drift east/north in the weather map plane (m), zw: unused
-  vec4 cloudMapOrigin; // xyz: as noiseOrigin, modulo the cloud-map period, in cloud-map periods
+  vec4 shape;          // x: thickness (m), y: weather slice index, z: light march distance (m),
+                       // w: 1 when tiles blend towards the secondary type, else 0
+  vec4 shapeOrigin;    // xyz: camera ECEF minus wind drift, modulo the shape period, in periods;
+                       // w: 1 / shape period (1/m)
+  vec4 detailOrigin;   // the same for the detail noise and its period
+  vec4 cloudMapOrigin; // the same for the cloud map (the shape texture at a larger period)
+  vec4 coverageShift;  // xy: coverage drift east/north in the weather map plane (m), z: unused,
+                       // w: the shape noise's ECEF z scale (1, or < 1 for streaks)
+  vec4 ambient;        // rgb: mean sky radiance at the layer top (linear units); w: unused
+  vec4 sunDiffuse;     // rgb: sunlight at the layer top as diffuse radiance, E T mu / pi; w: mu of the sun
+  SkyCloudType primary;    // the layer's own type
+  SkyCloudType secondary;  // the type its tiles blend towards
 };
 
 struct SkyFrame {
@@ -48,13 +71,12 @@ struct SkyFrame {
   vec4 camToAnchor[3];  // rows of the rotation camera-local -> weather-anchor-local
   vec4 camInAnchor;     // xyz: camera relative to the anchor sphere centre, anchor frame (m);
                         // w: anchor sphere radius (m)
-  vec4 weatherMap;      // x: 1 / (2 half extent) (1/m), y: layer count, z: 1 / noise period (1/m),
-                        // w: 1 / cloud-map period (1/m)
+  vec4 weatherMap;      // x: 1 / (2 half extent) (1/m), y: layer count, zw: unused
   vec4 earth;           // x: camera radius r (m), y: camera height above ground (m),
-                        // z: hGround (2r - hGround) (m^2), w: unused
+                        // z: hGround (2r - hGround) (m^2), w: the same for the atmosphere top (m^2)
   vec4 sunDir;          // xyz: unit vector towards the sun, local frame; w: unused
-  vec4 sunRadiance;     // rgb: sun irradiance at the clouds (linear units); w: unused
-  vec4 ambient;         // rgb: isotropic ambient radiance inside the clouds; w: unused
+  vec4 sunIrradiance;   // rgb: sun irradiance at the top of the atmosphere (linear units); w: unused
+  vec4 groundIrradiance;  // rgb: sky irradiance on horizontal ground (linear units); w: unused
   uvec4 image;          // x: width, y: height, z: tiles per row, w: tile count
   uvec4 dispatch;       // x: tile permutation stride (coprime to the tile count), yzw: unused
   SkyLayer layers[kMaxLayers];
@@ -62,8 +84,13 @@ struct SkyFrame {
 
 #ifdef __cplusplus
 static_assert(sizeof(vec4) == 16 && sizeof(uvec4) == 16);
-static_assert(sizeof(SkyLayer) == 80);
-static_assert(offsetof(SkyLayer, noiseOrigin) == 32);
+static_assert(sizeof(SkyCloudType) == 64);
+static_assert(sizeof(SkyLayer) == 256);
+static_assert(offsetof(SkyLayer, shapeOrigin) == 32);
+static_assert(offsetof(SkyLayer, ambient) == 96);
+static_assert(offsetof(SkyLayer, sunDiffuse) == 112);
+static_assert(offsetof(SkyLayer, primary) == 128);
+static_assert(offsetof(SkyLayer, secondary) == 192);
 static_assert(offsetof(SkyFrame, localToEcef) == 48);
 static_assert(offsetof(SkyFrame, camToAnchor) == 96);
 static_assert(offsetof(SkyFrame, camInAnchor) == 144);
@@ -71,7 +98,7 @@ static_assert(offsetof(SkyFrame, image) == 240);
 static_assert(offsetof(SkyFrame, dispatch) == 256);
 static_assert(offsetof(SkyFrame, layers) == 272);
 static_assert(offsetof(SkyLayer, cloudMapOrigin) == 64);
-static_assert(sizeof(SkyFrame) == 272 + 80 * kMaxLayers);
+static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers);
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

@@ -14,6 +14,7 @@
 
 namespace {
 
+using sky::gpu::SkyCloudType;
 using sky::gpu::SkyFrame;
 using sky::gpu::SkyLayer;
 
@@ -43,15 +44,22 @@ TEST(SharedLayout, GlslangOffsetsMatchCpp) {
       {"frame.weatherMap", offsetof(SkyFrame, weatherMap)},
       {"frame.earth", offsetof(SkyFrame, earth)},
       {"frame.sunDir", offsetof(SkyFrame, sunDir)},
-      {"frame.sunRadiance", offsetof(SkyFrame, sunRadiance)},
-      {"frame.ambient", offsetof(SkyFrame, ambient)},
+      {"frame.sunIrradiance", offsetof(SkyFrame, sunIrradiance)},
+      {"frame.groundIrradiance", offsetof(SkyFrame, groundIrradiance)},
       {"frame.image", offsetof(SkyFrame, image)},
       {"frame.dispatch", offsetof(SkyFrame, dispatch)},
       {"frame.layers.heights", layers + offsetof(SkyLayer, heights)},
       {"frame.layers.shape", layers + offsetof(SkyLayer, shape)},
-      {"frame.layers.noiseOrigin", layers + offsetof(SkyLayer, noiseOrigin)},
-      {"frame.layers.coverageShift", layers + offsetof(SkyLayer, coverageShift)},
+      {"frame.layers.shapeOrigin", layers + offsetof(SkyLayer, shapeOrigin)},
+      {"frame.layers.detailOrigin", layers + offsetof(SkyLayer, detailOrigin)},
       {"frame.layers.cloudMapOrigin", layers + offsetof(SkyLayer, cloudMapOrigin)},
+      {"frame.layers.coverageShift", layers + offsetof(SkyLayer, coverageShift)},
+      {"frame.layers.ambient", layers + offsetof(SkyLayer, ambient)},
+      {"frame.layers.sunDiffuse", layers + offsetof(SkyLayer, sunDiffuse)},
+      {"frame.layers.primary.a", layers + offsetof(SkyLayer, primary) + offsetof(SkyCloudType, a)},
+      {"frame.layers.primary.d", layers + offsetof(SkyLayer, primary) + offsetof(SkyCloudType, d)},
+      {"frame.layers.secondary.a", layers + offsetof(SkyLayer, secondary) + offsetof(SkyCloudType, a)},
+      {"frame.layers.secondary.d", layers + offsetof(SkyLayer, secondary) + offsetof(SkyCloudType, d)},
   };
   // Lines look like "frame.layers.shape: offset 288, type 8b52, ..., topLevelArrayStride 80".
   std::map<std::string, std::size_t> seen;

@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "sky/render/cloud_renderer.hpp"
 #include "sky/weather/model.hpp"
@@ -20,9 +21,30 @@ weather::CloudLayer layer(std::uint32_t id, double base_m, double thickness_m, d
 weather::WeatherSnapshot tiledSnapshot(const geo::Geodetic& around, weather::CloudLayer layer, float coverage,
                                        float density);
 
-// Mean |a - b| over rgb, max |a - b|, RMSE over rgb.
+// A storm cell: one layer given by level-13 tiles (~1 km) around a point,
+// coverage coreCoverage out to core_m, falling linearly to edgeCoverage at
+// radius_m, none beyond; the layer's own coverage is 0.
+weather::WeatherSnapshot stormCell(weather::CloudLayer layer, double lat_deg, double lon_deg, double core_m,
+                                   double radius_m, float coreCoverage, float edgeCoverage);
+
+// The six scenes of issue 5's correctness suite, with their weather and sun.
+struct Scene {
+  std::string name;
+  geo::GeodeticPose camera;
+  weather::WeatherSnapshot weather;
+  double sunAzimuth_deg = 0, sunElevation_deg = 0;
+  // Inputs pointing at this scene's weather (valid while the scene lives).
+  render::FrameInputs inputs() const;
+};
+std::vector<Scene> issueScenes();
+
+// Mean |a - b| over rgb, max |a - b|, RMSE over rgb; and the RMSE of the
+// displayed value x / (1 + x) (the compression any tonemap applies) with b's
+// mean displayed value, for comparing images whose cloud edges in the sun's
+// forward lobe reach radiance ~1000 (a linear RMSE is then those few pixels).
 struct Diff {
   double meanAbs = 0, maxAbs = 0, rmse = 0;
+  double displayedRmse = 0, displayedMean = 0;
 };
 Diff diff(const render::Image& a, const render::Image& b);
 

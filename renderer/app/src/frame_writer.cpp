@@ -6,15 +6,19 @@
 
 #include <nlohmann/json.hpp>
 
+#include "sky/render/exr_output.hpp"
+
 namespace sky::app {
 
-Result<FrameWriter> FrameWriter::open(const std::string& directory, bool writeFloat) {
+Result<FrameWriter> FrameWriter::open(const std::string& directory, const FrameOutputs& outputs,
+                                      const RunSettings& run) {
   std::error_code ec;
   std::filesystem::create_directories(directory, ec);
   if (ec) return fail(ErrorCode::Io, directory + ": cannot create: " + ec.message());
   FrameWriter w;
   w.directory_ = directory;
-  w.writeFloat_ = writeFloat;
+  w.outputs_ = outputs;
+  w.run_ = run;
   w.metadata_.open(directory + "/frames.jsonl", std::ios::trunc);
   if (!w.metadata_) return fail(ErrorCode::Io, directory + "/frames.jsonl: cannot open for writing");
   return w;
@@ -24,15 +28,18 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
   char name[32];
   std::snprintf(name, sizeof name, "frame_%06llu", static_cast<unsigned long long>(r.frame));
   const std::string base = directory_ + "/" + name;
-  if (auto ok = render::writePng(image, base + ".png"); !ok) return ok;
-  if (writeFloat_) {
+  if (outputs_.png)
+    if (auto ok = render::writePng(image, base + ".png"); !ok) return ok;
+  if (outputs_.exr)
+    if (auto ok = render::writeExr(image, base + ".exr"); !ok) return ok;
+  if (outputs_.pfm) {
     if (auto ok = writePfm(image, base + ".pfm", PfmChannels::Radiance); !ok) return ok;
     if (auto ok = writePfm(image, base + ".transmittance.pfm", PfmChannels::Transmittance); !ok) return ok;
   }
   const auto& p = r.host.pose;
-  const nlohmann::json line = {
+  const auto& s = run_.render;
+  nlohmann::json line = {
       {"frame", r.frame},
-      {"file", std::string(name) + ".png"},
       {"source", r.source},
       {"host_frame", r.host.hostFrame},
       {"host_time_s", r.host.hostTime_s},
@@ -44,11 +51,26 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
       {"roll_deg", p.roll_deg},
       {"weather_clock_s", r.weatherClock_s},
       {"weather_version", r.weatherVersion},
+      {"weather_connected", r.weatherConnected},
       {"layers", r.layerCount},
+      {"sun_azimuth_deg", r.sunAzimuth_deg},
+      {"sun_elevation_deg", r.sunElevation_deg},
+      {"preset", run_.preset},
+      {"resolution", {s.width, s.height}},
+      {"vertical_fov_deg", s.verticalFov_deg},
+      {"noise_seeds", {{"shape", s.noiseSeed}}},
       {"non_finite", r.stats.nonFinite},
       {"mean_luminance", r.stats.meanLuminance},
       {"render_ms", r.render_ms},
+      {"cpu_ms", r.cpu_ms},
   };
+  if (r.utc_s) line["utc_s"] = *r.utc_s;
+  nlohmann::json gpu = nlohmann::json::object();
+  for (const auto& t : r.gpu) gpu[t.pass] = gpu.value(t.pass, 0.0) + t.gpu_ms;
+  line["gpu_ms"] = gpu;
+  if (r.presented) line["presented"] = *r.presented;
+  if (outputs_.png) line["file"] = std::string(name) + ".png";
+  if (outputs_.exr) line["exr"] = std::string(name) + ".exr";
   metadata_ << line.dump() << '\n';
   metadata_.flush();
   if (!metadata_) return fail(ErrorCode::Io, directory_ + "/frames.jsonl: write failed");

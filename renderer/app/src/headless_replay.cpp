@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -18,6 +19,7 @@
 #include "sky/app/frame_writer.hpp"
 #include "sky/app/replay_outputs.hpp"
 #include "sky/app/shared_state.hpp"
+#include "sky/app/timed_render.hpp"
 #include "sky/app/weather_client.hpp"
 #include "sky/flight/flight.hpp"
 #include "sky/sim/flight_file.hpp"
@@ -37,6 +39,8 @@ constexpr std::uint32_t kSheetCellWidth = 240;
 constexpr double kMinVideoFps = 1, kMaxVideoFps = 60;
 // Poll period while waiting for weather.
 constexpr auto kWeatherPoll = std::chrono::milliseconds(5);
+// How often a window's events are handled while the replay waits for a frame's time.
+constexpr auto kWindowPoll = std::chrono::milliseconds(20);
 
 std::string duration(double s) {
   char buf[32];
@@ -78,7 +82,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   // A tiny tolerance so that a step dividing the span exactly includes the end.
   const auto frameCount = static_cast<std::size_t>(std::floor((t1 - t0) / o.step_s + 1e-9)) + 1;
 
-  auto writer = FrameWriter::open(o.outDir + "/frames", o.writeFloat);
+  auto writer = FrameWriter::open(o.outDir + "/frames", o.outputs, RunSettings{o.preset, renderer.settings()});
   if (!writer) {
     std::fprintf(stderr, "skyshell-render: %s\n", describe(writer.error()).c_str());
     return 2;
@@ -125,9 +129,9 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   } stopper{weather, guard, ioThread};
 
   const auto& s = renderer.settings();
-  std::printf("skyshell-render: replaying %s headless: %zu frames of %.3f s (flight %.1f-%.1f s) at %ux%u, "
+  std::printf("skyshell-render: replaying %s %s: %zu frames of %.3f s (flight %.1f-%.1f s) at %ux%u, "
               "weather from %s, output to %s\n",
-              o.flightPath.c_str(), frameCount, o.step_s, t0 - first_s, t1 - first_s, s.width, s.height,
+              o.flightPath.c_str(), o.display ? "in a window" : "headless", frameCount, o.step_s, t0 - first_s, t1 - first_s, s.width, s.height,
               weatherSource.c_str(), o.outDir.c_str());
   std::fflush(stdout);
 
@@ -149,6 +153,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   ContactSheet sheet(kSheetColumns, kSheetRows, kSheetCellWidth, s.width, s.height);
   std::size_t nextPick = 0;
   std::vector<double> renderMs;
+  std::map<std::string, std::vector<double>> gpuMs;  // per pass, over the frames it ran in
   std::set<std::uint64_t> versionsSeen;
   std::size_t nonFinite = 0;
   const auto start = Clock::now();
@@ -162,9 +167,19 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
       break;
     }
     const double t = t0 + double(i) * o.step_s;
-    if (o.pace > 0)
-      std::this_thread::sleep_until(start + std::chrono::duration_cast<Clock::duration>(
-                                                std::chrono::duration<double>((t - t0) / o.pace)));
+    if (o.pace > 0) {
+      const auto due = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>((t - t0) / o.pace));
+      // A window keeps handling its events while the replay waits.
+      while (o.display && Clock::now() + kWindowPoll < due && !o.display->closed()) {
+        o.display->poll();
+        std::this_thread::sleep_for(kWindowPoll);
+      }
+      std::this_thread::sleep_until(due);
+    }
+    if (o.display && o.display->closed()) {
+      std::printf("replay: the window was closed after %zu frames\n", done);
+      break;
+    }
     pose = flight::sample(*flight, t);
     if (weather && needsResubscribe(subscribedAt, pose.position)) {
       const std::uint64_t before = state.weatherVersion();
@@ -190,15 +205,26 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     in.sunElevation_deg = o.sunElevation_deg;
     if (sunFromDate) in.utc_s = double(*flight->startUtc_s) + (t - first_s);
     in.frameIndex = i;
-    const auto r0 = Clock::now();
-    auto image = renderer.render(in);
+    FrameRecord record;
+    auto image = timedRender(renderer, in, record);
     if (!image) {
       std::fprintf(stderr, "skyshell-render: frame %zu: %s\n", i, describe(image.error()).c_str());
       exitCode = 3;
       break;
     }
+    if (o.display) {
+      auto shown = o.display->show(*image);
+      if (!shown) {
+        std::fprintf(stderr, "skyshell-render: frame %zu: %s\n", i, describe(shown.error()).c_str());
+        exitCode = 3;
+        break;
+      }
+      record.presented = *shown;
+      for (const auto& pass : renderer.lastPassTimes())
+        if (pass.pass == "present") record.gpu.push_back(pass);
+    }
+    logValidationMessages(renderer);
     if (weather) weather->reportCamera(pose, i, view.version, in.weatherClock_s);
-    FrameRecord record;
     record.frame = i;
     record.host.pose = pose;
     record.host.hostFrame = static_cast<std::uint32_t>(i);
@@ -206,15 +232,15 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     record.source = "replay";
     record.weatherClock_s = in.weatherClock_s;
     record.weatherVersion = view.version;
+    record.weatherConnected = view.connected;
     record.layerCount = view.snapshot.layers.size();
-    record.stats = render::computeStats(*image);
-    record.render_ms = std::chrono::duration<double, std::milli>(Clock::now() - r0).count();
     if (auto ok = writer->write(*image, record); !ok) {
       std::fprintf(stderr, "skyshell-render: %s\n", describe(ok.error()).c_str());
       exitCode = 2;
       break;
     }
     renderMs.push_back(record.render_ms);
+    for (const auto& pass : record.gpu) gpuMs[pass.pass].push_back(pass.gpu_ms);
     versionsSeen.insert(view.version);
     nonFinite += record.stats.nonFinite;
     if (nextPick < picks.size() && picks[nextPick] == i) {
@@ -242,7 +268,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
       report["contact_sheet"] = "contact-sheet.png";
     else
       std::fprintf(stderr, "skyshell-render: warning: %s\n", describe(ok.error()).c_str());
-    if (o.video && exitCode == 0) {
+    if (o.video && o.outputs.png && exitCode == 0) {
       const double fps = std::clamp(1.0 / o.step_s, kMinVideoFps, kMaxVideoFps);
       if (auto ok = encodeVideo(o.outDir + "/frames", fps, o.outDir + "/replay.mp4"); ok)
         report["video"] = "replay.mp4";
@@ -269,12 +295,20 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   }
   report["device"] = renderer.deviceName();
   report["render_ms"] = {{"p50", ms.p50}, {"p90", ms.p90}, {"p99", ms.p99}, {"mean", ms.mean}, {"max", ms.max}};
+  nlohmann::json gpu = nlohmann::json::object();
+  for (const auto& [pass, samples] : gpuMs) {
+    const Percentiles p = percentiles(samples);
+    gpu[pass] = {{"frames", samples.size()}, {"p50", p.p50}, {"p90", p.p90}, {"p99", p.p99}, {"mean", p.mean},
+                 {"max", p.max}};
+  }
+  report["gpu_ms"] = gpu;
   report["wall_s"] = wall_s;
   report["weather_source"] = weatherSource;
   report["weather_clock_s"] = {clockBase_s, clockBase_s + double(frameCount - 1) * o.step_s * clockRate};
   report["weather_clock_rate"] = clockRate;
   report["weather_versions_seen"] = versionsSeen;
   report["non_finite_pixels"] = nonFinite;
+  if (o.display) report["frames_presented"] = o.display->presented();
   report["metadata_index"] = "frames/frames.jsonl";
   std::ofstream(o.outDir + "/report.json", std::ios::trunc) << report.dump(2) << '\n';
   std::printf("replay: wrote %zu frames to %s/frames in %.1f s (render p50 %.0f ms, p90 %.0f ms); "

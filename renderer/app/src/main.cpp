@@ -1,7 +1,8 @@
 // skyshell-render: one image-generator channel. Takes its camera from a CIGI
 // host over UDP (or, with --fdm-port, from FlightGear's --native-fdm stream,
 // smoothed), its weather from skyshell-weatherd over TCP, and renders the
-// clouds on Vulkan. Headless: writes a PNG (and metadata) per frame.
+// clouds on Vulkan. Headless: writes a PNG, an EXR and metadata per frame;
+// windowed: shows the frames in a GLFW window (and writes their metadata).
 #include <atomic>
 #include <charconv>
 #include <cmath>
@@ -24,10 +25,14 @@
 #include "sky/app/drawable_weather.hpp"
 #include "sky/app/fdm_listener.hpp"
 #include "sky/app/frame_writer.hpp"
+#include "sky/app/glfw_window.hpp"
 #include "sky/app/headless_replay.hpp"
+#include "sky/app/timed_render.hpp"
 #include "sky/app/weather_client.hpp"
+#include "sky/app/window_display.hpp"
 #include "sky/geo/geodetic.hpp"
 #include "sky/render/cloud_renderer.hpp"
+#include "sky/render/noise_cache.hpp"
 
 namespace asio = boost::asio;
 using Clock = std::chrono::steady_clock;
@@ -45,7 +50,12 @@ struct Options {
   double fdmFrameRate_hz = 30;
   std::string outDir = "skyshell-frames";
   bool headless = false;
+  bool window = false;
+  bool validation = false;
+  std::string cacheDir = sky::render::defaultCacheDirectory().string();
+  bool noNoiseCache = false;
   bool writeFloat = false;
+  bool noExr = false;
   unsigned width = 320, height = 180;
   double fov_deg = 60;
   double sunAzimuth_deg = 135, sunElevation_deg = 40;
@@ -105,9 +115,17 @@ int main(int argc, char** argv) {
                  "with --fdm-port: render at most this many frames per second (the camera is smoothed, so "
                  "frames are not tied to packets)")
       ->check(CLI::Range(0.1, 1000.0));
-  app.add_flag("--headless", o.headless, "render off-screen and write frames to --out");
-  app.add_option("--out", o.outDir, "output folder for headless frames");
-  app.add_flag("--write-float", o.writeFloat, "also write each frame's linear radiance as .pfm");
+  app.add_flag("--headless", o.headless, "render off-screen and write frames (PNG, EXR, metadata) to --out");
+  app.add_flag("--window", o.window,
+               "show the frames in a window (X11: DISPLAY; works under Xvfb); with --headless, also write them");
+  app.add_option("--out", o.outDir, "output folder for frames and their metadata (frames.jsonl)");
+  app.add_flag("--vulkan-validation", o.validation,
+               "enable VK_LAYER_KHRONOS_validation and log its messages (Debian: vulkan-validationlayers)");
+  app.add_option("--cache-dir", o.cacheDir, "folder for cached noise textures")->capture_default_str();
+  app.add_flag("--no-noise-cache", o.noNoiseCache, "generate the noise textures at start, do not cache them");
+  app.add_flag("--write-float", o.writeFloat, "also write each frame's linear radiance and transmittance as .pfm");
+  app.add_flag("--no-exr", o.noExr,
+               "headless: skip the per-frame EXR (linear radiance, cloud transmittance, cloud depth)");
   app.add_option("--width", o.width)->check(CLI::Range(16, 8192));
   app.add_option("--height", o.height)->check(CLI::Range(16, 8192));
   app.add_option("--fov", o.fov_deg, "vertical field of view, deg")->check(CLI::Range(1.0, 170.0));
@@ -142,8 +160,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   spdlog::set_default_logger(spdlog::stderr_color_mt("render"));
 
-  if (!o.headless) {
-    std::fprintf(stderr, "skyshell-render: only --headless is available in this build (the windowed front end comes later)\n");
+  if (!o.headless && !o.window) {
+    std::fprintf(stderr, "skyshell-render: choose --headless (frames to files), --window (frames to a window), or both\n");
     return 2;
   }
   const auto colon = o.server.rfind(':');
@@ -163,11 +181,46 @@ int main(int argc, char** argv) {
     }
   }
 
-  auto renderer = sky::render::CloudRenderer::create({o.width, o.height, o.fov_deg, 1});
+  // Windowed only: the metadata is written, the images are not.
+  sky::app::FrameOutputs outputs;
+  outputs.png = o.headless;
+  outputs.exr = o.headless && !o.noExr;
+  outputs.pfm = o.headless && o.writeFloat;
+  // The window outlives the renderer, whose surface and swapchain live on it.
+  std::unique_ptr<sky::app::GlfwWindow> window;
+  if (o.window) {
+    auto opened = sky::app::GlfwWindow::open(o.width, o.height, "skyshell-render");
+    if (!opened) {
+      std::fprintf(stderr, "skyshell-render: --window: %s\n", sky::describe(opened.error()).c_str());
+      return 3;
+    }
+    window = std::move(*opened);
+  }
+  sky::render::RenderSettings settings{o.width, o.height, o.fov_deg, 1, o.noNoiseCache ? std::string() : o.cacheDir};
+  sky::render::GpuOptions gpu;
+  gpu.window = window ? &window->surface() : nullptr;
+  gpu.validation = o.validation;
+  auto renderer = sky::render::CloudRenderer::create(settings, gpu);
   if (!renderer) {
     std::fprintf(stderr, "skyshell-render: %s\n", sky::describe(renderer.error()).c_str());
     return 3;
   }
+  spdlog::info("{}", (*renderer)->noiseReport());
+  if (o.validation) spdlog::info("vulkan validation on ({})", "VK_LAYER_KHRONOS_validation");
+  std::optional<sky::app::WindowDisplay> display;
+  if (window) display.emplace(**renderer, *window);
+  // Said at every exit, so a run under --vulkan-validation can be checked.
+  struct ValidationSummary {
+    sky::render::CloudRenderer& renderer;
+    bool on;
+    ~ValidationSummary() {
+      if (!on) return;
+      sky::app::logValidationMessages(renderer);
+      const auto c = renderer.validationCounts();
+      std::printf("vulkan validation: %zu errors, %zu warnings\n", c.errors, c.warnings);
+      std::fflush(stdout);
+    }
+  } validationSummary{**renderer, o.validation};
   if (!o.replayFlight.empty()) {
     sky::app::ReplayOptions r;
     r.flightPath = o.replayFlight;
@@ -180,17 +233,18 @@ int main(int argc, char** argv) {
     r.serverPort = static_cast<unsigned short>(serverPort);
     r.weatherTimeout_s = o.weatherTimeout_s;
     r.outDir = o.outDir;
-    r.writeFloat = o.writeFloat;
+    r.outputs = outputs;
     r.video = !o.noVideo;
     r.sunAzimuth_deg = o.sunAzimuth_deg;
     r.sunElevation_deg = o.sunElevation_deg;
     r.fixedSun = o.fixedSun;
     r.weatherFile = o.weatherFile;
+    r.display = display ? &*display : nullptr;
     std::signal(SIGINT, onReplaySignal);
     std::signal(SIGTERM, onReplaySignal);
     return sky::app::runHeadlessReplay(r, **renderer, &gReplayStop);
   }
-  auto writer = sky::app::FrameWriter::open(o.outDir, o.writeFloat);
+  auto writer = sky::app::FrameWriter::open(o.outDir, outputs, {sky::app::kDefaultPreset, (*renderer)->settings()});
   if (!writer) {
     std::fprintf(stderr, "skyshell-render: %s\n", sky::describe(writer.error()).c_str());
     return 2;
@@ -295,6 +349,13 @@ int main(int argc, char** argv) {
         break;
       }
     }
+    if (display) {
+      display->poll();
+      if (display->closed()) {
+        spdlog::info("the window was closed: stopping");
+        break;
+      }
+    }
     if (!pose || pose->sequence == lastSequence || view.version == 0) {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
       continue;
@@ -316,23 +377,34 @@ int main(int argc, char** argv) {
     in.sunAzimuth_deg = o.sunAzimuth_deg;
     in.sunElevation_deg = o.sunElevation_deg;
     in.frameIndex = frames;
-    const auto t0 = Clock::now();
-    auto image = (*renderer)->render(in);
+    sky::app::FrameRecord record;
+    auto image = sky::app::timedRender(**renderer, in, record);
     if (!image) {
       std::fprintf(stderr, "skyshell-render: frame %llu: %s\n", static_cast<unsigned long long>(frames),
                    sky::describe(image.error()).c_str());
       exitCode = 3;
       break;
     }
-    sky::app::FrameRecord record;
     record.frame = frames;
     record.host = *pose;
     record.source = fdm ? "fdm" : "cigi";
     record.weatherClock_s = in.weatherClock_s;
     record.weatherVersion = view.version;
+    record.weatherConnected = view.connected;
     record.layerCount = view.snapshot.layers.size();
-    record.stats = sky::render::computeStats(*image);
-    record.render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    if (display) {
+      auto shown = display->show(*image);
+      if (!shown) {
+        std::fprintf(stderr, "skyshell-render: frame %llu: %s\n", static_cast<unsigned long long>(frames),
+                     sky::describe(shown.error()).c_str());
+        exitCode = 3;
+        break;
+      }
+      record.presented = *shown;
+      for (const auto& pass : (*renderer)->lastPassTimes())
+        if (pass.pass == "present") record.gpu.push_back(pass);
+    }
+    sky::app::logValidationMessages(**renderer);
     weather.reportCamera(pose->pose, frames, view.version, in.weatherClock_s);
     if (auto ok = writer->write(*image, record); !ok) {
       std::fprintf(stderr, "skyshell-render: %s\n", sky::describe(ok.error()).c_str());

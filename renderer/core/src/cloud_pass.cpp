@@ -23,17 +23,22 @@ vk::raii::Sampler makeSampler(const GpuContext& ctx, vk::SamplerAddressMode mode
 }  // namespace
 
 Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, std::uint32_t height,
-                                    const NoiseVolume& noise, const WeatherTexture& weather) {
+                                    const NoiseVolume& shape, const NoiseVolume& detail,
+                                    const AtmosphereTables& atmosphere, const WeatherTexture& weather) {
   CloudPass pass;
   pass.width_ = width;
   pass.height_ = height;
   const auto& device = ctx.device();
 
   ComputePipelineBuilder builder("sky.clouds");
-  builder.binding(gpu::kBindingFrame, vk::DescriptorType::eUniformBuffer)
-      .binding(gpu::kBindingNoise, vk::DescriptorType::eCombinedImageSampler)
+  builder.binding(gpu::kBindingFrame, vk::DescriptorType::eStorageBuffer)
+      .binding(gpu::kBindingShape, vk::DescriptorType::eCombinedImageSampler)
       .binding(gpu::kBindingWeather, vk::DescriptorType::eCombinedImageSampler)
       .binding(gpu::kBindingOutput, vk::DescriptorType::eStorageBuffer)
+      .binding(gpu::kBindingDetail, vk::DescriptorType::eCombinedImageSampler)
+      .binding(gpu::kBindingTransmittance, vk::DescriptorType::eCombinedImageSampler)
+      .binding(gpu::kBindingMultipleScattering, vk::DescriptorType::eCombinedImageSampler)
+      .binding(gpu::kBindingDepth, vk::DescriptorType::eStorageBuffer)
       .shader("clouds.comp.spv");
   auto pipeline = builder.build(ctx);
   if (!pipeline) return tl::unexpected(pipeline.error());
@@ -41,19 +46,39 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
 
   pass.noiseSampler_ = makeSampler(ctx, vk::SamplerAddressMode::eRepeat, "sky.noiseSampler");
   pass.weatherSampler_ = makeSampler(ctx, vk::SamplerAddressMode::eClampToBorder, "sky.weatherSampler");
+  pass.tableSampler_ = makeSampler(ctx, vk::SamplerAddressMode::eClampToEdge, "sky.tableSampler");
 
-  pass.noise_ = createSampledImage(ctx, vk::ImageType::e3D, vk::Format::eR8Unorm,
-                                   vk::Extent3D(noise.size, noise.size, noise.size), 1, "sky.shapeNoise");
-  if (auto ok = uploadImage(ctx, pass.noise_, std::as_bytes(std::span(noise.texels))); !ok)
+  auto noiseImage = [&](const NoiseVolume& n, const char* name) {
+    return createSampledImage(ctx, vk::ImageType::e3D, n.channels == 4 ? vk::Format::eR8G8B8A8Unorm : vk::Format::eR8Unorm,
+                              vk::Extent3D(n.size, n.size, n.size), 1, name);
+  };
+  pass.shape_ = noiseImage(shape, "sky.shapeNoise");
+  if (auto ok = uploadImage(ctx, pass.shape_, std::as_bytes(std::span(shape.texels))); !ok)
+    return tl::unexpected(ok.error());
+  pass.detail_ = noiseImage(detail, "sky.detailNoise");
+  if (auto ok = uploadImage(ctx, pass.detail_, std::as_bytes(std::span(detail.texels))); !ok)
+    return tl::unexpected(ok.error());
+  auto tableImage = [&](const AtmosphereTable& t, const char* name) {
+    return createSampledImage(ctx, vk::ImageType::e2D, vk::Format::eR16G16B16A16Sfloat,
+                              vk::Extent3D(t.width, t.height, 1), 1, name);
+  };
+  pass.transmittance_ = tableImage(atmosphere.transmittance, "sky.transmittanceTable");
+  if (auto ok = uploadImage(ctx, pass.transmittance_, std::as_bytes(std::span(atmosphere.transmittance.texels))); !ok)
+    return tl::unexpected(ok.error());
+  pass.multipleScattering_ = tableImage(atmosphere.multipleScattering, "sky.multipleScatteringTable");
+  if (auto ok = uploadImage(ctx, pass.multipleScattering_, std::as_bytes(std::span(atmosphere.multipleScattering.texels)));
+      !ok)
     return tl::unexpected(ok.error());
 
-  pass.uniforms_ = createHostBuffer(ctx, sizeof(gpu::SkyFrame), vk::BufferUsageFlagBits::eUniformBuffer, "sky.frameUniforms");
+  // A storage buffer, not a uniform buffer: see clouds.comp's FrameBlock.
+  pass.uniforms_ = createHostBuffer(ctx, sizeof(gpu::SkyFrame), vk::BufferUsageFlagBits::eStorageBuffer, "sky.frameBlock");
   pass.output_ = createHostBuffer(ctx, vk::DeviceSize(width) * height * 4 * sizeof(float),
                                   vk::BufferUsageFlagBits::eStorageBuffer, "sky.cloudOutput");
+  pass.depth_ = createHostBuffer(ctx, vk::DeviceSize(width) * height * sizeof(float),
+                                 vk::BufferUsageFlagBits::eStorageBuffer, "sky.cloudDepth");
 
-  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eUniformBuffer, 1),
-                             vk::DescriptorPoolSize(vk::DescriptorType::eCombinedImageSampler, 2),
-                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 1)};
+  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eCombinedImageSampler, 5),
+                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 3)};
   pass.descriptorPool_ = vk::raii::DescriptorPool(
       device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSizes));
   ctx.name(pass.descriptorPool_, "sky.clouds.descriptorPool");
@@ -64,17 +89,28 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
 
   const vk::DescriptorBufferInfo uniformInfo(*pass.uniforms_.buffer, 0, pass.uniforms_.size);
   const vk::DescriptorBufferInfo outputInfo(*pass.output_.buffer, 0, pass.output_.size);
-  const vk::DescriptorImageInfo noiseInfo(*pass.noiseSampler_, *pass.noise_.view, vk::ImageLayout::eShaderReadOnlyOptimal);
+  const vk::DescriptorBufferInfo depthInfo(*pass.depth_.buffer, 0, pass.depth_.size);
+  const vk::DescriptorImageInfo shapeInfo(*pass.noiseSampler_, *pass.shape_.view, vk::ImageLayout::eShaderReadOnlyOptimal);
+  const vk::DescriptorImageInfo detailInfo(*pass.noiseSampler_, *pass.detail_.view, vk::ImageLayout::eShaderReadOnlyOptimal);
+  const vk::DescriptorImageInfo tableInfo(*pass.tableSampler_, *pass.transmittance_.view,
+                                          vk::ImageLayout::eShaderReadOnlyOptimal);
+  const vk::DescriptorImageInfo msInfo(*pass.tableSampler_, *pass.multipleScattering_.view,
+                                       vk::ImageLayout::eShaderReadOnlyOptimal);
   const vk::DescriptorImageInfo weatherInfo(*pass.weatherSampler_, *weather.image().view,
                                             vk::ImageLayout::eShaderReadOnlyOptimal);
   const vk::DescriptorSet set = *pass.descriptorSet_;
   const std::array writes{
-      vk::WriteDescriptorSet(set, gpu::kBindingFrame, 0, vk::DescriptorType::eUniformBuffer, {}, uniformInfo),
-      vk::WriteDescriptorSet(set, gpu::kBindingNoise, 0, vk::DescriptorType::eCombinedImageSampler, noiseInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingFrame, 0, vk::DescriptorType::eStorageBuffer, {}, uniformInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingShape, 0, vk::DescriptorType::eCombinedImageSampler, shapeInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingDetail, 0, vk::DescriptorType::eCombinedImageSampler, detailInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingTransmittance, 0, vk::DescriptorType::eCombinedImageSampler, tableInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingMultipleScattering, 0, vk::DescriptorType::eCombinedImageSampler, msInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingWeather, 0, vk::DescriptorType::eCombinedImageSampler, weatherInfo),
-      vk::WriteDescriptorSet(set, gpu::kBindingOutput, 0, vk::DescriptorType::eStorageBuffer, {}, outputInfo)};
+      vk::WriteDescriptorSet(set, gpu::kBindingOutput, 0, vk::DescriptorType::eStorageBuffer, {}, outputInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingDepth, 0, vk::DescriptorType::eStorageBuffer, {}, depthInfo)};
   device.updateDescriptorSets(writes, {});
 
+  pass.timer_ = GpuTimer(ctx, 1, "sky.clouds.timer");
   pass.commands_ = ctx.allocateCommandBuffer();
   ctx.name(pass.commands_, "sky.clouds.commands");
   pass.fence_ = vk::raii::Fence(device, vk::FenceCreateInfo());
@@ -87,14 +123,20 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame) 
 
   commands_.reset();
   commands_.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
-  commands_.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_.pipeline);
-  commands_.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *descriptorSet_, {});
-  // One workgroup per 8x8 tile, in a 1D grid: the shader maps ids to tiles
-  // through the permutation in frame.dispatch.
-  commands_.dispatch(tileCount(width_, height_), 1, 1);
-  const vk::BufferMemoryBarrier toHost(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead,
-                                       VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *output_.buffer, 0,
-                                       VK_WHOLE_SIZE);
+  timer_.begin(commands_);
+  {
+    const auto timed = timer_.section(commands_, "clouds");
+    commands_.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_.pipeline);
+    commands_.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *descriptorSet_, {});
+    // One workgroup per 8x8 tile, in a 1D grid: the shader maps ids to tiles
+    // through the permutation in frame.dispatch.
+    commands_.dispatch(tileCount(width_, height_), 1, 1);
+  }
+  const std::array toHost{
+      vk::BufferMemoryBarrier(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead, VK_QUEUE_FAMILY_IGNORED,
+                              VK_QUEUE_FAMILY_IGNORED, *output_.buffer, 0, VK_WHOLE_SIZE),
+      vk::BufferMemoryBarrier(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead, VK_QUEUE_FAMILY_IGNORED,
+                              VK_QUEUE_FAMILY_IGNORED, *depth_.buffer, 0, VK_WHOLE_SIZE)};
   commands_.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, {},
                             toHost, {});
   commands_.end();
@@ -105,6 +147,8 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame) 
   image.height = height_;
   image.rgba.resize(std::size_t(width_) * height_ * 4);
   std::memcpy(image.rgba.data(), output_.mapped, image.rgba.size() * sizeof(float));
+  image.cloudDepth_m.resize(std::size_t(width_) * height_);
+  std::memcpy(image.cloudDepth_m.data(), depth_.mapped, image.cloudDepth_m.size() * sizeof(float));
   return image;
 }
 

@@ -1,13 +1,17 @@
 // The cloud pass: one compute dispatch over the image (shaders/clouds.comp)
-// with its uniform block, shape-noise texture, samplers, output buffer,
-// descriptor set and command buffer. Blocking: run() returns the read-back image.
+// with its frame block, shape and detail noise, the atmosphere's
+// transmittance and multiple-scattering tables, samplers, output buffers
+// (radiance + transmittance, cloud depth), descriptor set, timestamps and
+// command buffer. Blocking: run() returns the read-back image.
 #pragma once
 
 #include <cstdint>
 
+#include "atmosphere_tables.hpp"
 #include "compute_pipeline.hpp"
 #include "gpu_context.hpp"
 #include "gpu_memory.hpp"
+#include "gpu_timer.hpp"
 #include "noise_volume.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky_shared.h"
@@ -18,13 +22,16 @@ namespace sky::render {
 class CloudPass {
  public:
   // weather must outlive the pass (its image view is bound once here).
-  // Errors: Io/Malformed for the SPIR-V, Device from the noise upload; other
-  // Vulkan failures throw.
+  // Errors: Io/Malformed for the SPIR-V, Device from the texture uploads;
+  // other Vulkan failures throw.
   static Result<CloudPass> create(const GpuContext& ctx, std::uint32_t width, std::uint32_t height,
-                                  const NoiseVolume& noise, const WeatherTexture& weather);
+                                  const NoiseVolume& shape, const NoiseVolume& detail,
+                                  const AtmosphereTables& atmosphere, const WeatherTexture& weather);
 
   // Dispatches one frame and reads it back. Errors: Timeout, Device.
   Result<Image> run(const GpuContext& ctx, const gpu::SkyFrame& frame);
+  // GPU time of the last run's dispatch ("clouds").
+  std::vector<PassTime> lastTimes() const { return timer_.results(); }
 
  private:
   CloudPass() = default;
@@ -35,11 +42,17 @@ class CloudPass {
   ComputePipeline pipeline_;
   vk::raii::Sampler noiseSampler_{nullptr};
   vk::raii::Sampler weatherSampler_{nullptr};
-  GpuImage noise_;
-  GpuBuffer uniforms_;
+  vk::raii::Sampler tableSampler_{nullptr};
+  GpuImage shape_;
+  GpuImage detail_;
+  GpuImage transmittance_;
+  GpuImage multipleScattering_;
+  GpuBuffer uniforms_;  // the frame block (a storage buffer, see clouds.comp)
   GpuBuffer output_;
+  GpuBuffer depth_;
   vk::raii::DescriptorPool descriptorPool_{nullptr};
   vk::raii::DescriptorSet descriptorSet_{nullptr};
+  GpuTimer timer_;
   vk::raii::CommandBuffer commands_{nullptr};
   vk::raii::Fence fence_{nullptr};
   std::uint32_t width_ = 0, height_ = 0;

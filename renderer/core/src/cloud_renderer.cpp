@@ -4,24 +4,33 @@
 #include "sky/render/cloud_renderer.hpp"
 
 #include <exception>
+#include <optional>
 
 #include "sky/core/assert.hpp"
+#include "sky/render/noise_cache.hpp"
 
+#include "atmosphere_tables.hpp"
 #include "cloud_pass.hpp"
 #include "frame_setup.hpp"
 #include "gpu_context.hpp"
 #include "noise_volume.hpp"
+#include "presenter.hpp"
 #include "weather_texture.hpp"
 
 namespace sky::render {
 
 struct CloudRenderer::Impl {
-  // Destroyed in reverse order: the pass (which binds the weather image) before
-  // the weather texture, both before the context that owns the device.
+  // Destroyed in reverse order: the presenter, the pass (which binds the
+  // weather image) before the weather texture, all before the context that
+  // owns the device.
   std::unique_ptr<GpuContext> ctx;
   WeatherTexture weather;
   CloudPass pass;
+  std::optional<Presenter> presenter;
   RenderSettings settings;
+  AtmosphereTables atmosphere;  // CPU copy: the frame setup's sky light reads it
+  std::vector<PassTime> passTimes;
+  std::string noiseReport;
 };
 
 namespace {
@@ -37,6 +46,35 @@ auto atVulkanEdge(const char* what, F&& body) -> decltype(body()) {
   }
 }
 
+// A noise texture for these settings from the cache when it holds it, else
+// from generate(size, seed); *report says which. The fingerprint is the
+// generator's output at fingerprintSize; its bytes per texel give the
+// channel count.
+NoiseVolume cachedNoise(const RenderSettings& settings, const char* kind, std::uint32_t generatorVersion,
+                        std::uint32_t size, std::uint32_t fingerprintSize,
+                        NoiseVolume (*generate)(std::uint32_t, std::uint32_t), std::string* report) {
+  const NoiseVolume tiny = generate(fingerprintSize, settings.noiseSeed);
+  const std::size_t tinyTexels = std::size_t(fingerprintSize) * fingerprintSize * fingerprintSize;
+  SKY_ASSERT(tinyTexels > 0 && tiny.texels.size() % tinyTexels == 0);
+  const NoiseKey key{kind, generatorVersion, settings.noiseSeed, size,
+                     static_cast<std::uint32_t>(tiny.texels.size() / tinyTexels), fnv1a64(tiny.texels)};
+  CachedNoise cached = loadOrGenerateNoise(settings.noiseCacheDir, key, [&] {
+    return generate(size, settings.noiseSeed).texels;
+  });
+  const char* how = cached.source == NoiseSource::Loaded        ? "loaded from "
+                    : cached.source == NoiseSource::Regenerated ? "regenerated into "
+                    : cached.path.empty()                       ? "generated (no cache)"
+                                                                : "generated into ";
+  *report += std::string(report->empty() ? "" : "; ") + kind + " noise " + std::to_string(size) + "^3 seed " +
+             std::to_string(settings.noiseSeed) + ": " + how + cached.path.string() +
+             (cached.note.empty() ? "" : " (" + cached.note + ")");
+  NoiseVolume volume;
+  volume.size = size;
+  volume.channels = key.channels;
+  volume.texels = std::move(cached.texels);
+  return volume;
+}
+
 }  // namespace
 
 CloudRenderer::CloudRenderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -44,17 +82,30 @@ CloudRenderer::CloudRenderer(CloudRenderer&&) noexcept = default;
 CloudRenderer& CloudRenderer::operator=(CloudRenderer&&) noexcept = default;
 CloudRenderer::~CloudRenderer() = default;
 
-Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSettings& settings) {
+Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSettings& settings, const GpuOptions& gpu) {
   if (auto ok = validateSettings(settings); !ok) return tl::unexpected(ok.error());
   return atVulkanEdge("CloudRenderer::create", [&]() -> Result<std::unique_ptr<CloudRenderer>> {
-    auto ctx = GpuContext::create();
+    auto ctx = GpuContext::create(gpu);
     if (!ctx) return tl::unexpected(ctx.error());
     auto weather = WeatherTexture::create(**ctx);
     if (!weather) return tl::unexpected(weather.error());
-    const NoiseVolume noise = makeShapeNoise(kNoiseSize, settings.noiseSeed);
-    auto pass = CloudPass::create(**ctx, settings.width, settings.height, noise, *weather);
+    std::string noiseReport;
+    const NoiseVolume shape = cachedNoise(settings, "shape", kShapeNoiseGeneratorVersion, kShapeNoiseSize,
+                                          kShapeNoiseFingerprintSize, makeShapeNoise, &noiseReport);
+    const NoiseVolume detail = cachedNoise(settings, "detail", kDetailNoiseGeneratorVersion, kDetailNoiseSize,
+                                           kDetailNoiseFingerprintSize, makeDetailNoise, &noiseReport);
+    AtmosphereTables atmosphere = buildAtmosphereTables();
+    auto pass = CloudPass::create(**ctx, settings.width, settings.height, shape, detail, atmosphere, *weather);
     if (!pass) return tl::unexpected(pass.error());
-    auto impl = std::make_unique<Impl>(Impl{std::move(*ctx), std::move(*weather), std::move(*pass), settings});
+    std::optional<Presenter> presenter;
+    if (gpu.window) {
+      auto created = Presenter::create(**ctx, *gpu.window);
+      if (!created) return tl::unexpected(created.error());
+      presenter.emplace(std::move(*created));
+    }
+    auto impl = std::make_unique<Impl>(Impl{std::move(*ctx), std::move(*weather), std::move(*pass),
+                                            std::move(presenter), settings, std::move(atmosphere), {},
+                                            std::move(noiseReport)});
     return std::unique_ptr<CloudRenderer>(new CloudRenderer(std::move(impl)));
   });
 }
@@ -63,11 +114,38 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
   SKY_ASSERT(impl_ != nullptr);
   if (auto ok = validateInputs(inputs); !ok) return tl::unexpected(ok.error());
   return atVulkanEdge("CloudRenderer::render", [&]() -> Result<Image> {
+    impl_->passTimes.clear();
     if (auto ok = impl_->weather.update(*impl_->ctx, inputs); !ok) return tl::unexpected(ok.error());
-    const FrameSetup setup = prepareFrame(impl_->settings, inputs, impl_->weather.field());
-    return impl_->pass.run(*impl_->ctx, packFrame(setup));
+    impl_->passTimes = impl_->weather.lastUploadTimes();
+    const FrameSetup setup = prepareFrame(impl_->settings, inputs, impl_->weather.field(), impl_->atmosphere);
+    auto image = impl_->pass.run(*impl_->ctx, packFrame(setup));
+    if (image)
+      for (auto& t : impl_->pass.lastTimes()) impl_->passTimes.push_back(std::move(t));
+    return image;
   });
 }
+
+Result<bool> CloudRenderer::present(const Image& image) {
+  SKY_ASSERT(impl_ != nullptr);
+  if (!impl_->presenter) return fail(ErrorCode::InvalidArgument, "present: this renderer has no window");
+  if (image.width != impl_->settings.width || image.height != impl_->settings.height ||
+      image.rgba.size() != std::size_t(image.width) * image.height * 4)
+    return fail(ErrorCode::InvalidArgument, "present: the image is not a frame of this renderer");
+  return atVulkanEdge("CloudRenderer::present", [&]() -> Result<bool> {
+    auto shown = impl_->presenter->present(*impl_->ctx, image);
+    if (shown && *shown)
+      for (auto& t : impl_->presenter->lastTimes()) impl_->passTimes.push_back(std::move(t));
+    return shown;
+  });
+}
+
+const std::string& CloudRenderer::noiseReport() const { return impl_->noiseReport; }
+
+const std::vector<PassTime>& CloudRenderer::lastPassTimes() const { return impl_->passTimes; }
+
+std::vector<std::string> CloudRenderer::takeValidationMessages() { return impl_->ctx->takeValidationMessages(); }
+
+ValidationCounts CloudRenderer::validationCounts() { return impl_->ctx->validationCounts(); }
 
 std::string CloudRenderer::deviceName() const { return impl_->ctx->deviceName(); }
 

@@ -4,9 +4,11 @@
 #include "sky/render/cpu_reference.hpp"
 
 #include <cstdint>
+#include <string>
 
 #include <glm/glm.hpp>
 
+#include "atmosphere_tables.hpp"
 #include "frame_setup.hpp"
 #include "noise_volume.hpp"
 #include "sky_shared.h"
@@ -14,10 +16,16 @@
 
 namespace sky::render {
 
+struct CpuReference::Tables {
+  NoiseVolume shape;
+  NoiseVolume detail;
+  AtmosphereTables atmosphere;
+};
+
 namespace {
 
 // The core calls GLSL built-ins (dot, normalize, clamp, mix, min, max, sqrt,
-// exp) unqualified; GLM provides them with GLSL semantics.
+// exp, pow, smoothstep) unqualified; GLM provides them with GLSL semantics.
 using namespace glm;
 using gpu::kMaxLayers;
 
@@ -26,48 +34,64 @@ class CpuCore {
   using real = double;
   using real2 = glm::dvec2;
   using real3 = glm::dvec3;
+  using real4 = glm::dvec4;
   using uint = std::uint32_t;
 
-  CpuCore(const FrameSetup& setup, const NoiseVolume& noise, const WeatherField& weather)
-      : setup_(setup), noise_(noise), weather_(weather) {}
+  CpuCore(const FrameSetup& setup, const NoiseVolume& shape, const NoiseVolume& detail,
+          const AtmosphereTables& atmosphere, const WeatherField& weather)
+      : setup_(setup), shape_(shape), detail_(detail), atmosphere_(atmosphere), weather_(weather) {}
 
-  // Mirrors sampleWeather in shaders/clouds.comp.
-  real2 sampleWeather(int layer, real3 p) const {
-    const real3 q = setup_.camToAnchor * p + setup_.camInAnchor_m;
-    if (q.z <= 0.0) return real2(0.0);
-    const real2 plane =
-        real2(q.x, q.y) * (setup_.anchorRadius_m / q.z) - setup_.layers[std::size_t(layer)].coverageShift_m;
-    return weather_.sample(std::uint32_t(layer), plane.x, plane.y);
-  }
-
-  // Mirrors sampleNoise in shaders/clouds.comp.
-  real sampleNoise(int layer, real3 p) const {
-    return noise_.sample(setup_.layers[std::size_t(layer)].noiseOrigin + (setup_.localToEcef * p) / kNoisePeriod_m);
-  }
-
-  // Mirrors sampleCloudMap in shaders/clouds.comp.
-  real sampleCloudMap(int layer, real3 p) const {
-    return noise_.sample(setup_.layers[std::size_t(layer)].cloudMapOrigin + (setup_.localToEcef * p) / kCloudMapPeriod_m);
-  }
+  real3 sampleTransmittanceLut(real2 uv) const { return atmosphere_.sampleTransmittance(uv); }
+  real3 sampleMultipleScatteringLut(real2 uv) const { return atmosphere_.sampleMultipleScattering(uv); }
 
 #define SKY_CORE_CONST static constexpr
 #include "cloud_core.glsl"
 #undef SKY_CORE_CONST
 
-  CoreFrame coreFrame() const {
+  static CloudType coreType(const CloudTypeParams& p) {
+    CloudType t{};
+    t.extinction_perm = p.extinction_perm;
+    t.dropletDiameter_um = p.dropletDiameter_um;
+    t.baseRound = p.baseRound;
+    t.topRoundStart = p.topRoundStart;
+    t.peak = p.peak;
+    t.peakVariation = p.peakVariation;
+    t.anvil = p.anvil;
+    t.densityGradient = p.densityGradient;
+    t.densityBaseFade = p.densityBaseFade;
+    t.densityTopFade = p.densityTopFade;
+    t.coverageEdge = p.coverageEdge;
+    t.fibrous = p.fibrous;
+    t.erosion = p.erosion;
+    t.wispyHeight = p.wispyHeight;
+    t.columnFill = p.columnFill;
+    return t;
+  }
+
+  // Fills the layers layerAt() returns and the frame.
+  CoreFrame coreFrame() {
     CoreFrame f{};
-    f.r = setup_.r_m;
-    f.cGround = setup_.cGround_m2;
-    f.sunDir = setup_.sunDir;
-    f.sunRadiance = setup_.sunRadiance;
-    f.ambient = setup_.ambient;
+    f.air.r = setup_.r_m;
+    f.air.h = setup_.hGround_m;
+    f.air.cGround = setup_.cGround_m2;
+    f.air.cTop = setup_.cAtmosphereTop_m2;
+    f.air.sunDir = setup_.sunDir;
+    f.air.sunIrradiance = setup_.sunIrradiance;
+    f.groundIrradiance = setup_.groundIrradiance;
     f.layerCount = int(setup_.layers.size());
+    const CloudType cumulus = coreType(cloudTypeParams(weather::CloudType::Cumulus));
     for (std::size_t i = 0; i < kMaxLayers; ++i) {
+      CoreLayer& c = layers_[i];
       if (i < setup_.layers.size()) {
         const LayerSetup& l = setup_.layers[i];
-        f.layers[i] = CoreLayer(l.hBase_m, l.hTop_m, l.cBase_m2, l.cTop_m2, l.thickness_m);
+        c = CoreLayer{l.hBase_m, l.hTop_m, l.cBase_m2, l.cTop_m2, l.thickness_m, l.lightDistance_m, l.blends,
+                      coreType(l.primary), coreType(l.secondary), l.skyTop, l.sunDiffuseTop, l.sunCosine,
+                      LayerSampling{real4(l.shapeOrigin, 1.0 / l.shapePeriod_m), real4(l.detailOrigin, 1.0 / l.detailPeriod_m),
+                                    real4(l.cloudMapOrigin, 1.0 / l.cloudMapPeriod_m),
+                                    real3(l.coverageShift_m, double(i)), l.shapeStretchZ}};
       } else {
-        f.layers[i] = CoreLayer(0.0, 0.0, 0.0, 0.0, 1.0);
+        c = CoreLayer{0.0, 0.0, 0.0, 0.0, 1.0, 1.0, false, cumulus, cumulus, real3(0.0), real3(0.0), 0.0,
+                      LayerSampling{real4(0.0), real4(0.0), real4(0.0), real3(0.0, 0.0, double(i)), 1.0}};
       }
     }
     return f;
@@ -80,36 +104,104 @@ class CpuCore {
   }
 
  private:
+  CoreLayer layers_[kMaxLayers]{};
   const FrameSetup& setup_;
-  const NoiseVolume& noise_;
+  const NoiseVolume& shape_;
+  const NoiseVolume& detail_;
+  const AtmosphereTables& atmosphere_;
   const WeatherField& weather_;
 };
 
+CpuCore::CoreLayer CpuCore::layerAt(int li) { return layers_[li]; }
+
+// The hooks mirror those of shaders/clouds.comp.
+CpuCore::real3 CpuCore::sampleWeather(LayerSampling s, real3 p) {
+  const real3 q = setup_.camToAnchor * p + setup_.camInAnchor_m;
+  if (q.z <= 0.0) return real3(0.0);
+  const real2 plane = real2(q.x, q.y) * (setup_.anchorRadius_m / q.z) - real2(s.coverageShift.x, s.coverageShift.y);
+  return weather_.sample(std::uint32_t(s.coverageShift.z), plane.x, plane.y);
+}
+
+CpuCore::real2 CpuCore::sampleShape(LayerSampling s, real3 p) {
+  real3 e = setup_.localToEcef * p;
+  e.z *= s.shapeStretchZ;
+  const real4 v = shape_.sample(real3(s.shapeOrigin) + e * s.shapeOrigin.w);
+  return real2(v.x, v.y);
+}
+
+CpuCore::real CpuCore::sampleDetail(LayerSampling s, real3 p) {
+  return detail_.sample(real3(s.detailOrigin) + (setup_.localToEcef * p) * s.detailOrigin.w).x;
+}
+
+// The cloud map: the shape texture's smooth and Worley channels at its own period.
+CpuCore::real2 CpuCore::sampleCloudMap(LayerSampling s, real3 p) {
+  const real4 v = shape_.sample(real3(s.cloudMapOrigin) + (setup_.localToEcef * p) * s.cloudMapOrigin.w);
+  return real2(v.z, v.w);
+}
+
 }  // namespace
 
-Result<Image> renderCpuReference(const RenderSettings& settings, const FrameInputs& inputs) {
-  if (auto ok = validateSettings(settings); !ok) return tl::unexpected(ok.error());
-  if (auto ok = validateInputs(inputs); !ok) return tl::unexpected(ok.error());
-  const NoiseVolume noise = makeShapeNoise(kNoiseSize, settings.noiseSeed);
-  const WeatherField field = buildWeatherField(inputs.weather, inputs.camera.position);
-  const FrameSetup setup = prepareFrame(settings, inputs, field);
-  CpuCore core(setup, noise, field);
-  const auto frame = core.coreFrame();
+CpuReference::CpuReference(RenderSettings settings, std::shared_ptr<const Tables> tables)
+    : settings_(settings), tables_(std::move(tables)) {}
 
+Result<CpuReference> CpuReference::create(const RenderSettings& settings) {
+  if (auto ok = validateSettings(settings); !ok) return tl::unexpected(ok.error());
+  auto tables = std::make_shared<Tables>();
+  tables->shape = makeShapeNoise(kShapeNoiseSize, settings.noiseSeed);
+  tables->detail = makeDetailNoise(kDetailNoiseSize, settings.noiseSeed);
+  tables->atmosphere = buildAtmosphereTables();
+  return CpuReference(settings, std::move(tables));
+}
+
+Result<std::vector<std::array<float, 4>>> CpuReference::renderPixels(const FrameInputs& inputs,
+                                                                     std::span<const PixelCoord> pixels) const {
+  if (auto ok = validateInputs(inputs); !ok) return tl::unexpected(ok.error());
+  for (const PixelCoord& p : pixels)
+    if (p.x >= settings_.width || p.y >= settings_.height)
+      return fail(ErrorCode::InvalidArgument, "CpuReference::renderPixels: pixel (" + std::to_string(p.x) + ", " +
+                                                  std::to_string(p.y) + ") outside the image");
+  const WeatherField field = buildWeatherField(inputs.weather, inputs.camera.position);
+  const FrameSetup setup = prepareFrame(settings_, inputs, field, tables_->atmosphere);
+  CpuCore core(setup, tables_->shape, tables_->detail, tables_->atmosphere, field);
+  const auto frame = core.coreFrame();
+  std::vector<std::array<float, 4>> out;
+  out.reserve(pixels.size());
+  for (const PixelCoord& p : pixels) {
+    const auto r = core.shade(p.x, p.y, frame);
+    out.push_back({float(r.radiance.x), float(r.radiance.y), float(r.radiance.z), float(r.transmittance)});
+  }
+  return out;
+}
+
+Result<Image> CpuReference::render(const FrameInputs& inputs) const {
+  if (auto ok = validateInputs(inputs); !ok) return tl::unexpected(ok.error());
+  const WeatherField field = buildWeatherField(inputs.weather, inputs.camera.position);
+  const FrameSetup setup = prepareFrame(settings_, inputs, field, tables_->atmosphere);
+  CpuCore core(setup, tables_->shape, tables_->detail, tables_->atmosphere, field);
+  const auto frame = core.coreFrame();
   Image image;
-  image.width = settings.width;
-  image.height = settings.height;
-  image.rgba.resize(std::size_t(settings.width) * settings.height * 4);
-  for (std::uint32_t y = 0; y < settings.height; ++y)
-    for (std::uint32_t x = 0; x < settings.width; ++x) {
+  image.width = settings_.width;
+  image.height = settings_.height;
+  image.rgba.resize(std::size_t(settings_.width) * settings_.height * 4);
+  image.cloudDepth_m.resize(std::size_t(settings_.width) * settings_.height);
+  for (std::uint32_t y = 0; y < settings_.height; ++y)
+    for (std::uint32_t x = 0; x < settings_.width; ++x) {
       const auto r = core.shade(x, y, frame);
-      float* out = &image.rgba[(std::size_t(y) * settings.width + x) * 4];
+      const std::size_t i = std::size_t(y) * settings_.width + x;
+      float* out = &image.rgba[i * 4];
       out[0] = float(r.radiance.x);
       out[1] = float(r.radiance.y);
       out[2] = float(r.radiance.z);
       out[3] = float(r.transmittance);
+      image.cloudDepth_m[i] = float(r.depth);
     }
   return image;
+}
+
+Result<Image> renderCpuReference(const RenderSettings& settings, const FrameInputs& inputs) {
+  auto reference = CpuReference::create(settings);
+  if (!reference) return tl::unexpected(reference.error());
+  return reference->render(inputs);
 }
 
 }  // namespace sky::render

@@ -101,4 +101,23 @@ SkyDirection moonDirection(double unix_s, double lat_deg, double lon_deg) {
   return s;
 }
 
+double moonPhaseAngle_deg(double unix_s) {
+  const EquatorialDirection sun = sunEquatorial(unix_s), moon = moonEquatorial(unix_s);
+  const double ds = sun.declination_deg * kDeg, dm = moon.declination_deg * kDeg;
+  const double cosPsi = std::sin(ds) * std::sin(dm) +
+                        std::cos(ds) * std::cos(dm) * std::cos((sun.rightAscension_deg - moon.rightAscension_deg) * kDeg);
+  const double psi = std::acos(std::clamp(cosPsi, -1.0, 1.0));
+  // tan i = R sin psi / (Delta - R cos psi) with Delta / R = 385000 / 149.6e6
+  // (Meeus 48.3) is 180 - psi - (Delta / R) sin psi to first order.
+  constexpr double kMoonOverSunDistance = 385000.56 / 149597870.7;
+  return std::clamp(180.0 - psi / kDeg - kMoonOverSunDistance * std::sin(psi) / kDeg, 0.0, 180.0);
+}
+
+double moonToSunIlluminance(double phaseAngle_deg) {
+  const double a = std::abs(phaseAngle_deg);
+  const double moonMagnitude = -12.73 + 0.026 * a + 4e-9 * a * a * a * a;
+  constexpr double kSunMagnitude = -26.74;
+  return std::pow(10.0, -0.4 * (moonMagnitude - kSunMagnitude));
+}
+
 }  // namespace sky::render

@@ -20,13 +20,19 @@ namespace {
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 // Largest image edge, pixels: keeps buffers and the tile permutation in range.
 constexpr std::uint32_t kMaxImageEdge = 8192;
-// Sun irradiance at the clouds and the ambient radiance inside them, linear
-// units shared with the sky colours in cloud_core.glsl. Chosen by eye so a
-// sunlit cloud top is white (~1 after exposure) and a shadowed base is grey,
-// until the atmosphere model supplies physical values.
-constexpr double kSunIrradiance = 9.0;
-const glm::dvec3 kSunColour(1.0, 0.96, 0.90);
-const glm::dvec3 kAmbientRadiance(0.42, 0.46, 0.55);
+// Sun irradiance at the top of the atmosphere, linear units (white: the
+// atmosphere colours it). The units are the PNG's (exposure 1): this puts a
+// clear noon zenith near 0.3-0.5 and a sunlit cloud top near 1-2, the tones
+// the tonemap maps to mid and upper grey.
+constexpr double kSunIrradiance = 20.0;
+// Secondary march towards the sun: half the layer's thickness (Haggstrom 2018
+// sec. 4.2, "half the layer thickness"), at least 100 m (a thin layer's light
+// still crosses a few cells' edges) and at most 2 km (4 steps of 500 m keep
+// a cumulonimbus tower's self-shadowing).
+constexpr double kLightMarchFraction = 0.5;
+constexpr double kMinLightDistance_m = 100.0;
+constexpr double kMaxLightDistance_m = 2000.0;
+
 // Tile permutation stride as a fraction of the tile count (golden ratio
 // conjugate, lavapipe.md): any stride coprime to n permutes the tiles.
 constexpr double kStrideFraction = 0.618;
@@ -64,8 +70,12 @@ Result<void> validateInputs(const FrameInputs& in) {
   const auto& c = in.camera;
   const auto& p = c.position;
   for (double v : {p.lat_deg, p.lon_deg, p.alt_m, c.yaw_deg, c.pitch_deg, c.roll_deg, in.weatherClock_s,
-                   in.sunAzimuth_deg, in.sunElevation_deg, in.utc_s.value_or(0.0)})
+                   in.sunAzimuth_deg, in.sunElevation_deg, in.utc_s.value_or(0.0), in.moonAzimuth_deg,
+                   in.moonElevation_deg, in.moonPhaseAngle_deg})
     if (!std::isfinite(v)) return fail(ErrorCode::InvalidArgument, "frame inputs: non-finite value");
+  if (in.moonPhaseAngle_deg < 0 || in.moonPhaseAngle_deg > 180)
+    return fail(ErrorCode::InvalidArgument,
+                "frame inputs: moonPhaseAngle_deg " + num(in.moonPhaseAngle_deg) + " outside [0, 180]");
   if (p.lat_deg < -90 || p.lat_deg > 90)
     return fail(ErrorCode::InvalidArgument, "frame inputs: camera lat_deg " + num(p.lat_deg) + " outside [-90, 90]");
   if (p.alt_m < -1000 || p.alt_m > 1e6)
@@ -86,7 +96,8 @@ Result<void> validateInputs(const FrameInputs& in) {
   return {};
 }
 
-FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, const WeatherField& field) {
+FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, const WeatherField& field,
+                        const AtmosphereTables& tables) {
   FrameSetup s;
   s.width = settings.width;
   s.height = settings.height;
@@ -114,19 +125,68 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
   // Dead Sea shore at -430 m) stands on the ground instead of under it.
   s.hGround_m = std::max(alt_m, 0.0);
   s.cGround_m2 = s.hGround_m * (2 * s.r_m - s.hGround_m);
+  const double hAboveTop_m = s.hGround_m - atmosphereHeight_m();
+  s.cAtmosphereTop_m2 = hAboveTop_m * (2 * s.r_m - hAboveTop_m);
+  const double groundRadius_m = s.r_m - s.hGround_m;
 
-  SkyDirection sun{in.sunAzimuth_deg, in.sunElevation_deg};
-  if (in.utc_s) sun = sunDirection(*in.utc_s, in.camera.position.lat_deg, in.camera.position.lon_deg);
-  const double az = sun.azimuth_deg * kDegToRad, el = sun.elevation_deg * kDegToRad;
-  s.sunDir = {std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), std::sin(el)};
-  s.sunRadiance = kSunIrradiance * kSunColour;
-  s.ambient = kAmbientRadiance;
+  SkyDirection sun{in.sunAzimuth_deg, in.sunElevation_deg}, moon{in.moonAzimuth_deg, in.moonElevation_deg};
+  double moonPhase_deg = in.moonPhaseAngle_deg;
+  if (in.utc_s) {
+    const double lat = in.camera.position.lat_deg, lon = in.camera.position.lon_deg;
+    sun = sunDirection(*in.utc_s, lat, lon);
+    moon = moonDirection(*in.utc_s, lat, lon);
+    moonPhase_deg = moonPhaseAngle_deg(*in.utc_s);
+  }
+  auto towards = [](const SkyDirection& d) {
+    const double az = d.azimuth_deg * kDegToRad, el = d.elevation_deg * kDegToRad;
+    return glm::dvec3(std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), std::sin(el));
+  };
+  s.sunDir = towards(sun);
+  s.sunIrradiance = glm::dvec3(kSunIrradiance);
+  s.groundIrradiance = skyLightAt(tables, 0.0, groundRadius_m, s.sunDir, s.sunIrradiance).irradiance;
+  // One key light for the clouds, the air and the ground: the moon instead
+  // of the sun when it puts more light on the ground (direct and through the
+  // sky, by luminance): with a full moon from about the end of nautical
+  // twilight. Its light is the sun's spectrum scaled by the illuminance
+  // ratio of its phase (the moon's albedo is nearly grey; ~10 % redder,
+  // ignored); twilight's glow goes when the moon takes over.
+  if (sun.elevation_deg < 0 && moon.elevation_deg > -1) {
+    const glm::dvec3 moonDir = towards(moon);
+    const glm::dvec3 moonIrradiance(kSunIrradiance * moonToSunIlluminance(moonPhase_deg));
+    const glm::dvec3 moonSky = skyLightAt(tables, 0.0, groundRadius_m, moonDir, moonIrradiance).irradiance;
+    auto onGround = [&](const glm::dvec3& dir, const glm::dvec3& e, const glm::dvec3& sky) {
+      const glm::dvec3 v = e * sunTransmittanceAt(tables, 0.0, dir.z, groundRadius_m) * std::max(dir.z, 0.0) + sky;
+      return 0.2126 * v.r + 0.7152 * v.g + 0.0722 * v.b;
+    };
+    if (onGround(moonDir, moonIrradiance, moonSky) > onGround(s.sunDir, s.sunIrradiance, s.groundIrradiance)) {
+      s.sunDir = moonDir;
+      s.sunIrradiance = moonIrradiance;
+      s.groundIrradiance = moonSky;
+      s.moonLit = true;
+    }
+  }
 
   if (in.weather == nullptr) return s;
   const double sinceSnapshot_s = in.weatherClock_s - in.weather->weatherClock_s;
-  for (const auto& layer : in.weather->layers) {
+  for (std::size_t slice = 0; slice < in.weather->layers.size(); ++slice) {
+    const weather::CloudLayer& layer = in.weather->layers[slice];
     LayerSetup l;
     l.thickness_m = layer.thickness_m;
+    l.lightDistance_m = std::clamp(kLightMarchFraction * layer.thickness_m, kMinLightDistance_m, kMaxLightDistance_m);
+    l.primary = cloudTypeParams(layer.type);
+    l.blends = field.blendType[slice] != weather::CloudType::None;
+    l.secondary = l.blends ? cloudTypeParams(field.blendType[slice]) : l.primary;
+    l.shapePeriod_m = l.primary.shapePeriod_m;
+    l.detailPeriod_m = l.primary.detailPeriod_m;
+    l.cloudMapPeriod_m = kCloudMapPeriodFactor * l.primary.shapePeriod_m;
+    l.shapeStretchZ = 1.0 / l.primary.streak;
+    // The diffuse light the layer's top receives, over the camera: the sky,
+    // and the sun through the air (cloud_core.glsl's diffuseLight).
+    const double top_m = std::max(layer.base_m + layer.thickness_m, 0.0);
+    l.skyTop = skyLightAt(tables, top_m, groundRadius_m, s.sunDir, s.sunIrradiance).meanRadiance;
+    l.sunCosine = std::max(s.sunDir.z, 0.0);
+    l.sunDiffuseTop = s.sunIrradiance * sunTransmittanceAt(tables, top_m, s.sunDir.z, groundRadius_m) *
+                      (l.sunCosine / std::numbers::pi);
     l.hBase_m = alt_m - layer.base_m;
     l.hTop_m = alt_m - (layer.base_m + layer.thickness_m);
     l.cBase_m2 = l.hBase_m * (2 * s.r_m - l.hBase_m);
@@ -140,16 +200,22 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
     // (~1 degree per 100 km) as the camera travels; per-point advection comes
     // with the full model.
     const glm::dvec3 origin = toGlm(enu.originEcef_m) - s.localToEcef * windEnu_mps * in.weatherClock_s;
-    auto inPeriods = [&](double period_m) {
+    auto inPeriods = [&](double period_m, double stretchZ) {
       glm::dvec3 out;
       for (int k = 0; k < 3; ++k) {
-        const double m = std::fmod(origin[k], period_m);
+        const double m = std::fmod(origin[k] * (k == 2 ? stretchZ : 1.0), period_m);
         out[k] = (m < 0 ? m + period_m : m) / period_m;
       }
       return out;
     };
-    l.noiseOrigin = inPeriods(kNoisePeriod_m);
-    l.cloudMapOrigin = inPeriods(kCloudMapPeriod_m);
+    // Streaky types stretch the shape noise along the Earth's axis: a fixed
+    // ECEF axis keeps the pattern Earth-fixed (a stretch along the local wind
+    // would turn with the camera's position and slide the clouds). Streaks
+    // run north-south, foreshortened towards the poles, where they end as
+    // plain fibres.
+    l.shapeOrigin = inPeriods(l.shapePeriod_m, l.shapeStretchZ);
+    l.detailOrigin = inPeriods(l.detailPeriod_m, 1.0);
+    l.cloudMapOrigin = inPeriods(l.cloudMapPeriod_m, 1.0);
     // The coverage tiles are the server's field at the snapshot's clock; the
     // air over the camera now was, then, where the shared advection formula
     // (weather::advect, the one the server moves its regions with) says: the
@@ -158,7 +224,10 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
         {in.camera.position.lat_deg, in.camera.position.lon_deg}, layer.wind, -sinceSnapshot_s);
     const geo::Vec3d upwindEcef = geo::toEcef({upwind.lat_deg, upwind.lon_deg, alt_m});
     const glm::dvec3 drift = inFrame(enu, enu.originEcef_m - upwindEcef);
-    l.coverageShift_m = glm::dvec2(drift.x, drift.y);
+    // A uniform layer is the same everywhere: it does not drift off the map
+    // (an hour-old snapshot in a 150 m/s wind would otherwise be 540 km away,
+    // past the map's 100 km, and empty).
+    l.coverageShift_m = field.tiled[slice] ? glm::dvec2(drift.x, drift.y) : glm::dvec2(0.0);
     s.layers.push_back(l);
   }
   return s;
@@ -176,12 +245,11 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
     f.camToAnchor[row] = v4(glm::dvec3(s.camToAnchor[0][row], s.camToAnchor[1][row], s.camToAnchor[2][row]));
   }
   f.camInAnchor = v4(s.camInAnchor_m, s.anchorRadius_m);
-  f.weatherMap = gpu::vec4(float(1.0 / (2 * s.mapHalfExtent_m)), float(s.layers.size()),
-                           float(1.0 / kNoisePeriod_m), float(1.0 / kCloudMapPeriod_m));
-  f.earth = gpu::vec4(float(s.r_m), float(s.hGround_m), float(s.cGround_m2), 0.0f);
+  f.weatherMap = gpu::vec4(float(1.0 / (2 * s.mapHalfExtent_m)), float(s.layers.size()), 0.0f, 0.0f);
+  f.earth = gpu::vec4(float(s.r_m), float(s.hGround_m), float(s.cGround_m2), float(s.cAtmosphereTop_m2));
   f.sunDir = v4(s.sunDir);
-  f.sunRadiance = v4(s.sunRadiance);
-  f.ambient = v4(s.ambient);
+  f.sunIrradiance = v4(s.sunIrradiance);
+  f.groundIrradiance = v4(s.groundIrradiance);
 
   const std::uint32_t tilesX = (s.width + gpu::kLocalSize - 1) / gpu::kLocalSize;
   const std::uint32_t n = tileCount(s.width, s.height);
@@ -197,13 +265,23 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
     const LayerSetup& l = s.layers[i];
     gpu::SkyLayer& g = f.layers[i];
     g.heights = gpu::vec4(glm::dvec4(l.hBase_m, l.hTop_m, l.cBase_m2, l.cTop_m2));
-    g.shape = gpu::vec4(float(l.thickness_m), float(i), 0.0f, 0.0f);
-    g.noiseOrigin = v4(l.noiseOrigin);
-    g.cloudMapOrigin = v4(l.cloudMapOrigin);
-    g.coverageShift = gpu::vec4(float(l.coverageShift_m.x), float(l.coverageShift_m.y), 0.0f, 0.0f);
+    g.shape = gpu::vec4(float(l.thickness_m), float(i), float(l.lightDistance_m), l.blends ? 1.0f : 0.0f);
+    g.shapeOrigin = v4(l.shapeOrigin, 1.0 / l.shapePeriod_m);
+    g.detailOrigin = v4(l.detailOrigin, 1.0 / l.detailPeriod_m);
+    g.cloudMapOrigin = v4(l.cloudMapOrigin, 1.0 / l.cloudMapPeriod_m);
+    g.coverageShift = gpu::vec4(float(l.coverageShift_m.x), float(l.coverageShift_m.y), 0.0f, float(l.shapeStretchZ));
+    g.ambient = v4(l.skyTop);
+    g.sunDiffuse = v4(l.sunDiffuseTop, l.sunCosine);
+    g.primary = packCloudType(l.primary);
+    g.secondary = packCloudType(l.secondary);
   }
-  // Unused slots keep a positive thickness so the shader's per-layer setup never divides by 0.
-  for (std::size_t i = s.layers.size(); i < gpu::kMaxLayers; ++i) f.layers[i].shape.x = 1.0f;
+  // Unused slots keep a positive thickness and valid types so the shader's
+  // per-layer setup never divides by 0.
+  for (std::size_t i = s.layers.size(); i < gpu::kMaxLayers; ++i) {
+    f.layers[i].shape = gpu::vec4(1.0f, float(i), 1.0f, 0.0f);
+    f.layers[i].coverageShift.w = 1.0f;
+    f.layers[i].primary = f.layers[i].secondary = packCloudType(cloudTypeParams(weather::CloudType::Cumulus));
+  }
   return f;
 }
 

@@ -1,7 +1,8 @@
 // Everything one frame needs, derived on the CPU in double precision from the
 // pose, the weather, the clock and the sun: camera axes and Earth geometry in
-// the camera's local frame, per-layer heights, Earth-fixed noise origins and
-// wind drift. Packed into the GPU's uniform block, or fed to the CPU reference.
+// the camera's local frame, per-layer heights, cloud types, Earth-fixed noise
+// origins and wind drift, and the sky's light on the layers and the ground.
+// Packed into the GPU's uniform block, or fed to the CPU reference.
 #pragma once
 
 #include <cstdint>
@@ -11,18 +12,18 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "atmosphere_tables.hpp"
+#include "cloud_types.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky_shared.h"
 #include "weather_field.hpp"
 
 namespace sky::render {
 
-// World size of one period of the shape noise, m: with 4 Worley cells per
-// period, cells are ~1.2 km, the scale of fair-weather cumulus.
-inline constexpr double kNoisePeriod_m = 5000.0;
-// Period of the cloud map (the same noise sampled larger), m: 23 km and 5 km
-// share no small common multiple, so the pattern repeats only every 115 km.
-inline constexpr double kCloudMapPeriod_m = 23000.0;
+// Period of the cloud map (the shape texture sampled larger) relative to the
+// layer type's shape period: for cumulus 23 km against 5 km, which share no
+// small common multiple, so the pattern repeats only every 115 km.
+inline constexpr double kCloudMapPeriodFactor = 4.6;
 
 struct LayerSetup {
   double hBase_m = 0;       // camera height above the base (negative below)
@@ -30,9 +31,19 @@ struct LayerSetup {
   double cBase_m2 = 0;      // hBase (2r - hBase)
   double cTop_m2 = 0;       // hTop (2r - hTop)
   double thickness_m = 0;
-  glm::dvec3 noiseOrigin{0};       // (camera ECEF - wind drift) mod period, in periods
+  double lightDistance_m = 0;      // what the secondary march towards the sun covers
+  CloudTypeParams primary;         // the layer's type
+  CloudTypeParams secondary;       // the type its tiles blend towards (= primary when none)
+  bool blends = false;             // tiles carry a blend towards `secondary`
+  double shapePeriod_m = 0, detailPeriod_m = 0, cloudMapPeriod_m = 0;
+  double shapeStretchZ = 1;        // the shape noise's ECEF z scale (1 / the type's streak length)
+  glm::dvec3 shapeOrigin{0};       // (camera ECEF - wind drift) mod shape period, in periods
+  glm::dvec3 detailOrigin{0};      // the same for the detail period
+  glm::dvec3 cloudMapOrigin{0};    // the same for the cloud-map period
   glm::dvec2 coverageShift_m{0};   // wind drift of the coverage since the snapshot, east/north
-  glm::dvec3 cloudMapOrigin{0};    // as noiseOrigin, in cloud-map periods
+  glm::dvec3 skyTop{0};            // mean sky radiance at the layer top, linear units
+  glm::dvec3 sunDiffuseTop{0};     // sunlight at the layer top as diffuse radiance, E T mu / pi
+  double sunCosine = 0;            // mu of the sun at the layer top over the camera, >= 0
 };
 
 struct FrameSetup {
@@ -47,7 +58,12 @@ struct FrameSetup {
   double r_m = 0;              // camera distance from its local Earth centre = |camera ECEF|
   double hGround_m = 0;        // camera height above the ground sphere = altitude
   double cGround_m2 = 0;
-  glm::dvec3 sunDir{0, 0, 1}, sunRadiance{0}, ambient{0};
+  double cAtmosphereTop_m2 = 0;  // the same for the top of the atmosphere
+  // The key light (the sun, or the moon at night: moonLit); the model calls it the sun.
+  glm::dvec3 sunDir{0, 0, 1};
+  glm::dvec3 sunIrradiance{0};     // at the top of the atmosphere, linear units
+  bool moonLit = false;
+  glm::dvec3 groundIrradiance{0};  // sky irradiance on the ground, linear units
   std::vector<LayerSetup> layers;
 };
 
@@ -57,8 +73,10 @@ Result<void> validateSettings(const RenderSettings& settings);
 // fields (weather::validate), tile values and level, sun angles.
 Result<void> validateInputs(const FrameInputs& inputs);
 
-// Derives the frame; inputs must be valid and field built for this snapshot.
-FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& inputs, const WeatherField& field);
+// Derives the frame; inputs must be valid and field built for this snapshot;
+// tables give the sky's light.
+FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& inputs, const WeatherField& field,
+                        const AtmosphereTables& tables);
 
 // The uniform block, including the workgroup permutation for this image size.
 gpu::SkyFrame packFrame(const FrameSetup& setup);

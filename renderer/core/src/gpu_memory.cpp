@@ -2,8 +2,11 @@
 #include "gpu_memory.hpp"
 
 #include <cstring>
+#include <optional>
 
 #include "sky/core/assert.hpp"
+
+#include "gpu_timer.hpp"
 
 namespace sky::render {
 
@@ -52,13 +55,17 @@ GpuImage createSampledImage(const GpuContext& ctx, vk::ImageType type, vk::Forma
   return img;
 }
 
-Result<void> uploadImage(const GpuContext& ctx, GpuImage& image, std::span<const std::byte> texels) {
+Result<void> uploadImage(const GpuContext& ctx, GpuImage& image, std::span<const std::byte> texels,
+                         GpuTimer* timer, const char* pass) {
   GpuBuffer staging = createHostBuffer(ctx, texels.size(), vk::BufferUsageFlagBits::eTransferSrc, "sky.staging");
   std::memcpy(staging.mapped, texels.data(), texels.size());
 
   const vk::ImageSubresourceRange range(vk::ImageAspectFlagBits::eColor, 0, 1, 0, image.layers);
   vk::raii::CommandBuffer cmd = ctx.allocateCommandBuffer();
   cmd.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
+  if (timer) timer->begin(cmd);
+  std::optional<GpuTimer::Section> timed;
+  if (timer) timed.emplace(timer->section(cmd, pass ? pass : "upload"));
   // Undefined -> transfer destination: discards what the image held; the
   // source stage covers an earlier frame's shader reads.
   const vk::ImageMemoryBarrier toTransfer({}, vk::AccessFlagBits::eTransferWrite, vk::ImageLayout::eUndefined,
@@ -74,6 +81,7 @@ Result<void> uploadImage(const GpuContext& ctx, GpuImage& image, std::span<const
                                         VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *image.image, range);
   cmd.pipelineBarrier(vk::PipelineStageFlagBits::eTransfer, vk::PipelineStageFlagBits::eComputeShader, {}, {}, {},
                       toShader);
+  timed.reset();
   cmd.end();
   const vk::raii::Fence fence(ctx.device(), vk::FenceCreateInfo());
   return ctx.submitAndWait(cmd, fence);

@@ -40,8 +40,12 @@ struct GpuImage {
 GpuImage createSampledImage(const GpuContext& ctx, vk::ImageType type, vk::Format format, vk::Extent3D extent,
                             std::uint32_t layers, const char* debugName);
 
+class GpuTimer;
+
 // Copies texels (tightly packed, all layers) into the whole image and leaves it
-// in eShaderReadOnlyOptimal. Previous contents are discarded. Blocking.
-Result<void> uploadImage(const GpuContext& ctx, GpuImage& image, std::span<const std::byte> texels);
+// in eShaderReadOnlyOptimal. Previous contents are discarded. Blocking. With
+// a timer, the copy is timed as the section `pass`.
+Result<void> uploadImage(const GpuContext& ctx, GpuImage& image, std::span<const std::byte> texels,
+                         GpuTimer* timer = nullptr, const char* pass = nullptr);
 
 }  // namespace sky::render

@@ -1,10 +1,13 @@
-// Image statistics and PNG output: exposure, ACES filmic tonemap (Narkowicz
-// 2015 fit), sRGB transfer, 8-bit RGB through stb_image_write.
+// Image statistics, the display transform (exposure, ACES filmic tonemap,
+// Narkowicz 2015 fit, sRGB transfer, 8 bits) shared by the PNG and the
+// window, and PNG output through stb_image_write.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
+#include "image_output.hpp"
+#include "sky/core/assert.hpp"
 #include "sky/render/cloud_renderer.hpp"
 
 #define STB_IMAGE_WRITE_IMPLEMENTATION
@@ -52,9 +55,8 @@ ImageStats computeStats(const Image& image) {
   return stats;
 }
 
-Result<void> writePng(const Image& image, const std::string& path) {
-  if (!consistent(image))
-    return fail(ErrorCode::InvalidArgument, "writePng " + path + ": image size does not match its pixels");
+std::vector<std::uint8_t> tonemapToSrgb8(const Image& image) {
+  SKY_ASSERT(consistent(image));
   std::vector<std::uint8_t> rgb(std::size_t(image.width) * image.height * 3);
   for (std::size_t px = 0; px < std::size_t(image.width) * image.height; ++px)
     for (int c = 0; c < 3; ++c) {
@@ -62,6 +64,13 @@ Result<void> writePng(const Image& image, const std::string& path) {
       const double mapped = std::isfinite(v) ? srgbEncode(acesFilmic(std::max(0.0, v * kPngExposure))) : 0.0;
       rgb[px * 3 + std::size_t(c)] = static_cast<std::uint8_t>(std::lround(mapped * 255.0));
     }
+  return rgb;
+}
+
+Result<void> writePng(const Image& image, const std::string& path) {
+  if (!consistent(image))
+    return fail(ErrorCode::InvalidArgument, "writePng " + path + ": image size does not match its pixels");
+  const std::vector<std::uint8_t> rgb = tonemapToSrgb8(image);
   const int ok = stbi_write_png(path.c_str(), int(image.width), int(image.height), 3, rgb.data(), int(image.width) * 3);
   if (ok == 0) return fail(ErrorCode::Io, "writePng " + path + ": cannot write file");
   return {};

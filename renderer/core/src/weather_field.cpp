@@ -6,7 +6,6 @@
 #include <cstring>
 #include <unordered_map>
 
-#include <glm/gtc/packing.hpp>
 
 #include "sky/core/assert.hpp"
 #include "sky/weather/tiling.hpp"
@@ -19,7 +18,12 @@ namespace {
 struct TileValue {
   float coverage = 0;
   float density = 0;
+  weather::CloudType blendType = weather::CloudType::None;
+  float blend = 0;
 };
+
+// Channels per texel of the map: coverage, density, blend, unused.
+constexpr std::size_t kChannels = 4;
 
 void mix64(std::uint64_t& h, std::uint64_t v) {
   // FNV-1a over the value's bytes.
@@ -37,23 +41,23 @@ std::uint64_t bitsOf(double d) {
 
 }  // namespace
 
-glm::dvec2 WeatherField::sample(std::uint32_t slice, double x_m, double y_m) const {
+glm::dvec3 WeatherField::sample(std::uint32_t slice, double x_m, double y_m) const {
   SKY_ASSERT(slice < sliceCount);
   const int n = static_cast<int>(size);
   const double tx = (x_m / (2 * halfExtent_m) + 0.5) * size - 0.5;
   const double ty = (y_m / (2 * halfExtent_m) + 0.5) * size - 0.5;
-  if (!(std::abs(tx) < 2.0 * size && std::abs(ty) < 2.0 * size)) return {0, 0};  // far outside, or NaN
+  if (!(std::abs(tx) < 2.0 * size && std::abs(ty) < 2.0 * size)) return {0, 0, 0};  // far outside, or NaN
   const double fx = std::floor(tx), fy = std::floor(ty);
   const int i0 = static_cast<int>(fx), j0 = static_cast<int>(fy);
   const double ax = tx - fx, ay = ty - fy;
-  glm::dvec2 sum(0);
+  glm::dvec3 sum(0);
   for (int dj = 0; dj <= 1; ++dj)
     for (int di = 0; di <= 1; ++di) {
       const int i = i0 + di, j = j0 + dj;
       if (i < 0 || j < 0 || i >= n || j >= n) continue;
-      const std::size_t idx = ((std::size_t(slice) * size + std::size_t(j)) * size + std::size_t(i)) * 2;
+      const std::size_t idx = ((std::size_t(slice) * size + std::size_t(j)) * size + std::size_t(i)) * kChannels;
       const double w = (di ? ax : 1 - ax) * (dj ? ay : 1 - ay);
-      sum += w * glm::dvec2(glm::unpackHalf1x16(texels[idx]), glm::unpackHalf1x16(texels[idx + 1]));
+      sum += w * glm::dvec3(texels[idx], texels[idx + 1], texels[idx + 2]) / 255.0;
     }
   return sum;
 }
@@ -64,6 +68,7 @@ std::uint64_t weatherContentKey(const weather::WeatherSnapshot* snapshot) {
   mix64(h, snapshot->layers.size());
   for (const auto& layer : snapshot->layers) {
     mix64(h, layer.id);
+    mix64(h, static_cast<std::uint64_t>(layer.type));
     mix64(h, bitsOf(layer.coverage));
     mix64(h, bitsOf(layer.density));
   }
@@ -74,6 +79,8 @@ std::uint64_t weatherContentKey(const weather::WeatherSnapshot* snapshot) {
     mix64(h, tile.layerId);
     mix64(h, bitsOf(tile.coverage));
     mix64(h, bitsOf(tile.density));
+    mix64(h, static_cast<std::uint64_t>(tile.blendType));
+    mix64(h, bitsOf(tile.blend));
   }
   return h;
 }
@@ -87,19 +94,36 @@ WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const g
   field.sliceCount = gpu::kMaxLayers;
   field.contentKey = weatherContentKey(snapshot);
   const std::size_t sliceTexels = std::size_t(field.size) * field.size;
-  field.texels.assign(sliceTexels * field.sliceCount * 2, glm::packHalf1x16(0.0f));
+  field.texels.assign(sliceTexels * field.sliceCount * kChannels, 0);
+  field.blendType.fill(weather::CloudType::None);
+  field.tiled.fill(false);
   if (snapshot == nullptr) return field;
   SKY_ASSERT(snapshot->layers.size() <= gpu::kMaxLayers);
 
   // Per slice: the tiles of that layer by cell id (empty map = uniform layer).
   std::vector<std::unordered_map<std::uint64_t, TileValue>> tilesBySlice(snapshot->layers.size());
+  std::vector<std::array<double, weather::kMaxCloudType + 1>> blendWeight(snapshot->layers.size());
   bool anyTiles = false;
   for (const auto& tile : snapshot->tiles)
     for (std::size_t s = 0; s < snapshot->layers.size(); ++s)
       if (snapshot->layers[s].id == tile.layerId) {
-        tilesBySlice[s][tile.cellId] = {tile.coverage, tile.density};
+        tilesBySlice[s][tile.cellId] = {tile.coverage, tile.density, tile.blendType, tile.blend};
+        const auto type = static_cast<std::size_t>(tile.blendType);
+        if (tile.blend > 0 && type > 0 && type < blendWeight[s].size() && tile.blendType != snapshot->layers[s].type)
+          blendWeight[s][type] += tile.blend;
         anyTiles = true;
       }
+  // Each slice blends towards the type with the most blend weight (ties: the
+  // lower enum value).
+  for (std::size_t s = 0; s < snapshot->layers.size(); ++s) {
+    field.tiled[s] = !tilesBySlice[s].empty();
+    double best = 0;
+    for (std::size_t type = 1; type < blendWeight[s].size(); ++type)
+      if (blendWeight[s][type] > best) {
+        best = blendWeight[s][type];
+        field.blendType[s] = static_cast<weather::CloudType>(type);
+      }
+  }
 
   const double groundRadius_m = field.radius_m - anchor.alt_m;
   for (std::uint32_t j = 0; j < field.size; ++j)
@@ -122,9 +146,11 @@ WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const g
           const auto it = tilesBySlice[s].find(cell);
           v = it == tilesBySlice[s].end() ? TileValue{} : it->second;
         }
-        const std::size_t idx = ((s * field.size + j) * field.size + i) * 2;
-        field.texels[idx] = glm::packHalf1x16(std::clamp(v.coverage, 0.0f, 1.0f));
-        field.texels[idx + 1] = glm::packHalf1x16(std::clamp(v.density, 0.0f, 1.0f));
+        const std::size_t idx = ((s * field.size + j) * field.size + i) * kChannels;
+        const float blend = v.blendType == field.blendType[s] ? std::clamp(v.blend, 0.0f, 1.0f) : 0.0f;
+        field.texels[idx] = weather::quantizeUnit(v.coverage);
+        field.texels[idx + 1] = weather::quantizeUnit(v.density);
+        field.texels[idx + 2] = weather::quantizeUnit(blend);
       }
     }
   return field;

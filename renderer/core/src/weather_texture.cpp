@@ -9,14 +9,16 @@ namespace sky::render {
 
 Result<WeatherTexture> WeatherTexture::create(const GpuContext& ctx) {
   WeatherTexture t;
-  t.image_ = createSampledImage(ctx, vk::ImageType::e2D, vk::Format::eR16G16Sfloat,
+  t.image_ = createSampledImage(ctx, vk::ImageType::e2D, vk::Format::eR8G8B8A8Unorm,
                                 vk::Extent3D(kWeatherMapSize, kWeatherMapSize, 1), gpu::kMaxLayers, "sky.weatherMap");
+  t.timer_ = GpuTimer(ctx, 1, "sky.weatherMap.timer");
   t.field_ = buildWeatherField(nullptr, geo::Geodetic{});
   if (auto ok = t.upload(ctx); !ok) return tl::unexpected(ok.error());
   return t;
 }
 
 Result<void> WeatherTexture::update(const GpuContext& ctx, const FrameInputs& inputs) {
+  lastUploadTimes_.clear();
   const std::uint64_t key = weatherContentKey(inputs.weather);
   if (!weatherFieldStale(field_, key, geo::toEcef(inputs.camera.position))) return {};
   field_ = buildWeatherField(inputs.weather, inputs.camera.position);
@@ -25,7 +27,10 @@ Result<void> WeatherTexture::update(const GpuContext& ctx, const FrameInputs& in
 
 Result<void> WeatherTexture::upload(const GpuContext& ctx) {
   ++uploads_;
-  return uploadImage(ctx, image_, std::as_bytes(std::span(field_.texels)));
+  if (auto ok = uploadImage(ctx, image_, std::as_bytes(std::span(field_.texels)), &timer_, "weather_upload"); !ok)
+    return ok;
+  lastUploadTimes_ = timer_.results();
+  return {};
 }
 
 }  // namespace sky::render

@@ -1,4 +1,4 @@
-// The weather map on the GPU: a fixed-size RG16F 2D array (one slice per cloud
+// The weather map on the GPU: a fixed-size RGBA8 2D array (one slice per cloud
 // layer) and the CPU field it was uploaded from. Rebuilt and re-uploaded only
 // when the snapshot's content changes or the camera leaves the anchor's
 // neighbourhood (kWeatherRecentre_m).
@@ -8,6 +8,7 @@
 
 #include "gpu_context.hpp"
 #include "gpu_memory.hpp"
+#include "gpu_timer.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "weather_field.hpp"
 
@@ -24,14 +25,18 @@ class WeatherTexture {
   const WeatherField& field() const { return field_; }
   const GpuImage& image() const { return image_; }
   std::uint64_t uploads() const { return uploads_; }
+  // GPU time of the upload done by the last update(); empty when it uploaded nothing.
+  const std::vector<PassTime>& lastUploadTimes() const { return lastUploadTimes_; }
 
  private:
   WeatherTexture() = default;
   Result<void> upload(const GpuContext& ctx);
 
   GpuImage image_;
+  GpuTimer timer_;
   WeatherField field_;
   std::uint64_t uploads_ = 0;
+  std::vector<PassTime> lastUploadTimes_;
 };
 
 }  // namespace sky::render

@@ -2,42 +2,22 @@
 // double precision, checked against closed forms: every phase function
 // integrates to 1 over the sphere; the Jendersie-d'Eon fit reproduces the
 // parameters published for 10 um droplets; Wrenninge's octave sum with a <= b
-// never exceeds the sum of its weights; the march through a slab transmits
-// exp(-sigma_t * integral of the density) (the layer's trapezoid profile,
-// integrated by hand); ray-shell distances equal hand-computed ones for
-// vertical, horizontal and grazing rays.
+// never exceeds the sum of its weights; a uniform slab transmits exp(-sigma_t
+// L) along vertical and slant rays; the step integration conserves energy
+// (a conservative slab in a uniform radiance field leaves it uniform) and
+// has its sigma -> 0 limit; Haggstrom's height functions and anvils at
+// hand-computed points; the diffuse light's two-stream depth; ray-shell
+// distances for vertical, horizontal and grazing rays; cloud shadows on the
+// ground by the layers' two-stream depth.
 #include <cmath>
 #include <cstdint>
 
-#include <glm/glm.hpp>
 #include <gtest/gtest.h>
 
-#include "sky_shared.h"
+#include "core_harness.hpp"
 
-namespace sky::render {
+namespace sky::test {
 namespace {
-
-using namespace glm;
-using gpu::kMaxLayers;
-
-// The core inside a class whose texture hooks return what a test sets: a
-// uniform field.
-class Core {
- public:
-  using real = double;
-  using real2 = glm::dvec2;
-  using real3 = glm::dvec3;
-  using uint = std::uint32_t;
-
-  real coverage = 1.0, density = 1.0, noise = 1.0;
-  real2 sampleWeather(int, real3) const { return real2(coverage, density); }
-  real sampleNoise(int, real3) const { return noise; }
-  real sampleCloudMap(int, real3) const { return 0.5; }
-
-#define SKY_CORE_CONST static constexpr
-#include "cloud_core.glsl"
-#undef SKY_CORE_CONST
-};
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -55,6 +35,63 @@ double sphereIntegral(F p) {
   return 2 * kPi * sum * kPi / kN;
 }
 
+// A cloud type that fills its layer uniformly: fades far thinner than a
+// march step, density flat with height, no erosion, no diffuse depth.
+Core::CloudType uniformType(double extinction_perm) {
+  Core::CloudType t{};
+  t.extinction_perm = extinction_perm;
+  t.dropletDiameter_um = 10.0;
+  t.baseRound = 1e-9;
+  t.topRoundStart = 1.0 - 1e-9;
+  t.peak = 1.0 + 1e-6;
+  t.peakVariation = 0.0;
+  t.anvil = 0.0;
+  t.densityGradient = 0.0;
+  t.densityBaseFade = 1e-9;
+  t.densityTopFade = 1e-9;
+  t.coverageEdge = 0.25;
+  t.fibrous = 0.0;
+  t.erosion = 0.0;
+  t.wispyHeight = 0.2;
+  t.columnFill = 0.0;
+  return t;
+}
+
+// Haggstrom's cumulus (eq. 5-10, 14) as the type table writes it.
+Core::CloudType haggstromCumulus() {
+  Core::CloudType t = uniformType(0.06);
+  t.baseRound = 0.07;
+  t.topRoundStart = 0.2;
+  t.peak = 1.0;
+  t.densityGradient = 1.0;
+  t.densityBaseFade = 0.15;
+  t.densityTopFade = 0.1;
+  t.erosion = 0.35;
+  t.columnFill = 0.5;
+  return t;
+}
+
+// Frame of a camera at altitude alt under a sphere of radius R, with one
+// layer of the given type; no sun, no sky light.
+Core::CoreFrame frameAt(Core& c, double R, double alt, double base, double thickness, const Core::CloudType& type) {
+  Core::CoreFrame f{};
+  f.air.r = R + alt;
+  f.air.h = alt;
+  f.air.cGround = alt * (2 * f.air.r - alt);
+  const double hTopAtm = alt - Core::kAtmosphereHeight_m;
+  f.air.cTop = hTopAtm * (2 * f.air.r - hTopAtm);
+  f.air.sunDir = Core::real3(0, 0, 1);
+  f.air.sunIrradiance = Core::real3(0);
+  f.groundIrradiance = Core::real3(0);
+  f.layerCount = 1;
+  const double hBase = alt - base, hTop = alt - (base + thickness);
+  Core::CoreLayer& L = c.layers[0];
+  L = Core::CoreLayer{hBase, hTop, hBase * (2 * f.air.r - hBase), hTop * (2 * f.air.r - hTop), thickness,
+                      0.5 * thickness, false, type, type, Core::real3(0), Core::real3(0), 1.0,
+                      Core::LayerSampling{Core::real4(0.0), Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), 1.0}};
+  return f;
+}
+
 TEST(CloudCore, PhaseFunctionsIntegrateToOne) {
   Core c;
   for (double g : {0.0, 0.3, 0.6, 0.9, 0.99, -0.5})
@@ -68,6 +105,13 @@ TEST(CloudCore, PhaseFunctionsIntegrateToOne) {
       EXPECT_NEAR(sphereIntegral([&](double mu) { return c.phaseMie(mu, m, scale); }), 1.0, 1e-3)
           << "Mie d=" << d << " scale=" << scale;
   }
+  Core::CloudType ice = uniformType(1e-3);
+  ice.dropletDiameter_um = 0.0;
+  for (double scale : {1.0, 0.125})
+    EXPECT_NEAR(sphereIntegral([&](double mu) { return c.phaseCloud(mu, ice, scale); }), 1.0, 1e-3) << "ice";
+  EXPECT_NEAR(sphereIntegral([&](double mu) { return c.phaseRayleigh(mu); }), 1.0, 1e-6);
+  for (double g : {0.0, 0.8})
+    EXPECT_NEAR(sphereIntegral([&](double mu) { return c.phaseCornetteShanks(mu, g); }), 1.0, 1e-3) << "CS g=" << g;
 }
 
 TEST(CloudCore, MieFitMatchesThePublishedParametersAt10um) {
@@ -80,12 +124,15 @@ TEST(CloudCore, MieFitMatchesThePublishedParametersAt10um) {
   EXPECT_NEAR(m.w, 0.4824, 5e-4);
   // Forward peaked: far more light straight through than sideways or back.
   EXPECT_GT(c.phaseMie(1.0, m, 1.0), 100 * c.phaseMie(0.0, m, 1.0));
+  // Ice (HG, g = 0.75) is less forward-peaked than droplets.
+  Core::CloudType ice = uniformType(1e-3);
+  ice.dropletDiameter_um = 0.0;
+  EXPECT_LT(c.phaseCloud(1.0, ice, 1.0), c.phaseMie(1.0, m, 1.0));
 }
 
 TEST(CloudCore, OctaveSumIsBoundedByItsWeights) {
   Core c;
-  double phases[Core::kScatterOctaves];
-  for (auto& p : phases) p = 1.0;
+  const Core::real4 phases(1.0);
   // tau = 0: sum of b^i; tau > 0 only loses light; a <= b keeps each octave's
   // share b^i exp(-a^i tau) <= b^i.
   double weights = 0, b = 1;
@@ -98,62 +145,204 @@ TEST(CloudCore, OctaveSumIsBoundedByItsWeights) {
     EXPECT_GT(s, 0.0);
     last = s;
   }
+  // Octave 3 alone at tau = 8: b^3 exp(-a^3 8) = 0.125 e^-1.
+  EXPECT_NEAR(c.octaveSum(Core::real4(0, 0, 0, 1), 8.0), 0.125 * std::exp(-1.0), 1e-12);
   EXPECT_LE(Core::kOctaveExtinction, Core::kOctaveContribution);
 }
 
-// Frame of a camera at altitude alt below/inside/above one layer, Earth radius R.
-Core::CoreFrame frameAt(Core& c, double R, double alt, double base, double thickness) {
-  Core::CoreFrame f{};
-  f.r = R + alt;
-  f.cGround = alt * (2 * f.r - alt);
-  f.sunDir = Core::real3(0, 0, 1);
-  f.sunRadiance = Core::real3(0);
-  f.ambient = Core::real3(0);
-  f.layerCount = 1;
-  const double hBase = alt - base, hTop = alt - (base + thickness);
-  f.layers[0] = Core::CoreLayer(hBase, hTop, hBase * (2 * f.r - hBase), hTop * (2 * f.r - hTop), thickness);
-  for (unsigned i = 1; i < kMaxLayers; ++i) f.layers[i] = Core::CoreLayer(0, 0, 0, 0, 1);
-  (void)c;
-  return f;
-}
-
-TEST(CloudCore, SlabTransmittanceIsBeerLambert) {
+TEST(CloudCore, UniformSlabTransmitsBeerLambert) {
   Core c;
-  const double R = 6371000, base = 1500, H = 1000;
-  // The layer's vertical profile is a trapezoid (ramps over the bottom 10 %
-  // and the top 20 %): its integral over the thickness is H (1 - 0.05 - 0.1).
-  const double profileIntegral = H * (1 - Core::kProfileBottomFade / 2 - Core::kProfileTopFade / 2);
-  for (double density : {0.002, 0.02}) {
-    c.density = density;
-    Core::CoreFrame f = frameAt(c, R, 500, base, H);
-    const Core::real3 up(0, 0, 1);
-    const Core::Span span = c.layerSpan(f, f.layers[0], 1.0, 1e12);
-    EXPECT_NEAR(span.t0, base - 500, 1e-6);
-    EXPECT_NEAR(span.t1, base + H - 500, 1e-6);
-    Core::MarchState st{Core::real3(0), 1.0};
-    st = c.marchLayer(f, 0, up, span, 0.5, st);
-    const double tau = Core::kExtinctionPerDensity_perm * density * profileIntegral;
-    // Midpoint steps of dt = H/48 are exact on the profile's linear pieces;
-    // each of its two kinks costs at most sigma dt^2/8 times the slope jump
-    // (1/(0.1 H) and 1/(0.2 H)): 8.1e-5 in tau at density 0.002, so T is
-    // within 1e-4 of exp(-tau); at 0.02 the bound is 8.1e-4 in tau.
-    const double dt = H / Core::kPrimarySteps;
-    const double tauBound = Core::kExtinctionPerDensity_perm * density * dt * dt / 8 *
-                            (1 / (Core::kProfileBottomFade * H) + 1 / (Core::kProfileTopFade * H));
-    EXPECT_NEAR(-std::log(st.transmittance), tau, tauBound) << "density " << density;
-    if (density < 0.01) {
-      EXPECT_NEAR(st.transmittance, std::exp(-tau), 1e-4);
-    }
+  const double R = 6371000, base = 1500, H = 1000, alt = 500;
+  // Optical depths up to 4 (vertical) and 8 (slant); the march stops once
+  // under kMinTransmittance is left, so that case is checked on its own.
+  for (double sigma : {2e-4, 2e-3, 4e-3}) {
+    Core::CoreFrame f = frameAt(c, R, alt, base, H, uniformType(sigma));
+    // Vertical: the span is the layer, H long.
+    const Core::Span up = c.layerSpan(f, c.layers[0], 1.0, 1e12);
+    EXPECT_NEAR(up.t0, base - alt, 1e-6);
+    EXPECT_NEAR(up.t1, base + H - alt, 1e-6);
+    const auto r = c.marchLayer(f, 0, Core::real3(0, 0, 1), up, 0.5, 1.0);
+    EXPECT_NEAR(r.transmittance, std::exp(-sigma * H), 1e-4) << "vertical, sigma " << sigma;
+    // Slant, 30 degrees up: the path between the spheres of radius R + base
+    // and R + base + H, by hand: sqrt(rs^2 - r^2 (1 - mu^2)) - r mu.
+    const double mu = 0.5, rc = R + alt;
+    auto dist = [&](double rs) { return std::sqrt(rs * rs - rc * rc * (1 - mu * mu)) - rc * mu; };
+    const double path = dist(R + base + H) - dist(R + base);
+    const Core::real3 dir(std::sqrt(1 - mu * mu), 0, mu);
+    const Core::Span slant = c.layerSpan(f, c.layers[0], mu, 1e12);
+    EXPECT_NEAR(slant.t1 - slant.t0, path, 1e-3);
+    const double slantT = c.marchLayer(f, 0, dir, slant, 0.5, 1.0).transmittance;
+    if (std::exp(-sigma * path) > Core::kMinTransmittance)
+      EXPECT_NEAR(slantT, std::exp(-sigma * path), 1e-4) << "slant, sigma " << sigma;
+    else  // early exit: stopped within one step of falling under the threshold
+      EXPECT_LT(slantT, Core::kMinTransmittance * std::exp(sigma * (slant.t1 - slant.t0) / Core::kPrimarySteps));
   }
   // sigma_t -> 0: nothing absorbed, nothing scattered, no division by zero.
-  c.density = 1e-30;
-  Core::CoreFrame f = frameAt(c, R, 500, base, H);
-  f.sunRadiance = Core::real3(1);
-  Core::MarchState st{Core::real3(0), 1.0};
-  st = c.marchLayer(f, 0, Core::real3(0, 0, 1), c.layerSpan(f, f.layers[0], 1.0, 1e12), 0.5, st);
-  EXPECT_EQ(st.transmittance, 1.0);
-  EXPECT_TRUE(std::isfinite(st.inscatter.x));
-  EXPECT_LT(st.inscatter.x, 1e-20);
+  Core::CoreFrame f = frameAt(c, R, alt, base, H, uniformType(1e-30));
+  f.air.sunIrradiance = Core::real3(1);
+  c.layers[0].skyTop = Core::real3(1);
+  const auto r = c.marchLayer(f, 0, Core::real3(0, 0, 1), c.layerSpan(f, c.layers[0], 1.0, 1e12), 0.5, 1.0);
+  EXPECT_EQ(r.transmittance, 1.0);
+  EXPECT_TRUE(std::isfinite(r.inscatter.x));
+  EXPECT_LT(r.inscatter.x, 1e-20);
+}
+
+// Hillaire's step integral conserves energy exactly: in a uniform, isotropic
+// radiance field L a slab of albedo a returns L (T + a (1 - T)) whatever its
+// optical depth or step count (a conservative slab, a = 1, leaves L as it
+// is); Ford's eq. 4.4 (sigma dropped from the exponent) breaks this.
+TEST(CloudCore, StepIntegrationConservesEnergy) {
+  Core c;
+  const double L = 0.7;
+  for (double sigma : {1e-4, 0.01, 0.06, 1.0}) {
+    Core::CoreFrame f = frameAt(c, 6371000, 500, 1500, 1000, uniformType(sigma));
+    c.layers[0].skyTop = Core::real3(L);
+    const auto r = c.marchLayer(f, 0, Core::real3(0, 0, 1), c.layerSpan(f, c.layers[0], 1.0, 1e12), 0.5, 1.0);
+    const double T = r.transmittance;
+    EXPECT_NEAR(r.inscatter.x, L * Core::kAlbedo * (1 - T), 1e-12 * L) << sigma;
+    EXPECT_LE(L * T + r.inscatter.x, L * (1 + 1e-12)) << sigma;
+  }
+  // With sunlight the in-scattered light is at most what the slab removes
+  // times the largest source: the sun through the octave sum at tau = 0 plus
+  // the diffuse light.
+  Core::CoreFrame f = frameAt(c, 6371000, 500, 1500, 1000, haggstromCumulus());
+  f.air.sunIrradiance = Core::real3(20);
+  f.air.sunDir = normalize(Core::real3(0.3, 0.2, 0.9));
+  c.layers[0].skyTop = Core::real3(0.3);
+  c.layers[0].sunDiffuseTop = Core::real3(5);
+  c.coverage = 0.8;
+  c.noise = 0.9;
+  const Core::real3 dir = normalize(Core::real3(0.1, 0.2, 1.0));
+  const auto r = c.marchLayer(f, 0, dir, c.layerSpan(f, c.layers[0], dir.z, 1e12), 0.5, 1.0);
+  const double maxSource = 20 * c.octaveSum(c.octavePhases(dot(dir, f.air.sunDir), c.layers[0].primary), 0.0) + 5.3;
+  EXPECT_LT(r.transmittance, 0.9);
+  EXPECT_LE(r.inscatter.x, Core::kAlbedo * (1 - r.transmittance) * maxSource);
+}
+
+TEST(CloudCore, HeightFunctionsAtHandComputedPoints) {
+  Core c;
+  const Core::CloudType cu = haggstromCumulus();
+  // SA = SAT(ph / 0.07) * SAT((wh - ph) / (0.8 wh)), wh = 1 (peak noise 1).
+  EXPECT_NEAR(c.shapeProfile(cu, 0.035, 0.5, 1.0), 0.5, 1e-12);  // top factor saturates at 1
+  EXPECT_NEAR(c.shapeProfile(cu, 0.6, 0.5, 1.0), (1 - 0.6) / 0.8, 1e-12);
+  EXPECT_EQ(c.shapeProfile(cu, 0.0, 0.5, 1.0), 0.0);
+  EXPECT_EQ(c.shapeProfile(cu, 1.0, 0.5, 1.0), 0.0);
+  // A low top (peak noise 0, peak variation 0.5: wh = 0.5) ends the cloud at 0.5.
+  Core::CloudType varied = cu;
+  varied.peakVariation = 0.5;
+  EXPECT_EQ(c.shapeProfile(varied, 0.55, 0.5, 0.0), 0.0);
+  EXPECT_NEAR(c.shapeProfile(varied, 0.3, 0.5, 0.0), (0.5 - 0.3) / (0.8 * 0.5), 1e-12);
+  // DA = ph * SAT(ph / 0.15) * SAT((1 - ph) / 0.1).
+  EXPECT_NEAR(c.densityProfile(cu, 0.5), 0.5, 1e-12);
+  EXPECT_NEAR(c.densityProfile(cu, 0.1), 0.1 * 0.1 / 0.15, 1e-12);
+  EXPECT_NEAR(c.densityProfile(cu, 0.95), 0.95 * 0.5, 1e-12);
+  // Anvil (eq. 17-18) at coverage 1: at ph = 0.8 the shape exponent is
+  // 1 - 0.5 = 0.5 and the density is cut by SAT(R(sqrt(0.8), 0.4, 0.95, 1, 0.2)).
+  Core::CloudType cb = cu;
+  cb.anvil = 1.0;
+  const double sa = (1 - 0.8) / 0.8;
+  EXPECT_NEAR(c.shapeProfile(cb, 0.8, 1.0, 1.0), std::sqrt(sa), 1e-12);
+  const double cut = 1 + (std::sqrt(0.8) - 0.4) / (0.95 - 0.4) * (0.2 - 1);
+  EXPECT_NEAR(c.densityProfile(cb, 0.8), 0.8 * cut, 1e-12);
+  // The anvil spreads coverage over the cell at the top, not below 0.65.
+  EXPECT_NEAR(c.anvilCoverage(cb, 0.95, 0.2), 1.0, 1e-12);
+  EXPECT_NEAR(c.anvilCoverage(cb, 0.5, 0.2), 0.2, 1e-12);
+  EXPECT_EQ(c.anvilCoverage(cb, 0.95, 0.0), 0.0);
+}
+
+TEST(CloudCore, CoverageIsAnAreaFractionAndZeroIsEmpty) {
+  Core c;
+  const Core::CloudType cu = haggstromCumulus();
+  // Coverage 0: nothing for any noise.
+  for (double n : {0.0, 0.5, 1.0}) EXPECT_EQ(c.cloudShape(cu, Core::real2(n), 0.0, 1.0), 0.0);
+  // With SA = 1, cloud starts at noise 1 - c and is full kCoverageEdge later.
+  EXPECT_EQ(c.cloudShape(cu, Core::real2(0.59), 0.4, 1.0), 0.0);
+  EXPECT_NEAR(c.cloudShape(cu, Core::real2(0.6 + 0.125), 0.4, 1.0), 0.5, 1e-12);
+  EXPECT_EQ(c.cloudShape(cu, Core::real2(0.9), 0.4, 1.0), 1.0);
+  // The cloud map moves partial coverage only: 0 and 1 are fixed points.
+  for (double m : {0.0, 0.5, 1.0}) {
+    EXPECT_EQ(c.mappedCoverage(0.0, m), 0.0);
+    EXPECT_EQ(c.mappedCoverage(1.0, m), 1.0);
+  }
+  EXPECT_NEAR(c.mappedCoverage(0.5, 0.5), 0.5, 1e-12);
+  // Erosion leaves full shape full and carves edges (eq. 16).
+  EXPECT_NEAR(c.erodeShape(cu, 1.0, 0.3, 0.5, 0.5), 1.0, 1e-12);
+  EXPECT_LT(c.erodeShape(cu, 0.3, 0.9, 0.5, 0.5), 0.3);
+  // Fibrous types read the second noise channel.
+  Core::CloudType ci = cu;
+  ci.fibrous = 1.0;
+  EXPECT_EQ(c.cloudShape(ci, Core::real2(1.0, 0.0), 0.5, 1.0), 0.0);
+  EXPECT_EQ(c.cloudShape(cu, Core::real2(1.0, 0.0), 0.5, 1.0), 1.0);
+}
+
+// The diffuse light: at the layer top the sky's radiance as it is; below,
+// the sky plus the sunlight scattered out of the beam, through the depth
+// above by the two-stream t = 1 / (1 + 3/4 (1 - g) tau).
+TEST(CloudCore, DiffuseLightFollowsTheTwoStreamDepth) {
+  Core c;
+  Core::CoreLayer L{};
+  L.thickness = 1000;
+  L.skyTop = Core::real3(0.3);
+  L.sunDiffuseTop = Core::real3(4.0);
+  L.sunCosine = 0.5;
+  const Core::CloudType cu = haggstromCumulus();
+  EXPECT_NEAR(c.diffuseLight(L, cu, 1.0, 1.0, 1.0).x, 0.3, 1e-12);
+  const double tau = 0.06 * 1.0 * 1.0 * 0.5 * 1000;  // extinction, density, coverage, fill, depth
+  const double expected = (0.3 + 4.0 * (1 - std::exp(-tau / 0.5))) / (1 + 0.75 * (1 - 0.85) * tau);
+  EXPECT_NEAR(c.diffuseLight(L, cu, 0.0, 1.0, 1.0).x, expected, 1e-12);
+  // Less cover above lets more through.
+  EXPECT_GT(c.diffuseLight(L, cu, 0.0, 0.3, 1.0).x / (0.3 + 4.0), c.diffuseLight(L, cu, 0.0, 1.0, 1.0).x / (0.3 + 4.0));
+}
+
+// Cloud shadows on the ground: each layer's optical depth where the sun
+// ray crosses it, tau = extinction x density x coverage x column fill x
+// thickness; the beam e^(-tau / mu) and the diffuse part 1 / (1 + 0.75 (1 -
+// g) tau), multiplied over the layers; no cloud, no shadow; and the
+// ground's radiance from them by hand.
+TEST(CloudCore, GroundShadowIsTheTwoStreamDepthOfTheLayersAbove) {
+  Core c;
+  const double R = 6371000, alt = 500;
+  Core::CloudType st = uniformType(0.01);
+  st.columnFill = 0.8;
+  Core::CoreFrame f = frameAt(c, R, alt, 1500, 1000, st);
+  const double mu = 0.5;
+  f.air.sunDir = Core::real3(std::sqrt(1 - mu * mu), 0, mu);
+  const Core::real3 ground(0, 0, -alt);  // the ground point under the camera
+  c.coverage = 0.9;
+  c.density = 0.7;
+  const double tau = 0.01 * 0.7 * 0.9 * 0.8 * 1000;
+  const double beam = std::exp(-tau / mu), spread = 1 / (1 + 0.75 * (1 - 0.85) * tau);
+  Core::real2 s = c.groundShadow(f, ground, mu);
+  EXPECT_NEAR(s.x, beam, 1e-12);
+  EXPECT_NEAR(s.y, spread, 1e-12);
+  // A second, thinner layer higher up: the factors multiply.
+  Core::CloudType ci = uniformType(5e-4);
+  ci.columnFill = 0.3;
+  c.layers[1] = c.layers[0];
+  const double hB = alt - 8000, hT = alt - 9000;
+  c.layers[1].hBase = hB;
+  c.layers[1].hTop = hT;
+  c.layers[1].cBase = hB * (2 * f.air.r - hB);
+  c.layers[1].cTop = hT * (2 * f.air.r - hT);
+  c.layers[1].primary = c.layers[1].secondary = ci;
+  f.layerCount = 2;
+  const double tau2 = 5e-4 * 0.7 * 0.9 * 0.3 * 1000;
+  s = c.groundShadow(f, ground, mu);
+  EXPECT_NEAR(s.x, beam * std::exp(-tau2 / mu), 1e-12);
+  EXPECT_NEAR(s.y, spread / (1 + 0.75 * (1 - 0.85) * tau2), 1e-12);
+  // The ground's radiance: albedo / pi x (sun mu T (beam + (1 - beam)
+  // spread) + sky spread), clear air (no table: T = 1).
+  f.air.sunIrradiance = Core::real3(2.0);
+  f.groundIrradiance = Core::real3(0.4);
+  const double b2 = beam * std::exp(-tau2 / mu), s2 = spread / (1 + 0.75 * (1 - 0.85) * tau2);
+  const double expected = 0.1 / kPi * (2.0 * mu * (b2 + (1 - b2) * s2) + 0.4 * s2);
+  EXPECT_NEAR(c.groundRadiance(f, Core::real3(0, 0, -1), alt).x, expected, 1e-9);
+  // No cloud: the sun and the sky reach the ground whole.
+  c.coverage = 0.0;
+  s = c.groundShadow(f, ground, mu);
+  EXPECT_EQ(s.x, 1.0);
+  EXPECT_EQ(s.y, 1.0);
+  EXPECT_NEAR(c.groundRadiance(f, Core::real3(0, 0, -1), alt).x, 0.1 / kPi * (2.0 * mu + 0.4), 1e-9);
 }
 
 TEST(CloudCore, RayShellDistancesMatchHandComputedOnes) {
@@ -195,4 +384,4 @@ TEST(CloudCore, RayShellDistancesMatchHandComputedOnes) {
 }
 
 }  // namespace
-}  // namespace sky::render
+}  // namespace sky::test

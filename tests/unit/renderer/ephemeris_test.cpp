@@ -57,5 +57,32 @@ TEST(Ephemeris, MoonMatchesMeeusExample47aToItsStatedPrecision) {
   EXPECT_NEAR(q.declination_deg, 13.768368, 0.3);
 }
 
+// Meeus example 48.a, 1992 April 12.0 TD: phase angle 69.0756 deg,
+// illuminated fraction (1 + cos i) / 2 = 0.6786. Our moon is good to ~0.3 deg.
+TEST(Ephemeris, MoonPhaseMatchesMeeusExample48a) {
+  const double i = moonPhaseAngle_deg(unixOf(2448724.5));
+  EXPECT_NEAR(i, 69.0756, 0.4);
+  EXPECT_NEAR((1 + std::cos(i * 3.14159265358979323846 / 180.0)) / 2, 0.6786, 0.005);
+  // Full moon 2024-01-25 17:54 UTC, new moon 2024-01-11 11:57 UTC (USNO): the
+  // phase angle is the moon's ecliptic latitude (up to ~5 deg) from 0 or 180.
+  EXPECT_LT(moonPhaseAngle_deg(1706205240.0), 6.0);
+  EXPECT_GT(moonPhaseAngle_deg(1704974220.0), 174.0);
+}
+
+// The moon's light against published magnitudes: full moon V = -12.74 and
+// the sun -26.74, so 10^(-0.4 x 14) = 2.5e-6 of the sun; a quarter moon
+// (phase angle 90) about -10.1, a tenth of the full moon.
+TEST(Ephemeris, MoonlightAgainstPublishedMagnitudes) {
+  auto magnitude = [](double alpha) { return -26.74 - 2.5 * std::log10(moonToSunIlluminance(alpha)); };
+  EXPECT_NEAR(magnitude(0), -12.74, 0.05);
+  EXPECT_NEAR(moonToSunIlluminance(0), 2.5e-6, 0.1e-6);
+  EXPECT_NEAR(magnitude(90), -10.1, 0.2);
+  EXPECT_NEAR(moonToSunIlluminance(90) / moonToSunIlluminance(0), 0.09, 0.015);
+  // Full moon illuminance outside the air, 0.25-0.32 lux (Krisciunas &
+  // Schaefer 1991; Allen), against the sun's 127-133 klux.
+  EXPECT_GT(moonToSunIlluminance(0) * 133000.0, 0.25);
+  EXPECT_LT(moonToSunIlluminance(0) * 127000.0, 0.35);
+}
+
 }  // namespace
 }  // namespace sky::render

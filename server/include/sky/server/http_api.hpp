@@ -8,6 +8,8 @@
 //                        400 {"error": ...} naming the field, 401 without the token
 //   POST /api/metar      METAR reports previewed, or applied with the token
 //                        (metar_api.hpp)
+//   GET  /, /console/*   the operator console's files, when options.console is set
+//                        (console_files.hpp)
 //   GET  /api/renderers  the weather-stream subscribers and their cameras
 //   GET  /api/ws         WebSocket upgrade: the console's live feed (console_feed.hpp)
 // Every endpoint, with its JSON, is in server/API.md.
@@ -35,11 +37,14 @@ class logger;
 
 namespace sky::server {
 
+class ConsoleFiles;
+
 struct HttpApiOptions {
   std::string listenAddress = "127.0.0.1";
   std::uint16_t port = 0;   // 0: ephemeral
   std::string token;        // empty: read-only (changes are refused)
   std::vector<Station> stations;  // METAR station table for POST /api/metar
+  std::shared_ptr<const ConsoleFiles> console;  // null: no console pages
   std::string serverId = "skyshell-weatherd";  // in the WebSocket hello
   ConsoleFeedOptions feed;
   std::shared_ptr<spdlog::logger> log;

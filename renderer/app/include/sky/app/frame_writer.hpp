@@ -1,11 +1,16 @@
-// Writes a headless channel's output: one PNG per frame (optionally the
-// linear radiance and the transmittance as PFM), and one JSON line of metadata per frame in
-// frames.jsonl (camera pose and its source, host frame, weather clock, image statistics).
+// Writes a channel's per-frame output: a PNG (tonemapped sRGB) and an EXR
+// (linear radiance, cloud transmittance, cloud depth) per frame, optionally
+// PFMs, and one JSON line of metadata per frame in frames.jsonl, the frames'
+// sidecar: camera pose and its source, host frame, weather clock and version,
+// the sun, the settings in use (preset, resolution, field of view, noise
+// seeds), GPU time per pass, image statistics, and the files written.
 #pragma once
 
 #include <cstdint>
 #include <fstream>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "sky/app/shared_state.hpp"
 #include "sky/core/result.hpp"
@@ -13,26 +18,52 @@
 
 namespace sky::app {
 
+// Name recorded while there is no preset system: the compiled-in model
+// constants and the RenderSettings written next to it.
+inline constexpr const char* kDefaultPreset = "default";
+
+struct FrameOutputs {
+  bool png = true;
+  bool exr = true;
+  bool pfm = false;  // radiance and transmittance as PFM (--write-float)
+};
+
+// What stays the same for every frame of a run; written on every line so
+// each line describes its frame on its own.
+struct RunSettings {
+  std::string preset = kDefaultPreset;
+  render::RenderSettings render;
+};
+
 struct FrameRecord {
   std::uint64_t frame = 0;
   HostPose host;
-  std::string source = "cigi";  // where the camera came from: "cigi" or "fdm" (FlightGear)
+  std::string source = "cigi";  // where the camera came from: "cigi", "fdm" (FlightGear) or "replay"
   double weatherClock_s = 0;
-  std::uint64_t weatherVersion = 0;
+  std::uint64_t weatherVersion = 0;  // this channel's count of weather updates applied (snapshots, deltas)
+  bool weatherConnected = false;     // the stream to the server was up when the frame was drawn
   std::size_t layerCount = 0;
+  double sunAzimuth_deg = 0, sunElevation_deg = 0;  // the sun the frame was lit by, local ENU
+  std::optional<double> utc_s;                      // when the sun came from the date (s since 1970)
   render::ImageStats stats;
-  double render_ms = 0;
+  double render_ms = 0;     // wall time of CloudRenderer::render
+  double cpu_ms = 0;        // process CPU time during it (all threads: lavapipe's workers too)
+  std::vector<render::PassTime> gpu;  // GPU time per pass (timestamps), in submission order
+  std::optional<bool> presented;      // windowed: whether the frame reached the window
 };
 
 class FrameWriter {
  public:
-  static Result<FrameWriter> open(const std::string& directory, bool writeFloat);
+  static Result<FrameWriter> open(const std::string& directory, const FrameOutputs& outputs,
+                                  const RunSettings& run);
   Result<void> write(const render::Image& image, const FrameRecord& record);
   const std::string& directory() const { return directory_; }
+  const FrameOutputs& outputs() const { return outputs_; }
 
  private:
   std::string directory_;
-  bool writeFloat_ = false;
+  FrameOutputs outputs_;
+  RunSettings run_;
   std::ofstream metadata_;
 };
 

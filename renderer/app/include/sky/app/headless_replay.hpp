@@ -1,6 +1,7 @@
-// skyshell-render --replay: renders a recorded flight headless, one frame per
-// fixed step of flight time, with the weather the server streams, then writes
-// an MP4 (ffmpeg), a contact sheet and a JSON report next to the frames.
+// skyshell-render --replay: renders a recorded flight headless (or shows it
+// in a window), one frame per fixed step of flight time, with the weather the
+// server streams, then writes an MP4 (ffmpeg), a contact sheet and a JSON
+// report next to the frames.
 //
 // Deterministic: frame i shows the flight at t0 + i × step and the weather at
 // clock base + i × step × rate (base: --weather-clock, else the server's clock
@@ -18,6 +19,8 @@
 #include <optional>
 #include <string>
 
+#include "sky/app/frame_writer.hpp"
+#include "sky/app/window_display.hpp"
 #include "sky/render/cloud_renderer.hpp"
 
 namespace sky::app {
@@ -33,20 +36,23 @@ struct ReplayOptions {
   unsigned short serverPort = 0;
   double weatherTimeout_s = 30;  // for the first snapshot and after each re-subscription
   std::string outDir;
-  bool writeFloat = false;
-  bool video = true;             // MP4 through ffmpeg (skipped with a warning if ffmpeg is missing)
+  FrameOutputs outputs;          // per frame: PNG, EXR, PFM; frames.jsonl always
+  bool video = true;             // MP4 through ffmpeg from the PNGs (skipped with a warning if ffmpeg is missing)
   double sunAzimuth_deg = 135, sunElevation_deg = 40;  // when the flight has no date, or fixedSun
   bool fixedSun = false;  // ignore the flight's recorded date (IGC, GPX) for the sun
-  std::string preset = "skeleton";  // recorded in the report
+  std::string preset = kDefaultPreset;  // recorded in the report and every frame's metadata
   // Flight seconds per wall second: a frame is not rendered before its time
   // (so a weather change timed in flight seconds lands on the frames it
   // should). 0: as fast as the renderer goes.
   double pace = 0;
+  // Windowed: every frame is also shown here; closing the window ends the
+  // replay (exit code 0, report written). Not owned.
+  WindowDisplay* display = nullptr;
 };
 
-// Runs the replay to the end (or until *stop turns true). Returns the process
-// exit code: 0 done, 2 bad input (flight file, output folder), 3 render
-// failure, 4 no weather in time.
+// Runs the replay to the end (or until *stop turns true, or the window is
+// closed). Returns the process exit code: 0 done (or window closed), 2 bad
+// input (flight file, output folder), 3 render failure, 4 no weather in time.
 int runHeadlessReplay(const ReplayOptions& options, render::CloudRenderer& renderer, const std::atomic<bool>* stop);
 
 }  // namespace sky::app

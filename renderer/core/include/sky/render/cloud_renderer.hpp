@@ -1,5 +1,5 @@
 // The headless cloud renderer's public face: settings, one frame's inputs (a
-// CIGI camera pose, the weather, the weather clock, the sun), the linear image
+// CIGI camera pose, the weather, the weather clock, the sun and the moon), the linear image
 // it returns, and PNG output. The Vulkan machinery stays behind a pimpl.
 #pragma once
 
@@ -12,6 +12,7 @@
 
 #include "sky/core/result.hpp"
 #include "sky/geo/geodetic.hpp"
+#include "sky/render/gpu_options.hpp"
 #include "sky/weather/model.hpp"
 
 namespace sky::render {
@@ -23,6 +24,9 @@ struct RenderSettings {
   std::uint32_t width = 320, height = 180;  // pixels, [1, 8192]
   double verticalFov_deg = 60;              // (0, 179)
   std::uint32_t noiseSeed = 1;              // shape noise; same seed, same clouds
+  // Where noise textures are cached between starts (noise_cache.hpp);
+  // empty: generated at every start.
+  std::string noiseCacheDir;
 };
 
 struct FrameInputs {
@@ -36,14 +40,29 @@ struct FrameInputs {
   // When set (UTC, s since 1970), the sun is where it is at that instant seen
   // from the camera (ephemeris.hpp), and the two angles above are ignored.
   std::optional<double> utc_s;
+  // The moon, when utc_s is unset (with utc_s the ephemeris places it and
+  // gives its phase): direction in the camera's local ENU frame and phase
+  // angle, 0 full to 180 new. The clouds are lit by one key light: the sun,
+  // or the moon when it lights the ground more (frame_setup.cpp).
+  double moonAzimuth_deg = 0, moonElevation_deg = -90, moonPhaseAngle_deg = 180;
   std::uint64_t frameIndex = 0;  // carried for reprojection; the skeleton's image does not depend on it
 };
 
 // Linear radiance, rgba per pixel (a = view-ray transmittance through the
-// clouds), row-major, top row first.
+// clouds), row-major, top row first; and per pixel the cloud depth: the
+// distance along the view ray to where the clouds took the light out of it,
+// weighted by how much they took (m; 0 where the ray met no cloud, i.e.
+// a = 1). Images that are not renders (contact sheets) leave it empty.
 struct Image {
   std::uint32_t width = 0, height = 0;
   std::vector<float> rgba;
+  std::vector<float> cloudDepth_m;  // width * height, or empty
+};
+
+// GPU time of one pass, from timestamps written before and after its commands.
+struct PassTime {
+  std::string pass;   // "weather_upload", "clouds", "present", ...
+  double gpu_ms = 0;  // ms
 };
 
 struct ImageStats {
@@ -57,11 +76,33 @@ class CloudRenderer {
   // chooses by name), loads the SPIR-V and builds the pass. Errors: Unsupported
   // when there is no Vulkan driver or device, Io when the shader is missing,
   // Device for any other Vulkan failure, InvalidArgument for bad settings.
-  static Result<std::unique_ptr<CloudRenderer>> create(const RenderSettings& settings);
+  // `gpu` adds Khronos validation and, for a windowed front end, the window
+  // surface (then present() shows frames in it).
+  static Result<std::unique_ptr<CloudRenderer>> create(const RenderSettings& settings, const GpuOptions& gpu = {});
 
   // Renders one frame (blocking). Errors: InvalidArgument for out-of-range
   // inputs (more than kMaxLayers layers, bad pose), Device/Timeout from the GPU.
   Result<Image> render(const FrameInputs& inputs);
+
+  // Shows a rendered image in the window (created with GpuOptions::window),
+  // with the PNG's display transform. Returns false when the window could
+  // not take a frame this time (minimised, being resized). Errors:
+  // InvalidArgument without a window or for an image of another size,
+  // Device/Timeout from the GPU.
+  Result<bool> present(const Image& image);
+
+  // The passes the GPU ran for the last render() (and a present() after it),
+  // in submission order; empty when the device's queue has no timestamps.
+  const std::vector<PassTime>& lastPassTimes() const;
+
+  // Validation messages since the last call, and the totals (nothing
+  // without GpuOptions::validation).
+  std::vector<std::string> takeValidationMessages();
+  ValidationCounts validationCounts();
+
+  // How the noise textures were obtained at create(): "shape noise 64^3 seed
+  // 1: loaded from <file>" (or generated, regenerated and why).
+  const std::string& noiseReport() const;
 
   std::string deviceName() const;
   const RenderSettings& settings() const;

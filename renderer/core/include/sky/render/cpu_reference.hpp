@@ -1,14 +1,48 @@
-// CPU reference: the same cloud model as the GPU pass (shaders/include/
+// CPU reference: the same cloud and sky model as the GPU pass (shaders/include/
 // cloud_core.glsl compiled as C++), evaluated in double precision with
-// emulated texture filtering, for image tests and numerical checks.
+// emulated texture filtering, for image tests and numerical checks. It reads
+// the same noise and atmosphere tables the GPU uploads, built the same way.
 #pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
 
 #include "sky/render/cloud_renderer.hpp"
 
 namespace sky::render {
 
-// Renders the frame on the CPU. Same contract and errors as
-// CloudRenderer::render (no Device errors). Slow: meant for small images.
+struct PixelCoord {
+  std::uint32_t x = 0, y = 0;  // column, row (top row 0)
+};
+
+class CpuReference {
+ public:
+  // Builds the shape and detail noise (from settings.noiseSeed) and the
+  // atmosphere tables once. Errors: InvalidArgument for bad settings.
+  static Result<CpuReference> create(const RenderSettings& settings);
+
+  // Every pixel of the frame. Same contract and errors as
+  // CloudRenderer::render (no Device errors). Slow: meant for small images.
+  Result<Image> render(const FrameInputs& inputs) const;
+
+  // Only the listed pixels, rgba each (a = cloud transmittance), in the
+  // order given. InvalidArgument for a pixel outside the image.
+  Result<std::vector<std::array<float, 4>>> renderPixels(const FrameInputs& inputs,
+                                                         std::span<const PixelCoord> pixels) const;
+
+  const RenderSettings& settings() const { return settings_; }
+
+ private:
+  struct Tables;
+  CpuReference(RenderSettings settings, std::shared_ptr<const Tables> tables);
+  RenderSettings settings_;
+  std::shared_ptr<const Tables> tables_;
+};
+
+// One-shot convenience: create() then render() (rebuilds the tables each call).
 Result<Image> renderCpuReference(const RenderSettings& settings, const FrameInputs& inputs);
 
 }  // namespace sky::render

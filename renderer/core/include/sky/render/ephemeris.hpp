@@ -9,7 +9,8 @@
 // periodic terms (the largest six in longitude, four in latitude), ~0.3 degree:
 // enough to place it in the sky, not for eclipses.
 // Geocentric directions; no refraction, no parallax (the moon's horizontal
-// parallax, up to ~1 degree, is applied for the moon's elevation).
+// parallax, up to ~1 degree, is applied for the moon's elevation). And how
+// bright the moon is: its phase angle and its light relative to the sun's.
 #pragma once
 
 namespace sky::render {
@@ -33,5 +34,17 @@ EquatorialDirection moonEquatorial(double unix_s);
 
 SkyDirection sunDirection(double unix_s, double lat_deg, double lon_deg);
 SkyDirection moonDirection(double unix_s, double lat_deg, double lon_deg);
+
+// The moon's phase angle (sun - moon - Earth), deg in [0, 180]: 0 full, 180
+// new. From the geocentric elongation psi (Meeus 48.2-48.3, the moon at its
+// mean distance: i = 180 - psi - 0.147 sin psi deg, within ~0.02 deg of the
+// exact form; the moon's position limits it to ~0.3 deg).
+double moonPhaseAngle_deg(double unix_s);
+
+// The moon's illuminance over the sun's, both outside the air, at phase
+// angle alpha (deg): V magnitudes -26.74 for the sun and -12.73 + 0.026
+// |alpha| + 4e-9 alpha^4 for the moon at its mean distance (Allen, as
+// Krisciunas & Schaefer 1991 eq. 9 use it): 2.5e-6 at full moon.
+double moonToSunIlluminance(double phaseAngle_deg);
 
 }  // namespace sky::render

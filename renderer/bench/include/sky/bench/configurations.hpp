@@ -1,0 +1,50 @@
+// Render configurations the bench measures: a named RenderSettings plus what
+// the bench itself varies. `reference` is the ground truth every other
+// configuration is compared with. builtInConfigurations() (configurations.cpp)
+// is the one place presets plug in once the renderer has them.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sky/core/result.hpp"
+#include "sky/render/cloud_renderer.hpp"
+
+namespace sky::bench {
+
+inline constexpr const char* kReferenceName = "reference";
+
+struct Configuration {
+  std::string name;         // [a-z0-9-], what --configs selects and the report shows
+  std::string description;  // what it changes against reference, one line
+  // Fraction of the output resolution the renderer draws at; the bench
+  // resizes the image bilinearly to the output size before comparing
+  // (display.hpp). The renderer has no render scale of its own yet; when it
+  // does, a preset sets it in RenderSettings and this stays 1. (0, 1].
+  double renderScale = 1.0;
+  // Whether frames reuse earlier frames (reprojection, temporal
+  // accumulation). Only such a configuration can ghost: for the others the
+  // bench measures ghosting against the configuration's own frames (0). For
+  // one that does, it measures against reference until the renderer can draw
+  // the same configuration without history (then that is the baseline:
+  // runner.cpp, temporalBaseline).
+  bool reusesHistory = false;
+  // The renderer's settings for this configuration; width, height and
+  // verticalFov_deg are overwritten per scene and resolution by settingsFor.
+  render::RenderSettings settings;
+};
+
+// Every configuration the bench knows, `reference` first.
+std::vector<Configuration> builtInConfigurations();
+
+// The configurations named (comma-separated names or "all"), `reference`
+// always first, whether named or not. Errors: InvalidArgument naming an
+// unknown configuration and listing the known ones.
+Result<std::vector<Configuration>> selectConfigurations(const std::string& names);
+
+// The RenderSettings a configuration renders a scene with at an output size.
+render::RenderSettings settingsFor(const Configuration& config, std::uint32_t outWidth, std::uint32_t outHeight,
+                                   double verticalFov_deg);
+
+}  // namespace sky::bench

@@ -1,0 +1,309 @@
+// The bench run (see runner.hpp): renders, times, compares, and writes each
+// scene's images and contact sheet.
+#include "sky/bench/runner.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <thread>
+
+#include "sky/bench/contact_sheet.hpp"
+#include "sky/bench/cpu_time.hpp"
+#include "sky/bench/display.hpp"
+#include "sky/bench/driver_pin.hpp"
+#include "sky/bench/renderer_probe.hpp"
+
+namespace sky::bench {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msBetween(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+struct Rendered {
+  render::Image image;
+  FrameTiming timing;
+};
+
+Result<Rendered> timedRender(render::CloudRenderer& renderer, const render::FrameInputs& inputs) {
+  const CpuSnapshot before = sampleCpu();
+  const auto t0 = Clock::now();
+  auto image = renderer.render(inputs);
+  const auto t1 = Clock::now();
+  const CpuSnapshot after = sampleCpu();
+  if (!image) return tl::unexpected(image.error());
+  Rendered out{std::move(*image), {}};
+  out.timing.wall_ms = msBetween(t0, t1);
+  const CpuUse use = cpuBetween(before, after);
+  out.timing.cpu_ms = use.cpu_ms;
+  out.timing.maxThread_ms = use.maxThread_ms;
+  const RendererCounters counters = rendererCounters(renderer, out.image);
+  out.timing.gpu_ms = counters.gpuCloud_ms;
+  out.timing.lookups = counters.densityLookups;
+  return out;
+}
+
+// The reference's frames of one scene at one resolution.
+struct ReferenceFrames {
+  std::vector<std::vector<float>> linear;
+  std::vector<Srgb8Image> srgb;
+  double medianWall_ms = 0;
+};
+
+// What a case keeps for the temporal error and the contact sheet.
+struct KeptFrames {
+  std::vector<Srgb8Image> srgb;
+};
+
+std::string fixed(double v, int digits) {
+  if (!std::isfinite(v)) return v > 0 ? "inf" : "nan";
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
+
+std::string sizeName(std::uint32_t w, std::uint32_t h) { return std::to_string(w) + "x" + std::to_string(h); }
+
+Result<CaseResult> runCase(const LoadedScene& ls, const Configuration& config, const Resolution& res,
+                           const RunOptions& options, ReferenceFrames& reference, KeptFrames& kept,
+                           std::string& deviceName) {
+  const Scene& scene = ls.scene;
+  const bool isReference = config.name == kReferenceName;
+  CaseResult cr;
+  cr.scene = scene.name;
+  cr.configuration = config.name;
+  cr.path = scene.isPath();
+  cr.width = res.width;
+  cr.height = res.height;
+  const render::RenderSettings settings = settingsFor(config, res.width, res.height, scene.verticalFov_deg);
+  cr.renderWidth = settings.width;
+  cr.renderHeight = settings.height;
+
+  const auto c0 = Clock::now();
+  auto renderer = render::CloudRenderer::create(settings);
+  if (!renderer) return tl::unexpected(renderer.error());
+  cr.create_ms = msBetween(c0, Clock::now());
+  deviceName = (*renderer)->deviceName();
+  keepVulkanDriversLoaded();
+  for (std::uint32_t i = 0; i < options.warmup; ++i)
+    if (auto warm = (*renderer)->render(frameInputs(ls, 0)); !warm) return tl::unexpected(warm.error());
+
+  const std::uint32_t frames = cr.path ? scene.frames : 1;
+  const std::uint32_t repeats = std::max(1u, cr.path ? options.pathRepeats : options.repeats);
+  std::vector<float> firstStill;
+  double mseSum = 0, rmseSum = 0, ssimSum = 0;
+  cr.worst.psnr_dB = std::numeric_limits<double>::infinity();
+  cr.worst.rmseLinear = 0;
+  for (std::uint32_t rep = 0; rep < repeats; ++rep)
+    for (std::uint32_t f = 0; f < frames; ++f) {
+      auto rendered = timedRender(**renderer, frameInputs(ls, f));
+      if (!rendered) return tl::unexpected(rendered.error());
+      cr.frames.push_back(rendered->timing);
+      if (rep > 0) {
+        const auto& px = rendered->image.rgba;
+        if (!cr.path && (px.size() != firstStill.size() ||
+                         std::memcmp(px.data(), firstStill.data(), px.size() * sizeof(float)) != 0))
+          cr.repeatable = false;
+        continue;
+      }
+      cr.nonFinitePixels += render::computeStats(rendered->image).nonFinite;
+      std::vector<float> linear =
+          (rendered->image.width == res.width && rendered->image.height == res.height)
+              ? rendered->image.rgba
+              : resizeBilinear({rendered->image.width, rendered->image.height, rendered->image.rgba}, res.width,
+                               res.height);
+      if (!cr.path) firstStill = rendered->image.rgba;
+      Srgb8Image srgb = toSrgb8({res.width, res.height, linear});
+      if (isReference) {
+        reference.linear.push_back(linear);
+        reference.srgb.push_back(srgb);
+      }
+      auto rmse = rmseLinear({res.width, res.height, linear}, {res.width, res.height, reference.linear[f]});
+      auto r8 = rmse8(srgb, reference.srgb[f]);
+      auto p = psnr(srgb, reference.srgb[f]);
+      auto s = ssim(srgb, reference.srgb[f]);
+      if (!rmse || !r8 || !p || !s) return fail(ErrorCode::InvalidArgument, scene.name + ": cannot compare images");
+      rmseSum += *rmse;
+      mseSum += *r8 * *r8;
+      ssimSum += *s;
+      cr.worst.rmseLinear = std::max(cr.worst.rmseLinear, *rmse);
+      cr.worst.psnr_dB = std::min(cr.worst.psnr_dB, *p);
+      cr.worst.ssim = std::min(cr.worst.ssim, *s);
+      kept.srgb.push_back(std::move(srgb));
+    }
+  cr.error.rmseLinear = rmseSum / frames;
+  cr.error.ssim = ssimSum / frames;
+  const double mse = mseSum / frames;  // PSNR of the MSE pooled over the path's frames
+  cr.error.psnr_dB = mse == 0 ? std::numeric_limits<double>::infinity() : 10 * std::log10(255.0 * 255.0 / mse);
+  if (!cr.path) cr.worst = cr.error;
+  if (cr.path) {
+    // temporalBaseline: a configuration without history is its own baseline;
+    // one with history is compared with reference until the renderer can draw
+    // it history-free (metrics.hpp, ghosting).
+    const std::span<const Srgb8Image> baseline =
+        config.reusesHistory ? std::span<const Srgb8Image>(reference.srgb) : std::span<const Srgb8Image>(kept.srgb);
+    auto te = temporalError(kept.srgb, reference.srgb, baseline);
+    if (!te) return tl::unexpected(te.error());
+    cr.temporal = std::move(*te);
+  }
+
+  std::vector<double> wall, cpu, busiest, gpu;
+  double lookups = 0, gpuTotal_ms = 0;
+  bool allLookups = true;
+  for (const FrameTiming& t : cr.frames) {
+    wall.push_back(t.wall_ms);
+    cpu.push_back(t.cpu_ms);
+    busiest.push_back(t.maxThread_ms);
+    if (t.gpu_ms) gpu.push_back(*t.gpu_ms), gpuTotal_ms += *t.gpu_ms;
+    if (t.lookups) lookups += double(*t.lookups);
+    allLookups = allLookups && t.lookups.has_value();
+  }
+  cr.wall_ms = spreadOf(wall);
+  cr.cpu_ms = spreadOf(cpu);
+  cr.maxThread_ms = spreadOf(busiest);
+  if (gpu.size() == cr.frames.size()) cr.gpu_ms = spreadOf(gpu);
+  if (cr.gpu_ms && allLookups && gpuTotal_ms > 0) cr.lookupsPerSecond = lookups / (gpuTotal_ms * 1e-3);
+  if (isReference) reference.medianWall_ms = cr.wall_ms.median;
+  return cr;
+}
+
+// Writes each configuration's displayed frame and the scene's contact sheet:
+// one row per configuration (its frame, the reference, the error heat map).
+Result<std::string> writeSceneImages(const std::string& stem, const std::vector<CaseResult>& cases,
+                                     const std::vector<KeptFrames>& kept, const RunOptions& options) {
+  const std::filesystem::path dir = options.outDir / "contact";
+  std::error_code ec;
+  std::filesystem::create_directories(dir / "frames", ec);
+  if (ec) return fail(ErrorCode::Io, (dir / "frames").string() + ": " + ec.message());
+  const Srgb8Image& ref = kept.front().srgb.back();
+  std::vector<Srgb8Image> heat(cases.size());
+  std::vector<std::vector<SheetCell>> rows;
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const Srgb8Image& img = kept[i].srgb.back();
+    if (auto ok = writePng(img, (dir / "frames" / (stem + "-" + cases[i].configuration + ".png")).string()); !ok)
+      return tl::unexpected(ok.error());
+    const std::string timeLabel = cases[i].configuration + " " + fixed(cases[i].wall_ms.median, 1) + " MS";
+    if (i == 0) {
+      rows.push_back({{&img, timeLabel}});
+      continue;
+    }
+    auto map = errorHeatMap(img, ref);
+    auto shownSsim = ssim(img, ref);
+    auto shownPsnr = psnr(img, ref);
+    if (!map || !shownSsim || !shownPsnr) return fail(ErrorCode::InvalidArgument, stem + ": cannot compare images");
+    heat[i] = std::move(*map);
+    // The metrics of the frame shown (a path's last), not of the whole path.
+    rows.push_back({{&img, timeLabel},
+                    {&ref, "REFERENCE"},
+                    {&heat[i], "SSIM " + fixed(*shownSsim, 3) + " PSNR " + fixed(*shownPsnr, 1)}});
+  }
+  const std::string title = stem + (cases.front().path ? " (LAST FRAME)" : "") + " - ERROR 0 TO " +
+                            fixed(kHeatMapFullScale, 0) + " LEVELS, BLACK TO WHITE";
+  const std::string file = "contact/" + stem + ".png";
+  if (auto ok = writePng(contactSheet(title, rows), (options.outDir / file).string()); !ok)
+    return tl::unexpected(ok.error());
+  return file;
+}
+
+std::string readFirstLine(const char* path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  return line;
+}
+
+}  // namespace
+
+Spread spreadOf(std::vector<double> values) {
+  Spread s;
+  s.samples = values.size();
+  if (values.empty()) return s;
+  std::sort(values.begin(), values.end());
+  auto rank = [&](double q) { return values[std::min(values.size() - 1, std::size_t(q * double(values.size())))]; };
+  const std::size_t n = values.size();
+  s.median = n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+  s.min = values.front();
+  s.max = values.back();
+  s.p10 = rank(0.1);
+  s.p90 = rank(0.9);
+  return s;
+}
+
+std::string loadAverage() {
+  std::istringstream in(readFirstLine("/proc/loadavg"));
+  std::string a, b, c;
+  in >> a >> b >> c;
+  return a + " " + b + " " + c;
+}
+
+MachineInfo describeMachine() {
+  MachineInfo m;
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  for (std::string line; std::getline(cpuinfo, line);)
+    if (line.rfind("model name", 0) == 0) {
+      m.cpu = line.substr(line.find(':') + 2);
+      break;
+    }
+  m.cores = std::thread::hardware_concurrency();
+  const char* lp = std::getenv("LP_NUM_THREADS");
+  m.lpNumThreads = lp ? lp : "(unset: lavapipe uses one thread per CPU)";
+  m.loadAverageStart = loadAverage();
+  const std::time_t now = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  m.started = buf;
+  return m;
+}
+
+Result<BenchReport> runBench(const std::vector<LoadedScene>& scenes, const RunOptions& options) {
+  BenchReport report;
+  report.machine = describeMachine();
+  report.timingSource = rendererCountersSource();
+  report.warmup = options.warmup;
+  report.repeats = options.repeats;
+  report.pathRepeats = options.pathRepeats;
+  auto log = [&](const std::string& line) {
+    if (options.log) options.log(line);
+  };
+  if (options.configurations.empty() || options.configurations.front().name != kReferenceName)
+    return fail(ErrorCode::InvalidArgument, "the first configuration must be reference");
+  for (const Resolution& res : options.resolutions)
+    for (const LoadedScene& ls : scenes) {
+      const std::string stem = ls.scene.name + "-" + sizeName(res.width, res.height);
+      ReferenceFrames reference;
+      std::vector<CaseResult> cases;
+      std::vector<KeptFrames> kept;
+      for (const Configuration& config : options.configurations) {
+        KeptFrames frames;
+        auto cr = runCase(ls, config, res, options, reference, frames, report.machine.device);
+        if (!cr) return fail(cr.error().code, stem + " " + config.name + ": " + cr.error().detail);
+        log(stem + " " + config.name + ": " + fixed(cr->wall_ms.median, 2) + " ms median (" +
+            fixed(cr->wall_ms.min, 2) + "-" + fixed(cr->wall_ms.max, 2) + ", " + std::to_string(cr->wall_ms.samples) +
+            " frames), SSIM " + fixed(cr->error.ssim, 4) + ", PSNR " + fixed(cr->error.psnr_dB, 2) + " dB" +
+            (cr->nonFinitePixels ? ", " + std::to_string(cr->nonFinitePixels) + " NON-FINITE PIXELS" : ""));
+        cases.push_back(std::move(*cr));
+        kept.push_back(std::move(frames));
+      }
+      auto sheet = writeSceneImages(stem, cases, kept, options);
+      if (!sheet) return tl::unexpected(sheet.error());
+      for (CaseResult& c : cases) {
+        c.contactSheet = *sheet;
+        report.cases.push_back(std::move(c));
+      }
+    }
+  report.machine.loadAverageEnd = loadAverage();
+  return report;
+}
+
+}  // namespace sky::bench

@@ -1,0 +1,487 @@
+// Browser tests of the operator console (server/console/) against a real
+// skyshell-weatherd: node console_test.mjs <case>. ctest runs each case as
+// its own test (label console); a case that cannot run here (no Chromium, no
+// playwright-core, a server without the WebSocket it needs) exits 77 and is
+// reported skipped.
+import { execFileSync } from "node:child_process";
+import fs from "node:fs";
+import path from "node:path";
+import {
+  assert, child, config, launch, near, openConsole, run, skip, TOKEN, until, Weatherd, withoutWebSocketAllowances,
+} from "./harness.mjs";
+
+const R = 6371008.8;  // the console's sphere (mean Earth radius)
+const D2R = Math.PI / 180;
+
+// Text of the layer table's row for a layer id.
+const rowText = (page, id) => page.textContent(`#layer-table tbody tr[data-id="${id}"]`).catch(() => "");
+
+async function setup(name, cleanup, options = {}) {
+  await import("./harness.mjs").then((h) => h.loadPlaywright());
+  const w = await new Weatherd(name, options).start();
+  cleanup(() => w.stop());
+  const hasWs = await w.hasWebSocket();
+  const browser = await launch();
+  cleanup(() => browser.close());
+  return { w, hasWs, browser };
+}
+
+function noProblems(...lists) {
+  const all = lists.flat();
+  assert(all.length === 0, `the pages reported:\n  ${all.join("\n  ")}`);
+}
+
+const cases = {
+  // A layer edited in one console appears in another and in GET /api/state;
+  // a change made through the API appears in both consoles.
+  async two_pages(cleanup) {
+    const { w, hasWs, browser } = await setup("two_pages", cleanup);
+    const allowed = withoutWebSocketAllowances(hasWs);
+    const a = await openConsole(browser, w, { token: TOKEN, allowed, name: "A" });
+    const b = await openConsole(browser, w, { allowed, name: "B" });
+    console.log(`  link: A ${await a.page.getAttribute("body", "data-link")}, B ${await b.page.getAttribute("body", "data-link")}`);
+    await a.page.click('#layer-table tbody tr[data-id="1"]');
+    await a.page.fill('[name="coverage_pct"]', "85");
+    // 85 % is 6.8 oktas: the pair follows.
+    assert((await a.page.inputValue('[name="coverage_oktas"]')) === "6.8", "oktas follow the percentage");
+    await a.page.fill('[name="base_ft"]', "5000");
+    await a.page.click("#layer-apply");
+    await until("A's note to say applied", async () => /applied #/.test(await a.page.textContent("#layers .note")));
+    const s = await w.state();
+    const l1 = s.layers.find((l) => l.id === 1);
+    near(l1.coverage, 0.85, 1e-9, "layer 1 coverage in the API");
+    near(l1.base_m, 5000 * 0.3048, 1e-6, "5000 ft base in metres in the API");
+    await until("B to show 85 %", async () => /85 %/.test(await rowText(b.page, 1)));
+    assert(/1524 m/.test(await rowText(b.page, 1)), "B shows the base in metres");
+    // The other way: a change through the API reaches both pages.
+    const r = await w.api("POST", "/api/changes", { author: "api-test", changes: [{ op: "set_layer", layer: {
+      id: 5, type: "stratus", base_m: 300, thickness_m: 200, transition_band_m: 20, coverage: 0.4, density: 0.8,
+      wind: { speed_mps: 5, from_deg: 180, vertical_mps: 0 } } }] });
+    assert(r.status === 200, `API change: ${r.text}`);
+    for (const p of [a.page, b.page]) await until("layer 5 in a console", async () => /stratus/.test(await rowText(p, 5)));
+    await until("B's event log to name the API author", async () => /api-test/.test(await b.page.textContent("#events")));
+    assert(/console/.test(await b.page.textContent("#events")), "B's log names the console's author");
+    noProblems(a.problems, b.problems);
+  },
+
+  // The live path: the console is on the WebSocket (not polling), a change
+  // reaches it by push, and it does not poll the state meanwhile.
+  async live_ws(cleanup) {
+    const { w, hasWs, browser } = await setup("live_ws", cleanup);
+    if (!hasWs) skip("this skyshell-weatherd has no WebSocket at /api/ws yet (GET /api/ws does not upgrade)");
+    const a = await openConsole(browser, w, { name: "A" });
+    await until("the console to be live", async () => (await a.page.getAttribute("body", "data-link")) === "live");
+    let statePolls = 0;
+    a.page.on("request", (req) => { if (new URL(req.url()).pathname === "/api/state") ++statePolls; });
+    const r = await w.api("POST", "/api/changes", { author: "ws-test", changes: [{ op: "set_clock", rate: 10 }] });
+    assert(r.status === 200, r.text);
+    await until("the pushed rate", async () => /×10/.test(await a.page.textContent("#clock-rate")));
+    await until("the pushed event", async () => /ws-test/.test(await a.page.textContent("#events")));
+    await new Promise((res) => setTimeout(res, 3000));
+    assert(statePolls === 0, `the live console polled GET /api/state ${statePolls} times`);
+    await until("health from the socket", async () => /console clients\s*[1-9]/.test(await a.page.textContent("#health")));
+    noProblems(a.problems);
+  },
+
+  // METAR: a preview lists each report's layers (or why it does not parse)
+  // and changes nothing; apply puts the station's weather in the state.
+  async metar(cleanup) {
+    const { w, hasWs, browser } = await setup("metar", cleanup);
+    const a = await openConsole(browser, w, { token: TOKEN, allowed: withoutWebSocketAllowances(hasWs), name: "A" });
+    const before = await w.state();
+    // LJLJ (Ljubljana, 388 m in deploy/metar/stations.csv): broken at 3000 ft
+    // above the station; the second report's cloud group is malformed.
+    await a.page.fill('[name="reports"]',
+      "METAR LJLJ 221150Z 24008KT 9999 BKN030 12/06 Q1018\nMETAR LIPQ 221150Z 24008KT 9999 BKN0x5 12/06 Q1018");
+    await a.page.click("#metar-preview");
+    await until("the preview", async () => (await a.page.$$("#metar-result li")).length === 2);
+    const items = await a.page.$$eval("#metar-result li", (lis) => lis.map((li) => [li.className, li.textContent]));
+    assert(items[0][0] === "ok" && /LJLJ/.test(items[0][1]) && /\/8/.test(items[0][1]), `report 1 previewed: ${items[0][1]}`);
+    assert(items[1][0] === "bad" && /BKN0x5/.test(items[1][1]), `report 2 refused naming its group: ${items[1][1]}`);
+    assert((await w.state()).sequence === before.sequence, "a preview changes nothing");
+    await a.page.click("#metar-apply");
+    await until("applied", async () => /applied #/.test(await a.page.textContent("#metar .note")));
+    const s = await w.state();
+    const region = s.regions.find((r) => Math.abs(r.center_lat_deg - 46.2237) < 0.01);
+    assert(region, `a region at LJLJ: ${JSON.stringify(s.regions)}`);
+    const layer = region.layers.find((l) => l.coverage > 0);
+    // BKN is 5 to 7 oktas (WMO code table 2700); 3000 ft above a 388 m station.
+    assert(layer.coverage >= 5 / 8 && layer.coverage <= 7 / 8, `BKN coverage ${layer.coverage}`);
+    near(layer.base_m, 3000 * 0.3048 + 388, 15, "BKN030 base in metres MSL");
+    await until("the METAR event", async () => /metar/.test(await a.page.textContent("#events")));
+    noProblems(a.problems);
+  },
+
+  // A storm cell placed by clicking on the map, resized by its handle,
+  // appears in the API where it was clicked.
+  async region_click(cleanup) {
+    const { w, hasWs, browser } = await setup("region_click", cleanup);
+    const lat0 = 46, lon0 = 13, scale = 100;  // m per CSS px
+    const a = await openConsole(browser, w, { token: TOKEN, allowed: withoutWebSocketAllowances(hasWs), name: "A",
+      hash: `#focus=${lat0},${lon0}&scale=${scale}` });
+    const box = await a.page.locator("#map").boundingBox();
+    const cx = box.x + box.width / 2, cy = box.y + box.height / 2;
+    const dx = 120, dy = -80;  // px: east and north of the focus
+    await a.page.click("#mode-storm");
+    await a.page.mouse.click(cx + dx, cy + dy);
+    await until("the region form", async () => a.page.isVisible("#region-form"));
+    // The size handle sits on the east edge: 5 km (50 px) east of the centre
+    // for the default 10 km cell; dragging it to 80 px makes the cell 16 km.
+    await a.page.mouse.move(cx + dx + 50, cy + dy);
+    await a.page.mouse.down();
+    await a.page.mouse.move(cx + dx + 65, cy + dy, { steps: 4 });
+    await a.page.mouse.move(cx + dx + 80, cy + dy, { steps: 4 });
+    await a.page.mouse.up();
+    await a.page.click("#region-apply");
+    await until("applied", async () => /applied #/.test(await a.page.textContent("#region .note")));
+    const s = await w.state();
+    assert(s.regions.length === 1, `one region: ${JSON.stringify(s.regions)}`);
+    const r = s.regions[0];
+    // Independent of the page's projection code: a flat local frame, good
+    // to well under a pixel 15 km from the focus.
+    near(r.center_lat_deg, lat0 + (-dy * scale) / R / D2R, 0.001, "centre latitude");
+    near(r.center_lon_deg, lon0 + (dx * scale) / (R * Math.cos(lat0 * D2R)) / D2R, 0.0015, "centre longitude");
+    near(r.size_x_m, 16000, 300, "width after dragging the handle");
+    assert(r.layers.length === 1 && r.layers[0].type === "cumulonimbus", "a storm cell's layer");
+    // The transition handle: the default 4 km perimeter ends 40 px beyond the
+    // 80 px edge; dragged out to 150 px it becomes 7 km.
+    await a.page.mouse.move(cx + dx + 120, cy + dy);
+    await a.page.mouse.down();
+    await a.page.mouse.move(cx + dx + 135, cy + dy, { steps: 4 });
+    await a.page.mouse.move(cx + dx + 150, cy + dy, { steps: 4 });
+    await a.page.mouse.up();
+    await a.page.click("#region-apply");
+    await until("the perimeter applied", async () => {
+      const g = (await w.state()).regions[0];
+      return g && Math.abs(g.transition_m - 7000) < 300;
+    });
+    // A clearing placed by press and drag: 60 px from its centre is a 12 km
+    // hole, every global layer at coverage 0 inside.
+    await a.page.click("#mode-clearing");
+    await a.page.mouse.move(cx - 150, cy + 100);
+    await a.page.mouse.down();
+    await a.page.mouse.move(cx - 120, cy + 100, { steps: 4 });
+    await a.page.mouse.move(cx - 90, cy + 100, { steps: 4 });
+    await a.page.mouse.up();
+    await a.page.click("#region-apply");
+    const clearing = await until("the clearing in the API", async () => (await w.state()).regions.find((g) => g.id !== r.id));
+    near(clearing.size_x_m, 12000, 300, "clearing size from the drag");
+    assert(clearing.layers.length === 1 && clearing.layers[0].id === 1 && clearing.layers[0].coverage === 0,
+      `a clearing of layer 1: ${JSON.stringify(clearing.layers)}`);
+    noProblems(a.problems);
+  },
+
+  // The weather clock: pause, a jump, a rate; a layer change scheduled as a
+  // ramp shows on the timeline and in the API's pending changes.
+  async clock(cleanup) {
+    const { w, hasWs, browser } = await setup("clock", cleanup);
+    const a = await openConsole(browser, w, { token: TOKEN, allowed: withoutWebSocketAllowances(hasWs), name: "A" });
+    await a.page.click('[data-rate="0"]');
+    await until("paused", async () => (await w.state()).clock_rate === 0);
+    await until("the page says paused", async () => /paused/.test(await a.page.textContent("#clock-rate")));
+    await a.page.fill('[name="jump"]', "12:00");
+    await a.page.click("#clock-jump-form button");
+    await until("the jump", async () => Math.abs((await w.state()).clock_s - 43200) < 1e-6);
+    await until("the page's clock", async () => (await a.page.textContent("#clock-now")) === "12:00:00");
+    // Coverage 0.6 -> 0.9 from 12:10 over 10 minutes.
+    await a.page.click('#layer-table tbody tr[data-id="1"]');
+    await a.page.fill('[name="coverage_oktas"]', "7.2");
+    assert((await a.page.inputValue('[name="coverage_pct"]')) === "90", "7.2 oktas is 90 %");
+    await a.page.fill('[name="ramp"]', "600");
+    await a.page.fill('[name="at"]', "12:10:00");
+    await a.page.click("#layer-apply");
+    await until("applied", async () => /applied #/.test(await a.page.textContent("#layers .note")));
+    const s = await w.state();
+    assert(s.pending.length === 1 && s.pending[0].start_s === 43800 && s.pending[0].end_s === 44400,
+      `pending: ${JSON.stringify(s.pending)}`);
+    near(s.layers[0].coverage, 0.6, 1e-12, "not yet started");
+    await until("the timeline entry", async () => /at 12:10:00, in 00:10:00/.test(await a.page.textContent("#timeline-list")));
+    await a.page.click('[data-rate="60"]');
+    await until("x60", async () => (await w.state()).clock_rate === 60);
+    noProblems(a.problems);
+  },
+
+  // Invalid input is refused next to its field, before anything is sent;
+  // a refusal from the server (the layer was removed meanwhile by someone
+  // else) lands next to the field it names; the state stays as it was.
+  async invalid(cleanup) {
+    const { w, hasWs, browser } = await setup("invalid", cleanup);
+    const allowed = [...withoutWebSocketAllowances(hasWs),
+      { text: /status of 400/, url: /\/api\/changes$/, why: "the server's refusal this test provokes" }];
+    const a = await openConsole(browser, w, { token: TOKEN, allowed, name: "A" });
+    const before = await w.state();
+    await a.page.click('#layer-table tbody tr[data-id="1"]');
+    const err = (f) => a.page.textContent(`#layer-form [data-err="${f}"]`);
+    await a.page.fill('[name="coverage_pct"]', "140");
+    assert(/outside 0–100 %/.test(await err("coverage")), `coverage message: ${await err("coverage")}`);
+    await a.page.fill('[name="coverage_pct"]', "50");
+    await a.page.fill('[name="base_m"]', "-600");
+    assert(/below the ground/.test(await err("base")), `base message: ${await err("base")}`);
+    await a.page.fill('[name="base_m"]', "2000");
+    await a.page.fill('[name="top_m"]', "1500");
+    assert(/must be above the base/.test(await err("top")), `top message: ${await err("top")}`);
+    let posts = 0;
+    a.page.on("request", (req) => { if (req.method() === "POST") ++posts; });
+    await a.page.click("#layer-apply");
+    await new Promise((res) => setTimeout(res, 500));
+    assert(posts === 0, "an invalid draft is not sent");
+    assert(await a.page.getAttribute('[name="top_m"]', "aria-invalid") === "true", "the top field is marked");
+    const after = await w.state();
+    assert(after.sequence === before.sequence && JSON.stringify(after.layers) === JSON.stringify(before.layers), "state unchanged");
+    // The server's refusal: layer 1 removed through the API; this console
+    // still has it open and asks to remove it.
+    await a.page.click("#layer-revert");
+    const r = await w.api("POST", "/api/changes", { changes: [{ op: "remove_layer", id: 1 }] });
+    assert(r.status === 200, r.text);
+    const seq = (await w.state()).sequence;
+    await a.page.click("#layer-remove");
+    await until("the server's reason next to the id", async () => /no layer 1/.test(await err("id")));
+    assert(/nothing applied/.test(await a.page.textContent("#layers .note")), "the note says nothing was applied");
+    assert((await w.state()).sequence === seq, "the refused change left the state as it was");
+    noProblems(a.problems);
+  },
+
+  // Without the token the page is read-only; the token is asked once per
+  // tab session and kept across a reload; a wrong one is refused.
+  async readonly(cleanup) {
+    const { w, hasWs, browser } = await setup("readonly", cleanup);
+    const allowed = [...withoutWebSocketAllowances(hasWs),
+      { text: /status of 401/, url: /\/api\/changes$/, why: "the wrong token this test tries" }];
+    const a = await openConsole(browser, w, { allowed, name: "A" });
+    for (const sel of ["#layer-apply", "#mode-storm", "#metar-apply", '[data-rate="60"]', '#layer-form [name="coverage_pct"]'])
+      assert(await a.page.isDisabled(sel), `${sel} disabled without the token`);
+    assert(/read-only/.test(await a.page.textContent("#token-state")), "the page says read-only");
+    assert(await a.page.isEnabled("#metar-preview"), "a METAR preview needs no token");
+    // A wrong token: the first change is refused and the page is read-only again.
+    await a.page.fill('[name="token"]', "not-the-token");
+    await a.page.click("#token-use");
+    await a.page.click('[data-rate="60"]');
+    await until("the refusal", async () => /refused the token/.test(await a.page.textContent("#clock .note")));
+    assert(await a.page.isDisabled('[data-rate="60"]'), "read-only again after a refused token");
+    // The right token, then a reload: still allowed (sessionStorage).
+    await a.page.fill('[name="token"]', TOKEN);
+    await a.page.click("#token-use");
+    await a.page.reload();
+    await until("reloaded", async () => (await a.page.getAttribute("body", "data-sequence")) !== null);
+    assert(await a.page.isEnabled('[data-rate="60"]'), "the token survives a reload");
+    await a.page.click('[data-rate="60"]');
+    await until("rate x60 applied", async () => (await w.state()).clock_rate === 60);
+    // Another tab session (a new context) starts without it.
+    const b = await openConsole(browser, w, { allowed, name: "B" });
+    assert(await b.page.isDisabled("#layer-apply"), "a new session is read-only");
+    noProblems(a.problems, b.problems);
+  },
+
+  // The server goes away and comes back on the same port with the same
+  // database: the page says offline, then recovers by itself and works.
+  async restart(cleanup) {
+    const { w, hasWs, browser } = await setup("restart", cleanup, { db: true });
+    const allowed = [...withoutWebSocketAllowances(hasWs),
+      { text: /ERR_CONNECTION_REFUSED|ERR_EMPTY_RESPONSE|ERR_CONNECTION_RESET|WebSocket connection to .* failed/,
+        why: "the server is stopped on purpose" }];
+    const a = await openConsole(browser, w, { token: TOKEN, allowed, name: "A" });
+    await w.stop();
+    await until("offline", async () => (await a.page.getAttribute("body", "data-link")) === "offline", 30000);
+    await w.start();
+    await until("back", async () => ["live", "polling"].includes(await a.page.getAttribute("body", "data-link")), 30000);
+    await a.page.click('[data-rate="10"]');
+    await until("a change after the restart", async () => (await w.state()).clock_rate === 10);
+    await until("the page to show it", async () => /×10/.test(await a.page.textContent("#clock-rate")));
+    noProblems(a.problems);
+  },
+
+  // Every control can be clicked where it is drawn: at the usual instructor
+  // station sizes no card spills over another (a wide row under the next
+  // card takes its clicks: the scenario Load button once sat under the
+  // renderer list). Hit-tests the centre of each visible control.
+  async layout(cleanup) {
+    const { w, hasWs, browser } = await setup("layout", cleanup);
+    for (const viewport of [{ width: 1920, height: 1080 }, { width: 1600, height: 1000 }, { width: 1366, height: 768 },
+      { width: 1280, height: 800 }, { width: 1024, height: 768 }]) {
+      const a = await openConsole(browser, w, { token: TOKEN, allowed: withoutWebSocketAllowances(hasWs),
+        name: `${viewport.width}x${viewport.height}`, viewport });
+      const controls = await a.page.$$("button, input, select, textarea");
+      let checked = 0;
+      const covered = [];
+      for (const c of controls) {
+        if (!(await c.isVisible())) continue;
+        await c.scrollIntoViewIfNeeded();
+        const hit = await c.evaluate((el) => {
+          const r = el.getBoundingClientRect();
+          const x = r.left + r.width / 2, y = r.top + r.height / 2;
+          const top = document.elementFromPoint(x, y);
+          const label = el.closest("label");
+          const ok = top !== null && (el === top || el.contains(top) || (label !== null && label.contains(top)));
+          return { ok, what: el.id || el.name || el.textContent.trim().slice(0, 20) || el.tagName,
+            over: top ? (top.closest("section") || top).id || top.tagName : "nothing" };
+        });
+        checked += 1;
+        if (!hit.ok) covered.push(`${hit.what} (under ${hit.over})`);
+      }
+      assert(checked > 20, `${viewport.width}x${viewport.height}: only ${checked} visible controls`);
+      assert(covered.length === 0, `${viewport.width}x${viewport.height}: covered controls: ${covered.join(", ")}`);
+      console.log(`  ${viewport.width}x${viewport.height}: ${checked} controls, all clickable`);
+      noProblems(a.problems);
+      await a.context.close();
+    }
+  },
+
+  // A screenshot of a busy console: the artefact in the build tree (and
+  // docs/images/console.png when SKY_CONSOLE_DOCS_SCREENSHOT names it).
+  async screenshot(cleanup) {
+    const { w, hasWs, browser } = await setup("screenshot", cleanup);
+    const layer = (id, type, base_m, thickness_m, coverage, speed, from) => ({ op: "set_layer", layer: {
+      id, type, base_m, thickness_m, transition_band_m: 100, coverage, density: 1,
+      wind: { speed_mps: speed, from_deg: from, vertical_mps: 0 } } });
+    const region = (id, lat, lon, size, transition, layers, extra = {}) => ({ op: "set_region", region: {
+      id, center_lat_deg: lat, center_lon_deg: lon, size_x_m: size, size_y_m: size * (extra.aspect || 1),
+      corner_radius_m: size / 2 * Math.min(1, extra.aspect || 1), rotation_deg: extra.rotation || 0, transition_m: transition, layers } });
+    const now = (await w.state()).clock_s;
+    const r = await w.api("POST", "/api/changes", { author: "instructor", changes: [
+      layer(1, "cumulus", 1500, 1500, 0.45, 10, 270), layer(2, "altostratus", 4500, 1200, 0.3, 18, 250),
+      region(1, 46.05, 13.25, 14000, 9000, [{ ...layer(6, "cumulonimbus", 900, 9000, 0.95, 12, 250).layer }]),
+      region(2, 45.9, 12.75, 22000, 12000, [{ ...layer(1, "cumulus", 1500, 1500, 0, 10, 270).layer }], { aspect: 0.6, rotation: 30 }),
+    ] });
+    assert(r.status === 200, r.text);
+    const later = await w.api("POST", "/api/changes", { author: "instructor", changes: [
+      { ...layer(1, "cumulus", 1500, 1800, 0.8, 12, 280), at_s: now + 600, ramp_s: 900 },
+      { op: "remove_layer", id: 2, at_s: now + 1800, ramp_s: 600 }] });
+    assert(later.status === 200, later.text);
+    const a = await openConsole(browser, w, { token: TOKEN, allowed: withoutWebSocketAllowances(hasWs), name: "A",
+      hash: "#focus=46.0,13.0&scale=90" });
+    await a.page.fill('[name="reports"]', "METAR LJLJ 221150Z 24008KT 9999 FEW025 SCT045 BKN090 12/06 Q1018");
+    await a.page.click("#metar-preview");
+    await until("the preview", async () => (await a.page.$$("#metar-result li")).length === 1);
+    await a.page.click('#layer-table tbody tr[data-id="1"]');
+    await until("the timeline", async () => /scheduled|ramping|at /.test(await a.page.textContent("#timeline-list")));
+    await a.page.waitForTimeout(500);
+    fs.mkdirSync(config.out, { recursive: true });
+    const shot = path.join(config.out, "console.png");
+    await a.page.screenshot({ path: shot });
+    console.log(`  screenshot: ${shot}`);
+    if (process.env.SKY_CONSOLE_DOCS_SCREENSHOT) {
+      fs.copyFileSync(shot, process.env.SKY_CONSOLE_DOCS_SCREENSHOT);
+      console.log(`  copied to ${process.env.SKY_CONSOLE_DOCS_SCREENSHOT}`);
+    }
+    assert(fs.statSync(shot).size > 50000, "a screenshot with something in it");
+    noProblems(a.problems);
+  },
+};
+
+// A real renderer channel (skyshell-render, headless) flown by
+// skyshell-replay over CIGI appears in the renderer list and as an aircraft
+// on the map where the flight is.
+cases.renderers = async (cleanup) => {
+  const { w, hasWs, browser } = await setup("renderers", cleanup);
+  if ((await w.api("GET", "/api/renderers")).status === 404)
+    skip("this skyshell-weatherd has no GET /api/renderers yet (it comes with the WebSocket)");
+  if (!config.render || !config.replay || !config.flight) throw new Error("SKY_RENDER, SKY_REPLAY, SKY_TEST_FLIGHT must be set");
+  // lavapipe's JIT leaves allocations no suppression can name: no leak
+  // check for the renderer process (as in tests/integration).
+  const render = child(w.dir, "render", config.render, ["--headless", "--server", `127.0.0.1:${w.streamPort}`,
+    "--cigi-port", "0", "--port-file", path.join(w.dir, "render.port"), "--out", path.join(w.dir, "frames"),
+    "--width", "32", "--height", "18", "--weather-timeout", "60"], { ASAN_OPTIONS: "detect_leaks=0:abort_on_error=1" });
+  cleanup(() => render.stop());
+  const cigiPort = await until("the renderer's CIGI port", async () => {
+    const f = path.join(w.dir, "render.port");
+    return fs.existsSync(f) ? Number(fs.readFileSync(f, "utf8")) : 0;
+  }, 60000);
+  const replay = child(w.dir, "replay", config.replay, [config.flight, "--port", String(cigiPort), "--loop", "--quiet"]);
+  cleanup(() => replay.stop());
+  // The flight: level, heading east at 900 m near 46.2 N 12.8 E.
+  const listed = await until("the renderer in GET /api/renderers", async () => {
+    const list = (await w.api("GET", "/api/renderers")).json;
+    const arr = Array.isArray(list) ? list : list && list.renderers;
+    return arr && arr.find((r) => r.lat_deg !== null && Math.abs(r.lat_deg - 46.2) < 0.01);
+  }, 90000, 500);
+  near(listed.lon_deg, 12.8, 0.02, "renderer longitude");
+  near(listed.heading_deg, 90, 2, "renderer heading");
+  const lat0 = 46.2, lon0 = 12.8, scale = 20;
+  const a = await openConsole(browser, w, { allowed: withoutWebSocketAllowances(hasWs), name: "A",
+    hash: `#focus=${lat0},${lon0}&scale=${scale}` });
+  await until("the renderer row", async () => /46\.2/.test(await a.page.textContent("#renderers tbody")), 30000);
+  // The aircraft symbol is yellow (#ffe14d): look for it where the flight is
+  // on a flat local frame (the replay moves ~55 m/s east: up to 20 px here).
+  const found = await until("a yellow aircraft on the map", async () => {
+    const r = (await w.api("GET", "/api/renderers")).json;
+    const pose = (Array.isArray(r) ? r : r.renderers).find((x) => x.lat_deg !== null);
+    const x = ((pose.lon_deg - lon0) * D2R * R * Math.cos(lat0 * D2R)) / scale;
+    const y = (-(pose.lat_deg - lat0) * D2R * R) / scale;
+    return a.page.evaluate(([dx, dy]) => {
+      const c = document.querySelector("#map");
+      const g = c.getContext("2d");
+      const k = c.width / c.getBoundingClientRect().width;
+      const cx = (c.width / 2 + dx * k) | 0, cy = (c.height / 2 + dy * k) | 0, half = (30 * k) | 0;
+      const img = g.getImageData(cx - half, cy - half, 2 * half, 2 * half).data;
+      let yellow = 0;
+      for (let i = 0; i < img.length; i += 4) if (img[i] > 230 && img[i + 1] > 200 && img[i + 2] < 120) ++yellow;
+      return yellow > 10;
+    }, [x, y]);
+  }, 30000, 500);
+  assert(found, "the aircraft is drawn");
+  noProblems(a.problems);
+};
+
+// A scenario file chosen in the page is loaded (its start replaces the
+// weather, its timeline is pending); a bad one is refused naming its line.
+cases.scenario = async (cleanup) => {
+  const { w, hasWs, browser } = await setup("scenario", cleanup);
+  if ((await w.api("POST", "/api/scenario", "not toml = ")).status === 404)
+    skip("this skyshell-weatherd has no POST /api/scenario yet (it comes with the WebSocket work)");
+  const start = "[clock]\nstart_s = 1000.0\nrate = 1.0\n\n[[layer]]\nid = 3\ntype = \"stratus\"\nbase_m = 300.0\n" +
+    "thickness_m = 400.0\ntransition_band_m = 50.0\ncoverage = 0.7\ndensity = 1.0\n" +
+    "wind = { speed_mps = 4.0, from_deg = 90.0, vertical_mps = 0.0 }\n";
+  const good = path.join(w.dir, "fog-lifts.toml");
+  fs.writeFileSync(good, start + "\n[[timeline]]\nat_s = 1600\nop = \"remove_layer\"\nid = 3\nramp_s = 300\n");
+  const bad = path.join(w.dir, "bad.toml");
+  const badText = start.replace("coverage = 0.7", "coverage = 1.7");
+  fs.writeFileSync(bad, badText);
+  const badLine = badText.split("\n").findIndex((l) => l.startsWith("coverage")) + 1;
+  const allowed = [...withoutWebSocketAllowances(hasWs),
+    { text: /status of 400/, url: /\/api\/scenario$/, why: "the bad scenario this test loads" }];
+  const a = await openConsole(browser, w, { token: TOKEN, allowed, name: "A" });
+  await a.page.setInputFiles('#scenario-form [name="scenario"]', good);
+  await a.page.click("#scenario-load");
+  await until("loaded", async () => /loaded fog-lifts\.toml/.test(await a.page.textContent("#clock .note")));
+  const s = await w.state();
+  assert(s.layers.length === 1 && s.layers[0].id === 3 && s.layers[0].coverage === 0.7, `the start: ${JSON.stringify(s.layers)}`);
+  assert(s.pending.some((p) => p.start_s === 1600 && p.end_s === 1900), `the timeline pending: ${JSON.stringify(s.pending)}`);
+  await until("the timeline entry in the page", async () => /at 00:26:40/.test(await a.page.textContent("#timeline-list")));
+  await a.page.setInputFiles('#scenario-form [name="scenario"]', bad);
+  await a.page.click("#scenario-load");
+  await until("the refusal naming the line", async () =>
+    new RegExp(`bad\\.toml:${badLine}\\b`).test(await a.page.textContent("#scenario-error")));
+  assert((await w.state()).sequence === s.sequence, "a refused scenario changes nothing");
+  noProblems(a.problems);
+};
+
+// Installed (cmake --install into a fresh prefix), skyshell-weatherd finds
+// its console under <prefix>/share/skyshell/console without being told, and
+// serves it at / and /console/*. No browser needed.
+cases.installed = async (cleanup) => {
+  const build = process.env.SKY_BUILD_DIR;
+  if (!build) throw new Error("SKY_BUILD_DIR must be set");
+  const prefix = path.join(config.out, "prefix");
+  fs.rmSync(prefix, { recursive: true, force: true });
+  execFileSync(process.env.SKY_CMAKE || "cmake", ["--install", build, "--prefix", prefix], { stdio: "pipe" });
+  const installed = path.join(prefix, "bin", "skyshell-weatherd");
+  assert(fs.existsSync(path.join(prefix, "share", "skyshell", "console", "index.html")), "index.html installed");
+  const w = new Weatherd("installed");
+  config.weatherd = installed;
+  await w.start();
+  cleanup(() => w.stop());
+  const root = await fetch(`${w.base}/`);
+  assert(root.status === 200 && /text\/html/.test(root.headers.get("content-type")), `GET / ${root.status}`);
+  assert(/Skyshell weather console/.test(await root.text()), "the console's page");
+  const js = await fetch(`${w.base}/console/app.js`);
+  assert(js.status === 200 && /text\/javascript/.test(js.headers.get("content-type")), "app.js as JavaScript");
+  const logged = w.log();
+  assert(logged.includes(path.join(prefix, "share", "skyshell", "console")), `served from the prefix: ${logged}`);
+};
+
+const name = process.argv[2];
+if (!cases[name]) {
+  console.log(`usage: node console_test.mjs <${Object.keys(cases).join("|")}>`);
+  process.exit(2);
+}
+run(name, (cleanup) => cases[name](cleanup));

@@ -1,0 +1,83 @@
+// The console's own geometry against closed forms, without a browser: the
+// sphere's distances, the projection, the region shape and the coverage blend
+// the map draws (server/console/geo.js, coverage.js), which must agree with
+// the server's (sky/weather/region.hpp: smoothstep across the perimeter;
+// snapshot_builder.cpp: the weighted blend into the global layer).
+import { assert, near, run, skip } from "./harness.mjs";
+
+
+const smoothstep = (t) => t * t * (3 - 2 * t);
+
+run("coverage", async () => {
+  // The console's files are ES modules in a folder without a package.json:
+  // Node.js reads them as such from 20 on (syntax detection).
+  if (Number(process.versions.node.split(".")[0]) < 20) skip(`Node.js 20 or newer needed, this is ${process.version}`);
+  const { coverageAt, regionEdgeDistance_m, regionOutline, regionWeight } = await import("../../server/console/coverage.js");
+  const { direct, EARTH_RADIUS_M, inverse, Projection } = await import("../../server/console/geo.js");
+  // A degree of the equator, due east.
+  const eq = inverse(0, 0, 0, 1);
+  near(eq.distance_m, (EARTH_RADIUS_M * Math.PI) / 180, 1e-6, "one degree of the equator");
+  near(eq.azimuth_deg, 90, 1e-9, "due east");
+  // A quarter meridian, due north.
+  near(inverse(0, 10, 90, 10).distance_m, (EARTH_RADIUS_M * Math.PI) / 2, 1e-6, "equator to pole");
+  // direct() undoes inverse(), and the projection round-trips, across the antimeridian too.
+  for (const [lat, lon, az, s] of [[46, 13, 37, 12345], [-33, 179.9, 95, 40000], [80, -120, 200, 250000]]) {
+    const p = direct(lat, lon, az, s);
+    const back = inverse(lat, lon, p.lat_deg, p.lon_deg);
+    near(back.distance_m, s, 1e-6, "direct/inverse distance");
+    near(((back.azimuth_deg - az + 540) % 360) - 180, 0, 1e-7, "direct/inverse azimuth");
+    const proj = new Projection(lat, lon);
+    const xy = proj.forward(p.lat_deg, p.lon_deg);
+    near(Math.hypot(xy.x_m, xy.y_m), s, 1e-6, "projected distance is true from the focus");
+    const q = proj.inverse(xy.x_m, xy.y_m);
+    near(q.lat_deg, p.lat_deg, 1e-9, "projection round trip lat");
+    near(((q.lon_deg - p.lon_deg + 540) % 360) - 180, 0, 1e-9, "projection round trip lon");
+  }
+
+  // A round cell (corner radius = half its size): the edge is a circle, so
+  // the edge distance is the distance from the centre less the radius.
+  const cell = { id: 1, center_lat_deg: 46, center_lon_deg: 13, size_x_m: 10000, size_y_m: 10000,
+    corner_radius_m: 5000, rotation_deg: 0, transition_m: 4000, layers: [] };
+  for (const [s, weight] of [[0, 1], [4999, 1], [5000 + 1000, smoothstep(0.75)], [5000 + 2000, 0.5],
+    [5000 + 3000, smoothstep(0.25)], [9001, 0], [50000, 0]]) {
+    const p = direct(46, 13, 37, s);
+    near(regionEdgeDistance_m(cell, p.lat_deg, p.lon_deg), s - 5000, 1e-6, `edge distance at ${s} m`);
+    near(regionWeight(cell, p.lat_deg, p.lon_deg), weight, 1e-9, `weight at ${s} m`);
+  }
+  // A rotated rectangle: x runs at rotation + 90 degrees, y at rotation.
+  const rect = { id: 2, center_lat_deg: 46, center_lon_deg: 13, size_x_m: 8000, size_y_m: 4000,
+    corner_radius_m: 0, rotation_deg: 30, transition_m: 2000, layers: [] };
+  const along = (az, s) => { const p = direct(46, 13, az, s); return regionEdgeDistance_m(rect, p.lat_deg, p.lon_deg); };
+  near(along(120, 5000), 1000, 1e-6, "beyond the x edge");
+  near(along(30, 3000), 1000, 1e-6, "beyond the y edge");
+  near(along(210, 1000), -1000, 1e-6, "inside, nearest the y edge");
+  near(along(30 + (Math.atan2(5000, 3000) * 180) / Math.PI, Math.hypot(5000, 3000)), Math.hypot(1000, 1000), 1e-6,
+    "beyond the corner");
+  // Outlines lie on the edge and on the perimeter's outer edge.
+  for (const [r, grow] of [[cell, 0], [cell, 4000], [rect, 0], [rect, 2000]]) {
+    for (const p of regionOutline(r, grow)) near(regionEdgeDistance_m(r, p.lat_deg, p.lon_deg), grow, 0.01, "outline on its edge");
+  }
+
+  // The blend: a clearing (coverage 0) in a 0.6 layer is 0.6 - w * 0.6.
+  const clearing = { ...cell, layers: [{ id: 1, coverage: 0 }] };
+  const state = { layers: [{ id: 1, coverage: 0.6 }], regions: [clearing] };
+  for (const [s, w] of [[0, 1], [7000, 0.5], [6000, smoothstep(0.75)], [9500, 0]]) {
+    const p = direct(46, 13, 300, s);
+    near(coverageAt(state, 1, p.lat_deg, p.lon_deg), 0.6 * (1 - w), 1e-9, `clearing coverage at ${s} m`);
+  }
+  // A layer only a region has is 0 outside it.
+  const storm = { ...cell, layers: [{ id: 6, coverage: 0.9 }] };
+  const stormState = { layers: [{ id: 1, coverage: 0.6 }], regions: [storm] };
+  near(coverageAt(stormState, 6, 46, 13), 0.9, 1e-12, "storm layer inside");
+  const far = direct(46, 13, 0, 20000);
+  near(coverageAt(stormState, 6, far.lat_deg, far.lon_deg), 0, 1e-12, "storm layer outside");
+  near(coverageAt(stormState, 1, 46, 13), 0.6, 1e-12, "the global layer is untouched by another id");
+  // Two overlapping regions: weights summed and capped at 1, values averaged by weight.
+  const a = { ...cell, layers: [{ id: 1, coverage: 0.2 }] };
+  const b = { ...cell, center_lon_deg: 13.01, layers: [{ id: 1, coverage: 1.0 }] };
+  const both = { layers: [{ id: 1, coverage: 0.6 }], regions: [a, b] };
+  const mid = direct(46, 13, 90, 0.005 * 111195 * Math.cos((46 * Math.PI) / 180));
+  const wa = regionWeight(a, mid.lat_deg, mid.lon_deg), wb = regionWeight(b, mid.lat_deg, mid.lon_deg);
+  assert(wa === 1 && wb === 1, "the midpoint is inside both");
+  near(coverageAt(both, 1, mid.lat_deg, mid.lon_deg), 0.6, 1e-12, "two full weights: the mean of 0.2 and 1.0");
+});

@@ -1,0 +1,167 @@
+// The bench's scene suite: the shipped deploy/bench/suite.toml loads with all
+// its weather; strict parsing names file, line and field; camera paths
+// interpolate the short way round; and the small pure pieces of the run
+// (configurations, spreads, the side-by-side line and sun angles).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "sky/bench/configurations.hpp"
+#include "sky/bench/results.hpp"
+#include "sky/bench/side_by_side.hpp"
+#include "sky/bench/suite.hpp"
+#include "sky/bench/suite_loader.hpp"
+
+namespace sky::bench {
+namespace {
+
+constexpr const char* kStill = R"(
+[[scene]]
+name = "a"
+weather = "w.toml"
+sun = { azimuth_deg = 90, elevation_deg = 30 }
+camera = { lat_deg = 46, lon_deg = 13, alt_m = 500, yaw_deg = 0, pitch_deg = 10, roll_deg = 0 }
+)";
+
+std::string pathScene(const std::string& keys, int frames) {
+  return "[[scene]]\nname = \"p\"\nweather = \"w.toml\"\nsun = { azimuth_deg = 0, elevation_deg = 10 }\nframes = " +
+         std::to_string(frames) + "\npath = [\n" + keys + "]\n";
+}
+
+const std::string kKeyA = "{ t_s = 0, lat_deg = 10, lon_deg = 179, alt_m = 100, yaw_deg = 350, pitch_deg = 0, roll_deg = -10 },\n";
+const std::string kKeyB = "{ t_s = 2, lat_deg = 12, lon_deg = -179, alt_m = 300, yaw_deg = 10, pitch_deg = 20, roll_deg = 10 },\n";
+
+TEST(Suite, ShippedSuiteLoadsEveryScene) {
+  auto scenes = loadSuite(SKY_BENCH_SUITE_FILE, {});
+  ASSERT_TRUE(scenes) << describe(scenes.error());
+  std::set<std::string> names;
+  std::size_t paths = 0;
+  for (const auto& s : *scenes) {
+    names.insert(s.scene.name);
+    paths += s.scene.isPath();
+    EXPECT_FALSE(s.weather.snapshot.layers.empty()) << s.scene.name;
+  }
+  // The issue's suite: eight stills and two paths.
+  for (const char* n : {"cumulus-midday", "sunset-backlit", "overcast-below", "inside-cloud", "above-deck-10km",
+                        "cumulonimbus", "cirrus-over-cumulus", "polar", "fast-turn", "cumulus-fly-through"})
+    EXPECT_TRUE(names.count(n)) << n;
+  EXPECT_EQ(paths, 2u);
+  auto two = loadSuite(SKY_BENCH_SUITE_FILE, {"polar", "fast-turn"});
+  ASSERT_TRUE(two);
+  ASSERT_EQ(two->size(), 2u);
+  EXPECT_EQ((*two)[0].scene.name, "polar");
+  auto unknown = loadSuite(SKY_BENCH_SUITE_FILE, {"no-such-scene"});
+  ASSERT_FALSE(unknown);
+  EXPECT_NE(unknown.error().detail.find("cumulus-midday"), std::string::npos);  // lists the known scenes
+}
+
+TEST(Suite, StillParses) {
+  auto suite = parseSuite(kStill, "s.toml");
+  ASSERT_TRUE(suite) << describe(suite.error());
+  ASSERT_EQ(suite->scenes.size(), 1u);
+  const Scene& s = suite->scenes[0];
+  EXPECT_FALSE(s.isPath());
+  EXPECT_EQ(s.frames, 1u);
+  EXPECT_DOUBLE_EQ(s.verticalFov_deg, 60);
+  EXPECT_DOUBLE_EQ(s.keys[0].pose.position.alt_m, 500);
+  EXPECT_DOUBLE_EQ(s.sunElevation_deg, 30);
+}
+
+TEST(Suite, ErrorsNameLineAndField) {
+  struct Case {
+    std::string text, fieldInError;
+  };
+  const std::string still(kStill);
+  const Case cases[] = {
+      {still + "colour = 1\n", "colour"},                                                  // unknown key in the scene
+      {"[[scene]]\nname = \"a\"\nweather = \"w\"\ncamera = {}\n", "scene[0].sun"},           // missing sun
+      {std::string(kStill).replace(still.find("alt_m = 500"), 11, "alt_m = 2e6"), "camera.alt_m"},  // out of range
+      {std::string(kStill).replace(still.find("\"a\""), 3, "\"a b\""), "scene[0].name"},    // bad name
+      {still + still, "scene[1].name"},                                                    // duplicate
+      {pathScene(kKeyB + kKeyA, 4), "path[1].t_s"},                                        // times go back
+      {pathScene(kKeyA + kKeyB, 1), "frames"},                                             // too few frames
+      {pathScene(kKeyA, 4), "path"},                                                       // one key is no path
+      {still + "frames = 3\n", "frames"},                                                  // a still with frames
+      {"[[scene]\n", "TOML"},                                                              // syntax
+  };
+  for (const Case& c : cases) {
+    auto suite = parseSuite(c.text, "s.toml");
+    ASSERT_FALSE(suite) << c.text;
+    EXPECT_NE(suite.error().detail.find("s.toml:"), std::string::npos) << suite.error().detail;
+    EXPECT_NE(suite.error().detail.find(c.fieldInError), std::string::npos) << suite.error().detail;
+  }
+}
+
+TEST(Suite, PathInterpolatesTheShortWayRound) {
+  auto suite = parseSuite(pathScene(kKeyA + kKeyB, 5), "p.toml");
+  ASSERT_TRUE(suite) << describe(suite.error());
+  const Scene& s = suite->scenes[0];
+  ASSERT_TRUE(s.isPath());
+  EXPECT_DOUBLE_EQ(frameTime_s(s, 0), 0.0);
+  EXPECT_DOUBLE_EQ(frameTime_s(s, 2), 1.0);
+  EXPECT_DOUBLE_EQ(frameTime_s(s, 4), 2.0);
+  const auto mid = poseAt(s, 1.0);
+  EXPECT_NEAR(mid.position.lat_deg, 11, 1e-12);
+  EXPECT_NEAR(std::abs(mid.position.lon_deg), 180, 1e-9);  // across the antimeridian, not through 0
+  EXPECT_NEAR(mid.position.alt_m, 200, 1e-9);
+  EXPECT_NEAR(std::fmod(mid.yaw_deg + 360, 360), 0, 1e-9);  // 350 -> 10 through north
+  EXPECT_NEAR(mid.pitch_deg, 10, 1e-12);
+  EXPECT_NEAR(mid.roll_deg, 0, 1e-12);
+  EXPECT_DOUBLE_EQ(poseAt(s, -5).position.alt_m, 100);  // clamped to the ends
+  EXPECT_DOUBLE_EQ(poseAt(s, 50).position.alt_m, 300);
+}
+
+TEST(Configurations, ReferenceFirstAndUnknownNamesRefused) {
+  auto all = selectConfigurations("all");
+  ASSERT_TRUE(all);
+  EXPECT_EQ(all->front().name, kReferenceName);
+  auto some = selectConfigurations("half-res");
+  ASSERT_TRUE(some);
+  ASSERT_EQ(some->size(), 2u);
+  EXPECT_EQ((*some)[0].name, kReferenceName);
+  EXPECT_EQ((*some)[1].name, "half-res");
+  auto bad = selectConfigurations("half-res,ultra");
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().detail.find("ultra"), std::string::npos);
+  const auto s = settingsFor((*some)[1], 320, 180, 45);
+  EXPECT_EQ(s.width, 160u);
+  EXPECT_EQ(s.height, 90u);
+  EXPECT_DOUBLE_EQ(s.verticalFov_deg, 45);
+}
+
+TEST(Spread, MedianAndRange) {
+  const Spread odd = spreadOf({5, 1, 3});
+  EXPECT_EQ(odd.samples, 3u);
+  EXPECT_DOUBLE_EQ(odd.median, 3);
+  EXPECT_DOUBLE_EQ(odd.min, 1);
+  EXPECT_DOUBLE_EQ(odd.max, 5);
+  EXPECT_DOUBLE_EQ(spreadOf({4, 1, 2, 3}).median, 2.5);
+  std::vector<double> hundred;
+  for (int i = 1; i <= 100; ++i) hundred.push_back(i);
+  EXPECT_DOUBLE_EQ(spreadOf(hundred).p10, 11);  // nearest rank: the value at index floor(0.1 n)
+  EXPECT_DOUBLE_EQ(spreadOf(hundred).p90, 91);
+  EXPECT_EQ(spreadOf({}).samples, 0u);
+}
+
+TEST(SideBySide, SunAnglesFromEnu) {
+  // The peer's sun (-0.5, 0.5, 1): north-west, elevation atan(1 / sqrt(0.5)).
+  auto s = sunAnglesFromEnu(-0.5, 0.5, 1);
+  ASSERT_TRUE(s);
+  EXPECT_NEAR(s->azimuth_deg, 315, 1e-9);
+  EXPECT_NEAR(s->elevation_deg, std::atan(1 / std::sqrt(0.5)) * 180 / M_PI, 1e-9);
+  EXPECT_NEAR(sunAnglesFromEnu(0, 1, 0)->azimuth_deg, 0, 1e-12);
+  EXPECT_NEAR(sunAnglesFromEnu(1, 0, 0)->azimuth_deg, 90, 1e-12);
+  EXPECT_NEAR(sunAnglesFromEnu(0, 0, 2)->elevation_deg, 90, 1e-12);
+  EXPECT_FALSE(sunAnglesFromEnu(0, 0, 0));
+  EXPECT_FALSE(sunAnglesFromEnu(NAN, 0, 1));
+}
+
+TEST(SideBySide, LineFormatIsExact) {
+  EXPECT_EQ(cloudPassLine(640, 360, 100.0, 180.5, 95.25),
+            "CLOUDPASS 640x360 100.000 cpu_ms=180.500 cores=1.80 max_thread_ms=95.250");
+  EXPECT_EQ(cloudPassLine(320, 180, 0.0, 1.0, 1.0), "CLOUDPASS 320x180 0.000 cpu_ms=1.000 cores=0.00 max_thread_ms=1.000");
+}
+
+}  // namespace
+}  // namespace sky::bench
