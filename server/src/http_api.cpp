@@ -11,6 +11,7 @@
 #include <spdlog/spdlog.h>
 
 #include "sky/server/api_json.hpp"
+#include "sky/server/conditions_api.hpp"
 #include "sky/server/console_files.hpp"
 #include "sky/server/metar_api.hpp"
 #include "sky/server/scenario_api.hpp"
@@ -210,6 +211,11 @@ HttpApi::Reply HttpApi::handle(const std::string& method, const std::string& tar
     const nlohmann::json list = hooks_.renderers ? hooks_.renderers() : nlohmann::json::array();
     return {200, "application/json",
             nlohmann::json{{"renderers", list}}.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)};
+  }
+  if (method == "GET" && path == "/api/conditions") {
+    auto q = parseConditionsQuery(query);
+    if (!q) return {400, "application/json", errorJson(q.error().detail)};
+    return {200, "application/json", conditionsJson(weather_, *q).dump()};
   }
   if (path == "/api/ws")
     return {426, "application/json", errorJson("upgrade: GET /api/ws is a WebSocket (send Upgrade: websocket)")};

@@ -1,0 +1,44 @@
+// GET /api/conditions (see conditions_api.hpp).
+#include "sky/server/conditions_api.hpp"
+
+#include "sky/server/live_weather.hpp"
+#include "sky/server/snapshot_builder.hpp"
+#include "sky/weather/query.hpp"
+
+namespace sky::server {
+
+nlohmann::json conditionsJson(const LiveWeather& weather, const ConditionsQuery& q) {
+  const double clock_s = weather.clockNow();
+  const std::vector<weather::CloudLayer> layers = weather.layersAt(clock_s);
+  const std::vector<weather::Region> regions = weather.regionsAt(clock_s);
+  // The snapshot a subscriber of the point's surroundings would get: the
+  // point's own cell (and its neighbours) at the asked level.
+  stream::Subscribe area;
+  area.area = {q.lat_deg, q.lon_deg, 1.0};
+  area.tileLevel = q.level;
+  weather::WeatherSnapshot snapshot = buildSnapshot(area, layers, clock_s, kDefaultMaxCells, regions);
+  // As a subscriber holds them: the stream carries a tile's fractions in 8
+  // bits (stream/messages.cpp).
+  for (weather::CoverageTile& t : snapshot.tiles) {
+    t.coverage = weather::dequantizeUnit(weather::quantizeUnit(t.coverage));
+    t.density = weather::dequantizeUnit(weather::quantizeUnit(t.density));
+    t.blend = weather::dequantizeUnit(weather::quantizeUnit(t.blend));
+  }
+  const weather::PointWeather pw =
+      weather::weatherAt(snapshot.layers, weather::snapshotLookup(snapshot, clock_s), q.lat_deg, q.lon_deg, q.alt_m);
+  return {{"lat_deg", q.lat_deg},
+          {"lon_deg", q.lon_deg},
+          {"alt_m", q.alt_m},
+          {"clock_s", clock_s},
+          {"tile_level", snapshot.tileLevel},
+          {"wind",
+           {{"speed_mps", pw.wind.speed_mps},
+            {"from_deg", pw.wind.fromDirection_deg},
+            {"vertical_mps", pw.wind.vertical_mps}}},
+          {"cloud_density", pw.cloudDensity},
+          {"layer_id", pw.layerId ? nlohmann::json(*pw.layerId) : nlohmann::json(nullptr)},
+          {"air_temperature_c", weather::isaTemperature_c(q.alt_m)},
+          {"pressure_hpa", weather::isaPressure_hpa(q.alt_m)}};
+}
+
+}  // namespace sky::server

@@ -1,0 +1,300 @@
+// A host asks the renderer, over real CIGI UDP, for the weather at points
+// around the ownship (Environmental Conditions Requests) and the renderer
+// answers (Weather Conditions Response, Aerosol Concentration Response) from
+// the weather it holds; the same points asked of the weather server
+// (GET /api/conditions, the same protocol/ function over the same tiles)
+// must give the same wind, vertical wind and cloud. A few answers are also
+// checked against hand values from the scenario, so both sides cannot agree
+// on something wrong.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "child_process.hpp"
+#include "sky/cigi/codec.hpp"
+#include "weatherd_process.hpp"
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+namespace sky::test {
+namespace {
+
+// The renderer's documented mapping of cloud to the CIGI response (README,
+// "CIGI answers"): humidity 100 % in cloud, 50 % in clear air; visibility
+// 3.912 / (0.05 /m x density), at most 50 km; cloud water 0.5 g/m^3 x density.
+constexpr double kExtinctionPerDensity = 0.05, kClearVisibility_m = 50000, kLiquidWater_gpm3 = 0.5;
+
+// Two layers with different winds and a gap between them (the wind there is
+// interpolated), clock at x1.
+constexpr const char* kScenario = R"([clock]
+start_s = 0.0
+rate = 1.0
+
+[[layer]]
+id = 1
+type = "cumulus"
+base_m = 1500.0
+thickness_m = 1500.0
+transition_band_m = 200.0
+coverage = 0.4
+density = 0.8
+wind = { speed_mps = 10.0, from_deg = 270.0, vertical_mps = 0.5 }
+
+[[layer]]
+id = 2
+type = "altostratus"
+base_m = 5000.0
+thickness_m = 1000.0
+transition_band_m = 100.0
+coverage = 0.9
+density = 0.6
+wind = { speed_mps = 25.0, from_deg = 300.0, vertical_mps = -0.2 }
+)";
+
+constexpr double kLat = 46.2, kLon = 12.8;
+
+// A CIGI host on one UDP socket: sends a datagram to the renderer and reads
+// the IG's answers.
+class CigiHost {
+ public:
+  CigiHost() : fd_(::socket(AF_INET, SOCK_DGRAM, 0)) {}
+  ~CigiHost() { ::close(fd_); }
+  void send(unsigned port, const std::vector<cigi::Packet>& packets) {
+    cigi::DatagramWriter w(cigi::ByteOrder::Big);
+    cigi::IgControl ig;
+    ig.hostFrame = frame_++;
+    w.add(ig);
+    for (const auto& p : packets) w.add(p);
+    sockaddr_in to{};
+    to.sin_family = AF_INET;
+    to.sin_port = htons(static_cast<std::uint16_t>(port));
+    to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    const auto& bytes = w.bytes();
+    ASSERT_EQ(::sendto(fd_, bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to),
+              static_cast<ssize_t>(bytes.size()));
+  }
+  // The next IG datagram within `timeout`, decoded.
+  std::optional<cigi::Datagram> receive(std::chrono::milliseconds timeout) {
+    pollfd p{fd_, POLLIN, 0};
+    if (::poll(&p, 1, static_cast<int>(timeout.count())) <= 0) return std::nullopt;
+    std::vector<std::uint8_t> buf(65536);
+    const ssize_t n = ::recv(fd_, buf.data(), buf.size(), 0);
+    if (n <= 0) return std::nullopt;
+    auto d = cigi::decodeDatagram(std::span(buf.data(), std::size_t(n)));
+    EXPECT_TRUE(d) << describe(d.error());
+    return d ? std::optional(*d) : std::nullopt;
+  }
+
+ private:
+  int fd_;
+  std::uint32_t frame_ = 0;
+};
+
+cigi::EntityControl ownship() {
+  cigi::EntityControl e;
+  e.lat_deg = kLat;
+  e.lon_deg = kLon;
+  e.alt_m = 900;
+  e.yaw_deg = 90;
+  return e;
+}
+
+struct Point {
+  const char* what;
+  double lat_deg, lon_deg, alt_m;
+};
+
+struct IgAnswer {
+  std::optional<cigi::WeatherConditionsResponse> weather;
+  std::vector<cigi::AerosolConcentrationResponse> aerosols;
+};
+
+// Asks until answered (UDP may drop; the renderer answers every datagram).
+IgAnswer ask(CigiHost& host, unsigned port, std::uint8_t id, const Point& p) {
+  cigi::EnvironmentalConditionsRequest r;
+  r.requestType = cigi::kRequestWeather | cigi::kRequestAerosol;
+  r.requestId = id;
+  r.lat_deg = p.lat_deg;
+  r.lon_deg = p.lon_deg;
+  r.alt_m = p.alt_m;
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    host.send(port, {ownship(), r});
+    for (auto until = std::chrono::steady_clock::now() + 2s; std::chrono::steady_clock::now() < until;) {
+      auto d = host.receive(500ms);
+      if (!d) continue;
+      IgAnswer a;
+      for (const auto& packet : d->packets) {
+        if (const auto* w = std::get_if<cigi::WeatherConditionsResponse>(&packet); w && w->requestId == id)
+          a.weather = *w;
+        if (const auto* c = std::get_if<cigi::AerosolConcentrationResponse>(&packet); c && c->requestId == id)
+          a.aerosols.push_back(*c);
+      }
+      if (a.weather) return a;
+    }
+  }
+  ADD_FAILURE() << "no Weather Conditions Response to request " << int(id) << " (" << p.what << ")";
+  return {};
+}
+
+double angleBetween_deg(double a, double b) {
+  const double d = std::fmod(std::abs(a - b), 360.0);
+  return std::min(d, 360.0 - d);
+}
+
+TEST(CigiConditions, TheRendererAnswersWhatTheServerSaysAtThePoint) {
+  const fs::path dir = fs::path(SKY_TEST_OUTPUT_DIR) / "conditions-vs-server";
+  fs::remove_all(dir);  // an old port file would name a port nobody listens on
+  fs::create_directories(dir);
+  std::ofstream(dir / "two-layers.toml") << kScenario;
+  Weatherd w("conditions-vs-server-weatherd", (dir / "two-layers.toml").string());
+  ASSERT_GT(w.streamPort, 0u) << w.process->log();
+  ASSERT_GT(w.httpPort, 0u) << w.process->log();
+  // A 20 km storm region on the ownship, drifting with the wind, with denser
+  // cumulus: inside it the renderer's tiles carry coverage 0.95.
+  const auto posted = w.request("POST", "/api/changes", R"({"changes": [{"op": "set_region", "region": {
+      "id": 3, "center_lat_deg": 46.2, "center_lon_deg": 12.8, "size_x_m": 20000, "size_y_m": 20000,
+      "corner_radius_m": 2000, "transition_m": 1000, "drifts_with_wind": true,
+      "layers": [{"id": 1, "type": "cumulus", "base_m": 1500, "thickness_m": 1500, "transition_band_m": 200,
+                  "coverage": 0.95, "density": 1,
+                  "wind": {"speed_mps": 10, "from_deg": 270, "vertical_mps": 0.5}}]}}]})");
+  ASSERT_EQ(posted.status, 200) << posted.body;
+
+  ChildProcess render({SKY_RENDER, "--headless", "--server", "127.0.0.1:" + std::to_string(w.streamPort),
+                       "--cigi-port", "0", "--port-file", (dir / "render.port").string(), "--out",
+                       (dir / "frames").string(), "--width", "32", "--height", "18", "--no-exr",
+                       "--weather-timeout", "120"},
+                      (dir / "render.log").string(), {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
+  const unsigned cigiPort = waitForPortFile((dir / "render.port").string(), 120s);
+  ASSERT_GT(cigiPort, 0u) << render.log();
+
+  // The ownship's pose makes the renderer subscribe around it: wait for the
+  // snapshot with the region's tiles before asking.
+  CigiHost host;
+  bool tiles = false;
+  for (auto until = std::chrono::steady_clock::now() + 180s; !tiles && std::chrono::steady_clock::now() < until;) {
+    host.send(cigiPort, {ownship()});
+    while (host.receive(100ms)) {
+    }
+    const std::string log = render.log();
+    for (std::size_t at = log.find("weather snapshot: "); at != std::string::npos;
+         at = log.find("weather snapshot: ", at + 1))
+      tiles = tiles || log.compare(at, 30, "weather snapshot: 2 layers, 0 ") != 0;
+    if (!tiles) std::this_thread::sleep_for(200ms);
+  }
+  ASSERT_TRUE(tiles) << "no snapshot with tiles:\n" << render.log();
+
+  const double kmLat = 1.0 / 111.2, kmLon = 1.0 / (111.2 * std::cos(kLat * M_PI / 180));
+  const Point points[] = {
+      {"in the region, inside layer 1", kLat, kLon, 2200},
+      {"outside the region (40 km east), inside layer 1", kLat, kLon + 40 * kmLon, 2200},
+      {"below every layer", kLat, kLon, 500},
+      {"in layer 1's base transition band", kLat, kLon, 1450},
+      {"between the layers", kLat, kLon, 4000},
+      {"inside layer 2", kLat + 30 * kmLat, kLon - 20 * kmLon, 5500},
+      {"above every layer", kLat, kLon, 9000},
+  };
+  std::vector<nlohmann::json> server;
+  std::vector<IgAnswer> ig;
+  for (std::size_t i = 0; i < std::size(points); ++i) {
+    const Point& p = points[i];
+    ig.push_back(ask(host, cigiPort, static_cast<std::uint8_t>(10 + i), p));
+    char target[160];
+    std::snprintf(target, sizeof target, "/api/conditions?lat_deg=%.9f&lon_deg=%.9f&alt_m=%.3f", p.lat_deg,
+                  p.lon_deg, p.alt_m);
+    const auto reply = w.request("GET", target, "", "");
+    ASSERT_EQ(reply.status, 200) << reply.body;
+    server.push_back(nlohmann::json::parse(reply.body));
+    ASSERT_TRUE(ig.back().weather) << p.what;
+    const auto& wcr = *ig.back().weather;
+    const auto& s = server.back();
+    SCOPED_TRACE(std::string(p.what) + ": server " + s.dump());
+    EXPECT_EQ(s["tile_level"], 11);
+    // Wind: the CIGI fields are floats.
+    EXPECT_NEAR(wcr.horizontalWind_mps, s["wind"]["speed_mps"].get<double>(), 1e-4);
+    EXPECT_NEAR(wcr.verticalWind_mps, s["wind"]["vertical_mps"].get<double>(), 1e-5);
+    if (s["wind"]["speed_mps"].get<double>() > 0.1) {
+      EXPECT_LT(angleBetween_deg(wcr.windDirection_deg, s["wind"]["from_deg"].get<double>()), 1e-3);
+    }
+    // Cloud: present or not, and how dense (from the visibility).
+    const double density = s["cloud_density"].get<double>();
+    EXPECT_EQ(wcr.humidity_pct, density > 0 ? 100 : 50);
+    const double visibility = density > 0 ? std::min(kClearVisibility_m, 3.912 / (kExtinctionPerDensity * density))
+                                          : kClearVisibility_m;
+    EXPECT_NEAR(wcr.visibility_m, visibility, 1e-4 * visibility);
+    // The densest layer's cloud water, in its Aerosol Concentration Response.
+    if (!s["layer_id"].is_null()) {
+      const auto layer = s["layer_id"].get<std::uint32_t>();
+      const auto it = std::find_if(ig.back().aerosols.begin(), ig.back().aerosols.end(),
+                                   [&](const auto& a) { return static_cast<std::uint32_t>(a.layerId) == layer; });
+      ASSERT_NE(it, ig.back().aerosols.end()) << "no aerosol response for layer " << layer;
+      EXPECT_NEAR(it->concentration_gpm3, kLiquidWater_gpm3 * density, 1e-5);
+    }
+    EXPECT_NEAR(wcr.airTemperature_c, s["air_temperature_c"].get<double>(), 1e-4);
+    EXPECT_NEAR(wcr.pressure_hpa, s["pressure_hpa"].get<double>(), 1e-3);
+    std::printf("[conditions] %-48s IG wind %6.2f m/s from %6.1f, vertical %5.2f, humidity %3d, visibility %8.1f m"
+                " | server density %.4f layer %s\n",
+                p.what, wcr.horizontalWind_mps, wcr.windDirection_deg, wcr.verticalWind_mps, wcr.humidity_pct,
+                wcr.visibility_m, density, s["layer_id"].dump().c_str());
+  }
+  // Hand values from the scenario and the region: coverage x density x
+  // presence, and each layer's own wind inside it. Tile fractions travel in
+  // 8 bits: within half a step of 1/255 where the layer has tiles.
+  constexpr double kTileStep = 0.5 / 255;
+  EXPECT_NEAR(server[0]["cloud_density"].get<double>(), 0.95 * 1.0, kTileStep);  // the region's cumulus
+  EXPECT_NEAR(server[1]["cloud_density"].get<double>(), 0.4 * 0.8, kTileStep);   // the global layer
+  EXPECT_EQ(server[2]["cloud_density"].get<double>(), 0.0);
+  EXPECT_GT(server[3]["cloud_density"].get<double>(), 0.0);                 // fading in below the base
+  EXPECT_LT(server[3]["cloud_density"].get<double>(), 0.95);
+  EXPECT_EQ(server[4]["cloud_density"].get<double>(), 0.0);
+  EXPECT_NEAR(server[5]["cloud_density"].get<double>(), 0.9 * 0.6, 1e-6);
+  EXPECT_EQ(server[6]["cloud_density"].get<double>(), 0.0);
+  EXPECT_NEAR(ig[0].weather->horizontalWind_mps, 10, 1e-4);
+  EXPECT_NEAR(ig[0].weather->verticalWind_mps, 0.5, 1e-5);
+  EXPECT_NEAR(ig[5].weather->horizontalWind_mps, 25, 1e-4);
+  EXPECT_NEAR(ig[5].weather->windDirection_deg, 300, 1e-3);
+  EXPECT_NEAR(ig[6].weather->horizontalWind_mps, 25, 1e-4);  // above the top: the highest layer's
+  // Between the layers (4000 m: 1/2 of the way from layer 1's top at 3000 m
+  // to layer 2's base at 5000 m) the wind is neither layer's.
+  const double between = ig[4].weather->horizontalWind_mps;
+  EXPECT_GT(between, 10.5);
+  EXPECT_LT(between, 24.5);
+  EXPECT_EQ(w.process->stop(), 0) << w.process->log();
+}
+
+TEST(CigiConditions, TheServerRefusesABadQueryNamingTheField) {
+  Weatherd w("conditions-bad-query");
+  ASSERT_GT(w.httpPort, 0u) << w.process->log();
+  const std::pair<const char*, const char*> cases[] = {
+      {"/api/conditions?lat_deg=46&lon_deg=12", "alt_m: missing"},
+      {"/api/conditions?lat_deg=91&lon_deg=12&alt_m=0", "lat_deg: 91 is not in"},
+      {"/api/conditions?lat_deg=46&lon_deg=abc&alt_m=0", "lon_deg: 'abc' is not a number"},
+      {"/api/conditions?lat_deg=46&lon_deg=12&alt_m=0&level=2.5", "level: '2.5' is not an integer"},
+      {"/api/conditions?lat_deg=46&lat_deg=47&lon_deg=12&alt_m=0", "lat_deg: given twice"},
+      {"/api/conditions?lat=46&lon_deg=12&alt_m=0", "unknown key 'lat'"},
+  };
+  for (const auto& [target, message] : cases) {
+    const auto reply = w.request("GET", target, "", "");
+    EXPECT_EQ(reply.status, 400) << target;
+    EXPECT_NE(reply.body.find(message), std::string::npos) << target << ": " << reply.body;
+  }
+  const auto ok = w.request("GET", "/api/conditions?lat_deg=46&lon_deg=12&alt_m=2000&level=13", "", "");
+  ASSERT_EQ(ok.status, 200) << ok.body;
+  EXPECT_EQ(nlohmann::json::parse(ok.body)["tile_level"], 13);
+  EXPECT_EQ(w.process->stop(), 0) << w.process->log();
+}
+
+}  // namespace
+}  // namespace sky::test
