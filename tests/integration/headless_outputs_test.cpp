@@ -229,9 +229,10 @@ TEST(HeadlessOutputs, MetadataDescribesEachFrameAndTheReportSumsGpuTimes) {
   EXPECT_EQ(run.report["preset"], "default");
 }
 
-// The shape noise through skyshell-render's --cache-dir: the first start
-// generates and writes it, the second loads it (and draws the same bytes),
-// a damaged cache file is detected and regenerated (the same image again).
+// The noise textures through skyshell-render's --cache-dir: the first start
+// generates and writes them (shape and detail, one file each), the second
+// loads them (and draws the same bytes), a damaged shape file is detected
+// and regenerated (the same image again).
 TEST(HeadlessOutputs, NoiseCacheIsLoadedOnTheSecondStartAndRegeneratedWhenDamaged) {
   const fs::path cache = fs::path(SKY_TEST_OUTPUT_DIR) / "noise-cache";
   fs::remove_all(cache);
@@ -242,12 +243,19 @@ TEST(HeadlessOutputs, NoiseCacheIsLoadedOnTheSecondStartAndRegeneratedWhenDamage
   const ReplayResult first = replay("cache-1", SKY_SCENARIO_CLOUDY, args);
   EXPECT_NE(first.log.find("shape noise 64^3 seed 1: generated into " + cache.string()), std::string::npos)
       << first.log;
+  EXPECT_NE(first.log.find("detail noise 32^3 seed 1: generated into " + cache.string()), std::string::npos)
+      << first.log;
   std::vector<fs::path> files;
   for (const auto& e : fs::directory_iterator(cache)) files.push_back(e.path());
-  ASSERT_EQ(files.size(), 1u);
-  EXPECT_EQ(files[0].extension(), ".noise");
+  ASSERT_EQ(files.size(), 2u);
+  // The shape file first (files[0] below is the one the test damages).
+  std::sort(files.begin(), files.end(), [](const fs::path& a, const fs::path& b) {
+    return (a.filename().string().rfind("shape", 0) == 0) > (b.filename().string().rfind("shape", 0) == 0);
+  });
+  ASSERT_EQ(files[0].filename().string().rfind("shape", 0), 0u) << files[0];
+  for (const fs::path& f : files) EXPECT_EQ(f.extension(), ".noise");
   const auto cachedBytes = readAll(files[0]);
-  EXPECT_GT(cachedBytes.size(), std::size_t(64 * 64 * 64)) << "the 64^3 texels and a header";
+  EXPECT_GT(cachedBytes.size(), std::size_t(64 * 64 * 64 * 4)) << "the 64^3 RGBA8 texels and a header";
 
   const ReplayResult second = replay("cache-2", SKY_SCENARIO_CLOUDY, args);
   EXPECT_NE(second.log.find("loaded from " + files[0].string()), std::string::npos) << second.log;

@@ -44,8 +44,10 @@ GpuImage createSampledImage(const GpuContext& ctx, vk::ImageType type, vk::Forma
       device, vk::MemoryAllocateInfo(req.size, ctx.memoryType(req.memoryTypeBits,
                                                               vk::MemoryPropertyFlagBits::eDeviceLocal)));
   img.image.bindMemory(*img.memory, 0);
+  // A view's type must match the shader's sampler (sampler2D, sampler2DArray).
   const vk::ImageViewType viewType = type == vk::ImageType::e3D ? vk::ImageViewType::e3D
-                                                                 : vk::ImageViewType::e2DArray;
+                                     : layers > 1               ? vk::ImageViewType::e2DArray
+                                                                : vk::ImageViewType::e2D;
   img.view = vk::raii::ImageView(
       device, vk::ImageViewCreateInfo({}, *img.image, viewType, format, {},
                                       vk::ImageSubresourceRange(vk::ImageAspectFlagBits::eColor, 0, 1, 0, layers)));

@@ -35,8 +35,9 @@ struct GpuImage {
   std::uint32_t layers = 1;
 };
 
-// A device-local sampled image (2D array when layers > 1 or type is e2D,
-// 3D when extent.depth > 1), in eShaderReadOnlyOptimal after the first upload.
+// A device-local sampled image, viewed as 3D (type e3D), a 2D array (e2D with
+// layers > 1: the weather map, sampler2DArray) or 2D (e2D with one layer: the
+// atmosphere tables, sampler2D); in eShaderReadOnlyOptimal after the first upload.
 GpuImage createSampledImage(const GpuContext& ctx, vk::ImageType type, vk::Format format, vk::Extent3D extent,
                             std::uint32_t layers, const char* debugName);
 
