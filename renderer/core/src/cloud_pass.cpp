@@ -60,7 +60,7 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
     return tl::unexpected(ok.error());
   auto tableImage = [&](const AtmosphereTable& t, const char* name) {
     return createSampledImage(ctx, vk::ImageType::e2D, vk::Format::eR16G16B16A16Sfloat,
-                              vk::Extent3D(t.width, t.height, 1), 1, name);
+                              vk::Extent3D(t.width, t.height, 1), 1, name, /*plain2D=*/true);
   };
   pass.transmittance_ = tableImage(atmosphere.transmittance, "sky.transmittanceTable");
   if (auto ok = uploadImage(ctx, pass.transmittance_, std::as_bytes(std::span(atmosphere.transmittance.texels))); !ok)

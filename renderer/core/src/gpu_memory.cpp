@@ -29,7 +29,8 @@ GpuBuffer createHostBuffer(const GpuContext& ctx, vk::DeviceSize size, vk::Buffe
 }
 
 GpuImage createSampledImage(const GpuContext& ctx, vk::ImageType type, vk::Format format, vk::Extent3D extent,
-                            std::uint32_t layers, const char* debugName) {
+                            std::uint32_t layers, const char* debugName, bool plain2D) {
+  SKY_ASSERT(!plain2D || (type == vk::ImageType::e2D && layers == 1));
   const auto& device = ctx.device();
   GpuImage img;
   img.format = format;
@@ -45,6 +46,7 @@ GpuImage createSampledImage(const GpuContext& ctx, vk::ImageType type, vk::Forma
                                                               vk::MemoryPropertyFlagBits::eDeviceLocal)));
   img.image.bindMemory(*img.memory, 0);
   const vk::ImageViewType viewType = type == vk::ImageType::e3D ? vk::ImageViewType::e3D
+                                     : plain2D                   ? vk::ImageViewType::e2D
                                                                  : vk::ImageViewType::e2DArray;
   img.view = vk::raii::ImageView(
       device, vk::ImageViewCreateInfo({}, *img.image, viewType, format, {},

@@ -35,10 +35,12 @@ struct GpuImage {
   std::uint32_t layers = 1;
 };
 
-// A device-local sampled image (2D array when layers > 1 or type is e2D,
-// 3D when extent.depth > 1), in eShaderReadOnlyOptimal after the first upload.
+// A device-local sampled image, in eShaderReadOnlyOptimal after the first
+// upload. Its view: 3D for an e3D image; for an e2D image a 2D array
+// (sampler2DArray) unless plain2D, then 2D (sampler2D, one layer): the view
+// type must match what the shader declares.
 GpuImage createSampledImage(const GpuContext& ctx, vk::ImageType type, vk::Format format, vk::Extent3D extent,
-                            std::uint32_t layers, const char* debugName);
+                            std::uint32_t layers, const char* debugName, bool plain2D = false);
 
 class GpuTimer;
 
