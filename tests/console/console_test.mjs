@@ -265,7 +265,12 @@ const cases = {
     await until("reloaded", async () => (await a.page.getAttribute("body", "data-sequence")) !== null);
     assert(await a.page.isEnabled('[data-rate="60"]'), "the token survives a reload");
     await a.page.click('[data-rate="60"]');
-    await until("rate x60 applied", async () => (await w.state()).clock_rate === 60);
+    try {
+      await until("rate x60 applied", async () => (await w.state()).clock_rate === 60);
+    } catch (e) {
+      // What the page made of the click (a refusal, still applying, nothing).
+      throw new Error(`${e.message}; the clock card's note: "${await a.page.textContent("#clock .note")}"`);
+    }
     // Another tab session (a new context) starts without it.
     const b = await openConsole(browser, w, { allowed, name: "B" });
     assert(await b.page.isDisabled("#layer-apply"), "a new session is read-only");

@@ -229,10 +229,10 @@ TEST(HeadlessOutputs, MetadataDescribesEachFrameAndTheReportSumsGpuTimes) {
   EXPECT_EQ(run.report["preset"], "default");
 }
 
-// The noise textures through skyshell-render's --cache-dir: the first start
-// generates and writes them (shape and detail, one file each), the second
-// loads them (and draws the same bytes), a damaged shape file is detected
-// and regenerated (the same image again).
+// The noise textures (the cloud model's shape and detail noise) through
+// skyshell-render's --cache-dir: the first start generates and writes them,
+// the second loads them (and draws the same bytes), a damaged cache file is
+// detected and regenerated (the same image again), the other still loaded.
 TEST(HeadlessOutputs, NoiseCacheIsLoadedOnTheSecondStartAndRegeneratedWhenDamaged) {
   const fs::path cache = fs::path(SKY_TEST_OUTPUT_DIR) / "noise-cache";
   fs::remove_all(cache);
@@ -245,22 +245,26 @@ TEST(HeadlessOutputs, NoiseCacheIsLoadedOnTheSecondStartAndRegeneratedWhenDamage
       << first.log;
   EXPECT_NE(first.log.find("detail noise 32^3 seed 1: generated into " + cache.string()), std::string::npos)
       << first.log;
-  std::vector<fs::path> files;
+  std::vector<fs::path> files;  // the shape noise's file first
   for (const auto& e : fs::directory_iterator(cache)) files.push_back(e.path());
   ASSERT_EQ(files.size(), 2u);
-  // The shape file first (files[0] below is the one the test damages).
   std::sort(files.begin(), files.end(), [](const fs::path& a, const fs::path& b) {
-    return (a.filename().string().rfind("shape", 0) == 0) > (b.filename().string().rfind("shape", 0) == 0);
+    return (a.filename().string().rfind("shape-", 0) == 0) > (b.filename().string().rfind("shape-", 0) == 0);
   });
-  ASSERT_EQ(files[0].filename().string().rfind("shape", 0), 0u) << files[0];
-  for (const fs::path& f : files) EXPECT_EQ(f.extension(), ".noise");
+  ASSERT_EQ(files[0].filename().string().rfind("shape-", 0), 0u) << files[0];
+  ASSERT_EQ(files[1].filename().string().rfind("detail-", 0), 0u) << files[1];
+  for (const auto& f : files) EXPECT_EQ(f.extension(), ".noise");
   const auto cachedBytes = readAll(files[0]);
-  EXPECT_GT(cachedBytes.size(), std::size_t(64 * 64 * 64 * 4)) << "the 64^3 RGBA8 texels and a header";
+  const auto detailBytes = readAll(files[1]);
+  EXPECT_GT(cachedBytes.size(), std::size_t(64 * 64 * 64 * 4)) << "the 64^3 RGBA texels and a header";
+  EXPECT_GT(detailBytes.size(), std::size_t(32 * 32 * 32)) << "the 32^3 texels and a header";
 
   const ReplayResult second = replay("cache-2", SKY_SCENARIO_CLOUDY, args);
   EXPECT_NE(second.log.find("loaded from " + files[0].string()), std::string::npos) << second.log;
+  EXPECT_NE(second.log.find("loaded from " + files[1].string()), std::string::npos) << second.log;
   EXPECT_EQ(second.log.find("generated"), std::string::npos) << second.log;
   EXPECT_EQ(readAll(files[0]), cachedBytes);
+  EXPECT_EQ(readAll(files[1]), detailBytes);
   const std::string png = "frames/frame_000000.png";
   EXPECT_TRUE(readAll(first.dir / png) == readAll(second.dir / png)) << "cached noise must draw the same clouds";
 
@@ -271,6 +275,7 @@ TEST(HeadlessOutputs, NoiseCacheIsLoadedOnTheSecondStartAndRegeneratedWhenDamage
   EXPECT_NE(third.log.find("regenerated into " + files[0].string()), std::string::npos) << third.log;
   EXPECT_NE(third.log.find("checksum"), std::string::npos) << third.log;
   EXPECT_EQ(readAll(files[0]), cachedBytes) << "the damaged file is rewritten whole";
+  EXPECT_NE(third.log.find("loaded from " + files[1].string()), std::string::npos) << third.log;
   EXPECT_TRUE(readAll(first.dir / png) == readAll(third.dir / png));
 }
 
