@@ -133,6 +133,10 @@ void WsClient::writeNext() {
       self->close();
       return;
     }
+    if (self->closing_) {
+      self->sendCloseFrame();  // shutdown waited for this message
+      return;
+    }
     self->writeNext();
   });
   stallTimer_.expires_after(stallTimeout_);
@@ -147,16 +151,23 @@ void WsClient::writeNext() {
 void WsClient::shutdown() {
   if (closing_ || closed_) return;
   closing_ = true;
-  if (!open_ || writeInFlight_) {
+  if (!open_) {
     close();
     return;
   }
-  ws_.async_close(websocket::close_code::going_away, [self = shared_from_this()](beast::error_code) {
-    self->close();
-  });
   closeTimer_.expires_after(kShutdownGrace);
   closeTimer_.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
     if (!ec) self->close();
+  });
+  // With a message on the wire the close frame follows it (the write's
+  // handler sends it): cutting the socket mid-message would leave the console
+  // without the reason.
+  if (!writeInFlight_) sendCloseFrame();
+}
+
+void WsClient::sendCloseFrame() {
+  ws_.async_close(websocket::close_code::going_away, [self = shared_from_this()](beast::error_code) {
+    self->close();
   });
 }
 

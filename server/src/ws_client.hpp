@@ -49,8 +49,9 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
   void sendState(WsText state);
   void sendRenderers(WsText renderers);
   void sendHealth(WsText health);
-  // Sends a close frame when nothing is being written, else closes the
-  // socket; either way done within a second. For server shutdown.
+  // Sends a close frame, after the message being written if there is one (a
+  // websocket writes one frame at a time); the socket is closed within a
+  // second either way. For server shutdown.
   void shutdown();
   // Closes the socket now. Idempotent.
   void close(bool dropped = false);
@@ -61,6 +62,7 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
  private:
   void readMore();
   void writeNext();
+  void sendCloseFrame();
 
   boost::beast::websocket::stream<boost::beast::tcp_stream> ws_;
   boost::asio::steady_timer stallTimer_;
