@@ -100,6 +100,11 @@ export class Weatherd {
       "--http-port-file", portFile, "--token-file", path.join(this.dir, "token"), "--heartbeat-ms", "200"];
     if (config.stations) args.push("--metar-stations", config.stations);
     if (this.db) args.push("--db", this.db);
+    // The CIGI weather input too (UDP, loopback): a host's Weather Control
+    // reaches the consoles like an API change.
+    const cigiPortFile = path.join(this.dir, "cigi.port");
+    fs.rmSync(cigiPortFile, { force: true });
+    args.push("--cigi-port", "0", "--cigi-port-file", cigiPortFile);
     const log = fs.openSync(path.join(this.dir, `weatherd-${++this.starts}.log`), "w");
     this.proc = track(spawn(config.weatherd, args, { stdio: ["ignore", log, log] }));
     this.exited = new Promise((resolve) => this.proc.on("exit", (code, signal) => resolve({ code, signal })));
@@ -110,6 +115,8 @@ export class Weatherd {
     }, 30000, 50).catch((e) => { throw new Error(`${e.message}\n${this.log()}`); });
     this.httpPort = port;
     this.streamPort = Number(fs.readFileSync(streamPortFile, "utf8"));
+    this.cigiPort = await until("the CIGI port file", async () =>
+      fs.existsSync(cigiPortFile) ? Number(fs.readFileSync(cigiPortFile, "utf8")) : 0, 10000, 50);
     this.base = `http://127.0.0.1:${port}`;
     return this;
   }
