@@ -131,6 +131,7 @@ void main() {
   f.air = AirFrame(frame.earth.x, frame.earth.y, frame.earth.z, frame.earth.w, frame.sunDir.xyz,
                    frame.sunIrradiance.rgb);
   f.groundIrradiance = frame.groundIrradiance.rgb;
+  f.march = MarchParams(int(frame.dispatch.y), int(frame.dispatch.z), frame.weatherMap.z, frame.weatherMap.w);
   f.layerCount = int(frame.weatherMap.y);
   vec3 dir = cameraRay(frame.camForward.xyz, frame.camRight.xyz, frame.camDown.xyz, frame.camRight.w,
                        frame.camDown.w, float(px.x), float(px.y), float(frame.image.x), float(frame.image.y));

@@ -37,8 +37,11 @@ SKY_CORE_CONST int kScatterOctaves = 4;
 SKY_CORE_CONST real kOctaveExtinction = 0.5;
 SKY_CORE_CONST real kOctaveContribution = 0.5;
 SKY_CORE_CONST real kOctaveEccentricity = 0.5;
-// Primary samples per layer span; fixed so cost is predictable (lavapipe.md:
-// ~9.5 ns per primary step, 60-130 lookups per pixel fit a 33 ms frame).
+// The march's cost knobs are run-time numbers of the frame (CoreFrame.march,
+// RenderSettings::march, the presets); these are their defaults, the
+// `high` preset. Primary samples per layer span, spread evenly over it, so
+// cost is predictable (lavapipe.md: ~9.5 ns per primary step, 60-130 lookups
+// per pixel fit a 33 ms frame).
 SKY_CORE_CONST int kPrimarySteps = 48;
 // Light samples towards the sun (Haggstrom 2018: 4 was the best trade); the
 // distance they cover is per layer (LayerSetup::lightDistance_m).
@@ -52,6 +55,8 @@ SKY_CORE_CONST real kMaxSpan_m = 60000.0;
 SKY_CORE_CONST real kMaxViewDistance_m = 150000.0;
 // Early exit once the view ray keeps less than 1 % of the background.
 SKY_CORE_CONST real kMinTransmittance = 0.01;
+// Samples skipped per empty primary sample: 1 marches every sample.
+SKY_CORE_CONST real kEmptyStride = 1.0;
 // Diffuse light inside a layer: the sky's light and the sunlight scattered
 // out of the direct beam above a point reach it as diffuse light, transmitted
 // through the optical depth tau above as by a conservatively scattering slab
@@ -102,8 +107,17 @@ real2 sampleCloudMap(LayerSampling s, real3 pLocal);
 real2 sampleShape(LayerSampling s, real3 pLocal);
 real sampleDetail(LayerSampling s, real3 pLocal);
 
+// The march's cost knobs (defaults above; RenderSettings::march).
+struct MarchParams {
+  int primarySteps;      // samples per layer span, evenly spaced, >= 1
+  int lightSteps;        // samples of the secondary march towards the sun, >= 1
+  real minTransmittance; // stop once the view ray keeps less; 0: never
+  real emptyStride;      // samples advanced after one that met no cloud, >= 1
+};
+
 struct CoreFrame {
   AirFrame air;
+  MarchParams march;
   real3 groundIrradiance;  // sky irradiance on horizontal ground, linear units
   int layerCount;
 };
@@ -220,13 +234,13 @@ real octaveSum(real4 phases, real tauSun) {
 // the cheap sample), with the coverage, type and cloud map of the primary
 // sample standing for the path (a few hundred metres; map texels ~780 m).
 // Heights along it rise by muSun per metre (the sun's cosine at p; the
-// curvature over <= 2 km is under 0.4 m). `steps` is kLightSteps, or 0 where
+// curvature over <= 2 km is under 0.4 m). `steps` is lightSteps, or 0 where
 // there is no density: lavapipe runs every branch for all lanes of a
 // subgroup, but leaves a loop once no lane is in it, so a zero trip count is
 // what skips the march.
 real lightOpticalDepth(real3 sunDir, real muSun, real thickness, real lightDistance, LayerSampling ls, CloudType t,
-                       real3 p, real ph, real c, real peakNoise, real densityScale, int steps) {
-  real lightDt = lightDistance / real(kLightSteps);
+                       real3 p, real ph, real c, real peakNoise, real densityScale, int lightSteps, int steps) {
+  real lightDt = lightDistance / real(lightSteps);
   real dph = lightDt * muSun / thickness;
   real tau = 0.0;
   for (int j = 0; j < steps; ++j) {
@@ -254,7 +268,8 @@ real3 diffuseLight(CoreLayer L, CloudType t, real ph, real c, real densityScale)
 // layers in front left) only decides the early exit.
 LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real transmittanceBefore) {
   CoreLayer L = layerAt(li);
-  real dt = (s.t1 - s.t0) / real(kPrimarySteps);
+  real steps = real(f.march.primarySteps);
+  real dt = (s.t1 - s.t0) / steps;
   // The phase of each octave depends on the angle to the sun only: once per
   // span for each of the layer's two types.
   real nu = dot(dir, f.air.sunDir);
@@ -276,9 +291,13 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
   LayerResult res = LayerResult(real3(0.0), 1.0, 0.5 * (s.t0 + s.t1));
   real depthSum = 0.0;
   real weightSum = 0.0;
-  for (int i = 0; i < kPrimarySteps; ++i) {
-    if (transmittanceBefore * res.transmittance < kMinTransmittance) break;
-    real t = s.t0 + (real(i) + jitter) * dt;
+  // fi: the sample's index along the span; a sample that meets no cloud
+  // moves it on by emptyStride (1: every sample), one that does by 1.
+  real stride = 1.0;
+  for (real fi = 0.0; fi < steps; fi += stride) {
+    if (transmittanceBefore * res.transmittance < f.march.minTransmittance) break;
+    stride = f.march.emptyStride;
+    real t = s.t0 + (fi + jitter) * dt;
     real3 p = dir * t;
     real h = heightAboveCameraSphere(p, f.air.r);
     real ph = (h + L.hBase) / L.thickness;
@@ -298,9 +317,11 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
     // Erosion leaves a full shape (1) full: the detail fetch only at the edges.
     real rho = (shape < 1.0 ? erodeShape(ct, shape, sampleDetail(L.sampling, p), c, ph) : 1.0) * da;
     if (rho <= 0.0) continue;
-    real u = (real(i) + jitter) / real(kPrimarySteps);
+    stride = 1.0;
+    real u = (fi + jitter) / steps;
     real tauSun = lightOpticalDepth(f.air.sunDir, mix(muStart, muEnd, u), L.thickness, L.lightDistance, L.sampling, ct,
-                                    p, ph, c, map.y, weather.y, rho > 0.0 ? kLightSteps : 0);
+                                    p, ph, c, map.y, weather.y, f.march.lightSteps,
+                                    rho > 0.0 ? f.march.lightSteps : 0);
     // Sunlight at p through the clear air above it (reddened at low sun,
     // none in the Earth's shadow), and the sky's light from all around.
     real3 sun = mix(mix(sunBaseStart, sunTopStart, ph), mix(sunBaseEnd, sunTopEnd, ph), u);
@@ -393,7 +414,7 @@ PixelResult shadePixel(CoreFrame f, real3 dir, real jitter) {
   real cloudT = 1.0;
   for (int k = 0; k < f.layerCount; ++k) {
     Span s = spans[order[k]];
-    if (s.t1 <= s.t0 || cloudT < kMinTransmittance) continue;
+    if (s.t1 <= s.t0 || cloudT < f.march.minTransmittance) continue;
     LayerResult r = marchLayer(f, order[k], dir, s, jitter, cloudT);
     if (r.transmittance >= 1.0) continue;  // met no cloud
     layers[n] = r;

@@ -71,14 +71,16 @@ struct SkyFrame {
   vec4 camToAnchor[3];  // rows of the rotation camera-local -> weather-anchor-local
   vec4 camInAnchor;     // xyz: camera relative to the anchor sphere centre, anchor frame (m);
                         // w: anchor sphere radius (m)
-  vec4 weatherMap;      // x: 1 / (2 half extent) (1/m), y: layer count, zw: unused
+  vec4 weatherMap;      // x: 1 / (2 half extent) (1/m), y: layer count, z: the march's minimum
+                        // transmittance, w: its empty stride (RenderSettings::march)
   vec4 earth;           // x: camera radius r (m), y: camera height above ground (m),
                         // z: hGround (2r - hGround) (m^2), w: the same for the atmosphere top (m^2)
   vec4 sunDir;          // xyz: unit vector towards the sun, local frame; w: unused
   vec4 sunIrradiance;   // rgb: sun irradiance at the top of the atmosphere (linear units); w: unused
   vec4 groundIrradiance;  // rgb: sky irradiance on horizontal ground (linear units); w: unused
   uvec4 image;          // x: width, y: height, z: tiles per row, w: tile count
-  uvec4 dispatch;       // x: tile permutation stride (coprime to the tile count), yzw: unused
+  uvec4 dispatch;       // x: tile permutation stride (coprime to the tile count), y: primary steps per
+                        // layer span, z: light steps, w: unused
   SkyLayer layers[kMaxLayers];
 };
 

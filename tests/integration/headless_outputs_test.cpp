@@ -200,7 +200,8 @@ TEST(HeadlessOutputs, MetadataDescribesEachFrameAndTheReportSumsGpuTimes) {
     const auto& f = run.frames[i];
     SCOPED_TRACE(f.dump());
     EXPECT_EQ(f["frame"], i);
-    EXPECT_EQ(f["preset"], "default");
+    EXPECT_EQ(f["preset"], "high");
+    EXPECT_EQ(f["march"]["primary_steps"], 48);
     EXPECT_EQ(f["resolution"], nlohmann::json::array({kWidth, kHeight}));
     EXPECT_EQ(f["vertical_fov_deg"], 60.0);
     EXPECT_EQ(f["noise_seeds"]["shape"], 1);
@@ -226,7 +227,7 @@ TEST(HeadlessOutputs, MetadataDescribesEachFrameAndTheReportSumsGpuTimes) {
   EXPECT_GT(gpu["clouds"]["p50"].get<double>(), 0.0);
   EXPECT_LE(gpu["clouds"]["p50"].get<double>(), gpu["clouds"]["p90"].get<double>());
   EXPECT_EQ(gpu["weather_upload"]["frames"], 1);
-  EXPECT_EQ(run.report["preset"], "default");
+  EXPECT_EQ(run.report["preset"], "high");
 }
 
 // The noise textures (the cloud model's shape and detail noise) through

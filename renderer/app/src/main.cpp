@@ -27,6 +27,7 @@
 #include "sky/app/frame_writer.hpp"
 #include "sky/app/glfw_window.hpp"
 #include "sky/app/headless_replay.hpp"
+#include "sky/render/presets.hpp"
 #include "sky/app/timed_render.hpp"
 #include "sky/app/weather_client.hpp"
 #include "sky/app/window_display.hpp"
@@ -58,6 +59,7 @@ struct Options {
   bool noExr = false;
   unsigned width = 320, height = 180;
   double fov_deg = 60;
+  std::string preset = sky::app::kDefaultPreset;
   double sunAzimuth_deg = 135, sunElevation_deg = 40;
   std::uint64_t maxFrames = 0;
   double idleExit_s = 0;
@@ -129,6 +131,9 @@ int main(int argc, char** argv) {
   app.add_option("--width", o.width)->check(CLI::Range(16, 8192));
   app.add_option("--height", o.height)->check(CLI::Range(16, 8192));
   app.add_option("--fov", o.fov_deg, "vertical field of view, deg")->check(CLI::Range(1.0, 170.0));
+  app.add_option("--preset", o.preset,
+                 "quality preset: reference, high, medium, low, realtime (README.md, \"Quality presets\")")
+      ->capture_default_str();
   app.add_option("--sun-azimuth", o.sunAzimuth_deg, "deg from true north");
   app.add_option("--sun-elevation", o.sunElevation_deg, "deg above the horizon");
   app.add_option("--max-frames", o.maxFrames, "stop after this many frames (0 = no limit)");
@@ -196,7 +201,13 @@ int main(int argc, char** argv) {
     }
     window = std::move(*opened);
   }
-  sky::render::RenderSettings settings{o.width, o.height, o.fov_deg, 1, o.noNoiseCache ? std::string() : o.cacheDir};
+  auto preset = sky::render::findPreset(o.preset);
+  if (!preset) {
+    std::fprintf(stderr, "skyshell-render: --preset: %s\n", sky::describe(preset.error()).c_str());
+    return 2;
+  }
+  sky::render::RenderSettings settings{o.width, o.height, o.fov_deg, 1, o.noNoiseCache ? std::string() : o.cacheDir,
+                                       preset->march};
   sky::render::GpuOptions gpu;
   gpu.window = window ? &window->surface() : nullptr;
   gpu.validation = o.validation;
@@ -238,13 +249,14 @@ int main(int argc, char** argv) {
     r.sunAzimuth_deg = o.sunAzimuth_deg;
     r.sunElevation_deg = o.sunElevation_deg;
     r.fixedSun = o.fixedSun;
+    r.preset = o.preset;
     r.weatherFile = o.weatherFile;
     r.display = display ? &*display : nullptr;
     std::signal(SIGINT, onReplaySignal);
     std::signal(SIGTERM, onReplaySignal);
     return sky::app::runHeadlessReplay(r, **renderer, &gReplayStop);
   }
-  auto writer = sky::app::FrameWriter::open(o.outDir, outputs, {sky::app::kDefaultPreset, (*renderer)->settings()});
+  auto writer = sky::app::FrameWriter::open(o.outDir, outputs, {o.preset, (*renderer)->settings()});
   if (!writer) {
     std::fprintf(stderr, "skyshell-render: %s\n", sky::describe(writer.error()).c_str());
     return 2;

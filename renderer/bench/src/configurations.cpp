@@ -5,21 +5,21 @@
 #include <cmath>
 #include <sstream>
 
+#include "sky/render/presets.hpp"
+
 namespace sky::bench {
 
 std::vector<Configuration> builtInConfigurations() {
-  // PRESETS PLUG IN HERE. The renderer has no quality presets yet: its only
-  // knobs are resolution, field of view and the noise seed, and its march
-  // (steps, light steps) is fixed in shaders/include/cloud_core.glsl. So today
-  // `reference` is simply the renderer as it is, and the other entries trade
-  // resolution only. When presets land, each becomes one entry here
-  // ({"medium", "...", 1.0, true, render::presetSettings(Preset::Medium)}
-  // or the like), `reference` takes the reference preset, and the seeds'
-  // configurations (Haggstrom's and Ford's final settings) become entries too.
+  // The renderer's presets (sky/render/presets.hpp), `reference` first,
+  // then the resolution-only trades of the default preset.
   std::vector<Configuration> all;
-  all.push_back({kReferenceName, "the renderer's only quality today: full resolution, fixed march", 1.0, false, {}});
-  all.push_back({"half-res", "renders at 1/2 the width and height, bilinear upscale (bench-side)", 0.5, false, {}});
-  all.push_back({"quarter-res", "renders at 1/4 the width and height, bilinear upscale (bench-side)", 0.25, false, {}});
+  for (const render::Preset& p : render::presets()) {
+    Configuration c{p.name, "preset: " + p.description, 1.0, false, {}};
+    c.settings.march = p.march;
+    all.push_back(c);
+  }
+  all.push_back({"half-res", "preset high at 1/2 the width and height, bilinear upscale (bench-side)", 0.5, false, {}});
+  all.push_back({"quarter-res", "preset high at 1/4 the width and height, bilinear upscale (bench-side)", 0.25, false, {}});
   return all;
 }
 

@@ -78,6 +78,8 @@ class CpuCore {
     f.air.sunDir = setup_.sunDir;
     f.air.sunIrradiance = setup_.sunIrradiance;
     f.groundIrradiance = setup_.groundIrradiance;
+    f.march = MarchParams{int(setup_.march.primarySteps), int(setup_.march.lightSteps), setup_.march.minTransmittance,
+                          double(setup_.march.emptyStride)};
     f.layerCount = int(setup_.layers.size());
     const CloudType cumulus = coreType(cloudTypeParams(weather::CloudType::Cumulus));
     for (std::size_t i = 0; i < kMaxLayers; ++i) {

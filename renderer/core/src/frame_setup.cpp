@@ -63,6 +63,19 @@ Result<void> validateSettings(const RenderSettings& s) {
   if (!(s.verticalFov_deg > 0 && s.verticalFov_deg < 179))
     return fail(ErrorCode::InvalidArgument,
                 "render settings: verticalFov_deg " + num(s.verticalFov_deg) + " outside (0, 179)");
+  const MarchSettings& m = s.march;
+  if (m.primarySteps < 1 || m.primarySteps > 1024)
+    return fail(ErrorCode::InvalidArgument,
+                "render settings: march.primarySteps " + std::to_string(m.primarySteps) + " outside [1, 1024]");
+  if (m.lightSteps < 1 || m.lightSteps > 64)
+    return fail(ErrorCode::InvalidArgument,
+                "render settings: march.lightSteps " + std::to_string(m.lightSteps) + " outside [1, 64]");
+  if (!(m.minTransmittance >= 0 && m.minTransmittance < 1))
+    return fail(ErrorCode::InvalidArgument,
+                "render settings: march.minTransmittance " + num(m.minTransmittance) + " outside [0, 1)");
+  if (m.emptyStride < 1 || m.emptyStride > 16)
+    return fail(ErrorCode::InvalidArgument,
+                "render settings: march.emptyStride " + std::to_string(m.emptyStride) + " outside [1, 16]");
   return {};
 }
 
@@ -103,6 +116,7 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
   s.height = settings.height;
   s.tanHalfFov = std::tan(0.5 * settings.verticalFov_deg * kDegToRad);
   s.aspect = double(settings.width) / double(settings.height);
+  s.march = settings.march;
 
   const geo::EnuFrame enu = geo::enuFrameAt(in.camera.position);
   const geo::BodyAxes axes = geo::bodyAxes(in.camera);
@@ -245,7 +259,8 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
     f.camToAnchor[row] = v4(glm::dvec3(s.camToAnchor[0][row], s.camToAnchor[1][row], s.camToAnchor[2][row]));
   }
   f.camInAnchor = v4(s.camInAnchor_m, s.anchorRadius_m);
-  f.weatherMap = gpu::vec4(float(1.0 / (2 * s.mapHalfExtent_m)), float(s.layers.size()), 0.0f, 0.0f);
+  f.weatherMap = gpu::vec4(float(1.0 / (2 * s.mapHalfExtent_m)), float(s.layers.size()),
+                             float(s.march.minTransmittance), float(s.march.emptyStride));
   f.earth = gpu::vec4(float(s.r_m), float(s.hGround_m), float(s.cGround_m2), float(s.cAtmosphereTop_m2));
   f.sunDir = v4(s.sunDir);
   f.sunIrradiance = v4(s.sunIrradiance);
@@ -259,7 +274,7 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
     while (std::gcd(stride, n) != 1) ++stride;
   }
   f.image = gpu::uvec4(s.width, s.height, tilesX, n);
-  f.dispatch = gpu::uvec4(stride, 0, 0, 0);
+  f.dispatch = gpu::uvec4(stride, s.march.primarySteps, s.march.lightSteps, 0);
 
   for (std::size_t i = 0; i < s.layers.size(); ++i) {
     const LayerSetup& l = s.layers[i];

@@ -65,6 +65,7 @@ struct FrameSetup {
   bool moonLit = false;
   glm::dvec3 groundIrradiance{0};  // sky irradiance on the ground, linear units
   std::vector<LayerSetup> layers;
+  MarchSettings march;  // the march's cost knobs, as set
 };
 
 // Checks settings (size, field of view) for CloudRenderer::create.

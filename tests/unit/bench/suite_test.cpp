@@ -130,6 +130,20 @@ TEST(Configurations, ReferenceFirstAndUnknownNamesRefused) {
   EXPECT_DOUBLE_EQ(s.verticalFov_deg, 45);
 }
 
+TEST(Configurations, PresetsAreConfigurationsWithTheirMarch) {
+  auto chosen = selectConfigurations("realtime,medium");
+  ASSERT_TRUE(chosen) << chosen.error().detail;
+  ASSERT_EQ(chosen->size(), 3u);
+  EXPECT_EQ((*chosen)[0].settings.march.primarySteps, 256u) << "reference is the reference preset";
+  EXPECT_EQ((*chosen)[0].settings.march.minTransmittance, 0.0);
+  EXPECT_EQ((*chosen)[1].name, "realtime");
+  EXPECT_EQ((*chosen)[1].settings.march.primarySteps, 16u);
+  EXPECT_EQ((*chosen)[1].settings.march.lightSteps, 1u);
+  EXPECT_EQ((*chosen)[2].name, "medium");
+  EXPECT_EQ((*chosen)[2].settings.march.primarySteps, 32u);
+  EXPECT_EQ(settingsFor((*chosen)[1], 160, 90, 60).march.emptyStride, 3u);
+}
+
 TEST(Spread, MedianAndRange) {
   const Spread odd = spreadOf({5, 1, 3});
   EXPECT_EQ(odd.samples, 3u);

@@ -75,6 +75,7 @@ Core::CloudType haggstromCumulus() {
 // layer of the given type; no sun, no sky light.
 Core::CoreFrame frameAt(Core& c, double R, double alt, double base, double thickness, const Core::CloudType& type) {
   Core::CoreFrame f{};
+  f.march = Core::MarchParams{Core::kPrimarySteps, Core::kLightSteps, Core::kMinTransmittance, Core::kEmptyStride};
   f.air.r = R + alt;
   f.air.h = alt;
   f.air.cGround = alt * (2 * f.air.r - alt);

@@ -41,6 +41,7 @@ Core::CoreLayer slabLayer(const Core::CoreFrame& f, double base_m, double thickn
 
 Core::CoreFrame frame(Core& c, double sigma) {
   Core::CoreFrame f{};
+  f.march = Core::MarchParams{Core::kPrimarySteps, Core::kLightSteps, Core::kMinTransmittance, Core::kEmptyStride};
   f.air.r = kEarth_m + kAlt_m;
   f.air.h = kAlt_m;
   f.air.cGround = kAlt_m * (2 * f.air.r - kAlt_m);

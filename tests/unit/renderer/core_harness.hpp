@@ -26,6 +26,8 @@ class Core {
 
   real coverage = 1.0, density = 1.0, blend = 0.0, noise = 1.0, detail = 0.5;
   real2 cloudMap = real2(0.5, 1.0);
+  // Shape-noise lookups so far (primary and light march): the march's cost.
+  std::uint64_t shapeLookups = 0;
   // Transmittance table lookup; unset: clear air transmits everything.
   std::function<real3(real2)> table;
   // Multiple-scattering table lookup; unset: none.
@@ -46,7 +48,10 @@ class Core {
 inline Core::CoreLayer Core::layerAt(int li) { return layers[li]; }
 inline Core::real3 Core::sampleWeather(LayerSampling, real3) { return real3(coverage, density, blend); }
 inline Core::real2 Core::sampleCloudMap(LayerSampling, real3) { return cloudMap; }
-inline Core::real2 Core::sampleShape(LayerSampling, real3) { return real2(noise, noise); }
+inline Core::real2 Core::sampleShape(LayerSampling, real3) {
+  ++shapeLookups;
+  return real2(noise, noise);
+}
 inline Core::real Core::sampleDetail(LayerSampling, real3) { return detail; }
 
 }  // namespace sky::test

@@ -18,9 +18,9 @@
 
 namespace sky::app {
 
-// Name recorded while there is no preset system: the compiled-in model
-// constants and the RenderSettings written next to it.
-inline constexpr const char* kDefaultPreset = "default";
+// The preset (sky/render/presets.hpp) when --preset is not given: `high`,
+// RenderSettings' default march.
+inline constexpr const char* kDefaultPreset = "high";
 
 struct FrameOutputs {
   bool png = true;

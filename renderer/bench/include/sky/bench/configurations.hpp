@@ -1,7 +1,7 @@
 // Render configurations the bench measures: a named RenderSettings plus what
 // the bench itself varies. `reference` is the ground truth every other
 // configuration is compared with. builtInConfigurations() (configurations.cpp)
-// is the one place presets plug in once the renderer has them.
+// is where the renderer's presets (sky/render/presets.hpp) plug in.
 #pragma once
 
 #include <cstdint>

@@ -20,6 +20,18 @@ namespace sky::render {
 // Cloud layers one frame can draw (the shaders' kMaxLayers, checked there).
 inline constexpr std::size_t kMaxLayers = 4;
 
+// The cloud march's cost knobs (shaders/include/cloud_core.glsl), carried
+// in the frame block as run-time numbers. The defaults are the `high`
+// preset (presets.hpp), the march as it was before presets.
+struct MarchSettings {
+  std::uint32_t primarySteps = 48;  // samples per layer span, evenly spaced, [1, 1024]
+  std::uint32_t lightSteps = 4;     // samples towards the sun per lit sample, [1, 64]
+  double minTransmittance = 0.01;   // stop the view ray once it keeps less, [0, 1); 0: never
+  // Samples advanced after one that met no cloud: long strides through empty
+  // air, single ones inside cloud. 1 marches every sample. [1, 16].
+  std::uint32_t emptyStride = 1;
+};
+
 struct RenderSettings {
   std::uint32_t width = 320, height = 180;  // pixels, [1, 8192]
   double verticalFov_deg = 60;              // (0, 179)
@@ -27,6 +39,7 @@ struct RenderSettings {
   // Where noise textures are cached between starts (noise_cache.hpp);
   // empty: generated at every start.
   std::string noiseCacheDir;
+  MarchSettings march;
 };
 
 struct FrameInputs {
