@@ -116,7 +116,12 @@ TEST(LiveWeather, ABatchIsAllOrNothing) {
   EXPECT_TRUE(f.weather.events(10).empty());
   EXPECT_EQ(f.weather.rejected(), 1u);
   EXPECT_FALSE(f.weather.submit(ChangeRequest{{}, "test", "api"}));
-  EXPECT_FALSE(f.weather.submit(f.one(SetRegion{})));  // regions: not implemented yet
+  // A region with no size and no layers is refused, and names why.
+  auto emptyRegion = f.weather.submit(f.one(SetRegion{}));
+  ASSERT_FALSE(emptyRegion);
+  EXPECT_NE(emptyRegion.error().detail.find("changes[0].region"), std::string::npos) << emptyRegion.error().detail;
+  EXPECT_TRUE(f.weather.view().regions.empty());
+  EXPECT_EQ(f.weather.rejected(), 3u);
 }
 
 TEST(LiveWeather, ClockPausesRunsAndJumps) {

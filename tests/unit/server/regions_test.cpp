@@ -9,6 +9,8 @@
 #include <GeographicLib/Geodesic.hpp>
 #include <gtest/gtest.h>
 
+#include "region_builder.hpp"
+
 #include "sky/server/api_json.hpp"
 #include "sky/server/live_weather.hpp"
 #include "sky/server/snapshot_builder.hpp"
@@ -34,18 +36,7 @@ weather::CloudLayer layer(std::uint32_t id, weather::CloudType type, double cove
   return l;
 }
 
-weather::Region cell(std::uint32_t id, double lat, double lon, double size_m, double transition_m,
-                     std::vector<weather::CloudLayer> layers) {
-  weather::Region r;
-  r.id = id;
-  r.centerLat_deg = lat;
-  r.centerLon_deg = lon;
-  r.sizeX_m = size_m;
-  r.sizeY_m = size_m;
-  r.transition_m = transition_m;
-  r.layers = std::move(layers);
-  return r;
-}
+constexpr auto cell = test::squareRegion;
 
 struct Fixture {
   WallClock::time_point now = kT0;

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "region_builder.hpp"
+
 #include "sky/server/snapshot_builder.hpp"
 
 namespace sky::server {
@@ -25,18 +27,7 @@ weather::CloudLayer layer(std::uint32_t id, weather::CloudType type, double cove
   return l;
 }
 
-weather::Region region(std::uint32_t id, double lat, double lon, double size_m, double transition_m,
-                       std::vector<weather::CloudLayer> layers) {
-  weather::Region r;
-  r.id = id;
-  r.centerLat_deg = lat;
-  r.centerLon_deg = lon;
-  r.sizeX_m = size_m;
-  r.sizeY_m = size_m;
-  r.transition_m = transition_m;
-  r.layers = std::move(layers);
-  return r;
-}
+constexpr auto region = test::squareRegion;
 
 stream::Subscribe around(double lat, double lon, double radius_m, int level = 13) {
   stream::Subscribe s;
