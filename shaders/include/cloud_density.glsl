@@ -71,28 +71,36 @@ real mappedCoverage(real coverage, real m) {
   return clamp(coverage + kCloudMapAmplitude * (m - 0.5) * 4.0 * coverage * (1.0 - coverage), 0.0, 1.0);
 }
 
+// How far into the anvil zone ph is, times the anvil amount: 0 below
+// kAnvilStart (and for types without an anvil), the amount above kAnvilEnd.
+real anvilRamp(CloudType t, real ph) {
+  return t.anvil * saturate1((ph - kAnvilStart) / (kAnvilEnd - kAnvilStart));
+}
+
 // Coverage c raised towards 1 in the anvil zone (ph in [0.65, 0.95]) by the
 // anvil amount: an anvil spreads over the whole storm cell the weather map
 // gives (Haggstrom's eq. 17 spreads only where the map already has cloud;
 // a storm cell's tiles are mostly its anvil's footprint). c = 0 stays 0.
 real anvilCoverage(CloudType t, real ph, real c) {
   if (c <= 0.0) return 0.0;
-  return mix(c, 1.0, t.anvil * saturate1((ph - kAnvilStart) / (kAnvilEnd - kAnvilStart)));
+  return mix(c, 1.0, anvilRamp(t, ph));
 }
 
 // Shape-altering height function SA (Haggstrom eq. 5-7, with anvils eq. 17)
 // at height fraction ph, for coverage c and the cloud map's peak value
-// peakNoise in [0, 1]. 0 outside the layer.
+// peakNoise in [0, 1]. 0 outside the layer. An anvil's top is flat: over the
+// anvil zone the top rounding gives way to 1 (by the anvil ramp), so the
+// anvil reaches the layer top wherever the tower's varied peak wh ends
+// (Haggstrom's wh is one weather-map value per cell; ours varies with the
+// cloud map, and eq. 17's exponent cannot lift SA = 0 above wh).
 real shapeProfile(CloudType t, real ph, real c, real peakNoise) {
   if (ph <= 0.0 || ph >= 1.0) return 0.0;
   real wh = t.peak * (1.0 - t.peakVariation * (1.0 - peakNoise));
   real bottom = saturate1(ph / t.baseRound);
   real top = saturate1((wh - ph) / (wh * (1.0 - t.topRoundStart)));
-  real sa = bottom * top;
-  if (t.anvil > 0.0 && sa > 0.0) {
-    real e = mix(1.0, 1.0 - t.anvil * c, saturate1((ph - kAnvilStart) / (kAnvilEnd - kAnvilStart)));
-    sa = pow(sa, max(e, kMinAnvilExponent));
-  }
+  real ramp = anvilRamp(t, ph);
+  real sa = bottom * mix(top, 1.0, ramp);
+  if (ramp > 0.0 && sa > 0.0) sa = pow(sa, max(1.0 - ramp * c, kMinAnvilExponent));
   return sa;
 }
 

@@ -237,11 +237,13 @@ TEST(CloudCore, HeightFunctionsAtHandComputedPoints) {
   EXPECT_NEAR(c.densityProfile(cu, 0.5), 0.5, 1e-12);
   EXPECT_NEAR(c.densityProfile(cu, 0.1), 0.1 * 0.1 / 0.15, 1e-12);
   EXPECT_NEAR(c.densityProfile(cu, 0.95), 0.95 * 0.5, 1e-12);
-  // Anvil (eq. 17-18) at coverage 1: at ph = 0.8 the shape exponent is
-  // 1 - 0.5 = 0.5 and the density is cut by SAT(R(sqrt(0.8), 0.4, 0.95, 1, 0.2)).
+  // Anvil (eq. 17-18) at coverage 1: at ph = 0.8, half way through the anvil
+  // zone, the top rounding (1 - 0.8) / 0.8 is lifted half way to 1, the shape
+  // exponent is 1 - 0.5 = 0.5 and the density is cut by SAT(R(sqrt(0.8),
+  // 0.4, 0.95, 1, 0.2)).
   Core::CloudType cb = cu;
   cb.anvil = 1.0;
-  const double sa = (1 - 0.8) / 0.8;
+  const double sa = 0.5 * (1 - 0.8) / 0.8 + 0.5;
   EXPECT_NEAR(c.shapeProfile(cb, 0.8, 1.0, 1.0), std::sqrt(sa), 1e-12);
   const double cut = 1 + (std::sqrt(0.8) - 0.4) / (0.95 - 0.4) * (0.2 - 1);
   EXPECT_NEAR(c.densityProfile(cb, 0.8), 0.8 * cut, 1e-12);
