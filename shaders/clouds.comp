@@ -35,7 +35,8 @@ layout(std430, set = 0, binding = kBindingDepth) writeonly buffer DepthBlock { f
 // Copies of the frame's sampling numbers, set at the start of main.
 mat3 gCamToAnchor;     // camera-local -> weather-anchor-local
 vec4 gCamInAnchor;     // xyz: camera in the anchor frame (m); w: anchor sphere radius (m)
-float gMapScale;       // 1 / (2 half extent) of the weather map (1/m)
+float gMapScale;       // 1 / (2 half extent) of the weather map's fine ring (1/m)
+vec4 gRings;           // the frame's weatherRings
 mat3 gLocalToEcef;     // camera-local -> ECEF axes
 
 vec3 sampleTransmittanceLut(vec2 uv) {
@@ -49,13 +50,20 @@ vec3 sampleMultipleScatteringLut(vec2 uv) {
 #include "cloud_core.glsl"
 
 // Weather map lookup: camera-local point -> weather anchor frame -> gnomonic
-// plane of the anchor sphere (x = R q.x / q.z) -> texture coordinates.
+// plane of the anchor sphere (x = R q.x / q.z) -> texture coordinates of the
+// rings: the fine ring inside its blend band, the coarse ring beyond, linear
+// in the max norm between (WeatherField::sample, ringBlendWeight).
 vec3 sampleWeather(LayerSampling s, vec3 p) {
   vec3 q = gCamToAnchor * p + gCamInAnchor.xyz;
   if (q.z <= 0.0) return vec3(0.0);
   vec2 plane = q.xy * (gCamInAnchor.w / q.z) - s.coverageShift.xy;
-  vec2 uv = plane * gMapScale + 0.5;
-  return textureLod(weatherTex, vec3(uv, s.coverageShift.z), 0.0).xyz;
+  float e = 2.0 * max(abs(plane.x), abs(plane.y)) * gMapScale;
+  float w = clamp((e - gRings.y) / (gRings.z - gRings.y), 0.0, 1.0);
+  vec3 v = vec3(0.0);
+  if (w < 1.0) v = textureLod(weatherTex, vec3(plane * gMapScale + 0.5, s.coverageShift.z), 0.0).xyz;
+  if (w > 0.0)
+    v = mix(v, textureLod(weatherTex, vec3(plane * gRings.x + 0.5, s.coverageShift.z + float(kMaxLayers)), 0.0).xyz, w);
+  return v;
 }
 
 // Earth-fixed noise coordinates: rotate to ECEF axes, scale by the period and
@@ -126,6 +134,7 @@ void main() {
   gLocalToEcef = transpose(mat3(frame.localToEcef[0].xyz, frame.localToEcef[1].xyz, frame.localToEcef[2].xyz));
   gCamInAnchor = frame.camInAnchor;
   gMapScale = frame.weatherMap.x;
+  gRings = frame.weatherRings;
 
   CoreFrame f;
   f.air = AirFrame(frame.earth.x, frame.earth.y, frame.earth.z, frame.earth.w, frame.sunDir.xyz,

@@ -49,10 +49,12 @@ SKY_CORE_CONST int kLightSteps = 4;
 // Longest span marched through one layer, m: beyond this a grazing ray's
 // samples would be more than ~1.2 km apart and only add noise.
 SKY_CORE_CONST real kMaxSpan_m = 60000.0;
-// Spans starting farther than this are not marched, m: the weather map reaches
-// 100 km (gnomonic half extent), its corners about 141 km; aerial perspective
-// has faded clouds there to a few percent of their contrast.
-SKY_CORE_CONST real kMaxViewDistance_m = 150000.0;
+// Spans starting farther than this are not marched, m: the weather map's
+// coarse ring reaches 600 km (gnomonic half extent), past the horizon of a
+// layer at 2 km seen from 12 km (~550 km); in the low air aerial
+// perspective has faded clouds to a few percent of their contrast by
+// ~150 km, but seen from cruise altitude through thin air they stay visible.
+SKY_CORE_CONST real kMaxViewDistance_m = 600000.0;
 // Early exit once the view ray keeps less than 1 % of the background.
 SKY_CORE_CONST real kMinTransmittance = 0.01;
 // Samples skipped per empty primary sample: 1 marches every sample.

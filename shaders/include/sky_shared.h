@@ -22,7 +22,7 @@ SKY_SHARED_CONST kBindingFrame = 0u;          // read-only storage buffer holdin
 SKY_SHARED_CONST kBindingShape = 1u;          // sampler3D, tileable shape noise (RGBA8, repeat):
                                               // billowy Perlin-Worley, fibrous, smooth fBm, Worley
 SKY_SHARED_CONST kBindingWeather = 2u;        // sampler2DArray, RGBA8 = coverage, density, type blend;
-                                              // one slice per layer
+                                              // one slice per layer and ring: layer ring * kMaxLayers + slice
 SKY_SHARED_CONST kBindingOutput = 3u;         // storage buffer of vec4 radiance (rgb) + transmittance (a)
 SKY_SHARED_CONST kBindingDetail = 4u;         // sampler3D, tileable Worley detail noise (R8, repeat)
 SKY_SHARED_CONST kBindingTransmittance = 5u;  // sampler2D, atmosphere transmittance table (RGBA16F, clamp)
@@ -82,6 +82,8 @@ struct SkyFrame {
   uvec4 dispatch;       // x: tile permutation stride (coprime to the tile count), y: primary steps per
                         // layer span, z: light steps, w: unused
   SkyLayer layers[kMaxLayers];
+  vec4 weatherRings;    // x: 1 / (2 half extent) of the coarse ring (1/m); y, z: the blend band's start and
+                        // end in fractions of the fine ring's half extent (max norm); w: unused
 };
 
 #ifdef __cplusplus
@@ -100,7 +102,8 @@ static_assert(offsetof(SkyFrame, image) == 240);
 static_assert(offsetof(SkyFrame, dispatch) == 256);
 static_assert(offsetof(SkyFrame, layers) == 272);
 static_assert(offsetof(SkyLayer, cloudMapOrigin) == 64);
-static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers);
+static_assert(offsetof(SkyFrame, weatherRings) == 272 + 256 * kMaxLayers);
+static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 16);
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

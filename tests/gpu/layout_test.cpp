@@ -48,6 +48,7 @@ TEST(SharedLayout, GlslangOffsetsMatchCpp) {
       {"frame.groundIrradiance", offsetof(SkyFrame, groundIrradiance)},
       {"frame.image", offsetof(SkyFrame, image)},
       {"frame.dispatch", offsetof(SkyFrame, dispatch)},
+      {"frame.weatherRings", offsetof(SkyFrame, weatherRings)},
       {"frame.layers.heights", layers + offsetof(SkyLayer, heights)},
       {"frame.layers.shape", layers + offsetof(SkyLayer, shape)},
       {"frame.layers.shapeOrigin", layers + offsetof(SkyLayer, shapeOrigin)},

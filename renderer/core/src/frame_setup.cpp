@@ -129,7 +129,8 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
   s.camToAnchor = glm::dmat3(inFrame(a, enu.east), inFrame(a, enu.north), inFrame(a, enu.up));
   s.camInAnchor_m = inFrame(a, enu.originEcef_m - field.centreEcef_m);
   s.anchorRadius_m = field.radius_m;
-  s.mapHalfExtent_m = field.halfExtent_m;
+  s.mapHalfExtent_m = field.halfExtent_m[0];
+  s.coarseHalfExtent_m = field.halfExtent_m[1];
 
   // The local sphere: centre below the camera along its up vector, radius
   // |camera ECEF|, so R_local = r - alt and heights above it are altitudes.
@@ -261,6 +262,7 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   f.camInAnchor = v4(s.camInAnchor_m, s.anchorRadius_m);
   f.weatherMap = gpu::vec4(float(1.0 / (2 * s.mapHalfExtent_m)), float(s.layers.size()),
                              float(s.march.minTransmittance), float(s.march.emptyStride));
+  f.weatherRings = gpu::vec4(float(1.0 / (2 * s.coarseHalfExtent_m)), float(kRingBlendStart), float(kRingBlendEnd), 0.0f);
   f.earth = gpu::vec4(float(s.r_m), float(s.hGround_m), float(s.cGround_m2), float(s.cAtmosphereTop_m2));
   f.sunDir = v4(s.sunDir);
   f.sunIrradiance = v4(s.sunIrradiance);

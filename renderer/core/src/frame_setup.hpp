@@ -54,7 +54,8 @@ struct FrameSetup {
   glm::dmat3 camToAnchor{1};   // columns: camera east, north, up in the weather anchor's frame
   glm::dvec3 camInAnchor_m{0}; // camera relative to the anchor sphere centre, anchor frame
   double anchorRadius_m = 0;
-  double mapHalfExtent_m = 0;
+  double mapHalfExtent_m = 0;        // the fine ring's
+  double coarseHalfExtent_m = 0;     // the coarse ring's
   double r_m = 0;              // camera distance from its local Earth centre = |camera ECEF|
   double hGround_m = 0;        // camera height above the ground sphere = altitude
   double cGround_m2 = 0;

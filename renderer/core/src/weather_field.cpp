@@ -41,21 +41,35 @@ std::uint64_t bitsOf(double d) {
 
 }  // namespace
 
+double ringBlendWeight(double x_m, double y_m) {
+  const double e = std::max(std::abs(x_m), std::abs(y_m)) / kWeatherRingHalfExtent_m[0];
+  return std::clamp((e - kRingBlendStart) / (kRingBlendEnd - kRingBlendStart), 0.0, 1.0);
+}
+
 glm::dvec3 WeatherField::sample(std::uint32_t slice, double x_m, double y_m) const {
-  SKY_ASSERT(slice < sliceCount);
+  const double w = ringBlendWeight(x_m, y_m);
+  glm::dvec3 v(0);
+  if (w < 1) v = sampleRing(0, slice, x_m, y_m);
+  if (w > 0) v += w * (sampleRing(1, slice, x_m, y_m) - v);
+  return v;
+}
+
+glm::dvec3 WeatherField::sampleRing(std::uint32_t ring, std::uint32_t slice, double x_m, double y_m) const {
+  SKY_ASSERT(slice < sliceCount && ring < kWeatherRings);
   const int n = static_cast<int>(size);
-  const double tx = (x_m / (2 * halfExtent_m) + 0.5) * size - 0.5;
-  const double ty = (y_m / (2 * halfExtent_m) + 0.5) * size - 0.5;
+  const double tx = (x_m / (2 * halfExtent_m[ring]) + 0.5) * size - 0.5;
+  const double ty = (y_m / (2 * halfExtent_m[ring]) + 0.5) * size - 0.5;
   if (!(std::abs(tx) < 2.0 * size && std::abs(ty) < 2.0 * size)) return {0, 0, 0};  // far outside, or NaN
   const double fx = std::floor(tx), fy = std::floor(ty);
   const int i0 = static_cast<int>(fx), j0 = static_cast<int>(fy);
   const double ax = tx - fx, ay = ty - fy;
+  const std::size_t layer = std::size_t(ring) * sliceCount + slice;
   glm::dvec3 sum(0);
   for (int dj = 0; dj <= 1; ++dj)
     for (int di = 0; di <= 1; ++di) {
       const int i = i0 + di, j = j0 + dj;
       if (i < 0 || j < 0 || i >= n || j >= n) continue;
-      const std::size_t idx = ((std::size_t(slice) * size + std::size_t(j)) * size + std::size_t(i)) * kChannels;
+      const std::size_t idx = ((layer * size + std::size_t(j)) * size + std::size_t(i)) * kChannels;
       const double w = (di ? ax : 1 - ax) * (dj ? ay : 1 - ay);
       sum += w * glm::dvec3(texels[idx], texels[idx + 1], texels[idx + 2]) / 255.0;
     }
@@ -94,7 +108,7 @@ WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const g
   field.sliceCount = gpu::kMaxLayers;
   field.contentKey = weatherContentKey(snapshot);
   const std::size_t sliceTexels = std::size_t(field.size) * field.size;
-  field.texels.assign(sliceTexels * field.sliceCount * kChannels, 0);
+  field.texels.assign(sliceTexels * field.sliceCount * kWeatherRings * kChannels, 0);
   field.blendType.fill(weather::CloudType::None);
   field.tiled.fill(false);
   if (snapshot == nullptr) return field;
@@ -126,33 +140,35 @@ WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const g
   }
 
   const double groundRadius_m = field.radius_m - anchor.alt_m;
-  for (std::uint32_t j = 0; j < field.size; ++j)
-    for (std::uint32_t i = 0; i < field.size; ++i) {
-      const double x_m = ((i + 0.5) / field.size - 0.5) * 2 * field.halfExtent_m;
-      const double y_m = ((j + 0.5) / field.size - 0.5) * 2 * field.halfExtent_m;
-      std::uint64_t cell = 0;
-      if (anyTiles) {
-        // Inverse gnomonic: the direction from the sphere centre through the
-        // plane point, down to the ground on the anchor sphere.
-        const geo::Vec3d dir = geo::normalize(field.frame.east * x_m + field.frame.north * y_m +
-                                              field.frame.up * field.radius_m);
-        const geo::Geodetic g = geo::fromEcef(field.centreEcef_m + dir * groundRadius_m);
-        cell = weather::cellAt(g.lat_deg, g.lon_deg, snapshot->tileLevel);
-      }
-      for (std::size_t s = 0; s < snapshot->layers.size(); ++s) {
-        const auto& layer = snapshot->layers[s];
-        TileValue v{static_cast<float>(layer.coverage), static_cast<float>(layer.density)};
-        if (!tilesBySlice[s].empty()) {
-          const auto it = tilesBySlice[s].find(cell);
-          v = it == tilesBySlice[s].end() ? TileValue{} : it->second;
+  for (std::uint32_t ring = 0; ring < kWeatherRings; ++ring)
+    for (std::uint32_t j = 0; j < field.size; ++j)
+      for (std::uint32_t i = 0; i < field.size; ++i) {
+        const double x_m = ((i + 0.5) / field.size - 0.5) * 2 * field.halfExtent_m[ring];
+        const double y_m = ((j + 0.5) / field.size - 0.5) * 2 * field.halfExtent_m[ring];
+        std::uint64_t cell = 0;
+        if (anyTiles) {
+          // Inverse gnomonic: the direction from the sphere centre through the
+          // plane point, down to the ground on the anchor sphere. The coarse
+          // ring takes the tile at its texel's centre.
+          const geo::Vec3d dir = geo::normalize(field.frame.east * x_m + field.frame.north * y_m +
+                                                field.frame.up * field.radius_m);
+          const geo::Geodetic g = geo::fromEcef(field.centreEcef_m + dir * groundRadius_m);
+          cell = weather::cellAt(g.lat_deg, g.lon_deg, snapshot->tileLevel);
         }
-        const std::size_t idx = ((s * field.size + j) * field.size + i) * kChannels;
-        const float blend = v.blendType == field.blendType[s] ? std::clamp(v.blend, 0.0f, 1.0f) : 0.0f;
-        field.texels[idx] = weather::quantizeUnit(v.coverage);
-        field.texels[idx + 1] = weather::quantizeUnit(v.density);
-        field.texels[idx + 2] = weather::quantizeUnit(blend);
+        for (std::size_t s = 0; s < snapshot->layers.size(); ++s) {
+          const auto& layer = snapshot->layers[s];
+          TileValue v{static_cast<float>(layer.coverage), static_cast<float>(layer.density)};
+          if (!tilesBySlice[s].empty()) {
+            const auto it = tilesBySlice[s].find(cell);
+            v = it == tilesBySlice[s].end() ? TileValue{} : it->second;
+          }
+          const std::size_t idx = (((ring * field.sliceCount + s) * field.size + j) * field.size + i) * kChannels;
+          const float blend = v.blendType == field.blendType[s] ? std::clamp(v.blend, 0.0f, 1.0f) : 0.0f;
+          field.texels[idx] = weather::quantizeUnit(v.coverage);
+          field.texels[idx + 1] = weather::quantizeUnit(v.density);
+          field.texels[idx + 2] = weather::quantizeUnit(blend);
+        }
       }
-    }
   return field;
 }
 

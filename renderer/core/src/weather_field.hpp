@@ -17,25 +17,45 @@
 
 namespace sky::render {
 
-// Texels per edge of the weather map: 256 over 200 km is ~780 m per texel,
-// about the server's ~1 km tiles.
+// The map has rings of detail about one anchor, each a square grid of
+// kWeatherMapSize texels per edge in the anchor's gnomonic plane: ring 0
+// (fine) 256 over 200 km, ~780 m per texel, about the server's finest tiles;
+// ring 1 (coarse) 256 over 1200 km, ~4.7 km per texel (the ~5 km tiles the
+// renderer subscribes to), out past the horizon of a layer seen from cruise
+// altitude (~550 km for a deck at 2 km seen from 12 km). A point takes the
+// finest ring that covers it; across the fine ring's outer band the two
+// blend (ringBlendWeight), so there is no seam.
 inline constexpr std::uint32_t kWeatherMapSize = 256;
-// Half the map's edge in the gnomonic plane, m; beyond it coverage is 0.
-inline constexpr double kWeatherHalfExtent_m = 100000.0;
+inline constexpr std::uint32_t kWeatherRings = 2;
+// Half the edge of each ring in the gnomonic plane, m; beyond the last ring
+// coverage is 0.
+inline constexpr std::array<double, kWeatherRings> kWeatherRingHalfExtent_m = {100000.0, 600000.0};
+inline constexpr double kWeatherHalfExtent_m = kWeatherRingHalfExtent_m[0];
+// The blend band, in fractions of the fine ring's half extent (max norm):
+// fine inside kRingBlendStart, coarse beyond kRingBlendEnd (which leaves the
+// fine ring's bilinear filter a texel and more inside its edge).
+inline constexpr double kRingBlendStart = 0.85, kRingBlendEnd = 0.95;
 // The map is rebuilt around the camera when it has moved this far from the
-// anchor, m, so at least ~90 km of map remains ahead in every direction.
+// anchor, m, so at least ~75 km of fine ring remains ahead in every direction.
 inline constexpr double kWeatherRecentre_m = 10000.0;
+
+// Weight of the coarse ring at gnomonic plane point (x, y) m: 0 inside the
+// fine ring's blend band, 1 outside it, linear in the max norm between. The
+// GPU's sampleWeather (shaders/clouds.comp) computes the same from the
+// frame's weatherMap.x and weatherRings.
+double ringBlendWeight(double x_m, double y_m);
 
 struct WeatherField {
   geo::EnuFrame frame;          // anchor point (ECEF) and its east/north/up
   double anchorAlt_m = 0;       // anchor altitude above the ellipsoid
   double radius_m = 0;          // |anchor ECEF|: radius of the anchor sphere
   geo::Vec3d centreEcef_m;      // anchor sphere centre = anchor - up * radius
-  double halfExtent_m = kWeatherHalfExtent_m;
+  std::array<double, kWeatherRings> halfExtent_m = kWeatherRingHalfExtent_m;
   std::uint32_t size = kWeatherMapSize;
-  std::uint32_t sliceCount = 0;        // slices in texels (always gpu::kMaxLayers)
-  std::vector<std::uint8_t> texels;    // unorm8 (the stream's 1/255 steps): slice, row (north),
-                                       // column (east), (coverage, density, blend, 0)
+  std::uint32_t sliceCount = 0;        // slices per ring in texels (always gpu::kMaxLayers)
+  std::vector<std::uint8_t> texels;    // unorm8 (the stream's 1/255 steps): ring, slice, row (north),
+                                       // column (east), (coverage, density, blend, 0); the GPU's
+                                       // array layer ring * sliceCount + slice
   // Per slice, the one type its tiles blend towards (None: no blend). A tile
   // may name another type than the slice's; the slice takes the type with the
   // largest summed blend in its tiles and such tiles draw unblended.
@@ -46,8 +66,10 @@ struct WeatherField {
   std::uint64_t contentKey = 0;        // weatherContentKey() of the source snapshot
 
   // (coverage, density, blend) at gnomonic plane coordinates (m, east/north
-  // of the anchor): bilinear, zero outside the map, as the GPU's clamp-to-border.
+  // of the anchor): the rings blended by ringBlendWeight, as the GPU.
   glm::dvec3 sample(std::uint32_t slice, double x_m, double y_m) const;
+  // One ring alone: bilinear, zero outside it, as the GPU's clamp-to-border.
+  glm::dvec3 sampleRing(std::uint32_t ring, std::uint32_t slice, double x_m, double y_m) const;
 };
 
 // Hash of everything in a snapshot that the map depends on (layer ids, order,

@@ -10,7 +10,8 @@ namespace sky::render {
 Result<WeatherTexture> WeatherTexture::create(const GpuContext& ctx) {
   WeatherTexture t;
   t.image_ = createSampledImage(ctx, vk::ImageType::e2D, vk::Format::eR8G8B8A8Unorm,
-                                vk::Extent3D(kWeatherMapSize, kWeatherMapSize, 1), gpu::kMaxLayers, "sky.weatherMap");
+                                vk::Extent3D(kWeatherMapSize, kWeatherMapSize, 1), gpu::kMaxLayers * kWeatherRings,
+                                "sky.weatherMap");
   t.timer_ = GpuTimer(ctx, 1, "sky.weatherMap.timer");
   t.field_ = buildWeatherField(nullptr, geo::Geodetic{});
   if (auto ok = t.upload(ctx); !ok) return tl::unexpected(ok.error());

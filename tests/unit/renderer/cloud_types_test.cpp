@@ -112,7 +112,7 @@ TEST(WeatherField, BlendTowardsTheTypeWithTheMostWeight) {
   // Over the covered part of the map: coverage 0.5; blend 0.6 where a tile
   // names cumulonimbus and 0 where it names stratus (a slice holds one blend
   // type), never stratus' 1. Texel centres, so no value is interpolated.
-  const double texel_m = 2 * f.halfExtent_m / f.size;
+  const double texel_m = 2 * f.halfExtent_m[0] / f.size;
   double lowest = 1, highest = 0;
   for (int j = -40; j < 40; ++j)
     for (int i = -40; i < 40; ++i) {

@@ -12,8 +12,9 @@
 
 namespace sky::app {
 
-// The weather texture spans about 100 km around the camera: 120 km keeps its
-// edge filled.
+// The weather map's fine ring spans 100 km around the camera: 120 km keeps
+// its edge filled. (Its coarse ring reaches 600 km; of tiled layers it holds
+// only what this area brings.)
 inline constexpr double kSubscribeRadius_m = 120000.0;
 inline constexpr double kResubscribeDistance_m = 30000.0;
 // The finest S2 level whose covering of that cap stays within this many tiles

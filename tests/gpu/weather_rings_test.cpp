@@ -1,0 +1,97 @@
+// The weather map's coarse ring on the GPU: from cruise altitude (10 km), a
+// patch of cumulus the server placed 250 km away, beyond the fine ring's
+// 100 km, is drawn where the CPU reference draws it (the same rings, sampled
+// in double) and makes cloud in the pixels looking at it; before the rings
+// the map ended at 100 km and spans starting past 150 km were not marched,
+// so it was empty.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "renderer_fixture.hpp"
+#include "scenes.hpp"
+#include "sky/render/cpu_reference.hpp"
+
+namespace sky::test {
+namespace {
+
+// Displayed RMSE (relative to the mean displayed value) and mean luminance
+// tolerances as gpu_vs_cpu_test.cpp's (measured there 0-0.7 % and below
+// 0.1 %); cloud transmittance RMSE as the scene suite's.
+constexpr double kRelativeRmseTolerance = 0.05;
+constexpr double kRelativeMeanTolerance = 0.005;
+constexpr double kAlphaRmseTolerance = 0.04;
+
+TEST(WeatherRings, FarCloudFromCruiseAltitude) {
+  // 320x180 at 60 degrees: 1/3 degree per pixel; the patch is ~13 degrees
+  // wide, and seen edge-on, a degree or so tall.
+  constexpr std::uint32_t kW = 320, kH = 180;
+  SKY_RENDERER(r, kW, kH);
+  auto reference = render::CpuReference::create(r.settings());
+  ASSERT_TRUE(reference) << describe(reference.error());
+  weather::CloudLayer cu = layer(1, 1000.0, 1500.0, 0.0, 1.0);
+  cu.type = weather::CloudType::Cumulus;
+  const double patchLat = 47.0 + 250000.0 / 111195.0;
+  const weather::WeatherSnapshot snap = stormCell(cu, patchLat, 8.0, 20000.0, 30000.0, 0.9f, 0.6f);
+  // Looking north, 3 degrees down: that ray enters the layer's top ~205 km
+  // out and is ~1.75 km up at 250 km (the Earth's curvature: d^2 / 2R =
+  // 4.9 km), so it crosses the patch inside its 60 km span.
+  render::FrameInputs in;
+  in.camera = pose(47.0, 8.0, 10000.0, 0.0, -3.0);
+  in.weather = &snap;
+  in.sunAzimuth_deg = 135.0;
+  in.sunElevation_deg = 45.0;
+  auto gpu = r.render(in);
+  ASSERT_TRUE(gpu) << describe(gpu.error());
+  savePng(*gpu, "gpu_far_cloud");
+  EXPECT_EQ(render::computeStats(*gpu).nonFinite, 0u);
+  // The CPU reference on a window around the patch (rows 80-103, columns
+  // 120-199) and the GPU on the same pixels.
+  std::vector<render::PixelCoord> pixels;
+  for (std::uint32_t y = 80; y < 104; ++y)
+    for (std::uint32_t x = 120; x < 200; ++x) pixels.push_back({x, y});
+  auto cpu = reference->renderPixels(in, pixels);
+  ASSERT_TRUE(cpu) << describe(cpu.error());
+  float minGpu = 1, minCpu = 1;
+  std::size_t cloudyGpu = 0, nonFinite = 0;
+  double alpha2 = 0, sum2 = 0, meanGpu = 0, meanCpu = 0, meanCompressed = 0;
+  auto compressed = [](float v) { return double(v) / (1.0 + double(v)); };
+  auto luminance = [](const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; };
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    const float* g = &gpu->rgba[(std::size_t(pixels[i].y) * kW + pixels[i].x) * 4];
+    const float* c = (*cpu)[i].data();
+    for (int k = 0; k < 4; ++k)
+      if (!std::isfinite(c[k])) ++nonFinite;
+    for (int k = 0; k < 3; ++k) {
+      sum2 += (compressed(g[k]) - compressed(c[k])) * (compressed(g[k]) - compressed(c[k]));
+      meanCompressed += compressed(c[k]);
+    }
+    minGpu = std::min(minGpu, g[3]);
+    minCpu = std::min(minCpu, c[3]);
+    if (g[3] < 0.9f) ++cloudyGpu;
+    alpha2 += double(g[3] - c[3]) * double(g[3] - c[3]);
+    meanGpu += luminance(g);
+    meanCpu += luminance(c);
+  }
+  const double n = double(pixels.size());
+  const double alphaRmse = std::sqrt(alpha2 / n), rmse = std::sqrt(sum2 / (3 * n));
+  meanCompressed /= 3 * n;
+  const double meanError = std::abs(meanGpu - meanCpu) / meanCpu;
+  std::printf("[ rings    ] far cloud: min transmittance gpu %.3f cpu %.3f, %zu pixels below 0.9; "
+              "mean %.4f (gpu %+.3f %%) displayed rmse %.2f %% alpha rmse %.4f\n",
+              minGpu, minCpu, cloudyGpu, meanCpu / n, 100 * (meanGpu - meanCpu) / meanCpu,
+              100 * rmse / meanCompressed, alphaRmse);
+  EXPECT_EQ(nonFinite, 0u);
+  EXPECT_LT(minCpu, 0.2f) << "the CPU reference must see the patch through the coarse ring";
+  EXPECT_LT(minGpu, 0.2f) << "the GPU must see the patch through the coarse ring";
+  EXPECT_GT(cloudyGpu, std::size_t(20));
+  EXPECT_LT(meanError, kRelativeMeanTolerance);
+  EXPECT_LT(rmse, kRelativeRmseTolerance * meanCompressed);
+  EXPECT_LT(alphaRmse, kAlphaRmseTolerance);
+}
+
+}  // namespace
+}  // namespace sky::test
