@@ -99,8 +99,10 @@ std::uint64_t weatherContentKey(const weather::WeatherSnapshot* snapshot) {
   return h;
 }
 
-WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const geo::Geodetic& anchor) {
+WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const geo::Geodetic& anchor,
+                               const WeatherField* previous) {
   WeatherField field;
+  field.anchor = anchor;
   field.frame = geo::enuFrameAt(anchor);
   field.anchorAlt_m = anchor.alt_m;
   field.radius_m = geo::length(field.frame.originEcef_m);
@@ -139,6 +141,17 @@ WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const g
       }
   }
 
+  const std::size_t cellCount = std::size_t(kWeatherRings) * sliceTexels;
+  const bool reuse = anyTiles && previous != nullptr && previous->cellLevel == snapshot->tileLevel &&
+                     previous->cells.size() == cellCount && previous->anchor.lat_deg == anchor.lat_deg &&
+                     previous->anchor.lon_deg == anchor.lon_deg && previous->anchor.alt_m == anchor.alt_m;
+  if (anyTiles) {
+    field.cellLevel = snapshot->tileLevel;
+    if (reuse)
+      field.cells = previous->cells;
+    else
+      field.cells.assign(cellCount, 0);
+  }
   const double groundRadius_m = field.radius_m - anchor.alt_m;
   for (std::uint32_t ring = 0; ring < kWeatherRings; ++ring)
     for (std::uint32_t j = 0; j < field.size; ++j)
@@ -146,7 +159,10 @@ WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const g
         const double x_m = ((i + 0.5) / field.size - 0.5) * 2 * field.halfExtent_m[ring];
         const double y_m = ((j + 0.5) / field.size - 0.5) * 2 * field.halfExtent_m[ring];
         std::uint64_t cell = 0;
-        if (anyTiles) {
+        const std::size_t cellIndex = (std::size_t(ring) * field.size + j) * field.size + i;
+        if (reuse) {
+          cell = field.cells[cellIndex];
+        } else if (anyTiles) {
           // Inverse gnomonic: the direction from the sphere centre through the
           // plane point, down to the ground on the anchor sphere. The coarse
           // ring takes the tile at its texel's centre.
@@ -154,6 +170,7 @@ WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const g
                                                 field.frame.up * field.radius_m);
           const geo::Geodetic g = geo::fromEcef(field.centreEcef_m + dir * groundRadius_m);
           cell = weather::cellAt(g.lat_deg, g.lon_deg, snapshot->tileLevel);
+          field.cells[cellIndex] = cell;
         }
         for (std::size_t s = 0; s < snapshot->layers.size(); ++s) {
           const auto& layer = snapshot->layers[s];
@@ -172,9 +189,19 @@ WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const g
   return field;
 }
 
-bool weatherFieldStale(const WeatherField& field, std::uint64_t contentKey, const geo::Vec3d& cameraEcef_m) {
+geo::Geodetic weatherAnchorFor(const geo::Geodetic& camera) {
+  const geo::Vec3d e = geo::toEcef(camera);
+  const double a = kWeatherAnchorLattice_m;
+  const geo::Vec3d lattice{std::round(e.x / a) * a, std::round(e.y / a) * a, std::round(e.z / a) * a};
+  geo::Geodetic g = geo::fromEcef(lattice);
+  g.alt_m = 0;
+  return g;
+}
+
+bool weatherFieldStale(const WeatherField& field, std::uint64_t contentKey, const geo::Geodetic& anchor) {
   if (field.texels.empty() || field.contentKey != contentKey) return true;
-  return geo::length(cameraEcef_m - field.frame.originEcef_m) > kWeatherRecentre_m;
+  return field.anchor.lat_deg != anchor.lat_deg || field.anchor.lon_deg != anchor.lon_deg ||
+         field.anchor.alt_m != anchor.alt_m;
 }
 
 }  // namespace sky::render

@@ -35,9 +35,13 @@ inline constexpr double kWeatherHalfExtent_m = kWeatherRingHalfExtent_m[0];
 // fine inside kRingBlendStart, coarse beyond kRingBlendEnd (which leaves the
 // fine ring's bilinear filter a texel and more inside its edge).
 inline constexpr double kRingBlendStart = 0.85, kRingBlendEnd = 0.95;
-// The map is rebuilt around the camera when it has moved this far from the
-// anchor, m, so at least ~75 km of fine ring remains ahead in every direction.
-inline constexpr double kWeatherRecentre_m = 10000.0;
+// The map's anchor is the camera's ECEF position rounded to a cubic lattice
+// of this spacing, m, brought down to the ellipsoid (weatherAnchorFor): the
+// camera stays within ~4.4 km of it (half the cube's diagonal), so at least
+// ~80 km of fine ring lies ahead in every direction; the map moves when the
+// camera's lattice point changes. A function of the camera alone, so the GPU
+// map and the CPU reference's are built at the same anchor.
+inline constexpr double kWeatherAnchorLattice_m = 5000.0;
 
 // Weight of the coarse ring at gnomonic plane point (x, y) m: 0 inside the
 // fine ring's blend band, 1 outside it, linear in the max norm between. The
@@ -64,6 +68,12 @@ struct WeatherField {
   // over the map and drifting it changes nothing).
   std::array<bool, gpu::kMaxLayers> tiled{};
   std::uint64_t contentKey = 0;        // weatherContentKey() of the source snapshot
+  geo::Geodetic anchor;                // where the map was built
+  // Per ring and texel (ring, row, column), the S2 cell of level cellLevel
+  // at the texel's centre; empty (cellLevel -1) when the snapshot had no
+  // tiles. A new snapshot at the same anchor and level reuses them.
+  int cellLevel = -1;
+  std::vector<std::uint64_t> cells;
 
   // (coverage, density, blend) at gnomonic plane coordinates (m, east/north
   // of the anchor): the rings blended by ringBlendWeight, as the GPU.
@@ -79,9 +89,18 @@ std::uint64_t weatherContentKey(const weather::WeatherSnapshot* snapshot);
 // Fills the map around anchor. A layer without tiles is uniform (its own
 // coverage and density); a layer with tiles is empty where a cell has none.
 // The snapshot must already be validated (at most gpu::kMaxLayers layers).
-WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const geo::Geodetic& anchor);
+// With `previous` built at the same anchor and its cells at the snapshot's
+// tile level, the texels' cells are taken from it instead of found again
+// (no geodesy: new tiles cost a hash lookup per texel); the result is the
+// same as without it.
+WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const geo::Geodetic& anchor,
+                               const WeatherField* previous = nullptr);
 
-// True when the map must be rebuilt for this snapshot key and camera position.
-bool weatherFieldStale(const WeatherField& field, std::uint64_t contentKey, const geo::Vec3d& cameraEcef_m);
+// The anchor of the map for a camera at this position (see kWeatherAnchorLattice_m).
+geo::Geodetic weatherAnchorFor(const geo::Geodetic& camera);
+
+// True when the map must be rebuilt for this snapshot key and anchor
+// (weatherAnchorFor the camera).
+bool weatherFieldStale(const WeatherField& field, std::uint64_t contentKey, const geo::Geodetic& anchor);
 
 }  // namespace sky::render

@@ -21,8 +21,10 @@ Result<WeatherTexture> WeatherTexture::create(const GpuContext& ctx) {
 Result<void> WeatherTexture::update(const GpuContext& ctx, const FrameInputs& inputs) {
   lastUploadTimes_.clear();
   const std::uint64_t key = weatherContentKey(inputs.weather);
-  if (!weatherFieldStale(field_, key, geo::toEcef(inputs.camera.position))) return {};
-  field_ = buildWeatherField(inputs.weather, inputs.camera.position);
+  const geo::Geodetic anchor = weatherAnchorFor(inputs.camera.position);
+  if (!weatherFieldStale(field_, key, anchor)) return {};
+  // New weather at the same anchor reuses the texels' cells (no geodesy).
+  field_ = buildWeatherField(inputs.weather, anchor, &field_);
   return upload(ctx);
 }
 

@@ -1,7 +1,7 @@
 // The weather map on the GPU: a fixed-size RGBA8 2D array (one slice per cloud
-// layer) and the CPU field it was uploaded from. Rebuilt and re-uploaded only
-// when the snapshot's content changes or the camera leaves the anchor's
-// neighbourhood (kWeatherRecentre_m).
+// layer and ring) and the CPU field it was uploaded from. Rebuilt and
+// re-uploaded only when the snapshot's content changes (at the same anchor
+// reusing the texels' cells) or the camera's anchor moves (kWeatherAnchorLattice_m).
 #pragma once
 
 #include <cstdint>

@@ -4,9 +4,13 @@
 // the coarse ring (the fine ring alone, the map before rings, gives nothing
 // there); a uniform layer reaches to the coarse ring's edge; and across the
 // fine ring's edge the sampled coverage is continuous (at most 0.01 between
-// samples 10 m apart) although the two rings differ by far more there.
+// samples 10 m apart) although the two rings differ by far more there. The
+// map's anchor is the camera's lattice point, within 4.4 km of it anywhere
+// (poles, antimeridian, orbit); new weather at the same anchor reuses the
+// texels' cells and gives the same map as a fresh build.
 #include <algorithm>
 #include <cmath>
+#include <chrono>
 #include <cstdio>
 
 #include <glm/vec2.hpp>
@@ -122,6 +126,63 @@ TEST(WeatherRings, CoverageIsContinuousAcrossTheRingBoundary) {
   EXPECT_EQ(ringBlendWeight(84000.0, -30000.0), 0.0);
   EXPECT_NEAR(ringBlendWeight(-90000.0, 10000.0), 0.5, 1e-12);
   EXPECT_EQ(ringBlendWeight(20000.0, 96000.0), 1.0);
+}
+
+TEST(WeatherRings, AnchorIsTheCamerasLatticePoint) {
+  for (const geo::Geodetic camera : {geo::Geodetic{47.0, 8.0, 500.0}, geo::Geodetic{89.999, 30.0, 10000.0},
+                                     geo::Geodetic{-89.9, -120.0, 0.0}, geo::Geodetic{0.01, 179.999, 12000.0},
+                                     geo::Geodetic{-33.9, 151.2, 400000.0}}) {
+    SCOPED_TRACE(camera.lat_deg);
+    const geo::Geodetic a = weatherAnchorFor(camera);
+    EXPECT_EQ(a.alt_m, 0.0);
+    // Horizontal distance: the great circle between the two directions, on
+    // the ground; half the lattice cube's diagonal is 4.33 km, and seen from
+    // orbit the direction moves less.
+    EXPECT_LT(geo::geodesicDistance_m(camera.lat_deg, camera.lon_deg, a.lat_deg, a.lon_deg), 4400.0);
+    // The same camera, the same anchor, bit for bit (the GPU map and the CPU
+    // reference's must agree).
+    const geo::Geodetic b = weatherAnchorFor(camera);
+    EXPECT_EQ(a.lat_deg, b.lat_deg);
+    EXPECT_EQ(a.lon_deg, b.lon_deg);
+  }
+  // Moving 20 km moves the anchor.
+  const geo::Geodetic here = weatherAnchorFor({47.0, 8.0, 500.0});
+  const geo::Geodetic there = weatherAnchorFor({47.0 + 20000.0 / kMetresPerDegree, 8.0, 500.0});
+  EXPECT_GT(geo::geodesicDistance_m(here.lat_deg, here.lon_deg, there.lat_deg, there.lon_deg), 10000.0);
+}
+
+TEST(WeatherRings, NewWeatherAtTheSameAnchorReusesTheCells) {
+  constexpr int kLevel = 11;
+  const geo::Geodetic anchor = weatherAnchorFor({47.0, 8.0, 3000.0});
+  weather::WeatherSnapshot first;
+  first.tileLevel = kLevel;
+  first.layers = {tiledLayer()};
+  const auto cells = weather::coverCap({47.0, 8.0, 150000.0}, kLevel, 8000);
+  for (std::size_t i = 0; i < cells.size(); ++i) first.tiles.push_back({cells[i], 1, float(i % 7) / 7.0f, 1.0f});
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  const WeatherField a = buildWeatherField(&first, anchor);
+  const auto t1 = Clock::now();
+  ASSERT_EQ(a.cellLevel, kLevel);
+  ASSERT_EQ(a.cells.size(), std::size_t(kWeatherRings) * kWeatherMapSize * kWeatherMapSize);
+  // New weather: every third tile changes coverage, some tiles go away.
+  weather::WeatherSnapshot second = first;
+  for (std::size_t i = 0; i < second.tiles.size(); i += 3) second.tiles[i].coverage = 0.9f;
+  second.tiles.resize(second.tiles.size() - 200);
+  const auto t2 = Clock::now();
+  const WeatherField reused = buildWeatherField(&second, anchor, &a);
+  const auto t3 = Clock::now();
+  const WeatherField fresh = buildWeatherField(&second, anchor);
+  const auto t4 = Clock::now();
+  EXPECT_EQ(reused.texels, fresh.texels);
+  EXPECT_EQ(reused.cells, fresh.cells);
+  EXPECT_NE(reused.texels, a.texels);
+  auto ms = [](Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); };
+  std::printf("[ rings    ] map build: fresh %.1f ms, %.1f ms; reusing the cells %.1f ms\n", ms(t1 - t0), ms(t4 - t3),
+              ms(t3 - t2));
+  // Another anchor or tile level: the cells are found again, same result.
+  const geo::Geodetic elsewhere = weatherAnchorFor({47.2, 8.0, 3000.0});
+  EXPECT_EQ(buildWeatherField(&second, elsewhere, &a).texels, buildWeatherField(&second, elsewhere).texels);
 }
 
 }  // namespace
