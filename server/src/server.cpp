@@ -204,7 +204,7 @@ BuiltSnapshot Server::snapshotFor(const stream::Subscribe& request) {
       buildSnapshotWithGenerations(request, weather_.layersAt(clockNow()), clockNow(), options_.maxCellsPerSnapshot,
                                    weather_.regionsAt(clockNow()), &tileCache_);
   log_->debug("event=snapshot level={} asked={} tiles={}", built.snapshot.tileLevel, request.tileLevel,
-              built.snapshot.tiles.size());
+              tileCount(built));
   return built;
 }
 

@@ -198,16 +198,15 @@ void Session::writeNext() {
 
 Frame Session::weatherFrame(const stream::Subscribe& request) {
   BuiltSnapshot built = handler_.snapshotFor(request);
-  const weather::WeatherSnapshot& snapshot = built.snapshot;
   std::optional<Frame> frame;
   if (peerHolds_ && peerHoldsFor_ && sameArea(*peerHoldsFor_, request)) {
     // A delta that resends most tiles is no better than the snapshot (tiles
     // are nearly all of either's size).
     if (auto delta = diffBuilt(*peerHolds_, built);
-        delta && (delta->tiles.empty() || 4 * delta->tiles.size() < 3 * snapshot.tiles.size()))
+        delta && (delta->tiles.empty() || 4 * delta->tiles.size() < 3 * tileCount(built)))
       frame = stream::encodeFrame(stream::encodeMessage(*delta));
   }
-  if (!frame) frame = stream::encodeFrame(stream::encodeMessage(snapshot));
+  if (!frame) frame = stream::encodeFrame(stream::encodeMessage(wholeSnapshot(built)));
   peerHolds_ = std::move(built);
   peerHoldsFor_ = request;
   return std::move(*frame);

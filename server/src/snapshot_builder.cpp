@@ -149,10 +149,10 @@ void keepWeight(TileCache::Weights& out, std::size_t cell, double w) {
 // weighted mean of the contributing regions' values; none when the layer
 // comes out the same everywhere. Only the cells a region reaches are
 // blended (a storm cell reaches a few hundred of an area's thousands).
-std::vector<weather::CoverageTile> layerTiles(std::span<const std::uint64_t> cells, const weather::CloudLayer& layer,
-                                              std::span<const Contribution> contributions) {
-  std::vector<weather::CoverageTile> tiles;
-  if (contributions.empty()) return tiles;
+LayerTiles layerTiles(std::span<const std::uint64_t> cells, const weather::CloudLayer& layer,
+                      std::span<const Contribution> contributions) {
+  LayerTiles out;
+  if (contributions.empty()) return out;
   // Per reached cell, the sums over the contributions in their order.
   struct Sum {
     std::uint32_t cell;
@@ -202,11 +202,18 @@ std::vector<weather::CoverageTile> layerTiles(std::span<const std::uint64_t> cel
   }
   // A layer the same everywhere in the area needs no tiles: a renderer takes
   // a layer without tiles as uniform (its own coverage and density).
-  if (!varies) return tiles;
-  tiles.reserve(cells.size());
-  for (std::uint64_t cell : cells) tiles.push_back({cell, layer.id, coverage, density});
-  for (const auto& [ci, t] : blended) tiles[ci] = t;
-  return tiles;
+  if (!varies) return out;
+  out.coverage = coverage;
+  out.density = density;
+  out.tiles.reserve(cells.size());
+  for (std::uint64_t cell : cells) out.tiles.push_back({cell, layer.id, coverage, density});
+  out.reached.reserve(blended.size());
+  for (const auto& [ci, t] : blended) {
+    out.tiles[ci] = t;
+    out.reached.push_back(ci);
+  }
+  std::sort(out.reached.begin(), out.reached.end());
+  return out;
 }
 
 // A region's layer of this id, if it has one (a region's layer ids are distinct).
@@ -228,7 +235,7 @@ std::vector<weather::CoverageTile> tilesFromWeights(std::span<const std::uint64_
     contributions.clear();
     for (std::size_t k = 0; k < regions.size(); ++k)
       if (const auto* rl = layerOf(regions[k], layer.id); rl && weights[k]) contributions.push_back({weights[k], rl});
-    const auto t = layerTiles(cells, layer, contributions);
+    const auto t = layerTiles(cells, layer, contributions).tiles;
     tiles.insert(tiles.end(), t.begin(), t.end());
   }
   return tiles;
@@ -246,6 +253,7 @@ TileCache::Entry& TileCache::covering(const weather::SphericalCap& cap, int want
   if (auto it = coverings_.find(key); it != coverings_.end()) return it->second;
   if (coverings_.size() >= kMaxCachedCoverings) coverings_.clear();
   Entry e;
+  e.serial = ++coveringSerials_;
   e.cap = cap;
   e.covering = coverArea(cap, wantedLevel, maxCells);
   e.centres.reserve(e.covering.cells.size());
@@ -321,10 +329,9 @@ std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> ce
   return tilesFromWeights(cells, layers, regions, byRegion);
 }
 
-std::vector<weather::CoverageTile> deriveTiles(TileCache& cache, TileCache::Entry& entry,
-                                               std::span<const weather::CloudLayer> layers,
-                                               std::span<const weather::Region> regions,
-                                               std::vector<LayerRun>* runs) {
+std::vector<LayerRun> deriveRuns(TileCache& cache, TileCache::Entry& entry,
+                                 std::span<const weather::CloudLayer> layers,
+                                 std::span<const weather::Region> regions) {
   // Room for every region's weights first: the pointers below must stay valid.
   if (entry.shapeWeights.size() + regions.size() > kMaxShapesPerCovering) entry.shapeWeights.clear();
   // The regions that can reach a cell of this covering (its cells reach past
@@ -336,7 +343,8 @@ std::vector<weather::CoverageTile> deriveTiles(TileCache& cache, TileCache::Entr
   for (std::size_t k = 0; k < regions.size(); ++k)
     reaches[k] = sphereDistance_m(cap.centerLat_deg, cap.centerLon_deg, regions[k].centerLat_deg,
                                   regions[k].centerLon_deg) <= cap.radius_m + reachOf(regions[k]) + margin_m;
-  std::vector<weather::CoverageTile> tiles;
+  std::vector<LayerRun> runs;
+  runs.reserve(layers.size());
   std::vector<Contribution> contributions;
   std::vector<std::uint64_t> inputs;
   for (const weather::CloudLayer& layer : layers) {
@@ -361,27 +369,38 @@ std::vector<weather::CoverageTile> deriveTiles(TileCache& cache, TileCache::Entr
       for (std::size_t k = 0; k < regions.size(); ++k)
         if (const auto* rl = reaches[k] ? layerOf(regions[k], layer.id) : nullptr)
           contributions.push_back({&cache.weights(entry, regions[k]), rl});
-      memo.tiles = layerTiles(entry.covering.cells, layer, contributions);
+      auto tiles = layerTiles(entry.covering.cells, layer, contributions);
+      tiles.covering = entry.serial;
+      // New tiles, not the old ones overwritten: snapshots sent before still
+      // hold the old.
+      memo.tiles = tiles.tiles.empty() ? nullptr : std::make_shared<const LayerTiles>(std::move(tiles));
       memo.inputs = inputs;
       memo.generation = cache.nextGeneration();
       memo.valid = true;
     }
-    if (runs) runs->push_back({memo.generation, memo.tiles.size()});
-  }
-  // Copied once all are known: one allocation for the snapshot's tiles.
-  std::size_t count = 0;
-  for (const weather::CloudLayer& layer : layers) count += entry.layers[layer.id].tiles.size();
-  tiles.reserve(count);
-  for (const weather::CloudLayer& layer : layers) {
-    const auto& t = entry.layers[layer.id].tiles;
-    tiles.insert(tiles.end(), t.begin(), t.end());
+    runs.push_back({memo.generation, memo.tiles});
   }
   // Layers gone from the table take their memo with them.
   for (auto it = entry.layers.begin(); it != entry.layers.end();)
     it = std::any_of(layers.begin(), layers.end(), [&](const auto& l) { return l.id == it->first; })
              ? std::next(it)
              : entry.layers.erase(it);
-  return tiles;
+  return runs;
+}
+
+weather::WeatherSnapshot wholeSnapshot(const BuiltSnapshot& built) {
+  weather::WeatherSnapshot whole = built.snapshot;
+  if (built.runs.empty()) return whole;
+  whole.tiles.reserve(tileCount(built));
+  for (const LayerRun& run : built.runs)
+    if (run.tiles) whole.tiles.insert(whole.tiles.end(), run.tiles->tiles.begin(), run.tiles->tiles.end());
+  return whole;
+}
+
+std::size_t tileCount(const BuiltSnapshot& built) {
+  std::size_t n = built.snapshot.tiles.size();
+  for (const LayerRun& run : built.runs) n += run.size();
+  return n;
 }
 
 BuiltSnapshot buildSnapshotWithGenerations(const stream::Subscribe& request,
@@ -411,8 +430,7 @@ BuiltSnapshot buildSnapshotWithGenerations(const stream::Subscribe& request,
   if (cache) {
     TileCache::Entry& e = cache->covering(cap, request.tileLevel, budget);
     snapshot.tileLevel = e.covering.level;
-    built.runs.reserve(table.size());
-    snapshot.tiles = deriveTiles(*cache, e, table, regions, &built.runs);
+    built.runs = deriveRuns(*cache, e, table, regions);
     return built;
   }
   const Covering covering = coverArea(cap, request.tileLevel, budget);
@@ -425,49 +443,7 @@ weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,
                                        std::span<const weather::CloudLayer> layers,
                                        double clock_s, std::size_t maxCells,
                                        std::span<const weather::Region> regions, TileCache* cache) {
-  return buildSnapshotWithGenerations(request, layers, clock_s, maxCells, regions, cache).snapshot;
-}
-
-namespace {
-
-// Whether `runs` describe `s`: one run per layer, adding up to its tiles.
-bool runsCover(const BuiltSnapshot& s) {
-  if (s.runs.size() != s.snapshot.layers.size()) return false;
-  std::size_t n = 0;
-  for (const LayerRun& r : s.runs) n += r.tiles;
-  return n == s.snapshot.tiles.size();
-}
-
-}  // namespace
-
-std::optional<weather::WeatherDelta> diffBuilt(const BuiltSnapshot& before, const BuiltSnapshot& after) {
-  const auto& b = before.snapshot;
-  const auto& a = after.snapshot;
-  // Layers whose tiles are known to be the same (same generation, same level).
-  std::vector<std::uint32_t> same;
-  if (b.tileLevel == a.tileLevel && runsCover(before) && runsCover(after))
-    for (std::size_t i = 0; i < a.layers.size(); ++i) {
-      const std::uint64_t g = after.runs[i].generation;
-      for (std::size_t j = 0; g != 0 && j < b.layers.size(); ++j)
-        if (b.layers[j].id == a.layers[i].id && before.runs[j].generation == g) same.push_back(a.layers[i].id);
-    }
-  if (same.empty()) return weather::diffSnapshots(b, a);
-  // Those layers' tiles are equal in both, so the diff without them is the
-  // same diff: their layers are still compared, their tiles never differ.
-  auto without = [&](const BuiltSnapshot& s) {
-    weather::WeatherSnapshot r;
-    r.weatherClock_s = s.snapshot.weatherClock_s;
-    r.layers = s.snapshot.layers;
-    r.tileLevel = s.snapshot.tileLevel;
-    auto from = s.snapshot.tiles.begin();
-    for (std::size_t i = 0; i < s.runs.size(); ++i) {
-      const auto n = static_cast<std::ptrdiff_t>(s.runs[i].tiles);
-      if (std::find(same.begin(), same.end(), r.layers[i].id) == same.end()) r.tiles.insert(r.tiles.end(), from, from + n);
-      from += n;
-    }
-    return r;
-  };
-  return weather::diffSnapshots(without(before), without(after));
+  return wholeSnapshot(buildSnapshotWithGenerations(request, layers, clock_s, maxCells, regions, cache));
 }
 
 }  // namespace sky::server

@@ -64,9 +64,9 @@ Result<void> validateSettings(const RenderSettings& s) {
     return fail(ErrorCode::InvalidArgument,
                 "render settings: verticalFov_deg " + num(s.verticalFov_deg) + " outside (0, 179)");
   const MarchSettings& m = s.march;
-  if (m.primarySteps < 1 || m.primarySteps > 1024)
+  if (m.primarySteps < 1 || m.primarySteps > 4096)
     return fail(ErrorCode::InvalidArgument,
-                "render settings: march.primarySteps " + std::to_string(m.primarySteps) + " outside [1, 1024]");
+                "render settings: march.primarySteps " + std::to_string(m.primarySteps) + " outside [1, 4096]");
   if (m.lightSteps < 1 || m.lightSteps > 64)
     return fail(ErrorCode::InvalidArgument,
                 "render settings: march.lightSteps " + std::to_string(m.lightSteps) + " outside [1, 64]");

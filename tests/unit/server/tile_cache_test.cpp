@@ -197,6 +197,7 @@ TEST_F(TileCacheTest, DiffBuiltIsTheDiffOfTheWholeSnapshots) {
       [&] {},                                                        // nothing changed
       [&] { global[1].coverage = 0.4; },                             // one layer
       [&] { regions[1].centerLon_deg += 0.01; },                     // the storm moves
+      [&] { regions[1].centerLon_deg -= 0.25; },                     // far: cells reached before and now are apart
       [&] { regions[0].layers[0].coverage = 0.3; },                  // a region's layer
       [&] { global[2].base_m += 100; },                              // a uniform layer's table entry
       [&] { regions[1].centerLon_deg = 30; },                        // the storm leaves: its tiles go
@@ -216,7 +217,7 @@ TEST_F(TileCacheTest, DiffBuiltIsTheDiffOfTheWholeSnapshots) {
         skipped += after.runs[k].generation != 0 && after.snapshot.layers[k].id == before.snapshot.layers[j].id &&
                    after.runs[k].generation == before.runs[j].generation;
     const auto fast = diffBuilt(before, after);
-    const auto whole = weather::diffSnapshots(before.snapshot, after.snapshot);
+    const auto whole = weather::diffSnapshots(wholeSnapshot(before), wholeSnapshot(after));
     ASSERT_EQ(fast.has_value(), whole.has_value()) << "step " << i;
     if (whole) {
       EXPECT_EQ(fast->tileLevel, whole->tileLevel) << "step " << i;
@@ -226,13 +227,41 @@ TEST_F(TileCacheTest, DiffBuiltIsTheDiffOfTheWholeSnapshots) {
       EXPECT_TRUE(fast->tiles == whole->tiles) << "step " << i << ": " << fast->tiles.size() << " tiles, not "
                                                << whole->tiles.size();
       // And it takes the peer to the new snapshot.
-      weather::WeatherSnapshot held = before.snapshot;
+      weather::WeatherSnapshot held = wholeSnapshot(before);
       ASSERT_TRUE(weather::applyDelta(held, *fast)) << "step " << i;
-      EXPECT_TRUE(held.tiles == after.snapshot.tiles) << "step " << i;
+      EXPECT_TRUE(held.tiles == wholeSnapshot(after).tiles) << "step " << i;
     }
     before = after;
   }
   EXPECT_GE(skipped, 8) << "untouched layers kept their generation, so their tiles were skipped";
+}
+
+// Snapshots hold the cache's tiles, not copies: subscribers' snapshots of
+// one state share them. A change replaces a layer's tiles in the cache and
+// leaves the ones a subscriber already holds as they were (the server diffs
+// the next snapshot against them).
+TEST_F(TileCacheTest, SnapshotsShareTheCachesTilesAndKeepTheirOwnAcrossAChange) {
+  auto build = [&] { return buildSnapshotWithGenerations(area, global, 0.0, kDefaultMaxCells, regions, &cache); };
+  const BuiltSnapshot first = build();
+  const BuiltSnapshot second = build();
+  ASSERT_EQ(first.runs.size(), first.snapshot.layers.size());
+  EXPECT_TRUE(first.snapshot.tiles.empty()) << "tiles are in the runs";
+  std::size_t shared = 0;
+  for (std::size_t k = 0; k < first.runs.size(); ++k)
+    if (first.runs[k].tiles) {
+      EXPECT_EQ(first.runs[k].tiles.get(), second.runs[k].tiles.get()) << "layer " << first.snapshot.layers[k].id;
+      ++shared;
+    }
+  EXPECT_GE(shared, 3u) << "layers 1, 2 and 6 vary over the area";
+
+  const weather::WeatherSnapshot held = wholeSnapshot(first);
+  regions[0].layers[1].coverage = 0.2;  // the clearing's layer 2 thins
+  regions[1].centerLon_deg += 0.02;     // the storm moves
+  const BuiltSnapshot after = build();
+  EXPECT_TRUE(wholeSnapshot(first).tiles == held.tiles) << "a held snapshot changed under its subscriber";
+  EXPECT_FALSE(wholeSnapshot(after).tiles == held.tiles);
+  // And the new one is what deriving from scratch gives.
+  EXPECT_TRUE(wholeSnapshot(after).tiles == buildSnapshot(area, global, 0.0, kDefaultMaxCells, regions).tiles);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <optional>
 #include <tuple>
 #include <unordered_map>
@@ -49,6 +50,18 @@ Covering coverArea(const weather::SphericalCap& cap, int wantedLevel, std::size_
 std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLayer> layers,
                                                 std::span<const weather::Region> regions);
 
+// One layer's tiles over a covering (every cell, in the covering's order),
+// with what lets two of them be compared without reading them all: the value
+// every tile has that no region reaches (the layer's own coverage and
+// density), and the indices, ascending, of the tiles regions reach (only
+// those can differ from it).
+struct LayerTiles {
+  std::vector<weather::CoverageTile> tiles;
+  float coverage = 0, density = 0;
+  std::vector<std::uint32_t> reached;
+  std::uint64_t covering = 0;  // TileCache::Entry::serial of the cells (0: not known)
+};
+
 // A unit vector on the mean sphere (x towards 0 N 0 E, z towards the north
 // pole): the cheap "is this cell within reach of that region" test is a dot
 // product, with no trigonometry per cell.
@@ -77,7 +90,9 @@ class TileCache {
   // what they were derived from (see deriveTiles).
   struct LayerMemo {
     std::vector<std::uint64_t> inputs;
-    std::vector<weather::CoverageTile> tiles;  // empty: the layer is uniform there
+    // Empty: the layer is uniform there. Shared with the snapshots built from
+    // it (a snapshot holds them, not a copy), replaced, never changed.
+    std::shared_ptr<const LayerTiles> tiles;
     std::uint64_t generation = 0;              // of these tiles (0: none derived yet)
     bool valid = false;
   };
@@ -90,6 +105,7 @@ class TileCache {
   struct Entry {
     weather::SphericalCap cap;
     Covering covering;
+    std::uint64_t serial = 0;  // no other covering this cache made has it
     std::vector<weather::CellCentre> centres;  // of covering.cells
     std::vector<UnitVector> units;             // of centres
     std::unordered_map<ShapeKey, Weights, ShapeKeyHash> shapeWeights;
@@ -118,6 +134,7 @@ class TileCache {
   std::size_t cellWeightCount_ = 0;
   std::uint64_t tileHits_ = 0, tileMisses_ = 0;
   std::uint64_t generations_ = 0;
+  std::uint64_t coveringSerials_ = 0;
 };
 
 // One tile per (cell, table layer) for each layer that varies over the
@@ -133,33 +150,42 @@ class TileCache {
 std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> cells,
                                                std::span<const weather::CloudLayer> layers,
                                                std::span<const weather::Region> regions = {});
-// One layer's run of tiles in a snapshot (its tiles are consecutive, in the
-// order of the layer table) and the generation of those tiles in the
-// TileCache that derived them: two runs from one cache with the same non-zero
-// generation are the very same tiles (0: not known).
+// One layer's tiles in a snapshot, as the TileCache that derived them holds
+// them, and their generation there: two runs from one cache with the same
+// non-zero generation are the very same tiles (0: not known).
 struct LayerRun {
   std::uint64_t generation = 0;
-  std::size_t tiles = 0;
+  std::shared_ptr<const LayerTiles> tiles;  // null: none
+  std::size_t size() const { return tiles ? tiles->tiles.size() : 0; }
 };
 
-// The same, for the cells of a cached covering (their weights from the cache);
-// runs, when given, gets each layer's run (by index of `layers`).
-std::vector<weather::CoverageTile> deriveTiles(TileCache& cache, TileCache::Entry& entry,
-                                               std::span<const weather::CloudLayer> layers,
-                                               std::span<const weather::Region> regions,
-                                               std::vector<LayerRun>* runs = nullptr);
+// Each layer's run of tiles (by index of `layers`) for the cells of a cached
+// covering, their weights from the cache: what deriveTiles gives, by layer,
+// without copying a tile the cache already holds.
+std::vector<LayerRun> deriveRuns(TileCache& cache, TileCache::Entry& entry,
+                                 std::span<const weather::CloudLayer> layers,
+                                 std::span<const weather::Region> regions);
 
-// A snapshot with its layers' runs of tiles (by index of snapshot.layers;
-// empty when not known).
+// A snapshot as the server keeps it for a subscriber. With a cache its tiles
+// stay in `runs` (one per layer of snapshot.layers, shared with the cache:
+// sixty-four subscribers' snapshots of one change hold no copy of a tile) and
+// snapshot.tiles is empty; without one, runs is empty and the tiles are in
+// snapshot.tiles.
 struct BuiltSnapshot {
   weather::WeatherSnapshot snapshot;
   std::vector<LayerRun> runs;
 };
 
-// weather::diffSnapshots(before.snapshot, after.snapshot), without reading
-// the tiles of layers whose generation both share (a delta leaves those out
-// anyway): what a change costs a subscriber grows with the tiles it changed,
-// not with the tiles of its area.
+// The snapshot with all its tiles (the layers' runs one after the other), as
+// it goes on the wire; and how many tiles that is.
+weather::WeatherSnapshot wholeSnapshot(const BuiltSnapshot& built);
+std::size_t tileCount(const BuiltSnapshot& built);
+
+// weather::diffSnapshots(wholeSnapshot(before), wholeSnapshot(after)),
+// comparing tiles layer by layer and never reading the tiles of layers whose
+// generation both share (a delta leaves those out anyway): what a change
+// costs a subscriber grows with the tiles it changed, not with the tiles of
+// its area.
 std::optional<weather::WeatherDelta> diffBuilt(const BuiltSnapshot& before, const BuiltSnapshot& after);
 
 // The snapshot answering `request` at weather clock clock_s.
@@ -168,7 +194,7 @@ weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,
                                        double clock_s, std::size_t maxCells,
                                        std::span<const weather::Region> regions = {},
                                        TileCache* cache = nullptr);
-// The same, with its runs of tiles (see LayerRun; generations 0 without a cache).
+// The same, as the server keeps it (see BuiltSnapshot).
 BuiltSnapshot buildSnapshotWithGenerations(const stream::Subscribe& request,
                                            std::span<const weather::CloudLayer> layers, double clock_s,
                                            std::size_t maxCells, std::span<const weather::Region> regions,

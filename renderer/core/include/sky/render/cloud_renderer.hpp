@@ -24,7 +24,7 @@ inline constexpr std::size_t kMaxLayers = 4;
 // in the frame block as run-time numbers. The defaults are the `high`
 // preset (presets.hpp), the march as it was before presets.
 struct MarchSettings {
-  std::uint32_t primarySteps = 48;  // samples per layer span, evenly spaced, [1, 1024]
+  std::uint32_t primarySteps = 48;  // samples per layer span, evenly spaced, [1, 4096]
   std::uint32_t lightSteps = 4;     // samples towards the sun per lit sample, [1, 64]
   double minTransmittance = 0.01;   // stop the view ray once it keeps less, [0, 1); 0: never
   // Samples advanced after one that met no cloud: long strides through empty

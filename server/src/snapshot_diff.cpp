@@ -1,0 +1,104 @@
+// The delta between two snapshots the server built, layer by layer (see
+// diffBuilt in snapshot_builder.hpp).
+#include <algorithm>
+
+#include "sky/server/snapshot_builder.hpp"
+
+namespace sky::server {
+
+namespace {
+
+// Whether `s` keeps its tiles in its runs, one run per layer.
+bool byLayer(const BuiltSnapshot& s) {
+  return s.runs.size() == s.snapshot.layers.size() && s.snapshot.tiles.empty();
+}
+
+// The snapshot's layer table alone, at `tileLevel`.
+weather::WeatherSnapshot tableOf(const BuiltSnapshot& s, int tileLevel) {
+  return {s.snapshot.weatherClock_s, s.snapshot.layers, tileLevel, {}};
+}
+
+const LayerRun* runOf(const BuiltSnapshot& s, std::uint32_t layerId) {
+  for (std::size_t i = 0; i < s.snapshot.layers.size(); ++i)
+    if (s.snapshot.layers[i].id == layerId) return &s.runs[i];
+  return nullptr;
+}
+
+// Whether two runs hold tiles for the same cells in the same order (known
+// without reading them when both are over one covering).
+bool sameCells(const LayerTiles& was, const LayerTiles& now) {
+  const auto& a = was.tiles;
+  const auto& b = now.tiles;
+  if (a.size() != b.size()) return false;
+  if (was.covering != 0 && was.covering == now.covering) return true;
+  return std::equal(a.begin(), a.end(), b.begin(),
+                    [](const auto& x, const auto& y) { return x.cellId == y.cellId && x.layerId == y.layerId; });
+}
+
+// Appends to `out` the tiles of `now` that differ from `was` (same cells, in
+// order). Where both have the same value outside the cells regions reach,
+// only the reached cells of either can differ: a storm cell moving over an
+// area compares its few hundred cells, not the area's thousands.
+void changedTiles(const LayerTiles& was, const LayerTiles& now, std::vector<weather::CoverageTile>& out) {
+  const auto& a = was.tiles;
+  const auto& b = now.tiles;
+  if (was.coverage != now.coverage || was.density != now.density) {
+    for (std::size_t k = 0; k < b.size(); ++k)
+      if (!(a[k] == b[k])) out.push_back(b[k]);
+    return;
+  }
+  // The union of both reached sets, ascending (so `out` keeps `now`'s order).
+  auto i = was.reached.begin(), j = now.reached.begin();
+  while (i != was.reached.end() || j != now.reached.end()) {
+    std::uint32_t k;
+    if (j == now.reached.end() || (i != was.reached.end() && *i < *j))
+      k = *i++;
+    else if (i == was.reached.end() || *j < *i)
+      k = *j++;
+    else
+      k = (++i, *j++);
+    if (!(a[k] == b[k])) out.push_back(b[k]);
+  }
+}
+
+}  // namespace
+
+std::optional<weather::WeatherDelta> diffBuilt(const BuiltSnapshot& before, const BuiltSnapshot& after) {
+  const auto whole = [&] { return weather::diffSnapshots(wholeSnapshot(before), wholeSnapshot(after)); };
+  if (!byLayer(before) || !byLayer(after)) return whole();
+  const std::size_t beforeTiles = tileCount(before), afterTiles = tileCount(after);
+  const int beforeLevel = before.snapshot.tileLevel, afterLevel = after.snapshot.tileLevel;
+  if (beforeTiles != 0 && afterTiles != 0 && beforeLevel != afterLevel) return std::nullopt;
+  // The layer table's part of the delta (upserts, removals, and no delta
+  // when layers were reordered), from the tables alone.
+  auto delta = weather::diffSnapshots(tableOf(before, afterLevel), tableOf(after, afterLevel));
+  if (!delta) return std::nullopt;
+  // Tiles, in the order of `after`'s: per layer, the tiles that differ from
+  // the same layer's before. Any layer whose cells are not the ones it had
+  // (a layer gaining or losing tiles, a covering that moved) goes through
+  // the general diff, which knows when a delta cannot say it.
+  for (std::size_t i = 0; i < after.snapshot.layers.size(); ++i) {
+    const LayerRun& now = after.runs[i];
+    const LayerRun* was = runOf(before, after.snapshot.layers[i].id);
+    if (!was) {  // a new layer: all its tiles
+      if (now.tiles) delta->tiles.insert(delta->tiles.end(), now.tiles->tiles.begin(), now.tiles->tiles.end());
+      continue;
+    }
+    if (now.generation != 0 && now.generation == was->generation && beforeLevel == afterLevel) continue;
+    if (!now.tiles) {
+      if (!was->tiles) continue;
+      return whole();  // the layer lost its tiles: no delta says that
+    }
+    if (!was->tiles) {  // the layer gained tiles (a region came): all of them
+      delta->tiles.insert(delta->tiles.end(), now.tiles->tiles.begin(), now.tiles->tiles.end());
+      continue;
+    }
+    if (!sameCells(*was->tiles, *now.tiles)) return whole();
+    changedTiles(*was->tiles, *now.tiles, delta->tiles);
+  }
+  // With no tiles a delta cannot move the snapshot's level.
+  if (delta->tiles.empty() && beforeLevel != afterLevel) return std::nullopt;
+  return delta;
+}
+
+}  // namespace sky::server
