@@ -178,12 +178,19 @@ TEST_F(HeadlessReplay, WeatherFileWithoutAServer) {
   const std::vector<std::string> noServer = {"--weather-file", SKY_SCENARIO_CLOUDY, "--no-video", "--replay-end", "3"};
   const ReplayRun a = replay(port_, SKY_TEST_FLIGHT, dir_ / "fa", noServer);
   ASSERT_EQ(a.exitCode, 0) << a.log;
-  const ReplayRun b = replay(port_, SKY_TEST_FLIGHT, dir_ / "fb", noServer);
+  // The second run stops early (--max-frames) and draws the same frames.
+  std::vector<std::string> twoFrames = noServer;
+  twoFrames.insert(twoFrames.end(), {"--max-frames", "2"});
+  const ReplayRun b = replay(port_, SKY_TEST_FLIGHT, dir_ / "fb", twoFrames);
   ASSERT_EQ(b.exitCode, 0) << b.log;
   const auto report = nlohmann::json::parse(readAll(dir_ / "fa" / "report.json"));
   EXPECT_EQ(report["weather_source"], SKY_SCENARIO_CLOUDY);
   EXPECT_EQ(report["frames"], 3);  // 0, 1.5, 3 s
-  for (const char* f : {"frame_000000.png", "frame_000001.png", "frame_000002.png"})
+  const auto reportB = nlohmann::json::parse(readAll(dir_ / "fb" / "report.json"));
+  EXPECT_EQ(reportB["frames"], 2);
+  EXPECT_EQ(reportB["complete"], true);
+  EXPECT_FALSE(fs::exists(dir_ / "fb" / "frames" / "frame_000002.png"));
+  for (const char* f : {"frame_000000.png", "frame_000001.png"})
     EXPECT_TRUE(readAll(dir_ / "fa" / "frames" / f) == readAll(dir_ / "fb" / "frames" / f)) << f;
   std::ifstream jsonl(dir_ / "fa" / "frames" / "frames.jsonl");
   std::string line;

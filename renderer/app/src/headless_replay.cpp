@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -80,7 +81,8 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     return 2;
   }
   // A tiny tolerance so that a step dividing the span exactly includes the end.
-  const auto frameCount = static_cast<std::size_t>(std::floor((t1 - t0) / o.step_s + 1e-9)) + 1;
+  const auto frameCount = std::min(static_cast<std::size_t>(std::floor((t1 - t0) / o.step_s + 1e-9)) + 1,
+                                   o.maxFrames > 0 ? o.maxFrames : std::numeric_limits<std::size_t>::max());
 
   auto writer = FrameWriter::open(o.outDir + "/frames", o.outputs, RunSettings{o.preset, renderer.settings()});
   if (!writer) {

@@ -239,6 +239,7 @@ int main(int argc, char** argv) {
     r.pace = o.replayPace;
     r.start_s = o.replayStart_s;
     if (o.replayEnd_s >= 0) r.end_s = o.replayEnd_s;
+    r.maxFrames = o.maxFrames;
     if (std::isfinite(o.replayWeatherClock_s)) r.weatherClock_s = o.replayWeatherClock_s;
     r.serverHost = serverHost;
     r.serverPort = static_cast<unsigned short>(serverPort);

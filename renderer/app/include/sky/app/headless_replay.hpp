@@ -30,6 +30,7 @@ struct ReplayOptions {
   double step_s = 1.0 / 30.0;           // flight seconds per frame, (0, 3600]
   double start_s = 0;                   // offset into the flight, s
   std::optional<double> end_s;          // offset into the flight, s (default: its end)
+  std::size_t maxFrames = 0;            // stop after this many frames (0: no limit)
   std::optional<double> weatherClock_s; // weather clock of the first frame (default: the server's)
   std::string weatherFile;  // a scenario TOML instead of a server (its layers, uniform; its clock)
   std::string serverHost;
