@@ -151,7 +151,7 @@ Result<CpuReference> CpuReference::create(const RenderSettings& settings) {
   auto tables = std::make_shared<Tables>();
   tables->shape = makeShapeNoise(kShapeNoiseSize, settings.noiseSeed);
   tables->detail = makeDetailNoise(kDetailNoiseSize, settings.noiseSeed);
-  tables->atmosphere = buildAtmosphereTables();
+  tables->atmosphere = sharedAtmosphereTables();
   return CpuReference(settings, std::move(tables));
 }
 
