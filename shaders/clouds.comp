@@ -110,7 +110,7 @@ CoreLayer layerAt(int li) {
                                   vec3(l.coverageShift.xy, l.shape.y), l.coverageShift.w);
   return CoreLayer(l.heights.x, l.heights.y, l.heights.z, l.heights.w, l.shape.x, l.shape.z, l.shape.w > 0.5,
                    unpackType(l.primary), unpackType(l.secondary), l.ambient.rgb, l.sunDiffuse.rgb,
-                   l.sunDiffuse.w, s);
+                   l.sunDiffuse.w, s, l.ambient.w > 0.5);
 }
 
 void main() {
@@ -131,7 +131,8 @@ void main() {
   f.air = AirFrame(frame.earth.x, frame.earth.y, frame.earth.z, frame.earth.w, frame.sunDir.xyz,
                    frame.sunIrradiance.rgb);
   f.groundIrradiance = frame.groundIrradiance.rgb;
-  f.march = MarchParams(int(frame.dispatch.y), int(frame.dispatch.z), frame.weatherMap.z, frame.weatherMap.w);
+  f.march = MarchParams(int(frame.dispatch.y), int(frame.dispatch.z), frame.weatherMap.z, frame.weatherMap.w,
+                        frame.steps.x, frame.steps.y, frame.steps.z);
   f.layerCount = int(frame.weatherMap.y);
   vec3 dir = cameraRay(frame.camForward.xyz, frame.camRight.xyz, frame.camDown.xyz, frame.camRight.w,
                        frame.camDown.w, float(px.x), float(px.y), float(frame.image.x), float(frame.image.y));

@@ -57,7 +57,8 @@ struct SkyLayer {
   vec4 cloudMapOrigin; // the same for the cloud map (the shape texture at a larger period)
   vec4 coverageShift;  // xy: coverage drift east/north in the weather map plane (m), z: unused,
                        // w: the shape noise's ECEF z scale (1, or < 1 for streaks)
-  vec4 ambient;        // rgb: mean sky radiance at the layer top (linear units); w: unused
+  vec4 ambient;        // rgb: mean sky radiance at the layer top (linear units); w: 1 when the layer
+                       // has no coverage anywhere on the weather map (not marched), else 0
   vec4 sunDiffuse;     // rgb: sunlight at the layer top as diffuse radiance, E T mu / pi; w: mu of the sun
   SkyCloudType primary;    // the layer's own type
   SkyCloudType secondary;  // the type its tiles blend towards
@@ -82,6 +83,8 @@ struct SkyFrame {
   uvec4 dispatch;       // x: tile permutation stride (coprime to the tile count), y: primary steps per
                         // layer span, z: light steps, w: unused
   SkyLayer layers[kMaxLayers];
+  vec4 steps;           // the march in metres (RenderSettings::march): x: step inside cloud (m; 0: even
+                        // placement), y: step through clear air (m), z: step growth per metre, w: unused
 };
 
 #ifdef __cplusplus
@@ -100,7 +103,8 @@ static_assert(offsetof(SkyFrame, image) == 240);
 static_assert(offsetof(SkyFrame, dispatch) == 256);
 static_assert(offsetof(SkyFrame, layers) == 272);
 static_assert(offsetof(SkyLayer, cloudMapOrigin) == 64);
-static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers);
+static_assert(offsetof(SkyFrame, steps) == 272 + 256 * kMaxLayers);
+static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 16);
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

@@ -75,7 +75,8 @@ Core::CloudType haggstromCumulus() {
 // layer of the given type; no sun, no sky light.
 Core::CoreFrame frameAt(Core& c, double R, double alt, double base, double thickness, const Core::CloudType& type) {
   Core::CoreFrame f{};
-  f.march = Core::MarchParams{Core::kPrimarySteps, Core::kLightSteps, Core::kMinTransmittance, Core::kEmptyStride};
+  f.march = Core::MarchParams{Core::kPrimarySteps, Core::kLightSteps, Core::kMinTransmittance, Core::kEmptyStride,
+                              Core::kCloudStep_m, Core::kEmptyStep_m, Core::kStepGrowth};
   f.air.r = R + alt;
   f.air.h = alt;
   f.air.cGround = alt * (2 * f.air.r - alt);
@@ -89,7 +90,8 @@ Core::CoreFrame frameAt(Core& c, double R, double alt, double base, double thick
   Core::CoreLayer& L = c.layers[0];
   L = Core::CoreLayer{hBase, hTop, hBase * (2 * f.air.r - hBase), hTop * (2 * f.air.r - hTop), thickness,
                       0.5 * thickness, false, type, type, Core::real3(0), Core::real3(0), 1.0,
-                      Core::LayerSampling{Core::real4(0.0), Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), 1.0}};
+                      Core::LayerSampling{Core::real4(0.0), Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), 1.0},
+                      false};
   return f;
 }
 

@@ -36,12 +36,14 @@ Core::CoreLayer slabLayer(const Core::CoreFrame& f, double base_m, double thickn
   const double hBase = kAlt_m - base_m, hTop = kAlt_m - (base_m + thickness_m);
   return Core::CoreLayer{hBase, hTop, hBase * (2 * f.air.r - hBase), hTop * (2 * f.air.r - hTop), thickness_m,
                          0.5 * thickness_m, false, t, t, Core::real3(0), Core::real3(0), 1.0,
-                         Core::LayerSampling{Core::real4(0.0), Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), 1.0}};
+                         Core::LayerSampling{Core::real4(0.0), Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), 1.0},
+                      false};
 }
 
 Core::CoreFrame frame(Core& c, double sigma) {
   Core::CoreFrame f{};
-  f.march = Core::MarchParams{Core::kPrimarySteps, Core::kLightSteps, Core::kMinTransmittance, Core::kEmptyStride};
+  f.march = Core::MarchParams{Core::kPrimarySteps, Core::kLightSteps, Core::kMinTransmittance, Core::kEmptyStride,
+                              Core::kCloudStep_m, Core::kEmptyStep_m, Core::kStepGrowth};
   f.air.r = kEarth_m + kAlt_m;
   f.air.h = kAlt_m;
   f.air.cGround = kAlt_m * (2 * f.air.r - kAlt_m);

@@ -28,6 +28,8 @@ class Core {
   real2 cloudMap = real2(0.5, 1.0);
   // Shape-noise lookups so far (primary and light march): the march's cost.
   std::uint64_t shapeLookups = 0;
+  // Every texture lookup of the cloud model (weather, cloud map, shape, detail).
+  std::uint64_t lookups = 0;
   // Transmittance table lookup; unset: clear air transmits everything.
   std::function<real3(real2)> table;
   // Multiple-scattering table lookup; unset: none.
@@ -46,12 +48,22 @@ class Core {
 };
 
 inline Core::CoreLayer Core::layerAt(int li) { return layers[li]; }
-inline Core::real3 Core::sampleWeather(LayerSampling, real3) { return real3(coverage, density, blend); }
-inline Core::real2 Core::sampleCloudMap(LayerSampling, real3) { return cloudMap; }
+inline Core::real3 Core::sampleWeather(LayerSampling, real3) {
+  ++lookups;
+  return real3(coverage, density, blend);
+}
+inline Core::real2 Core::sampleCloudMap(LayerSampling, real3) {
+  ++lookups;
+  return cloudMap;
+}
 inline Core::real2 Core::sampleShape(LayerSampling, real3) {
+  ++lookups;
   ++shapeLookups;
   return real2(noise, noise);
 }
-inline Core::real Core::sampleDetail(LayerSampling, real3) { return detail; }
+inline Core::real Core::sampleDetail(LayerSampling, real3) {
+  ++lookups;
+  return detail;
+}
 
 }  // namespace sky::test

@@ -20,7 +20,8 @@ namespace {
 using render::Preset;
 
 Core::MarchParams params(const render::MarchSettings& m) {
-  return Core::MarchParams{int(m.primarySteps), int(m.lightSteps), m.minTransmittance, double(m.emptyStride)};
+  return Core::MarchParams{int(m.primarySteps), int(m.lightSteps), m.minTransmittance, double(m.emptyStride),
+                           m.cloudStep_m, m.emptyStep_m, m.stepGrowth};
 }
 
 // One layer from base to base + thickness over a camera at 500 m (R = 6371
@@ -55,7 +56,8 @@ Core::CoreFrame slabFrame(Core& c, const render::MarchSettings& m, double sigma,
   c.layers[0] = Core::CoreLayer{hBase, hTop, hBase * (2 * f.air.r - hBase), hTop * (2 * f.air.r - hTop), H, 0.5 * H,
                                 false, t, t, Core::real3(0), Core::real3(0), 1.0,
                                 Core::LayerSampling{Core::real4(0.0), Core::real4(0.0), Core::real4(0.0),
-                                                    Core::real3(0.0), 1.0}};
+                                                    Core::real3(0.0), 1.0},
+                                false};
   return f;
 }
 
