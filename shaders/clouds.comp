@@ -25,6 +25,7 @@ layout(set = 0, binding = kBindingDetail) uniform sampler3D detailTex;
 layout(set = 0, binding = kBindingTransmittance) uniform sampler2D transmittanceTex;
 layout(set = 0, binding = kBindingMultipleScattering) uniform sampler2D multipleScatteringTex;
 layout(std430, set = 0, binding = kBindingDepth) writeonly buffer DepthBlock { float depths[]; };
+layout(std430, set = 0, binding = kBindingCoverageMip) readonly buffer CoverageMipBlock { float coverageMip[]; };
 
 #define real float
 #define real2 vec2
@@ -56,6 +57,17 @@ vec3 sampleWeather(LayerSampling s, vec3 p) {
   vec2 plane = q.xy * (gCamInAnchor.w / q.z) - s.coverageShift.xy;
   vec2 uv = plane * gMapScale + 0.5;
   return textureLod(weatherTex, vec3(uv, s.coverageShift.z), 0.0).xyz;
+}
+
+// The max-coverage mip cell of a camera-local point: the weather lookup's
+// plane coordinates, then the cell (nearest; 0 outside the map).
+float sampleMaxCoverage(LayerSampling s, vec3 p) {
+  vec3 q = gCamToAnchor * p + gCamInAnchor.xyz;
+  if (q.z <= 0.0) return 0.0;
+  vec2 uv = (q.xy * (gCamInAnchor.w / q.z) - s.coverageShift.xy) * gMapScale + 0.5;
+  if (any(lessThan(uv, vec2(0.0))) || any(greaterThanEqual(uv, vec2(1.0)))) return 0.0;
+  uvec2 cell = uvec2(uv * float(kCoverageMipSize));
+  return coverageMip[(uint(s.coverageShift.z) * kCoverageMipSize + cell.y) * kCoverageMipSize + cell.x];
 }
 
 // Earth-fixed noise coordinates: rotate to ECEF axes, scale by the period and

@@ -13,6 +13,8 @@
 //   real2 sampleCloudMap(LayerSampling s, real3 pLocal)  // (coverage modulation, peak height) in [0, 1]
 //   real2 sampleShape(LayerSampling s, real3 pLocal)     // (billowy, fibrous) shape noise in [0, 1]
 //   real  sampleDetail(LayerSampling s, real3 pLocal)    // Worley detail noise in [0, 1]
+//   real  sampleMaxCoverage(LayerSampling s, real3 pLocal) // the weather map's max-coverage mip cell:
+//                                                          // >= any coverage sampleWeather gives in it
 // pLocal is camera-relative, local frame: x east, y north, z up (m).
 
 #include "core_common.glsl"
@@ -112,6 +114,7 @@ real3 sampleWeather(LayerSampling s, real3 pLocal);
 real2 sampleCloudMap(LayerSampling s, real3 pLocal);
 real2 sampleShape(LayerSampling s, real3 pLocal);
 real sampleDetail(LayerSampling s, real3 pLocal);
+real sampleMaxCoverage(LayerSampling s, real3 pLocal);
 
 // The march's cost knobs (defaults above; RenderSettings::march). Two ways
 // to place the samples of a layer span: evenly (cloudStep 0: primarySteps
@@ -305,6 +308,9 @@ CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
   cs.densityScale = 0.0;
   cs.blend = 0.0;
   if (ph <= 0.0 || ph >= 1.0) return cs;
+  // Empty-space skipping: a long step in a mip cell without coverage is
+  // clear, known from one read.
+  if (cheap && sampleMaxCoverage(L.sampling, p) <= 0.0) return cs;
   real3 weather = sampleWeather(L.sampling, p);
   if (weather.x <= 0.0) return cs;
   cs.blend = L.blends ? weather.z : 0.0;

@@ -28,6 +28,10 @@ SKY_SHARED_CONST kBindingDetail = 4u;         // sampler3D, tileable Worley deta
 SKY_SHARED_CONST kBindingTransmittance = 5u;  // sampler2D, atmosphere transmittance table (RGBA16F, clamp)
 SKY_SHARED_CONST kBindingMultipleScattering = 6u;  // sampler2D, atmosphere multiple scattering (RGBA16F, clamp)
 SKY_SHARED_CONST kBindingDepth = 7u;               // storage buffer of float cloud depth (m, 0 = no cloud) per pixel
+SKY_SHARED_CONST kBindingCoverageMip = 10u;        // read-only storage buffer of float: the weather map's max-coverage
+                                                   // mip, kMaxLayers x kCoverageMipSize^2 (slice, row north, column east)
+// Cells per edge of the max-coverage mip (renderer/core/src/coverage_mip.hpp).
+SKY_SHARED_CONST kCoverageMipSize = 32u;
 
 // Workgroup edge of the cloud pass, pixels (8x8 = 64 invocations = 8 lavapipe
 // subgroups of 8 lanes).

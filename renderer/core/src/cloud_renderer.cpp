@@ -14,6 +14,7 @@
 
 #include "atmosphere_tables.hpp"
 #include "cloud_pass.hpp"
+#include "coverage_mip.hpp"
 #include "frame_setup.hpp"
 #include "gpu_context.hpp"
 #include "noise_volume.hpp"
@@ -34,6 +35,7 @@ struct CloudRenderer::Impl {
   AtmosphereTables atmosphere;  // CPU copy: the frame setup's sky light reads it
   std::vector<PassTime> passTimes;
   std::string noiseReport;
+  std::uint64_t coverageMipUploads = ~std::uint64_t(0);  // weather uploads the pass's coverage mip is of
 };
 
 namespace {
@@ -134,6 +136,10 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
     impl_->passTimes.clear();
     if (auto ok = impl_->weather.update(*impl_->ctx, inputs); !ok) return tl::unexpected(ok.error());
     impl_->passTimes = impl_->weather.lastUploadTimes();
+    if (impl_->weather.uploads() != impl_->coverageMipUploads) {  // a new map: its max-coverage mip
+      impl_->pass.setCoverageMip(buildCoverageMip(impl_->weather.field()));
+      impl_->coverageMipUploads = impl_->weather.uploads();
+    }
     const FrameSetup setup = prepareFrame(impl_->settings, inputs, impl_->weather.field(), impl_->atmosphere);
     auto image = impl_->pass.run(*impl_->ctx, packFrame(setup));
     if (image)

@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "atmosphere_tables.hpp"
+#include "coverage_mip.hpp"
 #include "frame_setup.hpp"
 #include "noise_volume.hpp"
 #include "sky_shared.h"
@@ -39,7 +40,8 @@ class CpuCore {
 
   CpuCore(const FrameSetup& setup, const NoiseVolume& shape, const NoiseVolume& detail,
           const AtmosphereTables& atmosphere, const WeatherField& weather)
-      : setup_(setup), shape_(shape), detail_(detail), atmosphere_(atmosphere), weather_(weather) {}
+      : setup_(setup), shape_(shape), detail_(detail), atmosphere_(atmosphere), weather_(weather),
+        coverageMip_(buildCoverageMip(weather)) {}
 
   real3 sampleTransmittanceLut(real2 uv) const { return atmosphere_.sampleTransmittance(uv); }
   real3 sampleMultipleScatteringLut(real2 uv) const { return atmosphere_.sampleMultipleScattering(uv); }
@@ -117,6 +119,7 @@ class CpuCore {
   const NoiseVolume& detail_;
   const AtmosphereTables& atmosphere_;
   const WeatherField& weather_;
+  const std::vector<float> coverageMip_;
 };
 
 CpuCore::CoreLayer CpuCore::layerAt(int li) { return layers_[li]; }
@@ -128,6 +131,14 @@ CpuCore::real3 CpuCore::sampleWeather(LayerSampling s, real3 p) {
   if (q.z <= 0.0) return real3(0.0);
   const real2 plane = real2(q.x, q.y) * (setup_.anchorRadius_m / q.z) - real2(s.coverageShift.x, s.coverageShift.y);
   return weather_.sample(std::uint32_t(s.coverageShift.z), plane.x, plane.y);
+}
+
+CpuCore::real CpuCore::sampleMaxCoverage(LayerSampling s, real3 p) {
+  ++lookups_;
+  const real3 q = setup_.camToAnchor * p + setup_.camInAnchor_m;
+  if (q.z <= 0.0) return 0.0;
+  const real2 plane = real2(q.x, q.y) * (setup_.anchorRadius_m / q.z) - real2(s.coverageShift.x, s.coverageShift.y);
+  return sampleCoverageMip(coverageMip_, weather_, std::uint32_t(s.coverageShift.z), plane.x, plane.y);
 }
 
 CpuCore::real2 CpuCore::sampleShape(LayerSampling s, real3 p) {

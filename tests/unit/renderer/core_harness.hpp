@@ -56,6 +56,11 @@ inline Core::real2 Core::sampleCloudMap(LayerSampling, real3) {
   ++lookups;
   return cloudMap;
 }
+// The mip of a uniform field holds its coverage.
+inline Core::real Core::sampleMaxCoverage(LayerSampling, real3) {
+  ++lookups;
+  return coverage;
+}
 inline Core::real2 Core::sampleShape(LayerSampling, real3) {
   ++lookups;
   ++shapeLookups;

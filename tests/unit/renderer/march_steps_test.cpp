@@ -5,7 +5,8 @@
 // grow with distance (every step is exact for a constant extinction, and the
 // steps tile the span); growth and long steps through clear air cut the
 // lookups; a layer with no coverage anywhere makes no lookups and leaves the
-// image as it is without it.
+// image as it is without it; the weather map's max-coverage mip bounds every
+// weather lookup in its cells.
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -13,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "core_harness.hpp"
+#include "coverage_mip.hpp"
 #include "sky/render/cpu_reference.hpp"
 #include "sky/weather/model.hpp"
 
@@ -175,6 +177,43 @@ TEST(MarchSteps, LayerWithNoCoverageCostsNothingInTheCpuReference) {
   ASSERT_EQ(a->rgba.size(), b->rgba.size());
   for (std::size_t i = 0; i < a->rgba.size(); ++i) ASSERT_EQ(a->rgba[i], b->rgba[i]) << "value " << i;
   for (std::size_t i = 0; i < a->cloudDepth_m.size(); ++i) ASSERT_EQ(a->cloudDepth_m[i], b->cloudDepth_m[i]);
+}
+
+}  // namespace
+}  // namespace sky::test
+
+namespace sky::test {
+namespace {
+
+// The max-coverage mip is conservative: no bilinear weather lookup inside a
+// cell returns more coverage than the cell holds (so a long step skipped on
+// a 0 cell would have found no cloud), and cells away from the cloud hold 0.
+TEST(MarchSteps, CoverageMipBoundsEveryWeatherLookup) {
+  render::WeatherField field;
+  field.sliceCount = gpu::kMaxLayers;
+  field.texels.assign(std::size_t(field.sliceCount) * field.size * field.size * 4, 0);
+  // Slice 1: a ragged patch of coverage around texel (100, 60), and one lone texel.
+  std::uint32_t state = 12345;
+  auto next = [&] { return state = state * 1664525u + 1013904223u; };
+  for (std::uint32_t j = 40; j < 80; ++j)
+    for (std::uint32_t i = 90; i < 120; ++i)
+      if (next() % 3 == 0) field.texels[((std::size_t(1) * field.size + j) * field.size + i) * 4] = std::uint8_t(next() % 256);
+  field.texels[((std::size_t(1) * field.size + 200) * field.size + 17) * 4] = 255;
+  const std::vector<float> mip = render::buildCoverageMip(field);
+  ASSERT_EQ(mip.size(), std::size_t(gpu::kMaxLayers) * render::kCoverageMipCells * render::kCoverageMipCells);
+  std::size_t zeroCells = 0;
+  for (std::size_t c = std::size_t(render::kCoverageMipCells) * render::kCoverageMipCells;
+       c < 2 * std::size_t(render::kCoverageMipCells) * render::kCoverageMipCells; ++c)
+    zeroCells += mip[c] == 0.0f;
+  EXPECT_GT(zeroCells, 900u) << "of 1024 cells, all but those near the patch and the lone texel";
+  for (std::uint32_t slice : {0u, 1u})
+    for (int k = 0; k < 200000; ++k) {
+      const double x = (double(next() % 2000001) / 1e6 - 1.0) * 1.02 * field.halfExtent_m;
+      const double y = (double(next() % 2000001) / 1e6 - 1.0) * 1.02 * field.halfExtent_m;
+      const double coverage = field.sample(slice, x, y).x;
+      ASSERT_GE(render::sampleCoverageMip(mip, field, slice, x, y) + 1e-6, coverage)
+          << "slice " << slice << " at " << x << ", " << y;
+    }
 }
 
 }  // namespace
