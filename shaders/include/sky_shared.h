@@ -85,7 +85,7 @@ struct SkyFrame {
   vec4 groundIrradiance;  // rgb: sky irradiance on horizontal ground (linear units); w: unused
   uvec4 image;          // x: width, y: height, z: tiles per row, w: tile count
   uvec4 dispatch;       // x: tile permutation stride (coprime to the tile count), y: primary steps per
-                        // layer span, z: light steps, w: unused
+                        // layer span, z: light steps, w: clear-air steps (0: the default, kAirSteps)
   SkyLayer layers[kMaxLayers];
   vec4 steps;           // the march in metres (RenderSettings::march): x: step inside cloud (m; 0: even
                         // placement), y: step through clear air (m), z: step growth per metre, w: unused

@@ -57,10 +57,11 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     else if (key == "cloud") m.cloudStep_m = v;
     else if (key == "empty") m.emptyStep_m = v;
     else if (key == "growth") m.stepGrowth = v;
+    else if (key == "air") m.airSteps = std::uint32_t(v);
     else if (key == "scale" && v > 0 && v <= 1) c.renderScale = v;
     else
       return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': unknown key '" + key +
-                                                  "' (base, primary, light, exit, stride, cloud, empty, growth, scale)");
+                                                  "' (base, primary, light, exit, stride, cloud, empty, growth, air, scale)");
   }
   return c;
 }

@@ -79,6 +79,7 @@ class CpuCore {
     f.air.cTop = setup_.cAtmosphereTop_m2;
     f.air.sunDir = setup_.sunDir;
     f.air.sunIrradiance = setup_.sunIrradiance;
+    f.air.airSteps = int(setup_.march.airSteps);
     f.groundIrradiance = setup_.groundIrradiance;
     f.march = MarchParams{int(setup_.march.primarySteps), int(setup_.march.lightSteps), setup_.march.minTransmittance,
                           double(setup_.march.emptyStride), setup_.march.cloudStep_m, setup_.march.emptyStep_m,

@@ -94,6 +94,9 @@ Result<void> validateSettings(const RenderSettings& s) {
   if (m.cloudStep_m > 0 && !(m.emptyStep_m >= m.cloudStep_m && m.emptyStep_m <= 20000))
     return fail(ErrorCode::InvalidArgument, "render settings: march.emptyStep_m " + num(m.emptyStep_m) +
                                                 " outside [cloudStep_m = " + num(m.cloudStep_m) + ", 20000]");
+  if (m.airSteps > 64)
+    return fail(ErrorCode::InvalidArgument,
+                "render settings: march.airSteps " + std::to_string(m.airSteps) + " outside [0, 64]");
   if (!(m.stepGrowth >= 0 && m.stepGrowth <= 1))
     return fail(ErrorCode::InvalidArgument,
                 "render settings: march.stepGrowth " + num(m.stepGrowth) + " outside [0, 1]");
@@ -296,7 +299,7 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
     while (std::gcd(stride, n) != 1) ++stride;
   }
   f.image = gpu::uvec4(s.width, s.height, tilesX, n);
-  f.dispatch = gpu::uvec4(stride, s.march.primarySteps, s.march.lightSteps, 0);
+  f.dispatch = gpu::uvec4(stride, s.march.primarySteps, s.march.lightSteps, s.march.airSteps);
   f.steps = gpu::vec4(float(s.march.cloudStep_m), float(s.march.emptyStep_m), float(s.march.stepGrowth), 0.0f);
 
   for (std::size_t i = 0; i < s.layers.size(); ++i) {

@@ -73,7 +73,7 @@ TEST(Presets, NamesAndUnknownNameError) {
   for (std::size_t i = 0; i < all.size(); ++i) EXPECT_EQ(all[i].name, names[i]);
   auto medium = render::findPreset("medium");
   ASSERT_TRUE(medium);
-  EXPECT_EQ(medium->march.primarySteps, 32u);
+  EXPECT_EQ(medium->march.cloudStep_m, 60.0);
   EXPECT_EQ(medium->march.lightSteps, 3u);
   auto bad = render::findPreset("ultra");
   ASSERT_FALSE(bad);
@@ -96,11 +96,22 @@ TEST(Presets, HighIsTheDefaultAndReferenceTheMostExpensive) {
   EXPECT_EQ(all[0].march.minTransmittance, 0.0) << "reference: no early exit";
   EXPECT_EQ(all[0].march.emptyStride, 1u) << "reference: every sample";
   EXPECT_GE(all[0].march.lightSteps, 6u);
+  EXPECT_EQ(all[0].march.cloudStep_m, 0.0) << "reference: evenly placed samples";
+  EXPECT_EQ(all[0].march.airSteps, 0u) << "reference: the default air march";
+  // Cheaper presets: never more light steps, an earlier exit; evenly placed
+  // ones fewer samples, those in metres (primarySteps a cap) longer steps.
   for (std::size_t i = 1; i < all.size(); ++i) {
-    EXPECT_LT(all[i].march.primarySteps, all[i - 1].march.primarySteps) << all[i].name;
-    EXPECT_LE(all[i].march.lightSteps, all[i - 1].march.lightSteps) << all[i].name;
-    EXPECT_GE(all[i].march.minTransmittance, all[i - 1].march.minTransmittance) << all[i].name;
-    EXPECT_GE(all[i].march.emptyStride, all[i - 1].march.emptyStride) << all[i].name;
+    const render::MarchSettings &m = all[i].march, &before = all[i - 1].march;
+    EXPECT_LE(m.lightSteps, before.lightSteps) << all[i].name;
+    EXPECT_GE(m.minTransmittance, before.minTransmittance) << all[i].name;
+    if (m.cloudStep_m == 0) {
+      EXPECT_LT(m.primarySteps, before.primarySteps) << all[i].name;
+    }
+    if (before.cloudStep_m > 0) {
+      EXPECT_GT(m.cloudStep_m, before.cloudStep_m) << all[i].name;
+      EXPECT_GE(m.emptyStep_m, before.emptyStep_m) << all[i].name;
+      EXPECT_GE(m.stepGrowth, before.stepGrowth) << all[i].name;
+    }
   }
 }
 

@@ -45,7 +45,7 @@ Result<std::vector<Configuration>> selectConfigurations(const std::string& names
 
 // A configuration from a spec NAME:key=value,... (keys: base = a preset
 // whose march it starts from, else high's; primary, light, exit, stride,
-// cloud, empty, growth = the MarchSettings fields; scale = render scale).
+// cloud, empty, growth, air = the MarchSettings fields; scale = render scale).
 // --configs takes such specs next to names; a list with a spec in it is
 // separated by ';' (a spec has commas). Errors: InvalidArgument naming the bad part.
 Result<Configuration> customConfiguration(const std::string& spec);

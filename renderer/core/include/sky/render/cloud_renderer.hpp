@@ -39,6 +39,9 @@ struct MarchSettings {
   double cloudStep_m = 0;  // [0, 10000]
   double emptyStep_m = 0;  // [cloudStep_m, 20000] when cloudStep_m > 0
   double stepGrowth = 0;   // [0, 1]
+  // Steps of the clear-air march along each view ray (aerial perspective and
+  // the sky; atmosphere_core.glsl); 0: its default, 16. [0, 64].
+  std::uint32_t airSteps = 0;
 };
 
 struct RenderSettings {
