@@ -25,6 +25,7 @@ layout(set = 0, binding = kBindingDetail) uniform sampler3D detailTex;
 layout(set = 0, binding = kBindingTransmittance) uniform sampler2D transmittanceTex;
 layout(set = 0, binding = kBindingMultipleScattering) uniform sampler2D multipleScatteringTex;
 layout(std430, set = 0, binding = kBindingDepth) writeonly buffer DepthBlock { float depths[]; };
+layout(std430, set = 0, binding = kBindingCoverageMip) readonly buffer CoverageMipBlock { float coverageMip[]; };
 
 #define real float
 #define real2 vec2
@@ -64,6 +65,29 @@ vec3 sampleWeather(LayerSampling s, vec3 p) {
   if (w > 0.0)
     v = mix(v, textureLod(weatherTex, vec3(plane * gRings.x + 0.5, s.coverageShift.z + float(kMaxLayers)), 0.0).xyz, w);
   return v;
+}
+
+// The max-coverage mip of a camera-local point: the weather lookup's plane
+// coordinates and ring weight, then each ring's cell it reads (nearest; 0
+// outside a ring), the larger of the two across the blend band
+// (sampleCoverageMip on the CPU).
+float mipCell(uint ring, uint slice, vec2 uv) {
+  if (any(lessThan(uv, vec2(0.0))) || any(greaterThanEqual(uv, vec2(1.0)))) return 0.0;
+  uvec2 cell = uvec2(uv * float(kCoverageMipSize));
+  return coverageMip[((ring * kMaxLayers + slice) * kCoverageMipSize + cell.y) * kCoverageMipSize + cell.x];
+}
+
+float sampleMaxCoverage(LayerSampling s, vec3 p) {
+  vec3 q = gCamToAnchor * p + gCamInAnchor.xyz;
+  if (q.z <= 0.0) return 0.0;
+  vec2 plane = q.xy * (gCamInAnchor.w / q.z) - s.coverageShift.xy;
+  float e = 2.0 * max(abs(plane.x), abs(plane.y)) * gMapScale;
+  float w = clamp((e - gRings.y) / (gRings.z - gRings.y), 0.0, 1.0);
+  uint slice = uint(s.coverageShift.z);
+  float most = 0.0;
+  if (w < 1.0) most = mipCell(0u, slice, plane * gMapScale + 0.5);
+  if (w > 0.0) most = max(most, mipCell(1u, slice, plane * gRings.x + 0.5));
+  return most;
 }
 
 // Earth-fixed noise coordinates: rotate to ECEF axes, scale by the period and
@@ -118,7 +142,7 @@ CoreLayer layerAt(int li) {
                                   vec3(l.coverageShift.xy, l.shape.y), l.coverageShift.w);
   return CoreLayer(l.heights.x, l.heights.y, l.heights.z, l.heights.w, l.shape.x, l.shape.z, l.shape.w > 0.5,
                    unpackType(l.primary), unpackType(l.secondary), l.ambient.rgb, l.sunDiffuse.rgb,
-                   l.sunDiffuse.w, s);
+                   l.sunDiffuse.w, s, l.ambient.w > 0.5);
 }
 
 void main() {
@@ -138,9 +162,10 @@ void main() {
 
   CoreFrame f;
   f.air = AirFrame(frame.earth.x, frame.earth.y, frame.earth.z, frame.earth.w, frame.sunDir.xyz,
-                   frame.sunIrradiance.rgb);
+                   frame.sunIrradiance.rgb, int(frame.dispatch.w));
   f.groundIrradiance = frame.groundIrradiance.rgb;
-  f.march = MarchParams(int(frame.dispatch.y), int(frame.dispatch.z), frame.weatherMap.z, frame.weatherMap.w);
+  f.march = MarchParams(int(frame.dispatch.y), int(frame.dispatch.z), frame.weatherMap.z, frame.weatherMap.w,
+                        frame.steps.x, frame.steps.y, frame.steps.z);
   f.layerCount = int(frame.weatherMap.y);
   vec3 dir = cameraRay(frame.camForward.xyz, frame.camRight.xyz, frame.camDown.xyz, frame.camRight.w,
                        frame.camDown.w, float(px.x), float(px.y), float(frame.image.x), float(frame.image.y));

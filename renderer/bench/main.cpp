@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
 
   app.add_option("--suite", suite, "scene suite file (TOML)")->capture_default_str();
   app.add_option("--scenes", scenes, "comma-separated scene names (default: every scene of the suite)");
-  app.add_option("--configs", configs, "comma-separated configurations, or all; reference is always run")
+  app.add_option("--configs", configs, "comma-separated configurations, or all; reference is always run; NAME:key=value,... adds a custom one (then separate the list with ;)")
       ->capture_default_str();
   app.add_option("--resolution", resolutions, "output size WxH; repeat for several (default 320x180)");
   app.add_option("--width", width, "output width (with --height: one resolution; side-by-side default 640)");

@@ -78,6 +78,7 @@ struct AirFrame {
   real cTop;          // (h - H) (2r - (h - H)) for the atmosphere top at height H, m^2
   real3 sunDir;       // unit, local frame
   real3 sunIrradiance;  // at the top of the atmosphere, linear units
+  int airSteps;         // steps of marchAir (MarchSettings::airSteps); 0: kAirSteps
 };
 
 // Cumulative single scattering and transmittance of the air from the camera
@@ -272,9 +273,10 @@ AirPath marchAir(AirFrame a, real3 dir, real tEnd, real q[kAirQueries], int coun
   int next = 0;
   // Queries before the air starts see nothing.
   while (next < count && q[next] <= tA) ++next;
-  for (int i = 0; i < kAirSteps; ++i) {
-    real u0 = real(i) / real(kAirSteps);
-    real u1 = real(i + 1) / real(kAirSteps);
+  int steps = a.airSteps > 0 ? a.airSteps : kAirSteps;
+  for (int i = 0; i < steps; ++i) {
+    real u0 = real(i) / real(steps);
+    real u1 = real(i + 1) / real(steps);
     real s0 = tA + (tB - tA) * u0 * u0;
     real s1 = tA + (tB - tA) * u1 * u1;
     real tm = 0.5 * (s0 + s1);

@@ -13,6 +13,8 @@
 //   real2 sampleCloudMap(LayerSampling s, real3 pLocal)  // (coverage modulation, peak height) in [0, 1]
 //   real2 sampleShape(LayerSampling s, real3 pLocal)     // (billowy, fibrous) shape noise in [0, 1]
 //   real  sampleDetail(LayerSampling s, real3 pLocal)    // Worley detail noise in [0, 1]
+//   real  sampleMaxCoverage(LayerSampling s, real3 pLocal) // the weather map's max-coverage mip cell:
+//                                                          // >= any coverage sampleWeather gives in it
 // pLocal is camera-relative, local frame: x east, y north, z up (m).
 
 #include "core_common.glsl"
@@ -59,6 +61,11 @@ SKY_CORE_CONST real kMaxViewDistance_m = 600000.0;
 SKY_CORE_CONST real kMinTransmittance = 0.01;
 // Samples skipped per empty primary sample: 1 marches every sample.
 SKY_CORE_CONST real kEmptyStride = 1.0;
+// Step lengths of the march in metres (MarchParams): 0, the default, places
+// the samples evenly instead.
+SKY_CORE_CONST real kCloudStep_m = 0.0;
+SKY_CORE_CONST real kEmptyStep_m = 0.0;
+SKY_CORE_CONST real kStepGrowth = 0.0;
 // Diffuse light inside a layer: the sky's light and the sunlight scattered
 // out of the direct beam above a point reach it as diffuse light, transmitted
 // through the optical depth tau above as by a conservatively scattering slab
@@ -97,6 +104,7 @@ struct CoreLayer {
   real3 sunDiffuseTop; // sunlight at the layer top as a diffuse radiance, E T mu / pi
   real sunCosine;      // mu of the sun at the layer top (>= 0)
   LayerSampling sampling;
+  bool absent;         // no coverage anywhere on the weather map: not marched, casts no shadow
 };
 
 // The layers are read through this hook, not carried in CoreFrame: a frame
@@ -108,14 +116,28 @@ real3 sampleWeather(LayerSampling s, real3 pLocal);
 real2 sampleCloudMap(LayerSampling s, real3 pLocal);
 real2 sampleShape(LayerSampling s, real3 pLocal);
 real sampleDetail(LayerSampling s, real3 pLocal);
+real sampleMaxCoverage(LayerSampling s, real3 pLocal);
 
-// The march's cost knobs (defaults above; RenderSettings::march).
+// The march's cost knobs (defaults above; RenderSettings::march). Two ways
+// to place the samples of a layer span: evenly (cloudStep 0: primarySteps
+// samples over the span, the empty stride skipping through clear air), or
+// in metres (cloudStep > 0): long steps of emptyStep through clear air
+// judged by the cheap density (no detail noise, no light march), short
+// steps of cloudStep inside cloud, both growing by stepGrowth metres per
+// metre of distance from the camera, at most primarySteps samples a span.
 struct MarchParams {
-  int primarySteps;      // samples per layer span, evenly spaced, >= 1
+  int primarySteps;      // even: samples per layer span; metres: most samples a span; >= 1
   int lightSteps;        // samples of the secondary march towards the sun, >= 1
   real minTransmittance; // stop once the view ray keeps less; 0: never
-  real emptyStride;      // samples advanced after one that met no cloud, >= 1
+  real emptyStride;      // even: samples advanced after one that met no cloud, >= 1
+  real cloudStep;        // m, step inside cloud at the camera; 0: even placement
+  real emptyStep;        // m, step through clear air at the camera, >= cloudStep
+  real stepGrowth;       // step length added per metre of distance, >= 0
 };
+
+// Short steps that met no cloud before the march in metres returns to long
+// steps: one stray empty sample inside a cloud's ragged edge does not.
+SKY_CORE_CONST int kEmptyRunToLongSteps = 2;
 
 struct CoreFrame {
   AirFrame air;
@@ -266,12 +288,64 @@ real3 diffuseLight(CoreLayer L, CloudType t, real ph, real c, real densityScale)
   return (L.skyTop + L.sunDiffuseTop * scatteredOut) * transmitted;
 }
 
+// The density at p (height fraction ph) of layer L and what the light march
+// there needs; rho 0 where there is no cloud. `cheap`: without the detail
+// noise's erosion (which only removes cloud, so rho > 0 wherever the full
+// density is > 0): the long steps' test for cloud.
+struct CloudSample {
+  real rho;
+  CloudType ct;
+  real coverage;      // after the cloud map and the anvil
+  real peakNoise;     // the cloud map's peak value
+  real densityScale;  // the weather map's density
+  real blend;
+};
+
+CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
+  CloudSample cs;
+  cs.rho = 0.0;
+  cs.ct = L.primary;
+  cs.coverage = 0.0;
+  cs.peakNoise = 0.0;
+  cs.densityScale = 0.0;
+  cs.blend = 0.0;
+  if (ph <= 0.0 || ph >= 1.0) return cs;
+  // Empty-space skipping: a long step in a mip cell without coverage is
+  // clear, known from one read.
+  if (cheap && sampleMaxCoverage(L.sampling, p) <= 0.0) return cs;
+  real3 weather = sampleWeather(L.sampling, p);
+  if (weather.x <= 0.0) return cs;
+  cs.blend = L.blends ? weather.z : 0.0;
+  cs.ct = cs.blend > 0.0 ? mixCloudType(L.primary, L.secondary, cs.blend) : L.primary;
+  real2 map = sampleCloudMap(L.sampling, p);
+  cs.peakNoise = map.y;
+  cs.densityScale = weather.y;
+  cs.coverage = anvilCoverage(cs.ct, ph, weather.x < 1.0 ? mappedCoverage(weather.x, map.x) : 1.0);
+  real sa = shapeProfile(cs.ct, ph, cs.coverage, map.y);
+  if (sa <= 0.0) return cs;
+  real shape = cloudShape(cs.ct, sampleShape(L.sampling, p), cs.coverage, sa);
+  if (shape <= 0.0) return cs;
+  real da = densityProfile(cs.ct, ph) * weather.y;
+  if (da <= 0.0 || cheap) {
+    cs.rho = max(da, 0.0) * shape;
+    return cs;
+  }
+  // Erosion leaves a full shape (1) full: the detail fetch only at the edges.
+  cs.rho = (shape < 1.0 ? erodeShape(cs.ct, shape, sampleDetail(L.sampling, p), cs.coverage, ph) : 1.0) * da;
+  return cs;
+}
+
 // Marches one layer's span front to back; transmittanceBefore (what the
-// layers in front left) only decides the early exit.
+// layers in front left) only decides the early exit. Each sample stands for
+// a segment of the span (evenly: span / primarySteps; in metres: the step
+// there) and sits at the pixel's jitter along it.
 LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real transmittanceBefore) {
   CoreLayer L = layerAt(li);
+  LayerResult res = LayerResult(real3(0.0), 1.0, 0.5 * (s.t0 + s.t1));
+  if (L.absent) return res;
   real steps = real(f.march.primarySteps);
-  real dt = (s.t1 - s.t0) / steps;
+  real evenDt = (s.t1 - s.t0) / steps;
+  bool metres = f.march.cloudStep > 0.0;
   // The phase of each octave depends on the angle to the sun only: once per
   // span for each of the layer's two types.
   real nu = dot(dir, f.air.sunDir);
@@ -290,48 +364,65 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
   real3 sunTopStart = f.air.sunIrradiance * sunTransmittance(topHeight, muStart, groundRadius);
   real3 sunBaseEnd = f.air.sunIrradiance * sunTransmittance(baseHeight, muEnd, groundRadius);
   real3 sunTopEnd = f.air.sunIrradiance * sunTransmittance(topHeight, muEnd, groundRadius);
-  LayerResult res = LayerResult(real3(0.0), 1.0, 0.5 * (s.t0 + s.t1));
+  real spanLength = max(s.t1 - s.t0, 1e-6);
   real depthSum = 0.0;
   real weightSum = 0.0;
-  // fi: the sample's index along the span; a sample that meets no cloud
-  // moves it on by emptyStride (1: every sample), one that does by 1.
-  real stride = 1.0;
-  for (real fi = 0.0; fi < steps; fi += stride) {
+  // Even: fi is the sample's index along the span; a sample that meets no
+  // cloud moves it on by emptyStride (1: every sample), one that does by 1.
+  // Metres: segStart is where the current step begins; `longSteps` while the
+  // march is in clear air.
+  real fi = 0.0;
+  real segStart = s.t0;
+  bool longSteps = metres;
+  int emptyRun = 0;
+  real shortUntil = s.t0;  // the short steps go on at least to where a long step met cloud
+  for (int i = 0; i < f.march.primarySteps; ++i) {
+    if (metres ? segStart >= s.t1 : fi >= steps) break;
     if (transmittanceBefore * res.transmittance < f.march.minTransmittance) break;
-    stride = f.march.emptyStride;
-    real t = s.t0 + (fi + jitter) * dt;
+    real step = longSteps ? f.march.emptyStep : f.march.cloudStep;
+    real len = metres ? min(step + f.march.stepGrowth * segStart, s.t1 - segStart) : evenDt;
+    real t = metres ? segStart + jitter * len : s.t0 + (fi + jitter) * evenDt;
     real3 p = dir * t;
     real h = heightAboveCameraSphere(p, f.air.r);
     real ph = (h + L.hBase) / L.thickness;
-    if (ph <= 0.0 || ph >= 1.0) continue;
-    real3 weather = sampleWeather(L.sampling, p);
-    if (weather.x <= 0.0) continue;
-    real blend = L.blends ? weather.z : 0.0;
-    CloudType ct = blend > 0.0 ? mixCloudType(L.primary, L.secondary, blend) : L.primary;
-    real2 map = sampleCloudMap(L.sampling, p);
-    real c = anvilCoverage(ct, ph, weather.x < 1.0 ? mappedCoverage(weather.x, map.x) : 1.0);
-    real sa = shapeProfile(ct, ph, c, map.y);
-    if (sa <= 0.0) continue;
-    real shape = cloudShape(ct, sampleShape(L.sampling, p), c, sa);
-    if (shape <= 0.0) continue;
-    real da = densityProfile(ct, ph) * weather.y;
-    if (da <= 0.0) continue;
-    // Erosion leaves a full shape (1) full: the detail fetch only at the edges.
-    real rho = (shape < 1.0 ? erodeShape(ct, shape, sampleDetail(L.sampling, p), c, ph) : 1.0) * da;
-    if (rho <= 0.0) continue;
-    stride = 1.0;
-    real u = (fi + jitter) / steps;
+    CloudSample cs = cloudSample(L, p, ph, longSteps);
+    if (longSteps) {
+      // Cloud ahead: march this step again in short steps (it stays at
+      // segStart); clear: the whole long step is.
+      if (cs.rho > 0.0) {
+        longSteps = false;
+        emptyRun = 0;
+        shortUntil = t;
+      } else {
+        segStart += len;
+      }
+      continue;
+    }
+    if (cs.rho <= 0.0) {
+      fi += f.march.emptyStride;
+      segStart += len;
+      ++emptyRun;
+      longSteps = metres && emptyRun >= kEmptyRunToLongSteps && segStart > shortUntil &&
+                  f.march.emptyStep > f.march.cloudStep;
+      continue;
+    }
+    fi += 1.0;
+    segStart += len;
+    emptyRun = 0;
+    CloudType ct = cs.ct;
+    real u = (t - s.t0) / spanLength;
     real tauSun = lightOpticalDepth(f.air.sunDir, mix(muStart, muEnd, u), L.thickness, L.lightDistance, L.sampling, ct,
-                                    p, ph, c, map.y, weather.y, f.march.lightSteps,
-                                    rho > 0.0 ? f.march.lightSteps : 0);
+                                    p, ph, cs.coverage, cs.peakNoise, cs.densityScale, f.march.lightSteps,
+                                    cs.rho > 0.0 ? f.march.lightSteps : 0);
     // Sunlight at p through the clear air above it (reddened at low sun,
     // none in the Earth's shadow), and the sky's light from all around.
     real3 sun = mix(mix(sunBaseStart, sunTopStart, ph), mix(sunBaseEnd, sunTopEnd, ph), u);
-    real3 scattered = sun * octaveSum(mix(phases1, phases2, blend), tauSun) + diffuseLight(L, ct, ph, c, weather.y);
+    real3 scattered = sun * octaveSum(mix(phases1, phases2, cs.blend), tauSun) +
+                      diffuseLight(L, ct, ph, cs.coverage, cs.densityScale);
     // Hillaire 2016 energy-conserving step: integral over the step of
-    // sigma_s L e^{-sigma_t s} = albedo L (1 - e^{-sigma_t dt}); its limit as
-    // sigma_t -> 0 is sigma_s L dt (scatterFraction).
-    real x = ct.extinction_perm * rho * dt;
+    // sigma_s L e^{-sigma_t s} = albedo L (1 - e^{-sigma_t len}); its limit
+    // as sigma_t -> 0 is sigma_s L len (scatterFraction).
+    real x = ct.extinction_perm * cs.rho * len;
     real absorbed = x * scatterFraction(x);  // 1 - e^{-x}, exact near 0
     res.inscatter += scattered * (kAlbedo * absorbed) * res.transmittance;
     real weight = res.transmittance * absorbed;
@@ -357,6 +448,7 @@ real2 groundShadow(CoreFrame f, real3 p, real muSun) {
   real groundRadius = f.air.r - f.air.h;
   for (int k = 0; k < f.layerCount; ++k) {
     CoreLayer L = layerAt(k);
+    if (L.absent) continue;
     // Height of the layer's middle above the ground, and the distance to it
     // along the sun from the ground (stable sphere root).
     real hMid = max(f.air.h - 0.5 * (L.hBase + L.hTop), 0.0);

@@ -28,6 +28,10 @@ SKY_SHARED_CONST kBindingDetail = 4u;         // sampler3D, tileable Worley deta
 SKY_SHARED_CONST kBindingTransmittance = 5u;  // sampler2D, atmosphere transmittance table (RGBA16F, clamp)
 SKY_SHARED_CONST kBindingMultipleScattering = 6u;  // sampler2D, atmosphere multiple scattering (RGBA16F, clamp)
 SKY_SHARED_CONST kBindingDepth = 7u;               // storage buffer of float cloud depth (m, 0 = no cloud) per pixel
+SKY_SHARED_CONST kBindingCoverageMip = 10u;        // read-only storage buffer of float: the weather map's max-coverage
+                                                   // mip, rings x kMaxLayers x kCoverageMipSize^2 (ring, slice, row north, column east)
+// Cells per edge of the max-coverage mip (renderer/core/src/coverage_mip.hpp).
+SKY_SHARED_CONST kCoverageMipSize = 32u;
 
 // Workgroup edge of the cloud pass, pixels (8x8 = 64 invocations = 8 lavapipe
 // subgroups of 8 lanes).
@@ -57,7 +61,8 @@ struct SkyLayer {
   vec4 cloudMapOrigin; // the same for the cloud map (the shape texture at a larger period)
   vec4 coverageShift;  // xy: coverage drift east/north in the weather map plane (m), z: unused,
                        // w: the shape noise's ECEF z scale (1, or < 1 for streaks)
-  vec4 ambient;        // rgb: mean sky radiance at the layer top (linear units); w: unused
+  vec4 ambient;        // rgb: mean sky radiance at the layer top (linear units); w: 1 when the layer
+                       // has no coverage anywhere on the weather map (not marched), else 0
   vec4 sunDiffuse;     // rgb: sunlight at the layer top as diffuse radiance, E T mu / pi; w: mu of the sun
   SkyCloudType primary;    // the layer's own type
   SkyCloudType secondary;  // the type its tiles blend towards
@@ -80,10 +85,12 @@ struct SkyFrame {
   vec4 groundIrradiance;  // rgb: sky irradiance on horizontal ground (linear units); w: unused
   uvec4 image;          // x: width, y: height, z: tiles per row, w: tile count
   uvec4 dispatch;       // x: tile permutation stride (coprime to the tile count), y: primary steps per
-                        // layer span, z: light steps, w: unused
+                        // layer span, z: light steps, w: clear-air steps (0: the default, kAirSteps)
   SkyLayer layers[kMaxLayers];
   vec4 weatherRings;    // x: 1 / (2 half extent) of the coarse ring (1/m); y, z: the blend band's start and
                         // end in fractions of the fine ring's half extent (max norm); w: unused
+  vec4 steps;           // the march in metres (RenderSettings::march): x: step inside cloud (m; 0: even
+                        // placement), y: step through clear air (m), z: step growth per metre, w: unused
 };
 
 #ifdef __cplusplus
@@ -103,7 +110,8 @@ static_assert(offsetof(SkyFrame, dispatch) == 256);
 static_assert(offsetof(SkyFrame, layers) == 272);
 static_assert(offsetof(SkyLayer, cloudMapOrigin) == 64);
 static_assert(offsetof(SkyFrame, weatherRings) == 272 + 256 * kMaxLayers);
-static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 16);
+static_assert(offsetof(SkyFrame, steps) == 272 + 256 * kMaxLayers + 16);
+static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 32);
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

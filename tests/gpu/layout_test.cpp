@@ -61,6 +61,7 @@ TEST(SharedLayout, GlslangOffsetsMatchCpp) {
       {"frame.layers.primary.d", layers + offsetof(SkyLayer, primary) + offsetof(SkyCloudType, d)},
       {"frame.layers.secondary.a", layers + offsetof(SkyLayer, secondary) + offsetof(SkyCloudType, a)},
       {"frame.layers.secondary.d", layers + offsetof(SkyLayer, secondary) + offsetof(SkyCloudType, d)},
+      {"frame.steps", offsetof(SkyFrame, steps)},
   };
   // Lines look like "frame.layers.shape: offset 288, type 8b52, ..., topLevelArrayStride 80".
   std::map<std::string, std::size_t> seen;

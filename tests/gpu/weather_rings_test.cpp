@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -14,6 +15,7 @@
 #include "renderer_fixture.hpp"
 #include "scenes.hpp"
 #include "sky/render/cpu_reference.hpp"
+#include "sky/render/presets.hpp"
 
 namespace sky::test {
 namespace {
@@ -25,11 +27,12 @@ constexpr double kRelativeRmseTolerance = 0.05;
 constexpr double kRelativeMeanTolerance = 0.005;
 constexpr double kAlphaRmseTolerance = 0.04;
 
-TEST(WeatherRings, FarCloudFromCruiseAltitude) {
-  // 320x180 at 60 degrees: 1/3 degree per pixel; the patch is ~13 degrees
-  // wide, and seen edge-on, a degree or so tall.
-  constexpr std::uint32_t kW = 320, kH = 180;
-  SKY_RENDERER(r, kW, kH);
+// 320x180 at 60 degrees: 1/3 degree per pixel; the patch is ~13 degrees
+// wide, and seen edge-on, a degree or so tall.
+constexpr std::uint32_t kW = 320, kH = 180;
+
+void expectFarCloud(render::CloudRenderer& r, const std::string& preset) {
+  SCOPED_TRACE(preset);
   auto reference = render::CpuReference::create(r.settings());
   ASSERT_TRUE(reference) << describe(reference.error());
   weather::CloudLayer cu = layer(1, 1000.0, 1500.0, 0.0, 1.0);
@@ -46,7 +49,7 @@ TEST(WeatherRings, FarCloudFromCruiseAltitude) {
   in.sunElevation_deg = 45.0;
   auto gpu = r.render(in);
   ASSERT_TRUE(gpu) << describe(gpu.error());
-  savePng(*gpu, "gpu_far_cloud");
+  savePng(*gpu, "gpu_far_cloud_" + preset);
   EXPECT_EQ(render::computeStats(*gpu).nonFinite, 0u);
   // The CPU reference on a window around the patch (rows 80-103, columns
   // 120-199) and the GPU on the same pixels.
@@ -80,9 +83,9 @@ TEST(WeatherRings, FarCloudFromCruiseAltitude) {
   const double alphaRmse = std::sqrt(alpha2 / n), rmse = std::sqrt(sum2 / (3 * n));
   meanCompressed /= 3 * n;
   const double meanError = std::abs(meanGpu - meanCpu) / meanCpu;
-  std::printf("[ rings    ] far cloud: min transmittance gpu %.3f cpu %.3f, %zu pixels below 0.9; "
+  std::printf("[ rings    ] %s far cloud: min transmittance gpu %.3f cpu %.3f, %zu pixels below 0.9; "
               "mean %.4f (gpu %+.3f %%) displayed rmse %.2f %% alpha rmse %.4f\n",
-              minGpu, minCpu, cloudyGpu, meanCpu / n, 100 * (meanGpu - meanCpu) / meanCpu,
+              preset.c_str(), minGpu, minCpu, cloudyGpu, meanCpu / n, 100 * (meanGpu - meanCpu) / meanCpu,
               100 * rmse / meanCompressed, alphaRmse);
   EXPECT_EQ(nonFinite, 0u);
   EXPECT_LT(minCpu, 0.2f) << "the CPU reference must see the patch through the coarse ring";
@@ -91,6 +94,21 @@ TEST(WeatherRings, FarCloudFromCruiseAltitude) {
   EXPECT_LT(meanError, kRelativeMeanTolerance);
   EXPECT_LT(rmse, kRelativeRmseTolerance * meanCompressed);
   EXPECT_LT(alphaRmse, kAlphaRmseTolerance);
+}
+
+// The default march, and the march in metres (realtime), whose long steps
+// skip on the max-coverage mip and whose layers are left out when the map
+// has no coverage for them: both must take the coarse ring into account.
+TEST(WeatherRings, FarCloudFromCruiseAltitude) {
+  SKY_RENDERER(r, kW, kH);
+  expectFarCloud(r, "high");
+  const auto realtime = render::findPreset("realtime");
+  ASSERT_TRUE(realtime) << describe(realtime.error());
+  render::RenderSettings s = r.settings();
+  s.march = realtime->march;
+  auto fast = render::CloudRenderer::create(s);
+  ASSERT_TRUE(fast) << describe(fast.error());
+  expectFarCloud(**fast, "realtime");
 }
 
 }  // namespace

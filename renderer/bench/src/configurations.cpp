@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 
 #include "sky/render/presets.hpp"
@@ -23,14 +24,64 @@ std::vector<Configuration> builtInConfigurations() {
   return all;
 }
 
+Result<Configuration> customConfiguration(const std::string& spec) {
+  const auto colon = spec.find(':');
+  if (colon == std::string::npos || colon == 0)
+    return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': want NAME:key=value,...");
+  Configuration c;
+  c.name = spec.substr(0, colon);
+  if (!std::all_of(c.name.begin(), c.name.end(), [](char ch) {
+        return (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '-';
+      }) || c.name == kReferenceName)
+    return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': name must be [a-z0-9-], not reference");
+  c.description = "custom: " + spec.substr(colon + 1);
+  std::stringstream in(spec.substr(colon + 1));
+  for (std::string item; std::getline(in, item, ',');) {
+    const auto eq = item.find('=');
+    const std::string key = item.substr(0, eq), value = eq == std::string::npos ? "" : item.substr(eq + 1);
+    char* end = nullptr;
+    const double v = std::strtod(value.c_str(), &end);
+    const bool number = !value.empty() && end != value.c_str() && *end == '\0' && std::isfinite(v) && v >= 0;
+    render::MarchSettings& m = c.settings.march;
+    if (key == "base") {
+      auto preset = render::findPreset(value);
+      if (!preset) return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': " + preset.error().detail);
+      m = preset->march;
+      continue;
+    }
+    if (!number) return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': '" + item + "' is not key=number");
+    if (key == "primary") m.primarySteps = std::uint32_t(v);
+    else if (key == "light") m.lightSteps = std::uint32_t(v);
+    else if (key == "exit") m.minTransmittance = v;
+    else if (key == "stride") m.emptyStride = std::uint32_t(v);
+    else if (key == "cloud") m.cloudStep_m = v;
+    else if (key == "empty") m.emptyStep_m = v;
+    else if (key == "growth") m.stepGrowth = v;
+    else if (key == "air") m.airSteps = std::uint32_t(v);
+    else if (key == "scale" && v > 0 && v <= 1) c.renderScale = v;
+    else
+      return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': unknown key '" + key +
+                                                  "' (base, primary, light, exit, stride, cloud, empty, growth, air, scale)");
+  }
+  return c;
+}
+
 Result<std::vector<Configuration>> selectConfigurations(const std::string& names) {
   const std::vector<Configuration> all = builtInConfigurations();
   if (names.empty() || names == "all") return all;
   std::vector<Configuration> chosen{all.front()};
   std::stringstream in(names);
   std::string name;
-  while (std::getline(in, name, ',')) {
+  // With a custom spec (it has ':' and may have commas) the list separator is ';'.
+  const char separator = names.find(':') != std::string::npos ? ';' : ',';
+  while (std::getline(in, name, separator)) {
     if (name.empty() || name == kReferenceName) continue;
+    if (name.find(':') != std::string::npos) {
+      auto custom = customConfiguration(name);
+      if (!custom) return tl::unexpected(custom.error());
+      chosen.push_back(*custom);
+      continue;
+    }
     auto it = std::find_if(all.begin(), all.end(), [&](const Configuration& c) { return c.name == name; });
     if (it == all.end()) {
       std::string known;

@@ -79,6 +79,11 @@ void store(AtmosphereTable& table, std::uint32_t i, std::uint32_t j, const glm::
 
 }  // namespace
 
+const AtmosphereTables& sharedAtmosphereTables() {
+  static const AtmosphereTables tables = buildAtmosphereTables();
+  return tables;
+}
+
 AtmosphereTables buildAtmosphereTables() {
   using C = AirCore;
   AtmosphereTables tables;

@@ -44,6 +44,11 @@ double atmosphereHeight_m();
 // transmittance, then 1024 x 256 directions of 20 steps for the multiple scattering).
 AtmosphereTables buildAtmosphereTables();
 
+// The tables, built once per process on first use (thread-safe): they depend
+// on nothing, and building them takes ~0.5 s of a renderer's start (Release),
+// which a bench creating a renderer per case paid every time.
+const AtmosphereTables& sharedAtmosphereTables();
+
 // Sunlight reaching height h_m (sun at cosine muSun from the vertical) per
 // unit irradiance at the top: the table's transmittance times the visible
 // part of the sun's disc (atmosphere_core.glsl's sunTransmittance).

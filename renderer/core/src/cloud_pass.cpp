@@ -5,7 +5,9 @@
 #include <cstring>
 #include <span>
 
+#include "coverage_mip.hpp"
 #include "frame_setup.hpp"
+#include "sky/core/assert.hpp"
 
 namespace sky::render {
 
@@ -39,6 +41,7 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
       .binding(gpu::kBindingTransmittance, vk::DescriptorType::eCombinedImageSampler)
       .binding(gpu::kBindingMultipleScattering, vk::DescriptorType::eCombinedImageSampler)
       .binding(gpu::kBindingDepth, vk::DescriptorType::eStorageBuffer)
+      .binding(gpu::kBindingCoverageMip, vk::DescriptorType::eStorageBuffer)
       .shader("clouds.comp.spv");
   auto pipeline = builder.build(ctx);
   if (!pipeline) return tl::unexpected(pipeline.error());
@@ -76,9 +79,12 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
                                   vk::BufferUsageFlagBits::eStorageBuffer, "sky.cloudOutput");
   pass.depth_ = createHostBuffer(ctx, vk::DeviceSize(width) * height * sizeof(float),
                                  vk::BufferUsageFlagBits::eStorageBuffer, "sky.cloudDepth");
+  pass.coverageMip_ = createHostBuffer(ctx, vk::DeviceSize(kCoverageMipFloats * sizeof(float)),
+                                       vk::BufferUsageFlagBits::eStorageBuffer, "sky.coverageMip");
+  std::memset(pass.coverageMip_.mapped, 0, pass.coverageMip_.size);
 
   const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eCombinedImageSampler, 5),
-                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 3)};
+                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 4)};
   pass.descriptorPool_ = vk::raii::DescriptorPool(
       device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSizes));
   ctx.name(pass.descriptorPool_, "sky.clouds.descriptorPool");
@@ -90,6 +96,7 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
   const vk::DescriptorBufferInfo uniformInfo(*pass.uniforms_.buffer, 0, pass.uniforms_.size);
   const vk::DescriptorBufferInfo outputInfo(*pass.output_.buffer, 0, pass.output_.size);
   const vk::DescriptorBufferInfo depthInfo(*pass.depth_.buffer, 0, pass.depth_.size);
+  const vk::DescriptorBufferInfo mipInfo(*pass.coverageMip_.buffer, 0, pass.coverageMip_.size);
   const vk::DescriptorImageInfo shapeInfo(*pass.noiseSampler_, *pass.shape_.view, vk::ImageLayout::eShaderReadOnlyOptimal);
   const vk::DescriptorImageInfo detailInfo(*pass.noiseSampler_, *pass.detail_.view, vk::ImageLayout::eShaderReadOnlyOptimal);
   const vk::DescriptorImageInfo tableInfo(*pass.tableSampler_, *pass.transmittance_.view,
@@ -107,7 +114,8 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
       vk::WriteDescriptorSet(set, gpu::kBindingMultipleScattering, 0, vk::DescriptorType::eCombinedImageSampler, msInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingWeather, 0, vk::DescriptorType::eCombinedImageSampler, weatherInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingOutput, 0, vk::DescriptorType::eStorageBuffer, {}, outputInfo),
-      vk::WriteDescriptorSet(set, gpu::kBindingDepth, 0, vk::DescriptorType::eStorageBuffer, {}, depthInfo)};
+      vk::WriteDescriptorSet(set, gpu::kBindingDepth, 0, vk::DescriptorType::eStorageBuffer, {}, depthInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingCoverageMip, 0, vk::DescriptorType::eStorageBuffer, {}, mipInfo)};
   device.updateDescriptorSets(writes, {});
 
   pass.timer_ = GpuTimer(ctx, 1, "sky.clouds.timer");
@@ -116,6 +124,11 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
   pass.fence_ = vk::raii::Fence(device, vk::FenceCreateInfo());
   ctx.name(pass.fence_, "sky.clouds.fence");
   return pass;
+}
+
+void CloudPass::setCoverageMip(const std::vector<float>& mip) {
+  SKY_ASSERT(mip.size() * sizeof(float) == coverageMip_.size);
+  std::memcpy(coverageMip_.mapped, mip.data(), coverageMip_.size);
 }
 
 Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "atmosphere_tables.hpp"
 #include "compute_pipeline.hpp"
@@ -30,6 +31,9 @@ class CloudPass {
 
   // Dispatches one frame and reads it back. Errors: Timeout, Device.
   Result<Image> run(const GpuContext& ctx, const gpu::SkyFrame& frame);
+  // Replaces the max-coverage mip the march reads (coverage_mip.hpp; size
+  // kMaxLayers x kCoverageMipSize^2). Call between runs.
+  void setCoverageMip(const std::vector<float>& mip);
   // GPU time of the last run's dispatch ("clouds").
   std::vector<PassTime> lastTimes() const { return timer_.results(); }
 
@@ -50,6 +54,7 @@ class CloudPass {
   GpuBuffer uniforms_;  // the frame block (a storage buffer, see clouds.comp)
   GpuBuffer output_;
   GpuBuffer depth_;
+  GpuBuffer coverageMip_;  // the weather map's max-coverage mip (host-visible storage buffer)
   vk::raii::DescriptorPool descriptorPool_{nullptr};
   vk::raii::DescriptorSet descriptorSet_{nullptr};
   GpuTimer timer_;

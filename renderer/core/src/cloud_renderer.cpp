@@ -4,6 +4,9 @@
 #include "sky/render/cloud_renderer.hpp"
 
 #include <exception>
+#include <map>
+#include <mutex>
+#include <tuple>
 #include <optional>
 
 #include "sky/core/assert.hpp"
@@ -11,6 +14,7 @@
 
 #include "atmosphere_tables.hpp"
 #include "cloud_pass.hpp"
+#include "coverage_mip.hpp"
 #include "frame_setup.hpp"
 #include "gpu_context.hpp"
 #include "noise_volume.hpp"
@@ -31,6 +35,7 @@ struct CloudRenderer::Impl {
   AtmosphereTables atmosphere;  // CPU copy: the frame setup's sky light reads it
   std::vector<PassTime> passTimes;
   std::string noiseReport;
+  std::uint64_t coverageMipUploads = ~std::uint64_t(0);  // weather uploads the pass's coverage mip is of
 };
 
 namespace {
@@ -53,6 +58,20 @@ auto atVulkanEdge(const char* what, F&& body) -> decltype(body()) {
 NoiseVolume cachedNoise(const RenderSettings& settings, const char* kind, std::uint32_t generatorVersion,
                         std::uint32_t size, std::uint32_t fingerprintSize,
                         NoiseVolume (*generate)(std::uint32_t, std::uint32_t), std::string* report) {
+  // Without a disk cache the texture is generated: once per process for each
+  // (kind, version, seed, size), so a process creating many renderers (the
+  // bench: one per case) does not regenerate it (~1 s each in Release).
+  if (settings.noiseCacheDir.empty()) {
+    static std::mutex mutex;
+    static std::map<std::tuple<std::string, std::uint32_t, std::uint32_t, std::uint32_t>, NoiseVolume> generated;
+    const std::lock_guard lock(mutex);
+    const auto key = std::make_tuple(std::string(kind), generatorVersion, settings.noiseSeed, size);
+    auto it = generated.find(key);
+    if (it == generated.end()) it = generated.emplace(key, generate(size, settings.noiseSeed)).first;
+    *report += std::string(report->empty() ? "" : "; ") + kind + " noise " + std::to_string(size) + "^3 seed " +
+               std::to_string(settings.noiseSeed) + ": generated (no cache)";
+    return it->second;
+  }
   const NoiseVolume tiny = generate(fingerprintSize, settings.noiseSeed);
   const std::size_t tinyTexels = std::size_t(fingerprintSize) * fingerprintSize * fingerprintSize;
   SKY_ASSERT(tinyTexels > 0 && tiny.texels.size() % tinyTexels == 0);
@@ -94,7 +113,7 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
                                           kShapeNoiseFingerprintSize, makeShapeNoise, &noiseReport);
     const NoiseVolume detail = cachedNoise(settings, "detail", kDetailNoiseGeneratorVersion, kDetailNoiseSize,
                                            kDetailNoiseFingerprintSize, makeDetailNoise, &noiseReport);
-    AtmosphereTables atmosphere = buildAtmosphereTables();
+    AtmosphereTables atmosphere = sharedAtmosphereTables();
     auto pass = CloudPass::create(**ctx, settings.width, settings.height, shape, detail, atmosphere, *weather);
     if (!pass) return tl::unexpected(pass.error());
     std::optional<Presenter> presenter;
@@ -117,6 +136,10 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
     impl_->passTimes.clear();
     if (auto ok = impl_->weather.update(*impl_->ctx, inputs); !ok) return tl::unexpected(ok.error());
     impl_->passTimes = impl_->weather.lastUploadTimes();
+    if (impl_->weather.uploads() != impl_->coverageMipUploads) {  // a new map: its max-coverage mip
+      impl_->pass.setCoverageMip(buildCoverageMip(impl_->weather.field()));
+      impl_->coverageMipUploads = impl_->weather.uploads();
+    }
     const FrameSetup setup = prepareFrame(impl_->settings, inputs, impl_->weather.field(), impl_->atmosphere);
     auto image = impl_->pass.run(*impl_->ctx, packFrame(setup));
     if (image)

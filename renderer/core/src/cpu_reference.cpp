@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "atmosphere_tables.hpp"
+#include "coverage_mip.hpp"
 #include "frame_setup.hpp"
 #include "noise_volume.hpp"
 #include "sky_shared.h"
@@ -39,7 +40,8 @@ class CpuCore {
 
   CpuCore(const FrameSetup& setup, const NoiseVolume& shape, const NoiseVolume& detail,
           const AtmosphereTables& atmosphere, const WeatherField& weather)
-      : setup_(setup), shape_(shape), detail_(detail), atmosphere_(atmosphere), weather_(weather) {}
+      : setup_(setup), shape_(shape), detail_(detail), atmosphere_(atmosphere), weather_(weather),
+        coverageMip_(buildCoverageMip(weather)) {}
 
   real3 sampleTransmittanceLut(real2 uv) const { return atmosphere_.sampleTransmittance(uv); }
   real3 sampleMultipleScatteringLut(real2 uv) const { return atmosphere_.sampleMultipleScattering(uv); }
@@ -77,9 +79,11 @@ class CpuCore {
     f.air.cTop = setup_.cAtmosphereTop_m2;
     f.air.sunDir = setup_.sunDir;
     f.air.sunIrradiance = setup_.sunIrradiance;
+    f.air.airSteps = int(setup_.march.airSteps);
     f.groundIrradiance = setup_.groundIrradiance;
     f.march = MarchParams{int(setup_.march.primarySteps), int(setup_.march.lightSteps), setup_.march.minTransmittance,
-                          double(setup_.march.emptyStride)};
+                          double(setup_.march.emptyStride), setup_.march.cloudStep_m, setup_.march.emptyStep_m,
+                          setup_.march.stepGrowth};
     f.layerCount = int(setup_.layers.size());
     const CloudType cumulus = coreType(cloudTypeParams(weather::CloudType::Cumulus));
     for (std::size_t i = 0; i < kMaxLayers; ++i) {
@@ -90,14 +94,17 @@ class CpuCore {
                       coreType(l.primary), coreType(l.secondary), l.skyTop, l.sunDiffuseTop, l.sunCosine,
                       LayerSampling{real4(l.shapeOrigin, 1.0 / l.shapePeriod_m), real4(l.detailOrigin, 1.0 / l.detailPeriod_m),
                                     real4(l.cloudMapOrigin, 1.0 / l.cloudMapPeriod_m),
-                                    real3(l.coverageShift_m, double(i)), l.shapeStretchZ}};
+                                    real3(l.coverageShift_m, double(i)), l.shapeStretchZ},
+                      l.absent};
       } else {
         c = CoreLayer{0.0, 0.0, 0.0, 0.0, 1.0, 1.0, false, cumulus, cumulus, real3(0.0), real3(0.0), 0.0,
-                      LayerSampling{real4(0.0), real4(0.0), real4(0.0), real3(0.0, 0.0, double(i)), 1.0}};
+                      LayerSampling{real4(0.0), real4(0.0), real4(0.0), real3(0.0, 0.0, double(i)), 1.0}, true};
       }
     }
     return f;
   }
+
+  std::uint64_t lookups() const { return lookups_; }
 
   PixelResult shade(std::uint32_t px, std::uint32_t py, const CoreFrame& f) {
     const real3 dir = cameraRay(setup_.camForward, setup_.camRight, setup_.camDown, setup_.tanHalfFov,
@@ -107,24 +114,36 @@ class CpuCore {
 
  private:
   CoreLayer layers_[kMaxLayers]{};
+  std::uint64_t lookups_ = 0;  // the cloud model's texture lookups so far
   const FrameSetup& setup_;
   const NoiseVolume& shape_;
   const NoiseVolume& detail_;
   const AtmosphereTables& atmosphere_;
   const WeatherField& weather_;
+  const std::vector<float> coverageMip_;
 };
 
 CpuCore::CoreLayer CpuCore::layerAt(int li) { return layers_[li]; }
 
 // The hooks mirror those of shaders/clouds.comp.
 CpuCore::real3 CpuCore::sampleWeather(LayerSampling s, real3 p) {
+  ++lookups_;
   const real3 q = setup_.camToAnchor * p + setup_.camInAnchor_m;
   if (q.z <= 0.0) return real3(0.0);
   const real2 plane = real2(q.x, q.y) * (setup_.anchorRadius_m / q.z) - real2(s.coverageShift.x, s.coverageShift.y);
   return weather_.sample(std::uint32_t(s.coverageShift.z), plane.x, plane.y);
 }
 
+CpuCore::real CpuCore::sampleMaxCoverage(LayerSampling s, real3 p) {
+  ++lookups_;
+  const real3 q = setup_.camToAnchor * p + setup_.camInAnchor_m;
+  if (q.z <= 0.0) return 0.0;
+  const real2 plane = real2(q.x, q.y) * (setup_.anchorRadius_m / q.z) - real2(s.coverageShift.x, s.coverageShift.y);
+  return sampleCoverageMip(coverageMip_, weather_, std::uint32_t(s.coverageShift.z), plane.x, plane.y);
+}
+
 CpuCore::real2 CpuCore::sampleShape(LayerSampling s, real3 p) {
+  ++lookups_;
   real3 e = setup_.localToEcef * p;
   e.z *= s.shapeStretchZ;
   const real4 v = shape_.sample(real3(s.shapeOrigin) + e * s.shapeOrigin.w);
@@ -132,11 +151,13 @@ CpuCore::real2 CpuCore::sampleShape(LayerSampling s, real3 p) {
 }
 
 CpuCore::real CpuCore::sampleDetail(LayerSampling s, real3 p) {
+  ++lookups_;
   return detail_.sample(real3(s.detailOrigin) + (setup_.localToEcef * p) * s.detailOrigin.w).x;
 }
 
 // The cloud map: the shape texture's smooth and Worley channels at its own period.
 CpuCore::real2 CpuCore::sampleCloudMap(LayerSampling s, real3 p) {
+  ++lookups_;
   const real4 v = shape_.sample(real3(s.cloudMapOrigin) + (setup_.localToEcef * p) * s.cloudMapOrigin.w);
   return real2(v.z, v.w);
 }
@@ -151,7 +172,7 @@ Result<CpuReference> CpuReference::create(const RenderSettings& settings) {
   auto tables = std::make_shared<Tables>();
   tables->shape = makeShapeNoise(kShapeNoiseSize, settings.noiseSeed);
   tables->detail = makeDetailNoise(kDetailNoiseSize, settings.noiseSeed);
-  tables->atmosphere = buildAtmosphereTables();
+  tables->atmosphere = sharedAtmosphereTables();
   return CpuReference(settings, std::move(tables));
 }
 
@@ -175,7 +196,7 @@ Result<std::vector<std::array<float, 4>>> CpuReference::renderPixels(const Frame
   return out;
 }
 
-Result<Image> CpuReference::render(const FrameInputs& inputs) const {
+Result<Image> CpuReference::render(const FrameInputs& inputs, std::uint64_t* densityLookups) const {
   if (auto ok = validateInputs(inputs); !ok) return tl::unexpected(ok.error());
   const WeatherField field = buildWeatherField(inputs.weather, weatherAnchorFor(inputs.camera.position));
   const FrameSetup setup = prepareFrame(settings_, inputs, field, tables_->atmosphere);
@@ -197,6 +218,7 @@ Result<Image> CpuReference::render(const FrameInputs& inputs) const {
       out[3] = float(r.transmittance);
       image.cloudDepth_m[i] = float(r.depth);
     }
+  if (densityLookups != nullptr) *densityLookups = core.lookups();
   return image;
 }
 

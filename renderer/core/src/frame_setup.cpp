@@ -17,6 +17,20 @@ static_assert(kMaxLayers == gpu::kMaxLayers, "cloud_renderer.hpp and sky_shared.
 
 namespace {
 
+// Largest coverage in a slice of the weather map, over all its rings, in
+// [0, 1] (0: no cloud anywhere on it, so the layer is absent from the view).
+double maxCoverage(const WeatherField& field, std::uint32_t slice) {
+  if (slice >= field.sliceCount) return 0.0;
+  const std::size_t texels = std::size_t(field.size) * field.size;
+  std::uint8_t most = 0;
+  for (std::uint32_t ring = 0; ring < kWeatherRings; ++ring) {
+    const std::size_t first = (std::size_t(ring) * field.sliceCount + slice) * texels * 4;
+    if (field.texels.size() < first + texels * 4) break;
+    for (std::size_t i = 0; i < texels && most < 255; ++i) most = std::max(most, field.texels[first + i * 4]);
+  }
+  return most / 255.0;
+}
+
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 // Largest image edge, pixels: keeps buffers and the tile permutation in range.
 constexpr std::uint32_t kMaxImageEdge = 8192;
@@ -76,6 +90,18 @@ Result<void> validateSettings(const RenderSettings& s) {
   if (m.emptyStride < 1 || m.emptyStride > 16)
     return fail(ErrorCode::InvalidArgument,
                 "render settings: march.emptyStride " + std::to_string(m.emptyStride) + " outside [1, 16]");
+  if (!(m.cloudStep_m >= 0 && m.cloudStep_m <= 10000))
+    return fail(ErrorCode::InvalidArgument,
+                "render settings: march.cloudStep_m " + num(m.cloudStep_m) + " outside [0, 10000]");
+  if (m.cloudStep_m > 0 && !(m.emptyStep_m >= m.cloudStep_m && m.emptyStep_m <= 20000))
+    return fail(ErrorCode::InvalidArgument, "render settings: march.emptyStep_m " + num(m.emptyStep_m) +
+                                                " outside [cloudStep_m = " + num(m.cloudStep_m) + ", 20000]");
+  if (m.airSteps > 64)
+    return fail(ErrorCode::InvalidArgument,
+                "render settings: march.airSteps " + std::to_string(m.airSteps) + " outside [0, 64]");
+  if (!(m.stepGrowth >= 0 && m.stepGrowth <= 1))
+    return fail(ErrorCode::InvalidArgument,
+                "render settings: march.stepGrowth " + num(m.stepGrowth) + " outside [0, 1]");
   return {};
 }
 
@@ -187,6 +213,7 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
     const weather::CloudLayer& layer = in.weather->layers[slice];
     LayerSetup l;
     l.thickness_m = layer.thickness_m;
+    l.absent = maxCoverage(field, std::uint32_t(slice)) <= 0;
     l.lightDistance_m = std::clamp(kLightMarchFraction * layer.thickness_m, kMinLightDistance_m, kMaxLightDistance_m);
     l.primary = cloudTypeParams(layer.type);
     l.blends = field.blendType[slice] != weather::CloudType::None;
@@ -276,7 +303,8 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
     while (std::gcd(stride, n) != 1) ++stride;
   }
   f.image = gpu::uvec4(s.width, s.height, tilesX, n);
-  f.dispatch = gpu::uvec4(stride, s.march.primarySteps, s.march.lightSteps, 0);
+  f.dispatch = gpu::uvec4(stride, s.march.primarySteps, s.march.lightSteps, s.march.airSteps);
+  f.steps = gpu::vec4(float(s.march.cloudStep_m), float(s.march.emptyStep_m), float(s.march.stepGrowth), 0.0f);
 
   for (std::size_t i = 0; i < s.layers.size(); ++i) {
     const LayerSetup& l = s.layers[i];
@@ -287,7 +315,7 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
     g.detailOrigin = v4(l.detailOrigin, 1.0 / l.detailPeriod_m);
     g.cloudMapOrigin = v4(l.cloudMapOrigin, 1.0 / l.cloudMapPeriod_m);
     g.coverageShift = gpu::vec4(float(l.coverageShift_m.x), float(l.coverageShift_m.y), 0.0f, float(l.shapeStretchZ));
-    g.ambient = v4(l.skyTop);
+    g.ambient = v4(l.skyTop, l.absent ? 1.0 : 0.0);
     g.sunDiffuse = v4(l.sunDiffuseTop, l.sunCosine);
     g.primary = packCloudType(l.primary);
     g.secondary = packCloudType(l.secondary);

@@ -44,6 +44,9 @@ struct LayerSetup {
   glm::dvec3 skyTop{0};            // mean sky radiance at the layer top, linear units
   glm::dvec3 sunDiffuseTop{0};     // sunlight at the layer top as diffuse radiance, E T mu / pi
   double sunCosine = 0;            // mu of the sun at the layer top over the camera, >= 0
+  // No coverage anywhere on the weather map (the whole view: the map reaches
+  // past the march's 150 km): the layer is not marched and casts no shadow.
+  bool absent = false;
 };
 
 struct FrameSetup {

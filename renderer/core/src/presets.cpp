@@ -15,15 +15,30 @@ MarchSettings march(std::uint32_t primarySteps, std::uint32_t lightSteps, double
   return m;
 }
 
+// The march in metres (MarchSettings::cloudStep_m > 0): primarySteps caps a
+// span's samples.
+MarchSettings metres(std::uint32_t maxSamples, std::uint32_t lightSteps, double minTransmittance, double cloudStep_m,
+                     double emptyStep_m, double stepGrowth, std::uint32_t airSteps) {
+  MarchSettings m = march(maxSamples, lightSteps, minTransmittance, 1);
+  m.cloudStep_m = cloudStep_m;
+  m.emptyStep_m = emptyStep_m;
+  m.stepGrowth = stepGrowth;
+  m.airSteps = airSteps;
+  return m;
+}
+
 }  // namespace
 
 const std::vector<Preset>& presets() {
   static const std::vector<Preset> all = {
       {"reference", "ground truth: 256 primary steps, 8 light steps, no early exit, every sample", march(256, 8, 0, 1)},
       {"high", "the default: 48 primary steps, 4 light steps, exit at 1 %, every sample", MarchSettings{}},
-      {"medium", "32 primary steps, 3 light steps, exit at 2 %, empty stride 2", march(32, 3, 0.02, 2)},
-      {"low", "24 primary steps, 2 light steps, exit at 3 %, empty stride 2", march(24, 2, 0.03, 2)},
-      {"realtime", "16 primary steps, 1 light step, exit at 5 %, empty stride 3", march(16, 1, 0.05, 3)},
+      {"medium", "steps of 60 m in cloud, 240 m in clear air, +1 % of the distance; 3 light steps, exit at 2 %, 12 air steps",
+       metres(256, 3, 0.02, 60, 240, 0.01, 12)},
+      {"low", "steps of 100 m in cloud, 400 m in clear air, +1 % of the distance; 2 light steps, exit at 3 %, 8 air steps",
+       metres(192, 2, 0.03, 100, 400, 0.01, 8)},
+      {"realtime", "steps of 150 m in cloud, 600 m in clear air, +2 % of the distance; 1 light step, exit at 5 %, 8 air steps",
+       metres(128, 1, 0.05, 150, 600, 0.02, 8)},
   };
   return all;
 }

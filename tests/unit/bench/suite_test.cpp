@@ -137,11 +137,32 @@ TEST(Configurations, PresetsAreConfigurationsWithTheirMarch) {
   EXPECT_EQ((*chosen)[0].settings.march.primarySteps, 256u) << "reference is the reference preset";
   EXPECT_EQ((*chosen)[0].settings.march.minTransmittance, 0.0);
   EXPECT_EQ((*chosen)[1].name, "realtime");
-  EXPECT_EQ((*chosen)[1].settings.march.primarySteps, 16u);
+  EXPECT_EQ((*chosen)[1].settings.march.cloudStep_m, 150.0);
   EXPECT_EQ((*chosen)[1].settings.march.lightSteps, 1u);
   EXPECT_EQ((*chosen)[2].name, "medium");
-  EXPECT_EQ((*chosen)[2].settings.march.primarySteps, 32u);
-  EXPECT_EQ(settingsFor((*chosen)[1], 160, 90, 60).march.emptyStride, 3u);
+  EXPECT_EQ((*chosen)[2].settings.march.cloudStep_m, 60.0);
+  EXPECT_EQ(settingsFor((*chosen)[1], 160, 90, 60).march.emptyStep_m, 600.0);
+}
+
+TEST(Configurations, CustomSpecsAndTheirErrors) {
+  auto chosen = selectConfigurations("medium;m2:base=realtime,cloud=80,empty=320,growth=0.03,light=2,air=10,scale=0.5");
+  ASSERT_TRUE(chosen) << chosen.error().detail;
+  ASSERT_EQ(chosen->size(), 3u);
+  const Configuration& c = (*chosen)[2];
+  EXPECT_EQ(c.name, "m2");
+  EXPECT_EQ(c.settings.march.cloudStep_m, 80.0);
+  EXPECT_EQ(c.settings.march.emptyStep_m, 320.0);
+  EXPECT_EQ(c.settings.march.stepGrowth, 0.03);
+  EXPECT_EQ(c.settings.march.lightSteps, 2u);
+  EXPECT_EQ(c.settings.march.airSteps, 10u);
+  EXPECT_EQ(c.settings.march.minTransmittance, 0.05) << "from the base, realtime";
+  EXPECT_EQ(c.renderScale, 0.5);
+  for (const char* bad : {"x:cloud=abc", "x:wobble=1", "x:base=ultra", "Bad:cloud=1", "reference:cloud=1", ":cloud=1"}) {
+    auto r = customConfiguration(bad);
+    ASSERT_FALSE(r) << bad;
+    EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument) << bad;
+    EXPECT_NE(r.error().detail.find(bad), std::string::npos) << r.error().detail;
+  }
 }
 
 TEST(Spread, MedianAndRange) {

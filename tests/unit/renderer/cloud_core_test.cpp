@@ -35,61 +35,13 @@ double sphereIntegral(F p) {
   return 2 * kPi * sum * kPi / kN;
 }
 
-// A cloud type that fills its layer uniformly: fades far thinner than a
-// march step, density flat with height, no erosion, no diffuse depth.
-Core::CloudType uniformType(double extinction_perm) {
-  Core::CloudType t{};
-  t.extinction_perm = extinction_perm;
-  t.dropletDiameter_um = 10.0;
-  t.baseRound = 1e-9;
-  t.topRoundStart = 1.0 - 1e-9;
-  t.peak = 1.0 + 1e-6;
-  t.peakVariation = 0.0;
-  t.anvil = 0.0;
-  t.densityGradient = 0.0;
-  t.densityBaseFade = 1e-9;
-  t.densityTopFade = 1e-9;
-  t.coverageEdge = 0.25;
-  t.fibrous = 0.0;
-  t.erosion = 0.0;
-  t.wispyHeight = 0.2;
-  t.columnFill = 0.0;
-  return t;
-}
-
-// Haggstrom's cumulus (eq. 5-10, 14) as the type table writes it.
-Core::CloudType haggstromCumulus() {
-  Core::CloudType t = uniformType(0.06);
-  t.baseRound = 0.07;
-  t.topRoundStart = 0.2;
-  t.peak = 1.0;
-  t.densityGradient = 1.0;
-  t.densityBaseFade = 0.15;
-  t.densityTopFade = 0.1;
-  t.erosion = 0.35;
-  t.columnFill = 0.5;
-  return t;
-}
 
 // Frame of a camera at altitude alt under a sphere of radius R, with one
 // layer of the given type; no sun, no sky light.
 Core::CoreFrame frameAt(Core& c, double R, double alt, double base, double thickness, const Core::CloudType& type) {
-  Core::CoreFrame f{};
-  f.march = Core::MarchParams{Core::kPrimarySteps, Core::kLightSteps, Core::kMinTransmittance, Core::kEmptyStride};
-  f.air.r = R + alt;
-  f.air.h = alt;
-  f.air.cGround = alt * (2 * f.air.r - alt);
-  const double hTopAtm = alt - Core::kAtmosphereHeight_m;
-  f.air.cTop = hTopAtm * (2 * f.air.r - hTopAtm);
-  f.air.sunDir = Core::real3(0, 0, 1);
-  f.air.sunIrradiance = Core::real3(0);
-  f.groundIrradiance = Core::real3(0);
+  Core::CoreFrame f = frameOver(R, alt, 0);
   f.layerCount = 1;
-  const double hBase = alt - base, hTop = alt - (base + thickness);
-  Core::CoreLayer& L = c.layers[0];
-  L = Core::CoreLayer{hBase, hTop, hBase * (2 * f.air.r - hBase), hTop * (2 * f.air.r - hTop), thickness,
-                      0.5 * thickness, false, type, type, Core::real3(0), Core::real3(0), 1.0,
-                      Core::LayerSampling{Core::real4(0.0), Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), 1.0}};
+  c.layers[0] = shellLayer(f, alt, base, thickness, type);
   return f;
 }
 

@@ -17,39 +17,14 @@ namespace {
 
 constexpr double kEarth_m = 6371000, kAlt_m = 500, kBase_m = 1500, kThickness_m = 1000;
 
-// A type that fills its layer uniformly (as cloud_core_test.cpp's).
-Core::CloudType uniformSlab(double extinction_perm) {
-  Core::CloudType t{};
-  t.extinction_perm = extinction_perm;
-  t.dropletDiameter_um = 10.0;
-  t.baseRound = 1e-9;
-  t.topRoundStart = 1.0 - 1e-9;
-  t.peak = 1.0 + 1e-6;
-  t.densityBaseFade = 1e-9;
-  t.densityTopFade = 1e-9;
-  t.coverageEdge = 0.25;
-  t.wispyHeight = 0.2;
-  return t;
-}
-
 Core::CoreLayer slabLayer(const Core::CoreFrame& f, double base_m, double thickness_m, const Core::CloudType& t) {
-  const double hBase = kAlt_m - base_m, hTop = kAlt_m - (base_m + thickness_m);
-  return Core::CoreLayer{hBase, hTop, hBase * (2 * f.air.r - hBase), hTop * (2 * f.air.r - hTop), thickness_m,
-                         0.5 * thickness_m, false, t, t, Core::real3(0), Core::real3(0), 1.0,
-                         Core::LayerSampling{Core::real4(0.0), Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), 1.0}};
+  return shellLayer(f, kAlt_m, base_m, thickness_m, t);
 }
 
 Core::CoreFrame frame(Core& c, double sigma) {
-  Core::CoreFrame f{};
-  f.march = Core::MarchParams{Core::kPrimarySteps, Core::kLightSteps, Core::kMinTransmittance, Core::kEmptyStride};
-  f.air.r = kEarth_m + kAlt_m;
-  f.air.h = kAlt_m;
-  f.air.cGround = kAlt_m * (2 * f.air.r - kAlt_m);
-  const double hTopAtm = kAlt_m - Core::kAtmosphereHeight_m;
-  f.air.cTop = hTopAtm * (2 * f.air.r - hTopAtm);
-  f.air.sunDir = Core::real3(0, 0, 1);
+  Core::CoreFrame f = frameOver(kEarth_m, kAlt_m, 0);
   f.layerCount = 1;
-  c.layers[0] = slabLayer(f, kBase_m, kThickness_m, uniformSlab(sigma));
+  c.layers[0] = slabLayer(f, kBase_m, kThickness_m, uniformType(sigma));
   return f;
 }
 
@@ -88,7 +63,7 @@ TEST(CloudDepth, TwoSlabsWeighEachByTheLightItRemoves) {
   Core c;
   Core::CoreFrame f = frame(c, 1e-3);
   const double base2 = 6000, thick2 = 500, sigma2 = 2e-3;
-  c.layers[1] = slabLayer(f, base2, thick2, uniformSlab(sigma2));
+  c.layers[1] = slabLayer(f, base2, thick2, uniformType(sigma2));
   f.layerCount = 2;
   const auto r = c.shadePixel(f, kUp, 0.5);
   const double T1 = std::exp(-1e-3 * kThickness_m), T2 = std::exp(-sigma2 * thick2);

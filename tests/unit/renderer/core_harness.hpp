@@ -28,6 +28,8 @@ class Core {
   real2 cloudMap = real2(0.5, 1.0);
   // Shape-noise lookups so far (primary and light march): the march's cost.
   std::uint64_t shapeLookups = 0;
+  // Every texture lookup of the cloud model (weather, cloud map, shape, detail).
+  std::uint64_t lookups = 0;
   // Transmittance table lookup; unset: clear air transmits everything.
   std::function<real3(real2)> table;
   // Multiple-scattering table lookup; unset: none.
@@ -46,12 +48,94 @@ class Core {
 };
 
 inline Core::CoreLayer Core::layerAt(int li) { return layers[li]; }
-inline Core::real3 Core::sampleWeather(LayerSampling, real3) { return real3(coverage, density, blend); }
-inline Core::real2 Core::sampleCloudMap(LayerSampling, real3) { return cloudMap; }
+inline Core::real3 Core::sampleWeather(LayerSampling, real3) {
+  ++lookups;
+  return real3(coverage, density, blend);
+}
+inline Core::real2 Core::sampleCloudMap(LayerSampling, real3) {
+  ++lookups;
+  return cloudMap;
+}
+// The mip of a uniform field holds its coverage.
+inline Core::real Core::sampleMaxCoverage(LayerSampling, real3) {
+  ++lookups;
+  return coverage;
+}
 inline Core::real2 Core::sampleShape(LayerSampling, real3) {
+  ++lookups;
   ++shapeLookups;
   return real2(noise, noise);
 }
-inline Core::real Core::sampleDetail(LayerSampling, real3) { return detail; }
+inline Core::real Core::sampleDetail(LayerSampling, real3) {
+  ++lookups;
+  return detail;
+}
+
+// Scenes for the closed-form tests.
+
+// A cloud type that fills its layer uniformly: fades far thinner than a
+// march step, density flat with height, no erosion, no diffuse depth.
+inline Core::CloudType uniformType(double extinction_perm) {
+  Core::CloudType t{};
+  t.extinction_perm = extinction_perm;
+  t.dropletDiameter_um = 10.0;
+  t.baseRound = 1e-9;
+  t.topRoundStart = 1.0 - 1e-9;
+  t.peak = 1.0 + 1e-6;
+  t.peakVariation = 0.0;
+  t.anvil = 0.0;
+  t.densityGradient = 0.0;
+  t.densityBaseFade = 1e-9;
+  t.densityTopFade = 1e-9;
+  t.coverageEdge = 0.25;
+  t.fibrous = 0.0;
+  t.erosion = 0.0;
+  t.wispyHeight = 0.2;
+  t.columnFill = 0.0;
+  return t;
+}
+
+// Haggstrom's cumulus (eq. 5-10, 14) as the type table writes it.
+inline Core::CloudType haggstromCumulus(double extinction_perm = 0.06) {
+  Core::CloudType t = uniformType(extinction_perm);
+  t.baseRound = 0.07;
+  t.topRoundStart = 0.2;
+  t.peak = 1.0;
+  t.densityGradient = 1.0;
+  t.densityBaseFade = 0.15;
+  t.densityTopFade = 0.1;
+  t.erosion = 0.35;
+  t.columnFill = 0.5;
+  return t;
+}
+
+// A frame for a camera at altitude alt (m) over a sphere of radius R (m):
+// the ground and atmosphere-top shells, the sun straight up with irradiance
+// `sun` (0: none), no ground light, no layer yet, the core's default march.
+inline Core::CoreFrame frameOver(double R, double alt, double sun) {
+  Core::CoreFrame f{};
+  f.march = Core::MarchParams{Core::kPrimarySteps, Core::kLightSteps, Core::kMinTransmittance, Core::kEmptyStride,
+                              Core::kCloudStep_m, Core::kEmptyStep_m, Core::kStepGrowth};
+  f.air.r = R + alt;
+  f.air.h = alt;
+  f.air.cGround = alt * (2 * f.air.r - alt);
+  const double hTopAtm = alt - Core::kAtmosphereHeight_m;
+  f.air.cTop = hTopAtm * (2 * f.air.r - hTopAtm);
+  f.air.sunDir = Core::real3(0, 0, 1);
+  f.air.sunIrradiance = Core::real3(sun);
+  f.groundIrradiance = Core::real3(0);
+  return f;
+}
+
+// The layer of type t from base to base + thickness (m), for frame f's
+// camera at altitude alt, sampled with no offsets.
+inline Core::CoreLayer shellLayer(const Core::CoreFrame& f, double alt, double base, double thickness,
+                                  const Core::CloudType& t) {
+  const double hBase = alt - base, hTop = alt - (base + thickness);
+  return Core::CoreLayer{hBase, hTop, hBase * (2 * f.air.r - hBase), hTop * (2 * f.air.r - hTop), thickness,
+                         0.5 * thickness, false, t, t, Core::real3(0), Core::real3(0), 1.0,
+                         Core::LayerSampling{Core::real4(0.0), Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), 1.0},
+                         false};
+}
 
 }  // namespace sky::test

@@ -20,7 +20,8 @@ namespace {
 using render::Preset;
 
 Core::MarchParams params(const render::MarchSettings& m) {
-  return Core::MarchParams{int(m.primarySteps), int(m.lightSteps), m.minTransmittance, double(m.emptyStride)};
+  return Core::MarchParams{int(m.primarySteps), int(m.lightSteps), m.minTransmittance, double(m.emptyStride),
+                           m.cloudStep_m, m.emptyStep_m, m.stepGrowth};
 }
 
 // One layer from base to base + thickness over a camera at 500 m (R = 6371
@@ -28,34 +29,15 @@ Core::MarchParams params(const render::MarchSettings& m) {
 // cumulus profile (density and shape vary with height).
 Core::CoreFrame slabFrame(Core& c, const render::MarchSettings& m, double sigma, bool cumulus) {
   const double R = 6371000, alt = 500, base = 1500, H = 1000;
-  Core::CloudType t{};
-  t.extinction_perm = sigma;
-  t.dropletDiameter_um = 10.0;
-  t.baseRound = cumulus ? 0.07 : 1e-9;
-  t.topRoundStart = cumulus ? 0.2 : 1.0 - 1e-9;
-  t.peak = cumulus ? 1.0 : 1.0 + 1e-6;
-  t.densityGradient = cumulus ? 1.0 : 0.0;
-  t.densityBaseFade = cumulus ? 0.15 : 1e-9;
-  t.densityTopFade = cumulus ? 0.1 : 1e-9;
-  t.coverageEdge = 0.25;
-  t.erosion = cumulus ? 0.35 : 0.0;
-  t.wispyHeight = 0.2;
-  Core::CoreFrame f{};
+  Core::CloudType t = uniformType(sigma);
+  if (cumulus) {
+    t = haggstromCumulus(sigma);
+    t.columnFill = 0.0;  // the profile alone
+  }
+  Core::CoreFrame f = frameOver(R, alt, 1);
   f.march = params(m);
-  f.air.r = R + alt;
-  f.air.h = alt;
-  f.air.cGround = alt * (2 * f.air.r - alt);
-  const double hTopAtm = alt - Core::kAtmosphereHeight_m;
-  f.air.cTop = hTopAtm * (2 * f.air.r - hTopAtm);
-  f.air.sunDir = Core::real3(0, 0, 1);
-  f.air.sunIrradiance = Core::real3(1);
-  f.groundIrradiance = Core::real3(0);
   f.layerCount = 1;
-  const double hBase = alt - base, hTop = alt - (base + H);
-  c.layers[0] = Core::CoreLayer{hBase, hTop, hBase * (2 * f.air.r - hBase), hTop * (2 * f.air.r - hTop), H, 0.5 * H,
-                                false, t, t, Core::real3(0), Core::real3(0), 1.0,
-                                Core::LayerSampling{Core::real4(0.0), Core::real4(0.0), Core::real4(0.0),
-                                                    Core::real3(0.0), 1.0}};
+  c.layers[0] = shellLayer(f, alt, base, H, t);
   return f;
 }
 
@@ -71,7 +53,7 @@ TEST(Presets, NamesAndUnknownNameError) {
   for (std::size_t i = 0; i < all.size(); ++i) EXPECT_EQ(all[i].name, names[i]);
   auto medium = render::findPreset("medium");
   ASSERT_TRUE(medium);
-  EXPECT_EQ(medium->march.primarySteps, 32u);
+  EXPECT_EQ(medium->march.cloudStep_m, 60.0);
   EXPECT_EQ(medium->march.lightSteps, 3u);
   auto bad = render::findPreset("ultra");
   ASSERT_FALSE(bad);
@@ -94,11 +76,22 @@ TEST(Presets, HighIsTheDefaultAndReferenceTheMostExpensive) {
   EXPECT_EQ(all[0].march.minTransmittance, 0.0) << "reference: no early exit";
   EXPECT_EQ(all[0].march.emptyStride, 1u) << "reference: every sample";
   EXPECT_GE(all[0].march.lightSteps, 6u);
+  EXPECT_EQ(all[0].march.cloudStep_m, 0.0) << "reference: evenly placed samples";
+  EXPECT_EQ(all[0].march.airSteps, 0u) << "reference: the default air march";
+  // Cheaper presets: never more light steps, an earlier exit; evenly placed
+  // ones fewer samples, those in metres (primarySteps a cap) longer steps.
   for (std::size_t i = 1; i < all.size(); ++i) {
-    EXPECT_LT(all[i].march.primarySteps, all[i - 1].march.primarySteps) << all[i].name;
-    EXPECT_LE(all[i].march.lightSteps, all[i - 1].march.lightSteps) << all[i].name;
-    EXPECT_GE(all[i].march.minTransmittance, all[i - 1].march.minTransmittance) << all[i].name;
-    EXPECT_GE(all[i].march.emptyStride, all[i - 1].march.emptyStride) << all[i].name;
+    const render::MarchSettings &m = all[i].march, &before = all[i - 1].march;
+    EXPECT_LE(m.lightSteps, before.lightSteps) << all[i].name;
+    EXPECT_GE(m.minTransmittance, before.minTransmittance) << all[i].name;
+    if (m.cloudStep_m == 0) {
+      EXPECT_LT(m.primarySteps, before.primarySteps) << all[i].name;
+    }
+    if (before.cloudStep_m > 0) {
+      EXPECT_GT(m.cloudStep_m, before.cloudStep_m) << all[i].name;
+      EXPECT_GE(m.emptyStep_m, before.emptyStep_m) << all[i].name;
+      EXPECT_GE(m.stepGrowth, before.stepGrowth) << all[i].name;
+    }
   }
 }
 

@@ -43,6 +43,13 @@ std::vector<Configuration> builtInConfigurations();
 // unknown configuration and listing the known ones.
 Result<std::vector<Configuration>> selectConfigurations(const std::string& names);
 
+// A configuration from a spec NAME:key=value,... (keys: base = a preset
+// whose march it starts from, else high's; primary, light, exit, stride,
+// cloud, empty, growth, air = the MarchSettings fields; scale = render scale).
+// --configs takes such specs next to names; a list with a spec in it is
+// separated by ';' (a spec has commas). Errors: InvalidArgument naming the bad part.
+Result<Configuration> customConfiguration(const std::string& spec);
+
 // The RenderSettings a configuration renders a scene with at an output size.
 render::RenderSettings settingsFor(const Configuration& config, std::uint32_t outWidth, std::uint32_t outHeight,
                                    double verticalFov_deg);

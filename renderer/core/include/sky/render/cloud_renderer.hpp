@@ -30,6 +30,18 @@ struct MarchSettings {
   // Samples advanced after one that met no cloud: long strides through empty
   // air, single ones inside cloud. 1 marches every sample. [1, 16].
   std::uint32_t emptyStride = 1;
+  // The march in metres instead of evenly placed samples (cloud_core.glsl,
+  // MarchParams): cloudStep_m > 0 steps cloudStep_m inside cloud and
+  // emptyStep_m (>= cloudStep_m) through clear air, judged there by the
+  // cheap density (shape without the detail noise), both growing by
+  // stepGrowth metres per metre of distance from the camera; primarySteps
+  // then caps the samples of a layer span. cloudStep_m 0: even placement.
+  double cloudStep_m = 0;  // [0, 10000]
+  double emptyStep_m = 0;  // [cloudStep_m, 20000] when cloudStep_m > 0
+  double stepGrowth = 0;   // [0, 1]
+  // Steps of the clear-air march along each view ray (aerial perspective and
+  // the sky; atmosphere_core.glsl); 0: its default, 16. [0, 64].
+  std::uint32_t airSteps = 0;
 };
 
 struct RenderSettings {

@@ -26,7 +26,10 @@ class CpuReference {
 
   // Every pixel of the frame. Same contract and errors as
   // CloudRenderer::render (no Device errors). Slow: meant for small images.
-  Result<Image> render(const FrameInputs& inputs) const;
+  // densityLookups, when given, receives the frame's texture lookups of
+  // the cloud model (weather map, cloud map, shape and detail noise; primary
+  // march, light march and ground shadows): what the march costs.
+  Result<Image> render(const FrameInputs& inputs, std::uint64_t* densityLookups = nullptr) const;
 
   // Only the listed pixels, rgba each (a = cloud transmittance), in the
   // order given. InvalidArgument for a pixel outside the image.
