@@ -24,12 +24,14 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "sky/render/cloud_renderer.hpp"
+#include "sky/render/cpu_reference.hpp"
 
 namespace {
 
@@ -38,6 +40,7 @@ using Clock = std::chrono::steady_clock;
 struct Options {
   std::uint32_t width = 320, height = 180;
   int frames = 30, warmup = 3;
+  bool lookups = false;  // also count the cloud model's lookups (CPU reference) per view
   std::string json;
 };
 
@@ -95,8 +98,11 @@ int main(int argc, char** argv) {
     else if (k == "--frames") o.frames = std::stoi(v);
     else if (k == "--warmup") o.warmup = std::stoi(v);
     else if (k == "--json") o.json = v;
+    else if (k == "--lookups") o.lookups = v != "0";
     else {
-      std::fprintf(stderr, "usage: sky_render_bench [--width W] [--height H] [--frames N] [--warmup N] [--json FILE]\n");
+      std::fprintf(stderr,
+                   "usage: sky_render_bench [--width W] [--height H] [--frames N] [--warmup N] [--lookups 0|1] "
+                   "[--json FILE]\n");
       return 2;
     }
   }
@@ -126,8 +132,22 @@ int main(int argc, char** argv) {
   const char* threads = std::getenv("LP_NUM_THREADS");
   std::printf("sky_render_bench: %ux%u on '%s', LP_NUM_THREADS=%s, %d frames per view after %d warm-up\n", o.width,
               o.height, (*renderer)->deviceName().c_str(), threads ? threads : "(unset)", o.frames, o.warmup);
-  std::printf("%-14s %9s %9s %9s %9s %9s %11s\n", "view", "gpu p50", "gpu p90", "wall p50", "cpu p50", "busiest",
-              "ns/pixel");
+  // The cloud model's texture lookups of a frame are counted by the CPU
+  // reference, which runs the same core with the same march (in double: an
+  // early exit may fall a sample apart); divided by the GPU pass's time they
+  // are the pass's effective lookup rate, to set against sky_lookup_bench's
+  // limit (one 3D lookup per step and nothing else).
+  std::optional<sky::render::CpuReference> reference;
+  if (o.lookups) {
+    auto created = sky::render::CpuReference::create(settings);
+    if (!created) {
+      std::fprintf(stderr, "sky_render_bench: %s\n", sky::describe(created.error()).c_str());
+      return 1;
+    }
+    reference.emplace(std::move(*created));
+  }
+  std::printf("%-14s %9s %9s %9s %9s %9s %11s%s\n", "view", "gpu p50", "gpu p90", "wall p50", "cpu p50", "busiest",
+              "ns/pixel", o.lookups ? "   lookups  M/s (gpu)  M/cpu-s" : "");
   nlohmann::json report = {{"width", o.width}, {"height", o.height}, {"device", (*renderer)->deviceName()},
                            {"lp_num_threads", threads ? threads : ""}, {"views", nlohmann::json::object()}};
   const View views[] = {{"peer_pitch0", 800, 0}, {"peer_pitch30", 800, 30}, {"above_down30", 4000, -30},
@@ -135,6 +155,7 @@ int main(int argc, char** argv) {
   for (const View& v : views) {
     std::map<std::string, std::vector<double>> gpu;
     std::vector<double> wall, cpu, busiest;
+    sky::render::FrameInputs last;
     for (int f = 0; f < o.warmup + o.frames; ++f) {
       sky::render::FrameInputs in;
       in.camera.position = {46.2, 12.8, v.alt_m + v.climb_mps * f / 30.0};
@@ -145,6 +166,7 @@ int main(int argc, char** argv) {
       in.sunAzimuth_deg = sunAzimuth_deg;
       in.sunElevation_deg = sunElevation_deg;
       in.frameIndex = std::uint64_t(f);
+      last = in;
       const auto threads0 = threadCpu_ns();
       const double cpu0 = processCpu_ms();
       const auto t0 = Clock::now();
@@ -161,9 +183,20 @@ int main(int argc, char** argv) {
       for (const auto& p : (*renderer)->lastPassTimes()) gpu[p.pass].push_back(p.gpu_ms);
     }
     const double clouds50 = rank(gpu["clouds"], 0.5);
-    std::printf("%-14s %7.1f ms %7.1f ms %7.1f ms %7.1f ms %7.1f ms %11.0f\n", v.name, clouds50,
+    std::printf("%-14s %7.1f ms %7.1f ms %7.1f ms %7.1f ms %7.1f ms %11.0f", v.name, clouds50,
                 rank(gpu["clouds"], 0.9), rank(wall, 0.5), rank(cpu, 0.5), rank(busiest, 0.5),
                 clouds50 * 1e6 / (double(o.width) * o.height));
+    std::uint64_t lookups = 0;
+    if (reference) {
+      auto counted = reference->render(last, &lookups);
+      if (!counted) {
+        std::fprintf(stderr, "\nsky_render_bench: %s\n", sky::describe(counted.error()).c_str());
+        return 1;
+      }
+      std::printf(" %9.3g %9.1f %9.1f", double(lookups), double(lookups) / (clouds50 * 1e-3) * 1e-6,
+                  double(lookups) / (rank(cpu, 0.5) * 1e-3) * 1e-6);
+    }
+    std::printf("\n");
     nlohmann::json passes = nlohmann::json::object();
     for (const auto& [name, samples] : gpu)
       passes[name] = {{"frames", samples.size()}, {"p50", rank(samples, 0.5)}, {"p90", rank(samples, 0.9)}};
@@ -171,6 +204,7 @@ int main(int argc, char** argv) {
                                {"wall_ms", {{"p50", rank(wall, 0.5)}, {"p90", rank(wall, 0.9)}}},
                                {"process_cpu_ms", {{"p50", rank(cpu, 0.5)}}},
                                {"busiest_thread_cpu_ms", {{"p50", rank(busiest, 0.5)}}}};
+    if (reference) report["views"][v.name]["cloud_model_lookups"] = lookups;
   }
   if (!o.json.empty()) std::ofstream(o.json) << report.dump(2) << '\n';
   return 0;
