@@ -19,6 +19,30 @@ std::vector<Configuration> builtInConfigurations() {
     c.settings.march = p.march;
     all.push_back(c);
   }
+  // The seeds' final settings in our march, as far as it has them (each
+  // description says what is left out).
+  Configuration h{"haggstrom-2018",
+                  "Haggstrom 2018's final march: 14 m steps growing by 0.04 m per metre (eq. 20, sec. 4.2.1), "
+                  "longer steps outside cloud (2x here: the thesis gives no factor), 4 sun steps, stop at full "
+                  "opacity (T < 0.001 here); no 4x4 reprojection",
+                  1.0, false, {}};
+  h.settings.march.primarySteps = 4096;
+  h.settings.march.cloudStep_m = 14;
+  h.settings.march.emptyStep_m = 28;
+  h.settings.march.stepGrowth = 0.04;
+  h.settings.march.lightSteps = 4;
+  h.settings.march.minTransmittance = 0.001;
+  all.push_back(h);
+  Configuration f{"ford-2024",
+                  "Ford 2024's final march: step 100 (m here), large steps twice the small (sec. 4.6.2), early exit "
+                  "at transmittance 0.075 (sec. 5.4.1); no 8-frame TAA window, no skipping below density 0.01",
+                  1.0, false, {}};
+  f.settings.march.primarySteps = 4096;
+  f.settings.march.cloudStep_m = 100;
+  f.settings.march.emptyStep_m = 200;
+  f.settings.march.stepGrowth = 0;
+  f.settings.march.minTransmittance = 0.075;
+  all.push_back(f);
   all.push_back({"half-res", "preset high at 1/2 the width and height, bilinear upscale (bench-side)", 0.5, false, {}});
   all.push_back({"quarter-res", "preset high at 1/4 the width and height, bilinear upscale (bench-side)", 0.25, false, {}});
   return all;

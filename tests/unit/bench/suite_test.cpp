@@ -130,6 +130,24 @@ TEST(Configurations, ReferenceFirstAndUnknownNamesRefused) {
   EXPECT_DOUBLE_EQ(s.verticalFov_deg, 45);
 }
 
+// The seeds' final settings, with the figures their papers give
+// (Haggstrom 2018 eq. 20 and sec. 3.2.1.3, 4.2.1; Ford 2024 sec. 4.6.2, 5.4).
+TEST(Configurations, TheSeedsFinalSettingsAreBuiltIn) {
+  auto chosen = selectConfigurations("haggstrom-2018,ford-2024");
+  ASSERT_TRUE(chosen) << chosen.error().detail;
+  ASSERT_EQ(chosen->size(), 3u);
+  const render::MarchSettings& h = (*chosen)[1].settings.march;
+  EXPECT_EQ((*chosen)[1].name, "haggstrom-2018");
+  EXPECT_DOUBLE_EQ(h.cloudStep_m, 14.0);
+  EXPECT_DOUBLE_EQ(h.stepGrowth, 0.04);
+  EXPECT_EQ(h.lightSteps, 4u);
+  const render::MarchSettings& f = (*chosen)[2].settings.march;
+  EXPECT_EQ((*chosen)[2].name, "ford-2024");
+  EXPECT_DOUBLE_EQ(f.cloudStep_m, 100.0);
+  EXPECT_DOUBLE_EQ(f.emptyStep_m, 2 * f.cloudStep_m);
+  EXPECT_DOUBLE_EQ(f.minTransmittance, 0.075);
+}
+
 TEST(Configurations, PresetsAreConfigurationsWithTheirMarch) {
   auto chosen = selectConfigurations("realtime,medium");
   ASSERT_TRUE(chosen) << chosen.error().detail;
