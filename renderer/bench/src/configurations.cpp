@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
+#include <string>
+#include <utility>
 
 #include "sky/render/presets.hpp"
 
@@ -21,28 +23,27 @@ std::vector<Configuration> builtInConfigurations() {
   }
   // The seeds' final settings in our march, as far as it has them (each
   // description says what is left out).
-  Configuration h{"haggstrom-2018",
-                  "Haggstrom 2018's final march: 14 m steps growing by 0.04 m per metre (eq. 20, sec. 4.2.1), "
-                  "longer steps outside cloud (2x here: the thesis gives no factor), 4 sun steps, stop at full "
-                  "opacity (T < 0.001 here); no 4x4 reprojection",
-                  1.0, false, {}};
-  h.settings.march.primarySteps = 4096;
-  h.settings.march.cloudStep_m = 14;
-  h.settings.march.emptyStep_m = 28;
-  h.settings.march.stepGrowth = 0.04;
-  h.settings.march.lightSteps = 4;
-  h.settings.march.minTransmittance = 0.001;
-  all.push_back(h);
-  Configuration f{"ford-2024",
-                  "Ford 2024's final march: step 100 (m here), large steps twice the small (sec. 4.6.2), early exit "
-                  "at transmittance 0.075 (sec. 5.4.1); no 8-frame TAA window, no skipping below density 0.01",
-                  1.0, false, {}};
-  f.settings.march.primarySteps = 4096;
-  f.settings.march.cloudStep_m = 100;
-  f.settings.march.emptyStep_m = 200;
-  f.settings.march.stepGrowth = 0;
-  f.settings.march.minTransmittance = 0.075;
-  all.push_back(f);
+  auto metres = [](std::string name, std::string description, double cloud_m, double empty_m, double growth,
+                   double minTransmittance) {
+    Configuration c{std::move(name), std::move(description), 1.0, false, {}};
+    render::MarchSettings& m = c.settings.march;  // high's, but for the placement and the exit
+    m.primarySteps = 4096;
+    m.cloudStep_m = cloud_m;
+    m.emptyStep_m = empty_m;
+    m.stepGrowth = growth;
+    m.minTransmittance = minTransmittance;
+    return c;
+  };
+  all.push_back(metres("haggstrom-2018",
+                       "Haggstrom 2018's final march: 14 m steps growing by 0.04 m per metre (eq. 20, sec. 4.2.1), "
+                       "longer steps outside cloud (2x here: the thesis gives no factor), 4 sun steps, stop at full "
+                       "opacity (T < 0.001 here); no 4x4 reprojection",
+                       14, 28, 0.04, 0.001));
+  all.back().settings.march.lightSteps = 4;
+  all.push_back(metres("ford-2024",
+                       "Ford 2024's final march: step 100 (m here), large steps twice the small (sec. 4.6.2), early "
+                       "exit at transmittance 0.075 (sec. 5.4.1); no 8-frame TAA window, no skipping below density 0.01",
+                       100, 200, 0, 0.075));
   all.push_back({"half-res", "preset high at 1/2 the width and height, bilinear upscale (bench-side)", 0.5, false, {}});
   all.push_back({"quarter-res", "preset high at 1/4 the width and height, bilinear upscale (bench-side)", 0.25, false, {}});
   return all;

@@ -33,6 +33,29 @@ struct CloudTypeParams {
   double streak = 1;          // length of shape features along the Earth's axis over their width (>= 1)
 };
 
+// The same numbers as the shared core's CloudType (cloud_core.glsl compiled
+// as C++: the CPU reference's core and the tests' harness each have one).
+template <class CoreCloudType>
+CoreCloudType coreCloudType(const CloudTypeParams& p) {
+  CoreCloudType t{};
+  t.extinction_perm = p.extinction_perm;
+  t.dropletDiameter_um = p.dropletDiameter_um;
+  t.baseRound = p.baseRound;
+  t.topRoundStart = p.topRoundStart;
+  t.peak = p.peak;
+  t.peakVariation = p.peakVariation;
+  t.anvil = p.anvil;
+  t.densityGradient = p.densityGradient;
+  t.densityBaseFade = p.densityBaseFade;
+  t.densityTopFade = p.densityTopFade;
+  t.coverageEdge = p.coverageEdge;
+  t.fibrous = p.fibrous;
+  t.erosion = p.erosion;
+  t.wispyHeight = p.wispyHeight;
+  t.columnFill = p.columnFill;
+  return t;
+}
+
 // The numbers of a type; None (no type given) draws as cumulus.
 const CloudTypeParams& cloudTypeParams(weather::CloudType type);
 

@@ -50,25 +50,7 @@ class CpuCore {
 #include "cloud_core.glsl"
 #undef SKY_CORE_CONST
 
-  static CloudType coreType(const CloudTypeParams& p) {
-    CloudType t{};
-    t.extinction_perm = p.extinction_perm;
-    t.dropletDiameter_um = p.dropletDiameter_um;
-    t.baseRound = p.baseRound;
-    t.topRoundStart = p.topRoundStart;
-    t.peak = p.peak;
-    t.peakVariation = p.peakVariation;
-    t.anvil = p.anvil;
-    t.densityGradient = p.densityGradient;
-    t.densityBaseFade = p.densityBaseFade;
-    t.densityTopFade = p.densityTopFade;
-    t.coverageEdge = p.coverageEdge;
-    t.fibrous = p.fibrous;
-    t.erosion = p.erosion;
-    t.wispyHeight = p.wispyHeight;
-    t.columnFill = p.columnFill;
-    return t;
-  }
+  static CloudType coreType(const CloudTypeParams& p) { return coreCloudType<CloudType>(p); }
 
   // Fills the layers layerAt() returns and the frame.
   CoreFrame coreFrame() {

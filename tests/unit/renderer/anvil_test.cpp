@@ -20,25 +20,7 @@ namespace {
 
 using weather::CloudType;
 
-Core::CloudType coreType(const render::CloudTypeParams& p) {
-  Core::CloudType t{};
-  t.extinction_perm = p.extinction_perm;
-  t.dropletDiameter_um = p.dropletDiameter_um;
-  t.baseRound = p.baseRound;
-  t.topRoundStart = p.topRoundStart;
-  t.peak = p.peak;
-  t.peakVariation = p.peakVariation;
-  t.anvil = p.anvil;
-  t.densityGradient = p.densityGradient;
-  t.densityBaseFade = p.densityBaseFade;
-  t.densityTopFade = p.densityTopFade;
-  t.coverageEdge = p.coverageEdge;
-  t.fibrous = p.fibrous;
-  t.erosion = p.erosion;
-  t.wispyHeight = p.wispyHeight;
-  t.columnFill = p.columnFill;
-  return t;
-}
+Core::CloudType coreType(const render::CloudTypeParams& p) { return render::coreCloudType<Core::CloudType>(p); }
 
 // The storm cell of the GPU suite's cumulonimbus scene (tests/gpu/scenes.cpp):
 // coverage 0.9 out to 3 km, falling linearly to 0.15 at 14 km, 0 beyond.
