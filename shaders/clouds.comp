@@ -1,7 +1,8 @@
 // Cloud pass: one invocation per pixel marches every cloud layer and the
 // clear air along the view ray (model in include/cloud_core.glsl) and writes
 // linear radiance and cloud transmittance to one storage buffer, the cloud
-// depth to a second one. Frame layout: include/sky_shared.h.
+// depth to a second one; with interleaving only one pixel of each n x n block
+// (reproject.comp fills the others from earlier frames). Frame layout: include/sky_shared.h.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
@@ -149,8 +150,14 @@ void main() {
   // Workgroup i draws tile (i * stride) mod n: lavapipe hands each thread a
   // contiguous range of workgroup ids, and the permutation spreads every range
   // over the whole image (lavapipe.md, "static split").
+  // With interleaving the tiles cover the packed image of this frame's
+  // pixels: packed pixel `sub` is pixel sub * n + phase of the full image.
   uint tile = (gl_WorkGroupID.x * frame.dispatch.x) % frame.image.w;
-  uvec2 px = uvec2(tile % frame.image.z, tile / frame.image.z) * kLocalSize + gl_LocalInvocationID.xy;
+  uvec2 sub = uvec2(tile % frame.image.z, tile / frame.image.z) * kLocalSize + gl_LocalInvocationID.xy;
+  uint n = frame.interleave.x;
+  uvec2 packed = (frame.image.xy + uvec2(n - 1u)) / n;
+  if (sub.x >= packed.x || sub.y >= packed.y) return;
+  uvec2 px = sub * n + frame.interleave.yz;
   if (px.x >= frame.image.x || px.y >= frame.image.y) return;
 
   // GLSL's mat3(a, b, c) takes columns; the frame holds rows.
@@ -170,6 +177,6 @@ void main() {
   vec3 dir = cameraRay(frame.camForward.xyz, frame.camRight.xyz, frame.camDown.xyz, frame.camRight.w,
                        frame.camDown.w, float(px.x), float(px.y), float(frame.image.x), float(frame.image.y));
   PixelResult r = shadePixel(f, dir, pixelJitter(px.x, px.y));
-  pixels[px.y * frame.image.x + px.x] = vec4(r.radiance, r.transmittance);
-  depths[px.y * frame.image.x + px.x] = r.depth;
+  pixels[sub.y * packed.x + sub.x] = vec4(r.radiance, r.transmittance);
+  depths[sub.y * packed.x + sub.x] = r.depth;
 }

@@ -91,6 +91,9 @@ struct SkyFrame {
                         // end in fractions of the fine ring's half extent (max norm); w: unused
   vec4 steps;           // the march in metres (RenderSettings::march): x: step inside cloud (m; 0: even
                         // placement), y: step through clear air (m), z: step growth per metre, w: unused
+  uvec4 interleave;     // x: n, the pass draws 1 pixel of each n x n block (1: every pixel); y, z: this
+                        // frame's pixel in the block (column, row); w: unused. The output holds the
+                        // drawn pixels packed, ceil(width / n) per row (reproject.comp reads them).
 };
 
 #ifdef __cplusplus
@@ -111,7 +114,8 @@ static_assert(offsetof(SkyFrame, layers) == 272);
 static_assert(offsetof(SkyLayer, cloudMapOrigin) == 64);
 static_assert(offsetof(SkyFrame, weatherRings) == 272 + 256 * kMaxLayers);
 static_assert(offsetof(SkyFrame, steps) == 272 + 256 * kMaxLayers + 16);
-static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 32);
+static_assert(offsetof(SkyFrame, interleave) == 272 + 256 * kMaxLayers + 32);
+static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 48);
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

@@ -17,8 +17,9 @@ std::vector<Configuration> builtInConfigurations() {
   // then the resolution-only trades of the default preset.
   std::vector<Configuration> all;
   for (const render::Preset& p : render::presets()) {
-    Configuration c{p.name, "preset: " + p.description, 1.0, false, {}};
+    Configuration c{p.name, "preset: " + p.description, 1.0, p.temporal.interleave > 1, {}};
     c.settings.march = p.march;
+    c.settings.temporal = p.temporal;
     all.push_back(c);
   }
   // The seeds' final settings in our march, as far as it has them (each
@@ -72,6 +73,8 @@ Result<Configuration> customConfiguration(const std::string& spec) {
       auto preset = render::findPreset(value);
       if (!preset) return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': " + preset.error().detail);
       m = preset->march;
+      c.settings.temporal = preset->temporal;
+      c.reusesHistory = preset->temporal.interleave > 1;
       continue;
     }
     if (!number) return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': '" + item + "' is not key=number");
@@ -84,9 +87,13 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     else if (key == "growth") m.stepGrowth = v;
     else if (key == "air") m.airSteps = std::uint32_t(v);
     else if (key == "scale" && v > 0 && v <= 1) c.renderScale = v;
+    else if (key == "interleave" && (v == 1 || v == 2 || v == 4)) {
+      c.settings.temporal.interleave = std::uint32_t(v);
+      c.reusesHistory = v > 1;
+    }
     else
       return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': unknown key '" + key +
-                                                  "' (base, primary, light, exit, stride, cloud, empty, growth, air, scale)");
+                                                  "' (base, primary, light, exit, stride, cloud, empty, growth, air, scale, interleave 1|2|4)");
   }
   return c;
 }

@@ -96,7 +96,15 @@ Result<CaseResult> runCase(const LoadedScene& ls, const Configuration& config, c
   cr.create_ms = msBetween(c0, Clock::now());
   deviceName = (*renderer)->deviceName();
   keepVulkanDriversLoaded();
-  for (std::uint32_t i = 0; i < options.warmup; ++i)
+  // A configuration that reuses history starts with it full: n^2 + 1 frames
+  // of the first view (a simulator sitting still before it moves), so a
+  // still scene shows the converged image and its steady per-frame cost.
+  std::uint32_t warmup = options.warmup;
+  if (config.reusesHistory) {
+    const std::uint32_t n = settings.temporal.interleave;
+    warmup = std::max(warmup, n * n + 1);
+  }
+  for (std::uint32_t i = 0; i < warmup; ++i)
     if (auto warm = (*renderer)->render(frameInputs(ls, 0)); !warm) return tl::unexpected(warm.error());
 
   const std::uint32_t frames = cr.path ? scene.frames : 1;
@@ -149,10 +157,26 @@ Result<CaseResult> runCase(const LoadedScene& ls, const Configuration& config, c
   if (!cr.path) cr.worst = cr.error;
   if (cr.path) {
     // temporalBaseline: a configuration without history is its own baseline;
-    // one with history is compared with reference until the renderer can draw
-    // it history-free (metrics.hpp, ghosting).
+    // one with history is compared with the same configuration drawing every
+    // pixel of every frame (metrics.hpp, ghosting).
+    std::vector<Srgb8Image> historyFree;
+    if (config.reusesHistory) {
+      render::RenderSettings whole = settings;
+      whole.temporal = {};
+      auto plain = render::CloudRenderer::create(whole);
+      if (!plain) return tl::unexpected(plain.error());
+      for (std::uint32_t f = 0; f < frames; ++f) {
+        auto image = (*plain)->render(frameInputs(ls, f));
+        if (!image) return tl::unexpected(image.error());
+        std::vector<float> linear = (image->width == res.width && image->height == res.height)
+                                        ? image->rgba
+                                        : resizeBilinear({image->width, image->height, image->rgba}, res.width,
+                                                         res.height);
+        historyFree.push_back(toSrgb8({res.width, res.height, linear}));
+      }
+    }
     const std::span<const Srgb8Image> baseline =
-        config.reusesHistory ? std::span<const Srgb8Image>(reference.srgb) : std::span<const Srgb8Image>(kept.srgb);
+        config.reusesHistory ? std::span<const Srgb8Image>(historyFree) : std::span<const Srgb8Image>(kept.srgb);
     auto te = temporalError(kept.srgb, reference.srgb, baseline);
     if (!te) return tl::unexpected(te.error());
     cr.temporal = std::move(*te);

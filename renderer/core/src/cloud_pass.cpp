@@ -118,7 +118,7 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
       vk::WriteDescriptorSet(set, gpu::kBindingCoverageMip, 0, vk::DescriptorType::eStorageBuffer, {}, mipInfo)};
   device.updateDescriptorSets(writes, {});
 
-  pass.timer_ = GpuTimer(ctx, 1, "sky.clouds.timer");
+  pass.timer_ = GpuTimer(ctx, 2, "sky.clouds.timer");
   pass.commands_ = ctx.allocateCommandBuffer();
   ctx.name(pass.commands_, "sky.clouds.commands");
   pass.fence_ = vk::raii::Fence(device, vk::FenceCreateInfo());
@@ -131,7 +131,10 @@ void CloudPass::setCoverageMip(const std::vector<float>& mip) {
   std::memcpy(coverageMip_.mapped, mip.data(), coverageMip_.size);
 }
 
-Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame) {
+Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, ReprojectPass* reproject,
+                             const gpu::SkyReproject* reprojectParams) {
+  SKY_ASSERT((reproject == nullptr) == (reprojectParams == nullptr));
+  SKY_ASSERT(reproject != nullptr || frame.interleave.x == 1);
   std::memcpy(uniforms_.mapped, &frame, sizeof frame);
 
   commands_.reset();
@@ -143,7 +146,15 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame) 
     commands_.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *descriptorSet_, {});
     // One workgroup per 8x8 tile, in a 1D grid: the shader maps ids to tiles
     // through the permutation in frame.dispatch.
-    commands_.dispatch(tileCount(width_, height_), 1, 1);
+    commands_.dispatch(frame.image.w, 1, 1);
+  }
+  if (reproject != nullptr) {
+    reproject->record(commands_, timer_, *reprojectParams);
+    commands_.end();
+    if (auto ok = ctx.submitAndWait(commands_, fence_); !ok) return tl::unexpected(ok.error());
+    Image image;
+    reproject->readBack(image);
+    return image;
   }
   const std::array toHost{
       vk::BufferMemoryBarrier(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead, VK_QUEUE_FAMILY_IGNORED,

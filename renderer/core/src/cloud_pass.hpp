@@ -14,6 +14,7 @@
 #include "gpu_memory.hpp"
 #include "gpu_timer.hpp"
 #include "noise_volume.hpp"
+#include "reproject_pass.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky_shared.h"
 #include "weather_texture.hpp"
@@ -29,12 +30,20 @@ class CloudPass {
                                   const NoiseVolume& shape, const NoiseVolume& detail,
                                   const AtmosphereTables& atmosphere, const WeatherTexture& weather);
 
-  // Dispatches one frame and reads it back. Errors: Timeout, Device.
-  Result<Image> run(const GpuContext& ctx, const gpu::SkyFrame& frame);
+  // Dispatches one frame and reads it back. With a reprojection pass, that
+  // pass follows in the same submission (with its block) and the image read
+  // back is the one it wrote; without, the frame must draw every pixel.
+  // Errors: Timeout, Device.
+  Result<Image> run(const GpuContext& ctx, const gpu::SkyFrame& frame, ReprojectPass* reproject = nullptr,
+                    const gpu::SkyReproject* reprojectParams = nullptr);
+  // What the clouds write: radiance + transmittance and cloud depth of the
+  // pixels drawn, packed (sky_shared.h, SkyFrame::interleave).
+  const GpuBuffer& output() const { return output_; }
+  const GpuBuffer& depth() const { return depth_; }
   // Replaces the max-coverage mip the march reads (coverage_mip.hpp; size
   // kMaxLayers x kCoverageMipSize^2). Call between runs.
   void setCoverageMip(const std::vector<float>& mip);
-  // GPU time of the last run's dispatch ("clouds").
+  // GPU time of the last run's dispatches ("clouds", then "reproject").
   std::vector<PassTime> lastTimes() const { return timer_.results(); }
 
  private:

@@ -19,23 +19,28 @@
 #include "gpu_context.hpp"
 #include "noise_volume.hpp"
 #include "presenter.hpp"
+#include "reproject_pass.hpp"
+#include "temporal_plan.hpp"
 #include "weather_texture.hpp"
 
 namespace sky::render {
 
 struct CloudRenderer::Impl {
-  // Destroyed in reverse order: the presenter, the pass (which binds the
-  // weather image) before the weather texture, all before the context that
-  // owns the device.
+  // Destroyed in reverse order: the presenter, the reprojection pass (which
+  // binds the cloud pass's output), the pass (which binds the weather image)
+  // before the weather texture, all before the context that owns the device.
   std::unique_ptr<GpuContext> ctx;
   WeatherTexture weather;
   CloudPass pass;
+  std::optional<ReprojectPass> reproject;  // with interleaving (settings.temporal.interleave > 1)
+  TemporalPlanner planner;
   std::optional<Presenter> presenter;
   RenderSettings settings;
   AtmosphereTables atmosphere;  // CPU copy: the frame setup's sky light reads it
   std::vector<PassTime> passTimes;
   std::string noiseReport;
   std::uint64_t coverageMipUploads = ~std::uint64_t(0);  // weather uploads the pass's coverage mip is of
+  TemporalReport temporal{};  // what the reprojection did with the last frame
 };
 
 namespace {
@@ -116,6 +121,12 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
     AtmosphereTables atmosphere = sharedAtmosphereTables();
     auto pass = CloudPass::create(**ctx, settings.width, settings.height, shape, detail, atmosphere, *weather);
     if (!pass) return tl::unexpected(pass.error());
+    std::optional<ReprojectPass> reproject;
+    if (settings.temporal.interleave > 1) {
+      auto created = ReprojectPass::create(**ctx, settings.width, settings.height, pass->output(), pass->depth());
+      if (!created) return tl::unexpected(created.error());
+      reproject.emplace(std::move(*created));
+    }
     std::optional<Presenter> presenter;
     if (gpu.window) {
       auto created = Presenter::create(**ctx, *gpu.window);
@@ -123,6 +134,7 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
       presenter.emplace(std::move(*created));
     }
     auto impl = std::make_unique<Impl>(Impl{std::move(*ctx), std::move(*weather), std::move(*pass),
+                                            std::move(reproject), TemporalPlanner(settings.temporal),
                                             std::move(presenter), settings, std::move(atmosphere), {},
                                             std::move(noiseReport)});
     return std::unique_ptr<CloudRenderer>(new CloudRenderer(std::move(impl)));
@@ -140,10 +152,26 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
       impl_->pass.setCoverageMip(buildCoverageMip(impl_->weather.field()));
       impl_->coverageMipUploads = impl_->weather.uploads();
     }
-    const FrameSetup setup = prepareFrame(impl_->settings, inputs, impl_->weather.field(), impl_->atmosphere);
-    auto image = impl_->pass.run(*impl_->ctx, packFrame(setup));
-    if (image)
-      for (auto& t : impl_->pass.lastTimes()) impl_->passTimes.push_back(std::move(t));
+    FrameSetup setup = prepareFrame(impl_->settings, inputs, impl_->weather.field(), impl_->atmosphere);
+    impl_->temporal = {};
+    if (!impl_->reproject) {
+      auto image = impl_->pass.run(*impl_->ctx, packFrame(setup));
+      if (image)
+        for (auto& t : impl_->pass.lastTimes()) impl_->passTimes.push_back(std::move(t));
+      return image;
+    }
+    const TemporalPlan plan = impl_->planner.plan(setup, inputs);
+    setup.interleave = plan.interleave;
+    setup.phase = plan.phase;
+    auto image = impl_->pass.run(*impl_->ctx, packFrame(setup), &*impl_->reproject, &plan.params);
+    if (!image) {
+      impl_->planner.forget();
+      return image;
+    }
+    for (auto& t : impl_->pass.lastTimes()) impl_->passTimes.push_back(std::move(t));
+    impl_->temporal = impl_->reproject->counts();
+    impl_->temporal.drawnWhole = plan.drawWhole;
+    impl_->temporal.reason = plan.reason;
     return image;
   });
 }
@@ -165,6 +193,8 @@ Result<bool> CloudRenderer::present(const Image& image) {
 const std::string& CloudRenderer::noiseReport() const { return impl_->noiseReport; }
 
 const std::vector<PassTime>& CloudRenderer::lastPassTimes() const { return impl_->passTimes; }
+
+const TemporalReport& CloudRenderer::lastTemporal() const { return impl_->temporal; }
 
 std::vector<std::string> CloudRenderer::takeValidationMessages() { return impl_->ctx->takeValidationMessages(); }
 

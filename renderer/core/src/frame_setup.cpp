@@ -102,6 +102,21 @@ Result<void> validateSettings(const RenderSettings& s) {
   if (!(m.stepGrowth >= 0 && m.stepGrowth <= 1))
     return fail(ErrorCode::InvalidArgument,
                 "render settings: march.stepGrowth " + num(m.stepGrowth) + " outside [0, 1]");
+  const TemporalSettings& t = s.temporal;
+  if (t.interleave != 1 && t.interleave != 2 && t.interleave != 4)
+    return fail(ErrorCode::InvalidArgument,
+                "render settings: temporal.interleave " + std::to_string(t.interleave) + " is not 1, 2 or 4");
+  auto range = [](const char* field, double v, double lo, double hi, bool openLow) -> Result<void> {
+    if (std::isfinite(v) && (openLow ? v > lo : v >= lo) && v <= hi) return {};
+    return fail(ErrorCode::InvalidArgument, std::string("render settings: temporal.") + field + " " + num(v) +
+                                                " outside " + (openLow ? "(" : "[") + num(lo) + ", " + num(hi) + "]");
+  };
+  for (auto ok : {range("resetDistance_m", t.resetDistance_m, 0, 1e7, true),
+                  range("resetRotation_deg", t.resetRotation_deg, 0, 180, true),
+                  range("resetClockStep_s", t.resetClockStep_s, 0, 1e6, false),
+                  range("resetSunTurn_deg", t.resetSunTurn_deg, 0, 180, true),
+                  range("depthTolerance", t.depthTolerance, 0, 1, true)})
+    if (!ok) return ok;
   return {};
 }
 
@@ -150,6 +165,7 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
   s.camRight = inFrame(enu, axes.right);
   s.camDown = inFrame(enu, axes.down);
   s.localToEcef = glm::dmat3(toGlm(enu.east), toGlm(enu.north), toGlm(enu.up));
+  s.cameraEcef_m = toGlm(enu.originEcef_m);
 
   const geo::EnuFrame& a = field.frame;
   s.camToAnchor = glm::dmat3(inFrame(a, enu.east), inFrame(a, enu.north), inFrame(a, enu.up));
@@ -241,6 +257,7 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
     // drift uses the wind's direction at the camera, so it turns slowly
     // (~1 degree per 100 km) as the camera travels; per-point advection comes
     // with the full model.
+    l.windEnu_mps = windEnu_mps;
     const glm::dvec3 origin = toGlm(enu.originEcef_m) - s.localToEcef * windEnu_mps * in.weatherClock_s;
     auto inPeriods = [&](double period_m, double stretchZ) {
       glm::dvec3 out;
@@ -295,8 +312,12 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   f.sunIrradiance = v4(s.sunIrradiance);
   f.groundIrradiance = v4(s.groundIrradiance);
 
-  const std::uint32_t tilesX = (s.width + gpu::kLocalSize - 1) / gpu::kLocalSize;
-  const std::uint32_t n = tileCount(s.width, s.height);
+  // The tiles cover the packed image of the pixels this frame draws.
+  SKY_ASSERT(s.interleave >= 1 && s.phase.x < s.interleave && s.phase.y < s.interleave);
+  const std::uint32_t packedW = (s.width + s.interleave - 1) / s.interleave;
+  const std::uint32_t packedH = (s.height + s.interleave - 1) / s.interleave;
+  const std::uint32_t tilesX = (packedW + gpu::kLocalSize - 1) / gpu::kLocalSize;
+  const std::uint32_t n = tileCount(packedW, packedH);
   std::uint32_t stride = 1;
   if (n < kMaxPermutedTiles) {
     stride = std::max<std::uint32_t>(1, std::uint32_t(std::lround(kStrideFraction * n)));
@@ -305,6 +326,7 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   f.image = gpu::uvec4(s.width, s.height, tilesX, n);
   f.dispatch = gpu::uvec4(stride, s.march.primarySteps, s.march.lightSteps, s.march.airSteps);
   f.steps = gpu::vec4(float(s.march.cloudStep_m), float(s.march.emptyStep_m), float(s.march.stepGrowth), 0.0f);
+  f.interleave = gpu::uvec4(s.interleave, s.phase.x, s.phase.y, 0u);
 
   for (std::size_t i = 0; i < s.layers.size(); ++i) {
     const LayerSetup& l = s.layers[i];

@@ -41,6 +41,7 @@ struct LayerSetup {
   glm::dvec3 detailOrigin{0};      // the same for the detail period
   glm::dvec3 cloudMapOrigin{0};    // the same for the cloud-map period
   glm::dvec2 coverageShift_m{0};   // wind drift of the coverage since the snapshot, east/north
+  glm::dvec3 windEnu_mps{0};       // the layer's air velocity (where it blows to), local frame
   glm::dvec3 skyTop{0};            // mean sky radiance at the layer top, linear units
   glm::dvec3 sunDiffuseTop{0};     // sunlight at the layer top as diffuse radiance, E T mu / pi
   double sunCosine = 0;            // mu of the sun at the layer top over the camera, >= 0
@@ -54,6 +55,7 @@ struct FrameSetup {
   double tanHalfFov = 0, aspect = 1;
   glm::dvec3 camForward{0}, camRight{0}, camDown{0};  // local frame: x east, y north, z up
   glm::dmat3 localToEcef{1};   // columns: the camera's east, north, up in ECEF
+  glm::dvec3 cameraEcef_m{0};  // the local frame's origin
   glm::dmat3 camToAnchor{1};   // columns: camera east, north, up in the weather anchor's frame
   glm::dvec3 camInAnchor_m{0}; // camera relative to the anchor sphere centre, anchor frame
   double anchorRadius_m = 0;
@@ -70,6 +72,10 @@ struct FrameSetup {
   glm::dvec3 groundIrradiance{0};  // sky irradiance on the ground, linear units
   std::vector<LayerSetup> layers;
   MarchSettings march;  // the march's cost knobs, as set
+  // The pixels the cloud pass draws: one of each interleave x interleave
+  // block, the one at `phase` in it (TemporalPlanner); 1, {0, 0}: all.
+  std::uint32_t interleave = 1;
+  glm::uvec2 phase{0};
 };
 
 // Checks settings (size, field of view) for CloudRenderer::create.

@@ -23,12 +23,12 @@ struct Configuration {
   // (display.hpp). The renderer has no render scale of its own yet; when it
   // does, a preset sets it in RenderSettings and this stays 1. (0, 1].
   double renderScale = 1.0;
-  // Whether frames reuse earlier frames (reprojection, temporal
-  // accumulation). Only such a configuration can ghost: for the others the
-  // bench measures ghosting against the configuration's own frames (0). For
-  // one that does, it measures against reference until the renderer can draw
-  // the same configuration without history (then that is the baseline:
-  // runner.cpp, temporalBaseline).
+  // Whether frames reuse earlier frames (settings.temporal.interleave > 1).
+  // Only such a configuration can ghost: for the others the bench measures
+  // ghosting against the configuration's own frames (0); for one that does,
+  // against the same configuration drawing every pixel of every frame
+  // (runner.cpp, temporalBaseline). It also starts each case with its
+  // history full (n^2 + 1 warm-up frames of the first view).
   bool reusesHistory = false;
   // The renderer's settings for this configuration; width, height and
   // verticalFov_deg are overwritten per scene and resolution by settingsFor.
@@ -44,8 +44,9 @@ std::vector<Configuration> builtInConfigurations();
 Result<std::vector<Configuration>> selectConfigurations(const std::string& names);
 
 // A configuration from a spec NAME:key=value,... (keys: base = a preset
-// whose march it starts from, else high's; primary, light, exit, stride,
-// cloud, empty, growth, air = the MarchSettings fields; scale = render scale).
+// whose march and interleave it starts from, else high's; primary, light, exit, stride,
+// cloud, empty, growth, air = the MarchSettings fields; scale = render scale;
+// interleave = TemporalSettings::interleave, 1, 2 or 4).
 // --configs takes such specs next to names; a list with a spec in it is
 // separated by ';' (a spec has commas). Errors: InvalidArgument naming the bad part.
 Result<Configuration> customConfiguration(const std::string& spec);

@@ -44,6 +44,30 @@ struct MarchSettings {
   std::uint32_t airSteps = 0;
 };
 
+// Interleaved rendering with reprojection (shaders/reproject.comp,
+// renderer/core/src/temporal_plan.hpp): each frame the cloud pass draws one
+// pixel of every n x n block, in a fixed order that visits each pixel once
+// every n^2 frames, and every other pixel comes from the previous frame
+// through the camera's motion and the wind, at its cloud depth. A still view
+// converges in n^2 frames to exactly the image drawn whole.
+struct TemporalSettings {
+  std::uint32_t interleave = 1;  // n: 1 (every pixel, no history), 2 (1 of 4) or 4 (1 of 16)
+  // The history is dropped, and the frame drawn whole, when since the previous
+  // frame the camera moved further than resetDistance_m (a teleport), the view
+  // turned further than resetRotation_deg, the weather clock stepped further
+  // than resetClockStep_s (either way), the key light turned further than
+  // resetSunTurn_deg, the camera crossed a layer's base or top, or the weather
+  // (layers, tiles) changed.
+  double resetDistance_m = 1000;    // (0, 1e7]
+  double resetRotation_deg = 30;    // (0, 180]
+  double resetClockStep_s = 10;     // [0, 1e6]
+  double resetSunTurn_deg = 1;      // (0, 180]
+  // A history pixel is reused where its cloud depth is within this fraction
+  // (plus 20 m) of where the pixel's point was; else the pixel is upscaled
+  // from this frame's drawn pixels (disocclusion). (0, 1].
+  double depthTolerance = 0.1;
+};
+
 struct RenderSettings {
   std::uint32_t width = 320, height = 180;  // pixels, [1, 8192]
   double verticalFov_deg = 60;              // (0, 179)
@@ -52,6 +76,7 @@ struct RenderSettings {
   // empty: generated at every start.
   std::string noiseCacheDir;
   MarchSettings march;
+  TemporalSettings temporal;
 };
 
 struct FrameInputs {
@@ -70,7 +95,18 @@ struct FrameInputs {
   // angle, 0 full to 180 new. The clouds are lit by one key light: the sun,
   // or the moon when it lights the ground more (frame_setup.cpp).
   double moonAzimuth_deg = 0, moonElevation_deg = -90, moonPhaseAngle_deg = 180;
-  std::uint64_t frameIndex = 0;  // carried for reprojection; the skeleton's image does not depend on it
+  std::uint64_t frameIndex = 0;  // the caller's frame number, for its metadata; the image does not depend on it
+};
+
+// What the reprojection did with the last frame (all zero without
+// interleaving): whether the frame was drawn whole and why, and how many
+// pixels were drawn, reused from the history, or upscaled from the drawn
+// ones because their point was outside the previous view or the history
+// there showed something else (disocclusion).
+struct TemporalReport {
+  bool drawnWhole = false;
+  std::string reason;  // why it was drawn whole ("first frame", "teleport 2.1 km", ...); empty otherwise
+  std::uint64_t drawn = 0, reused = 0, offscreen = 0, disoccluded = 0;
 };
 
 // Linear radiance, rgba per pixel (a = view-ray transmittance through the
@@ -119,6 +155,8 @@ class CloudRenderer {
   // The passes the GPU ran for the last render() (and a present() after it),
   // in submission order; empty when the device's queue has no timestamps.
   const std::vector<PassTime>& lastPassTimes() const;
+  // What the reprojection did with the last render().
+  const TemporalReport& lastTemporal() const;
 
   // Validation messages since the last call, and the totals (nothing
   // without GpuOptions::validation).

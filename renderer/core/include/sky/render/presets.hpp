@@ -16,6 +16,7 @@ struct Preset {
   std::string name;         // what --preset takes
   std::string description;  // what it changes against reference, one line
   MarchSettings march;
+  TemporalSettings temporal;  // interleave 1: every pixel every frame
 };
 
 // Every preset, `reference` first, then from most to least expensive.

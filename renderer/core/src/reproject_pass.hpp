@@ -1,0 +1,52 @@
+// The reprojection pass (shaders/reproject.comp): recorded after the cloud
+// pass in the same command buffer, it reads the pixels the clouds drew this
+// frame and the previous frame's full image, and writes this frame's full
+// image, which the next frame reads as its history. Two image buffers
+// (radiance + transmittance, cloud depth) swap roles every frame; a small
+// counter buffer says what became of the pixels (reproject_shared.h).
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "compute_pipeline.hpp"
+#include "gpu_context.hpp"
+#include "gpu_memory.hpp"
+#include "gpu_timer.hpp"
+#include "reproject_shared.h"
+#include "sky/render/cloud_renderer.hpp"
+
+namespace sky::render {
+
+class ReprojectPass {
+ public:
+  // fresh and freshDepth: the cloud pass's output buffers (width * height
+  // entries; they must outlive the pass). Errors: Io/Malformed for the
+  // SPIR-V; other Vulkan failures throw.
+  static Result<ReprojectPass> create(const GpuContext& ctx, std::uint32_t width, std::uint32_t height,
+                                      const GpuBuffer& fresh, const GpuBuffer& freshDepth);
+
+  // Records the pass (after a barrier on the cloud pass's writes) and the
+  // barrier that makes its output readable by the host. The block is copied
+  // now; the output buffers swap at the next record().
+  void record(const vk::raii::CommandBuffer& commands, GpuTimer& timer, const gpu::SkyReproject& params);
+  // After the submission completed: the image the last record() wrote, and
+  // what became of its pixels.
+  void readBack(Image& image) const;
+  TemporalReport counts() const;
+
+ private:
+  ReprojectPass() = default;
+
+  ComputePipeline pipeline_;
+  GpuBuffer params_;
+  std::array<GpuBuffer, 2> colour_;  // full images; [current_] is written, the other read
+  std::array<GpuBuffer, 2> depth_;
+  GpuBuffer stats_;
+  vk::raii::DescriptorPool descriptorPool_{nullptr};
+  std::array<vk::raii::DescriptorSet, 2> sets_{nullptr, nullptr};  // [k] writes colour_[k], reads the other
+  std::uint32_t width_ = 0, height_ = 0;
+  std::uint32_t current_ = 0;  // the buffers the last record() wrote
+};
+
+}  // namespace sky::render

@@ -1,0 +1,152 @@
+// Interleave order, history rules and reprojection parameters (see temporal_plan.hpp).
+#include "temporal_plan.hpp"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <numbers>
+#include <sstream>
+
+#include "sky/core/assert.hpp"
+
+namespace sky::render {
+
+namespace {
+
+constexpr double kRadToDeg = 180.0 / std::numbers::pi;
+
+// Bayer matrices (ordered dither): entry = the frame of the cycle that draws
+// that pixel of the block (row, column).
+constexpr std::array<std::array<std::uint32_t, 2>, 2> kBayer2{{{0, 2}, {3, 1}}};
+constexpr std::array<std::array<std::uint32_t, 4>, 4> kBayer4{{{0, 8, 2, 10}, {12, 4, 14, 6}, {3, 11, 1, 9}, {15, 7, 13, 5}}};
+
+void mix64(std::uint64_t& h, std::uint64_t v) {
+  for (int i = 0; i < 8; ++i) {
+    h ^= (v >> (8 * i)) & 0xffu;
+    h *= 1099511628211ull;
+  }
+}
+
+void mixDouble(std::uint64_t& h, double v) { mix64(h, std::bit_cast<std::uint64_t>(v)); }
+
+double angleBetween_deg(const glm::dvec3& a, const glm::dvec3& b) {
+  const double c = glm::dot(a, b) / std::max(glm::length(a) * glm::length(b), 1e-300);
+  return std::acos(std::clamp(c, -1.0, 1.0)) * kRadToDeg;
+}
+
+std::string rounded(double v, int digits) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << v;
+  return s.str();
+}
+
+gpu::vec4 v4(const glm::dvec3& v, double w = 0) { return gpu::vec4(glm::dvec4(v, w)); }
+
+}  // namespace
+
+glm::uvec2 interleavePhase(std::uint32_t n, std::uint32_t cycleIndex) {
+  SKY_ASSERT(n == 1 || n == 2 || n == 4);
+  if (n == 1) return {0, 0};
+  const std::uint32_t k = cycleIndex % (n * n);
+  for (std::uint32_t y = 0; y < n; ++y)
+    for (std::uint32_t x = 0; x < n; ++x)
+      if ((n == 2 ? kBayer2[y][x] : kBayer4[y][x]) == k) return {x, y};
+  SKY_ASSERT(false);
+  return {0, 0};
+}
+
+std::uint64_t weatherSceneKey(const weather::WeatherSnapshot* snapshot) {
+  std::uint64_t h = weatherContentKey(snapshot);
+  if (snapshot == nullptr) return h;
+  for (const auto& layer : snapshot->layers) {
+    mixDouble(h, layer.base_m);
+    mixDouble(h, layer.thickness_m);
+    mixDouble(h, layer.wind.speed_mps);
+    mixDouble(h, layer.wind.fromDirection_deg);
+    mixDouble(h, layer.wind.vertical_mps);
+  }
+  return h;
+}
+
+std::string TemporalPlanner::resetReason(const Remembered& prev, const Remembered& now) const {
+  if (now.sceneKey != prev.sceneKey) return "weather changed";
+  const double moved_m = glm::length(now.cameraEcef_m - prev.cameraEcef_m);
+  if (moved_m > settings_.resetDistance_m) return "camera moved " + rounded(moved_m, 0) + " m";
+  // The turn between the two views: the rotation taking one camera's axes
+  // (in ECEF) to the other's.
+  const glm::dmat3 a = prev.localToEcef * glm::dmat3(prev.forward, prev.right, prev.down);
+  const glm::dmat3 b = now.localToEcef * glm::dmat3(now.forward, now.right, now.down);
+  const glm::dmat3 r = glm::transpose(b) * a;
+  const double turned_deg = std::acos(std::clamp((r[0][0] + r[1][1] + r[2][2] - 1.0) / 2.0, -1.0, 1.0)) * kRadToDeg;
+  if (turned_deg > settings_.resetRotation_deg) return "view turned " + rounded(turned_deg, 1) + " deg";
+  const double step_s = now.clock_s - prev.clock_s;
+  if (std::abs(step_s) > settings_.resetClockStep_s) return "weather clock stepped " + rounded(step_s, 1) + " s";
+  if (now.moonLit != prev.moonLit) return now.moonLit ? "the moon took over the light" : "the sun took over the light";
+  const double sunTurn_deg = angleBetween_deg(now.keyLightEcef, prev.keyLightEcef);
+  if (sunTurn_deg > settings_.resetSunTurn_deg) return "key light moved " + rounded(sunTurn_deg, 2) + " deg";
+  if (now.layerSide.size() != prev.layerSide.size()) return "weather changed";
+  for (std::size_t i = 0; i < now.layerSide.size(); ++i)
+    if (now.layerSide[i] != prev.layerSide[i])
+      return std::string("camera ") + (now.layerSide[i] == 0 ? "entered" : "left") + " cloud layer " +
+             std::to_string(i);
+  return {};
+}
+
+TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& inputs) {
+  Remembered now;
+  now.cameraEcef_m = setup.cameraEcef_m;
+  now.localToEcef = setup.localToEcef;
+  now.forward = setup.camForward;
+  now.right = setup.camRight;
+  now.down = setup.camDown;
+  now.keyLightEcef = setup.localToEcef * setup.sunDir;
+  now.moonLit = setup.moonLit;
+  now.clock_s = inputs.weatherClock_s;
+  now.sceneKey = weatherSceneKey(inputs.weather);
+  for (const LayerSetup& l : setup.layers) now.layerSide.push_back(l.hTop_m > 0 ? 1 : l.hBase_m < 0 ? -1 : 0);
+
+  TemporalPlan plan;
+  const std::uint32_t n = settings_.interleave;
+  const std::string reason = previous_ ? resetReason(*previous_, now) : std::string("first frame");
+  plan.drawWhole = !reason.empty();
+  plan.reason = reason;
+  plan.interleave = plan.drawWhole ? 1 : n;
+  plan.phase = plan.drawWhole ? glm::uvec2(0) : interleavePhase(n, std::uint32_t(frames_ % (n * n)));
+  ++frames_;
+
+  gpu::SkyReproject& p = plan.params;
+  p.camForward = v4(setup.camForward);
+  p.camRight = v4(setup.camRight, setup.tanHalfFov);
+  p.camDown = v4(setup.camDown, setup.aspect);
+  p.image = gpu::uvec4(setup.width, setup.height, plan.interleave, plan.drawWhole ? 0u : 1u);
+  const std::uint32_t packedW = (setup.width + plan.interleave - 1) / plan.interleave;
+  p.phase = gpu::uvec4(plan.phase.x, plan.phase.y, packedW, std::uint32_t(setup.layers.size()));
+  p.tolerance = gpu::vec4(float(settings_.depthTolerance), float(kDepthToleranceSlack_m), float(kLayerWindMargin_m), 0.0f);
+  p.prevPosition = v4(glm::dvec3(0), setup.r_m);
+  if (!plan.drawWhole) {
+    // The previous camera in this frame's local frame: ECEF differences in
+    // double, rotated by this frame's local axes (transpose = inverse).
+    const Remembered& prev = *previous_;
+    const glm::dmat3 toLocal = glm::transpose(setup.localToEcef);
+    const glm::dmat3 prevToLocal = toLocal * prev.localToEcef;
+    p.prevForward = v4(prevToLocal * prev.forward);
+    p.prevRight = v4(prevToLocal * prev.right);
+    p.prevDown = v4(prevToLocal * prev.down);
+    p.prevPosition = v4(toLocal * (prev.cameraEcef_m - setup.cameraEcef_m), setup.r_m);
+    const double step_s = now.clock_s - prev.clock_s;
+    SKY_ASSERT(setup.layers.size() <= gpu::kReprojectMaxLayers);
+    for (std::size_t i = 0; i < setup.layers.size(); ++i) {
+      const LayerSetup& l = setup.layers[i];
+      p.layerBand[i] = gpu::vec4(float(-l.hBase_m), float(-l.hTop_m), 0.0f, 0.0f);
+      p.layerMotion[i] = v4(l.windEnu_mps * step_s);
+    }
+  }
+  previous_ = now;
+  return plan;
+}
+
+}  // namespace sky::render

@@ -1,0 +1,77 @@
+// The CPU half of interleaved rendering (TemporalSettings): which pixel of
+// each n x n block a frame draws, whether the previous frame's image may be
+// reused at all (else the frame is drawn whole), and the reprojection pass's
+// parameters: the previous camera and each layer's wind motion in this
+// frame's local frame, from the two frames' setups in double precision.
+// Pure: no GPU, so the rules are unit-tested (tests/unit/renderer/temporal_plan_test.cpp).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/mat3x3.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+
+#include "frame_setup.hpp"
+#include "reproject_shared.h"
+#include "sky/render/cloud_renderer.hpp"
+
+namespace sky::render {
+
+// Absolute slack of TemporalSettings::depthTolerance (m).
+inline constexpr double kDepthToleranceSlack_m = 20;
+// Height margin around a layer inside which a point moves with its wind (m):
+// a cloud depth is a transmittance-weighted mean, which may lie just outside.
+inline constexpr double kLayerWindMargin_m = 300;
+
+// The pixel of its n x n block a frame draws, for the frame's place in the
+// cycle (0 .. n^2 - 1): ordered dispersed (Bayer), so consecutive frames
+// draw far-apart pixels and any n^2 consecutive frames draw every pixel once.
+glm::uvec2 interleavePhase(std::uint32_t n, std::uint32_t cycleIndex);
+
+// Everything about the weather that changes the image, apart from the clock
+// and the camera: layers (id, type, base, thickness, coverage, density,
+// wind) and tiles.
+std::uint64_t weatherSceneKey(const weather::WeatherSnapshot* snapshot);
+
+struct TemporalPlan {
+  bool drawWhole = true;   // no history: the cloud pass draws every pixel
+  std::string reason;      // why, when drawWhole
+  std::uint32_t interleave = 1;
+  glm::uvec2 phase{0};
+  gpu::SkyReproject params{};  // the reprojection pass's block (image.w = 1 when a history is used)
+};
+
+class TemporalPlanner {
+ public:
+  explicit TemporalPlanner(const TemporalSettings& settings) : settings_(settings) {}
+
+  // Plans the frame with this setup (inputs: its clock and weather) and
+  // remembers it as the previous frame for the next call.
+  TemporalPlan plan(const FrameSetup& setup, const FrameInputs& inputs);
+  // Forgets the previous frame (after a frame that failed on the GPU).
+  void forget() { previous_.reset(); }
+
+ private:
+  struct Remembered {
+    glm::dvec3 cameraEcef_m{0};
+    glm::dmat3 localToEcef{1};
+    glm::dvec3 forward{0}, right{0}, down{0};  // local frame of that frame
+    glm::dvec3 keyLightEcef{0};
+    bool moonLit = false;
+    double clock_s = 0;
+    std::uint64_t sceneKey = 0;
+    std::vector<int> layerSide;  // per layer: -1 under its base, 0 inside, 1 over its top
+  };
+  // Why the history cannot be used for a frame after `prev`; empty when it can.
+  std::string resetReason(const Remembered& prev, const Remembered& now) const;
+
+  TemporalSettings settings_;
+  std::optional<Remembered> previous_;
+  std::uint64_t frames_ = 0;  // frames planned: the place in the interleave cycle
+};
+
+}  // namespace sky::render

@@ -1,0 +1,66 @@
+// Layout of the reprojection pass's parameter block and its binding numbers,
+// shared by C++ (renderer/core/src/reproject_pass.cpp, temporal_plan.cpp) and
+// GLSL (shaders/reproject.comp). vec4/uvec4 members only, as sky_shared.h.
+#ifndef SKY_REPROJECT_SHARED_H
+#define SKY_REPROJECT_SHARED_H
+
+#ifdef __cplusplus
+#include <cstddef>
+#include <cstdint>
+#include <glm/vec4.hpp>
+namespace sky::gpu {
+using vec4 = glm::vec4;
+using uvec4 = glm::uvec4;
+#define SKY_REPROJECT_CONST static constexpr std::uint32_t
+#else
+#define SKY_REPROJECT_CONST const uint
+#endif
+
+// Descriptor set 0 bindings of the reprojection pass. Every image is a
+// storage buffer, row-major, top row first.
+SKY_REPROJECT_CONST kReprojectBindingParams = 0u;        // read-only: one SkyReproject
+SKY_REPROJECT_CONST kReprojectBindingFresh = 1u;         // read-only vec4: this frame's drawn pixels, packed
+SKY_REPROJECT_CONST kReprojectBindingFreshDepth = 2u;    // read-only float: their cloud depth (m, 0 none)
+SKY_REPROJECT_CONST kReprojectBindingHistory = 3u;       // read-only vec4: the previous frame's full image
+SKY_REPROJECT_CONST kReprojectBindingHistoryDepth = 4u;  // read-only float: its cloud depth
+SKY_REPROJECT_CONST kReprojectBindingOut = 5u;           // vec4: this frame's full image (the next history)
+SKY_REPROJECT_CONST kReprojectBindingOutDepth = 6u;      // float: its cloud depth
+SKY_REPROJECT_CONST kReprojectBindingStats = 7u;         // uint[kReprojectStatCount]: pixels per outcome
+
+// What became of each pixel (the stats buffer's entries).
+SKY_REPROJECT_CONST kStatFresh = 0u;       // drawn this frame
+SKY_REPROJECT_CONST kStatReused = 1u;      // taken from the history through the motion
+SKY_REPROJECT_CONST kStatOffscreen = 2u;   // its point was outside the previous view: upscaled
+SKY_REPROJECT_CONST kStatDisoccluded = 3u; // the history there shows something else (depth): upscaled
+SKY_REPROJECT_CONST kStatNoHistory = 4u;   // no history to take (a reset frame is drawn whole instead)
+SKY_REPROJECT_CONST kReprojectStatCount = 5u;
+
+SKY_REPROJECT_CONST kReprojectLocalSize = 8u;
+SKY_REPROJECT_CONST kReprojectMaxLayers = 4u;  // = kMaxLayers of sky_shared.h
+
+struct SkyReproject {
+  vec4 camForward;   // xyz: this frame's camera axes in its local frame (x east, y north, z up)
+  vec4 camRight;     // w: tan(vertical fov / 2)
+  vec4 camDown;      // w: width / height
+  vec4 prevForward;  // xyz: the previous frame's camera axes, in this frame's local frame
+  vec4 prevRight;
+  vec4 prevDown;
+  vec4 prevPosition; // xyz: the previous camera in this frame's local frame (m); w: camera radius r (m)
+  uvec4 image;       // x: width, y: height, z: n (interleave), w: 1 when there is a history, else 0
+  uvec4 phase;       // xy: this frame's drawn pixel in each n x n block; z: packed width; w: layer count
+  vec4 layerBand[kReprojectMaxLayers];    // x: layer base, y: top, as heights above the camera (m)
+  vec4 layerMotion[kReprojectMaxLayers];  // xyz: how far the layer's air moved since the previous
+                                          // frame, this frame's local frame (m)
+  vec4 tolerance;    // x: relative cloud-depth difference a reused pixel may have, y: the same in m
+                     // (added), z: margin around a layer band its wind applies in (m), w: unused
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(SkyReproject) == 16 * (9 + 2 * kReprojectMaxLayers + 1));
+static_assert(offsetof(SkyReproject, image) == 112);
+static_assert(offsetof(SkyReproject, layerBand) == 144);
+}  // namespace sky::gpu
+#endif
+#undef SKY_REPROJECT_CONST
+
+#endif  // SKY_REPROJECT_SHARED_H

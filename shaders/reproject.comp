@@ -1,0 +1,203 @@
+// Reprojection pass: builds this frame's full image from the pixels the
+// cloud pass drew (one of each n x n block, packed) and the previous frame's
+// full image. A drawn pixel is taken as drawn. Any other pixel is looked up
+// in the previous frame where its point was then: the point at the cloud
+// depth along its ray (at infinity where there is no cloud), moved back by
+// the wind of the layer it lies in, seen from the previous camera. The
+// history is taken when its cloud depth there agrees with that point's
+// distance from the previous camera; otherwise (disocclusion, a point
+// outside the previous view) the pixel is upscaled from this frame's drawn
+// pixels. Layout: include/reproject_shared.h; the CPU side decides when the
+// history is dropped altogether (temporal_plan.cpp).
+#version 450
+#extension GL_GOOGLE_include_directive : require
+
+#include "reproject_shared.h"
+
+layout(local_size_x = kReprojectLocalSize, local_size_y = kReprojectLocalSize) in;
+
+layout(std430, set = 0, binding = kReprojectBindingParams) readonly buffer ParamsBlock { SkyReproject params; };
+layout(std430, set = 0, binding = kReprojectBindingFresh) readonly buffer FreshBlock { vec4 fresh[]; };
+layout(std430, set = 0, binding = kReprojectBindingFreshDepth) readonly buffer FreshDepthBlock { float freshDepth[]; };
+layout(std430, set = 0, binding = kReprojectBindingHistory) readonly buffer HistoryBlock { vec4 history[]; };
+layout(std430, set = 0, binding = kReprojectBindingHistoryDepth) readonly buffer HistoryDepthBlock { float historyDepth[]; };
+layout(std430, set = 0, binding = kReprojectBindingOut) writeonly buffer OutBlock { vec4 outPixels[]; };
+layout(std430, set = 0, binding = kReprojectBindingOutDepth) writeonly buffer OutDepthBlock { float outDepth[]; };
+layout(std430, set = 0, binding = kReprojectBindingStats) buffer StatsBlock { uint stats[kReprojectStatCount]; };
+
+#define real float
+#define real2 vec2
+#define real3 vec3
+#define real4 vec4
+#define SKY_CORE_CONST const
+#include "core_common.glsl"
+
+shared uint counts[kReprojectStatCount];
+
+uvec2 gSize;   // image width, height
+uint gN;       // interleave
+uvec2 gPhase;  // this frame's drawn pixel in each block
+uint gPacked;  // packed width
+
+// The drawn pixel of block b, when it lies inside the image.
+bool drawnPixel(ivec2 b, out uint index) {
+  ivec2 px = b * int(gN) + ivec2(gPhase);
+  index = uint(b.y) * gPacked + uint(b.x);
+  return b.x >= 0 && b.y >= 0 && px.x < int(gSize.x) && px.y < int(gSize.y);
+}
+
+// This frame's drawn pixels interpolated at pixel px (bilinear over the grid
+// of drawn pixels, each block's drawn pixel at b * n + phase); depth from the
+// nearest of them.
+void upscale(ivec2 px, out vec4 colour, out float depth) {
+  vec2 g = (vec2(px) - vec2(gPhase)) / float(gN);
+  ivec2 b0 = ivec2(floor(g));
+  vec2 f = g - vec2(b0);
+  colour = vec4(0.0);
+  depth = 0.0;
+  float wsum = 0.0, best = -1.0;
+  for (int k = 0; k < 4; ++k) {
+    ivec2 o = ivec2(k & 1, k >> 1);
+    uint i;
+    if (!drawnPixel(b0 + o, i)) continue;
+    float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
+    colour += w * fresh[i];
+    wsum += w;
+    if (w > best) best = w, depth = freshDepth[i];
+  }
+  if (wsum > 0.0) colour /= wsum;
+}
+
+// Cloud depths that agree: both none, or both some and within tolerance.
+bool agree(float a, float b) {
+  if (a <= 0.0 || b <= 0.0) return a <= 0.0 && b <= 0.0;
+  return abs(a - b) <= params.tolerance.x * max(a, b) + params.tolerance.y;
+}
+
+// Where in the previous image (continuous pixel coordinates, pixel centres
+// at +0.5) the point along dir at cloud depth d was, and its distance from
+// the previous camera then (0 for no cloud: a direction at infinity, which
+// only the rotation moves). False when it was behind the previous camera.
+bool previousPixel(vec3 dir, float d, out vec2 p, out float expected) {
+  vec3 v = dir;
+  expected = 0.0;
+  if (d > 0.0) {
+    vec3 x = dir * d;
+    float h = heightAboveCameraSphere(x, params.prevPosition.w);
+    vec3 motion = vec3(0.0);
+    for (uint l = 0u; l < params.phase.w; ++l) {
+      vec4 band = params.layerBand[l];
+      if (h >= band.x - params.tolerance.z && h <= band.y + params.tolerance.z) {
+        motion = params.layerMotion[l].xyz;
+        break;
+      }
+    }
+    v = x - motion - params.prevPosition.xyz;
+    expected = length(v);
+  }
+  float z = dot(v, params.prevForward.xyz);
+  if (z <= 0.0) return false;
+  float sx = dot(v, params.prevRight.xyz) / z;
+  float sy = -dot(v, params.prevDown.xyz) / z;
+  float tanHalf = params.camRight.w, aspect = params.camDown.w;
+  p = vec2((sx / (tanHalf * aspect) + 1.0) * 0.5 * float(gSize.x), (1.0 - sy / tanHalf) * 0.5 * float(gSize.y));
+  return true;
+}
+
+bool insideImage(ivec2 q) { return q.x >= 0 && q.y >= 0 && q.x < int(gSize.x) && q.y < int(gSize.y); }
+
+// The history at continuous position p, bilinear over the taps whose depth
+// agrees with `expected`; exactly the nearest pixel when p is (within 1e-3
+// px) a pixel centre, so a still view keeps its pixels bit for bit. False
+// unless the agreeing taps hold at least half the bilinear weight (else a
+// neighbour with a sliver of weight would stand in for a pixel that shows
+// something else).
+bool historyAt(vec2 p, float expected, out vec4 colour) {
+  vec2 q = p - 0.5;
+  ivec2 i0 = ivec2(floor(q));
+  vec2 f = q - vec2(i0);
+  colour = vec4(0.0);
+  if (all(lessThan(abs(f - round(f)), vec2(1e-3)))) {
+    ivec2 c = i0 + ivec2(round(f));
+    if (!insideImage(c)) return false;
+    uint i = uint(c.y) * gSize.x + uint(c.x);
+    if (!agree(historyDepth[i], expected)) return false;
+    colour = history[i];
+    return true;
+  }
+  float wsum = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    ivec2 o = ivec2(k & 1, k >> 1);
+    ivec2 c = i0 + o;
+    if (!insideImage(c)) continue;
+    uint i = uint(c.y) * gSize.x + uint(c.x);
+    if (!agree(historyDepth[i], expected)) continue;
+    float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
+    colour += w * history[i];
+    wsum += w;
+  }
+  if (wsum < 0.5) return false;
+  colour /= wsum;
+  return true;
+}
+
+// Depth of the history pixel nearest p (p inside the image).
+float historyDepthNear(vec2 p) {
+  ivec2 c = clamp(ivec2(floor(p)), ivec2(0), ivec2(gSize) - 1);
+  return historyDepth[uint(c.y) * gSize.x + uint(c.x)];
+}
+
+uint resolvePixel(ivec2 px, out vec4 colour, out float depth) {
+  ivec2 b = px / int(gN);
+  uint drawn;
+  if (px == b * int(gN) + ivec2(gPhase) && drawnPixel(b, drawn)) {
+    colour = fresh[drawn];
+    depth = freshDepth[drawn];
+    return kStatFresh;
+  }
+  upscale(px, colour, depth);
+  if (params.image.w == 0u) return kStatNoHistory;
+  vec3 dir = cameraRay(params.camForward.xyz, params.camRight.xyz, params.camDown.xyz, params.camRight.w,
+                       params.camDown.w, float(px.x), float(px.y), float(gSize.x), float(gSize.y));
+  // First guess of the pixel's cloud depth: its own block's drawn pixel's
+  // (upscale's nearest); then what the history holds where that leads.
+  vec2 p;
+  float expected;
+  if (!previousPixel(dir, depth, p, expected) || !insideImage(ivec2(floor(p)))) return kStatOffscreen;
+  vec4 h;
+  if (historyAt(p, expected, h)) {
+    colour = h;
+    return kStatReused;
+  }
+  float guess = historyDepthNear(p);
+  vec2 p2;
+  if (!previousPixel(dir, guess, p2, expected) || !insideImage(ivec2(floor(p2)))) return kStatOffscreen;
+  if (historyAt(p2, expected, h)) {
+    colour = h;
+    depth = guess;
+    return kStatReused;
+  }
+  return kStatDisoccluded;
+}
+
+void main() {
+  if (gl_LocalInvocationIndex < kReprojectStatCount) counts[gl_LocalInvocationIndex] = 0u;
+  barrier();
+  gSize = params.image.xy;
+  gN = params.image.z;
+  gPhase = params.phase.xy;
+  gPacked = params.phase.z;
+  ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+  if (px.x < int(gSize.x) && px.y < int(gSize.y)) {
+    vec4 colour;
+    float depth;
+    uint outcome = resolvePixel(px, colour, depth);
+    uint i = uint(px.y) * gSize.x + uint(px.x);
+    outPixels[i] = colour;
+    outDepth[i] = depth;
+    atomicAdd(counts[outcome], 1u);
+  }
+  barrier();
+  if (gl_LocalInvocationIndex < kReprojectStatCount && counts[gl_LocalInvocationIndex] > 0u)
+    atomicAdd(stats[gl_LocalInvocationIndex], counts[gl_LocalInvocationIndex]);
+}
