@@ -65,6 +65,7 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
         {"empty_step_m", s.march.emptyStep_m},
         {"step_growth", s.march.stepGrowth},
         {"air_steps", s.march.airSteps}}},
+      {"interleave", s.temporal.interleave},
       {"resolution", {s.width, s.height}},
       {"vertical_fov_deg", s.verticalFov_deg},
       {"noise_seeds", {{"shape", s.noiseSeed}}},
@@ -78,6 +79,11 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
   for (const auto& t : r.gpu) gpu[t.pass] = gpu.value(t.pass, 0.0) + t.gpu_ms;
   line["gpu_ms"] = gpu;
   if (r.presented) line["presented"] = *r.presented;
+  if (s.temporal.interleave > 1) {
+    const render::TemporalReport& t = r.temporal;
+    line["temporal"] = {{"drawn_whole", t.drawnWhole}, {"reason", t.reason},     {"drawn", t.drawn},
+                        {"reused", t.reused},          {"offscreen", t.offscreen}, {"disoccluded", t.disoccluded}};
+  }
   if (outputs_.png) line["file"] = std::string(name) + ".png";
   if (outputs_.exr) line["exr"] = std::string(name) + ".exr";
   metadata_ << line.dump() << '\n';

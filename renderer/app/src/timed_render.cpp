@@ -26,6 +26,7 @@ Result<render::Image> timedRender(render::CloudRenderer& renderer, const render:
   record.render_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   record.cpu_ms = processCpu_ms() - cpu0;
   record.gpu = renderer.lastPassTimes();
+  record.temporal = renderer.lastTemporal();
   record.stats = render::computeStats(*image);
   // The same choice as the renderer's frame setup: the ephemeris when the
   // frame has a date, else the given angles.

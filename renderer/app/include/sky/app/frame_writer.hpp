@@ -49,6 +49,7 @@ struct FrameRecord {
   double render_ms = 0;     // wall time of CloudRenderer::render
   double cpu_ms = 0;        // process CPU time during it (all threads: lavapipe's workers too)
   std::vector<render::PassTime> gpu;  // GPU time per pass (timestamps), in submission order
+  render::TemporalReport temporal;    // what the reprojection did (interleaved presets)
   std::optional<bool> presented;      // windowed: whether the frame reached the window
 };
 
