@@ -41,17 +41,17 @@ const std::vector<Preset>& presets() {
        march(256, 8, 0, 1), {}},
       {"high", "the default: 48 primary steps, 4 light steps, exit at 1 %, every sample, every pixel", MarchSettings{}, {}},
       {"medium",
-       "steps of 60 m in cloud, 240 m in clear air, +1 % of the distance; 3 light steps, exit at 2 %, 12 air steps; "
-       "1 pixel of 4 per frame, the rest reprojected",
-       metres(256, 3, 0.02, 60, 240, 0.01, 12), interleaved(2)},
+       "steps of 40 m in cloud, 80 m in clear air, +1 % of the distance; 4 light steps, exit at 2 %, 12 air steps; "
+       "1 pixel of 16 per frame, the rest reprojected",
+       metres(256, 4, 0.02, 40, 80, 0.01, 12), interleaved(4)},
       {"low",
-       "steps of 100 m in cloud, 400 m in clear air, +1 % of the distance; 2 light steps, exit at 3 %, 8 air steps; "
+       "steps of 40 m in cloud, 80 m in clear air, +1 % of the distance; 3 light steps, exit at 3 %, 8 air steps; "
        "1 pixel of 16 per frame, the rest reprojected",
-       metres(192, 2, 0.03, 100, 400, 0.01, 8), interleaved(4)},
+       metres(256, 3, 0.03, 40, 80, 0.01, 8), interleaved(4)},
       {"realtime",
-       "steps of 150 m in cloud, 600 m in clear air, +2 % of the distance; 1 light step, exit at 5 %, 8 air steps; "
+       "steps of 40 m in cloud, 80 m in clear air, +2 % of the distance; 2 light steps, exit at 5 %, 8 air steps; "
        "1 pixel of 16 per frame, the rest reprojected",
-       metres(128, 1, 0.05, 150, 600, 0.02, 8), interleaved(4)},
+       metres(256, 2, 0.05, 40, 80, 0.02, 8), interleaved(4)},
   };
   return all;
 }

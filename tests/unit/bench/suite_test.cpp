@@ -4,6 +4,8 @@
 // (configurations, spreads, the side-by-side line and sun angles).
 #include <gtest/gtest.h>
 
+#include "sky/render/presets.hpp"
+
 #include <cmath>
 #include <set>
 
@@ -154,12 +156,25 @@ TEST(Configurations, PresetsAreConfigurationsWithTheirMarch) {
   ASSERT_EQ(chosen->size(), 3u);
   EXPECT_EQ((*chosen)[0].settings.march.primarySteps, 256u) << "reference is the reference preset";
   EXPECT_EQ((*chosen)[0].settings.march.minTransmittance, 0.0);
+  // Each preset's march and interleave come through as the renderer defines them.
+  const auto realtime = render::findPreset("realtime");
+  const auto medium = render::findPreset("medium");
+  ASSERT_TRUE(realtime && medium);
   EXPECT_EQ((*chosen)[1].name, "realtime");
-  EXPECT_EQ((*chosen)[1].settings.march.cloudStep_m, 150.0);
-  EXPECT_EQ((*chosen)[1].settings.march.lightSteps, 1u);
+  EXPECT_EQ((*chosen)[1].settings.march.cloudStep_m, realtime->march.cloudStep_m);
+  EXPECT_EQ((*chosen)[1].settings.march.lightSteps, realtime->march.lightSteps);
+  EXPECT_EQ((*chosen)[1].settings.temporal.interleave, realtime->temporal.interleave);
+  EXPECT_EQ((*chosen)[1].reusesHistory, realtime->temporal.interleave > 1);
   EXPECT_EQ((*chosen)[2].name, "medium");
-  EXPECT_EQ((*chosen)[2].settings.march.cloudStep_m, 60.0);
-  EXPECT_EQ(settingsFor((*chosen)[1], 160, 90, 60).march.emptyStep_m, 600.0);
+  EXPECT_EQ((*chosen)[2].settings.march.cloudStep_m, medium->march.cloudStep_m);
+  EXPECT_EQ(settingsFor((*chosen)[1], 160, 90, 60).march.emptyStep_m, realtime->march.emptyStep_m);
+  EXPECT_EQ(settingsFor((*chosen)[1], 160, 90, 60).temporal.interleave, realtime->temporal.interleave);
+  // A custom configuration's interleave, and its refusal of other values.
+  auto custom = selectConfigurations("x:base=high,interleave=2");
+  ASSERT_TRUE(custom) << custom.error().detail;
+  EXPECT_EQ(custom->back().settings.temporal.interleave, 2u);
+  EXPECT_TRUE(custom->back().reusesHistory);
+  EXPECT_FALSE(selectConfigurations("x:base=high,interleave=3"));
 }
 
 TEST(Configurations, CustomSpecsAndTheirErrors) {

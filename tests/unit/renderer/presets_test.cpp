@@ -53,8 +53,8 @@ TEST(Presets, NamesAndUnknownNameError) {
   for (std::size_t i = 0; i < all.size(); ++i) EXPECT_EQ(all[i].name, names[i]);
   auto medium = render::findPreset("medium");
   ASSERT_TRUE(medium);
-  EXPECT_EQ(medium->march.cloudStep_m, 60.0);
-  EXPECT_EQ(medium->march.lightSteps, 3u);
+  EXPECT_GT(medium->march.cloudStep_m, 0.0) << "medium marches in metres";
+  EXPECT_EQ(medium->temporal.interleave, 4u) << "medium draws 1 pixel of 16 per frame";
   auto bad = render::findPreset("ultra");
   ASSERT_FALSE(bad);
   EXPECT_EQ(bad.error().code, ErrorCode::InvalidArgument);
@@ -78,19 +78,29 @@ TEST(Presets, HighIsTheDefaultAndReferenceTheMostExpensive) {
   EXPECT_GE(all[0].march.lightSteps, 6u);
   EXPECT_EQ(all[0].march.cloudStep_m, 0.0) << "reference: evenly placed samples";
   EXPECT_EQ(all[0].march.airSteps, 0u) << "reference: the default air march";
-  // Cheaper presets: never more light steps, an earlier exit; evenly placed
-  // ones fewer samples, those in metres (primarySteps a cap) longer steps.
+  EXPECT_EQ(all[0].temporal.interleave, 1u) << "reference: every pixel of every frame";
+  EXPECT_EQ(high->temporal.interleave, 1u) << "high: every pixel of every frame";
+  // Cheaper presets: never more light steps, an earlier exit, never fewer
+  // pixels reprojected; evenly placed ones fewer samples, those in metres
+  // (primarySteps a cap) never shorter steps, never slower growth, never
+  // more air steps, and at least one of these strictly cheaper.
   for (std::size_t i = 1; i < all.size(); ++i) {
     const render::MarchSettings &m = all[i].march, &before = all[i - 1].march;
     EXPECT_LE(m.lightSteps, before.lightSteps) << all[i].name;
     EXPECT_GE(m.minTransmittance, before.minTransmittance) << all[i].name;
+    EXPECT_GE(all[i].temporal.interleave, all[i - 1].temporal.interleave) << all[i].name;
     if (m.cloudStep_m == 0) {
       EXPECT_LT(m.primarySteps, before.primarySteps) << all[i].name;
     }
     if (before.cloudStep_m > 0) {
-      EXPECT_GT(m.cloudStep_m, before.cloudStep_m) << all[i].name;
+      EXPECT_GE(m.cloudStep_m, before.cloudStep_m) << all[i].name;
       EXPECT_GE(m.emptyStep_m, before.emptyStep_m) << all[i].name;
       EXPECT_GE(m.stepGrowth, before.stepGrowth) << all[i].name;
+      EXPECT_LE(m.airSteps, before.airSteps) << all[i].name;
+      EXPECT_TRUE(m.lightSteps < before.lightSteps || m.minTransmittance > before.minTransmittance ||
+                  m.cloudStep_m > before.cloudStep_m || m.stepGrowth > before.stepGrowth ||
+                  m.airSteps < before.airSteps)
+          << all[i].name << " is not cheaper than " << all[i - 1].name;
     }
   }
 }
