@@ -62,7 +62,7 @@ int reportError(const sky::Error& e) {
 int main(int argc, char** argv) {
   CLI::App app{"skyshell-bench: cost and error of render configurations against reference"};
   std::string suite = SKY_BENCH_DEFAULT_SUITE;
-  std::string scenes, configs = "all", outDir;
+  std::string scenes, configs = "all", outDir, referenceKeys;
   std::vector<std::string> resolutions;
   unsigned warmup = 2, repeats = 5, pathRepeats = 1;
   bool quick = false, noPlots = false, list = false, sideBySide = false;
@@ -73,6 +73,9 @@ int main(int argc, char** argv) {
 
   app.add_option("--suite", suite, "scene suite file (TOML)")->capture_default_str();
   app.add_option("--scenes", scenes, "comma-separated scene names (default: every scene of the suite)");
+  app.add_option("--reference", referenceKeys,
+                 "the ground truth's settings as key=value,... (the custom keys; default: the reference preset), "
+                 "e.g. base=reference,light=64");
   app.add_option("--configs", configs, "comma-separated configurations, or all; reference is always run; NAME:key=value,... adds a custom one (then separate the list with ;)")
       ->capture_default_str();
   app.add_option("--resolution", resolutions, "output size WxH; repeat for several (default 320x180)");
@@ -163,6 +166,11 @@ int main(int argc, char** argv) {
   }
   auto chosen = sky::bench::selectConfigurations(configs);
   if (!chosen) return reportError(chosen.error());
+  if (!referenceKeys.empty()) {
+    auto truth = sky::bench::referenceConfiguration(referenceKeys);
+    if (!truth) return reportError(truth.error());
+    chosen->front() = *truth;
+  }
   options.configurations = *chosen;
   auto loaded = sky::bench::loadSuite(suite, list ? std::vector<std::string>{} : sceneNames);
   if (!loaded) return reportError(loaded.error());

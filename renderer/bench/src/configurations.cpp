@@ -109,6 +109,18 @@ Result<Configuration> customConfiguration(const std::string& spec) {
   return c;
 }
 
+Result<Configuration> referenceConfiguration(const std::string& keys) {
+  auto c = customConfiguration("ground-truth:" + keys);
+  if (!c) return tl::unexpected(c.error());
+  if (c->reusesHistory || c->renderScale != 1.0)
+    return fail(ErrorCode::InvalidArgument, "--reference '" + keys +
+                                                "': the ground truth draws every pixel of every frame at full size "
+                                                "(no interleave, no scale)");
+  c->name = kReferenceName;
+  c->description = "ground truth for this run: " + keys;
+  return c;
+}
+
 Result<std::vector<Configuration>> selectConfigurations(const std::string& names) {
   const std::vector<Configuration> all = builtInConfigurations();
   if (names.empty() || names == "all") return all;

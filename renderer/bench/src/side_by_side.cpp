@@ -1,6 +1,7 @@
 // Side-by-side mode (see side_by_side.hpp).
 #include "sky/bench/side_by_side.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -53,15 +54,19 @@ Result<void> runSideBySide(const SideBySideOptions& o, std::FILE* out, std::FILE
   in.sunElevation_deg = sun->elevation_deg;
 
   const auto& s = (*renderer)->settings();
+  // An interleaved configuration is timed with its history full (n^2 + 1
+  // frames of the view first), as the bench times its stills.
+  const std::uint32_t n = s.temporal.interleave;
+  const std::uint32_t warmup = n > 1 ? std::max(o.warmup, n * n + 1) : o.warmup;
   std::fprintf(err, "# skyshell-bench side-by-side: %ux%u (rendered %ux%u, configuration %s) on %s, camera %.1f m above "
                "the ellipsoid at %.4f %.4f, heading %.1f pitch %.1f, vfov %.1f, sun azimuth %.2f elevation %.2f; "
                "%u warm-up frames not printed; LP_NUM_THREADS=%s\n",
                o.width, o.height, s.width, s.height, o.configuration.name.c_str(), (*renderer)->deviceName().c_str(),
                o.heightAboveGround_m, o.lat_deg, o.lon_deg, o.yaw_deg, o.pitch_deg, o.verticalFov_deg,
-               sun->azimuth_deg, sun->elevation_deg, o.warmup,
+               sun->azimuth_deg, sun->elevation_deg, warmup,
                std::getenv("LP_NUM_THREADS") ? std::getenv("LP_NUM_THREADS") : "(unset)");
   bool announced = false;
-  for (std::uint32_t i = 0; i < o.warmup + o.frames; ++i) {
+  for (std::uint32_t i = 0; i < warmup + o.frames; ++i) {
     in.frameIndex = i;
     const CpuSnapshot before = sampleCpu();
     const auto t0 = std::chrono::steady_clock::now();
@@ -69,7 +74,7 @@ Result<void> runSideBySide(const SideBySideOptions& o, std::FILE* out, std::FILE
     const auto t1 = std::chrono::steady_clock::now();
     const CpuSnapshot after = sampleCpu();
     if (!image) return tl::unexpected(image.error());
-    if (i < o.warmup) continue;
+    if (i < warmup) continue;
     const RendererCounters counters = rendererCounters(**renderer, *image);
     if (!announced) {
       std::fprintf(err, "# %s\n",

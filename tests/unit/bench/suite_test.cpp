@@ -233,3 +233,24 @@ TEST(SideBySide, LineFormatIsExact) {
 
 }  // namespace
 }  // namespace sky::bench
+
+namespace sky::bench {
+namespace {
+
+TEST(Configurations, ReferenceCanBeReplacedForASweep) {
+  auto truth = referenceConfiguration("base=reference,light=64");
+  ASSERT_TRUE(truth) << truth.error().detail;
+  EXPECT_EQ(truth->name, kReferenceName);
+  EXPECT_EQ(truth->settings.march.lightSteps, 64u);
+  EXPECT_EQ(truth->settings.march.primarySteps, render::findPreset("reference")->march.primarySteps);
+  EXPECT_FALSE(truth->reusesHistory);
+  // The ground truth draws every pixel of every frame at full size.
+  auto interleaved = referenceConfiguration("base=medium");
+  ASSERT_FALSE(interleaved);
+  EXPECT_NE(interleaved.error().detail.find("every pixel"), std::string::npos) << interleaved.error().detail;
+  EXPECT_FALSE(referenceConfiguration("base=reference,scale=0.5"));
+  EXPECT_FALSE(referenceConfiguration("base=reference,light=x"));
+}
+
+}  // namespace
+}  // namespace sky::bench

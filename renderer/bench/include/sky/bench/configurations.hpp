@@ -51,6 +51,13 @@ Result<std::vector<Configuration>> selectConfigurations(const std::string& names
 // separated by ';' (a spec has commas). Errors: InvalidArgument naming the bad part.
 Result<Configuration> customConfiguration(const std::string& spec);
 
+// A ground truth other than the `reference` preset, from custom-configuration
+// keys ("base=reference,light=64"): named `reference`, it replaces the first
+// configuration of a run (a sweep against 64 light steps compares with that).
+// Errors: InvalidArgument as customConfiguration, and for an interleave > 1
+// (the ground truth draws every pixel of every frame).
+Result<Configuration> referenceConfiguration(const std::string& keys);
+
 // The RenderSettings a configuration renders a scene with at an output size.
 render::RenderSettings settingsFor(const Configuration& config, std::uint32_t outWidth, std::uint32_t outHeight,
                                    double verticalFov_deg);
