@@ -25,9 +25,9 @@ SKY_REPROJECT_CONST kReprojectBindingHistory = 3u;       // read-only vec4: the 
 SKY_REPROJECT_CONST kReprojectBindingHistoryDepth = 4u;  // read-only float: its cloud depth
 SKY_REPROJECT_CONST kReprojectBindingOut = 5u;           // vec4: this frame's full image (the next history)
 SKY_REPROJECT_CONST kReprojectBindingOutDepth = 6u;      // float: its cloud depth
-SKY_REPROJECT_CONST kReprojectBindingStats = 7u;         // uint[kReprojectStatCount]: pixels per outcome
+SKY_REPROJECT_CONST kReprojectBindingStats = 7u;         // uint per pixel: what became of it (below)
 
-// What became of each pixel (the stats buffer's entries).
+// What became of each pixel (the values of the outcome buffer).
 SKY_REPROJECT_CONST kStatFresh = 0u;       // drawn this frame
 SKY_REPROJECT_CONST kStatReused = 1u;      // taken from the history through the motion
 SKY_REPROJECT_CONST kStatOffscreen = 2u;   // its point was outside the previous view: upscaled
@@ -35,7 +35,10 @@ SKY_REPROJECT_CONST kStatDisoccluded = 3u; // the history there shows something 
 SKY_REPROJECT_CONST kStatNoHistory = 4u;   // no history to take (a reset frame is drawn whole instead)
 SKY_REPROJECT_CONST kReprojectStatCount = 5u;
 
-SKY_REPROJECT_CONST kReprojectLocalSize = 8u;
+// Workgroup of the pass: 32x2 pixels, rows of 32 so the history reads of a
+// subgroup lie along a row (measured ~10 % faster than 8x8 on lavapipe).
+SKY_REPROJECT_CONST kReprojectLocalSizeX = 32u;
+SKY_REPROJECT_CONST kReprojectLocalSizeY = 2u;
 SKY_REPROJECT_CONST kReprojectMaxLayers = 4u;  // = kMaxLayers of sky_shared.h
 
 struct SkyReproject {

@@ -1,6 +1,7 @@
 // Reprojection pass resources and recording (see reproject_pass.hpp).
 #include "reproject_pass.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <vector>
 
@@ -35,7 +36,7 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
     std::memset(pass.colour_[k].mapped, 0, pass.colour_[k].size);
     std::memset(pass.depth_[k].mapped, 0, pass.depth_[k].size);
   }
-  pass.stats_ = createHostBuffer(ctx, gpu::kReprojectStatCount * sizeof(std::uint32_t), storage, "sky.reproject.stats");
+  pass.stats_ = createHostBuffer(ctx, pixels * sizeof(std::uint32_t), storage, "sky.reproject.outcomes");
 
   const vk::DescriptorPoolSize poolSize(vk::DescriptorType::eStorageBuffer, 16);
   pass.descriptorPool_ = vk::raii::DescriptorPool(
@@ -68,7 +69,6 @@ void ReprojectPass::record(const vk::raii::CommandBuffer& commands, GpuTimer& ti
   SKY_ASSERT(params.image.x == width_ && params.image.y == height_);
   current_ = 1 - current_;
   std::memcpy(params_.mapped, &params, sizeof params);
-  std::memset(stats_.mapped, 0, stats_.size);
   const vk::MemoryBarrier cloudsWritten(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eShaderRead);
   commands.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {},
                            cloudsWritten, {}, {});
@@ -76,8 +76,8 @@ void ReprojectPass::record(const vk::raii::CommandBuffer& commands, GpuTimer& ti
     const auto timed = timer.section(commands, "reproject");
     commands.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_.pipeline);
     commands.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *sets_[current_], {});
-    const std::uint32_t g = gpu::kReprojectLocalSize;
-    commands.dispatch((width_ + g - 1) / g, (height_ + g - 1) / g, 1);
+    const std::uint32_t gx = gpu::kReprojectLocalSizeX, gy = gpu::kReprojectLocalSizeY;
+    commands.dispatch((width_ + gx - 1) / gx, (height_ + gy - 1) / gy, 1);
   }
   const vk::MemoryBarrier toHost(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead);
   commands.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, toHost,
@@ -94,8 +94,10 @@ void ReprojectPass::readBack(Image& image) const {
 }
 
 TemporalReport ReprojectPass::counts() const {
-  std::uint32_t c[gpu::kReprojectStatCount];
-  std::memcpy(c, stats_.mapped, sizeof c);
+  std::uint64_t c[gpu::kReprojectStatCount + 1] = {};
+  const auto* outcomes = static_cast<const std::uint32_t*>(stats_.mapped);
+  for (std::size_t i = 0, n = std::size_t(width_) * height_; i < n; ++i)
+    ++c[std::min<std::uint32_t>(outcomes[i], gpu::kReprojectStatCount)];
   TemporalReport r;
   r.drawn = c[gpu::kStatFresh];
   r.reused = c[gpu::kStatReused];

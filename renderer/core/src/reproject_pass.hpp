@@ -2,8 +2,8 @@
 // pass in the same command buffer, it reads the pixels the clouds drew this
 // frame and the previous frame's full image, and writes this frame's full
 // image, which the next frame reads as its history. Two image buffers
-// (radiance + transmittance, cloud depth) swap roles every frame; a small
-// counter buffer says what became of the pixels (reproject_shared.h).
+// (radiance + transmittance, cloud depth) swap roles every frame; an outcome
+// per pixel says what became of it (reproject_shared.h), counted on the host.
 #pragma once
 
 #include <array>
