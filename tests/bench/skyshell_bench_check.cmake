@@ -5,6 +5,8 @@
 # infinite, repeatable, no flicker), every other configuration must differ
 # from it, and every case must have been timed.
 # side-by-side: every stdout line must be exactly a CLOUDPASS line.
+# sweeps (with -DSWEEPS=deploy/bench/sweeps): the seeds' sweeps at 48x27 on
+# one scene write their four tables.
 # Prints "SKIPPED: no Vulkan device" (ctest SKIP_REGULAR_EXPRESSION) when the
 # bench exits 77.
 cmake_minimum_required(VERSION 3.25)
@@ -41,6 +43,33 @@ if(MODE STREQUAL "side-by-side")
     expect(ok "not a CLOUDPASS line: '${line}'")
   endforeach()
   message("side-by-side: ${count} CLOUDPASS lines, ${header}")
+  return()
+endif()
+
+if(MODE STREQUAL "sweeps")
+  # deploy/bench/sweeps at 48x27 on one scene: four tables, each with the
+  # rows of its sweep.
+  file(REMOVE_RECURSE "${OUT}")
+  execute_process(COMMAND bash ${SWEEPS} --bench ${BENCH} --resolution 48x27 --scenes cumulus-midday --out "${OUT}"
+                  RESULT_VARIABLE rc ERROR_VARIABLE err)
+  string(REPLACE ";" "," err "${err}")
+  if(NOT rc EQUAL 0 AND EXISTS "${OUT}/light.log")
+    file(READ "${OUT}/light.log" log)
+    if(log MATCHES "Unsupported")
+      message("SKIPPED: no Vulkan device: ${log}")
+      return()
+    endif()
+  endif()
+  expect(rc EQUAL 0 "exit ${rc}: ${err}")
+  file(READ "${OUT}/sweeps.md" md)
+  string(REGEX MATCHALL "\n## " headings "${md}")
+  list(LENGTH headings count)
+  expect(count EQUAL 4 "${count} sweep tables in sweeps.md, wanted 4")
+  foreach(row light-1 light-6 growth-0 growth-0p08 ford-steps ford-early-exit haggstrom-2018 haggstrom-4x4)
+    string(FIND "${md}" "| cumulus-midday | ${row} |" at)
+    expect(NOT at EQUAL -1 "no row for ${row} in sweeps.md")
+  endforeach()
+  message("sweeps: ${count} tables")
   return()
 endif()
 

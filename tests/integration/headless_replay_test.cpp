@@ -216,3 +216,54 @@ TEST_F(HeadlessReplay, BadFlightFileIsRefusedWithLineAndField) {
 
 }  // namespace
 }  // namespace sky::test
+
+namespace sky::test {
+namespace {
+
+// An interleaved preset through the whole program: the first frame is drawn
+// whole, the frames after it reuse the history (the camera moves a few metres
+// a frame), and the metadata says so per frame, with the reprojection pass
+// timed.
+TEST_F(HeadlessReplay, InterleavedPresetReportsItsReprojection) {
+  ASSERT_EQ(weatherd_->stop(), 0) << weatherd_->log();
+  weatherd_.reset();
+  std::vector<std::string> args = {"--weather-file", SKY_SCENARIO_CLOUDY, "--no-video", "--replay-end", "2",
+                                   "--preset", "realtime", "--max-frames", "8"};
+  // --step is the fixture's 1.5 s; this run wants frames 0.1 s apart.
+  std::vector<std::string> argv = {SKY_RENDER, "--headless", "--replay", SKY_TEST_FLIGHT, "--step", "0.1",
+                                   "--weather-clock", kWeatherClock, "--out", (dir_ / "rt").string(),
+                                   "--width", "160", "--height", "90"};
+  argv.insert(argv.end(), args.begin(), args.end());
+  ChildProcess render(argv, (dir_ / "rt").string() + ".log", {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
+  ASSERT_EQ(render.wait(300s).value_or(-1), 0) << render.log();
+  std::ifstream jsonl(dir_ / "rt" / "frames" / "frames.jsonl");
+  std::vector<nlohmann::json> frames;
+  for (std::string line; std::getline(jsonl, line);) frames.push_back(nlohmann::json::parse(line));
+  ASSERT_EQ(frames.size(), 8u);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    SCOPED_TRACE("frame " + std::to_string(i));
+    const auto& f = frames[i];
+    EXPECT_EQ(f["preset"], "realtime");
+    EXPECT_EQ(f["interleave"], 4);
+    ASSERT_TRUE(f.contains("temporal"));
+    const auto& t = f["temporal"];
+    EXPECT_EQ(t["drawn_whole"], i == 0) << t.dump();
+    if (i == 0) {
+      EXPECT_EQ(t["reason"], "first frame");
+      EXPECT_EQ(t["drawn"], 160 * 90);
+    } else {
+      EXPECT_EQ(t["reason"], "");
+      // 1 pixel of 16 drawn (40 x 22 or 23 blocks' worth), the rest mostly reused.
+      EXPECT_GE(t["drawn"].get<int>(), 40 * 22);
+      EXPECT_LE(t["drawn"].get<int>(), 40 * 23);
+      EXPECT_GT(t["reused"].get<int>(), 160 * 90 / 2);
+      EXPECT_EQ(t["drawn"].get<int>() + t["reused"].get<int>() + t["offscreen"].get<int>() +
+                    t["disoccluded"].get<int>(),
+                160 * 90);
+      EXPECT_TRUE(f["gpu_ms"].contains("reproject")) << f["gpu_ms"].dump();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace sky::test
