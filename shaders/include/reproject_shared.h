@@ -25,7 +25,7 @@ SKY_REPROJECT_CONST kReprojectBindingHistory = 3u;       // read-only vec4: the 
 SKY_REPROJECT_CONST kReprojectBindingHistoryDepth = 4u;  // read-only float: its cloud depth
 SKY_REPROJECT_CONST kReprojectBindingOut = 5u;           // vec4: this frame's full image (the next history)
 SKY_REPROJECT_CONST kReprojectBindingOutDepth = 6u;      // float: its cloud depth
-SKY_REPROJECT_CONST kReprojectBindingStats = 7u;         // uint per pixel: what became of it (below)
+SKY_REPROJECT_CONST kReprojectBindingOutcomes = 7u;         // uint per pixel: what became of it (below)
 
 // What became of each pixel (the values of the outcome buffer).
 SKY_REPROJECT_CONST kStatFresh = 0u;       // drawn this frame
@@ -36,7 +36,8 @@ SKY_REPROJECT_CONST kStatNoHistory = 4u;   // no history to take (a reset frame 
 SKY_REPROJECT_CONST kReprojectStatCount = 5u;
 
 // Workgroup of the pass: 32x2 pixels, rows of 32 so the history reads of a
-// subgroup lie along a row (measured ~10 % faster than 8x8 on lavapipe).
+// subgroup lie along a row (faster than 8x8 on lavapipe; time it with
+// `sky_render_bench --preset realtime`, which prints the pass).
 SKY_REPROJECT_CONST kReprojectLocalSizeX = 32u;
 SKY_REPROJECT_CONST kReprojectLocalSizeY = 2u;
 SKY_REPROJECT_CONST kReprojectMaxLayers = 4u;  // = kMaxLayers of sky_shared.h

@@ -121,9 +121,8 @@ int main(int argc, char** argv) {
   }
   settings.march = preset->march;
   settings.temporal = preset->temporal;
-  // An interleaved preset's history fills in n^2 frames of the first view.
-  const int n = int(settings.temporal.interleave);
-  o.warmup = std::max(o.warmup, n * n + 1);
+  // An interleaved preset is timed with its history full.
+  o.warmup = std::max(o.warmup, int(sky::render::historyWarmupFrames(settings.temporal)));
   auto renderer = sky::render::CloudRenderer::create(settings);
   if (!renderer) {
     std::fprintf(stderr, "sky_render_bench: %s\n", sky::describe(renderer.error()).c_str());

@@ -17,7 +17,7 @@ std::vector<Configuration> builtInConfigurations() {
   // then the resolution-only trades of the default preset.
   std::vector<Configuration> all;
   for (const render::Preset& p : render::presets()) {
-    Configuration c{p.name, "preset: " + p.description, 1.0, p.temporal.interleave > 1, {}};
+    Configuration c{p.name, "preset: " + p.description, 1.0, {}};
     c.settings.march = p.march;
     c.settings.temporal = p.temporal;
     all.push_back(c);
@@ -26,7 +26,7 @@ std::vector<Configuration> builtInConfigurations() {
   // description says what is left out).
   auto metres = [](std::string name, std::string description, double cloud_m, double empty_m, double growth,
                    double minTransmittance) {
-    Configuration c{std::move(name), std::move(description), 1.0, false, {}};
+    Configuration c{std::move(name), std::move(description), 1.0, {}};
     render::MarchSettings& m = c.settings.march;  // high's, but for the placement and the exit
     m.primarySteps = 4096;
     m.cloudStep_m = cloud_m;
@@ -47,17 +47,15 @@ std::vector<Configuration> builtInConfigurations() {
                        100, 200, 0, 0.075));
   // The 1-of-4 interleave (presets use 1 of 16): medium's march, each
   // pixel redrawn every 4 frames instead of 16 (less to reproject under motion).
-  for (const render::Preset& p : render::presets())
-    if (p.name == "medium") {
-      Configuration c{"medium-2x2", "preset medium drawing 1 pixel of 4 per frame (2x2) instead of 1 of 16", 1.0,
-                      true, {}};
-      c.settings.march = p.march;
-      c.settings.temporal = p.temporal;
-      c.settings.temporal.interleave = 2;
-      all.push_back(c);
-    }
-  all.push_back({"half-res", "preset high at 1/2 the width and height, bilinear upscale (bench-side)", 0.5, false, {}});
-  all.push_back({"quarter-res", "preset high at 1/4 the width and height, bilinear upscale (bench-side)", 0.25, false, {}});
+  if (const auto medium = render::findPreset("medium")) {
+    Configuration c{"medium-2x2", "preset medium drawing 1 pixel of 4 per frame (2x2) instead of 1 of 16", 1.0, {}};
+    c.settings.march = medium->march;
+    c.settings.temporal = medium->temporal;
+    c.settings.temporal.interleave = 2;
+    all.push_back(c);
+  }
+  all.push_back({"half-res", "preset high at 1/2 the width and height, bilinear upscale (bench-side)", 0.5, {}});
+  all.push_back({"quarter-res", "preset high at 1/4 the width and height, bilinear upscale (bench-side)", 0.25, {}});
   return all;
 }
 
@@ -85,7 +83,6 @@ Result<Configuration> customConfiguration(const std::string& spec) {
       if (!preset) return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': " + preset.error().detail);
       m = preset->march;
       c.settings.temporal = preset->temporal;
-      c.reusesHistory = preset->temporal.interleave > 1;
       continue;
     }
     if (!number) return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': '" + item + "' is not key=number");
@@ -98,10 +95,7 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     else if (key == "growth") m.stepGrowth = v;
     else if (key == "air") m.airSteps = std::uint32_t(v);
     else if (key == "scale" && v > 0 && v <= 1) c.renderScale = v;
-    else if (key == "interleave" && (v == 1 || v == 2 || v == 4)) {
-      c.settings.temporal.interleave = std::uint32_t(v);
-      c.reusesHistory = v > 1;
-    }
+    else if (key == "interleave" && (v == 1 || v == 2 || v == 4)) c.settings.temporal.interleave = std::uint32_t(v);
     else
       return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': unknown key '" + key +
                                                   "' (base, primary, light, exit, stride, cloud, empty, growth, air, scale, interleave 1|2|4)");
@@ -112,7 +106,7 @@ Result<Configuration> customConfiguration(const std::string& spec) {
 Result<Configuration> referenceConfiguration(const std::string& keys) {
   auto c = customConfiguration("ground-truth:" + keys);
   if (!c) return tl::unexpected(c.error());
-  if (c->reusesHistory || c->renderScale != 1.0)
+  if (c->reusesHistory() || c->renderScale != 1.0)
     return fail(ErrorCode::InvalidArgument, "--reference '" + keys +
                                                 "': the ground truth draws every pixel of every frame at full size "
                                                 "(no interleave, no scale)");

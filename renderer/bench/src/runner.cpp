@@ -73,6 +73,13 @@ std::string fixed(double v, int digits) {
   return s.str();
 }
 
+// A rendered image's linear rgba at the output size (a configuration with a
+// render scale is resized bilinearly, display.hpp).
+std::vector<float> atOutputSize(const render::Image& image, const Resolution& res) {
+  if (image.width == res.width && image.height == res.height) return image.rgba;
+  return resizeBilinear({image.width, image.height, image.rgba}, res.width, res.height);
+}
+
 std::string sizeName(std::uint32_t w, std::uint32_t h) { return std::to_string(w) + "x" + std::to_string(h); }
 
 Result<CaseResult> runCase(const LoadedScene& ls, const Configuration& config, const Resolution& res,
@@ -96,14 +103,10 @@ Result<CaseResult> runCase(const LoadedScene& ls, const Configuration& config, c
   cr.create_ms = msBetween(c0, Clock::now());
   deviceName = (*renderer)->deviceName();
   keepVulkanDriversLoaded();
-  // A configuration that reuses history starts with it full: n^2 + 1 frames
-  // of the first view (a simulator sitting still before it moves), so a
-  // still scene shows the converged image and its steady per-frame cost.
-  std::uint32_t warmup = options.warmup;
-  if (config.reusesHistory) {
-    const std::uint32_t n = settings.temporal.interleave;
-    warmup = std::max(warmup, n * n + 1);
-  }
+  // A configuration that reuses history starts with it full (the first view
+  // held still, as a simulator sits before it moves), so a still scene shows
+  // the converged image and its steady per-frame cost.
+  const std::uint32_t warmup = std::max(options.warmup, render::historyWarmupFrames(settings.temporal));
   for (std::uint32_t i = 0; i < warmup; ++i)
     if (auto warm = (*renderer)->render(frameInputs(ls, 0)); !warm) return tl::unexpected(warm.error());
 
@@ -126,11 +129,7 @@ Result<CaseResult> runCase(const LoadedScene& ls, const Configuration& config, c
         continue;
       }
       cr.nonFinitePixels += render::computeStats(rendered->image).nonFinite;
-      std::vector<float> linear =
-          (rendered->image.width == res.width && rendered->image.height == res.height)
-              ? rendered->image.rgba
-              : resizeBilinear({rendered->image.width, rendered->image.height, rendered->image.rgba}, res.width,
-                               res.height);
+      std::vector<float> linear = atOutputSize(rendered->image, res);
       if (!cr.path) firstStill = rendered->image.rgba;
       Srgb8Image srgb = toSrgb8({res.width, res.height, linear});
       if (isReference) {
@@ -160,7 +159,7 @@ Result<CaseResult> runCase(const LoadedScene& ls, const Configuration& config, c
     // one with history is compared with the same configuration drawing every
     // pixel of every frame (metrics.hpp, ghosting).
     std::vector<Srgb8Image> historyFree;
-    if (config.reusesHistory) {
+    if (config.reusesHistory()) {
       render::RenderSettings whole = settings;
       whole.temporal = {};
       auto plain = render::CloudRenderer::create(whole);
@@ -168,15 +167,11 @@ Result<CaseResult> runCase(const LoadedScene& ls, const Configuration& config, c
       for (std::uint32_t f = 0; f < frames; ++f) {
         auto image = (*plain)->render(frameInputs(ls, f));
         if (!image) return tl::unexpected(image.error());
-        std::vector<float> linear = (image->width == res.width && image->height == res.height)
-                                        ? image->rgba
-                                        : resizeBilinear({image->width, image->height, image->rgba}, res.width,
-                                                         res.height);
-        historyFree.push_back(toSrgb8({res.width, res.height, linear}));
+        historyFree.push_back(toSrgb8({res.width, res.height, atOutputSize(*image, res)}));
       }
     }
     const std::span<const Srgb8Image> baseline =
-        config.reusesHistory ? std::span<const Srgb8Image>(historyFree) : std::span<const Srgb8Image>(kept.srgb);
+        config.reusesHistory() ? std::span<const Srgb8Image>(historyFree) : std::span<const Srgb8Image>(kept.srgb);
     auto te = temporalError(kept.srgb, reference.srgb, baseline);
     if (!te) return tl::unexpected(te.error());
     cr.temporal = std::move(*te);

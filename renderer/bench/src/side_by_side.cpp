@@ -54,10 +54,9 @@ Result<void> runSideBySide(const SideBySideOptions& o, std::FILE* out, std::FILE
   in.sunElevation_deg = sun->elevation_deg;
 
   const auto& s = (*renderer)->settings();
-  // An interleaved configuration is timed with its history full (n^2 + 1
-  // frames of the view first), as the bench times its stills.
-  const std::uint32_t n = s.temporal.interleave;
-  const std::uint32_t warmup = n > 1 ? std::max(o.warmup, n * n + 1) : o.warmup;
+  // An interleaved configuration is timed with its history full, as the
+  // bench times its stills.
+  const std::uint32_t warmup = std::max(o.warmup, render::historyWarmupFrames(s.temporal));
   std::fprintf(err, "# skyshell-bench side-by-side: %ux%u (rendered %ux%u, configuration %s) on %s, camera %.1f m above "
                "the ellipsoid at %.4f %.4f, heading %.1f pitch %.1f, vfov %.1f, sun azimuth %.2f elevation %.2f; "
                "%u warm-up frames not printed; LP_NUM_THREADS=%s\n",

@@ -18,7 +18,7 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
   ComputePipelineBuilder builder("sky.reproject");
   for (std::uint32_t b : {gpu::kReprojectBindingParams, gpu::kReprojectBindingFresh, gpu::kReprojectBindingFreshDepth,
                           gpu::kReprojectBindingHistory, gpu::kReprojectBindingHistoryDepth, gpu::kReprojectBindingOut,
-                          gpu::kReprojectBindingOutDepth, gpu::kReprojectBindingStats})
+                          gpu::kReprojectBindingOutDepth, gpu::kReprojectBindingOutcomes})
     builder.binding(b, vk::DescriptorType::eStorageBuffer);
   builder.shader("reproject.comp.spv");
   auto pipeline = builder.build(ctx);
@@ -36,7 +36,7 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
     std::memset(pass.colour_[k].mapped, 0, pass.colour_[k].size);
     std::memset(pass.depth_[k].mapped, 0, pass.depth_[k].size);
   }
-  pass.stats_ = createHostBuffer(ctx, pixels * sizeof(std::uint32_t), storage, "sky.reproject.outcomes");
+  pass.outcomes_ = createHostBuffer(ctx, pixels * sizeof(std::uint32_t), storage, "sky.reproject.outcomes");
 
   const vk::DescriptorPoolSize poolSize(vk::DescriptorType::eStorageBuffer, 16);
   pass.descriptorPool_ = vk::raii::DescriptorPool(
@@ -55,7 +55,7 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
                            std::pair{gpu::kReprojectBindingHistoryDepth, info(pass.depth_[1 - k])},
                            std::pair{gpu::kReprojectBindingOut, info(pass.colour_[k])},
                            std::pair{gpu::kReprojectBindingOutDepth, info(pass.depth_[k])},
-                           std::pair{gpu::kReprojectBindingStats, info(pass.stats_)}};
+                           std::pair{gpu::kReprojectBindingOutcomes, info(pass.outcomes_)}};
     std::vector<vk::WriteDescriptorSet> writes;
     for (const auto& [binding, bufferInfo] : infos)
       writes.emplace_back(*pass.sets_[k], binding, 0, vk::DescriptorType::eStorageBuffer, nullptr, bufferInfo);
@@ -95,7 +95,7 @@ void ReprojectPass::readBack(Image& image) const {
 
 TemporalReport ReprojectPass::counts() const {
   std::uint64_t c[gpu::kReprojectStatCount + 1] = {};
-  const auto* outcomes = static_cast<const std::uint32_t*>(stats_.mapped);
+  const auto* outcomes = static_cast<const std::uint32_t*>(outcomes_.mapped);
   for (std::size_t i = 0, n = std::size_t(width_) * height_; i < n; ++i)
     ++c[std::min<std::uint32_t>(outcomes[i], gpu::kReprojectStatCount)];
   TemporalReport r;

@@ -42,7 +42,7 @@ class ReprojectPass {
   GpuBuffer params_;
   std::array<GpuBuffer, 2> colour_;  // full images; [current_] is written, the other read
   std::array<GpuBuffer, 2> depth_;
-  GpuBuffer stats_;
+  GpuBuffer outcomes_;  // uint per pixel: what became of it (kStat*)
   vk::raii::DescriptorPool descriptorPool_{nullptr};
   std::array<vk::raii::DescriptorSet, 2> sets_{nullptr, nullptr};  // [k] writes colour_[k], reads the other
   std::uint32_t width_ = 0, height_ = 0;

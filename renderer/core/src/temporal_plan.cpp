@@ -3,9 +3,7 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
-#include <cstring>
 #include <numbers>
 #include <sstream>
 
@@ -21,15 +19,6 @@ constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 // that pixel of the block (row, column).
 constexpr std::array<std::array<std::uint32_t, 2>, 2> kBayer2{{{0, 2}, {3, 1}}};
 constexpr std::array<std::array<std::uint32_t, 4>, 4> kBayer4{{{0, 8, 2, 10}, {12, 4, 14, 6}, {3, 11, 1, 9}, {15, 7, 13, 5}}};
-
-void mix64(std::uint64_t& h, std::uint64_t v) {
-  for (int i = 0; i < 8; ++i) {
-    h ^= (v >> (8 * i)) & 0xffu;
-    h *= 1099511628211ull;
-  }
-}
-
-void mixDouble(std::uint64_t& h, double v) { mix64(h, std::bit_cast<std::uint64_t>(v)); }
 
 double angleBetween_deg(const glm::dvec3& a, const glm::dvec3& b) {
   const double c = glm::dot(a, b) / std::max(glm::length(a) * glm::length(b), 1e-300);
@@ -57,19 +46,6 @@ glm::uvec2 interleavePhase(std::uint32_t n, std::uint32_t cycleIndex) {
       if ((n == 2 ? kBayer2[y][x] : kBayer4[y][x]) == k) return {x, y};
   SKY_ASSERT(false);
   return {0, 0};
-}
-
-std::uint64_t weatherSceneKey(const weather::WeatherSnapshot* snapshot) {
-  std::uint64_t h = weatherContentKey(snapshot);
-  if (snapshot == nullptr) return h;
-  for (const auto& layer : snapshot->layers) {
-    mixDouble(h, layer.base_m);
-    mixDouble(h, layer.thickness_m);
-    mixDouble(h, layer.wind.speed_mps);
-    mixDouble(h, layer.wind.fromDirection_deg);
-    mixDouble(h, layer.wind.vertical_mps);
-  }
-  return h;
 }
 
 std::string TemporalPlanner::resetReason(const Remembered& prev, const Remembered& now) const {

@@ -32,11 +32,6 @@ inline constexpr double kLayerWindMargin_m = 300;
 // draw far-apart pixels and any n^2 consecutive frames draw every pixel once.
 glm::uvec2 interleavePhase(std::uint32_t n, std::uint32_t cycleIndex);
 
-// Everything about the weather that changes the image, apart from the clock
-// and the camera: layers (id, type, base, thickness, coverage, density,
-// wind) and tiles.
-std::uint64_t weatherSceneKey(const weather::WeatherSnapshot* snapshot);
-
 struct TemporalPlan {
   bool drawWhole = true;   // no history: the cloud pass draws every pixel
   std::string reason;      // why, when drawWhole

@@ -99,6 +99,19 @@ std::uint64_t weatherContentKey(const weather::WeatherSnapshot* snapshot) {
   return h;
 }
 
+std::uint64_t weatherSceneKey(const weather::WeatherSnapshot* snapshot) {
+  std::uint64_t h = weatherContentKey(snapshot);
+  if (snapshot == nullptr) return h;
+  for (const auto& layer : snapshot->layers) {
+    mix64(h, bitsOf(layer.base_m));
+    mix64(h, bitsOf(layer.thickness_m));
+    mix64(h, bitsOf(layer.wind.speed_mps));
+    mix64(h, bitsOf(layer.wind.fromDirection_deg));
+    mix64(h, bitsOf(layer.wind.vertical_mps));
+  }
+  return h;
+}
+
 WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const geo::Geodetic& anchor,
                                const WeatherField* previous) {
   WeatherField field;

@@ -86,6 +86,11 @@ struct WeatherField {
 // coverage and density; tiles with their blend; tile level). nullptr hashes as "no weather".
 std::uint64_t weatherContentKey(const weather::WeatherSnapshot* snapshot);
 
+// weatherContentKey and everything else about the weather that changes the
+// image, apart from the clock and the camera: each layer's base, thickness
+// and wind. A change of it drops an interleaved renderer's history.
+std::uint64_t weatherSceneKey(const weather::WeatherSnapshot* snapshot);
+
 // Fills the map around anchor. A layer without tiles is uniform (its own
 // coverage and density); a layer with tiles is empty where a cell has none.
 // The snapshot must already be validated (at most gpu::kMaxLayers layers).

@@ -164,7 +164,7 @@ TEST(Configurations, PresetsAreConfigurationsWithTheirMarch) {
   EXPECT_EQ((*chosen)[1].settings.march.cloudStep_m, realtime->march.cloudStep_m);
   EXPECT_EQ((*chosen)[1].settings.march.lightSteps, realtime->march.lightSteps);
   EXPECT_EQ((*chosen)[1].settings.temporal.interleave, realtime->temporal.interleave);
-  EXPECT_EQ((*chosen)[1].reusesHistory, realtime->temporal.interleave > 1);
+  EXPECT_TRUE((*chosen)[1].reusesHistory()) << "realtime interleaves";
   EXPECT_EQ((*chosen)[2].name, "medium");
   EXPECT_EQ((*chosen)[2].settings.march.cloudStep_m, medium->march.cloudStep_m);
   EXPECT_EQ(settingsFor((*chosen)[1], 160, 90, 60).march.emptyStep_m, realtime->march.emptyStep_m);
@@ -173,7 +173,7 @@ TEST(Configurations, PresetsAreConfigurationsWithTheirMarch) {
   auto custom = selectConfigurations("x:base=high,interleave=2");
   ASSERT_TRUE(custom) << custom.error().detail;
   EXPECT_EQ(custom->back().settings.temporal.interleave, 2u);
-  EXPECT_TRUE(custom->back().reusesHistory);
+  EXPECT_TRUE(custom->back().reusesHistory());
   EXPECT_FALSE(selectConfigurations("x:base=high,interleave=3"));
 }
 
@@ -243,7 +243,7 @@ TEST(Configurations, ReferenceCanBeReplacedForASweep) {
   EXPECT_EQ(truth->name, kReferenceName);
   EXPECT_EQ(truth->settings.march.lightSteps, 64u);
   EXPECT_EQ(truth->settings.march.primarySteps, render::findPreset("reference")->march.primarySteps);
-  EXPECT_FALSE(truth->reusesHistory);
+  EXPECT_FALSE(truth->reusesHistory());
   // The ground truth draws every pixel of every frame at full size.
   auto interleaved = referenceConfiguration("base=medium");
   ASSERT_FALSE(interleaved);

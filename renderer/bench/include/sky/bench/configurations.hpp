@@ -23,16 +23,17 @@ struct Configuration {
   // (display.hpp). The renderer has no render scale of its own yet; when it
   // does, a preset sets it in RenderSettings and this stays 1. (0, 1].
   double renderScale = 1.0;
+  // The renderer's settings for this configuration; width, height and
+  // verticalFov_deg are overwritten per scene and resolution by settingsFor.
+  render::RenderSettings settings;
+
   // Whether frames reuse earlier frames (settings.temporal.interleave > 1).
   // Only such a configuration can ghost: for the others the bench measures
   // ghosting against the configuration's own frames (0); for one that does,
   // against the same configuration drawing every pixel of every frame
   // (runner.cpp, temporalBaseline). It also starts each case with its
-  // history full (n^2 + 1 warm-up frames of the first view).
-  bool reusesHistory = false;
-  // The renderer's settings for this configuration; width, height and
-  // verticalFov_deg are overwritten per scene and resolution by settingsFor.
-  render::RenderSettings settings;
+  // history full (render::historyWarmupFrames).
+  bool reusesHistory() const { return settings.temporal.interleave > 1; }
 };
 
 // Every configuration the bench knows, `reference` first.

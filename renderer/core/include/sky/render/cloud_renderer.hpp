@@ -68,6 +68,13 @@ struct TemporalSettings {
   double depthTolerance = 0.1;
 };
 
+// Frames of a still view after which an interleaved renderer's history is
+// full (n^2 + 1: the first, drawn whole, then one cycle); 0 without
+// interleaving. What the bench renders before it times a configuration.
+constexpr std::uint32_t historyWarmupFrames(const TemporalSettings& t) {
+  return t.interleave > 1 ? t.interleave * t.interleave + 1 : 0;
+}
+
 struct RenderSettings {
   std::uint32_t width = 320, height = 180;  // pixels, [1, 8192]
   double verticalFov_deg = 60;              // (0, 179)
