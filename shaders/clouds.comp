@@ -27,6 +27,7 @@ layout(set = 0, binding = kBindingTransmittance) uniform sampler2D transmittance
 layout(set = 0, binding = kBindingMultipleScattering) uniform sampler2D multipleScatteringTex;
 layout(std430, set = 0, binding = kBindingDepth) writeonly buffer DepthBlock { float depths[]; };
 layout(std430, set = 0, binding = kBindingCoverageMip) readonly buffer CoverageMipBlock { float coverageMip[]; };
+layout(std430, set = 0, binding = kBindingBlueNoise) readonly buffer BlueNoiseBlock { float blueNoise[]; };
 
 #define real float
 #define real2 vec2
@@ -175,8 +176,11 @@ void main() {
                         frame.steps.x, frame.steps.y, frame.steps.z);
   f.layerCount = int(frame.weatherMap.y);
   vec3 dir = cameraRay(frame.camForward.xyz, frame.camRight.xyz, frame.camDown.xyz, frame.camRight.w,
-                       frame.camDown.w, float(px.x), float(px.y), float(frame.image.x), float(frame.image.y));
-  PixelResult r = shadePixel(f, dir, pixelJitter(px.x, px.y));
+                       frame.camDown.w, float(px.x), float(px.y), frame.raster.x, frame.raster.y);
+  // The pixel's step offset: the blue-noise tile's, or the hash's (SkyFrame::steps.w).
+  uint tileIndex = (px.y & (kBlueNoiseSize - 1u)) * kBlueNoiseSize + (px.x & (kBlueNoiseSize - 1u));
+  float jitter = frame.steps.w > 0.5 ? blueNoise[tileIndex] : pixelJitter(px.x, px.y);
+  PixelResult r = shadePixel(f, dir, jitter);
   pixels[sub.y * packed.x + sub.x] = vec4(r.radiance, r.transmittance);
   depths[sub.y * packed.x + sub.x] = r.depth;
 }

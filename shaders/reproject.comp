@@ -36,6 +36,7 @@ layout(std430, set = 0, binding = kReprojectBindingOutcomes) writeonly buffer Ou
 // gathers on lavapipe (clouds.comp says more), and the per-tap tests below
 // would otherwise reload them for every tap.
 uvec2 gSize;   // image width, height
+vec2 gRaster;  // the image's extent for the camera rays (SkyReproject::raster)
 uint gN;       // interleave
 int gShift;    // log2(gN): n is 1, 2 or 4, and vector integer division is slow on the CPU
 uvec2 gPhase;  // this frame's drawn pixel in each block
@@ -49,6 +50,7 @@ uint gLayers;
 vec4 gBand[kReprojectMaxLayers];
 vec3 gMotion[kReprojectMaxLayers];
 bool gHasHistory;
+bool gStill;  // neither the camera nor any layer's air moved since the previous frame
 
 // The drawn pixel of block b, when it lies inside the image.
 bool drawnPixel(ivec2 b, out uint index) {
@@ -111,7 +113,7 @@ bool previousPixel(vec3 dir, float d, out vec2 p, out float expected) {
   if (z <= 0.0) return false;
   float sx = dot(v, gPrevRight) / z;
   float sy = -dot(v, gPrevDown) / z;
-  p = vec2((sx / (gTanHalf * gAspect) + 1.0) * 0.5 * float(gSize.x), (1.0 - sy / gTanHalf) * 0.5 * float(gSize.y));
+  p = vec2((sx / (gTanHalf * gAspect) + 1.0) * 0.5 * gRaster.x, (1.0 - sy / gTanHalf) * 0.5 * gRaster.y);
   return true;
 }
 
@@ -123,17 +125,22 @@ bool insideImage(ivec2 q) { return q.x >= 0 && q.y >= 0 && q.x < int(gSize.x) &&
 // unless the agreeing taps hold at least half the bilinear weight (else a
 // neighbour with a sliver of weight would stand in for a pixel that shows
 // something else).
-bool historyAt(vec2 p, float expected, out vec4 colour) {
+// seenDepth: the history's cloud depth there, blended as the colour (0
+// where no tap that agreed saw cloud).
+bool historyAt(vec2 p, float expected, out vec4 colour, out float seenDepth) {
   vec2 q = p - 0.5;
   ivec2 i0 = ivec2(floor(q));
   vec2 f = q - vec2(i0);
   colour = vec4(0.0);
+  seenDepth = 0.0;
   if (all(lessThan(abs(f - round(f)), vec2(1e-3)))) {
     ivec2 c = i0 + ivec2(round(f));
     if (!insideImage(c)) return false;
     uint i = uint(c.y) * gSize.x + uint(c.x);
-    if (!agree(historyDepth[i], expected)) return false;
+    float hd = historyDepth[i];
+    if (!agree(hd, expected)) return false;
     colour = history[i];
+    seenDepth = hd;
     return true;
   }
   float wsum = 0.0;
@@ -142,14 +149,28 @@ bool historyAt(vec2 p, float expected, out vec4 colour) {
     ivec2 c = i0 + o;
     if (!insideImage(c)) continue;
     uint i = uint(c.y) * gSize.x + uint(c.x);
-    if (!agree(historyDepth[i], expected)) continue;
+    float hd = historyDepth[i];
+    if (!agree(hd, expected)) continue;
     float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
     colour += w * history[i];
+    seenDepth += w * hd;
     wsum += w;
   }
   if (wsum < 0.5) return false;
   colour /= wsum;
+  seenDepth /= wsum;
   return true;
+}
+
+// The cloud depth along this frame's ray of a pixel taken from the history:
+// the guess it was looked up with, moved by how far the history's surface
+// lay from where the guess put it (seen from the previous camera; the two
+// rays differ by a small turn, so the difference carries over). The
+// history's own depth where the camera has not moved (a still view keeps its
+// depths bit for bit); 0 where the history saw no cloud.
+float reusedDepth(float guess, float expected, float seen) {
+  if (seen <= 0.0) return 0.0;
+  return gStill ? seen : max(guess + (seen - expected), 0.0);
 }
 
 // Depth of the history pixel nearest p (p inside the image).
@@ -171,22 +192,25 @@ float nearestDrawnDepth(ivec2 px) {
 
 // The pixel from the history: the point at `depth` (the nearest drawn
 // pixel's) seen from the previous camera; failing that, the point at the
-// depth the history holds there. `depth` becomes the one that agreed.
+// depth the history holds there. `depth` becomes the reused pixel's depth
+// (reusedDepth).
 uint reuseHistory(ivec2 px, out vec4 colour, inout float depth) {
-  vec3 dir = cameraRay(gForward, gRight, gDown, gTanHalf, gAspect, float(px.x), float(px.y), float(gSize.x),
-                       float(gSize.y));
+  vec3 dir = cameraRay(gForward, gRight, gDown, gTanHalf, gAspect, float(px.x), float(px.y), gRaster.x, gRaster.y);
   // First guess of the pixel's cloud depth: its own block's drawn pixel's
   // (upscale's nearest); then what the history holds where that leads.
   vec2 p;
-  float expected;
+  float expected, seen;
   colour = vec4(0.0);
   if (!previousPixel(dir, depth, p, expected) || !insideImage(ivec2(floor(p)))) return kStatOffscreen;
-  if (historyAt(p, expected, colour)) return kStatReused;
+  if (historyAt(p, expected, colour, seen)) {
+    depth = reusedDepth(depth, expected, seen);
+    return kStatReused;
+  }
   float guess = historyDepthNear(p);
   vec2 p2;
   if (!previousPixel(dir, guess, p2, expected) || !insideImage(ivec2(floor(p2)))) return kStatOffscreen;
-  if (historyAt(p2, expected, colour)) {
-    depth = guess;
+  if (historyAt(p2, expected, colour, seen)) {
+    depth = reusedDepth(guess, expected, seen);
     return kStatReused;
   }
   return kStatDisoccluded;
@@ -212,6 +236,7 @@ uint resolvePixel(ivec2 px, out vec4 colour, out float depth) {
 
 void main() {
   gSize = params.image.xy;
+  gRaster = params.raster.xy;
   gN = params.image.z;
   gShift = gN == 4u ? 2 : gN == 2u ? 1 : 0;
   gHasHistory = params.image.w != 0u;
@@ -235,6 +260,8 @@ void main() {
     gBand[l] = params.layerBand[l];
     gMotion[l] = params.layerMotion[l].xyz;
   }
+  gStill = gPrevPosition == vec3(0.0) && gPrevForward == gForward && gPrevRight == gRight && gPrevDown == gDown;
+  for (uint l = 0u; l < kReprojectMaxLayers; ++l) gStill = gStill && (l >= gLayers || gMotion[l] == vec3(0.0));
   ivec2 px = ivec2(gl_GlobalInvocationID.xy);
   if (px.x < int(gSize.x) && px.y < int(gSize.y)) {
     vec4 colour;

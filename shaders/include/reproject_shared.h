@@ -57,10 +57,11 @@ struct SkyReproject {
                                           // frame, this frame's local frame (m)
   vec4 tolerance;    // x: relative cloud-depth difference a reused pixel may have, y: the same in m
                      // (added), z: margin around a layer band its wind applies in (m), w: unused
+  vec4 raster;       // xy: the image's extent in its pixels for the camera rays (SkyFrame::raster); zw: unused
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(SkyReproject) == 16 * (9 + 2 * kReprojectMaxLayers + 1));
+static_assert(sizeof(SkyReproject) == 16 * (9 + 2 * kReprojectMaxLayers + 2));
 static_assert(offsetof(SkyReproject, image) == 112);
 static_assert(offsetof(SkyReproject, layerBand) == 144);
 }  // namespace sky::gpu

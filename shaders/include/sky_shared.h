@@ -30,6 +30,10 @@ SKY_SHARED_CONST kBindingMultipleScattering = 6u;  // sampler2D, atmosphere mult
 SKY_SHARED_CONST kBindingDepth = 7u;               // storage buffer of float cloud depth (m, 0 = no cloud) per pixel
 SKY_SHARED_CONST kBindingCoverageMip = 10u;        // read-only storage buffer of float: the weather map's max-coverage
                                                    // mip, rings x kMaxLayers x kCoverageMipSize^2 (ring, slice, row north, column east)
+SKY_SHARED_CONST kBindingBlueNoise = 11u;          // read-only storage buffer of float: the blue-noise tile,
+                                                   // kBlueNoiseSize^2 values in [0, 1), row-major
+// Pixels per edge of the blue-noise tile (renderer/core/src/blue_noise.hpp).
+SKY_SHARED_CONST kBlueNoiseSize = 64u;
 // Cells per edge of the max-coverage mip (renderer/core/src/coverage_mip.hpp).
 SKY_SHARED_CONST kCoverageMipSize = 32u;
 
@@ -90,10 +94,13 @@ struct SkyFrame {
   vec4 weatherRings;    // x: 1 / (2 half extent) of the coarse ring (1/m); y, z: the blend band's start and
                         // end in fractions of the fine ring's half extent (max norm); w: unused
   vec4 steps;           // the march in metres (RenderSettings::march): x: step inside cloud (m; 0: even
-                        // placement), y: step through clear air (m), z: step growth per metre, w: unused
+                        // placement), y: step through clear air (m), z: step growth per metre, w: 1 when the
+                        // step offsets come from the blue-noise tile, 0 from the pixel hash
   uvec4 interleave;     // x: n, the pass draws 1 pixel of each n x n block (1: every pixel); y, z: this
                         // frame's pixel in the block (column, row); w: unused. The output holds the
                         // drawn pixels packed, ceil(width / n) per row (reproject.comp reads them).
+  vec4 raster;          // xy: the image's extent in its own pixels for the camera rays: the full size over the
+                        // resolution divisor (image.xy rounds it up); zw: unused
 };
 
 #ifdef __cplusplus
@@ -115,7 +122,8 @@ static_assert(offsetof(SkyLayer, cloudMapOrigin) == 64);
 static_assert(offsetof(SkyFrame, weatherRings) == 272 + 256 * kMaxLayers);
 static_assert(offsetof(SkyFrame, steps) == 272 + 256 * kMaxLayers + 16);
 static_assert(offsetof(SkyFrame, interleave) == 272 + 256 * kMaxLayers + 32);
-static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 48);
+static_assert(offsetof(SkyFrame, raster) == 272 + 256 * kMaxLayers + 48);
+static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 64);
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

@@ -44,6 +44,7 @@ struct Options {
   bool lookups = false;  // also count the cloud model's lookups (CPU reference) per view
   std::string json;
   std::string preset = "high";  // its march and interleave (sky/render/presets.hpp)
+  std::uint32_t divisor = 0;    // the resolution divisor; 0: the preset's
 };
 
 struct View {
@@ -102,10 +103,11 @@ int main(int argc, char** argv) {
     else if (k == "--json") o.json = v;
     else if (k == "--preset") o.preset = v;
     else if (k == "--lookups") o.lookups = v != "0";
+    else if (k == "--divisor") o.divisor = std::uint32_t(std::stoul(v));
     else {
       std::fprintf(stderr,
                    "usage: sky_render_bench [--width W] [--height H] [--frames N] [--warmup N] [--lookups 0|1] "
-                   "[--json FILE]\n");
+                   "[--preset NAME] [--divisor 1|2|4] [--json FILE]\n");
       return 2;
     }
   }
@@ -121,6 +123,8 @@ int main(int argc, char** argv) {
   }
   settings.march = preset->march;
   settings.temporal = preset->temporal;
+  settings.resolution = preset->resolution;
+  if (o.divisor != 0) settings.resolution.divisor = o.divisor;
   // An interleaved preset is timed with its history full.
   o.warmup = std::max(o.warmup, int(sky::render::historyWarmupFrames(settings.temporal)));
   auto renderer = sky::render::CloudRenderer::create(settings);
@@ -199,6 +203,7 @@ int main(int argc, char** argv) {
                 rank(gpu["clouds"], 0.9), rank(wall, 0.5), rank(cpu, 0.5), rank(busiest, 0.5),
                 clouds50 * 1e6 / (double(o.width) * o.height));
     if (!gpu["reproject"].empty()) std::printf("  reproject p50 %.2f ms", rank(gpu["reproject"], 0.5));
+    if (!gpu["upscale"].empty()) std::printf("  upscale p50 %.2f ms", rank(gpu["upscale"], 0.5));
     std::uint64_t lookups = 0;
     if (reference) {
       auto counted = reference->render(last, &lookups);

@@ -144,6 +144,7 @@ TEST(Temporal, StillViewConvergesToTheWholeImage) {
       drawn += t.drawn;
       // The history holds the whole image; each frame redraws part of it.
       EXPECT_TRUE(identical(image, truth)) << "frame " << f;
+      EXPECT_EQ(image.cloudDepth_m, truth.cloudDepth_m) << "frame " << f;
     }
     EXPECT_EQ(drawn, std::uint64_t(kW) * kH);  // n^2 frames draw every pixel once
   }

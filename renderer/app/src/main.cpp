@@ -207,7 +207,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   sky::render::RenderSettings settings{o.width, o.height, o.fov_deg, 1, o.noNoiseCache ? std::string() : o.cacheDir,
-                                       preset->march, preset->temporal};
+                                       preset->march, preset->temporal, preset->resolution};
   sky::render::GpuOptions gpu;
   gpu.window = window ? &window->surface() : nullptr;
   gpu.validation = o.validation;

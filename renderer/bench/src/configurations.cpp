@@ -20,6 +20,7 @@ std::vector<Configuration> builtInConfigurations() {
     Configuration c{p.name, "preset: " + p.description, 1.0, {}};
     c.settings.march = p.march;
     c.settings.temporal = p.temporal;
+    c.settings.resolution = p.resolution;
     all.push_back(c);
   }
   // The seeds' final settings in our march, as far as it has them (each
@@ -54,6 +55,20 @@ std::vector<Configuration> builtInConfigurations() {
     c.settings.temporal.interleave = 2;
     all.push_back(c);
   }
+  // The renderer's own resolution scale: the clouds drawn at 1/2 the width
+  // and height, brought to full size by its depth-aware upscale.
+  for (const char* base : {"high", "realtime"})
+    if (const auto preset = render::findPreset(base)) {
+      Configuration c{std::string(base) + "-half",
+                      std::string("preset ") + base +
+                          " with the clouds drawn at 1/2 the width and height (the renderer's depth-aware upscale)",
+                      1.0,
+                      {}};
+      c.settings.march = preset->march;
+      c.settings.temporal = preset->temporal;
+      c.settings.resolution.divisor = 2;
+      all.push_back(c);
+    }
   all.push_back({"half-res", "preset high at 1/2 the width and height, bilinear upscale (bench-side)", 0.5, {}});
   all.push_back({"quarter-res", "preset high at 1/4 the width and height, bilinear upscale (bench-side)", 0.25, {}});
   return all;
@@ -83,6 +98,7 @@ Result<Configuration> customConfiguration(const std::string& spec) {
       if (!preset) return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': " + preset.error().detail);
       m = preset->march;
       c.settings.temporal = preset->temporal;
+      c.settings.resolution = preset->resolution;
       continue;
     }
     if (!number) return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': '" + item + "' is not key=number");
@@ -96,9 +112,14 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     else if (key == "air") m.airSteps = std::uint32_t(v);
     else if (key == "scale" && v > 0 && v <= 1) c.renderScale = v;
     else if (key == "interleave" && (v == 1 || v == 2 || v == 4)) c.settings.temporal.interleave = std::uint32_t(v);
+    else if (key == "divisor" && (v == 1 || v == 2 || v == 4)) c.settings.resolution.divisor = std::uint32_t(v);
+    else if (key == "depth-aware" && (v == 0 || v == 1)) c.settings.resolution.depthAware = v == 1;
+    else if (key == "blue" && (v == 0 || v == 1)) m.blueNoise = v == 1;
     else
-      return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': unknown key '" + key +
-                                                  "' (base, primary, light, exit, stride, cloud, empty, growth, air, scale, interleave 1|2|4)");
+      return fail(ErrorCode::InvalidArgument,
+                  "custom configuration '" + spec + "': unknown key '" + key +
+                      "' (base, primary, light, exit, stride, cloud, empty, growth, air, scale, interleave 1|2|4, "
+                      "divisor 1|2|4, depth-aware 0|1, blue 0|1)");
   }
   return c;
 }
@@ -106,10 +127,10 @@ Result<Configuration> customConfiguration(const std::string& spec) {
 Result<Configuration> referenceConfiguration(const std::string& keys) {
   auto c = customConfiguration("ground-truth:" + keys);
   if (!c) return tl::unexpected(c.error());
-  if (c->reusesHistory() || c->renderScale != 1.0)
+  if (c->reusesHistory() || c->renderScale != 1.0 || c->settings.resolution.divisor != 1)
     return fail(ErrorCode::InvalidArgument, "--reference '" + keys +
                                                 "': the ground truth draws every pixel of every frame at full size "
-                                                "(no interleave, no scale)");
+                                                "(no interleave, no scale, no divisor)");
   c->name = kReferenceName;
   c->description = "ground truth for this run: " + keys;
   return c;

@@ -26,7 +26,9 @@ vk::raii::Sampler makeSampler(const GpuContext& ctx, vk::SamplerAddressMode mode
 
 Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, std::uint32_t height,
                                     const NoiseVolume& shape, const NoiseVolume& detail,
-                                    const AtmosphereTables& atmosphere, const WeatherTexture& weather) {
+                                    const AtmosphereTables& atmosphere, const WeatherTexture& weather,
+                                    const std::vector<float>& blueNoise) {
+  SKY_ASSERT(blueNoise.size() == std::size_t(gpu::kBlueNoiseSize) * gpu::kBlueNoiseSize);
   CloudPass pass;
   pass.width_ = width;
   pass.height_ = height;
@@ -42,6 +44,7 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
       .binding(gpu::kBindingMultipleScattering, vk::DescriptorType::eCombinedImageSampler)
       .binding(gpu::kBindingDepth, vk::DescriptorType::eStorageBuffer)
       .binding(gpu::kBindingCoverageMip, vk::DescriptorType::eStorageBuffer)
+      .binding(gpu::kBindingBlueNoise, vk::DescriptorType::eStorageBuffer)
       .shader("clouds.comp.spv");
   auto pipeline = builder.build(ctx);
   if (!pipeline) return tl::unexpected(pipeline.error());
@@ -82,9 +85,12 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
   pass.coverageMip_ = createHostBuffer(ctx, vk::DeviceSize(kCoverageMipFloats * sizeof(float)),
                                        vk::BufferUsageFlagBits::eStorageBuffer, "sky.coverageMip");
   std::memset(pass.coverageMip_.mapped, 0, pass.coverageMip_.size);
+  pass.blueNoise_ = createHostBuffer(ctx, vk::DeviceSize(blueNoise.size() * sizeof(float)),
+                                     vk::BufferUsageFlagBits::eStorageBuffer, "sky.blueNoise");
+  std::memcpy(pass.blueNoise_.mapped, blueNoise.data(), pass.blueNoise_.size);
 
   const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eCombinedImageSampler, 5),
-                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 4)};
+                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 5)};
   pass.descriptorPool_ = vk::raii::DescriptorPool(
       device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSizes));
   ctx.name(pass.descriptorPool_, "sky.clouds.descriptorPool");
@@ -97,6 +103,7 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
   const vk::DescriptorBufferInfo outputInfo(*pass.output_.buffer, 0, pass.output_.size);
   const vk::DescriptorBufferInfo depthInfo(*pass.depth_.buffer, 0, pass.depth_.size);
   const vk::DescriptorBufferInfo mipInfo(*pass.coverageMip_.buffer, 0, pass.coverageMip_.size);
+  const vk::DescriptorBufferInfo blueInfo(*pass.blueNoise_.buffer, 0, pass.blueNoise_.size);
   const vk::DescriptorImageInfo shapeInfo(*pass.noiseSampler_, *pass.shape_.view, vk::ImageLayout::eShaderReadOnlyOptimal);
   const vk::DescriptorImageInfo detailInfo(*pass.noiseSampler_, *pass.detail_.view, vk::ImageLayout::eShaderReadOnlyOptimal);
   const vk::DescriptorImageInfo tableInfo(*pass.tableSampler_, *pass.transmittance_.view,
@@ -115,10 +122,11 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
       vk::WriteDescriptorSet(set, gpu::kBindingWeather, 0, vk::DescriptorType::eCombinedImageSampler, weatherInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingOutput, 0, vk::DescriptorType::eStorageBuffer, {}, outputInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingDepth, 0, vk::DescriptorType::eStorageBuffer, {}, depthInfo),
-      vk::WriteDescriptorSet(set, gpu::kBindingCoverageMip, 0, vk::DescriptorType::eStorageBuffer, {}, mipInfo)};
+      vk::WriteDescriptorSet(set, gpu::kBindingCoverageMip, 0, vk::DescriptorType::eStorageBuffer, {}, mipInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingBlueNoise, 0, vk::DescriptorType::eStorageBuffer, {}, blueInfo)};
   device.updateDescriptorSets(writes, {});
 
-  pass.timer_ = GpuTimer(ctx, 2, "sky.clouds.timer");
+  pass.timer_ = GpuTimer(ctx, 3, "sky.clouds.timer");
   pass.commands_ = ctx.allocateCommandBuffer();
   ctx.name(pass.commands_, "sky.clouds.commands");
   pass.fence_ = vk::raii::Fence(device, vk::FenceCreateInfo());
@@ -131,10 +139,10 @@ void CloudPass::setCoverageMip(const std::vector<float>& mip) {
   std::memcpy(coverageMip_.mapped, mip.data(), coverageMip_.size);
 }
 
-Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, ReprojectPass* reproject,
-                             const gpu::SkyReproject* reprojectParams) {
-  SKY_ASSERT((reproject == nullptr) == (reprojectParams == nullptr));
-  SKY_ASSERT(reproject != nullptr || frame.interleave.x == 1);
+Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, const Followers& next) {
+  SKY_ASSERT((next.reproject == nullptr) == (next.reprojectParams == nullptr));
+  SKY_ASSERT((next.upscale == nullptr) == (next.upscaleParams == nullptr));
+  SKY_ASSERT(next.reproject != nullptr || frame.interleave.x == 1);
   std::memcpy(uniforms_.mapped, &frame, sizeof frame);
 
   commands_.reset();
@@ -148,32 +156,25 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
     // through the permutation in frame.dispatch.
     commands_.dispatch(frame.image.w, 1, 1);
   }
-  if (reproject != nullptr) {
-    reproject->record(commands_, timer_, *reprojectParams);
-    commands_.end();
-    if (auto ok = ctx.submitAndWait(commands_, fence_); !ok) return tl::unexpected(ok.error());
-    Image image;
-    reproject->readBack(image);
-    return image;
+  if (next.reproject != nullptr) next.reproject->record(commands_, timer_, *next.reprojectParams);
+  if (next.upscale != nullptr) 
+    next.upscale->record(commands_, timer_, next.reproject != nullptr ? next.reproject->current() : 0,
+                         *next.upscaleParams);
+  if (next.reproject == nullptr && next.upscale == nullptr) {
+    const std::array toHost{
+        vk::BufferMemoryBarrier(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead,
+                                VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *output_.buffer, 0, VK_WHOLE_SIZE),
+        vk::BufferMemoryBarrier(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead,
+                                VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *depth_.buffer, 0, VK_WHOLE_SIZE)};
+    commands_.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, {},
+                              toHost, {});
   }
-  const std::array toHost{
-      vk::BufferMemoryBarrier(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead, VK_QUEUE_FAMILY_IGNORED,
-                              VK_QUEUE_FAMILY_IGNORED, *output_.buffer, 0, VK_WHOLE_SIZE),
-      vk::BufferMemoryBarrier(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead, VK_QUEUE_FAMILY_IGNORED,
-                              VK_QUEUE_FAMILY_IGNORED, *depth_.buffer, 0, VK_WHOLE_SIZE)};
-  commands_.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, {},
-                            toHost, {});
   commands_.end();
   if (auto ok = ctx.submitAndWait(commands_, fence_); !ok) return tl::unexpected(ok.error());
 
-  Image image;
-  image.width = width_;
-  image.height = height_;
-  image.rgba.resize(std::size_t(width_) * height_ * 4);
-  std::memcpy(image.rgba.data(), output_.mapped, image.rgba.size() * sizeof(float));
-  image.cloudDepth_m.resize(std::size_t(width_) * height_);
-  std::memcpy(image.cloudDepth_m.data(), depth_.mapped, image.cloudDepth_m.size() * sizeof(float));
-  return image;
+  if (next.upscale != nullptr) return next.upscale->readBack();
+  if (next.reproject != nullptr) return next.reproject->readBack();
+  return readImage(output_, depth_, width_, height_);
 }
 
 }  // namespace sky::render

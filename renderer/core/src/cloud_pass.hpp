@@ -15,6 +15,7 @@
 #include "gpu_timer.hpp"
 #include "noise_volume.hpp"
 #include "reproject_pass.hpp"
+#include "upscale_pass.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky_shared.h"
 #include "weather_texture.hpp"
@@ -23,19 +24,31 @@ namespace sky::render {
 
 class CloudPass {
  public:
-  // weather must outlive the pass (its image view is bound once here).
+  // weather must outlive the pass (its image view is bound once here);
+  // blueNoise is the tile (kBlueNoiseSize^2 values) the march's step offsets
+  // may come from (MarchSettings::blueNoise).
   // Errors: Io/Malformed for the SPIR-V, Device from the texture uploads;
   // other Vulkan failures throw.
   static Result<CloudPass> create(const GpuContext& ctx, std::uint32_t width, std::uint32_t height,
                                   const NoiseVolume& shape, const NoiseVolume& detail,
-                                  const AtmosphereTables& atmosphere, const WeatherTexture& weather);
+                                  const AtmosphereTables& atmosphere, const WeatherTexture& weather,
+                                  const std::vector<float>& blueNoise);
 
-  // Dispatches one frame and reads it back. With a reprojection pass, that
-  // pass follows in the same submission (with its block) and the image read
-  // back is the one it wrote; without, the frame must draw every pixel.
-  // Errors: Timeout, Device.
-  Result<Image> run(const GpuContext& ctx, const gpu::SkyFrame& frame, ReprojectPass* reproject = nullptr,
-                    const gpu::SkyReproject* reprojectParams = nullptr);
+  // The passes that follow the clouds in the same submission, each with
+  // its block: the reprojection (with interleaving; without it the frame
+  // must draw every pixel), then the upscale (with a resolution divisor).
+  // The upscale reads what came before it: its sources are this pass's
+  // output, or with a reprojection that pass's outputs 0 and 1, in order.
+  struct Followers {
+    ReprojectPass* reproject = nullptr;
+    const gpu::SkyReproject* reprojectParams = nullptr;
+    UpscalePass* upscale = nullptr;
+    const gpu::SkyUpscale* upscaleParams = nullptr;
+  };
+
+  // Dispatches one frame and its followers and reads back the image the
+  // last of them wrote. Errors: Timeout, Device.
+  Result<Image> run(const GpuContext& ctx, const gpu::SkyFrame& frame, const Followers& followers);
   // What the clouds write: radiance + transmittance and cloud depth of the
   // pixels drawn, packed (sky_shared.h, SkyFrame::interleave).
   const GpuBuffer& output() const { return output_; }
@@ -43,7 +56,7 @@ class CloudPass {
   // Replaces the max-coverage mip the march reads (coverage_mip.hpp; size
   // kMaxLayers x kCoverageMipSize^2). Call between runs.
   void setCoverageMip(const std::vector<float>& mip);
-  // GPU time of the last run's dispatches ("clouds", then "reproject").
+  // GPU time of the last run's dispatches ("clouds", then "reproject", "upscale").
   std::vector<PassTime> lastTimes() const { return timer_.results(); }
 
  private:
@@ -64,6 +77,7 @@ class CloudPass {
   GpuBuffer output_;
   GpuBuffer depth_;
   GpuBuffer coverageMip_;  // the weather map's max-coverage mip (host-visible storage buffer)
+  GpuBuffer blueNoise_;    // the step offsets' blue-noise tile (blue_noise.hpp)
   vk::raii::DescriptorPool descriptorPool_{nullptr};
   vk::raii::DescriptorSet descriptorSet_{nullptr};
   GpuTimer timer_;

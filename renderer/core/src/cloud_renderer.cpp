@@ -13,6 +13,7 @@
 #include "sky/render/noise_cache.hpp"
 
 #include "atmosphere_tables.hpp"
+#include "blue_noise.hpp"
 #include "cloud_pass.hpp"
 #include "coverage_mip.hpp"
 #include "frame_setup.hpp"
@@ -21,6 +22,7 @@
 #include "presenter.hpp"
 #include "reproject_pass.hpp"
 #include "temporal_plan.hpp"
+#include "upscale_pass.hpp"
 #include "weather_texture.hpp"
 
 namespace sky::render {
@@ -33,6 +35,7 @@ struct CloudRenderer::Impl {
   WeatherTexture weather;
   CloudPass pass;
   std::optional<ReprojectPass> reproject;  // with interleaving (settings.temporal.interleave > 1)
+  std::optional<UpscalePass> upscale;      // with a resolution divisor (settings.resolution.divisor > 1)
   TemporalPlanner planner;
   std::optional<Presenter> presenter;
   RenderSettings settings;
@@ -119,13 +122,29 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
     const NoiseVolume detail = cachedNoise(settings, "detail", kDetailNoiseGeneratorVersion, kDetailNoiseSize,
                                            kDetailNoiseFingerprintSize, makeDetailNoise, &noiseReport);
     AtmosphereTables atmosphere = sharedAtmosphereTables();
-    auto pass = CloudPass::create(**ctx, settings.width, settings.height, shape, detail, atmosphere, *weather);
+    // The size the cloud pass draws (FrameSetup::width).
+    const std::uint32_t divisor = settings.resolution.divisor;
+    const std::uint32_t smallW = (settings.width + divisor - 1) / divisor;
+    const std::uint32_t smallH = (settings.height + divisor - 1) / divisor;
+    auto pass = CloudPass::create(**ctx, smallW, smallH, shape, detail, atmosphere, *weather,
+                                  blueNoiseTile(settings.noiseSeed));
     if (!pass) return tl::unexpected(pass.error());
     std::optional<ReprojectPass> reproject;
     if (settings.temporal.interleave > 1) {
-      auto created = ReprojectPass::create(**ctx, settings.width, settings.height, pass->output(), pass->depth());
+      auto created = ReprojectPass::create(**ctx, smallW, smallH, pass->output(), pass->depth());
       if (!created) return tl::unexpected(created.error());
       reproject.emplace(std::move(*created));
+    }
+    std::optional<UpscalePass> upscale;
+    if (divisor > 1) {
+      std::vector<UpscalePass::Source> sources;
+      if (reproject)
+        sources = {reproject->output(0), reproject->output(1)};
+      else
+        sources = {{&pass->output(), &pass->depth()}};
+      auto created = UpscalePass::create(**ctx, smallW, smallH, settings.width, settings.height, sources);
+      if (!created) return tl::unexpected(created.error());
+      upscale.emplace(std::move(*created));
     }
     std::optional<Presenter> presenter;
     if (gpu.window) {
@@ -134,9 +153,9 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
       presenter.emplace(std::move(*created));
     }
     auto impl = std::make_unique<Impl>(Impl{std::move(*ctx), std::move(*weather), std::move(*pass),
-                                            std::move(reproject), TemporalPlanner(settings.temporal),
-                                            std::move(presenter), settings, std::move(atmosphere), {},
-                                            std::move(noiseReport)});
+                                            std::move(reproject), std::move(upscale),
+                                            TemporalPlanner(settings.temporal), std::move(presenter), settings,
+                                            std::move(atmosphere), {}, std::move(noiseReport)});
     return std::unique_ptr<CloudRenderer>(new CloudRenderer(std::move(impl)));
   });
 }
@@ -154,8 +173,16 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
     }
     FrameSetup setup = prepareFrame(impl_->settings, inputs, impl_->weather.field(), impl_->atmosphere);
     impl_->temporal = {};
+    CloudPass::Followers next;
+    gpu::SkyUpscale upscaleBlock{};
+    if (impl_->upscale) {
+      next.upscale = &*impl_->upscale;
+      next.upscaleParams = &upscaleBlock;
+    }
     if (!impl_->reproject) {
-      auto image = impl_->pass.run(*impl_->ctx, packFrame(setup));
+      const gpu::SkyFrame frame = packFrame(setup);
+      upscaleBlock = upscaleParams(frame, impl_->settings.resolution, impl_->settings.width, impl_->settings.height);
+      auto image = impl_->pass.run(*impl_->ctx, frame, next);
       if (image)
         for (auto& t : impl_->pass.lastTimes()) impl_->passTimes.push_back(std::move(t));
       return image;
@@ -163,7 +190,11 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
     const TemporalPlan plan = impl_->planner.plan(setup, inputs);
     setup.interleave = plan.interleave;
     setup.phase = plan.phase;
-    auto image = impl_->pass.run(*impl_->ctx, packFrame(setup), &*impl_->reproject, &plan.params);
+    const gpu::SkyFrame frame = packFrame(setup);
+    upscaleBlock = upscaleParams(frame, impl_->settings.resolution, impl_->settings.width, impl_->settings.height);
+    next.reproject = &*impl_->reproject;
+    next.reprojectParams = &plan.params;
+    auto image = impl_->pass.run(*impl_->ctx, frame, next);
     if (!image) {
       impl_->planner.forget();
       return image;

@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "atmosphere_tables.hpp"
+#include "blue_noise.hpp"
 #include "coverage_mip.hpp"
 #include "frame_setup.hpp"
 #include "noise_volume.hpp"
@@ -21,6 +22,7 @@ struct CpuReference::Tables {
   NoiseVolume shape;
   NoiseVolume detail;
   AtmosphereTables atmosphere;
+  std::vector<float> blueNoise;  // the cloud pass's tile (blue_noise.hpp)
 };
 
 namespace {
@@ -39,9 +41,9 @@ class CpuCore {
   using uint = std::uint32_t;
 
   CpuCore(const FrameSetup& setup, const NoiseVolume& shape, const NoiseVolume& detail,
-          const AtmosphereTables& atmosphere, const WeatherField& weather)
+          const AtmosphereTables& atmosphere, const WeatherField& weather, const std::vector<float>& blueNoise)
       : setup_(setup), shape_(shape), detail_(detail), atmosphere_(atmosphere), weather_(weather),
-        coverageMip_(buildCoverageMip(weather)) {}
+        blueNoise_(blueNoise), coverageMip_(buildCoverageMip(weather)) {}
 
   real3 sampleTransmittanceLut(real2 uv) const { return atmosphere_.sampleTransmittance(uv); }
   real3 sampleMultipleScatteringLut(real2 uv) const { return atmosphere_.sampleMultipleScattering(uv); }
@@ -90,8 +92,12 @@ class CpuCore {
 
   PixelResult shade(std::uint32_t px, std::uint32_t py, const CoreFrame& f) {
     const real3 dir = cameraRay(setup_.camForward, setup_.camRight, setup_.camDown, setup_.tanHalfFov,
-                                setup_.aspect, real(px), real(py), real(setup_.width), real(setup_.height));
-    return shadePixel(f, dir, pixelJitter(px, py));
+                                setup_.aspect, real(px), real(py), setup_.rasterWidth, setup_.rasterHeight);
+    // The step offset as clouds.comp takes it (a float of the tile, or the hash).
+    const real jitter = setup_.march.blueNoise
+                            ? real(blueNoise_[(py % kBlueNoiseSize) * kBlueNoiseSize + px % kBlueNoiseSize])
+                            : pixelJitter(px, py);
+    return shadePixel(f, dir, jitter);
   }
 
  private:
@@ -102,6 +108,7 @@ class CpuCore {
   const NoiseVolume& detail_;
   const AtmosphereTables& atmosphere_;
   const WeatherField& weather_;
+  const std::vector<float>& blueNoise_;
   const std::vector<float> coverageMip_;
 };
 
@@ -155,7 +162,11 @@ Result<CpuReference> CpuReference::create(const RenderSettings& settings) {
   tables->shape = makeShapeNoise(kShapeNoiseSize, settings.noiseSeed);
   tables->detail = makeDetailNoise(kDetailNoiseSize, settings.noiseSeed);
   tables->atmosphere = sharedAtmosphereTables();
-  return CpuReference(settings, std::move(tables));
+  tables->blueNoise = blueNoiseTile(settings.noiseSeed);
+  // The reference draws every pixel at full size: no resolution divisor.
+  RenderSettings full = settings;
+  full.resolution = {};
+  return CpuReference(full, std::move(tables));
 }
 
 Result<std::vector<std::array<float, 4>>> CpuReference::renderPixels(const FrameInputs& inputs,
@@ -167,7 +178,7 @@ Result<std::vector<std::array<float, 4>>> CpuReference::renderPixels(const Frame
                                                   std::to_string(p.y) + ") outside the image");
   const WeatherField field = buildWeatherField(inputs.weather, weatherAnchorFor(inputs.camera.position));
   const FrameSetup setup = prepareFrame(settings_, inputs, field, tables_->atmosphere);
-  CpuCore core(setup, tables_->shape, tables_->detail, tables_->atmosphere, field);
+  CpuCore core(setup, tables_->shape, tables_->detail, tables_->atmosphere, field, tables_->blueNoise);
   const auto frame = core.coreFrame();
   std::vector<std::array<float, 4>> out;
   out.reserve(pixels.size());
@@ -182,7 +193,7 @@ Result<Image> CpuReference::render(const FrameInputs& inputs, std::uint64_t* den
   if (auto ok = validateInputs(inputs); !ok) return tl::unexpected(ok.error());
   const WeatherField field = buildWeatherField(inputs.weather, weatherAnchorFor(inputs.camera.position));
   const FrameSetup setup = prepareFrame(settings_, inputs, field, tables_->atmosphere);
-  CpuCore core(setup, tables_->shape, tables_->detail, tables_->atmosphere, field);
+  CpuCore core(setup, tables_->shape, tables_->detail, tables_->atmosphere, field, tables_->blueNoise);
   const auto frame = core.coreFrame();
   Image image;
   image.width = settings_.width;

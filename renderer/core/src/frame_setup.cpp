@@ -102,6 +102,10 @@ Result<void> validateSettings(const RenderSettings& s) {
   if (!(m.stepGrowth >= 0 && m.stepGrowth <= 1))
     return fail(ErrorCode::InvalidArgument,
                 "render settings: march.stepGrowth " + num(m.stepGrowth) + " outside [0, 1]");
+  const std::uint32_t d = s.resolution.divisor;
+  if (d != 1 && d != 2 && d != 4)
+    return fail(ErrorCode::InvalidArgument,
+                "render settings: resolution.divisor " + std::to_string(d) + " is not 1, 2 or 4");
   const TemporalSettings& t = s.temporal;
   if (t.interleave != 1 && t.interleave != 2 && t.interleave != 4)
     return fail(ErrorCode::InvalidArgument,
@@ -153,8 +157,11 @@ Result<void> validateInputs(const FrameInputs& in) {
 FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, const WeatherField& field,
                         const AtmosphereTables& tables) {
   FrameSetup s;
-  s.width = settings.width;
-  s.height = settings.height;
+  const std::uint32_t d = settings.resolution.divisor;
+  s.width = (settings.width + d - 1) / d;
+  s.height = (settings.height + d - 1) / d;
+  s.rasterWidth = double(settings.width) / d;
+  s.rasterHeight = double(settings.height) / d;
   s.tanHalfFov = std::tan(0.5 * settings.verticalFov_deg * kDegToRad);
   s.aspect = double(settings.width) / double(settings.height);
   s.march = settings.march;
@@ -325,8 +332,10 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   }
   f.image = gpu::uvec4(s.width, s.height, tilesX, n);
   f.dispatch = gpu::uvec4(stride, s.march.primarySteps, s.march.lightSteps, s.march.airSteps);
-  f.steps = gpu::vec4(float(s.march.cloudStep_m), float(s.march.emptyStep_m), float(s.march.stepGrowth), 0.0f);
+  f.steps = gpu::vec4(float(s.march.cloudStep_m), float(s.march.emptyStep_m), float(s.march.stepGrowth),
+                      s.march.blueNoise ? 1.0f : 0.0f);
   f.interleave = gpu::uvec4(s.interleave, s.phase.x, s.phase.y, 0u);
+  f.raster = gpu::vec4(float(s.rasterWidth), float(s.rasterHeight), 0.0f, 0.0f);
 
   for (std::size_t i = 0; i < s.layers.size(); ++i) {
     const LayerSetup& l = s.layers[i];

@@ -51,8 +51,14 @@ struct LayerSetup {
 };
 
 struct FrameSetup {
+  // The image the cloud pass draws: the settings' size over the resolution
+  // divisor, rounded up. Its pixel (i, j) is centred where the full image's
+  // continuous coordinate is ((i + 0.5) d, (j + 0.5) d); rays take the
+  // full image's frustum, rasterWidth x rasterHeight of these pixels (the
+  // settings' size / d, not whole when the size is not a multiple of d).
   std::uint32_t width = 0, height = 0;
-  double tanHalfFov = 0, aspect = 1;
+  double rasterWidth = 0, rasterHeight = 0;
+  double tanHalfFov = 0, aspect = 1;  // the full image's: vertical, and width / height
   glm::dvec3 camForward{0}, camRight{0}, camDown{0};  // local frame: x east, y north, z up
   glm::dmat3 localToEcef{1};   // columns: the camera's east, north, up in ECEF
   glm::dvec3 cameraEcef_m{0};  // the local frame's origin

@@ -89,4 +89,16 @@ Result<void> uploadImage(const GpuContext& ctx, GpuImage& image, std::span<const
   return ctx.submitAndWait(cmd, fence);
 }
 
+Image readImage(const GpuBuffer& colour, const GpuBuffer& depth, std::uint32_t width, std::uint32_t height) {
+  Image image;
+  image.width = width;
+  image.height = height;
+  image.rgba.resize(std::size_t(width) * height * 4);
+  image.cloudDepth_m.resize(std::size_t(width) * height);
+  SKY_ASSERT(colour.size >= image.rgba.size() * sizeof(float) && depth.size >= image.cloudDepth_m.size() * sizeof(float));
+  std::memcpy(image.rgba.data(), colour.mapped, image.rgba.size() * sizeof(float));
+  std::memcpy(image.cloudDepth_m.data(), depth.mapped, image.cloudDepth_m.size() * sizeof(float));
+  return image;
+}
+
 }  // namespace sky::render

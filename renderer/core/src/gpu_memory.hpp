@@ -9,6 +9,7 @@
 #include <vulkan/vulkan_raii.hpp>
 
 #include "gpu_context.hpp"
+#include "sky/render/cloud_renderer.hpp"
 
 namespace sky::render {
 
@@ -24,6 +25,10 @@ struct GpuBuffer {
 // that matters; on a discrete GPU these are the uniform and readback buffers).
 GpuBuffer createHostBuffer(const GpuContext& ctx, vk::DeviceSize size, vk::BufferUsageFlags usage,
                            const char* debugName);
+
+// A width x height image out of the host-visible buffers a pass wrote
+// (radiance + transmittance, vec4 per pixel; cloud depth, float per pixel).
+Image readImage(const GpuBuffer& colour, const GpuBuffer& depth, std::uint32_t width, std::uint32_t height);
 
 struct GpuImage {
   // Destroyed in reverse order: view, image, then memory.

@@ -84,14 +84,7 @@ void ReprojectPass::record(const vk::raii::CommandBuffer& commands, GpuTimer& ti
                            {}, {});
 }
 
-void ReprojectPass::readBack(Image& image) const {
-  image.width = width_;
-  image.height = height_;
-  image.rgba.resize(std::size_t(width_) * height_ * 4);
-  std::memcpy(image.rgba.data(), colour_[current_].mapped, image.rgba.size() * sizeof(float));
-  image.cloudDepth_m.resize(std::size_t(width_) * height_);
-  std::memcpy(image.cloudDepth_m.data(), depth_[current_].mapped, image.cloudDepth_m.size() * sizeof(float));
-}
+Image ReprojectPass::readBack() const { return readImage(colour_[current_], depth_[current_], width_, height_); }
 
 TemporalReport ReprojectPass::counts() const {
   std::uint64_t c[gpu::kReprojectStatCount + 1] = {};

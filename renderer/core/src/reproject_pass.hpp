@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <utility>
 
 #include "compute_pipeline.hpp"
 #include "gpu_context.hpp"
@@ -32,8 +33,12 @@ class ReprojectPass {
   void record(const vk::raii::CommandBuffer& commands, GpuTimer& timer, const gpu::SkyReproject& params);
   // After the submission completed: the image the last record() wrote, and
   // what became of its pixels.
-  void readBack(Image& image) const;
+  Image readBack() const;
   TemporalReport counts() const;
+  // The two full images it writes in turn (k = 0, 1: radiance +
+  // transmittance, cloud depth), and which of them the last record() wrote.
+  std::pair<const GpuBuffer*, const GpuBuffer*> output(std::uint32_t k) const { return {&colour_[k], &depth_[k]}; }
+  std::uint32_t current() const { return current_; }
 
  private:
   ReprojectPass() = default;

@@ -99,6 +99,7 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   p.camRight = v4(setup.camRight, setup.tanHalfFov);
   p.camDown = v4(setup.camDown, setup.aspect);
   p.image = gpu::uvec4(setup.width, setup.height, plan.interleave, plan.drawWhole ? 0u : 1u);
+  p.raster = gpu::vec4(float(setup.rasterWidth), float(setup.rasterHeight), 0.0f, 0.0f);
   const std::uint32_t packedW = (setup.width + plan.interleave - 1) / plan.interleave;
   p.phase = gpu::uvec4(plan.phase.x, plan.phase.y, packedW, std::uint32_t(setup.layers.size()));
   p.tolerance = gpu::vec4(float(settings_.depthTolerance), float(kDepthToleranceSlack_m), float(kLayerWindMargin_m), 0.0f);

@@ -45,9 +45,11 @@ std::vector<Configuration> builtInConfigurations();
 Result<std::vector<Configuration>> selectConfigurations(const std::string& names);
 
 // A configuration from a spec NAME:key=value,... (keys: base = a preset
-// whose march and interleave it starts from, else high's; primary, light, exit, stride,
-// cloud, empty, growth, air = the MarchSettings fields; scale = render scale;
-// interleave = TemporalSettings::interleave, 1, 2 or 4).
+// whose march, interleave and divisor it starts from, else high's; primary, light, exit, stride,
+// cloud, empty, growth, air = the MarchSettings fields; scale = the bench-side render scale
+// (bilinear resize of the output); interleave = TemporalSettings::interleave, 1, 2 or 4;
+// divisor = ResolutionSettings::divisor, 1, 2 or 4 (the renderer's own upscale);
+// depth-aware = ResolutionSettings::depthAware, 0 or 1; blue = MarchSettings::blueNoise, 0 or 1).
 // --configs takes such specs next to names; a list with a spec in it is
 // separated by ';' (a spec has commas). Errors: InvalidArgument naming the bad part.
 Result<Configuration> customConfiguration(const std::string& spec);
@@ -55,8 +57,8 @@ Result<Configuration> customConfiguration(const std::string& spec);
 // A ground truth other than the `reference` preset, from custom-configuration
 // keys ("base=reference,light=64"): named `reference`, it replaces the first
 // configuration of a run (a sweep against 64 light steps compares with that).
-// Errors: InvalidArgument as customConfiguration, and for an interleave > 1
-// (the ground truth draws every pixel of every frame).
+// Errors: InvalidArgument as customConfiguration, and for an interleave > 1,
+// a scale or a divisor (the ground truth draws every pixel of every frame).
 Result<Configuration> referenceConfiguration(const std::string& keys);
 
 // The RenderSettings a configuration renders a scene with at an output size.

@@ -42,6 +42,12 @@ struct MarchSettings {
   // Steps of the clear-air march along each view ray (aerial perspective and
   // the sky; atmosphere_core.glsl); 0: its default, 16. [0, 64].
   std::uint32_t airSteps = 0;
+  // Where along its first step each pixel's samples sit (a fraction of the
+  // step, fixed per pixel): false, a white-noise hash of the pixel; true, a
+  // 64x64 blue-noise tile repeated over the image (renderer/core/src/blue_noise.hpp),
+  // so neighbouring pixels sample far apart and the march's error is noise
+  // of high spatial frequency instead of clumps.
+  bool blueNoise = false;
 };
 
 // Interleaved rendering with reprojection (shaders/reproject.comp,
@@ -75,6 +81,22 @@ constexpr std::uint32_t historyWarmupFrames(const TemporalSettings& t) {
   return t.interleave > 1 ? t.interleave * t.interleave + 1 : 0;
 }
 
+// A render-resolution scale (shaders/upscale.comp, renderer/core/src/upscale_pass.hpp):
+// the cloud pass and the reprojection work on an image `divisor` times
+// smaller each way, and an upscale pass brings it to the full size. The
+// upscale is guided by the scene's depth at full size: each output pixel
+// knows from its own ray whether it sees the ground or the sky, and takes
+// only the low-resolution pixels on its side of the horizon, so the horizon
+// stays sharp and sky does not bleed into the ground (or the reverse); the
+// cloud depth is the nearest of those pixels' (never a blend of two depths).
+struct ResolutionSettings {
+  // 1 (full size), 2 or 4. The small image is the size over d rounded up;
+  // its pixels are d x d pixels of the full image wherever the size is not
+  // a multiple of d, the last column and row reaching past its edge.
+  std::uint32_t divisor = 1;
+  bool depthAware = true;     // false: plain bilinear over the four nearest pixels
+};
+
 struct RenderSettings {
   std::uint32_t width = 320, height = 180;  // pixels, [1, 8192]
   double verticalFov_deg = 60;              // (0, 179)
@@ -84,6 +106,7 @@ struct RenderSettings {
   std::string noiseCacheDir;
   MarchSettings march;
   TemporalSettings temporal;
+  ResolutionSettings resolution;
 };
 
 struct FrameInputs {
@@ -113,6 +136,8 @@ struct FrameInputs {
 struct TemporalReport {
   bool drawnWhole = false;
   std::string reason;  // why it was drawn whole ("first frame", "teleport 2.1 km", ...); empty otherwise
+  // Pixels of the image the cloud pass works on: with a resolution divisor d,
+  // (width / d) x (height / d).
   std::uint64_t drawn = 0, reused = 0, offscreen = 0, disoccluded = 0;
 };
 

@@ -17,6 +17,7 @@ struct Preset {
   std::string description;  // what it changes against reference, one line
   MarchSettings march;
   TemporalSettings temporal;  // interleave 1: every pixel every frame
+  ResolutionSettings resolution{};  // divisor 1: the clouds drawn at full size
 };
 
 // Every preset, `reference` first, then from most to least expensive.
