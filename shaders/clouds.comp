@@ -180,6 +180,7 @@ void main() {
   // The pixel's step offset: the blue-noise tile's, or the hash's (SkyFrame::steps.w).
   uint tileIndex = (px.y & (kBlueNoiseSize - 1u)) * kBlueNoiseSize + (px.x & (kBlueNoiseSize - 1u));
   float jitter = frame.steps.w > 0.5 ? blueNoise[tileIndex] : pixelJitter(px.x, px.y);
+  jitter = fract(jitter + frame.raster.z);
   PixelResult r = shadePixel(f, dir, jitter);
   pixels[sub.y * packed.x + sub.x] = vec4(r.radiance, r.transmittance);
   depths[sub.y * packed.x + sub.x] = r.depth;

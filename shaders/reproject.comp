@@ -46,6 +46,7 @@ vec3 gPrevForward, gPrevRight, gPrevDown;  // the previous camera
 vec3 gPrevPosition;
 float gRadius, gTanHalf, gAspect;
 float gRelTolerance, gAbsTolerance, gBandMargin;
+float gAccumulation;  // the history's share of a redrawn pixel
 uint gLayers;
 vec4 gBand[kReprojectMaxLayers];
 vec3 gMotion[kReprojectMaxLayers];
@@ -222,6 +223,13 @@ uint resolvePixel(ivec2 px, out vec4 colour, out float depth) {
   if (px == (b << gShift) + ivec2(gPhase) && drawnPixel(b, drawn)) {
     colour = fresh[drawn];
     depth = freshDepth[drawn];
+    // Temporal accumulation: the redrawn pixel blended with its history,
+    // found through the motion at the depth just drawn (depth stays as drawn).
+    if (gHasHistory && gAccumulation > 0.0) {
+      vec4 before;
+      float guess = depth;
+      if (reuseHistory(px, before, guess) == kStatReused) colour = mix(colour, before, gAccumulation);
+    }
     return kStatFresh;
   }
   if (!gHasHistory) {
@@ -256,6 +264,7 @@ void main() {
   gRelTolerance = params.tolerance.x;
   gAbsTolerance = params.tolerance.y;
   gBandMargin = params.tolerance.z;
+  gAccumulation = params.tolerance.w;
   for (uint l = 0u; l < kReprojectMaxLayers; ++l) {
     gBand[l] = params.layerBand[l];
     gMotion[l] = params.layerMotion[l].xyz;

@@ -56,7 +56,8 @@ struct SkyReproject {
   vec4 layerMotion[kReprojectMaxLayers];  // xyz: how far the layer's air moved since the previous
                                           // frame, this frame's local frame (m)
   vec4 tolerance;    // x: relative cloud-depth difference a reused pixel may have, y: the same in m
-                     // (added), z: margin around a layer band its wind applies in (m), w: unused
+                     // (added), z: margin around a layer band its wind applies in (m), w: the history's
+                     // share of a redrawn pixel (TemporalSettings::accumulation; 0: none)
   vec4 raster;       // xy: the image's extent in its pixels for the camera rays (SkyFrame::raster); zw: unused
 };
 

@@ -100,7 +100,8 @@ struct SkyFrame {
                         // frame's pixel in the block (column, row); w: unused. The output holds the
                         // drawn pixels packed, ceil(width / n) per row (reproject.comp reads them).
   vec4 raster;          // xy: the image's extent in its own pixels for the camera rays: the full size over the
-                        // resolution divisor (image.xy rounds it up); zw: unused
+                        // resolution divisor (image.xy rounds it up); z: added (mod 1) to every pixel's step
+                        // offset (TemporalSettings::accumulation); w: unused
 };
 
 #ifdef __cplusplus

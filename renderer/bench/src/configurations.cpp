@@ -115,12 +115,16 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     else if (key == "divisor" && (v == 1 || v == 2 || v == 4)) c.settings.resolution.divisor = std::uint32_t(v);
     else if (key == "depth-aware" && (v == 0 || v == 1)) c.settings.resolution.depthAware = v == 1;
     else if (key == "blue" && (v == 0 || v == 1)) m.blueNoise = v == 1;
+    else if (key == "accumulate" && v <= 0.95) c.settings.temporal.accumulation = v;
     else
       return fail(ErrorCode::InvalidArgument,
                   "custom configuration '" + spec + "': unknown key '" + key +
                       "' (base, primary, light, exit, stride, cloud, empty, growth, air, scale, interleave 1|2|4, "
-                      "divisor 1|2|4, depth-aware 0|1, blue 0|1)");
+                      "divisor 1|2|4, depth-aware 0|1, blue 0|1, accumulate 0..0.95)");
   }
+  // Accumulation blends redraws with the history: without interleaving
+  // there is none (a base preset's accumulation goes with its interleave).
+  if (c.settings.temporal.interleave == 1) c.settings.temporal.accumulation = 0;
   return c;
 }
 

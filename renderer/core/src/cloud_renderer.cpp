@@ -190,6 +190,7 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
     const TemporalPlan plan = impl_->planner.plan(setup, inputs);
     setup.interleave = plan.interleave;
     setup.phase = plan.phase;
+    setup.jitterShift = plan.jitterShift;
     const gpu::SkyFrame frame = packFrame(setup);
     upscaleBlock = upscaleParams(frame, impl_->settings.resolution, impl_->settings.width, impl_->settings.height);
     next.reproject = &*impl_->reproject;

@@ -119,8 +119,12 @@ Result<void> validateSettings(const RenderSettings& s) {
                   range("resetRotation_deg", t.resetRotation_deg, 0, 180, true),
                   range("resetClockStep_s", t.resetClockStep_s, 0, 1e6, false),
                   range("resetSunTurn_deg", t.resetSunTurn_deg, 0, 180, true),
-                  range("depthTolerance", t.depthTolerance, 0, 1, true)})
+                  range("depthTolerance", t.depthTolerance, 0, 1, true),
+                  range("accumulation", t.accumulation, 0, 0.95, false)})
     if (!ok) return ok;
+  if (t.accumulation > 0 && t.interleave == 1)
+    return fail(ErrorCode::InvalidArgument,
+                "render settings: temporal.accumulation " + num(t.accumulation) + " needs temporal.interleave > 1");
   return {};
 }
 
@@ -335,7 +339,7 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   f.steps = gpu::vec4(float(s.march.cloudStep_m), float(s.march.emptyStep_m), float(s.march.stepGrowth),
                       s.march.blueNoise ? 1.0f : 0.0f);
   f.interleave = gpu::uvec4(s.interleave, s.phase.x, s.phase.y, 0u);
-  f.raster = gpu::vec4(float(s.rasterWidth), float(s.rasterHeight), 0.0f, 0.0f);
+  f.raster = gpu::vec4(float(s.rasterWidth), float(s.rasterHeight), float(s.jitterShift), 0.0f);
 
   for (std::size_t i = 0; i < s.layers.size(); ++i) {
     const LayerSetup& l = s.layers[i];

@@ -82,6 +82,9 @@ struct FrameSetup {
   // block, the one at `phase` in it (TemporalPlanner); 1, {0, 0}: all.
   std::uint32_t interleave = 1;
   glm::uvec2 phase{0};
+  // Added (mod 1) to every pixel's step offset: TemporalSettings::accumulation's
+  // per-cycle shift; 0 otherwise.
+  double jitterShift = 0;
 };
 
 // Checks settings (size, field of view) for CloudRenderer::create.

@@ -27,10 +27,18 @@ MarchSettings metres(std::uint32_t maxSamples, std::uint32_t lightSteps, double 
   return m;
 }
 
-TemporalSettings interleaved(std::uint32_t n) {
+// Interleaved, n x n, with temporal accumulation (TemporalSettings).
+TemporalSettings interleaved(std::uint32_t n, double accumulation) {
   TemporalSettings t;
   t.interleave = n;
+  t.accumulation = accumulation;
   return t;
+}
+
+ResolutionSettings divided(std::uint32_t divisor) {
+  ResolutionSettings r;
+  r.divisor = divisor;
+  return r;
 }
 
 }  // namespace
@@ -42,16 +50,17 @@ const std::vector<Preset>& presets() {
       {"high", "the default: 48 primary steps, 4 light steps, exit at 1 %, every sample, every pixel", MarchSettings{}, {}},
       {"medium",
        "steps of 40 m in cloud, 80 m in clear air, +1 % of the distance; 4 light steps, exit at 2 %, 12 air steps; "
-       "1 pixel of 16 per frame, the rest reprojected",
-       metres(256, 4, 0.02, 40, 80, 0.01, 12), interleaved(4)},
+       "1 pixel of 16 per frame, the rest reprojected, redraws accumulated (history 0.75)",
+       metres(256, 4, 0.02, 40, 80, 0.01, 12), interleaved(4, 0.75)},
       {"low",
        "steps of 40 m in cloud, 80 m in clear air, +1 % of the distance; 3 light steps, exit at 3 %, 8 air steps; "
-       "1 pixel of 16 per frame, the rest reprojected",
-       metres(256, 3, 0.03, 40, 80, 0.01, 8), interleaved(4)},
+       "1 pixel of 16 per frame, the rest reprojected, redraws accumulated (history 0.75)",
+       metres(256, 3, 0.03, 40, 80, 0.01, 8), interleaved(4, 0.75)},
       {"realtime",
-       "steps of 40 m in cloud, 80 m in clear air, +2 % of the distance; 2 light steps, exit at 5 %, 8 air steps; "
-       "1 pixel of 16 per frame, the rest reprojected",
-       metres(256, 2, 0.05, 40, 80, 0.02, 8), interleaved(4)},
+       "steps of 40 m in cloud, 80 m in clear air, +2 % of the distance; 3 light steps, exit at 5 %, 8 air steps; "
+       "the clouds drawn at 1/2 the width and height (depth-aware upscale); 1 pixel of 16 per frame, the rest "
+       "reprojected, redraws accumulated (history 0.75)",
+       metres(256, 3, 0.05, 40, 80, 0.02, 8), interleaved(4, 0.75), divided(2)},
   };
   return all;
 }

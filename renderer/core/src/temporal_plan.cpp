@@ -92,6 +92,13 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   plan.reason = reason;
   plan.interleave = plan.drawWhole ? 1 : n;
   plan.phase = plan.drawWhole ? glm::uvec2(0) : interleavePhase(n, std::uint32_t(frames_ % (n * n)));
+  // With accumulation each cycle of n^2 frames shifts the step offsets by
+  // the golden ratio: the additive recurrence spreads any number of
+  // consecutive cycles' offsets evenly over [0, 1).
+  if (settings_.accumulation > 0) {
+    const double cycle = double(frames_ / (std::uint64_t(n) * n));
+    plan.jitterShift = cycle * kGoldenRatioConjugate - std::floor(cycle * kGoldenRatioConjugate);
+  }
   ++frames_;
 
   gpu::SkyReproject& p = plan.params;
@@ -102,7 +109,8 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   p.raster = gpu::vec4(float(setup.rasterWidth), float(setup.rasterHeight), 0.0f, 0.0f);
   const std::uint32_t packedW = (setup.width + plan.interleave - 1) / plan.interleave;
   p.phase = gpu::uvec4(plan.phase.x, plan.phase.y, packedW, std::uint32_t(setup.layers.size()));
-  p.tolerance = gpu::vec4(float(settings_.depthTolerance), float(kDepthToleranceSlack_m), float(kLayerWindMargin_m), 0.0f);
+  p.tolerance = gpu::vec4(float(settings_.depthTolerance), float(kDepthToleranceSlack_m), float(kLayerWindMargin_m),
+                          float(settings_.accumulation));
   p.prevPosition = v4(glm::dvec3(0), setup.r_m);
   if (!plan.drawWhole) {
     // The previous camera in this frame's local frame: ECEF differences in

@@ -26,6 +26,8 @@ inline constexpr double kDepthToleranceSlack_m = 20;
 // Height margin around a layer inside which a point moves with its wind (m):
 // a cloud depth is a transmittance-weighted mean, which may lie just outside.
 inline constexpr double kLayerWindMargin_m = 300;
+// (sqrt(5) - 1) / 2: the step-offset shift per cycle with accumulation.
+inline constexpr double kGoldenRatioConjugate = 0.6180339887498949;
 
 // The pixel of its n x n block a frame draws, for the frame's place in the
 // cycle (0 .. n^2 - 1): ordered dispersed (Bayer), so consecutive frames
@@ -37,6 +39,7 @@ struct TemporalPlan {
   std::string reason;      // why, when drawWhole
   std::uint32_t interleave = 1;
   glm::uvec2 phase{0};
+  double jitterShift = 0;      // FrameSetup::jitterShift: the cycle's step-offset shift with accumulation
   gpu::SkyReproject params{};  // the reprojection pass's block (image.w = 1 when a history is used)
 };
 

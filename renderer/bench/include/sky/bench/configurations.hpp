@@ -49,7 +49,8 @@ Result<std::vector<Configuration>> selectConfigurations(const std::string& names
 // cloud, empty, growth, air = the MarchSettings fields; scale = the bench-side render scale
 // (bilinear resize of the output); interleave = TemporalSettings::interleave, 1, 2 or 4;
 // divisor = ResolutionSettings::divisor, 1, 2 or 4 (the renderer's own upscale);
-// depth-aware = ResolutionSettings::depthAware, 0 or 1; blue = MarchSettings::blueNoise, 0 or 1).
+// depth-aware = ResolutionSettings::depthAware, 0 or 1; blue = MarchSettings::blueNoise, 0 or 1;
+// accumulate = TemporalSettings::accumulation, 0 to 0.95, off with interleave 1).
 // --configs takes such specs next to names; a list with a spec in it is
 // separated by ';' (a spec has commas). Errors: InvalidArgument naming the bad part.
 Result<Configuration> customConfiguration(const std::string& spec);

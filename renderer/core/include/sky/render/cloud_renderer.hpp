@@ -72,13 +72,26 @@ struct TemporalSettings {
   // (plus 20 m) of where the pixel's point was; else the pixel is upscaled
   // from this frame's drawn pixels (disocclusion). (0, 1].
   double depthTolerance = 0.1;
+  // Temporal accumulation: a redrawn pixel keeps this share of what the
+  // history held there (where the history holds), an exponential mean over
+  // its redraws; and every n^2 frames each pixel's step offset moves on by
+  // the golden ratio (mod 1), so the redraws sample new places along the ray
+  // and the mean tends to the march with steps many times shorter. 0: a
+  // redrawn pixel is taken as drawn, and a still view converges exactly to
+  // the image drawn whole. [0, 0.95]; > 0 needs interleave > 1.
+  double accumulation = 0;
 };
 
 // Frames of a still view after which an interleaved renderer's history is
-// full (n^2 + 1: the first, drawn whole, then one cycle); 0 without
-// interleaving. What the bench renders before it times a configuration.
+// full: the first, drawn whole, then one cycle of n^2 frames (with
+// accumulation, enough cycles that the first frame's share of the mean is
+// under 5 %: ceil(ln 0.05 / ln accumulation)); 0 without interleaving. What
+// the bench renders before it times a configuration.
 constexpr std::uint32_t historyWarmupFrames(const TemporalSettings& t) {
-  return t.interleave > 1 ? t.interleave * t.interleave + 1 : 0;
+  if (t.interleave <= 1) return 0;
+  std::uint32_t cycles = 1;
+  for (double share = t.accumulation; share >= 0.05 && cycles < 64; share *= t.accumulation) ++cycles;
+  return t.interleave * t.interleave * cycles + 1;
 }
 
 // A render-resolution scale (shaders/upscale.comp, renderer/core/src/upscale_pass.hpp):
