@@ -94,11 +94,14 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     else if (key == "empty") m.emptyStep_m = v;
     else if (key == "growth") m.stepGrowth = v;
     else if (key == "air") m.airSteps = std::uint32_t(v);
+    else if (key == "multmin") m.coverageStepMin = v;
+    else if (key == "divmin") m.densityStepMin = v;
     else if (key == "scale" && v > 0 && v <= 1) c.renderScale = v;
     else if (key == "interleave" && (v == 1 || v == 2 || v == 4)) c.settings.temporal.interleave = std::uint32_t(v);
     else
       return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': unknown key '" + key +
-                                                  "' (base, primary, light, exit, stride, cloud, empty, growth, air, scale, interleave 1|2|4)");
+                                                  "' (base, primary, light, exit, stride, cloud, empty, growth, air, "
+                                                  "multmin, divmin, scale, interleave 1|2|4)");
   }
   return c;
 }

@@ -46,7 +46,8 @@ Result<std::vector<Configuration>> selectConfigurations(const std::string& names
 
 // A configuration from a spec NAME:key=value,... (keys: base = a preset
 // whose march and interleave it starts from, else high's; primary, light, exit, stride,
-// cloud, empty, growth, air = the MarchSettings fields; scale = render scale;
+// cloud, empty, growth, air = the MarchSettings fields; multmin, divmin =
+// coverageStepMin, densityStepMin (Haggstrom 2018 eq. 34, 36); scale = render scale;
 // interleave = TemporalSettings::interleave, 1, 2 or 4).
 // --configs takes such specs next to names; a list with a spec in it is
 // separated by ';' (a spec has commas). Errors: InvalidArgument naming the bad part.
