@@ -101,12 +101,9 @@ TEST(GpuVsCpu, RmseWithinTolerance) {
   compareScenes(r, *reference, scenes, "", false);
 }
 
-// The march in metres (long steps through clear air on the cheap density,
-// short ones in cloud, both growing with distance) and an absent second
-// layer: the GPU and the CPU reference still agree within the same bounds.
-TEST(GpuVsCpu, MarchInMetresWithinTolerance) {
-  SKY_RENDERER(shared, 64, 36);  // keeps the driver loaded (renderer_fixture.hpp)
-  (void)shared;
+// 64x36 with the march in metres: 100 m steps in cloud, 400 m in clear air,
+// growing by 0.01 m per m, at most 256 a span; 2 light steps.
+render::RenderSettings metresSettings() {
   render::RenderSettings settings;
   settings.width = 64;
   settings.height = 36;
@@ -115,6 +112,16 @@ TEST(GpuVsCpu, MarchInMetresWithinTolerance) {
   settings.march.cloudStep_m = 100;
   settings.march.emptyStep_m = 400;
   settings.march.stepGrowth = 0.01;
+  return settings;
+}
+
+// The march in metres (long steps through clear air on the cheap density,
+// short ones in cloud, both growing with distance) and an absent second
+// layer: the GPU and the CPU reference still agree within the same bounds.
+TEST(GpuVsCpu, MarchInMetresWithinTolerance) {
+  SKY_RENDERER(shared, 64, 36);  // keeps the driver loaded (renderer_fixture.hpp)
+  (void)shared;
+  const render::RenderSettings settings = metresSettings();
   auto r = render::CloudRenderer::create(settings);
   ASSERT_TRUE(r) << describe(r.error());
   auto reference = render::CpuReference::create(settings);
@@ -138,14 +145,7 @@ TEST(GpuVsCpu, MarchInMetresWithinTolerance) {
 TEST(GpuVsCpu, StepFactorsWithinTolerance) {
   SKY_RENDERER(shared, 64, 36);  // keeps the driver loaded (renderer_fixture.hpp)
   (void)shared;
-  render::RenderSettings settings;
-  settings.width = 64;
-  settings.height = 36;
-  settings.march.primarySteps = 256;
-  settings.march.lightSteps = 2;
-  settings.march.cloudStep_m = 100;
-  settings.march.emptyStep_m = 400;
-  settings.march.stepGrowth = 0.01;
+  render::RenderSettings settings = metresSettings();
   settings.march.coverageStepMin = 0.4;
   settings.march.densityStepMin = 0.4;
   auto r = render::CloudRenderer::create(settings);
