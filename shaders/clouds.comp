@@ -144,7 +144,7 @@ CoreLayer layerAt(int li) {
                                   vec3(l.coverageShift.xy, l.shape.y), l.coverageShift.w);
   return CoreLayer(l.heights.x, l.heights.y, l.heights.z, l.heights.w, l.shape.x, l.shape.z, l.shape.w > 0.5,
                    unpackType(l.primary), unpackType(l.secondary), l.ambient.rgb, l.sunDiffuse.rgb,
-                   l.sunDiffuse.w, s, l.ambient.w > 0.5);
+                   l.sunDiffuse.w, s, l.ambient.w > 0.5, l.coverageShift.z);
 }
 
 void main() {

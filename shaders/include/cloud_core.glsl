@@ -105,6 +105,8 @@ struct CoreLayer {
   real sunCosine;      // mu of the sun at the layer top (>= 0)
   LayerSampling sampling;
   bool absent;         // no coverage anywhere on the weather map: not marched, casts no shadow
+  real stepFactor;     // the march in metres' steps (cloud and empty) times this, > 0 (Haggstrom 2018
+                       // eq. 34 and 36 from the layer's mean coverage and density; 1: off)
 };
 
 // The layers are read through this hook, not carried in CoreFrame: a frame
@@ -124,7 +126,8 @@ real sampleMaxCoverage(LayerSampling s, real3 pLocal);
 // in metres (cloudStep > 0): long steps of emptyStep through clear air
 // judged by the cheap density (no detail noise, no light march), short
 // steps of cloudStep inside cloud, both growing by stepGrowth metres per
-// metre of distance from the camera, at most primarySteps samples a span.
+// metre of distance from the camera and times the layer's stepFactor, at
+// most primarySteps samples a span.
 struct MarchParams {
   int primarySteps;      // even: samples per layer span; metres: most samples a span; >= 1
   int lightSteps;        // samples of the secondary march towards the sun, >= 1
@@ -379,8 +382,8 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
   for (int i = 0; i < f.march.primarySteps; ++i) {
     if (metres ? segStart >= s.t1 : fi >= steps) break;
     if (transmittanceBefore * res.transmittance < f.march.minTransmittance) break;
-    real step = longSteps ? f.march.emptyStep : f.march.cloudStep;
-    real len = metres ? min(step + f.march.stepGrowth * segStart, s.t1 - segStart) : evenDt;
+    real step = (longSteps ? f.march.emptyStep : f.march.cloudStep) + f.march.stepGrowth * segStart;
+    real len = metres ? min(step * L.stepFactor, s.t1 - segStart) : evenDt;
     real t = metres ? segStart + jitter * len : s.t0 + (fi + jitter) * evenDt;
     real3 p = dir * t;
     real h = heightAboveCameraSphere(p, f.air.r);

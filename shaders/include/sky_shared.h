@@ -63,8 +63,9 @@ struct SkyLayer {
                        // w: 1 / shape period (1/m)
   vec4 detailOrigin;   // the same for the detail noise and its period
   vec4 cloudMapOrigin; // the same for the cloud map (the shape texture at a larger period)
-  vec4 coverageShift;  // xy: coverage drift east/north in the weather map plane (m), z: unused,
-                       // w: the shape noise's ECEF z scale (1, or < 1 for streaks)
+  vec4 coverageShift;  // xy: coverage drift east/north in the weather map plane (m), z: the march in
+                       // metres' step-length factor (> 0; 1: off), w: the shape noise's ECEF z scale
+                       // (1, or < 1 for streaks)
   vec4 ambient;        // rgb: mean sky radiance at the layer top (linear units); w: 1 when the layer
                        // has no coverage anywhere on the weather map (not marched), else 0
   vec4 sunDiffuse;     // rgb: sunlight at the layer top as diffuse radiance, E T mu / pi; w: mu of the sun

@@ -6,7 +6,7 @@
 # from it, and every case must have been timed.
 # side-by-side: every stdout line must be exactly a CLOUDPASS line.
 # sweeps (with -DSWEEPS=deploy/bench/sweeps): the seeds' sweeps at 48x27 on
-# one scene write their four tables.
+# one scene write their six tables.
 # Prints "SKIPPED: no Vulkan device" (ctest SKIP_REGULAR_EXPRESSION) when the
 # bench exits 77.
 cmake_minimum_required(VERSION 3.25)
@@ -47,8 +47,8 @@ if(MODE STREQUAL "side-by-side")
 endif()
 
 if(MODE STREQUAL "sweeps")
-  # deploy/bench/sweeps at 48x27 on one scene: four tables, each with the
-  # rows of its sweep.
+  # deploy/bench/sweeps at 48x27 on one scene: six tables, each with the
+  # rows of its sweep (--scenes replaces the multmin and divmin sweeps' own).
   file(REMOVE_RECURSE "${OUT}")
   execute_process(COMMAND bash ${SWEEPS} --bench ${BENCH} --resolution 48x27 --scenes cumulus-midday --out "${OUT}"
                   RESULT_VARIABLE rc ERROR_VARIABLE err)
@@ -64,8 +64,9 @@ if(MODE STREQUAL "sweeps")
   file(READ "${OUT}/sweeps.md" md)
   string(REGEX MATCHALL "\n## " headings "${md}")
   list(LENGTH headings count)
-  expect(count EQUAL 4 "${count} sweep tables in sweeps.md, wanted 4")
-  foreach(row light-1 light-6 growth-0 growth-0p08 ford-steps ford-early-exit haggstrom-2018 haggstrom-4x4)
+  expect(count EQUAL 6 "${count} sweep tables in sweeps.md, wanted 6")
+  foreach(row light-1 light-6 growth-0 growth-0p08 ford-steps ford-early-exit haggstrom-2018 haggstrom-4x4
+          multmin-0p1 multmin-0p4 multmin-1 divmin-0p1 divmin-0p4 divmin-1)
     string(FIND "${md}" "| cumulus-midday | ${row} |" at)
     expect(NOT at EQUAL -1 "no row for ${row} in sweeps.md")
   endforeach()

@@ -1,7 +1,8 @@
 // GPU image against the CPU reference (the same model compiled as C++ in
 // double precision with emulated texture filtering) at 64x36, for cameras
-// below, inside and above a layer, tiled and uniform coverage, with wind, and
-// tiles blending the layer's type towards another.
+// below, inside and above a layer, tiled and uniform coverage, with wind,
+// tiles blending the layer's type towards another, and the march in metres
+// with Haggstrom's coverage and density step factors.
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -38,6 +39,7 @@ struct Case {
   double clock_s;
   // Every other tile blends the cumulus layer towards this type by 0.7.
   weather::CloudType blendType = weather::CloudType::None;
+  double density = 1.0;  // the layer's, or its tiles'
 };
 
 // Renders each scene on the GPU and the CPU reference and checks the mean
@@ -47,11 +49,11 @@ void compareScenes(render::CloudRenderer& r, const render::CpuReference& referen
                    const std::string& prefix, bool emptyLayerAbove) {
   for (const Case& s : scenes) {
     SCOPED_TRACE(prefix + s.name);
-    weather::CloudLayer l = layer(1, 1500, 1000, s.coverage, 1.0);
+    weather::CloudLayer l = layer(1, 1500, 1000, s.coverage, s.density);
     l.wind = {s.windSpeed_mps, 300.0, 0.0};
     weather::WeatherSnapshot snap;
     if (s.tiled) {
-      snap = tiledSnapshot(s.camera.position, l, float(s.coverage), 1.0f);
+      snap = tiledSnapshot(s.camera.position, l, float(s.coverage), float(s.density));
       for (std::size_t i = 0; i < snap.tiles.size(); i += 2) {
         snap.tiles[i].blendType = s.blendType;
         snap.tiles[i].blend = s.blendType == weather::CloudType::None ? 0.0f : 0.7f;
@@ -99,12 +101,9 @@ TEST(GpuVsCpu, RmseWithinTolerance) {
   compareScenes(r, *reference, scenes, "", false);
 }
 
-// The march in metres (long steps through clear air on the cheap density,
-// short ones in cloud, both growing with distance) and an absent second
-// layer: the GPU and the CPU reference still agree within the same bounds.
-TEST(GpuVsCpu, MarchInMetresWithinTolerance) {
-  SKY_RENDERER(shared, 64, 36);  // keeps the driver loaded (renderer_fixture.hpp)
-  (void)shared;
+// 64x36 with the march in metres: 100 m steps in cloud, 400 m in clear air,
+// growing by 0.01 m per m, at most 256 a span; 2 light steps.
+render::RenderSettings metresSettings() {
   render::RenderSettings settings;
   settings.width = 64;
   settings.height = 36;
@@ -113,6 +112,16 @@ TEST(GpuVsCpu, MarchInMetresWithinTolerance) {
   settings.march.cloudStep_m = 100;
   settings.march.emptyStep_m = 400;
   settings.march.stepGrowth = 0.01;
+  return settings;
+}
+
+// The march in metres (long steps through clear air on the cheap density,
+// short ones in cloud, both growing with distance) and an absent second
+// layer: the GPU and the CPU reference still agree within the same bounds.
+TEST(GpuVsCpu, MarchInMetresWithinTolerance) {
+  SKY_RENDERER(shared, 64, 36);  // keeps the driver loaded (renderer_fixture.hpp)
+  (void)shared;
+  const render::RenderSettings settings = metresSettings();
   auto r = render::CloudRenderer::create(settings);
   ASSERT_TRUE(r) << describe(r.error());
   auto reference = render::CpuReference::create(settings);
@@ -133,11 +142,7 @@ TEST(GpuVsCpu, MarchInMetresWithinTolerance) {
 // hash's offsets the GPU image differs at the march's noise level, against
 // the reference with the tile's offsets only at float's.
 TEST(GpuVsCpu, BlueNoiseOffsetsAgree) {
-  render::RenderSettings settings;
-  settings.width = 64;
-  settings.height = 36;
-  settings.march.primarySteps = 256;
-  settings.march.lightSteps = 2;
+  render::RenderSettings settings = metresSettings();
   settings.march.cloudStep_m = 300;
   settings.march.emptyStep_m = 300;
   settings.march.blueNoise = true;
@@ -165,6 +170,30 @@ TEST(GpuVsCpu, BlueNoiseOffsetsAgree) {
               100 * same.displayedRmse / same.displayedMean, 100 * other.displayedRmse / other.displayedMean);
   EXPECT_LT(same.displayedRmse, kRelativeRmseTolerance * same.displayedMean);
   EXPECT_LT(same.displayedRmse, 0.5 * other.displayedRmse);
+}
+
+// The march in metres with Haggstrom 2018's step factors (multmin and divmin
+// 0.4, his best) on thin, sparse layers, where they change the steps:
+// uniform coverage 0.2 and density 0.2 give 0.4 x 0.4^-0.8 = 0.83, coverage
+// 0.35 and density 0.6 give 0.58 x 0.6^-0.8 = 0.87, the tiles their fine
+// ring's means. The GPU reads the factor from SkyLayer::coverageShift.z, the
+// CPU reference from the frame setup; within the same bounds as above.
+TEST(GpuVsCpu, StepFactorsWithinTolerance) {
+  SKY_RENDERER(shared, 64, 36);  // keeps the driver loaded (renderer_fixture.hpp)
+  (void)shared;
+  render::RenderSettings settings = metresSettings();
+  settings.march.coverageStepMin = 0.4;
+  settings.march.densityStepMin = 0.4;
+  auto r = render::CloudRenderer::create(settings);
+  ASSERT_TRUE(r) << describe(r.error());
+  auto reference = render::CpuReference::create(settings);
+  ASSERT_TRUE(reference) << describe(reference.error());
+  const std::vector<Case> scenes = {
+      {"below_sparse_thin", pose(47, 8, 800, 30, 25), false, 0.2, 0, 0, weather::CloudType::None, 0.2},
+      {"below_tiled_thin_wind", pose(47, 8, 800, 120, 15), true, 0.5, 12, 900, weather::CloudType::None, 0.3},
+      {"above_sparse", pose(60, -150, 4000, 45, -30), false, 0.35, 0, 0, weather::CloudType::None, 0.6},
+  };
+  compareScenes(**r, *reference, scenes, "factors_", false);
 }
 
 }  // namespace

@@ -64,6 +64,8 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
         {"cloud_step_m", s.march.cloudStep_m},
         {"empty_step_m", s.march.emptyStep_m},
         {"step_growth", s.march.stepGrowth},
+        {"coverage_step_min", s.march.coverageStepMin},
+        {"density_step_min", s.march.densityStepMin},
         {"air_steps", s.march.airSteps},
         {"blue_noise", s.march.blueNoise}}},
       {"interleave", s.temporal.interleave},

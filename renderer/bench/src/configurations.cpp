@@ -110,6 +110,8 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     else if (key == "empty") m.emptyStep_m = v;
     else if (key == "growth") m.stepGrowth = v;
     else if (key == "air") m.airSteps = std::uint32_t(v);
+    else if (key == "multmin") m.coverageStepMin = v;
+    else if (key == "divmin") m.densityStepMin = v;
     else if (key == "scale" && v > 0 && v <= 1) c.renderScale = v;
     else if (key == "interleave" && (v == 1 || v == 2 || v == 4)) c.settings.temporal.interleave = std::uint32_t(v);
     else if (key == "divisor" && (v == 1 || v == 2 || v == 4)) c.settings.resolution.divisor = std::uint32_t(v);
@@ -119,8 +121,8 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     else
       return fail(ErrorCode::InvalidArgument,
                   "custom configuration '" + spec + "': unknown key '" + key +
-                      "' (base, primary, light, exit, stride, cloud, empty, growth, air, scale, interleave 1|2|4, "
-                      "divisor 1|2|4, depth-aware 0|1, blue 0|1, accumulate 0..0.95)");
+                      "' (base, primary, light, exit, stride, cloud, empty, growth, air, multmin, divmin, scale, "
+                      "interleave 1|2|4, divisor 1|2|4, depth-aware 0|1, blue 0|1, accumulate 0..0.95)");
   }
   // Accumulation blends redraws with the history: without interleaving
   // there is none (a base preset's accumulation goes with its interleave).

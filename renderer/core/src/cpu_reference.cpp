@@ -79,10 +79,10 @@ class CpuCore {
                       LayerSampling{real4(l.shapeOrigin, 1.0 / l.shapePeriod_m), real4(l.detailOrigin, 1.0 / l.detailPeriod_m),
                                     real4(l.cloudMapOrigin, 1.0 / l.cloudMapPeriod_m),
                                     real3(l.coverageShift_m, double(i)), l.shapeStretchZ},
-                      l.absent};
+                      l.absent, l.stepFactor};
       } else {
         c = CoreLayer{0.0, 0.0, 0.0, 0.0, 1.0, 1.0, false, cumulus, cumulus, real3(0.0), real3(0.0), 0.0,
-                      LayerSampling{real4(0.0), real4(0.0), real4(0.0), real3(0.0, 0.0, double(i)), 1.0}, true};
+                      LayerSampling{real4(0.0), real4(0.0), real4(0.0), real3(0.0, 0.0, double(i)), 1.0}, true, 1.0};
       }
     }
     return f;

@@ -64,6 +64,31 @@ std::string num(double v) { return std::to_string(v); }
 
 }  // namespace
 
+LayerMeans fineRingMeans(const WeatherField& field, std::uint32_t slice) {
+  if (slice >= field.sliceCount) return {0.0, 1.0};
+  const std::size_t texels = std::size_t(field.size) * field.size;
+  const std::size_t first = std::size_t(slice) * texels * 4;  // ring 0
+  if (field.texels.size() < first + texels * 4) return {0.0, 1.0};
+  std::uint64_t coverageSum = 0, coveredDensitySum = 0;
+  for (std::size_t i = 0; i < texels; ++i) {
+    const std::uint64_t c = field.texels[first + i * 4], d = field.texels[first + i * 4 + 1];
+    coverageSum += c;
+    coveredDensitySum += c * d;
+  }
+  if (coverageSum == 0) return {0.0, 1.0};
+  return {double(coverageSum) / (255.0 * double(texels)), double(coveredDensitySum) / (255.0 * double(coverageSum))};
+}
+
+double stepLengthFactor(double coverage, double density, double coverageStepMin, double densityStepMin) {
+  // Eq. 34: the linear remap R(gc, 0.2, 0.7, multmin, 1), clamped to [multmin, 1].
+  const double ramp = coverageStepMin + (coverage - kStepCoverageLow) / (kStepCoverageHigh - kStepCoverageLow) *
+                                            (1.0 - coverageStepMin);
+  const double coverageFactor = std::max(coverageStepMin, std::min(1.0, ramp));
+  // Eq. 36.
+  const double densityFactor = 1.0 / std::pow(std::max(density, densityStepMin), kStepDensityExponent);
+  return coverageFactor * densityFactor;
+}
+
 std::uint32_t tileCount(std::uint32_t width, std::uint32_t height) {
   const std::uint32_t tx = (width + gpu::kLocalSize - 1) / gpu::kLocalSize;
   const std::uint32_t ty = (height + gpu::kLocalSize - 1) / gpu::kLocalSize;
@@ -102,6 +127,16 @@ Result<void> validateSettings(const RenderSettings& s) {
   if (!(m.stepGrowth >= 0 && m.stepGrowth <= 1))
     return fail(ErrorCode::InvalidArgument,
                 "render settings: march.stepGrowth " + num(m.stepGrowth) + " outside [0, 1]");
+  for (const auto& [field, v] :
+       {std::pair{"coverageStepMin", m.coverageStepMin}, std::pair{"densityStepMin", m.densityStepMin}}) {
+    if (!(v > 0 && v <= 1))
+      return fail(ErrorCode::InvalidArgument,
+                  std::string("render settings: march.") + field + " " + num(v) + " outside (0, 1]");
+    if (v != 1 && m.cloudStep_m == 0)
+      return fail(ErrorCode::InvalidArgument, std::string("render settings: march.") + field + " " + num(v) +
+                                                  " scales the march in metres; even placement (cloudStep_m 0) has no "
+                                                  "step length to scale");
+  }
   const std::uint32_t d = s.resolution.divisor;
   if (d != 1 && d != 2 && d != 4)
     return fail(ErrorCode::InvalidArgument,
@@ -241,6 +276,11 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
     LayerSetup l;
     l.thickness_m = layer.thickness_m;
     l.absent = maxCoverage(field, std::uint32_t(slice)) <= 0;
+    // A uniform layer's own numbers; a tiled one's means over the fine ring.
+    const LayerMeans means = field.tiled[slice] ? fineRingMeans(field, std::uint32_t(slice))
+                                                : LayerMeans{layer.coverage, layer.density};
+    l.stepFactor = stepLengthFactor(means.coverage, means.density, settings.march.coverageStepMin,
+                                    settings.march.densityStepMin);
     l.lightDistance_m = std::clamp(kLightMarchFraction * layer.thickness_m, kMinLightDistance_m, kMaxLightDistance_m);
     l.primary = cloudTypeParams(layer.type);
     l.blends = field.blendType[slice] != weather::CloudType::None;
@@ -349,7 +389,8 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
     g.shapeOrigin = v4(l.shapeOrigin, 1.0 / l.shapePeriod_m);
     g.detailOrigin = v4(l.detailOrigin, 1.0 / l.detailPeriod_m);
     g.cloudMapOrigin = v4(l.cloudMapOrigin, 1.0 / l.cloudMapPeriod_m);
-    g.coverageShift = gpu::vec4(float(l.coverageShift_m.x), float(l.coverageShift_m.y), 0.0f, float(l.shapeStretchZ));
+    g.coverageShift = gpu::vec4(float(l.coverageShift_m.x), float(l.coverageShift_m.y), float(l.stepFactor),
+                                 float(l.shapeStretchZ));
     g.ambient = v4(l.skyTop, l.absent ? 1.0 : 0.0);
     g.sunDiffuse = v4(l.sunDiffuseTop, l.sunCosine);
     g.primary = packCloudType(l.primary);
@@ -359,6 +400,7 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   // per-layer setup never divides by 0.
   for (std::size_t i = s.layers.size(); i < gpu::kMaxLayers; ++i) {
     f.layers[i].shape = gpu::vec4(1.0f, float(i), 1.0f, 0.0f);
+    f.layers[i].coverageShift.z = 1.0f;
     f.layers[i].coverageShift.w = 1.0f;
     f.layers[i].primary = f.layers[i].secondary = packCloudType(cloudTypeParams(weather::CloudType::Cumulus));
   }

@@ -45,6 +45,9 @@ struct LayerSetup {
   glm::dvec3 skyTop{0};            // mean sky radiance at the layer top, linear units
   glm::dvec3 sunDiffuseTop{0};     // sunlight at the layer top as diffuse radiance, E T mu / pi
   double sunCosine = 0;            // mu of the sun at the layer top over the camera, >= 0
+  // The march in metres' step lengths times this (stepLengthFactor), > 0; 1
+  // with the factors off.
+  double stepFactor = 1;
   // No coverage anywhere on the weather map (the whole view: the map reaches
   // past the march's 150 km): the layer is not marched and casts no shadow.
   bool absent = false;
@@ -86,6 +89,35 @@ struct FrameSetup {
   // per-cycle shift; 0 otherwise.
   double jitterShift = 0;
 };
+
+// Haggstrom 2018's coverage ramp of the step length (sec. 4.2.2, eq. 34):
+// full steps from mean coverage 0.7 up, coverageStepMin times them at 0.2 and
+// below, linear between; his values, kept (he tuned multmin with them).
+inline constexpr double kStepCoverageLow = 0.2;
+inline constexpr double kStepCoverageHigh = 0.7;
+// The exponent of his density factor 1 / max(gd, divmin)^0.8 (sec. 4.2.3,
+// eq. 36): under 1, so halving the density less than doubles the steps.
+inline constexpr double kStepDensityExponent = 0.8;
+
+// The step-length factor of a layer with mean coverage `coverage` and mean
+// density where covered `density` (both [0, 1]): eq. 34 times eq. 36, with
+// coverageStepMin and densityStepMin in (0, 1] (MarchSettings; 1, 1: 1).
+// Result in [coverageStepMin, densityStepMin^-0.8].
+double stepLengthFactor(double coverage, double density, double coverageStepMin, double densityStepMin);
+
+// A layer's mean coverage and mean density where covered, [0, 1] each.
+struct LayerMeans {
+  double coverage = 0;
+  double density = 1;
+};
+
+// The mean coverage and the mean density where covered of a slice over the
+// weather map's fine ring (the 200 km square around the anchor, a lattice
+// point a few km from the camera): the density weighted by the coverage, as a
+// texel's density matters to the march as much as it holds cloud. {0, 1}
+// for a slice with no cloud in it. prepareFrame uses it for tiled layers
+// (a uniform layer has its own coverage and density).
+LayerMeans fineRingMeans(const WeatherField& field, std::uint32_t slice);
 
 // Checks settings (size, field of view) for CloudRenderer::create.
 Result<void> validateSettings(const RenderSettings& settings);

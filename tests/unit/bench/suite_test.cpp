@@ -198,6 +198,28 @@ TEST(Configurations, CustomSpecsAndTheirErrors) {
   }
 }
 
+// Haggstrom 2018's step factors as custom keys (the multmin and divmin
+// sweeps of deploy/bench/sweeps): they set MarchSettings::coverageStepMin and
+// densityStepMin and nothing else; off (1) unless given.
+TEST(Configurations, MultminAndDivminSetTheStepFactors) {
+  auto c = customConfiguration("m:base=medium,interleave=1,multmin=0.4,divmin=0.2");
+  ASSERT_TRUE(c) << c.error().detail;
+  auto medium = render::findPreset("medium");
+  ASSERT_TRUE(medium);
+  EXPECT_EQ(c->settings.march.coverageStepMin, 0.4);
+  EXPECT_EQ(c->settings.march.densityStepMin, 0.2);
+  EXPECT_EQ(c->settings.march.cloudStep_m, medium->march.cloudStep_m);
+  EXPECT_EQ(c->settings.temporal.interleave, 1u);
+  auto off = customConfiguration("o:base=medium");
+  ASSERT_TRUE(off);
+  EXPECT_EQ(off->settings.march.coverageStepMin, 1.0);
+  EXPECT_EQ(off->settings.march.densityStepMin, 1.0);
+  EXPECT_FALSE(customConfiguration("x:multmin=abc"));
+  auto unknown = customConfiguration("x:multmax=0.4");
+  ASSERT_FALSE(unknown);
+  EXPECT_NE(unknown.error().detail.find("multmin, divmin"), std::string::npos) << unknown.error().detail;
+}
+
 TEST(Spread, MedianAndRange) {
   const Spread odd = spreadOf({5, 1, 3});
   EXPECT_EQ(odd.samples, 3u);

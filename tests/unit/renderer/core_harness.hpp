@@ -135,7 +135,7 @@ inline Core::CoreLayer shellLayer(const Core::CoreFrame& f, double alt, double b
   return Core::CoreLayer{hBase, hTop, hBase * (2 * f.air.r - hBase), hTop * (2 * f.air.r - hTop), thickness,
                          0.5 * thickness, false, t, t, Core::real3(0), Core::real3(0), 1.0,
                          Core::LayerSampling{Core::real4(0.0), Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), 1.0},
-                         false};
+                         false, 1.0};
 }
 
 }  // namespace sky::test

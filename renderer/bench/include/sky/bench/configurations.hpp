@@ -46,7 +46,8 @@ Result<std::vector<Configuration>> selectConfigurations(const std::string& names
 
 // A configuration from a spec NAME:key=value,... (keys: base = a preset
 // whose march, interleave and divisor it starts from, else high's; primary, light, exit, stride,
-// cloud, empty, growth, air = the MarchSettings fields; scale = the bench-side render scale
+// cloud, empty, growth, air = the MarchSettings fields; multmin, divmin =
+// coverageStepMin, densityStepMin (Haggstrom 2018 eq. 34, 36); scale = the bench-side render scale
 // (bilinear resize of the output); interleave = TemporalSettings::interleave, 1, 2 or 4;
 // divisor = ResolutionSettings::divisor, 1, 2 or 4 (the renderer's own upscale);
 // depth-aware = ResolutionSettings::depthAware, 0 or 1; blue = MarchSettings::blueNoise, 0 or 1;

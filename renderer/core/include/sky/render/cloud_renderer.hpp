@@ -39,6 +39,16 @@ struct MarchSettings {
   double cloudStep_m = 0;  // [0, 10000]
   double emptyStep_m = 0;  // [cloudStep_m, 20000] when cloudStep_m > 0
   double stepGrowth = 0;   // [0, 1]
+  // Haggstrom 2018's step lengths per layer (sec. 4.2.2-4.2.3), for the march
+  // in metres only (refused with even placement: validateSettings): both
+  // steps times max(m, min(1, R(gc, 0.2, 0.7, m, 1))) with m = coverageStepMin
+  // (eq. 34; shorter steps where the layer's mean coverage gc is low, so
+  // small clouds are not stepped over) and times 1 / max(gd, d)^0.8 with
+  // d = densityStepMin (eq. 36; longer steps where its mean density gd is
+  // low). gc and gd: frame_setup.cpp, layerMeans. 1 turns a factor off; he
+  // found 0.4 best for both.
+  double coverageStepMin = 1;  // (0, 1]
+  double densityStepMin = 1;   // (0, 1]
   // Steps of the clear-air march along each view ray (aerial perspective and
   // the sky; atmosphere_core.glsl); 0: its default, 16. [0, 64].
   std::uint32_t airSteps = 0;
