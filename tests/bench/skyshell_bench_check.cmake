@@ -6,7 +6,7 @@
 # from it, and every case must have been timed.
 # side-by-side: every stdout line must be exactly a CLOUDPASS line.
 # sweeps (with -DSWEEPS=deploy/bench/sweeps): the seeds' sweeps at 48x27 on
-# one scene write their six tables.
+# one scene write their eight tables.
 # Prints "SKIPPED: no Vulkan device" (ctest SKIP_REGULAR_EXPRESSION) when the
 # bench exits 77.
 cmake_minimum_required(VERSION 3.25)
@@ -47,7 +47,7 @@ if(MODE STREQUAL "side-by-side")
 endif()
 
 if(MODE STREQUAL "sweeps")
-  # deploy/bench/sweeps at 48x27 on one scene: six tables, each with the
+  # deploy/bench/sweeps at 48x27 on one scene: eight tables, each with the
   # rows of its sweep (--scenes replaces the multmin and divmin sweeps' own).
   file(REMOVE_RECURSE "${OUT}")
   execute_process(COMMAND bash ${SWEEPS} --bench ${BENCH} --resolution 48x27 --scenes cumulus-midday --out "${OUT}"
@@ -64,9 +64,10 @@ if(MODE STREQUAL "sweeps")
   file(READ "${OUT}/sweeps.md" md)
   string(REGEX MATCHALL "\n## " headings "${md}")
   list(LENGTH headings count)
-  expect(count EQUAL 6 "${count} sweep tables in sweeps.md, wanted 6")
+  expect(count EQUAL 8 "${count} sweep tables in sweeps.md, wanted 8")
   foreach(row light-1 light-6 growth-0 growth-0p08 ford-steps ford-early-exit haggstrom-2018 haggstrom-4x4
-          multmin-0p1 multmin-0p4 multmin-1 divmin-0p1 divmin-0p4 divmin-1)
+          multmin-0p1 multmin-0p4 multmin-1 divmin-0p1 divmin-0p4 divmin-1 res-full res-1of2 res-1of4-bilinear
+          acc-0 acc-0p9 acc-0p75-blue)
     string(FIND "${md}" "| cumulus-midday | ${row} |" at)
     expect(NOT at EQUAL -1 "no row for ${row} in sweeps.md")
   endforeach()
