@@ -157,7 +157,7 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
     commands_.dispatch(frame.image.w, 1, 1);
   }
   if (next.reproject != nullptr) next.reproject->record(commands_, timer_, *next.reprojectParams);
-  if (next.upscale != nullptr) 
+  if (next.upscale != nullptr)
     next.upscale->record(commands_, timer_, next.reproject != nullptr ? next.reproject->current() : 0,
                          *next.upscaleParams);
   if (next.reproject == nullptr && next.upscale == nullptr) {

@@ -124,8 +124,8 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
     AtmosphereTables atmosphere = sharedAtmosphereTables();
     // The size the cloud pass draws (FrameSetup::width).
     const std::uint32_t divisor = settings.resolution.divisor;
-    const std::uint32_t smallW = (settings.width + divisor - 1) / divisor;
-    const std::uint32_t smallH = (settings.height + divisor - 1) / divisor;
+    const std::uint32_t smallW = drawnExtent(settings.width, divisor);
+    const std::uint32_t smallH = drawnExtent(settings.height, divisor);
     auto pass = CloudPass::create(**ctx, smallW, smallH, shape, detail, atmosphere, *weather,
                                   blueNoiseTile(settings.noiseSeed));
     if (!pass) return tl::unexpected(pass.error());
@@ -173,37 +173,36 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
     }
     FrameSetup setup = prepareFrame(impl_->settings, inputs, impl_->weather.field(), impl_->atmosphere);
     impl_->temporal = {};
+    // With interleaving the planner chooses this frame's pixels and the
+    // reprojection's block; with a divisor the upscale follows.
     CloudPass::Followers next;
+    std::optional<TemporalPlan> plan;
+    if (impl_->reproject) {
+      plan = impl_->planner.plan(setup, inputs);
+      setup.interleave = plan->interleave;
+      setup.phase = plan->phase;
+      setup.jitterShift = plan->jitterShift;
+      next.reproject = &*impl_->reproject;
+      next.reprojectParams = &plan->params;
+    }
+    const gpu::SkyFrame frame = packFrame(setup);
     gpu::SkyUpscale upscaleBlock{};
     if (impl_->upscale) {
+      upscaleBlock = upscaleParams(frame, impl_->settings.resolution, impl_->settings.width, impl_->settings.height);
       next.upscale = &*impl_->upscale;
       next.upscaleParams = &upscaleBlock;
     }
-    if (!impl_->reproject) {
-      const gpu::SkyFrame frame = packFrame(setup);
-      upscaleBlock = upscaleParams(frame, impl_->settings.resolution, impl_->settings.width, impl_->settings.height);
-      auto image = impl_->pass.run(*impl_->ctx, frame, next);
-      if (image)
-        for (auto& t : impl_->pass.lastTimes()) impl_->passTimes.push_back(std::move(t));
-      return image;
-    }
-    const TemporalPlan plan = impl_->planner.plan(setup, inputs);
-    setup.interleave = plan.interleave;
-    setup.phase = plan.phase;
-    setup.jitterShift = plan.jitterShift;
-    const gpu::SkyFrame frame = packFrame(setup);
-    upscaleBlock = upscaleParams(frame, impl_->settings.resolution, impl_->settings.width, impl_->settings.height);
-    next.reproject = &*impl_->reproject;
-    next.reprojectParams = &plan.params;
     auto image = impl_->pass.run(*impl_->ctx, frame, next);
     if (!image) {
-      impl_->planner.forget();
+      if (plan) impl_->planner.forget();
       return image;
     }
     for (auto& t : impl_->pass.lastTimes()) impl_->passTimes.push_back(std::move(t));
-    impl_->temporal = impl_->reproject->counts();
-    impl_->temporal.drawnWhole = plan.drawWhole;
-    impl_->temporal.reason = plan.reason;
+    if (plan) {
+      impl_->temporal = impl_->reproject->counts();
+      impl_->temporal.drawnWhole = plan->drawWhole;
+      impl_->temporal.reason = plan->reason;
+    }
     return image;
   });
 }

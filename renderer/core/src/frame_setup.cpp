@@ -197,8 +197,8 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
                         const AtmosphereTables& tables) {
   FrameSetup s;
   const std::uint32_t d = settings.resolution.divisor;
-  s.width = (settings.width + d - 1) / d;
-  s.height = (settings.height + d - 1) / d;
+  s.width = drawnExtent(settings.width, d);
+  s.height = drawnExtent(settings.height, d);
   s.rasterWidth = double(settings.width) / d;
   s.rasterHeight = double(settings.height) / d;
   s.tanHalfFov = std::tan(0.5 * settings.verticalFov_deg * kDegToRad);
@@ -276,11 +276,14 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
     LayerSetup l;
     l.thickness_m = layer.thickness_m;
     l.absent = maxCoverage(field, std::uint32_t(slice)) <= 0;
-    // A uniform layer's own numbers; a tiled one's means over the fine ring.
-    const LayerMeans means = field.tiled[slice] ? fineRingMeans(field, std::uint32_t(slice))
-                                                : LayerMeans{layer.coverage, layer.density};
-    l.stepFactor = stepLengthFactor(means.coverage, means.density, settings.march.coverageStepMin,
-                                    settings.march.densityStepMin);
+    // A uniform layer's own numbers; a tiled one's means over the fine ring
+    // (a pass over the map, skipped when both factors are off: then it is 1).
+    const MarchSettings& m = settings.march;
+    if (m.coverageStepMin != 1 || m.densityStepMin != 1) {
+      const LayerMeans means = field.tiled[slice] ? fineRingMeans(field, std::uint32_t(slice))
+                                                  : LayerMeans{layer.coverage, layer.density};
+      l.stepFactor = stepLengthFactor(means.coverage, means.density, m.coverageStepMin, m.densityStepMin);
+    }
     l.lightDistance_m = std::clamp(kLightMarchFraction * layer.thickness_m, kMinLightDistance_m, kMaxLightDistance_m);
     l.primary = cloudTypeParams(layer.type);
     l.blends = field.blendType[slice] != weather::CloudType::None;

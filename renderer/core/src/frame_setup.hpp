@@ -119,6 +119,10 @@ struct LayerMeans {
 // (a uniform layer has its own coverage and density).
 LayerMeans fineRingMeans(const WeatherField& field, std::uint32_t slice);
 
+// Pixels along one edge of the image the cloud pass draws: a full edge of
+// `full` pixels over the resolution divisor, rounded up (FrameSetup::width).
+constexpr std::uint32_t drawnExtent(std::uint32_t full, std::uint32_t divisor) { return (full + divisor - 1) / divisor; }
+
 // Checks settings (size, field of view) for CloudRenderer::create.
 Result<void> validateSettings(const RenderSettings& settings);
 // Checks a frame's inputs: finite pose, latitude range, layer count and
