@@ -1,6 +1,7 @@
 // Bounded per-session outbound state (see outbox.hpp).
 #include "sky/server/outbox.hpp"
 
+#include <algorithm>
 #include <utility>
 
 #include "sky/core/assert.hpp"
@@ -17,12 +18,15 @@ void Outbox::pushControl(Frame frame) {
   control_.push_back(std::move(frame));
 }
 
-void Outbox::requestSnapshot(const stream::Subscribe& request) { snapshot_ = request; }
+void Outbox::requestSnapshot(const stream::Subscribe& request) {
+  SKY_ASSERT(request.areaIndex < stream::kMaxAreas);  // decodeMessage checks it
+  snapshots_[request.areaIndex] = request;
+}
 
 void Outbox::setHeartbeat(Frame frame) { heartbeat_ = std::move(frame); }
 
 void Outbox::dropWeather() {
-  snapshot_.reset();
+  for (auto& s : snapshots_) s.reset();
   heartbeat_.reset();
 }
 
@@ -32,12 +36,13 @@ std::optional<Outbox::Item> Outbox::takeNext() {
     control_.pop_front();
     return Item(std::move(f));
   }
-  if (snapshot_) {
-    const stream::Subscribe request = *snapshot_;
-    snapshot_.reset();
-    heartbeat_.reset();
-    return Item(request);
-  }
+  for (auto& pending : snapshots_)
+    if (pending) {
+      const stream::Subscribe request = *pending;
+      pending.reset();
+      heartbeat_.reset();
+      return Item(request);
+    }
   if (heartbeat_) {
     Frame f = std::move(*heartbeat_);
     heartbeat_.reset();
@@ -46,6 +51,9 @@ std::optional<Outbox::Item> Outbox::takeNext() {
   return std::nullopt;
 }
 
-bool Outbox::empty() const { return control_.empty() && !snapshot_ && !heartbeat_; }
+bool Outbox::empty() const {
+  return control_.empty() && !heartbeat_ &&
+         std::none_of(snapshots_.begin(), snapshots_.end(), [](const auto& s) { return s.has_value(); });
+}
 
 }  // namespace sky::server

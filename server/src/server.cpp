@@ -137,7 +137,7 @@ void Server::onAccept(const boost::system::error_code& ec, tcp::socket socket) {
              registry_.size() + 1);
   registry_.add(session);
   const stream::Hello hello{stream::kProtocolVersion, options_.serverId, clockNow(), weather_.clock().rate(),
-                            stream::kFeatureCameraReports};
+                            stream::kFeatureCameraReports | stream::kFeatureAreas};
   session->start(stream::encodeFrame(stream::encodeMessage(hello)));
   renderersChanged();
   accept();

@@ -29,7 +29,7 @@ Frame encodeErrorFrame(const Error& error) {
 }
 
 bool sameArea(const stream::Subscribe& a, const stream::Subscribe& b) {
-  return a.area.centerLat_deg == b.area.centerLat_deg && a.area.centerLon_deg == b.area.centerLon_deg &&
+  return a.areaIndex == b.areaIndex && a.area.centerLat_deg == b.area.centerLat_deg && a.area.centerLon_deg == b.area.centerLon_deg &&
          a.area.radius_m == b.area.radius_m && a.altMin_m == b.altMin_m && a.altMax_m == b.altMax_m &&
          a.tileLevel == b.tileLevel;
 }
@@ -63,9 +63,14 @@ void Session::sendHeartbeat(const Frame& heartbeat) {
 }
 
 void Session::weatherChanged() {
-  if (state_ != State::Open || !subscription_) return;
-  outbox_.requestSnapshot(*subscription_);
-  writeNext();
+  if (state_ != State::Open) return;
+  bool any = false;
+  for (const Area& a : areas_)
+    if (a.subscription) {
+      outbox_.requestSnapshot(*a.subscription);
+      any = true;
+    }
+  if (any) writeNext();
 }
 
 void Session::close() {
@@ -117,10 +122,10 @@ void Session::onRead(const boost::system::error_code& ec, std::size_t bytes) {
 
 void Session::handleMessage(const stream::Message& message) {
   if (const auto* subscribe = std::get_if<stream::Subscribe>(&message)) {
-    log_.debug("event=subscribe session={} peer={} lat_deg={} lon_deg={} radius_m={} level={}", id_, peer_,
-               subscribe->area.centerLat_deg, subscribe->area.centerLon_deg,
+    log_.debug("event=subscribe session={} peer={} area={} lat_deg={} lon_deg={} radius_m={} level={}", id_, peer_,
+               subscribe->areaIndex, subscribe->area.centerLat_deg, subscribe->area.centerLon_deg,
                subscribe->area.radius_m, subscribe->tileLevel);
-    subscription_ = *subscribe;
+    areas_[subscribe->areaIndex].subscription = *subscribe;  // decodeMessage checked the index
     outbox_.requestSnapshot(*subscribe);
     writeNext();
     handler_.rendererChanged(*this);
@@ -148,7 +153,8 @@ void Session::handleMessage(const stream::Message& message) {
 
 RendererInfo Session::info(std::chrono::steady_clock::time_point now) const {
   RendererInfo out{id_, peer_, std::nullopt, report_, 0};
-  if (subscription_) out.area = subscription_->area;
+  // The console shows the detailed area, the one around the camera.
+  if (areas_[0].subscription) out.area = areas_[0].subscription->area;
   if (report_) out.lastReportAge_s = std::max(0.0, std::chrono::duration<double>(now - reportAt_).count());
   return out;
 }
@@ -198,17 +204,18 @@ void Session::writeNext() {
 
 Frame Session::weatherFrame(const stream::Subscribe& request) {
   BuiltSnapshot built = handler_.snapshotFor(request);
+  Area& area = areas_[request.areaIndex];
   std::optional<Frame> frame;
-  if (peerHolds_ && peerHoldsFor_ && sameArea(*peerHoldsFor_, request)) {
+  if (area.peerHolds && area.peerHoldsFor && sameArea(*area.peerHoldsFor, request)) {
     // A delta that resends most tiles is no better than the snapshot (tiles
     // are nearly all of either's size).
-    if (auto delta = diffBuilt(*peerHolds_, built);
+    if (auto delta = diffBuilt(*area.peerHolds, built);
         delta && (delta->tiles.empty() || 4 * delta->tiles.size() < 3 * tileCount(built)))
       frame = stream::encodeFrame(stream::encodeMessage(*delta));
   }
   if (!frame) frame = stream::encodeFrame(stream::encodeMessage(wholeSnapshot(built)));
-  peerHolds_ = std::move(built);
-  peerHoldsFor_ = request;
+  area.peerHolds = std::move(built);
+  area.peerHoldsFor = request;
   return std::move(*frame);
 }
 

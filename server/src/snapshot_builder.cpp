@@ -413,6 +413,7 @@ BuiltSnapshot buildSnapshotWithGenerations(const stream::Subscribe& request,
   weather::WeatherSnapshot& snapshot = built.snapshot;
   snapshot.weatherClock_s = clock_s;
   snapshot.layers = table;
+  snapshot.areaIndex = request.areaIndex;
   // No region reaches the area: the weather there is uniform and needs no
   // tiles, so no covering either (the level is the one the budget allows).
   const auto& cap = request.area;

@@ -15,7 +15,7 @@ bool byLayer(const BuiltSnapshot& s) {
 
 // The snapshot's layer table alone, at `tileLevel`.
 weather::WeatherSnapshot tableOf(const BuiltSnapshot& s, int tileLevel) {
-  return {s.snapshot.weatherClock_s, s.snapshot.layers, tileLevel, {}};
+  return {s.snapshot.weatherClock_s, s.snapshot.layers, tileLevel, {}, s.snapshot.areaIndex};
 }
 
 const LayerRun* runOf(const BuiltSnapshot& s, std::uint32_t layerId) {

@@ -189,9 +189,10 @@ TEST(CigiConditions, TheRendererAnswersWhatTheServerSaysAtThePoint) {
     while (host.receive(100ms)) {
     }
     const std::string log = render.log();
-    for (std::size_t at = log.find("weather snapshot: "); at != std::string::npos;
-         at = log.find("weather snapshot: ", at + 1))
-      tiles = tiles || log.compare(at, 30, "weather snapshot: 2 layers, 0 ") != 0;
+    // The detailed area's snapshot (area 0): the one the conditions come from.
+    const std::string snapshot = "weather snapshot of area 0: ", none = snapshot + "2 layers, 0 ";
+    for (std::size_t at = log.find(snapshot); at != std::string::npos; at = log.find(snapshot, at + 1))
+      tiles = tiles || log.compare(at, none.size(), none) != 0;
     if (!tiles) std::this_thread::sleep_for(200ms);
   }
   ASSERT_TRUE(tiles) << "no snapshot with tiles:\n" << render.log();

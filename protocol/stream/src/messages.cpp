@@ -68,7 +68,9 @@ Result<Message> decodeSubscribe(const fbs::Subscribe& s) {
   out.altMin_m = s.alt_min_m();
   out.altMax_m = s.alt_max_m();
   out.tileLevel = s.tile_level();
-  for (auto r : {checkRange("Subscribe", "center_lat_deg", out.area.centerLat_deg, -90, 90),
+  out.areaIndex = s.area_index();
+  for (auto r : {checkRange("Subscribe", "area_index", out.areaIndex, 0, kMaxAreas - 1),
+                 checkRange("Subscribe", "center_lat_deg", out.area.centerLat_deg, -90, 90),
                  checkRange("Subscribe", "center_lon_deg", out.area.centerLon_deg, -540, 540),
                  checkRange("Subscribe", "radius_m", out.area.radius_m, 1, 2.0e7),
                  checkRange("Subscribe", "alt_min_m", out.altMin_m, -1000, 1.0e6),
@@ -145,7 +147,10 @@ Result<Message> decodeSnapshot(const fbs::Snapshot& s) {
   weather::WeatherSnapshot out;
   out.weatherClock_s = s.weather_clock_s();
   out.tileLevel = s.tile_level();
+  out.areaIndex = s.area_index();
   if (auto r = checkFinite("Snapshot", "weather_clock_s", out.weatherClock_s); !r)
+    return tl::unexpected(r.error());
+  if (auto r = checkRange("Snapshot", "area_index", out.areaIndex, 0, kMaxAreas - 1); !r)
     return tl::unexpected(r.error());
   if (auto r = checkRange("Snapshot", "tile_level", out.tileLevel, 0, 30); !r)
     return tl::unexpected(r.error());
@@ -166,7 +171,10 @@ Result<Message> decodeDelta(const fbs::Delta& d) {
   weather::WeatherDelta out;
   out.weatherClock_s = d.weather_clock_s();
   out.tileLevel = d.tile_level();
+  out.areaIndex = d.area_index();
   if (auto r = checkFinite("Delta", "weather_clock_s", out.weatherClock_s); !r) return tl::unexpected(r.error());
+  if (auto r = checkRange("Delta", "area_index", out.areaIndex, 0, kMaxAreas - 1); !r)
+    return tl::unexpected(r.error());
   if (auto r = checkRange("Delta", "tile_level", out.tileLevel, 0, 30); !r) return tl::unexpected(r.error());
   auto layers = decodeLayers("Delta", d.layers());
   if (!layers) return tl::unexpected(layers.error());
@@ -266,7 +274,7 @@ std::vector<std::uint8_t> encodeMessage(const Message& message) {
             return std::pair{fbs::Body::Subscribe,
                              fbs::CreateSubscribe(b, s.protocolVersion, s.area.centerLat_deg,
                                                   s.area.centerLon_deg, s.area.radius_m, s.altMin_m,
-                                                  s.altMax_m, static_cast<std::uint8_t>(s.tileLevel))
+                                                  s.altMax_m, static_cast<std::uint8_t>(s.tileLevel), s.areaIndex)
                                  .Union()};
           },
           [&](const weather::WeatherSnapshot& s) {
@@ -275,7 +283,8 @@ std::vector<std::uint8_t> encodeMessage(const Message& message) {
             const std::vector<fbs::Tile> tiles = encodeTiles(s.tiles);
             return std::pair{fbs::Body::Snapshot,
                              fbs::CreateSnapshotDirect(b, s.weatherClock_s, &layers,
-                                                       static_cast<std::uint8_t>(s.tileLevel), &tiles)
+                                                       static_cast<std::uint8_t>(s.tileLevel), &tiles,
+                                                       s.areaIndex)
                                  .Union()};
           },
           [&](const Heartbeat& h) {
@@ -291,7 +300,7 @@ std::vector<std::uint8_t> encodeMessage(const Message& message) {
             const std::vector<fbs::Tile> tiles = encodeTiles(d.tiles);
             return std::pair{fbs::Body::Delta,
                              fbs::CreateDeltaDirect(b, d.weatherClock_s, &layers, &d.removedLayerIds,
-                                                    static_cast<std::uint8_t>(d.tileLevel), &tiles)
+                                                    static_cast<std::uint8_t>(d.tileLevel), &tiles, d.areaIndex)
                                  .Union()};
           },
           [&](const CameraReport& r) {

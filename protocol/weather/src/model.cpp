@@ -62,6 +62,9 @@ std::uint8_t quantizeUnit(double v) {
 }
 
 Result<void> applyDelta(WeatherSnapshot& snapshot, const WeatherDelta& delta) {
+  if (delta.areaIndex != snapshot.areaIndex)
+    return fail(ErrorCode::InvalidArgument, "delta for area " + std::to_string(delta.areaIndex) +
+                                                " applied to the snapshot of area " + std::to_string(snapshot.areaIndex));
   WeatherSnapshot next = snapshot;  // all or nothing
   next.weatherClock_s = delta.weatherClock_s;
   for (const CloudLayer& layer : delta.layers) {
@@ -108,6 +111,8 @@ std::optional<WeatherDelta> diffSnapshots(const WeatherSnapshot& before, const W
   WeatherDelta d;
   d.weatherClock_s = after.weatherClock_s;
   d.tileLevel = after.tileLevel;
+  d.areaIndex = after.areaIndex;
+  if (before.areaIndex != after.areaIndex) return std::nullopt;
   if (!before.tiles.empty() && !after.tiles.empty() && before.tileLevel != after.tileLevel) return std::nullopt;
   // Layers: the ones kept must stay in their order, new ones come last.
   std::vector<std::uint32_t> kept;

@@ -43,4 +43,19 @@ weather::WeatherSnapshot drawableWeather(const weather::WeatherSnapshot& s, std:
   return out;
 }
 
+weather::WeatherSnapshot drawableCoarse(const weather::WeatherSnapshot& coarse,
+                                        const weather::WeatherSnapshot& drawable) {
+  std::set<std::uint32_t> keep;
+  for (const auto& l : drawable.layers) keep.insert(l.id);
+  weather::WeatherSnapshot out;
+  out.weatherClock_s = coarse.weatherClock_s;
+  out.tileLevel = coarse.tileLevel;
+  out.areaIndex = coarse.areaIndex;
+  for (const auto& l : coarse.layers)
+    if (keep.count(l.id)) out.layers.push_back(l);
+  for (const auto& t : coarse.tiles)
+    if (keep.count(t.layerId)) out.tiles.push_back(t);
+  return out;
+}
+
 }  // namespace sky::app

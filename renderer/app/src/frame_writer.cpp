@@ -24,6 +24,15 @@ Result<FrameWriter> FrameWriter::open(const std::string& directory, const FrameO
   return w;
 }
 
+namespace {
+nlohmann::json areasJson(const std::vector<FrameRecord::Area>& areas) {
+  nlohmann::json out = nlohmann::json::array();
+  for (std::size_t i = 0; i < areas.size(); ++i)
+    out.push_back({{"area", i}, {"tile_level", areas[i].tileLevel}, {"tiles", areas[i].tiles}});
+  return out;
+}
+}  // namespace
+
 Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r) {
   char name[32];
   std::snprintf(name, sizeof name, "frame_%06llu", static_cast<unsigned long long>(r.frame));
@@ -53,6 +62,7 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
       {"weather_version", r.weatherVersion},
       {"weather_connected", r.weatherConnected},
       {"layers", r.layerCount},
+      {"weather_areas", areasJson(r.weatherAreas)},
       {"sun_azimuth_deg", r.sunAzimuth_deg},
       {"sun_elevation_deg", r.sunElevation_deg},
       {"preset", run_.preset},

@@ -63,6 +63,15 @@ bool waitForWeather(const SharedState& state, std::uint64_t after, double timeou
   return true;
 }
 
+bool waitForCoarse(const SharedState& state, double timeout_s, const std::atomic<bool>* stop) {
+  const auto until = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
+  while (state.coarseVersion() == 0) {
+    if ((stop && *stop) || Clock::now() > until) return false;
+    std::this_thread::sleep_for(kWeatherPoll);
+  }
+  return true;
+}
+
 }  // namespace
 
 int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, const std::atomic<bool>* stop) {
@@ -138,13 +147,19 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   std::fflush(stdout);
 
   geo::GeodeticPose pose = flight::sample(*flight, t0);
-  if (weather) weather->subscribe(areaAround(pose));
-  geo::Geodetic subscribedAt = pose.position;
+  AreaTracker areas;
+  if (weather)
+    for (const auto& area : areas.update(pose)) weather->subscribe(area);
   if (!waitForWeather(state, 0, o.weatherTimeout_s, stop)) {
     std::fprintf(stderr, "skyshell-render: no weather from %s within %.0f s\n", weatherSource.c_str(),
                  o.weatherTimeout_s);
     return 4;
   }
+  // The coarse ring's weather too, when the server sends it, so that the
+  // first frames already see the far weather (the detailed area comes first).
+  if (weather && weather->serverTakesAreas() && !waitForCoarse(state, o.weatherTimeout_s, stop))
+    std::fprintf(stderr, "skyshell-render: warning: no coarse-area weather within %.0f s; the coarse ring "
+                         "holds the detailed area's\n", o.weatherTimeout_s);
   const WeatherView firstView = state.weather();
   const double clockBase_s = o.weatherClock_s.value_or(firstView.clockNow(Clock::now()));
   const double clockRate = firstView.clock.rate();
@@ -183,10 +198,9 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
       break;
     }
     pose = flight::sample(*flight, t);
-    if (weather && needsResubscribe(subscribedAt, pose.position)) {
+    if (const auto asked = weather ? areas.update(pose) : std::vector<stream::Subscribe>{}; !asked.empty()) {
       const std::uint64_t before = state.weatherVersion();
-      weather->subscribe(areaAround(pose));
-      subscribedAt = pose.position;
+      for (const auto& area : asked) weather->subscribe(area);
       if (!waitForWeather(state, before, o.weatherTimeout_s, stop))
         std::fprintf(stderr, "skyshell-render: warning: frame %zu: no weather for the new area within %.0f s; "
                              "drawing the old area's\n", i, o.weatherTimeout_s);
@@ -199,9 +213,11 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
       std::fprintf(stderr, "skyshell-render: warning: frame %zu: weather has %zu layers, drawing the %zu with most cloud\n",
                    i, view.snapshot.layers.size(), render::kMaxLayers);
     }
+    const auto coarse = view.coarse ? std::optional(drawableCoarse(*view.coarse, drawable)) : std::nullopt;
     render::FrameInputs in;
     in.camera = pose;
     in.weather = &drawable;
+    in.coarseWeather = coarse ? &*coarse : nullptr;
     in.weatherClock_s = clockBase_s + (t - t0) * clockRate;
     in.sunAzimuth_deg = o.sunAzimuth_deg;
     in.sunElevation_deg = o.sunElevation_deg;
@@ -236,6 +252,8 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     record.weatherVersion = view.version;
     record.weatherConnected = view.connected;
     record.layerCount = view.snapshot.layers.size();
+    record.weatherAreas = {{view.snapshot.tileLevel, view.snapshot.tiles.size()}};
+    if (view.coarse) record.weatherAreas.push_back({view.coarse->tileLevel, view.coarse->tiles.size()});
     if (auto ok = writer->write(*image, record); !ok) {
       std::fprintf(stderr, "skyshell-render: %s\n", describe(ok.error()).c_str());
       exitCode = 2;

@@ -326,7 +326,7 @@ int main(int argc, char** argv) {
   std::fflush(stdout);
 
   std::uint64_t frames = 0, lastSequence = 0, droppedWarnedAt = 0;
-  std::optional<sky::geo::Geodetic> subscribedAt;
+  sky::app::AreaTracker areas;
   const auto start = Clock::now();
   auto lastReport = start;
   Clock::time_point lastPoseAt{};
@@ -339,10 +339,8 @@ int main(int argc, char** argv) {
     if (fdm && Clock::now() < nextFdmFrameAt) std::this_thread::sleep_until(nextFdmFrameAt);
     const auto now = Clock::now();
     const auto pose = fdm ? fdm->poseAt(now) : state.pose();
-    if (pose && (!subscribedAt || sky::app::needsResubscribe(*subscribedAt, pose->pose.position))) {
-      weather.subscribe(sky::app::areaAround(pose->pose));
-      subscribedAt = pose->pose.position;
-    }
+    if (pose)
+      for (const auto& area : areas.update(pose->pose)) weather.subscribe(area);
     if (pose) lastPoseAt = pose->receivedAt;
     // Idle only once the newest pose has been rendered: a slow frame must not
     // skip the host's last pose (seen in CI under load: the final fix of the
@@ -383,9 +381,12 @@ int main(int argc, char** argv) {
       spdlog::warn("weather has {} layers, this channel draws {}: leaving out layer(s) {}", view.snapshot.layers.size(),
                    sky::render::kMaxLayers, fmt::join(dropped, ", "));
     }
+    const auto coarse =
+        view.coarse ? std::optional(sky::app::drawableCoarse(*view.coarse, drawable)) : std::nullopt;
     sky::render::FrameInputs in;
     in.camera = pose->pose;
     in.weather = &drawable;
+    in.coarseWeather = coarse ? &*coarse : nullptr;
     in.weatherClock_s = view.clockNow(now);
     in.sunAzimuth_deg = o.sunAzimuth_deg;
     in.sunElevation_deg = o.sunElevation_deg;
@@ -405,6 +406,8 @@ int main(int argc, char** argv) {
     record.weatherVersion = view.version;
     record.weatherConnected = view.connected;
     record.layerCount = view.snapshot.layers.size();
+    record.weatherAreas = {{view.snapshot.tileLevel, view.snapshot.tiles.size()}};
+    if (view.coarse) record.weatherAreas.push_back({view.coarse->tileLevel, view.coarse->tiles.size()});
     if (display) {
       auto shown = display->show(*image);
       if (!shown) {

@@ -62,8 +62,9 @@ void WeatherClient::stop() {
 
 void WeatherClient::subscribe(const stream::Subscribe& area) {
   asio::post(io_, [this, area] {
-    area_ = area;
-    if (socket_.is_open()) send(area);
+    if (area.areaIndex >= areas_.size()) return;
+    areas_[area.areaIndex] = area;
+    if (socket_.is_open() && (area.areaIndex == 0 || serverTakesAreas_)) send(area);
   });
 }
 
@@ -85,17 +86,20 @@ void WeatherClient::connect() {
     backoff_ = std::chrono::milliseconds(250);
     decoder_ = stream::FrameDecoder();
     inFlight_.clear();
-    pendingSubscribe_.reset();
+    for (auto& p : pendingSubscribe_) p.reset();
     pendingReport_.reset();
     serverTakesReports_ = false;  // until this server's Hello says so
+    serverTakesAreas_ = false;
     state_.setConnected(true);
-    if (area_) send(*area_);
+    // The detailed area at once; the others once the Hello says they are taken.
+    if (areas_[0]) send(*areas_[0]);
     read();
   });
 }
 
 void WeatherClient::scheduleReconnect() {
   serverTakesReports_ = false;
+  serverTakesAreas_ = false;
   if (stopped_) return;
   state_.setConnected(false);
   boost::system::error_code ec;
@@ -145,20 +149,29 @@ void WeatherClient::onFrame(std::span<const std::uint8_t> payload) {
                    const bool reports = (h.features & stream::kFeatureCameraReports) != 0;
                    serverTakesReports_ = reports;
                    reportNow_ = reports;
-                   spdlog::info("weather server '{}' protocol {} clock {:.1f} s x{}{}", h.serverId,
+                   const bool areas = (h.features & stream::kFeatureAreas) != 0;
+                   serverTakesAreas_ = areas;
+                   spdlog::info("weather server '{}' protocol {} clock {:.1f} s x{}{}{}", h.serverId,
                                 h.protocolVersion, h.weatherClock_s, h.clockRate,
-                                reports ? "; reporting the camera as '" + channel_ + "'" : "");
+                                reports ? "; reporting the camera as '" + channel_ + "'" : "",
+                                areas ? "" : "; it takes one area only: the coarse ring holds what the detailed area brings");
+                   if (areas) {
+                     for (std::size_t i = 1; i < areas_.size(); ++i)
+                       if (areas_[i]) send(*areas_[i]);
+                   } else {
+                     state_.dropCoarse();
+                   }
                  },
                  [&](const weather::WeatherSnapshot& s) {
-                   spdlog::info("weather snapshot: {} layers, {} tiles at S2 level {}", s.layers.size(),
-                                s.tiles.size(), s.tileLevel);
+                   spdlog::info("weather snapshot of area {}: {} layers, {} tiles at S2 level {}", s.areaIndex,
+                                s.layers.size(), s.tiles.size(), s.tileLevel);
                    state_.setSnapshot(s, now);
                  },
                  [&](const weather::WeatherDelta& d) {
                    if (auto r = state_.applyDelta(d, now); !r) {
                      ++malformed_;
                      spdlog::warn("weather stream: dropped a Delta: {}; asking for a new Snapshot", r.error().detail);
-                     if (area_) send(*area_);
+                     if (d.areaIndex < areas_.size() && areas_[d.areaIndex]) send(*areas_[d.areaIndex]);
                    }
                  },
                  [&](const stream::Heartbeat& h) { state_.setClock(h.weatherClock_s, clockRate_, now); },
@@ -228,11 +241,11 @@ bool WeatherClient::reportWorthSending(const stream::CameraReport& r, Clock::tim
 void WeatherClient::send(const stream::Message& message) {
   auto bytes = stream::encodeFrame(stream::encodeMessage(message));
   if (!inFlight_.empty()) {
-    // Coalesce: only the newest request and the newest report matter.
-    if (std::holds_alternative<stream::CameraReport>(message))
-      pendingReport_ = std::move(bytes);
+    // Coalesce: only the newest request of each area and the newest report matter.
+    if (const auto* sub = std::get_if<stream::Subscribe>(&message))
+      pendingSubscribe_[sub->areaIndex] = std::move(bytes);
     else
-      pendingSubscribe_ = std::move(bytes);
+      pendingReport_ = std::move(bytes);
     return;
   }
   inFlight_ = std::move(bytes);
@@ -243,7 +256,8 @@ void WeatherClient::flushWrite() {
   asio::async_write(socket_, asio::buffer(inFlight_), [this](boost::system::error_code ec, std::size_t) {
     inFlight_.clear();
     if (ec) return;  // the read side notices and reconnects
-    for (auto* pending : {&pendingSubscribe_, &pendingReport_}) {
+    static_assert(stream::kMaxAreas == 2, "one pending Subscribe per area");
+    for (auto* pending : {&pendingSubscribe_[0], &pendingSubscribe_[1], &pendingReport_}) {
       if (!*pending) continue;
       inFlight_ = std::move(**pending);
       pending->reset();

@@ -359,3 +359,80 @@ TEST(Messages, HelloFeatures) {
 
 }  // namespace
 }  // namespace sky::stream
+
+namespace sky::stream {
+namespace {
+
+// A connection holds up to kMaxAreas areas: Subscribe, Snapshot and Delta
+// carry the area index across the wire; one past the last is refused with
+// the field named; a message without the field (an older peer) is area 0.
+TEST(Areas, TheIndexRoundTripsAndIsRangeChecked) {
+  Subscribe s;
+  s.area = {47, 8, 900000};
+  s.tileLevel = 9;
+  s.areaIndex = 1;
+  auto m = decodeMessage(encodeMessage(s));
+  ASSERT_TRUE(m) << m.error().detail;
+  EXPECT_EQ(std::get<Subscribe>(*m).areaIndex, 1);
+  EXPECT_EQ(std::get<Subscribe>(*m).area.radius_m, 900000);
+
+  weather::WeatherSnapshot snap = sampleSnapshot();
+  snap.areaIndex = 1;
+  m = decodeMessage(encodeMessage(snap));
+  ASSERT_TRUE(m) << m.error().detail;
+  EXPECT_EQ(std::get<weather::WeatherSnapshot>(*m).areaIndex, 1);
+
+  weather::WeatherDelta d;
+  d.areaIndex = 1;
+  m = decodeMessage(encodeMessage(d));
+  ASSERT_TRUE(m) << m.error().detail;
+  EXPECT_EQ(std::get<weather::WeatherDelta>(*m).areaIndex, 1);
+
+  s.areaIndex = kMaxAreas;
+  m = decodeMessage(encodeMessage(s));
+  ASSERT_FALSE(m);
+  EXPECT_NE(m.error().detail.find("Subscribe.area_index"), std::string::npos) << m.error().detail;
+  snap.areaIndex = kMaxAreas;
+  m = decodeMessage(encodeMessage(snap));
+  ASSERT_FALSE(m);
+  EXPECT_NE(m.error().detail.find("Snapshot.area_index"), std::string::npos) << m.error().detail;
+  d.areaIndex = kMaxAreas;
+  m = decodeMessage(encodeMessage(d));
+  ASSERT_FALSE(m);
+  EXPECT_NE(m.error().detail.find("Delta.area_index"), std::string::npos) << m.error().detail;
+
+  // The default (0) is what a peer from before the field means.
+  Subscribe plain;
+  plain.area = {47, 8, 120000};
+  m = decodeMessage(encodeMessage(plain));
+  ASSERT_TRUE(m) << m.error().detail;
+  EXPECT_EQ(std::get<Subscribe>(*m).areaIndex, 0);
+}
+
+// A delta of one area never applies to another's snapshot, and leaves it as
+// it was; snapshots of two areas have no delta between them.
+TEST(Areas, ADeltaAppliesOnlyToItsOwnArea) {
+  weather::WeatherSnapshot coarse = sampleSnapshot();
+  coarse.areaIndex = 1;
+  weather::WeatherSnapshot fine = sampleSnapshot();
+  weather::WeatherDelta d;
+  d.areaIndex = 1;
+  d.weatherClock_s = 99;
+  d.layers = {coarse.layers[0]};
+  d.layers[0].coverage = 0.9;
+  const weather::WeatherSnapshot before = fine;
+  auto r = weather::applyDelta(fine, d);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().detail.find("area 1"), std::string::npos) << r.error().detail;
+  EXPECT_EQ(fine.weatherClock_s, before.weatherClock_s);
+  EXPECT_EQ(fine.layers[0].coverage, before.layers[0].coverage);
+  ASSERT_TRUE(weather::applyDelta(coarse, d));
+  EXPECT_EQ(coarse.layers[0].coverage, 0.9);
+  EXPECT_FALSE(weather::diffSnapshots(fine, coarse));
+  const auto same = weather::diffSnapshots(coarse, coarse);
+  ASSERT_TRUE(same);
+  EXPECT_EQ(same->areaIndex, 1);
+}
+
+}  // namespace
+}  // namespace sky::stream

@@ -2,6 +2,7 @@
 // (ties by id), their tiles only, in their order, and names the rest.
 #include <gtest/gtest.h>
 
+#include "sky/app/area_of_interest.hpp"
 #include "sky/app/drawable_weather.hpp"
 
 namespace sky::app {
@@ -54,6 +55,67 @@ TEST(DrawableWeather, ALayerOnlyARegionHasRanksByItsTiles) {
   const auto d = drawableWeather(s, 4, &dropped);
   EXPECT_EQ(dropped, (std::vector<std::uint32_t>{1}));
   EXPECT_EQ(d.layers.back().id, 9u);
+}
+
+}  // namespace
+}  // namespace sky::app
+
+namespace sky::app {
+namespace {
+
+// The coarse area's snapshot is cut to the layers the detailed area's
+// drawable keeps, whatever the coarse area's own ranking would be (there a
+// dropped layer may have more cloud), so both rings of the map hold one set.
+TEST(DrawableWeather, TheCoarseAreaKeepsTheDetailedAreasLayers) {
+  weather::WeatherSnapshot fine, coarse;
+  coarse.areaIndex = 1;
+  coarse.tileLevel = 9;
+  for (std::uint32_t id = 1; id <= 5; ++id) {
+    weather::CloudLayer l;
+    l.id = id;
+    l.coverage = 0.1 * id;
+    fine.layers.push_back(l);
+    l.coverage = 1.0 - 0.1 * id;  // the opposite ranking far away
+    coarse.layers.push_back(l);
+    coarse.tiles.push_back({1000 + id, id, 0.5f, 1.0f});
+  }
+  const auto drawable = drawableWeather(fine, 4);
+  const auto cut = drawableCoarse(coarse, drawable);
+  ASSERT_EQ(cut.layers.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(cut.layers[i].id, drawable.layers[i].id);
+  EXPECT_EQ(cut.layers.front().id, 2u) << "layer 1 has least cloud near the camera";
+  EXPECT_EQ(cut.tiles.size(), 4u);
+  for (const auto& t : cut.tiles) EXPECT_NE(t.layerId, 1u);
+  EXPECT_EQ(cut.areaIndex, 1);
+  EXPECT_EQ(cut.tileLevel, 9);
+}
+
+// Both areas are asked for on the first pose; the detailed one again every
+// 30 km, the coarse one every 100 km; the coarse one is area 1 at level 9
+// (~18 km cells) over 900 km, the detailed one area 0 at level 11.
+TEST(AreaTracker, AsksForEachAreaAgainAtItsOwnDistance) {
+  AreaTracker t;
+  geo::GeodeticPose pose;
+  pose.position = {46.0, 13.0, 3000};
+  auto asked = t.update(pose);
+  ASSERT_EQ(asked.size(), 2u);
+  EXPECT_EQ(asked[0].areaIndex, 0);
+  EXPECT_EQ(asked[0].tileLevel, 11);
+  EXPECT_EQ(asked[0].area.radius_m, kSubscribeRadius_m);
+  EXPECT_EQ(asked[1].areaIndex, 1);
+  EXPECT_EQ(asked[1].tileLevel, 9);
+  EXPECT_EQ(asked[1].area.radius_m, kCoarseSubscribeRadius_m);
+  EXPECT_TRUE(t.update(pose).empty());
+  const double kmLat = 1.0 / 111.2;
+  pose.position.lat_deg += 40 * kmLat;  // 40 km north
+  asked = t.update(pose);
+  ASSERT_EQ(asked.size(), 1u);
+  EXPECT_EQ(asked[0].areaIndex, 0);
+  pose.position.lat_deg += 70 * kmLat;  // 110 km from the first pose
+  asked = t.update(pose);
+  ASSERT_EQ(asked.size(), 2u) << "70 km from the last detailed area, 110 km from the coarse one";
+  EXPECT_EQ(asked[1].areaIndex, 1);
+  EXPECT_DOUBLE_EQ(asked[1].area.centerLat_deg, pose.position.lat_deg);
 }
 
 }  // namespace

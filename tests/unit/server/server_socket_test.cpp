@@ -3,10 +3,15 @@
 // a close while another client keeps being served.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
+#include <optional>
 #include <thread>
 
+#include "sky/geo/geodetic.hpp"
 #include "sky/server/scenario.hpp"
+#include "sky/weather/tiling.hpp"
 #include "sky/server/server.hpp"
 #include "stream_test_client.hpp"
 
@@ -155,6 +160,85 @@ TEST_F(ServerFixture, AChangeArrivesAsADeltaThatEqualsAFreshSnapshot) {
   ASSERT_TRUE(m);
   ASSERT_TRUE(std::holds_alternative<weather::WeatherSnapshot>(*m)) << stream::kindName(*m);
   for (const auto& t : std::get<weather::WeatherSnapshot>(*m).tiles) EXPECT_NEAR(t.coverage, 0.8f, 0.5f / 255);
+}
+
+// Two areas on one connection (a renderer's detailed area and its wide
+// coarse one): the Hello says the server takes them; each Subscribe is
+// answered with a Snapshot of its own area index, level and cells; a weather
+// change gives each area its own Delta, which applies to that area's snapshot
+// only; and re-subscribing one area leaves the other's Delta chain alone.
+TEST_F(ServerFixture, TwoAreasAreAnsweredEachOnItsOwn) {
+  TestClient client(server_->port());
+  auto hello = client.readNext<stream::Hello>();
+  ASSERT_TRUE(hello);
+  EXPECT_NE(hello->features & stream::kFeatureAreas, 0u);
+  client.send(subscribe(47.4, 8.5, 30'000, 10));
+  auto fine = client.readNext<weather::WeatherSnapshot>();
+  ASSERT_TRUE(fine) << fine.error().detail;
+  stream::Subscribe wide = subscribe(47.4, 8.5, 400'000, 7);
+  wide.areaIndex = 1;
+  client.send(wide);
+  auto coarse = client.readNext<weather::WeatherSnapshot>();
+  ASSERT_TRUE(coarse) << coarse.error().detail;
+  EXPECT_EQ(fine->areaIndex, 0);
+  EXPECT_EQ(fine->tileLevel, 10);
+  EXPECT_EQ(coarse->areaIndex, 1);
+  EXPECT_EQ(coarse->tileLevel, 7);
+  ASSERT_FALSE(coarse->tiles.empty());
+  // The wide area's cells reach far beyond the detailed one's 30 km: the
+  // region's tiles there arrive only through it.
+  double farthest_m = 0;
+  for (const auto& t : coarse->tiles) {
+    EXPECT_TRUE(weather::isCellAtLevel(t.cellId, 7));
+    const auto c = weather::cellCentre(t.cellId);
+    farthest_m = std::max(farthest_m, geo::geodesicDistance_m(47.4, 8.5, c.lat_deg, c.lon_deg));
+  }
+  EXPECT_GT(farthest_m, 300'000.0);
+
+  asio::post(server_->io(), [this] {
+    weather::CloudLayer l = server_->weather().view().layers.at(0);
+    l.coverage = 0.7;
+    ASSERT_TRUE(server_->weather().submit({{SetLayer{l, Timing{}}}, "test", "api"}));
+  });
+  std::array<std::optional<weather::WeatherDelta>, 2> deltas;
+  for (int n = 0; n < 2; ++n) {
+    auto d = client.readNext<weather::WeatherDelta>();
+    ASSERT_TRUE(d) << d.error().detail;
+    ASSERT_LT(d->areaIndex, 2);
+    EXPECT_FALSE(deltas[d->areaIndex]) << "one delta per area";
+    deltas[d->areaIndex] = *d;
+  }
+  ASSERT_TRUE(deltas[0] && deltas[1]);
+  weather::WeatherSnapshot crossed = *fine;
+  EXPECT_FALSE(weather::applyDelta(crossed, *deltas[1])) << "area 1's delta must not apply to area 0";
+  ASSERT_TRUE(weather::applyDelta(*fine, *deltas[0]));
+  ASSERT_TRUE(weather::applyDelta(*coarse, *deltas[1]));
+  EXPECT_NEAR(fine->layers[0].coverage, 0.7, 1e-6);
+  EXPECT_NEAR(coarse->layers[0].coverage, 0.7, 1e-6);
+
+  // The wide area moves; the detailed area still gets Deltas from what it holds.
+  wide.area.centerLat_deg = 50.0;
+  client.send(wide);
+  auto moved = client.readNext<weather::WeatherSnapshot>();
+  ASSERT_TRUE(moved);
+  EXPECT_EQ(moved->areaIndex, 1);
+  asio::post(server_->io(), [this] {
+    weather::CloudLayer l = server_->weather().view().layers.at(0);
+    l.coverage = 0.5;
+    ASSERT_TRUE(server_->weather().submit({{SetLayer{l, Timing{}}}, "test", "api"}));
+  });
+  bool fineDelta = false;
+  for (int n = 0; n < 2; ++n) {
+    auto m = client.read();
+    while (m && std::holds_alternative<stream::Heartbeat>(*m)) m = client.read();
+    ASSERT_TRUE(m);
+    if (const auto* d = std::get_if<weather::WeatherDelta>(&*m); d && d->areaIndex == 0) {
+      fineDelta = true;
+      ASSERT_TRUE(weather::applyDelta(*fine, *d));
+    }
+  }
+  EXPECT_TRUE(fineDelta);
+  EXPECT_NEAR(fine->layers[0].coverage, 0.5, 1e-6);
 }
 
 TEST_F(ServerFixture, TooFineALevelIsLoweredAndReported) {

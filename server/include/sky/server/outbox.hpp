@@ -3,6 +3,7 @@
 // catches up rather than a growing queue. Pure bookkeeping, no I/O.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <deque>
 #include <optional>
@@ -23,22 +24,23 @@ class Outbox {
 
   // Hello and Error: sent in order, before anything else. At most two ever.
   void pushControl(Frame frame);
-  // Replaces a subscription still waiting for its snapshot.
+  // Replaces a subscription of the same area (Subscribe::areaIndex) still
+  // waiting for its snapshot.
   void requestSnapshot(const stream::Subscribe& request);
   // Replaces a heartbeat not yet sent.
   void setHeartbeat(Frame frame);
   // Drops pending weather (snapshot, heartbeat): used when closing.
   void dropWeather();
 
-  // Control first, then the snapshot (which also drops a waiting heartbeat:
-  // the snapshot carries a newer clock), then the heartbeat.
+  // Control first, then the snapshots by area index (which also drop a
+  // waiting heartbeat: a snapshot carries a newer clock), then the heartbeat.
   std::optional<Item> takeNext();
 
   bool empty() const;
 
  private:
   std::deque<Frame> control_;
-  std::optional<stream::Subscribe> snapshot_;
+  std::array<std::optional<stream::Subscribe>, stream::kMaxAreas> snapshots_;  // by area index
   std::optional<Frame> heartbeat_;
 };
 

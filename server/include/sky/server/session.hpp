@@ -63,9 +63,9 @@ class Session : public std::enable_shared_from_this<Session> {
   void start(Frame hello);
   // Queues a heartbeat frame, replacing one not yet sent. Ignored once closing.
   void sendHeartbeat(const Frame& heartbeat);
-  // The weather changed: fresh weather for the current subscription (if any)
+  // The weather changed: fresh weather for each area subscribed (if any)
   // replaces whatever is still waiting to be sent; it goes out as a Delta
-  // from what the peer holds when it can, else as a Snapshot.
+  // from what the peer holds for that area when it can, else as a Snapshot.
   void weatherChanged();
   // Closes the socket now, cancelling pending I/O. Idempotent.
   void close();
@@ -103,12 +103,17 @@ class Session : public std::enable_shared_from_this<Session> {
   spdlog::logger& log_;
   State state_ = State::Open;
   stream::FrameDecoder decoder_;
-  std::optional<stream::Subscribe> subscription_;  // the latest area asked for
-  // What the peer holds: the last snapshot sent (or reached by deltas), and
-  // the subscription it answered. A new snapshot of the same subscription
-  // goes out as the Delta from it when a delta can say it and is smaller.
-  std::optional<BuiltSnapshot> peerHolds_;
-  std::optional<stream::Subscribe> peerHoldsFor_;
+  // Per area index (Subscribe::areaIndex), each on its own: the latest
+  // subscription asked for; what the peer holds, the last snapshot sent (or
+  // reached by deltas), and the subscription it answered. A new snapshot of
+  // the same subscription goes out as the Delta from it when a delta can say
+  // it and is smaller.
+  struct Area {
+    std::optional<stream::Subscribe> subscription;
+    std::optional<BuiltSnapshot> peerHolds;
+    std::optional<stream::Subscribe> peerHoldsFor;
+  };
+  std::array<Area, stream::kMaxAreas> areas_;
   // The newest CameraReport and when it arrived (reports replace each other).
   std::optional<stream::CameraReport> report_;
   std::chrono::steady_clock::time_point reportAt_{};

@@ -27,6 +27,12 @@ inline constexpr std::size_t kTileWireBytes = 16;
 // Bits of Hello::features: what a server takes beyond the base protocol of
 // its major version. A server from before the field sends 0.
 inline constexpr std::uint32_t kFeatureCameraReports = 1u << 0;  // takes CameraReport
+inline constexpr std::uint32_t kFeatureAreas = 1u << 1;          // takes Subscribe.areaIndex > 0
+
+// Areas of interest one connection may hold (Subscribe::areaIndex): a
+// renderer asks for its detailed area around the camera (0) and a wider one
+// at coarser tiles (1) for the weather map's coarse ring.
+inline constexpr std::uint8_t kMaxAreas = 2;
 
 struct Hello {
   std::uint16_t protocolVersion = kProtocolVersion;
@@ -42,6 +48,7 @@ struct Subscribe {
   double altMin_m = -500;  // altitude band of interest, MSL
   double altMax_m = 20000;
   int tileLevel = 8;  // S2 level, [0, 20]
+  std::uint8_t areaIndex = 0;  // [0, kMaxAreas); replaces only the area of this index
 };
 
 struct Heartbeat {

@@ -69,6 +69,9 @@ struct WeatherSnapshot {
   std::vector<CloudLayer> layers;
   int tileLevel = 0;  // S2 level of every tile, [0, 30]
   std::vector<CoverageTile> tiles;
+  // Which of a subscriber's areas (sky::stream::Subscribe::areaIndex) this
+  // answers: each area has its own snapshot, kept up to date by its own deltas.
+  std::uint8_t areaIndex = 0;
 };
 
 // A change to a snapshot: layers upserted by id, layers removed (with their
@@ -79,9 +82,10 @@ struct WeatherDelta {
   std::vector<std::uint32_t> removedLayerIds;
   int tileLevel = 0;  // must equal the snapshot's when tiles are present
   std::vector<CoverageTile> tiles;
+  std::uint8_t areaIndex = 0;  // must equal the snapshot's
 };
 
-// Applies a delta; on error (a tile level that differs from the snapshot's,
+// Applies a delta; on error (another area's delta, a tile level that differs from the snapshot's,
 // a tile of a layer that does not exist afterwards, removal of an unknown
 // layer) the snapshot is left exactly as it was.
 Result<void> applyDelta(WeatherSnapshot& snapshot, const WeatherDelta& delta);
@@ -89,7 +93,7 @@ Result<void> applyDelta(WeatherSnapshot& snapshot, const WeatherDelta& delta);
 // The delta that takes `before` to `after` (applyDelta(before, delta) gives
 // after exactly: same layers in the same order, same tiles by (cell, layer)):
 // changed and new layers, removed layers, and the tiles that differ. None when
-// a delta cannot say it: a different tile level, a layer losing tiles it had
+// a delta cannot say it: another area, a different tile level, a layer losing tiles it had
 // (a delta only upserts tiles), a tile gone, or layers reordered; the caller
 // then sends a snapshot.
 std::optional<WeatherDelta> diffSnapshots(const WeatherSnapshot& before, const WeatherSnapshot& after);

@@ -17,4 +17,9 @@ namespace sky::app {
 weather::WeatherSnapshot drawableWeather(const weather::WeatherSnapshot& snapshot, std::size_t maxLayers,
                                          std::vector<std::uint32_t>* dropped = nullptr);
 
+// The coarse area's snapshot cut to the layers `drawable` (the detailed
+// area's drawableWeather) draws, so both rings of the map hold the same
+// layers whatever the coarse area's own ranking would be.
+weather::WeatherSnapshot drawableCoarse(const weather::WeatherSnapshot& coarse, const weather::WeatherSnapshot& drawable);
+
 }  // namespace sky::app

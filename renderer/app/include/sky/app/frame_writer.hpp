@@ -43,6 +43,13 @@ struct FrameRecord {
   std::uint64_t weatherVersion = 0;  // this channel's count of weather updates applied (snapshots, deltas)
   bool weatherConnected = false;     // the stream to the server was up when the frame was drawn
   std::size_t layerCount = 0;
+  // The weather each area of interest brought (index 0 detailed, 1 coarse;
+  // one entry without a coarse area): S2 level and tiles of the snapshot held.
+  struct Area {
+    int tileLevel = 0;
+    std::size_t tiles = 0;
+  };
+  std::vector<Area> weatherAreas;
   double sunAzimuth_deg = 0, sunElevation_deg = 0;  // the sun the frame was lit by, local ENU
   std::optional<double> utc_s;                      // when the sun came from the date (s since 1970)
   render::ImageStats stats;

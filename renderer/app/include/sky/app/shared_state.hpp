@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <mutex>
 #include <optional>
+#include <string>
 
 #include "sky/geo/geodetic.hpp"
 #include "sky/weather/clock.hpp"
@@ -23,8 +24,12 @@ struct HostPose {
 };
 
 struct WeatherView {
-  weather::WeatherSnapshot snapshot;
-  std::uint64_t version = 0;  // increments with every snapshot received
+  weather::WeatherSnapshot snapshot;  // of the detailed area around the camera (area index 0)
+  // Of the wide area at coarse tiles (area index 1), for the weather map's
+  // coarse ring; none before it arrives or from a server without areas.
+  std::optional<weather::WeatherSnapshot> coarse;
+  std::uint64_t version = 0;  // increments with every snapshot and delta applied, of either area
+  std::uint64_t coarseVersion = 0;  // of the coarse area's alone
   // The server's weather clock, re-anchored on every Hello, Snapshot, Delta
   // and Heartbeat (protocol/'s WeatherClock: the same formula as the server's).
   weather::WeatherClock clock;
@@ -46,21 +51,40 @@ class SharedState {
     return pose_;
   }
 
+  // Takes the snapshot of its area (WeatherSnapshot::areaIndex: 0 detailed,
+  // 1 coarse; no other index gets past the stream's decoder).
   void setSnapshot(weather::WeatherSnapshot s, std::chrono::steady_clock::time_point now) {
     std::lock_guard lock(mutex_);
     weather_.clock = weather::WeatherClock(s.weatherClock_s, weather_.clock.rate(), now);
-    weather_.snapshot = std::move(s);
+    if (s.areaIndex == 1) {
+      weather_.coarse = std::move(s);
+      ++weather_.coarseVersion;
+    } else {
+      weather_.snapshot = std::move(s);
+      detailedSeen_ = true;
+    }
     ++weather_.version;
   }
-  // Applies a Delta to the held snapshot; on error nothing changes.
+  // Applies a Delta to the held snapshot of its area; on error nothing changes.
   Result<void> applyDelta(const weather::WeatherDelta& d, std::chrono::steady_clock::time_point now) {
     std::lock_guard lock(mutex_);
-    if (weather_.version == 0)
-      return fail(ErrorCode::InvalidArgument, "Delta before any Snapshot");
-    if (auto r = weather::applyDelta(weather_.snapshot, d); !r) return r;
+    weather::WeatherSnapshot* target = d.areaIndex == 1 ? (weather_.coarse ? &*weather_.coarse : nullptr)
+                                                        : (detailedSeen_ ? &weather_.snapshot : nullptr);
+    if (target == nullptr)
+      return fail(ErrorCode::InvalidArgument, "Delta of area " + std::to_string(d.areaIndex) + " before its Snapshot");
+    if (auto r = weather::applyDelta(*target, d); !r) return r;
     weather_.clock = weather::WeatherClock(d.weatherClock_s, weather_.clock.rate(), now);
+    if (d.areaIndex == 1) ++weather_.coarseVersion;
     ++weather_.version;
     return {};
+  }
+  // Forgets the coarse area's snapshot (a server that does not answer it
+  // would leave it stale for good).
+  void dropCoarse() {
+    std::lock_guard lock(mutex_);
+    if (!weather_.coarse) return;
+    weather_.coarse.reset();
+    ++weather_.version;
   }
   void setClock(double clock_s, double rate, std::chrono::steady_clock::time_point now) {
     std::lock_guard lock(mutex_);
@@ -78,11 +102,16 @@ class SharedState {
     std::lock_guard lock(mutex_);
     return weather_.version;
   }
+  std::uint64_t coarseVersion() const {
+    std::lock_guard lock(mutex_);
+    return weather_.coarseVersion;
+  }
 
  private:
   mutable std::mutex mutex_;
   std::optional<HostPose> pose_;
   WeatherView weather_;
+  bool detailedSeen_ = false;  // a Snapshot of area 0 has arrived
 };
 
 }  // namespace sky::app

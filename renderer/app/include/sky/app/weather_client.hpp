@@ -1,5 +1,6 @@
 // The renderer's connection to skyshell-weatherd: connects, subscribes for the
-// camera's area, keeps the latest snapshot and the weather clock in
+// camera's areas (the detailed one, and the wide coarse one when the server
+// takes a second area: Hello's kFeatureAreas), keeps the latest snapshots and the weather clock in
 // SharedState, and reconnects with backoff when the server goes away (the
 // last weather stays in SharedState meanwhile). It also tells a server that
 // takes them (Hello's kFeatureCameraReports) where this channel's camera is,
@@ -32,8 +33,13 @@ class WeatherClient {
 
   void start();
   void stop();
-  // Thread-safe: asks for weather around a new area (posted to the io thread).
+  // Thread-safe: asks for weather around a new area (posted to the io
+  // thread); it replaces the area of the same Subscribe::areaIndex. An area
+  // other than 0 goes only to a server that takes it (and again on every
+  // reconnect to one).
   void subscribe(const stream::Subscribe& area);
+  // Whether the server connected last said it takes more than one area.
+  bool serverTakesAreas() const { return serverTakesAreas_.load(); }
   // Thread-safe, cheap enough to call every frame: the pose this channel
   // rendered frame `frame` from, with the weather version it held and the
   // weather clock it drew. Sent as a CameraReport when the server takes them,
@@ -73,14 +79,16 @@ class WeatherClient {
   std::chrono::milliseconds backoff_{250};
   stream::FrameDecoder decoder_;
   std::array<std::uint8_t, 16384> rx_{};
-  std::optional<stream::Subscribe> area_;
+  std::array<std::optional<stream::Subscribe>, stream::kMaxAreas> areas_;  // by area index
   // Bounded outbound: one frame in flight; waiting, only the newest Subscribe
-  // and the newest CameraReport (the Subscribe goes first).
+  // of each area and the newest CameraReport (the Subscribes go first).
   std::vector<std::uint8_t> inFlight_;
-  std::optional<std::vector<std::uint8_t>> pendingSubscribe_, pendingReport_;
+  std::array<std::optional<std::vector<std::uint8_t>>, stream::kMaxAreas> pendingSubscribe_;
+  std::optional<std::vector<std::uint8_t>> pendingReport_;
   std::string channel_;
   // Set from the io thread on the server's Hello; read by reportCamera.
   std::atomic<bool> serverTakesReports_{false};
+  std::atomic<bool> serverTakesAreas_{false};
   std::atomic<bool> reportNow_{false};  // after a (re)connect: the next call reports
   std::atomic<std::uint64_t> reportsSent_{0};
   // reportCamera's throttle, on the caller's thread.

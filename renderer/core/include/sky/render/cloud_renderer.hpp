@@ -138,6 +138,10 @@ struct FrameInputs {
                                                       // Up to kMaxLayers layers. A layer with no
                                                       // tiles is uniform (its own coverage and
                                                       // density); with tiles, a missing cell is empty.
+  // The answer to a second, wider and coarser subscription (its own
+  // tileLevel): when set, the weather map's coarse ring takes its tiles from
+  // it; nullptr: the coarse ring is filled from `weather` as the fine one.
+  const weather::WeatherSnapshot* coarseWeather = nullptr;
   double weatherClock_s = 0;  // clouds advect with each layer's wind by this clock
   double sunAzimuth_deg = 135, sunElevation_deg = 40;  // in the camera's local ENU frame
   // When set (UTC, s since 1970), the sun is where it is at that instant seen
