@@ -6,7 +6,6 @@
 #include <cstring>
 #include <unordered_map>
 
-
 #include "sky/core/assert.hpp"
 #include "sky/weather/tiling.hpp"
 #include "sky_shared.h"
@@ -15,15 +14,7 @@ namespace sky::render {
 
 namespace {
 
-struct TileValue {
-  float coverage = 0;
-  float density = 0;
-  weather::CloudType blendType = weather::CloudType::None;
-  float blend = 0;
-};
-
-// Channels per texel of the map: coverage, density, blend, unused.
-constexpr std::size_t kChannels = 4;
+constexpr std::size_t kChannels = kWeatherChannels;
 
 void mix64(std::uint64_t& h, std::uint64_t v) {
   // FNV-1a over the value's bytes.
@@ -76,7 +67,28 @@ glm::dvec3 WeatherField::sampleRing(std::uint32_t ring, std::uint32_t slice, dou
   return sum;
 }
 
-std::uint64_t weatherContentKey(const weather::WeatherSnapshot* snapshot) {
+namespace {
+
+void mixTiles(std::uint64_t& h, const weather::WeatherSnapshot& snapshot) {
+  mix64(h, static_cast<std::uint64_t>(snapshot.tileLevel));
+  mix64(h, snapshot.tiles.size());
+  for (const auto& tile : snapshot.tiles) {
+    mix64(h, tile.cellId);
+    mix64(h, tile.layerId);
+    mix64(h, bitsOf(tile.coverage));
+    mix64(h, bitsOf(tile.density));
+    mix64(h, static_cast<std::uint64_t>(tile.blendType));
+    mix64(h, bitsOf(tile.blend));
+  }
+}
+
+// Marks the start of the coarse snapshot's part of a key, so that tiles
+// moved from one snapshot to the other change it.
+constexpr std::uint64_t kCoarseKeyMarker = 0x636f6172736552ull;  // "coarseR"
+
+}  // namespace
+
+std::uint64_t weatherContentKey(const weather::WeatherSnapshot* snapshot, const weather::WeatherSnapshot* coarse) {
   std::uint64_t h = 14695981039346656037ull;
   if (snapshot == nullptr) return h;
   mix64(h, snapshot->layers.size());
@@ -86,21 +98,19 @@ std::uint64_t weatherContentKey(const weather::WeatherSnapshot* snapshot) {
     mix64(h, bitsOf(layer.coverage));
     mix64(h, bitsOf(layer.density));
   }
-  mix64(h, static_cast<std::uint64_t>(snapshot->tileLevel));
-  mix64(h, snapshot->tiles.size());
-  for (const auto& tile : snapshot->tiles) {
-    mix64(h, tile.cellId);
-    mix64(h, tile.layerId);
-    mix64(h, bitsOf(tile.coverage));
-    mix64(h, bitsOf(tile.density));
-    mix64(h, static_cast<std::uint64_t>(tile.blendType));
-    mix64(h, bitsOf(tile.blend));
+  mixTiles(h, *snapshot);
+  // Only the coarse snapshot's tiles and level reach the map (its layers'
+  // own numbers never do), so only they enter the key: a change of a coarse
+  // layer's wind does not drop an interleaved renderer's history.
+  if (coarse != nullptr) {
+    mix64(h, kCoarseKeyMarker);
+    mixTiles(h, *coarse);
   }
   return h;
 }
 
-std::uint64_t weatherSceneKey(const weather::WeatherSnapshot* snapshot) {
-  std::uint64_t h = weatherContentKey(snapshot);
+std::uint64_t weatherSceneKey(const weather::WeatherSnapshot* snapshot, const weather::WeatherSnapshot* coarse) {
+  std::uint64_t h = weatherContentKey(snapshot, coarse);
   if (snapshot == nullptr) return h;
   for (const auto& layer : snapshot->layers) {
     mix64(h, bitsOf(layer.base_m));
@@ -112,7 +122,77 @@ std::uint64_t weatherSceneKey(const weather::WeatherSnapshot* snapshot) {
   return h;
 }
 
+bool WeatherTiles::ringTiled(std::uint32_t ring) const {
+  for (std::size_t s = 0; s < slices(); ++s)
+    if (!tiles(ring, s).empty()) return true;
+  return false;
+}
+
+WeatherTiles indexWeatherTiles(const weather::WeatherSnapshot* fine, const weather::WeatherSnapshot* coarse) {
+  WeatherTiles out;
+  out.blendType.fill(weather::CloudType::None);
+  out.tiled.fill(false);
+  if (fine == nullptr) return out;
+  SKY_ASSERT(fine->layers.size() <= gpu::kMaxLayers);
+  const std::size_t slices = fine->layers.size();
+  out.ringsShare = coarse == nullptr;
+  out.level = {fine->tileLevel, coarse != nullptr ? coarse->tileLevel : fine->tileLevel};
+  std::vector<std::array<double, weather::kMaxCloudType + 1>> blendWeight(slices);
+  // Fine tiles first, then coarse ones: the blend weights are summed in that
+  // order, so the sums (and ties between types) are the same in every build.
+  const std::uint32_t sources = out.ringsShare ? 1 : kWeatherRings;
+  for (std::uint32_t ring = 0; ring < sources; ++ring) {
+    const weather::WeatherSnapshot& snapshot = ring == 0 ? *fine : *coarse;
+    auto& bySlice = out.bySlice[ring];
+    bySlice.resize(slices);
+    for (const auto& tile : snapshot.tiles)
+      for (std::size_t s = 0; s < slices; ++s)
+        if (fine->layers[s].id == tile.layerId) {
+          const auto [it, inserted] =
+              bySlice[s].insert_or_assign(tile.cellId, TileValue{tile.coverage, tile.density, tile.blendType, tile.blend});
+          if (!inserted) out.duplicates = true;
+          const auto type = static_cast<std::size_t>(tile.blendType);
+          if (tile.blend > 0 && type > 0 && type < blendWeight[s].size() && tile.blendType != fine->layers[s].type)
+            blendWeight[s][type] += tile.blend;
+        }
+  }
+  if (out.ringsShare) out.bySlice[1].clear();
+  // Each slice blends towards the type with the most blend weight (ties: the
+  // lower enum value).
+  for (std::size_t s = 0; s < slices; ++s) {
+    out.tiled[s] = !out.tiles(0, s).empty() || !out.tiles(1, s).empty();
+    double best = 0;
+    for (std::size_t type = 1; type < blendWeight[s].size(); ++type)
+      if (blendWeight[s][type] > best) {
+        best = blendWeight[s][type];
+        out.blendType[s] = static_cast<weather::CloudType>(type);
+      }
+  }
+  return out;
+}
+
+void writeWeatherTexel(WeatherField& field, std::uint32_t ring, std::size_t slice, std::size_t texel,
+                       const TileValue& v) {
+  const std::size_t sliceTexels = std::size_t(field.size) * field.size;
+  const std::size_t idx = ((ring * field.sliceCount + slice) * sliceTexels + texel) * kChannels;
+  const float blend = v.blendType == field.blendType[slice] ? std::clamp(v.blend, 0.0f, 1.0f) : 0.0f;
+  field.texels[idx] = weather::quantizeUnit(v.coverage);
+  field.texels[idx + 1] = weather::quantizeUnit(v.density);
+  field.texels[idx + 2] = weather::quantizeUnit(blend);
+}
+
 WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const geo::Geodetic& anchor,
+                               const WeatherField* previous) {
+  return buildWeatherField(snapshot, nullptr, anchor, previous);
+}
+
+WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const weather::WeatherSnapshot* coarse,
+                               const geo::Geodetic& anchor, const WeatherField* previous) {
+  return buildWeatherField(indexWeatherTiles(snapshot, coarse), snapshot, coarse, anchor, previous);
+}
+
+WeatherField buildWeatherField(const WeatherTiles& tiles, const weather::WeatherSnapshot* snapshot,
+                               const weather::WeatherSnapshot* coarse, const geo::Geodetic& anchor,
                                const WeatherField* previous) {
   WeatherField field;
   field.anchor = anchor;
@@ -121,84 +201,58 @@ WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const g
   field.radius_m = geo::length(field.frame.originEcef_m);
   field.centreEcef_m = field.frame.originEcef_m - field.frame.up * field.radius_m;
   field.sliceCount = gpu::kMaxLayers;
-  field.contentKey = weatherContentKey(snapshot);
+  field.contentKey = weatherContentKey(snapshot, coarse);
   const std::size_t sliceTexels = std::size_t(field.size) * field.size;
   field.texels.assign(sliceTexels * field.sliceCount * kWeatherRings * kChannels, 0);
-  field.blendType.fill(weather::CloudType::None);
-  field.tiled.fill(false);
+  field.blendType = tiles.blendType;
+  field.tiled = tiles.tiled;
   if (snapshot == nullptr) return field;
-  SKY_ASSERT(snapshot->layers.size() <= gpu::kMaxLayers);
 
-  // Per slice: the tiles of that layer by cell id (empty map = uniform layer).
-  std::vector<std::unordered_map<std::uint64_t, TileValue>> tilesBySlice(snapshot->layers.size());
-  std::vector<std::array<double, weather::kMaxCloudType + 1>> blendWeight(snapshot->layers.size());
-  bool anyTiles = false;
-  for (const auto& tile : snapshot->tiles)
-    for (std::size_t s = 0; s < snapshot->layers.size(); ++s)
-      if (snapshot->layers[s].id == tile.layerId) {
-        tilesBySlice[s][tile.cellId] = {tile.coverage, tile.density, tile.blendType, tile.blend};
-        const auto type = static_cast<std::size_t>(tile.blendType);
-        if (tile.blend > 0 && type > 0 && type < blendWeight[s].size() && tile.blendType != snapshot->layers[s].type)
-          blendWeight[s][type] += tile.blend;
-        anyTiles = true;
-      }
-  // Each slice blends towards the type with the most blend weight (ties: the
-  // lower enum value).
-  for (std::size_t s = 0; s < snapshot->layers.size(); ++s) {
-    field.tiled[s] = !tilesBySlice[s].empty();
-    double best = 0;
-    for (std::size_t type = 1; type < blendWeight[s].size(); ++type)
-      if (blendWeight[s][type] > best) {
-        best = blendWeight[s][type];
-        field.blendType[s] = static_cast<weather::CloudType>(type);
-      }
-  }
-
-  const std::size_t cellCount = std::size_t(kWeatherRings) * sliceTexels;
-  const bool reuse = anyTiles && previous != nullptr && previous->cellLevel == snapshot->tileLevel &&
-                     previous->cells.size() == cellCount && previous->anchor.lat_deg == anchor.lat_deg &&
-                     previous->anchor.lon_deg == anchor.lon_deg && previous->anchor.alt_m == anchor.alt_m;
-  if (anyTiles) {
-    field.cellLevel = snapshot->tileLevel;
-    if (reuse)
-      field.cells = previous->cells;
-    else
-      field.cells.assign(cellCount, 0);
-  }
+  const bool sameAnchorAsPrevious = previous != nullptr && sameAnchor(previous->anchor, anchor);
   const double groundRadius_m = field.radius_m - anchor.alt_m;
-  for (std::uint32_t ring = 0; ring < kWeatherRings; ++ring)
+  for (std::uint32_t ring = 0; ring < kWeatherRings; ++ring) {
+    // A ring whose slices are all uniform needs no cells.
+    const bool needsCells = tiles.ringTiled(ring);
+    const bool reuse = needsCells && sameAnchorAsPrevious && previous->cellLevel[ring] == tiles.level[ring] &&
+                       previous->cells[ring].size() == sliceTexels;
+    std::vector<std::uint64_t>& cells = field.cells[ring];
+    if (needsCells) {
+      field.cellLevel[ring] = tiles.level[ring];
+      if (reuse)
+        cells = previous->cells[ring];
+      else
+        cells.assign(sliceTexels, 0);
+    }
     for (std::uint32_t j = 0; j < field.size; ++j)
       for (std::uint32_t i = 0; i < field.size; ++i) {
-        const double x_m = ((i + 0.5) / field.size - 0.5) * 2 * field.halfExtent_m[ring];
-        const double y_m = ((j + 0.5) / field.size - 0.5) * 2 * field.halfExtent_m[ring];
+        const std::size_t texel = std::size_t(j) * field.size + i;
         std::uint64_t cell = 0;
-        const std::size_t cellIndex = (std::size_t(ring) * field.size + j) * field.size + i;
         if (reuse) {
-          cell = field.cells[cellIndex];
-        } else if (anyTiles) {
+          cell = cells[texel];
+        } else if (needsCells) {
           // Inverse gnomonic: the direction from the sphere centre through the
           // plane point, down to the ground on the anchor sphere. The coarse
           // ring takes the tile at its texel's centre.
+          const double x_m = ((i + 0.5) / field.size - 0.5) * 2 * field.halfExtent_m[ring];
+          const double y_m = ((j + 0.5) / field.size - 0.5) * 2 * field.halfExtent_m[ring];
           const geo::Vec3d dir = geo::normalize(field.frame.east * x_m + field.frame.north * y_m +
                                                 field.frame.up * field.radius_m);
           const geo::Geodetic g = geo::fromEcef(field.centreEcef_m + dir * groundRadius_m);
-          cell = weather::cellAt(g.lat_deg, g.lon_deg, snapshot->tileLevel);
-          field.cells[cellIndex] = cell;
+          cell = weather::cellAt(g.lat_deg, g.lon_deg, tiles.level[ring]);
+          cells[texel] = cell;
         }
-        for (std::size_t s = 0; s < snapshot->layers.size(); ++s) {
+        for (std::size_t s = 0; s < tiles.slices(); ++s) {
           const auto& layer = snapshot->layers[s];
+          const SliceTiles& sliceTiles = tiles.tiles(ring, s);
           TileValue v{static_cast<float>(layer.coverage), static_cast<float>(layer.density)};
-          if (!tilesBySlice[s].empty()) {
-            const auto it = tilesBySlice[s].find(cell);
-            v = it == tilesBySlice[s].end() ? TileValue{} : it->second;
+          if (!sliceTiles.empty()) {
+            const auto it = sliceTiles.find(cell);
+            v = it == sliceTiles.end() ? TileValue{} : it->second;
           }
-          const std::size_t idx = (((ring * field.sliceCount + s) * field.size + j) * field.size + i) * kChannels;
-          const float blend = v.blendType == field.blendType[s] ? std::clamp(v.blend, 0.0f, 1.0f) : 0.0f;
-          field.texels[idx] = weather::quantizeUnit(v.coverage);
-          field.texels[idx + 1] = weather::quantizeUnit(v.density);
-          field.texels[idx + 2] = weather::quantizeUnit(blend);
+          writeWeatherTexel(field, ring, s, texel, v);
         }
       }
+  }
   return field;
 }
 
@@ -211,10 +265,13 @@ geo::Geodetic weatherAnchorFor(const geo::Geodetic& camera) {
   return g;
 }
 
+bool sameAnchor(const geo::Geodetic& a, const geo::Geodetic& b) {
+  return a.lat_deg == b.lat_deg && a.lon_deg == b.lon_deg && a.alt_m == b.alt_m;
+}
+
 bool weatherFieldStale(const WeatherField& field, std::uint64_t contentKey, const geo::Geodetic& anchor) {
   if (field.texels.empty() || field.contentKey != contentKey) return true;
-  return field.anchor.lat_deg != anchor.lat_deg || field.anchor.lon_deg != anchor.lon_deg ||
-         field.anchor.alt_m != anchor.alt_m;
+  return !sameAnchor(field.anchor, anchor);
 }
 
 }  // namespace sky::render

@@ -163,8 +163,10 @@ TEST(WeatherRings, NewWeatherAtTheSameAnchorReusesTheCells) {
   const auto t0 = Clock::now();
   const WeatherField a = buildWeatherField(&first, anchor);
   const auto t1 = Clock::now();
-  ASSERT_EQ(a.cellLevel, kLevel);
-  ASSERT_EQ(a.cells.size(), std::size_t(kWeatherRings) * kWeatherMapSize * kWeatherMapSize);
+  for (std::uint32_t ring = 0; ring < kWeatherRings; ++ring) {
+    ASSERT_EQ(a.cellLevel[ring], kLevel);
+    ASSERT_EQ(a.cells[ring].size(), std::size_t(kWeatherMapSize) * kWeatherMapSize);
+  }
   // New weather: every third tile changes coverage, some tiles go away.
   weather::WeatherSnapshot second = first;
   for (std::size_t i = 0; i < second.tiles.size(); i += 3) second.tiles[i].coverage = 0.9f;
