@@ -143,7 +143,8 @@ TEST(WeatherRings, FarCloudFromTheCoarseSnapshot) {
   weather::WeatherSnapshot fine;
   fine.tileLevel = 11;
   fine.layers = {cumulus()};
-  for (std::uint64_t cell : weather::coverCap({47.0, 8.0, 120000.0}, 11, 8000)) fine.tiles.push_back({cell, 1, 0.0f, 1.0f});
+  for (std::uint64_t cell : weather::coverCap({47.0, 8.0, 120000.0}, 11, 8000))
+    fine.tiles.push_back({cell, 1, 0.0f, 1.0f});
   weather::WeatherSnapshot coarse;
   coarse.tileLevel = 10;
   coarse.layers = fine.layers;
@@ -173,7 +174,8 @@ TEST(WeatherRings, FarCloudFromTheCoarseSnapshot) {
   auto before = r.render(farView(&fine, &coarse));
   ASSERT_TRUE(before) << describe(before.error());
   const std::uint64_t centre = weather::cellAt(kPatchLat, 8.0, 10);
-  const auto it = std::find_if(coarse.tiles.begin(), coarse.tiles.end(), [&](const auto& t) { return t.cellId == centre; });
+  const auto it =
+      std::find_if(coarse.tiles.begin(), coarse.tiles.end(), [&](const auto& t) { return t.cellId == centre; });
   ASSERT_NE(it, coarse.tiles.end());
   it->coverage = 0.0f;  // a hole in the middle of the patch
   expectFarCloud(r, "high, one coarse tile changed", fine, &coarse);

@@ -148,9 +148,8 @@ WeatherTiles indexWeatherTiles(const weather::WeatherSnapshot* fine, const weath
     for (const auto& tile : snapshot.tiles)
       for (std::size_t s = 0; s < slices; ++s)
         if (fine->layers[s].id == tile.layerId) {
-          const auto [it, inserted] =
-              bySlice[s].insert_or_assign(tile.cellId, TileValue{tile.coverage, tile.density, tile.blendType, tile.blend});
-          if (!inserted) out.duplicates = true;
+          const TileValue value{tile.coverage, tile.density, tile.blendType, tile.blend};
+          if (!bySlice[s].insert_or_assign(tile.cellId, value).second) out.duplicates = true;
           const auto type = static_cast<std::size_t>(tile.blendType);
           if (tile.blend > 0 && type > 0 && type < blendWeight[s].size() && tile.blendType != fine->layers[s].type)
             blendWeight[s][type] += tile.blend;

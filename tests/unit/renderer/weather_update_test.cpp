@@ -65,6 +65,17 @@ void expectChangesInsideRects(const WeatherField& before, const WeatherField& af
   EXPECT_LE(changed, c.texelsRewritten);
 }
 
+// A tile of random values; layer 1's blend towards cumulonimbus.
+weather::CoverageTile randomTile(std::uint64_t cell, std::uint32_t id, std::mt19937& rng) {
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  weather::CoverageTile t{cell, id, u(rng), u(rng)};
+  if (id == 1) {
+    t.blendType = weather::CloudType::Cumulonimbus;
+    t.blend = u(rng);
+  }
+  return t;
+}
+
 // Snapshots of three layers (1 and 2 tiled, 3 uniform) over the cells of a
 // cap, each cell present with probability 0.7; layer 1's tiles blend
 // towards cumulonimbus.
@@ -76,8 +87,7 @@ weather::WeatherSnapshot randomSnapshot(const std::vector<std::uint64_t>& cells,
   for (std::uint64_t cell : cells)
     for (std::uint32_t id : {1u, 2u})
       if (u(rng) < 0.7f)
-        s.tiles.push_back({cell, id, u(rng), u(rng), id == 1 ? weather::CloudType::Cumulonimbus : weather::CloudType::None,
-                           id == 1 ? u(rng) : 0.0f});
+        s.tiles.push_back(randomTile(cell, id, rng));
   return s;
 }
 
@@ -102,8 +112,7 @@ void randomStep(weather::WeatherSnapshot& s, const std::vector<std::uint64_t>& c
       const std::uint64_t cell = cells[rng() % cells.size()];
       const std::uint32_t id = 1 + rng() % 2;
       if (!present.insert({cell, id}).second) continue;
-      s.tiles.push_back({cell, id, u(rng), u(rng), id == 1 ? weather::CloudType::Cumulonimbus : weather::CloudType::None,
-                         id == 1 ? u(rng) : 0.0f});
+      s.tiles.push_back(randomTile(cell, id, rng));
     }
   } else if (op < 0.95f && !s.tiles.empty()) {
     s.tiles.erase(s.tiles.begin() + std::ptrdiff_t(rng() % s.tiles.size()));
@@ -241,8 +250,8 @@ TEST(WeatherUpdate, MoreThanTilesRebuilds) {
       {"fine tile removed", [](auto& f, auto&) { f.tiles.pop_back(); }, "a tile removed"},
       {"coarse tile removed", [](auto&, auto& c) { c.tiles.erase(c.tiles.begin()); }, "a tile removed"},
       {"coarse level", [](auto&, auto& c) { c.tileLevel = 10; }, "tile level changed"},
-      {"uniform layer gains a tile",
-       [](auto& f, auto&) { f.tiles.push_back({f.tiles[0].cellId, 3, 1.0f, 1.0f}); }, "a layer gained or lost its tiles"},
+      {"uniform layer gains a tile", [](auto& f, auto&) { f.tiles.push_back({f.tiles[0].cellId, 3, 1.0f, 1.0f}); },
+       "a layer gained or lost its tiles"},
       {"blend type", [](auto&, auto& c) {
          for (auto& t : c.tiles) t.blendType = weather::CloudType::Stratus;
        }, "blend type of a slice changed"},
