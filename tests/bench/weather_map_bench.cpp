@@ -92,10 +92,25 @@ void BM_CoverageMip(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(render::buildCoverageMip(updater.field()));
 }
 
+// The two parts of a per-tile update that grow with the snapshots' tiles
+// rather than with the changed texels: the content key and sorting the
+// tiles into rings and slices.
+void BM_ContentKey(benchmark::State& state) {
+  Weather w;
+  for (auto _ : state) benchmark::DoNotOptimize(render::weatherContentKey(&w.fine, &w.coarse));
+}
+
+void BM_IndexTiles(benchmark::State& state) {
+  Weather w;
+  for (auto _ : state) benchmark::DoNotOptimize(render::indexWeatherTiles(&w.fine, &w.coarse));
+}
+
 BENCHMARK(BM_FullBuildNewAnchor)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RebuildSameAnchor)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_TileUpdate)->Arg(1)->Arg(100)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CoverageMip)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ContentKey)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_IndexTiles)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

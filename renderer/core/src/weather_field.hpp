@@ -98,28 +98,49 @@ struct TileValue {
 };
 using SliceTiles = std::unordered_map<std::uint64_t, TileValue>;  // by S2 cell id
 
+// One ring's tiles from its source snapshot, by slice (the fine snapshot's
+// layers, in its order; tiles of other layer ids are left out).
+struct RingTiles {
+  std::vector<SliceTiles> bySlice;
+  // Per slice and cloud type, the summed blend of the tiles that blend
+  // towards a type other than the layer's own, in the snapshot's tile order.
+  std::vector<std::array<double, weather::kMaxCloudType + 1>> blendWeight;
+  // A (cell, layer) named twice: the later tile wins on the map but both
+  // count towards the blend type, which a per-tile update cannot redo, so
+  // such a snapshot is always built whole.
+  bool duplicates = false;
+};
+
 // The tiles a map is filled from, sorted by ring and slice. Slices are the
 // fine snapshot's layers in its order; ring 0 takes the fine snapshot's
 // tiles, ring 1 the coarse snapshot's (its tiles of layer ids the fine
 // snapshot lacks are ignored) or, without one, the fine snapshot's too.
 struct WeatherTiles {
   std::array<int, kWeatherRings> level{-1, -1};  // each ring's source tile level (-1: no weather)
-  std::array<std::vector<SliceTiles>, kWeatherRings> bySlice;  // [ring][slice]; ring 1 empty when shared
-  bool ringsShare = false;  // no coarse snapshot: ring 1 reads ring 0's tiles
+  std::array<RingTiles, kWeatherRings> rings;    // ring 1 empty when the rings share
+  bool ringsShare = false;                       // no coarse snapshot: ring 1 reads ring 0's tiles
+  // Per slice: the type with the most blend weight over both rings' tiles
+  // (ties: the lower enum value; None without any), and whether either ring
+  // has tiles.
   std::array<weather::CloudType, gpu::kMaxLayers> blendType{};
   std::array<bool, gpu::kMaxLayers> tiled{};
-  // A (cell, layer) named twice in one snapshot: the later tile wins on the
-  // map but both count towards the blend type, which a per-tile update
-  // cannot redo, so such a snapshot is always built whole.
-  bool duplicates = false;
 
-  std::size_t slices() const { return bySlice[0].size(); }
+  std::size_t slices() const { return rings[0].bySlice.size(); }
   const SliceTiles& tiles(std::uint32_t ring, std::size_t slice) const {
-    return bySlice[ringsShare ? 0 : ring][slice];
+    return rings[ringsShare ? 0 : ring].bySlice[slice];
   }
+  bool duplicates() const { return rings[0].duplicates || rings[1].duplicates; }
   // Whether any slice has tiles in this ring (it then needs texel cells).
   bool ringTiled(std::uint32_t ring) const;
 };
+
+// One snapshot's tiles sorted into the slices of these layers.
+RingTiles indexRingTiles(const weather::WeatherSnapshot& source, const std::vector<weather::CloudLayer>& layers);
+
+// The rings put together (coarseRing ignored without a coarse snapshot),
+// with each slice's blend type and tiled flag.
+WeatherTiles combineWeatherTiles(const weather::WeatherSnapshot& fine, const weather::WeatherSnapshot* coarse,
+                                 RingTiles fineRing, RingTiles coarseRing);
 
 // Sorts the tiles of a fine snapshot (validated, at most gpu::kMaxLayers
 // layers) and an optional coarse one into rings and slices, and chooses
@@ -138,6 +159,14 @@ void writeWeatherTexel(WeatherField& field, std::uint32_t ring, std::size_t slic
 // coarse snapshot without a fine one adds nothing (the map has no slices).
 std::uint64_t weatherContentKey(const weather::WeatherSnapshot* snapshot,
                                 const weather::WeatherSnapshot* coarse = nullptr);
+
+// The content key and its parts: the hash of each snapshot's tiles and
+// level (0 for an absent snapshot), so an update can tell which changed.
+struct WeatherKeys {
+  std::uint64_t content = 0;
+  std::uint64_t fineTiles = 0, coarseTiles = 0;
+};
+WeatherKeys weatherKeys(const weather::WeatherSnapshot* snapshot, const weather::WeatherSnapshot* coarse);
 
 // weatherContentKey and everything else about the weather that changes the
 // image, apart from the clock and the camera: each layer's base, thickness

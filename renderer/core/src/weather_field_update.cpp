@@ -33,6 +33,7 @@ std::span<const std::uint32_t> WeatherFieldUpdater::CellTexels::texelsOf(std::ui
 
 WeatherFieldUpdater::WeatherFieldUpdater() : field_(buildWeatherField(nullptr, geo::Geodetic{})) {
   tiles_ = indexWeatherTiles(nullptr, nullptr);
+  keys_ = weatherKeys(nullptr, nullptr);
 }
 
 void WeatherFieldUpdater::indexCells(std::uint32_t ring) {
@@ -59,21 +60,29 @@ void WeatherFieldUpdater::indexCells(std::uint32_t ring) {
   index.anchor = field_.anchor;
 }
 
-std::string WeatherFieldUpdater::rebuildReason(const weather::WeatherSnapshot* fine,
-                                               const weather::WeatherSnapshot* coarse, const geo::Geodetic& anchor,
-                                               const WeatherTiles& next, std::vector<ChangedTile>* changes) const {
+std::string WeatherFieldUpdater::snapshotReason(const weather::WeatherSnapshot* fine,
+                                                const weather::WeatherSnapshot* coarse,
+                                                const geo::Geodetic& anchor) const {
   if (!built_) return "first map";
   if (!sameAnchor(field_.anchor, anchor)) return "anchor moved";
   // No weather before or now: a different map only through these.
   if (fine == nullptr || !hadFine_) return "weather appeared or went away";
   if ((coarse != nullptr) != hadCoarse_) return "coarse weather appeared or went away";
   if (!sameMapLayers(fine->layers, layers_)) return "layers changed";
-  if (next.level != tiles_.level) return "tile level changed";
-  if (next.duplicates) return "a cell named twice in one snapshot";
+  const std::array<int, kWeatherRings> level{fine->tileLevel, coarse != nullptr ? coarse->tileLevel : fine->tileLevel};
+  if (level != tiles_.level) return "tile level changed";
+  return {};
+}
+
+std::string WeatherFieldUpdater::tileReason(const WeatherTiles& next, const std::array<bool, kWeatherRings>& unchanged,
+                                            std::vector<ChangedTile>* changes) const {
+  if (next.duplicates()) return "a cell named twice in one snapshot";
   if (next.blendType != tiles_.blendType) return "blend type of a slice changed";
-  SKY_ASSERT(next.ringsShare == tiles_.ringsShare && next.slices() == tiles_.slices());
+  // (tiles_.slices() may be gone: a reused ring was moved out of tiles_.)
+  SKY_ASSERT(next.ringsShare == tiles_.ringsShare && next.slices() == layers_.size());
   const std::uint32_t sources = next.ringsShare ? 1 : kWeatherRings;
-  for (std::uint32_t ring = 0; ring < sources; ++ring)
+  for (std::uint32_t ring = 0; ring < sources; ++ring) {
+    if (unchanged[ring]) continue;  // its snapshot's tiles are the ones the map holds
     for (std::size_t s = 0; s < next.slices(); ++s) {
       const SliceTiles& now = next.tiles(ring, s);
       const SliceTiles& before = tiles_.tiles(ring, s);
@@ -89,18 +98,37 @@ std::string WeatherFieldUpdater::rebuildReason(const weather::WeatherSnapshot* f
       // Every old tile is still there exactly when all were matched.
       if (kept != before.size()) return "a tile removed";
     }
+  }
   return {};
 }
 
 WeatherFieldChange WeatherFieldUpdater::update(const weather::WeatherSnapshot* fine,
                                                const weather::WeatherSnapshot* coarse, const geo::Geodetic& anchor) {
   WeatherFieldChange change;
-  const std::uint64_t key = weatherContentKey(fine, coarse);
-  if (built_ && key == field_.contentKey && sameAnchor(field_.anchor, anchor)) return change;
+  const WeatherKeys keys = weatherKeys(fine, coarse);
+  if (built_ && keys.content == field_.contentKey && sameAnchor(field_.anchor, anchor)) return change;
 
-  WeatherTiles next = indexWeatherTiles(fine, coarse);
+  change.reason = snapshotReason(fine, coarse, anchor);
+  // A snapshot whose tiles are the ones the map was filled from keeps its
+  // sorted tiles (moved out of tiles_, which `next` replaces either way):
+  // a change of the fine snapshot does not sort the coarse one's again.
+  std::array<bool, kWeatherRings> unchanged{};
+  WeatherTiles next;
+  if (fine == nullptr) {
+    next = indexWeatherTiles(nullptr, nullptr);
+  } else {
+    const bool perTile = change.reason.empty();
+    unchanged = {perTile && keys.fineTiles == keys_.fineTiles,
+                 perTile && coarse != nullptr && keys.coarseTiles == keys_.coarseTiles};
+    RingTiles fineRing = unchanged[0] ? std::move(tiles_.rings[0]) : indexRingTiles(*fine, fine->layers);
+    RingTiles coarseRing = coarse == nullptr ? RingTiles{}
+                           : unchanged[1]    ? std::move(tiles_.rings[1])
+                                             : indexRingTiles(*coarse, fine->layers);
+    next = combineWeatherTiles(*fine, coarse, std::move(fineRing), std::move(coarseRing));
+  }
   std::vector<ChangedTile> changes;
-  change.reason = rebuildReason(fine, coarse, anchor, next, &changes);
+  if (change.reason.empty()) change.reason = tileReason(next, unchanged, &changes);
+  keys_ = keys;
   if (!change.reason.empty()) {
     // At the same anchor and level the texels' cells are reused (no geodesy).
     field_ = buildWeatherField(next, fine, coarse, anchor, built_ ? &field_ : nullptr);
@@ -140,7 +168,7 @@ WeatherFieldChange WeatherFieldUpdater::update(const weather::WeatherSnapshot* f
   for (std::uint32_t layer = 0; layer < bounds.size(); ++layer)
     if (const Bounds& b = bounds[layer]; b.x0 <= b.x1)
       change.dirty.push_back({layer, b.x0, b.y0, b.x1 - b.x0 + 1, b.y1 - b.y0 + 1});
-  field_.contentKey = key;
+  field_.contentKey = keys.content;
   tiles_ = std::move(next);
   return change;
 }

@@ -65,23 +65,27 @@ class WeatherFieldUpdater {
     std::span<const std::uint32_t> texelsOf(std::uint64_t cell) const;
   };
 
-  // Why these inputs cannot be a per-tile update of the current map (empty
-  // when they can); fills *changes with the (source ring, slice, cell) tiles
-  // that are new or differ.
+  // A tile that is new or differs from the one the map holds.
   struct ChangedTile {
     std::uint32_t ring = 0;  // the ring whose tiles it is (0 for both when the rings share tiles)
     std::uint32_t slice = 0;
     std::uint64_t cell = 0;
     TileValue value;
   };
-  std::string rebuildReason(const weather::WeatherSnapshot* fine, const weather::WeatherSnapshot* coarse,
-                            const geo::Geodetic& anchor, const WeatherTiles& next,
-                            std::vector<ChangedTile>* changes) const;
+  // Why these snapshots cannot be a per-tile update of the current map, as
+  // far as that shows without their tiles (empty when they can).
+  std::string snapshotReason(const weather::WeatherSnapshot* fine, const weather::WeatherSnapshot* coarse,
+                             const geo::Geodetic& anchor) const;
+  // The same from their tiles (empty when they can); fills *changes with
+  // the new or changed tiles of the rings not `unchanged`.
+  std::string tileReason(const WeatherTiles& next, const std::array<bool, kWeatherRings>& unchanged,
+                         std::vector<ChangedTile>* changes) const;
   // Builds index_[ring] for the field's anchor and cell level unless it is already.
   void indexCells(std::uint32_t ring);
 
   WeatherField field_;
-  WeatherTiles tiles_;  // what field_ was filled from
+  WeatherTiles tiles_;  // what field_ was filled from (a ring moved out while an update reuses it)
+  WeatherKeys keys_;    // and its keys: a snapshot whose tiles key is the same needs no new index
   // The fine snapshot's layers as field_ has them (id, type, coverage and
   // density matter to the map), and which snapshots there were.
   std::vector<weather::CloudLayer> layers_;
