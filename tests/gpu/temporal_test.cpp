@@ -8,7 +8,7 @@
 //  * flying through a cumulus layer at 150 m/s, the error stays bounded;
 //  * the history is dropped, and the frame drawn whole (bit-identical to the
 //    whole image), on a teleport, a large turn, a clock jump, entering or
-//    leaving a layer and a weather change.
+//    leaving a layer and a weather change (of the fine or the coarse snapshot).
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -21,6 +21,7 @@
 #include "scenes.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky/render/presets.hpp"
+#include "sky/weather/tiling.hpp"
 
 namespace sky::test {
 namespace {
@@ -227,6 +228,12 @@ TEST(Temporal, HistoryIsDroppedWhenItCannotHold) {
   const weather::WeatherSnapshot snap = cumulus(10.0);
   weather::WeatherSnapshot thicker = snap;
   thicker.layers[0].coverage = 0.6;
+  // A coarse snapshot for the far ring (FrameInputs::coarseWeather) is
+  // weather too: one tile of the layer 300 km north.
+  weather::WeatherSnapshot coarse;
+  coarse.tileLevel = 9;
+  coarse.layers = snap.layers;
+  coarse.tiles.push_back({weather::cellAt(47.0 + 300000.0 / 111195.0, 8.0, 9), 1, 0.9f, 1.0f});
   struct Case {
     const char* expect;  // the start of the reason
     std::function<void(render::FrameInputs&)> change;
@@ -238,6 +245,7 @@ TEST(Temporal, HistoryIsDroppedWhenItCannotHold) {
       {"camera entered cloud layer 0", [](render::FrameInputs& in) { in.camera.position.alt_m = 1300.0; }},
       {"key light moved", [](render::FrameInputs& in) { in.sunElevation_deg -= 5.0; }},
       {"weather changed", [&](render::FrameInputs& in) { in.weather = &thicker; }},
+      {"weather changed", [&](render::FrameInputs& in) { in.coarseWeather = &coarse; }},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.expect);

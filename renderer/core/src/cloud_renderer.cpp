@@ -227,6 +227,8 @@ const std::vector<PassTime>& CloudRenderer::lastPassTimes() const { return impl_
 
 const TemporalReport& CloudRenderer::lastTemporal() const { return impl_->temporal; }
 
+const WeatherMapReport& CloudRenderer::lastWeatherMap() const { return impl_->weather.lastUpdate(); }
+
 std::vector<std::string> CloudRenderer::takeValidationMessages() { return impl_->ctx->takeValidationMessages(); }
 
 ValidationCounts CloudRenderer::validationCounts() { return impl_->ctx->validationCounts(); }

@@ -176,7 +176,8 @@ Result<std::vector<std::array<float, 4>>> CpuReference::renderPixels(const Frame
     if (p.x >= settings_.width || p.y >= settings_.height)
       return fail(ErrorCode::InvalidArgument, "CpuReference::renderPixels: pixel (" + std::to_string(p.x) + ", " +
                                                   std::to_string(p.y) + ") outside the image");
-  const WeatherField field = buildWeatherField(inputs.weather, weatherAnchorFor(inputs.camera.position));
+  const WeatherField field =
+      buildWeatherField(inputs.weather, inputs.coarseWeather, weatherAnchorFor(inputs.camera.position));
   const FrameSetup setup = prepareFrame(settings_, inputs, field, tables_->atmosphere);
   CpuCore core(setup, tables_->shape, tables_->detail, tables_->atmosphere, field, tables_->blueNoise);
   const auto frame = core.coreFrame();
@@ -191,7 +192,8 @@ Result<std::vector<std::array<float, 4>>> CpuReference::renderPixels(const Frame
 
 Result<Image> CpuReference::render(const FrameInputs& inputs, std::uint64_t* densityLookups) const {
   if (auto ok = validateInputs(inputs); !ok) return tl::unexpected(ok.error());
-  const WeatherField field = buildWeatherField(inputs.weather, weatherAnchorFor(inputs.camera.position));
+  const WeatherField field =
+      buildWeatherField(inputs.weather, inputs.coarseWeather, weatherAnchorFor(inputs.camera.position));
   const FrameSetup setup = prepareFrame(settings_, inputs, field, tables_->atmosphere);
   CpuCore core(setup, tables_->shape, tables_->detail, tables_->atmosphere, field, tables_->blueNoise);
   const auto frame = core.coreFrame();

@@ -163,6 +163,30 @@ Result<void> validateSettings(const RenderSettings& s) {
   return {};
 }
 
+namespace {
+
+// A snapshot's layers (count and fields), tile level and tile values. The
+// error names the input by `which` ("" for `weather`, whose messages have
+// always been unnamed; "coarseWeather: ").
+Result<void> validateSnapshot(const weather::WeatherSnapshot& w, const std::string& which) {
+  const std::string where = "frame inputs: " + which;
+  if (w.layers.size() > gpu::kMaxLayers)
+    return fail(ErrorCode::InvalidArgument, where + std::to_string(w.layers.size()) + " cloud layers, at most " +
+                                                std::to_string(gpu::kMaxLayers));
+  for (const auto& layer : w.layers)
+    if (auto ok = weather::validate(layer); !ok)
+      return fail(ErrorCode::InvalidArgument, which + ok.error().detail);
+  if (w.tileLevel < 0 || w.tileLevel > 30)
+    return fail(ErrorCode::InvalidArgument, where + "tileLevel " + std::to_string(w.tileLevel) + " outside [0, 30]");
+  for (const auto& t : w.tiles)
+    if (!(t.coverage >= 0 && t.coverage <= 1 && t.density >= 0 && t.density <= 1))
+      return fail(ErrorCode::InvalidArgument,
+                  where + "tile " + std::to_string(t.cellId) + " coverage/density outside [0, 1]");
+  return {};
+}
+
+}  // namespace
+
 Result<void> validateInputs(const FrameInputs& in) {
   const auto& c = in.camera;
   const auto& p = c.position;
@@ -178,18 +202,9 @@ Result<void> validateInputs(const FrameInputs& in) {
   if (p.alt_m < -1000 || p.alt_m > 1e6)
     return fail(ErrorCode::InvalidArgument, "frame inputs: camera alt_m " + num(p.alt_m) + " outside [-1000, 1e6]");
   if (in.weather == nullptr) return {};
-  const auto& w = *in.weather;
-  if (w.layers.size() > gpu::kMaxLayers)
-    return fail(ErrorCode::InvalidArgument, "frame inputs: " + std::to_string(w.layers.size()) +
-                                                " cloud layers, at most " + std::to_string(gpu::kMaxLayers));
-  for (const auto& layer : w.layers)
-    if (auto ok = weather::validate(layer); !ok) return fail(ErrorCode::InvalidArgument, ok.error().detail);
-  if (w.tileLevel < 0 || w.tileLevel > 30)
-    return fail(ErrorCode::InvalidArgument, "frame inputs: tileLevel " + std::to_string(w.tileLevel) + " outside [0, 30]");
-  for (const auto& t : w.tiles)
-    if (!(t.coverage >= 0 && t.coverage <= 1 && t.density >= 0 && t.density <= 1))
-      return fail(ErrorCode::InvalidArgument,
-                  "frame inputs: tile " + std::to_string(t.cellId) + " coverage/density outside [0, 1]");
+  if (auto ok = validateSnapshot(*in.weather, ""); !ok) return ok;
+  if (in.coarseWeather != nullptr)
+    if (auto ok = validateSnapshot(*in.coarseWeather, "coarseWeather: "); !ok) return ok;
   return {};
 }
 

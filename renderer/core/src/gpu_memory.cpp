@@ -37,7 +37,8 @@ GpuImage createSampledImage(const GpuContext& ctx, vk::ImageType type, vk::Forma
   img.layers = layers;
   const vk::ImageCreateInfo info({}, type, format, extent, 1, layers, vk::SampleCountFlagBits::e1,
                                  vk::ImageTiling::eOptimal,
-                                 vk::ImageUsageFlagBits::eSampled | vk::ImageUsageFlagBits::eTransferDst);
+                                 vk::ImageUsageFlagBits::eSampled | vk::ImageUsageFlagBits::eTransferDst |
+                                     vk::ImageUsageFlagBits::eTransferSrc);
   img.image = vk::raii::Image(device, info);
   const vk::MemoryRequirements req = img.image.getMemoryRequirements();
   img.memory = vk::raii::DeviceMemory(
@@ -87,6 +88,81 @@ Result<void> uploadImage(const GpuContext& ctx, GpuImage& image, std::span<const
   cmd.end();
   const vk::raii::Fence fence(ctx.device(), vk::FenceCreateInfo());
   return ctx.submitAndWait(cmd, fence);
+}
+
+Result<void> uploadImageRegions(const GpuContext& ctx, GpuImage& image, std::span<const std::byte> texels,
+                                std::span<const ImageRegion> regions, GpuTimer* timer, const char* pass) {
+  if (regions.empty()) return {};
+  GpuBuffer staging = createHostBuffer(ctx, texels.size(), vk::BufferUsageFlagBits::eTransferSrc, "sky.staging");
+  std::memcpy(staging.mapped, texels.data(), texels.size());
+  std::vector<vk::BufferImageCopy> copies;
+  copies.reserve(regions.size());
+  for (const ImageRegion& r : regions) {
+    SKY_ASSERT(r.layer < image.layers && r.width > 0 && r.height > 0 && r.x + r.width <= image.extent.width &&
+               r.y + r.height <= image.extent.height);
+    copies.emplace_back(r.byteOffset, 0, 0, vk::ImageSubresourceLayers(vk::ImageAspectFlagBits::eColor, 0, r.layer, 1),
+                        vk::Offset3D(std::int32_t(r.x), std::int32_t(r.y), 0), vk::Extent3D(r.width, r.height, 1));
+  }
+
+  const vk::ImageSubresourceRange range(vk::ImageAspectFlagBits::eColor, 0, 1, 0, image.layers);
+  vk::raii::CommandBuffer cmd = ctx.allocateCommandBuffer();
+  cmd.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
+  if (timer) timer->begin(cmd);
+  std::optional<GpuTimer::Section> timed;
+  if (timer) timed.emplace(timer->section(cmd, pass ? pass : "upload"));
+  // From the layout the shaders read (not eUndefined, which would let the
+  // driver discard the texels outside the regions); the source stage and
+  // access cover an earlier frame's reads.
+  const vk::ImageMemoryBarrier toTransfer(vk::AccessFlagBits::eShaderRead, vk::AccessFlagBits::eTransferWrite,
+                                          vk::ImageLayout::eShaderReadOnlyOptimal,
+                                          vk::ImageLayout::eTransferDstOptimal, VK_QUEUE_FAMILY_IGNORED,
+                                          VK_QUEUE_FAMILY_IGNORED, *image.image, range);
+  cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eTransfer, {}, {}, {},
+                      toTransfer);
+  cmd.copyBufferToImage(*staging.buffer, *image.image, vk::ImageLayout::eTransferDstOptimal, copies);
+  const vk::ImageMemoryBarrier toShader(vk::AccessFlagBits::eTransferWrite, vk::AccessFlagBits::eShaderRead,
+                                        vk::ImageLayout::eTransferDstOptimal, vk::ImageLayout::eShaderReadOnlyOptimal,
+                                        VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *image.image, range);
+  cmd.pipelineBarrier(vk::PipelineStageFlagBits::eTransfer, vk::PipelineStageFlagBits::eComputeShader, {}, {}, {},
+                      toShader);
+  timed.reset();
+  cmd.end();
+  const vk::raii::Fence fence(ctx.device(), vk::FenceCreateInfo());
+  return ctx.submitAndWait(cmd, fence);
+}
+
+Result<std::vector<std::byte>> downloadImage(const GpuContext& ctx, const GpuImage& image,
+                                             std::size_t bytesPerTexel) {
+  const std::size_t bytes = std::size_t(image.extent.width) * image.extent.height * image.extent.depth *
+                            image.layers * bytesPerTexel;
+  GpuBuffer readback = createHostBuffer(ctx, bytes, vk::BufferUsageFlagBits::eTransferDst, "sky.readback");
+  const vk::ImageSubresourceRange range(vk::ImageAspectFlagBits::eColor, 0, 1, 0, image.layers);
+  vk::raii::CommandBuffer cmd = ctx.allocateCommandBuffer();
+  cmd.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
+  const vk::ImageMemoryBarrier toTransfer(vk::AccessFlagBits::eShaderRead | vk::AccessFlagBits::eTransferWrite,
+                                          vk::AccessFlagBits::eTransferRead, vk::ImageLayout::eShaderReadOnlyOptimal,
+                                          vk::ImageLayout::eTransferSrcOptimal, VK_QUEUE_FAMILY_IGNORED,
+                                          VK_QUEUE_FAMILY_IGNORED, *image.image, range);
+  cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader | vk::PipelineStageFlagBits::eTransfer,
+                      vk::PipelineStageFlagBits::eTransfer, {}, {}, {}, toTransfer);
+  const vk::BufferImageCopy region(0, 0, 0,
+                                   vk::ImageSubresourceLayers(vk::ImageAspectFlagBits::eColor, 0, 0, image.layers),
+                                   {0, 0, 0}, image.extent);
+  cmd.copyImageToBuffer(*image.image, vk::ImageLayout::eTransferSrcOptimal, *readback.buffer, region);
+  const vk::ImageMemoryBarrier toShader(vk::AccessFlagBits::eTransferRead, vk::AccessFlagBits::eShaderRead,
+                                        vk::ImageLayout::eTransferSrcOptimal, vk::ImageLayout::eShaderReadOnlyOptimal,
+                                        VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *image.image, range);
+  const vk::BufferMemoryBarrier toHost(vk::AccessFlagBits::eTransferWrite, vk::AccessFlagBits::eHostRead,
+                                       VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *readback.buffer, 0, bytes);
+  cmd.pipelineBarrier(vk::PipelineStageFlagBits::eTransfer,
+                      vk::PipelineStageFlagBits::eComputeShader | vk::PipelineStageFlagBits::eHost, {}, {}, toHost,
+                      toShader);
+  cmd.end();
+  const vk::raii::Fence fence(ctx.device(), vk::FenceCreateInfo());
+  if (auto ok = ctx.submitAndWait(cmd, fence); !ok) return tl::unexpected(ok.error());
+  std::vector<std::byte> out(bytes);
+  std::memcpy(out.data(), readback.mapped, bytes);
+  return out;
 }
 
 Image readImage(const GpuBuffer& colour, const GpuBuffer& depth, std::uint32_t width, std::uint32_t height) {

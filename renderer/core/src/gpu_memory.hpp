@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include <vulkan/vulkan_raii.hpp>
 
@@ -42,7 +43,8 @@ struct GpuImage {
 
 // A device-local sampled image, viewed as 3D (type e3D), a 2D array (e2D with
 // layers > 1: the weather map, sampler2DArray) or 2D (e2D with one layer: the
-// atmosphere tables, sampler2D); in eShaderReadOnlyOptimal after the first upload.
+// atmosphere tables, sampler2D); in eShaderReadOnlyOptimal after the first
+// upload. It can be a transfer source (downloadImage reads it back).
 GpuImage createSampledImage(const GpuContext& ctx, vk::ImageType type, vk::Format format, vk::Extent3D extent,
                             std::uint32_t layers, const char* debugName);
 
@@ -53,5 +55,28 @@ class GpuTimer;
 // a timer, the copy is timed as the section `pass`.
 Result<void> uploadImage(const GpuContext& ctx, GpuImage& image, std::span<const std::byte> texels,
                          GpuTimer* timer = nullptr, const char* pass = nullptr);
+
+// One rectangle of one array layer of an image, its texels tightly packed
+// (row after row) in a caller's byte span from byteOffset on.
+struct ImageRegion {
+  std::uint32_t layer = 0;
+  std::uint32_t x = 0, y = 0;           // texels
+  std::uint32_t width = 0, height = 0;  // texels, > 0
+  std::size_t byteOffset = 0;
+};
+
+// Copies texels into these regions of an image already uploaded whole once
+// (in eShaderReadOnlyOptimal), keeping everything else it holds, and leaves
+// it in eShaderReadOnlyOptimal. Blocking. With a timer, the copy is timed
+// as the section `pass`.
+Result<void> uploadImageRegions(const GpuContext& ctx, GpuImage& image, std::span<const std::byte> texels,
+                                std::span<const ImageRegion> regions, GpuTimer* timer = nullptr,
+                                const char* pass = nullptr);
+
+// The whole image (all layers) read back, tightly packed as uploadImage takes
+// it, bytesPerTexel per texel. The image must be in eShaderReadOnlyOptimal
+// and stays so. Blocking. For tests: what the shaders sample, byte for byte.
+Result<std::vector<std::byte>> downloadImage(const GpuContext& ctx, const GpuImage& image,
+                                             std::size_t bytesPerTexel);
 
 }  // namespace sky::render

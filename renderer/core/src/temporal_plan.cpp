@@ -82,7 +82,7 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   now.keyLightEcef = setup.localToEcef * setup.sunDir;
   now.moonLit = setup.moonLit;
   now.clock_s = inputs.weatherClock_s;
-  now.sceneKey = weatherSceneKey(inputs.weather);
+  now.sceneKey = weatherSceneKey(inputs.weather, inputs.coarseWeather);
   for (const LayerSetup& l : setup.layers) now.layerSide.push_back(l.hTop_m > 0 ? 1 : l.hBase_m < 0 ? -1 : 0);
 
   TemporalPlan plan;

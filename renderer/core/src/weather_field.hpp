@@ -5,7 +5,9 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -62,18 +64,19 @@ struct WeatherField {
                                        // array layer ring * sliceCount + slice
   // Per slice, the one type its tiles blend towards (None: no blend). A tile
   // may name another type than the slice's; the slice takes the type with the
-  // largest summed blend in its tiles and such tiles draw unblended.
+  // largest summed blend in its tiles (of both rings) and such tiles draw unblended.
   std::array<weather::CloudType, gpu::kMaxLayers> blendType{};
-  // Per slice, whether the layer came with tiles (else the slice is uniform
-  // over the map and drifting it changes nothing).
+  // Per slice, whether the layer came with tiles in either ring (else the
+  // slice is uniform over the map and drifting it changes nothing).
   std::array<bool, gpu::kMaxLayers> tiled{};
-  std::uint64_t contentKey = 0;        // weatherContentKey() of the source snapshot
+  std::uint64_t contentKey = 0;        // weatherContentKey() of the source snapshots
   geo::Geodetic anchor;                // where the map was built
-  // Per ring and texel (ring, row, column), the S2 cell of level cellLevel
-  // at the texel's centre; empty (cellLevel -1) when the snapshot had no
-  // tiles. A new snapshot at the same anchor and level reuses them.
-  int cellLevel = -1;
-  std::vector<std::uint64_t> cells;
+  // Per ring, the S2 level of its cells (its source snapshot's tile level)
+  // and per texel (row, column) the cell of that level at the texel's
+  // centre; level -1 and no cells when no slice of the ring has tiles. A
+  // new snapshot at the same anchor and level reuses them.
+  std::array<int, kWeatherRings> cellLevel{-1, -1};
+  std::array<std::vector<std::uint64_t>, kWeatherRings> cells;
 
   // (coverage, density, blend) at gnomonic plane coordinates (m, east/north
   // of the anchor): the rings blended by ringBlendWeight, as the GPU.
@@ -82,14 +85,94 @@ struct WeatherField {
   glm::dvec3 sampleRing(std::uint32_t ring, std::uint32_t slice, double x_m, double y_m) const;
 };
 
-// Hash of everything in a snapshot that the map depends on (layer ids, order,
-// coverage and density; tiles with their blend; tile level). nullptr hashes as "no weather".
-std::uint64_t weatherContentKey(const weather::WeatherSnapshot* snapshot);
+// Channels per texel of the map: coverage, density, blend, unused.
+inline constexpr std::size_t kWeatherChannels = 4;
+
+// One tile's values as the map stores them (before quantisation).
+struct TileValue {
+  float coverage = 0;
+  float density = 0;
+  weather::CloudType blendType = weather::CloudType::None;
+  float blend = 0;
+  bool operator==(const TileValue&) const = default;
+};
+using SliceTiles = std::unordered_map<std::uint64_t, TileValue>;  // by S2 cell id
+
+// One ring's tiles from its source snapshot, by slice (the fine snapshot's
+// layers, in its order; tiles of other layer ids are left out).
+struct RingTiles {
+  std::vector<SliceTiles> bySlice;
+  // Per slice and cloud type, the summed blend of the tiles that blend
+  // towards a type other than the layer's own, in the snapshot's tile order.
+  std::vector<std::array<double, weather::kMaxCloudType + 1>> blendWeight;
+  // A (cell, layer) named twice: the later tile wins on the map but both
+  // count towards the blend type, which a per-tile update cannot redo, so
+  // such a snapshot is always built whole.
+  bool duplicates = false;
+};
+
+// The tiles a map is filled from, sorted by ring and slice. Slices are the
+// fine snapshot's layers in its order; ring 0 takes the fine snapshot's
+// tiles, ring 1 the coarse snapshot's (its tiles of layer ids the fine
+// snapshot lacks are ignored) or, without one, the fine snapshot's too.
+struct WeatherTiles {
+  std::array<int, kWeatherRings> level{-1, -1};  // each ring's source tile level (-1: no weather)
+  std::array<RingTiles, kWeatherRings> rings;    // ring 1 empty when the rings share
+  bool ringsShare = false;                       // no coarse snapshot: ring 1 reads ring 0's tiles
+  // Per slice: the type with the most blend weight over both rings' tiles
+  // (ties: the lower enum value; None without any), and whether either ring
+  // has tiles.
+  std::array<weather::CloudType, gpu::kMaxLayers> blendType{};
+  std::array<bool, gpu::kMaxLayers> tiled{};
+
+  std::size_t slices() const { return rings[0].bySlice.size(); }
+  const SliceTiles& tiles(std::uint32_t ring, std::size_t slice) const {
+    return rings[ringsShare ? 0 : ring].bySlice[slice];
+  }
+  bool duplicates() const { return rings[0].duplicates || rings[1].duplicates; }
+  // Whether any slice has tiles in this ring (it then needs texel cells).
+  bool ringTiled(std::uint32_t ring) const;
+};
+
+// One snapshot's tiles sorted into the slices of these layers.
+RingTiles indexRingTiles(const weather::WeatherSnapshot& source, const std::vector<weather::CloudLayer>& layers);
+
+// The rings put together (coarseRing ignored without a coarse snapshot),
+// with each slice's blend type and tiled flag.
+WeatherTiles combineWeatherTiles(const weather::WeatherSnapshot& fine, const weather::WeatherSnapshot* coarse,
+                                 RingTiles fineRing, RingTiles coarseRing);
+
+// Sorts the tiles of a fine snapshot (validated, at most gpu::kMaxLayers
+// layers) and an optional coarse one into rings and slices, and chooses
+// each slice's blend type. fine nullptr: no slices (coarse is then ignored).
+WeatherTiles indexWeatherTiles(const weather::WeatherSnapshot* fine, const weather::WeatherSnapshot* coarse);
+
+// Writes one texel (index row * size + column) of (ring, slice) from the
+// value it takes: quantised as the stream's fractions, the blend kept only
+// when the value blends towards the slice's blend type.
+void writeWeatherTexel(WeatherField& field, std::uint32_t ring, std::size_t slice, std::size_t texel,
+                       const TileValue& value);
+
+// Hash of everything in the snapshots that the map depends on (layer ids,
+// order, coverage and density; tiles with their blend; tile levels; the
+// coarse snapshot's tiles and level). nullptr hashes as "no weather"; a
+// coarse snapshot without a fine one adds nothing (the map has no slices).
+std::uint64_t weatherContentKey(const weather::WeatherSnapshot* snapshot,
+                                const weather::WeatherSnapshot* coarse = nullptr);
+
+// The content key and its parts: the hash of each snapshot's tiles and
+// level (0 for an absent snapshot), so an update can tell which changed.
+struct WeatherKeys {
+  std::uint64_t content = 0;
+  std::uint64_t fineTiles = 0, coarseTiles = 0;
+};
+WeatherKeys weatherKeys(const weather::WeatherSnapshot* snapshot, const weather::WeatherSnapshot* coarse);
 
 // weatherContentKey and everything else about the weather that changes the
 // image, apart from the clock and the camera: each layer's base, thickness
 // and wind. A change of it drops an interleaved renderer's history.
-std::uint64_t weatherSceneKey(const weather::WeatherSnapshot* snapshot);
+std::uint64_t weatherSceneKey(const weather::WeatherSnapshot* snapshot,
+                              const weather::WeatherSnapshot* coarse = nullptr);
 
 // Fills the map around anchor. A layer without tiles is uniform (its own
 // coverage and density); a layer with tiles is empty where a cell has none.
@@ -97,12 +180,28 @@ std::uint64_t weatherSceneKey(const weather::WeatherSnapshot* snapshot);
 // With `previous` built at the same anchor and its cells at the snapshot's
 // tile level, the texels' cells are taken from it instead of found again
 // (no geodesy: new tiles cost a hash lookup per texel); the result is the
-// same as without it.
+// same as without it. Ring 1 takes its tiles from the snapshot too.
 WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const geo::Geodetic& anchor,
                                const WeatherField* previous = nullptr);
 
+// The same with ring 1 filled from `coarse` (a second, wider subscription at
+// its own tile level; nullptr: from `snapshot`, as above). Per ring the
+// cells of `previous` are reused when its level and anchor match. A slice
+// whose layer has no coarse tiles is uniform in ring 1 at the fine layer's
+// coverage and density.
+WeatherField buildWeatherField(const weather::WeatherSnapshot* snapshot, const weather::WeatherSnapshot* coarse,
+                               const geo::Geodetic& anchor, const WeatherField* previous = nullptr);
+
+// The same from tiles already sorted (indexWeatherTiles(snapshot, coarse)).
+WeatherField buildWeatherField(const WeatherTiles& tiles, const weather::WeatherSnapshot* snapshot,
+                               const weather::WeatherSnapshot* coarse, const geo::Geodetic& anchor,
+                               const WeatherField* previous);
+
 // The anchor of the map for a camera at this position (see kWeatherAnchorLattice_m).
 geo::Geodetic weatherAnchorFor(const geo::Geodetic& camera);
+
+// Whether two anchors are the same point, bit for bit (what cell reuse needs).
+bool sameAnchor(const geo::Geodetic& a, const geo::Geodetic& b);
 
 // True when the map must be rebuilt for this snapshot key and anchor
 // (weatherAnchorFor the camera).

@@ -7,7 +7,11 @@
 // samples 10 m apart) although the two rings differ by far more there. The
 // map's anchor is the camera's lattice point, within 4.4 km of it anywhere
 // (poles, antimeridian, orbit); new weather at the same anchor reuses the
-// texels' cells and gives the same map as a fresh build.
+// texels' cells and gives the same map as a fresh build. With a second,
+// coarser snapshot (FrameInputs::coarseWeather) ring 1 takes its tiles from
+// it: far weather only that snapshot has is seen, uniform layers stay
+// uniform, fine-only tiles leave ring 1 uniform and still win inside the
+// fine ring.
 #include <algorithm>
 #include <cmath>
 #include <chrono>
@@ -18,6 +22,7 @@
 
 #include "sky/geo/geodetic.hpp"
 #include "sky/weather/tiling.hpp"
+#include "frame_setup.hpp"
 #include "weather_field.hpp"
 
 namespace sky::render {
@@ -163,8 +168,10 @@ TEST(WeatherRings, NewWeatherAtTheSameAnchorReusesTheCells) {
   const auto t0 = Clock::now();
   const WeatherField a = buildWeatherField(&first, anchor);
   const auto t1 = Clock::now();
-  ASSERT_EQ(a.cellLevel, kLevel);
-  ASSERT_EQ(a.cells.size(), std::size_t(kWeatherRings) * kWeatherMapSize * kWeatherMapSize);
+  for (std::uint32_t ring = 0; ring < kWeatherRings; ++ring) {
+    ASSERT_EQ(a.cellLevel[ring], kLevel);
+    ASSERT_EQ(a.cells[ring].size(), std::size_t(kWeatherMapSize) * kWeatherMapSize);
+  }
   // New weather: every third tile changes coverage, some tiles go away.
   weather::WeatherSnapshot second = first;
   for (std::size_t i = 0; i < second.tiles.size(); i += 3) second.tiles[i].coverage = 0.9f;
@@ -183,6 +190,188 @@ TEST(WeatherRings, NewWeatherAtTheSameAnchorReusesTheCells) {
   // Another anchor or tile level: the cells are found again, same result.
   const geo::Geodetic elsewhere = weatherAnchorFor({47.2, 8.0, 3000.0});
   EXPECT_EQ(buildWeatherField(&second, elsewhere, &a).texels, buildWeatherField(&second, elsewhere).texels);
+}
+
+// The coverage the coarse snapshot gives a level-9 cell: varying from cell
+// to cell (by the cell's position along S2's curve), so a lookup of the
+// wrong cell or level shows.
+float coarseCoverage(std::uint64_t cell) { return 0.3f + 0.1f * float((cell >> 45) % 7); }
+
+struct TwoSnapshots {
+  weather::WeatherSnapshot fine, coarse;
+};
+
+// Fine (level 11, 120 km around the camera) and coarse (level 9, wider)
+// snapshots of four layers: 1 tiled in both (fine 0.4 near the camera,
+// coarse coarseCoverage over a patch 300 km north and 0.2 around the
+// camera), 2 uniform (0.6, 0.5; the coarse snapshot says 0.1, unused),
+// 3 tiled only in the fine snapshot (0.9 on its tiles, 0.3 its own), 4
+// tiled only in the coarse one (0.25 its own, coarse tiles 0.8 around the
+// camera). The coarse snapshot also tiles a layer 99 the fine one lacks.
+constexpr int kFineLevel = 11, kCoarseLevel = 9;
+TwoSnapshots twoSnapshots(const geo::Geodetic& camera) {
+  TwoSnapshots t;
+  weather::WeatherSnapshot& f = t.fine;
+  f.tileLevel = kFineLevel;
+  f.layers = {tiledLayer(), tiledLayer(), tiledLayer(), tiledLayer()};
+  f.layers[1].id = 2;
+  f.layers[1].coverage = 0.6;
+  f.layers[1].density = 0.5;
+  f.layers[2].id = 3;
+  f.layers[2].coverage = 0.3;
+  f.layers[3].id = 4;
+  f.layers[3].coverage = 0.25;
+  for (std::uint64_t cell : weather::coverCap({camera.lat_deg, camera.lon_deg, 30000.0}, kFineLevel, 4000)) {
+    f.tiles.push_back({cell, 1, 0.4f, 1.0f});
+    f.tiles.push_back({cell, 3, 0.9f, 1.0f});
+  }
+  weather::WeatherSnapshot& c = t.coarse;
+  c.tileLevel = kCoarseLevel;
+  c.layers = f.layers;
+  c.layers[1].coverage = 0.1;  // a coarse layer's own numbers are not used
+  const double farLat = camera.lat_deg + 300000.0 / kMetresPerDegree;
+  for (std::uint64_t cell : weather::coverCap({farLat, camera.lon_deg, 60000.0}, kCoarseLevel, 4000))
+    c.tiles.push_back({cell, 1, coarseCoverage(cell), 0.9f});
+  for (std::uint64_t cell : weather::coverCap({camera.lat_deg, camera.lon_deg, 60000.0}, kCoarseLevel, 4000)) {
+    c.tiles.push_back({cell, 1, 0.2f, 0.9f});
+    c.tiles.push_back({cell, 4, 0.8f, 1.0f});
+  }
+  return t;
+}
+
+// A value as the map stores it: a float (as tiles carry it and the map
+// takes layers' numbers) quantised to 1/255.
+double quantized(float v) { return weather::quantizeUnit(v) / 255.0; }
+
+TEST(WeatherRings, CoarseSnapshotFillsTheCoarseRing) {
+  const geo::Geodetic camera{47.0, 8.0, 10000.0};
+  const TwoSnapshots t = twoSnapshots(camera);
+  const WeatherField both = buildWeatherField(&t.fine, &t.coarse, camera);
+  const WeatherField fineOnly = buildWeatherField(&t.fine, camera);
+  EXPECT_EQ(both.cellLevel[0], kFineLevel);
+  EXPECT_EQ(both.cellLevel[1], kCoarseLevel);
+
+  // 300 km north, beyond the fine ring: the coarse tile of the cell there,
+  // sampled at that cell's centre (a level-9 cell is ~4 coarse texels
+  // across, so all four filtered texels lie in it).
+  const double farLat = camera.lat_deg + 300000.0 / kMetresPerDegree;
+  const std::uint64_t farCell = weather::cellAt(farLat, camera.lon_deg, kCoarseLevel);
+  const weather::CellCentre centre = weather::cellCentre(farCell);
+  const glm::dvec2 far = planeOf(both, centre.lat_deg, centre.lon_deg);
+  ASSERT_GT(far.y, both.halfExtent_m[0] * kRingBlendEnd) << "the point must lie beyond the fine ring";
+  const glm::dvec3 v = both.sample(0, far.x, far.y);
+  EXPECT_NEAR(v.x, quantized(coarseCoverage(farCell)), 1e-9);
+  EXPECT_NEAR(v.y, quantized(0.9), 1e-9);
+  // Without the coarse snapshot ring 1 has only the fine tiles, which end
+  // 30 km out: nothing there.
+  EXPECT_EQ(fineOnly.sample(0, far.x, far.y).x, 0.0);
+
+  // The uniform layer is uniform in both rings at the fine snapshot's
+  // numbers, out to the coarse ring's edge.
+  for (const glm::dvec2 p : {glm::dvec2(0, 0), glm::dvec2(550000, 0), glm::dvec2(-400000, 400000), far}) {
+    EXPECT_NEAR(both.sample(1, p.x, p.y).x, quantized(0.6), 1e-9);
+    EXPECT_NEAR(both.sample(1, p.x, p.y).y, quantized(0.5), 1e-9);
+  }
+  EXPECT_FALSE(both.tiled[1]);
+
+  // Layer 3, tiled only in the fine snapshot: its tiles in ring 0, and ring
+  // 1 uniform at the layer's own 0.3, under the fine tiles too.
+  const glm::dvec2 near = planeOf(both, camera.lat_deg + 10000.0 / kMetresPerDegree, camera.lon_deg);
+  EXPECT_NEAR(both.sampleRing(0, 2, near.x, near.y).x, quantized(0.9), 1e-9);
+  EXPECT_EQ(both.sampleRing(0, 2, 60000.0, 0.0).x, 0.0) << "beyond its tiles the fine ring is empty";
+  for (const glm::dvec2 p : {near, glm::dvec2(60000, 0), far, glm::dvec2(0, -500000)})
+    EXPECT_NEAR(both.sampleRing(1, 2, p.x, p.y).x, quantized(0.3), 1e-9);
+  EXPECT_TRUE(both.tiled[2]);
+
+  // Layer 4, tiled only in the coarse snapshot: ring 0 uniform at 0.25,
+  // ring 1 its tiles (0.8 around the camera, empty far out).
+  EXPECT_NEAR(both.sampleRing(0, 3, near.x, near.y).x, quantized(0.25), 1e-9);
+  EXPECT_NEAR(both.sampleRing(0, 3, 90000.0, 0.0).x, quantized(0.25), 1e-9);
+  EXPECT_NEAR(both.sampleRing(1, 3, near.x, near.y).x, quantized(0.8), 1e-9);
+  EXPECT_EQ(both.sampleRing(1, 3, far.x, far.y).x, 0.0);
+  EXPECT_TRUE(both.tiled[3]);
+  EXPECT_FALSE(fineOnly.tiled[3]);
+
+  // Layer 1 near the camera: the fine tiles win inside the fine ring (0.4)
+  // although ring 1 holds the coarse 0.2 there.
+  EXPECT_NEAR(both.sample(0, near.x, near.y).x, quantized(0.4), 1e-9);
+  EXPECT_NEAR(both.sampleRing(1, 0, near.x, near.y).x, quantized(0.2), 1e-9);
+
+  // Coarse tiles of a layer the fine snapshot lacks change nothing.
+  TwoSnapshots extra = t;
+  for (std::uint64_t cell : weather::coverCap({camera.lat_deg, camera.lon_deg, 100000.0}, kCoarseLevel, 4000))
+    extra.coarse.tiles.push_back({cell, 99, 1.0f, 1.0f});
+  EXPECT_EQ(buildWeatherField(&extra.fine, &extra.coarse, camera).texels, both.texels);
+
+  // The map's key (and the interleaved renderer's scene key) sees the
+  // coarse snapshot and its tiles.
+  EXPECT_NE(weatherContentKey(&t.fine, &t.coarse), weatherContentKey(&t.fine));
+  EXPECT_EQ(weatherContentKey(&t.fine, nullptr), weatherContentKey(&t.fine));
+  TwoSnapshots changed = t;
+  changed.coarse.tiles[3].coverage = 0.95f;
+  EXPECT_NE(weatherContentKey(&changed.fine, &changed.coarse), weatherContentKey(&t.fine, &t.coarse));
+  EXPECT_NE(weatherSceneKey(&changed.fine, &changed.coarse), weatherSceneKey(&t.fine, &t.coarse));
+  EXPECT_NE(weatherSceneKey(&t.fine, &t.coarse), weatherSceneKey(&t.fine));
+}
+
+TEST(WeatherRings, BlendTypeCountsTheTilesOfBothRings) {
+  const geo::Geodetic camera{47.0, 8.0, 10000.0};
+  TwoSnapshots t = twoSnapshots(camera);
+  // Layer 1's fine tiles blend towards cumulonimbus (0.3 each), its coarse
+  // ones towards stratus (1 each): the ~200 fine tiles weigh ~60, the
+  // coarse ones more than that only if there are over 60 of them.
+  std::size_t coarseTiles = 0;
+  for (auto& tile : t.fine.tiles)
+    if (tile.layerId == 1) {
+      tile.blendType = weather::CloudType::Cumulonimbus;
+      tile.blend = 0.3f;
+    }
+  for (auto& tile : t.coarse.tiles)
+    if (tile.layerId == 1) {
+      tile.blendType = weather::CloudType::Stratus;
+      tile.blend = 1.0f;
+      ++coarseTiles;
+    }
+  double fineWeight = 0;
+  for (const auto& tile : t.fine.tiles)
+    if (tile.layerId == 1) fineWeight += tile.blend;
+  ASSERT_GT(double(coarseTiles), fineWeight) << "the test needs the coarse tiles to outweigh the fine ones";
+  EXPECT_EQ(buildWeatherField(&t.fine, camera).blendType[0], weather::CloudType::Cumulonimbus);
+  const WeatherField both = buildWeatherField(&t.fine, &t.coarse, camera);
+  EXPECT_EQ(both.blendType[0], weather::CloudType::Stratus);
+  // A slice holds one blend type: the coarse tiles blend in ring 1, the
+  // fine (cumulonimbus) tiles draw unblended in ring 0.
+  const glm::dvec2 near = planeOf(both, camera.lat_deg + 10000.0 / kMetresPerDegree, camera.lon_deg);
+  EXPECT_NEAR(both.sampleRing(1, 0, near.x, near.y).z, 1.0, 1e-9);
+  EXPECT_EQ(both.sampleRing(0, 0, near.x, near.y).z, 0.0);
+}
+
+TEST(WeatherRings, CoarseWeatherIsValidatedByName) {
+  const geo::Geodetic camera{47.0, 8.0, 10000.0};
+  TwoSnapshots t = twoSnapshots(camera);
+  FrameInputs in;
+  in.camera.position = camera;
+  in.weather = &t.fine;
+  in.coarseWeather = &t.coarse;
+  EXPECT_TRUE(validateInputs(in));
+  t.coarse.layers.resize(gpu::kMaxLayers + 1, t.coarse.layers[0]);
+  auto tooMany = validateInputs(in);
+  ASSERT_FALSE(tooMany);
+  EXPECT_NE(tooMany.error().detail.find("coarseWeather"), std::string::npos) << tooMany.error().detail;
+  t = twoSnapshots(camera);
+  t.coarse.tiles[0].coverage = 1.5f;
+  auto badTile = validateInputs(in);
+  ASSERT_FALSE(badTile);
+  EXPECT_NE(badTile.error().detail.find("coarseWeather"), std::string::npos) << badTile.error().detail;
+  t = twoSnapshots(camera);
+  t.coarse.tileLevel = 31;
+  EXPECT_FALSE(validateInputs(in));
+  // The fine snapshot's messages are as they were (no input named).
+  t = twoSnapshots(camera);
+  t.fine.tileLevel = -1;
+  auto badFine = validateInputs(in);
+  ASSERT_FALSE(badFine);
+  EXPECT_EQ(badFine.error().detail, "frame inputs: tileLevel -1 outside [0, 30]");
 }
 
 }  // namespace

@@ -139,8 +139,13 @@ struct FrameInputs {
                                                       // tiles is uniform (its own coverage and
                                                       // density); with tiles, a missing cell is empty.
   // The answer to a second, wider and coarser subscription (its own
-  // tileLevel): when set, the weather map's coarse ring takes its tiles from
-  // it; nullptr: the coarse ring is filled from `weather` as the fine one.
+  // tileLevel). When set, the weather map's coarse ring (ring 1, 1200 km)
+  // takes its tiles from it: a layer of `weather` with tiles here takes
+  // them (empty where a cell has none), one without is uniform there at
+  // `weather`'s own coverage and density; its tiles of layer ids `weather`
+  // lacks are ignored, and its layers' own numbers are not used (the layers
+  // drawn are `weather`'s, in its order). nullptr: ring 1 is filled from
+  // `weather`. Ignored without `weather`.
   const weather::WeatherSnapshot* coarseWeather = nullptr;
   double weatherClock_s = 0;  // clouds advect with each layer's wind by this clock
   double sunAzimuth_deg = 135, sunElevation_deg = 40;  // in the camera's local ENU frame
@@ -166,6 +171,17 @@ struct TemporalReport {
   // Pixels of the image the cloud pass works on: with a resolution divisor d,
   // (width / d) x (height / d).
   std::uint64_t drawn = 0, reused = 0, offscreen = 0, disoccluded = 0;
+};
+
+// What the weather map's update did for the last frame: nothing (same
+// weather, same anchor), rewrote the texels of the tiles that changed or
+// came (a snapshot that differs only in tiles) and uploaded the rectangles
+// around them, or rebuilt and uploaded the whole map (and why).
+struct WeatherMapReport {
+  bool rebuilt = false;
+  std::string reason;                 // why it was rebuilt ("anchor moved", ...); empty otherwise
+  std::uint64_t texelsRewritten = 0;  // RGBA8 texels written, over all rings and slices
+  std::uint64_t bytesUploaded = 0;    // bytes copied into the GPU's weather image
 };
 
 // Linear radiance, rgba per pixel (a = view-ray transmittance through the
@@ -216,6 +232,8 @@ class CloudRenderer {
   const std::vector<PassTime>& lastPassTimes() const;
   // What the reprojection did with the last render().
   const TemporalReport& lastTemporal() const;
+  // What the weather map's update did for the last render().
+  const WeatherMapReport& lastWeatherMap() const;
 
   // Validation messages since the last call, and the totals (nothing
   // without GpuOptions::validation).
