@@ -1,8 +1,8 @@
 // The weather map's CPU cost per new snapshot (renderer/core/src/
 // weather_field*.cpp): a full build at a new anchor (finding every texel's
 // cell: geodesy), a rebuild at the same anchor (cells reused), and a
-// per-tile update of 1 and of 100 changed tiles; and the max-coverage mip
-// the renderer recomputes after every upload. Snapshots as a renderer
+// per-tile update of 1 and of 100 changed tiles (with the max-coverage mip
+// updated over them); and the whole mip, which a rebuilt map needs. Snapshots as a renderer
 // holds them: fine level 11 (~4.9 km) over 120 km, coarse level 9 (~20 km)
 // over 650 km, two tiled layers and a uniform one.
 // Run: build/rel/tests/bench/sky_weather_map_bench (numbers are for this
@@ -65,12 +65,15 @@ void BM_RebuildSameAnchor(benchmark::State& state) {
   }
 }
 
-// state.range(0) tiles of the fine snapshot (spread over it) change value.
+// state.range(0) tiles of the fine snapshot (spread over it) change value;
+// with the max-coverage mip updated over the changed rectangles, as the
+// renderer does.
 void BM_TileUpdate(benchmark::State& state) {
   Weather w;
   const geo::Geodetic anchor = render::weatherAnchorFor(kCamera);
   WeatherFieldUpdater updater;
   updater.update(&w.fine, &w.coarse, anchor);
+  std::vector<float> mip = render::buildCoverageMip(updater.field());
   const std::size_t k = std::size_t(state.range(0));
   const std::size_t stride = w.fine.tiles.size() / k;
   std::uint64_t texels = 0;
@@ -80,6 +83,7 @@ void BM_TileUpdate(benchmark::State& state) {
     for (std::size_t t = 0; t < k; ++t) w.fine.tiles[t * stride].coverage = v;
     const auto change = updater.update(&w.fine, &w.coarse, anchor);
     if (change.kind != render::WeatherFieldChange::Kind::Tiles) state.SkipWithError("not a tile update");
+    render::updateCoverageMip(mip, updater.field(), change.dirty);
     texels += change.texelsRewritten;
   }
   state.counters["texels"] = benchmark::Counter(double(texels), benchmark::Counter::kAvgIterations);

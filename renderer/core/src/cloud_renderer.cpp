@@ -43,6 +43,7 @@ struct CloudRenderer::Impl {
   std::vector<PassTime> passTimes;
   std::string noiseReport;
   std::uint64_t coverageMipUploads = ~std::uint64_t(0);  // weather uploads the pass's coverage mip is of
+  std::vector<float> coverageMip{};                       // its CPU copy (updated per tile as the map is)
   TemporalReport temporal{};  // what the reprojection did with the last frame
 };
 
@@ -168,7 +169,15 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
     if (auto ok = impl_->weather.update(*impl_->ctx, inputs); !ok) return tl::unexpected(ok.error());
     impl_->passTimes = impl_->weather.lastUploadTimes();
     if (impl_->weather.uploads() != impl_->coverageMipUploads) {  // a new map: its max-coverage mip
-      impl_->pass.setCoverageMip(buildCoverageMip(impl_->weather.field()));
+      // After one upload of changed tiles only their cells of the mip; a
+      // rebuilt map (or a mip missed since) gets a whole new one.
+      const bool justTiles = !impl_->weather.lastUpdate().rebuilt && !impl_->coverageMip.empty() &&
+                             impl_->weather.uploads() == impl_->coverageMipUploads + 1;
+      if (justTiles)
+        updateCoverageMip(impl_->coverageMip, impl_->weather.field(), impl_->weather.lastRects());
+      else
+        impl_->coverageMip = buildCoverageMip(impl_->weather.field());
+      impl_->pass.setCoverageMip(impl_->coverageMip);
       impl_->coverageMipUploads = impl_->weather.uploads();
     }
     FrameSetup setup = prepareFrame(impl_->settings, inputs, impl_->weather.field(), impl_->atmosphere);

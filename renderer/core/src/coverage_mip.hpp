@@ -11,10 +11,12 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "sky_shared.h"
 #include "weather_field.hpp"
+#include "weather_field_update.hpp"
 
 namespace sky::render {
 
@@ -28,6 +30,11 @@ inline constexpr std::size_t kCoverageMipFloats =
 // kWeatherRings x kMaxLayers x cells x cells maxima in [0, 1]: ring, slice,
 // row (north), column (east).
 std::vector<float> buildCoverageMip(const WeatherField& field);
+
+// The mip of a field brought up to date after the texels in these
+// rectangles changed (WeatherFieldChange::dirty): only the cells whose
+// filter reaches into them are recomputed; the result equals buildCoverageMip.
+void updateCoverageMip(std::vector<float>& mip, const WeatherField& field, std::span<const TexelRect> changed);
 
 // At gnomonic plane point (x_m, y_m) (m east/north of the anchor) in slice:
 // the fine ring's cell inside the ring blend band, the coarse ring's beyond

@@ -21,6 +21,7 @@ Result<WeatherTexture> WeatherTexture::create(const GpuContext& ctx) {
 Result<void> WeatherTexture::update(const GpuContext& ctx, const FrameInputs& inputs) {
   lastUploadTimes_.clear();
   lastUpdate_ = {};
+  lastRects_.clear();
   const WeatherFieldChange change =
       updater_.update(inputs.weather, inputs.coarseWeather, weatherAnchorFor(inputs.camera.position));
   lastUpdate_.texelsRewritten = change.texelsRewritten;
@@ -38,6 +39,7 @@ Result<void> WeatherTexture::update(const GpuContext& ctx, const FrameInputs& in
       lastUpdate_.reason = change.reason;
       return uploadWhole(ctx);
     case WeatherFieldChange::Kind::Tiles:
+      lastRects_ = change.dirty;
       return uploadRects(ctx, change.dirty);
   }
   return {};

@@ -34,6 +34,9 @@ class WeatherTexture {
   const std::vector<PassTime>& lastUploadTimes() const { return lastUploadTimes_; }
   // What the last update() did: rebuilt or not, texels rewritten, bytes uploaded.
   const WeatherMapReport& lastUpdate() const { return lastUpdate_; }
+  // The texel rectangles the last update() rewrote and uploaded, when it
+  // did not rebuild (empty otherwise).
+  const std::vector<TexelRect>& lastRects() const { return lastRects_; }
 
  private:
   WeatherTexture() = default;
@@ -46,6 +49,7 @@ class WeatherTexture {
   std::uint64_t uploads_ = 0;
   std::vector<PassTime> lastUploadTimes_;
   WeatherMapReport lastUpdate_;
+  std::vector<TexelRect> lastRects_;
   bool imageBehind_ = false;  // an upload failed: the image may not hold the field
 };
 

@@ -1,8 +1,9 @@
 // Per-tile updates of the weather map (renderer/core/src/weather_field_update.*):
 // over seeded random sequences of tile changes and new tiles, in the fine
 // and the coarse snapshot, the map updated in place equals a full build of
-// the same snapshots bit for bit, in both rings, and every texel that
-// changed lies in the rectangle reported for upload; one level-11 tile
+// the same snapshots bit for bit, in both rings, every texel that changed
+// lies in the rectangle reported for upload, and the max-coverage mip
+// updated over those rectangles equals one built from the whole map; one level-11 tile
 // rewrites about the texels its cell covers (its area over a texel's, tens
 // of texels) while a move of the anchor rebuilds every texel; and every
 // change that is more than tiles (layers, levels, a tile removed, the blend
@@ -15,6 +16,7 @@
 
 #include <gtest/gtest.h>
 
+#include "coverage_mip.hpp"
 #include "sky/weather/tiling.hpp"
 #include "weather_field.hpp"
 #include "weather_field_update.hpp"
@@ -142,6 +144,7 @@ TEST(WeatherUpdate, RandomTileChangesGiveTheFullBuild) {
     // which keeps the test fast; the last step compares with a fresh one.
     WeatherField reference = buildWeatherField(&fine, coarsePtr, anchor);
     expectSameField(updater.field(), reference);
+    std::vector<float> mip = buildCoverageMip(updater.field());
     int tileSteps = 0, rebuilds = 0;
     std::uint64_t tileTexels = 0;
     for (int step = 0; step < kSteps; ++step) {
@@ -157,8 +160,13 @@ TEST(WeatherUpdate, RandomTileChangesGiveTheFullBuild) {
         ++tileSteps;
         tileTexels += change.texelsRewritten;
         expectChangesInsideRects(before, updater.field(), change);
+        // The max-coverage mip updated over the same rectangles is the one
+        // built from the whole map.
+        updateCoverageMip(mip, updater.field(), change.dirty);
+        EXPECT_TRUE(mip == buildCoverageMip(updater.field())) << "coverage mip";
       } else if (change.kind == Kind::Rebuilt) {
         ++rebuilds;
+        mip = buildCoverageMip(updater.field());
         EXPECT_FALSE(change.reason.empty());
       }
       if (::testing::Test::HasFailure()) return;
