@@ -3,10 +3,14 @@
 // ~18 km tiles) for the weather map's coarse ring. A storm region 300 km
 // from the flight is outside the detailed area, so its tiles can reach the
 // renderer only through the coarse one: the frames' metadata must show the
-// coarse area holding tiles while the detailed area, uniform there, holds none.
+// coarse area holding tiles while the detailed area, uniform there, holds none,
+// and a change to the storm while the replay runs must reach the weather map
+// tile by tile, not as a rebuild.
 #include <filesystem>
 #include <fstream>
+#include <chrono>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -16,6 +20,7 @@
 #include "weatherd_process.hpp"
 
 namespace fs = std::filesystem;
+using namespace std::chrono_literals;
 
 namespace sky::test {
 namespace {
@@ -41,13 +46,30 @@ TEST(CoarseArea, FarWeatherReachesTheRendererThroughTheCoarseArea) {
   ASSERT_EQ(posted.status, 200) << posted.body;
 
   const fs::path out = w.dir / "out";
+  const fs::path jsonl = out / "frames" / "frames.jsonl";
+  // Paced as flown (13 frames over 6 s), so that a change made while it runs
+  // arrives between frames.
   ChildProcess render({SKY_RENDER, "--headless", "--server", "127.0.0.1:" + std::to_string(w.streamPort), "--replay",
-                       SKY_TEST_FLIGHT, "--step", "3", "--no-exr", "--no-video", "--out", out.string(), "--width",
-                       "160", "--height", "90"},
+                       SKY_TEST_FLIGHT, "--step", "0.5", "--replay-pace", "1", "--no-exr", "--no-video", "--out",
+                       out.string(), "--width", "160", "--height", "90"},
                       (w.dir / "render.log").string(), {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
+  // Once a few frames are out, the storm thins: only the tiles it reaches
+  // change, and they arrive as a Delta of the coarse area.
+  const auto until = std::chrono::steady_clock::now() + 180s;
+  while (readFrames(jsonl).size() < 3 && std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(50ms);
+  ASSERT_GE(readFrames(jsonl).size(), 3u) << render.log();
+  const auto thinned = w.request("POST", "/api/changes", R"({"changes": [{"op": "set_region", "region": {
+      "id": 3, "center_lat_deg": 48.9, "center_lon_deg": 12.8, "size_x_m": 40000, "size_y_m": 40000,
+      "corner_radius_m": 5000, "transition_m": 5000, "drifts_with_wind": false,
+      "layers": [{"id": 1, "type": "cumulus", "base_m": 1500, "thickness_m": 1500, "transition_band_m": 100,
+                  "coverage": 0.3, "density": 1,
+                  "wind": {"speed_mps": 10, "from_deg": 270, "vertical_mps": 0}}]}}]})");
+  ASSERT_EQ(thinned.status, 200) << thinned.body;
   ASSERT_EQ(render.wait(300s).value_or(-1), 0) << render.log();
-  const auto frames = readFrames(out / "frames" / "frames.jsonl");
-  ASSERT_EQ(frames.size(), 3u) << render.log();
+
+  const auto frames = readFrames(jsonl);
+  ASSERT_EQ(frames.size(), 13u) << render.log();
   for (const auto& f : frames) {
     const auto& areas = f.at("weather_areas");
     ASSERT_EQ(areas.size(), 2u) << f.dump();
@@ -58,6 +80,28 @@ TEST(CoarseArea, FarWeatherReachesTheRendererThroughTheCoarseArea) {
     EXPECT_GT(areas[1]["tiles"].get<int>(), 5000) << f.dump();
   }
   EXPECT_NE(render.log().find("snapshot of area 1"), std::string::npos) << render.log();
+
+  // The map is built on the first frame with both areas' weather in it.
+  // The thinning reaches it tile by tile: a frame that rewrote texels
+  // without a rebuild, uploading a small part of what the first frame did.
+  EXPECT_TRUE(frames[0]["weather_map"]["rebuilt"]) << frames[0].dump();
+  const auto whole = frames[0]["weather_map"]["bytes_uploaded"].get<std::uint64_t>();
+  EXPECT_GT(whole, 0u);
+  std::size_t perTile = 0;
+  for (std::size_t i = 1; i < frames.size(); ++i) {
+    const auto& m = frames[i]["weather_map"];
+    // The camera may cross into another anchor cell (5 km lattice) on its
+    // 330 m of flight; nothing else rebuilds the map here.
+    if (m["rebuilt"]) {
+      EXPECT_EQ(m["reason"], "anchor moved") << frames[i].dump();
+      continue;
+    }
+    if (m["texels_rewritten"].get<std::uint64_t>() == 0) continue;
+    ++perTile;
+    EXPECT_LT(m["bytes_uploaded"].get<std::uint64_t>() * 20, whole) << frames[i].dump();
+  }
+  EXPECT_EQ(perTile, 1u) << "one change, applied tile by tile in one frame";
+  EXPECT_GT(frames.back()["weather_version"].get<int>(), frames.front()["weather_version"].get<int>());
 }
 
 }  // namespace
