@@ -23,6 +23,13 @@ std::string reasonKind(const std::string& detail) {
   }
   return kind.substr(0, 80);
 }
+
+// The ownship the areas of interest follow, when a pose has come.
+std::optional<geo::Geodetic> ownship(const SharedState& state) {
+  const auto pose = state.pose();
+  if (!pose) return std::nullopt;
+  return pose->pose.position;
+}
 }  // namespace
 
 CigiListener::CigiListener(asio::io_context& io, SharedState& state, const std::string& address,
@@ -90,17 +97,23 @@ void CigiListener::onDatagram(std::span<const std::uint8_t> bytes) {
   // weather this channel holds, by the query every process shares.
   for (const auto& packet : datagram->packets)
     if (const auto* request = std::get_if<cigi::EnvironmentalConditionsRequest>(&packet))
-      for (const auto& reply : answerConditions(*request, state_.weather(), std::chrono::steady_clock::now()))
+      for (const auto& reply :
+           answerConditions(*request, state_.weather(), std::chrono::steady_clock::now(), ownship(state_)))
         w.add(reply);
   boost::system::error_code ec;
   socket_.send_to(asio::buffer(w.bytes()), from_, 0, ec);
 }
 
 std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRequest& r, const WeatherView& view,
-                                          std::chrono::steady_clock::time_point now) {
+                                          std::chrono::steady_clock::time_point now,
+                                          const std::optional<geo::Geodetic>& camera) {
   std::vector<cigi::Packet> out;
+  // The layers (and their winds) are the same in both areas' snapshots; the
+  // tiles come from the area that reaches the point.
   const auto& layers = view.snapshot.layers;
-  const auto lookup = weather::snapshotLookup(view.snapshot, view.clockNow(now));
+  const bool far = view.coarse && camera &&
+                   geo::geodesicDistance_m(camera->lat_deg, camera->lon_deg, r.lat_deg, r.lon_deg) > kDetailedReach_m;
+  const auto lookup = weather::snapshotLookup(far ? *view.coarse : view.snapshot, view.clockNow(now));
   if (r.requestType & cigi::kRequestWeather) {
     const weather::PointWeather pw = weather::weatherAt(layers, lookup, r.lat_deg, r.lon_deg, r.alt_m);
     cigi::WeatherConditionsResponse wcr;

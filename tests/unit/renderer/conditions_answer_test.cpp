@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "sky/app/cigi_listener.hpp"
+#include "sky/weather/tiling.hpp"
 
 namespace sky::app {
 namespace {
@@ -62,6 +63,43 @@ TEST(ConditionsAnswer, ClearAirBelowAndOnlyWhatIsAsked) {
   EXPECT_FLOAT_EQ(w.visibility_m, float(kClearVisibility_m));
   r.requestType = cigi::kRequestMaritime;  // nothing we model
   EXPECT_TRUE(answerConditions(r, v, std::chrono::steady_clock::now()).empty());
+}
+
+}  // namespace
+}  // namespace sky::app
+
+namespace sky::app {
+namespace {
+
+// A point beyond the detailed area's reach from the camera is answered from
+// the coarse area's tiles: there a storm the detailed (uniform) snapshot
+// knows nothing of. Near the camera, or with no camera known, the detailed
+// snapshot answers.
+TEST(ConditionsAnswer, FarPointsFromTheCoarseArea) {
+  WeatherView v = viewWithOneLayer();  // layer 1 uniform at 0.6 in the detailed area
+  weather::WeatherSnapshot coarse = v.snapshot;
+  coarse.areaIndex = 1;
+  coarse.tileLevel = 9;
+  const double farLat = 46.0 + 300000.0 / 111195.0;  // 300 km north
+  coarse.tiles.push_back({weather::cellAt(farLat, 8.0, 9), 1, 1.0f, 1.0f});
+  v.coarse = coarse;
+  // The clock at the snapshots' own (frozen): no advection moves the tile.
+  const auto now = std::chrono::steady_clock::now();
+  v.clock = weather::WeatherClock(coarse.weatherClock_s, 0.0, now);
+  cigi::EnvironmentalConditionsRequest r;
+  r.requestType = cigi::kRequestAerosol;
+  r.lat_deg = farLat;
+  r.lon_deg = 8;
+  r.alt_m = 2000;
+  const geo::Geodetic camera{46.0, 8.0, 3000};
+  const auto concentration = [&](const std::optional<geo::Geodetic>& cam) {
+    const auto replies = answerConditions(r, v, now, cam);
+    return std::get<cigi::AerosolConcentrationResponse>(replies.at(0)).concentration_gpm3;
+  };
+  EXPECT_FLOAT_EQ(concentration(camera), 0.5f) << "the coarse tile's coverage 1";
+  EXPECT_FLOAT_EQ(concentration(std::nullopt), 0.3f) << "no camera: the detailed snapshot";
+  r.lat_deg = 46.5;  // 56 km from the camera: inside the detailed area
+  EXPECT_FLOAT_EQ(concentration(camera), 0.3f);
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include <utility>  // before asio: Boost 1.74 asio uses std::exchange without including it
 #include <boost/asio.hpp>
 
+#include "sky/app/area_of_interest.hpp"
 #include "sky/app/shared_state.hpp"
 #include "sky/cigi/codec.hpp"
 
@@ -32,9 +33,17 @@ inline constexpr double kCloudLiquidWater_gpm3 = 0.5;
 // The replies to one Environmental Conditions Request from the weather held:
 // wind, temperature and pressure (standard atmosphere), humidity and
 // visibility at the point (weather bit); each cloud layer 1-3's liquid water
-// there (aerosol bit). Pure: the clock comes in as `now`.
+// there (aerosol bit). Pure: the clock comes in as `now`. A point farther
+// than kDetailedReach_m from `camera` (the ownship the areas of interest
+// follow) is answered from the coarse area's tiles when the view has them:
+// the detailed area does not reach it.
 std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRequest& request,
-                                          const WeatherView& view, std::chrono::steady_clock::time_point now);
+                                          const WeatherView& view, std::chrono::steady_clock::time_point now,
+                                          const std::optional<geo::Geodetic>& camera = std::nullopt);
+
+// How far from the camera the detailed area always reaches: its radius less
+// the distance the camera goes before it is asked again (area_of_interest.hpp).
+inline constexpr double kDetailedReach_m = kSubscribeRadius_m - kResubscribeDistance_m;
 
 class CigiListener {
  public:
