@@ -175,10 +175,19 @@ void main() {
   f.march = MarchParams(int(frame.dispatch.y), int(frame.dispatch.z), frame.weatherMap.z, frame.weatherMap.w,
                         frame.steps.x, frame.steps.y, frame.steps.z);
   f.layerCount = int(frame.weatherMap.y);
-  vec3 dir = cameraRay(frame.camForward.xyz, frame.camRight.xyz, frame.camDown.xyz, frame.camRight.w,
-                       frame.camDown.w, float(px.x), float(px.y), frame.raster.x, frame.raster.y);
   // The pixel's step offset: the blue-noise tile's, or the hash's (SkyFrame::steps.w).
   uint tileIndex = (px.y & (kBlueNoiseSize - 1u)) * kBlueNoiseSize + (px.x & (kBlueNoiseSize - 1u));
+  // Where in the pixel the ray goes: its centre, or with pixelJitter an
+  // offset from two blue-noise values (the pixel's, and the one half a tile
+  // away), moved on by the cycle's shift.
+  vec2 at = vec2(px);
+  if (frame.pixelJitter.z > 0.5) {
+    uvec2 q = (px + uvec2(kBlueNoiseSize / 2u)) & (kBlueNoiseSize - 1u);
+    vec2 noise = vec2(blueNoise[tileIndex], blueNoise[q.y * kBlueNoiseSize + q.x]);
+    at += fract(noise + frame.pixelJitter.xy) - 0.5;
+  }
+  vec3 dir = cameraRay(frame.camForward.xyz, frame.camRight.xyz, frame.camDown.xyz, frame.camRight.w,
+                       frame.camDown.w, at.x, at.y, frame.raster.x, frame.raster.y);
   float jitter = frame.steps.w > 0.5 ? blueNoise[tileIndex] : pixelJitter(px.x, px.y);
   jitter = fract(jitter + frame.raster.z);
   PixelResult r = shadePixel(f, dir, jitter);

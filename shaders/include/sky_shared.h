@@ -103,6 +103,8 @@ struct SkyFrame {
   vec4 raster;          // xy: the image's extent in its own pixels for the camera rays: the full size over the
                         // resolution divisor (image.xy rounds it up); z: added (mod 1) to every pixel's step
                         // offset (TemporalSettings::accumulation); w: unused
+  vec4 pixelJitter;     // xy: added (mod 1) to the pixel's two blue-noise values for where in the pixel
+                        // its ray goes; z: 1 to jitter (TemporalSettings::pixelJitter), 0 for the centre
 };
 
 #ifdef __cplusplus
@@ -125,7 +127,7 @@ static_assert(offsetof(SkyFrame, weatherRings) == 272 + 256 * kMaxLayers);
 static_assert(offsetof(SkyFrame, steps) == 272 + 256 * kMaxLayers + 16);
 static_assert(offsetof(SkyFrame, interleave) == 272 + 256 * kMaxLayers + 32);
 static_assert(offsetof(SkyFrame, raster) == 272 + 256 * kMaxLayers + 48);
-static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 64);
+static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 80);
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

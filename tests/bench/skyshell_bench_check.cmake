@@ -67,7 +67,7 @@ if(MODE STREQUAL "sweeps")
   expect(count EQUAL 8 "${count} sweep tables in sweeps.md, wanted 8")
   foreach(row light-1 light-6 growth-0 growth-0p08 ford-steps ford-early-exit haggstrom-2018 haggstrom-4x4
           multmin-0p1 multmin-0p4 multmin-1 divmin-0p1 divmin-0p4 divmin-1 res-full res-1of2 res-1of4-bilinear
-          acc-0 acc-0p9 acc-0p75-blue)
+          acc-0 acc-0p9 acc-0p75-blue acc-0p75-jitter)
     string(FIND "${md}" "| cumulus-midday | ${row} |" at)
     expect(NOT at EQUAL -1 "no row for ${row} in sweeps.md")
   endforeach()

@@ -44,6 +44,9 @@ constexpr double kFlyMeanBound = 0.02, kFlyWorstBound = 0.03;
 // first frame (drawn whole) is: what interleaving without motion vectors,
 // the history held still, would show.
 constexpr double kBetterThanStale = 0.5;
+// How much closer to the pixel-area average pixel jitter must bring a still
+// view than centre samples (PixelJitterAveragesOverThePixel).
+constexpr double kJitterGain = 0.8;
 
 std::unique_ptr<render::CloudRenderer> makeRenderer(std::uint32_t interleave, const char* preset, std::string* skip) {
   render::RenderSettings s;
@@ -149,6 +152,62 @@ TEST(Temporal, StillViewConvergesToTheWholeImage) {
     }
     EXPECT_EQ(drawn, std::uint64_t(kW) * kH);  // n^2 frames draw every pixel once
   }
+}
+
+// The image averaged over each pixel's area: drawn whole at kSuper times the
+// size and box-filtered down.
+constexpr std::uint32_t kSuper = 3;
+render::Image boxDown(const render::Image& big, std::uint32_t k) {
+  render::Image out;
+  out.width = big.width / k;
+  out.height = big.height / k;
+  out.rgba.assign(std::size_t(out.width) * out.height * 4, 0.0f);
+  const float w = 1.0f / float(k * k);
+  for (std::uint32_t y = 0; y < out.height * k; ++y)
+    for (std::uint32_t x = 0; x < out.width * k; ++x)
+      for (int c = 0; c < 4; ++c)
+        out.rgba[((y / k) * out.width + x / k) * 4 + c] += w * big.rgba[(std::size_t(y) * big.width + x) * 4 + c];
+  return out;
+}
+
+// Pixel jitter with accumulation: the redraws of a still view go to other
+// places in their pixels, so the accumulated image tends to the pixel-area
+// average (anti-aliased cloud edges) instead of the centre sample. Against
+// the image drawn at 3x3 the size and box-filtered down, the jittered one
+// must be clearly closer than the same accumulation without jitter.
+TEST(Temporal, PixelJitterAveragesOverThePixel) {
+  std::string skip;
+  render::RenderSettings big;
+  big.width = kW * kSuper;
+  big.height = kH * kSuper;
+  big.march = render::findPreset("high")->march;
+  auto super = render::CloudRenderer::create(big);
+  if (!super) {
+    if (super.error().code == ErrorCode::Unsupported) GTEST_SKIP() << describe(super.error());
+    FAIL() << describe(super.error());
+  }
+  const weather::WeatherSnapshot snap = cumulus();
+  const render::FrameInputs in = cumulusInputs(snap);
+  const render::Image area = boxDown(renderOk(**super, in), kSuper);
+  double err[2] = {0, 0};
+  for (int jitter = 0; jitter <= 1; ++jitter) {
+    render::RenderSettings s;
+    s.width = kW;
+    s.height = kH;
+    s.march = big.march;
+    s.temporal.interleave = 2;
+    s.temporal.accumulation = 0.75;
+    s.temporal.pixelJitter = jitter == 1;
+    auto r = render::CloudRenderer::create(s);
+    ASSERT_TRUE(r) << describe(r.error());
+    render::Image image;
+    for (std::uint32_t f = 0; f < render::historyWarmupFrames(s.temporal); ++f) image = renderOk(**r, in);
+    err[jitter] = diff(image, area).displayedRmse;
+    savePng(image, jitter ? "temporal_pixel_jitter.png" : "temporal_no_jitter.png");
+  }
+  std::printf("[ measured ] displayed RMSE against the 3x3 box-filtered image: centre %.5f, jittered %.5f\n", err[0],
+              err[1]);
+  EXPECT_LT(err[1], kJitterGain * err[0]);
 }
 
 TEST(Temporal, TurnIsReprojected) {

@@ -84,6 +84,8 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
         {"air_steps", s.march.airSteps},
         {"blue_noise", s.march.blueNoise}}},
       {"interleave", s.temporal.interleave},
+      {"accumulation", s.temporal.accumulation},
+      {"pixel_jitter", s.temporal.pixelJitter && s.temporal.accumulation > 0},
       {"resolution_divisor", s.resolution.divisor},
       {"resolution", {s.width, s.height}},
       {"vertical_fov_deg", s.verticalFov_deg},

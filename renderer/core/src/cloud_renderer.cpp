@@ -191,6 +191,8 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
       setup.interleave = plan->interleave;
       setup.phase = plan->phase;
       setup.jitterShift = plan->jitterShift;
+      setup.pixelShift = plan->pixelShift;
+      setup.pixelJitter = plan->pixelJitter;
       next.reproject = &*impl_->reproject;
       next.reprojectParams = &plan->params;
     }

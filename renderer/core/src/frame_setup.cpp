@@ -398,6 +398,7 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
                       s.march.blueNoise ? 1.0f : 0.0f);
   f.interleave = gpu::uvec4(s.interleave, s.phase.x, s.phase.y, 0u);
   f.raster = gpu::vec4(float(s.rasterWidth), float(s.rasterHeight), float(s.jitterShift), 0.0f);
+  f.pixelJitter = gpu::vec4(float(s.pixelShift.x), float(s.pixelShift.y), s.pixelJitter ? 1.0f : 0.0f, 0.0f);
 
   for (std::size_t i = 0; i < s.layers.size(); ++i) {
     const LayerSetup& l = s.layers[i];

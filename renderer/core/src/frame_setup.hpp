@@ -88,6 +88,10 @@ struct FrameSetup {
   // Added (mod 1) to every pixel's step offset: TemporalSettings::accumulation's
   // per-cycle shift; 0 otherwise.
   double jitterShift = 0;
+  // TemporalSettings::pixelJitter's per-cycle shift of the ray positions in
+  // their pixels (R2 sequence, each in [0, 1)); applied when pixelJitter.
+  glm::dvec2 pixelShift{0};
+  bool pixelJitter = false;
 };
 
 // Haggstrom 2018's coverage ramp of the step length (sec. 4.2.2, eq. 34):

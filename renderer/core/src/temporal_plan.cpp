@@ -98,6 +98,13 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   if (settings_.accumulation > 0) {
     const double cycle = double(frames_ / (std::uint64_t(n) * n));
     plan.jitterShift = cycle * kGoldenRatioConjugate - std::floor(cycle * kGoldenRatioConjugate);
+    // Roberts' R2 sequence (the plastic number's generalised golden ratio):
+    // consecutive cycles' 2D shifts cover the pixel evenly.
+    if (settings_.pixelJitter) {
+      constexpr double kR2x = 0.7548776662466927, kR2y = 0.5698402909980532;
+      plan.pixelShift = {cycle * kR2x - std::floor(cycle * kR2x), cycle * kR2y - std::floor(cycle * kR2y)};
+      plan.pixelJitter = true;
+    }
   }
   ++frames_;
 

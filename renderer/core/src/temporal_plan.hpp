@@ -40,6 +40,8 @@ struct TemporalPlan {
   std::uint32_t interleave = 1;
   glm::uvec2 phase{0};
   double jitterShift = 0;      // FrameSetup::jitterShift: the cycle's step-offset shift with accumulation
+  glm::dvec2 pixelShift{0};    // FrameSetup::pixelShift: the cycle's ray-position shift with pixelJitter
+  bool pixelJitter = false;
   gpu::SkyReproject params{};  // the reprojection pass's block (image.w = 1 when a history is used)
 };
 

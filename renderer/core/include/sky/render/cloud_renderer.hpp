@@ -90,6 +90,12 @@ struct TemporalSettings {
   // redrawn pixel is taken as drawn, and a still view converges exactly to
   // the image drawn whole. [0, 0.95]; > 0 needs interleave > 1.
   double accumulation = 0;
+  // With accumulation, also jitter where in its pixel each ray goes: a 2D
+  // offset in [-0.5, 0.5) pixels from the blue-noise tile (two of its
+  // values, the pixel's and one 32 texels away), moved on each cycle by the
+  // R2 sequence, so the redraws average over the pixel's area (anti-aliased
+  // edges) instead of sampling its centre. Ignored without accumulation.
+  bool pixelJitter = false;
 };
 
 // Frames of a still view after which an interleaved renderer's history is
