@@ -33,16 +33,22 @@ std::vector<nlohmann::json> readFrames(const fs::path& jsonl) {
   return out;
 }
 
-TEST(CoarseArea, FarWeatherReachesTheRendererThroughTheCoarseArea) {
-  Weatherd w("coarse-area");
-  ASSERT_GT(w.streamPort, 0u) << w.process->log();
-  // 300 km north of the test flight (46.2 N 12.8 E): 2.7 degrees of latitude.
-  const auto posted = w.request("POST", "/api/changes", R"({"changes": [{"op": "set_region", "region": {
+// A 40 km storm region of layer 1 at this coverage, 300 km north of the test
+// flight (46.2 N 12.8 E: 2.7 degrees of latitude), not drifting.
+std::string farStorm(double coverage) {
+  return R"({"changes": [{"op": "set_region", "region": {
       "id": 3, "center_lat_deg": 48.9, "center_lon_deg": 12.8, "size_x_m": 40000, "size_y_m": 40000,
       "corner_radius_m": 5000, "transition_m": 5000, "drifts_with_wind": false,
       "layers": [{"id": 1, "type": "cumulus", "base_m": 1500, "thickness_m": 1500, "transition_band_m": 100,
-                  "coverage": 1.0, "density": 1,
-                  "wind": {"speed_mps": 10, "from_deg": 270, "vertical_mps": 0}}]}}]})");
+                  "coverage": )" +
+         std::to_string(coverage) + R"(, "density": 1,
+                  "wind": {"speed_mps": 10, "from_deg": 270, "vertical_mps": 0}}]}}]})";
+}
+
+TEST(CoarseArea, FarWeatherReachesTheRendererThroughTheCoarseArea) {
+  Weatherd w("coarse-area");
+  ASSERT_GT(w.streamPort, 0u) << w.process->log();
+  const auto posted = w.request("POST", "/api/changes", farStorm(1.0));
   ASSERT_EQ(posted.status, 200) << posted.body;
 
   const fs::path out = w.dir / "out";
@@ -59,12 +65,7 @@ TEST(CoarseArea, FarWeatherReachesTheRendererThroughTheCoarseArea) {
   while (readFrames(jsonl).size() < 3 && std::chrono::steady_clock::now() < until)
     std::this_thread::sleep_for(50ms);
   ASSERT_GE(readFrames(jsonl).size(), 3u) << render.log();
-  const auto thinned = w.request("POST", "/api/changes", R"({"changes": [{"op": "set_region", "region": {
-      "id": 3, "center_lat_deg": 48.9, "center_lon_deg": 12.8, "size_x_m": 40000, "size_y_m": 40000,
-      "corner_radius_m": 5000, "transition_m": 5000, "drifts_with_wind": false,
-      "layers": [{"id": 1, "type": "cumulus", "base_m": 1500, "thickness_m": 1500, "transition_band_m": 100,
-                  "coverage": 0.3, "density": 1,
-                  "wind": {"speed_mps": 10, "from_deg": 270, "vertical_mps": 0}}]}}]})");
+  const auto thinned = w.request("POST", "/api/changes", farStorm(0.3));
   ASSERT_EQ(thinned.status, 200) << thinned.body;
   ASSERT_EQ(render.wait(300s).value_or(-1), 0) << render.log();
 

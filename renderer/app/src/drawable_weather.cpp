@@ -7,6 +7,23 @@
 
 namespace sky::app {
 
+namespace {
+
+// The snapshot with only the layers of these ids, and their tiles.
+weather::WeatherSnapshot withLayers(const weather::WeatherSnapshot& s, const std::set<std::uint32_t>& keep) {
+  weather::WeatherSnapshot out;
+  out.weatherClock_s = s.weatherClock_s;
+  out.tileLevel = s.tileLevel;
+  out.areaIndex = s.areaIndex;
+  for (const auto& l : s.layers)
+    if (keep.count(l.id)) out.layers.push_back(l);
+  for (const auto& t : s.tiles)
+    if (keep.count(t.layerId)) out.tiles.push_back(t);
+  return out;
+}
+
+}  // namespace
+
 weather::WeatherSnapshot drawableWeather(const weather::WeatherSnapshot& s, std::size_t maxLayers,
                                          std::vector<std::uint32_t>* dropped) {
   if (dropped) dropped->clear();
@@ -32,30 +49,15 @@ weather::WeatherSnapshot drawableWeather(const weather::WeatherSnapshot& s, std:
     else if (dropped)
       dropped->push_back(ranked[i]->id);
   }
-  weather::WeatherSnapshot out;
-  out.weatherClock_s = s.weatherClock_s;
-  out.tileLevel = s.tileLevel;
-  for (const auto& l : s.layers)
-    if (keep.count(l.id)) out.layers.push_back(l);
-  for (const auto& t : s.tiles)
-    if (keep.count(t.layerId)) out.tiles.push_back(t);
   if (dropped) std::sort(dropped->begin(), dropped->end());
-  return out;
+  return withLayers(s, keep);
 }
 
 weather::WeatherSnapshot drawableCoarse(const weather::WeatherSnapshot& coarse,
                                         const weather::WeatherSnapshot& drawable) {
   std::set<std::uint32_t> keep;
   for (const auto& l : drawable.layers) keep.insert(l.id);
-  weather::WeatherSnapshot out;
-  out.weatherClock_s = coarse.weatherClock_s;
-  out.tileLevel = coarse.tileLevel;
-  out.areaIndex = coarse.areaIndex;
-  for (const auto& l : coarse.layers)
-    if (keep.count(l.id)) out.layers.push_back(l);
-  for (const auto& t : coarse.tiles)
-    if (keep.count(t.layerId)) out.tiles.push_back(t);
-  return out;
+  return withLayers(coarse, keep);
 }
 
 }  // namespace sky::app

@@ -58,63 +58,23 @@ GpuImage createSampledImage(const GpuContext& ctx, vk::ImageType type, vk::Forma
   return img;
 }
 
-Result<void> uploadImage(const GpuContext& ctx, GpuImage& image, std::span<const std::byte> texels,
-                         GpuTimer* timer, const char* pass) {
+namespace {
+
+// Copies texels (staged whole) into the image by `copies`, timed as `pass`,
+// between barriers from `from` (with the accesses that had it) to the layout
+// the shaders read.
+Result<void> copyIntoImage(const GpuContext& ctx, GpuImage& image, std::span<const std::byte> texels,
+                           std::span<const vk::BufferImageCopy> copies, vk::ImageLayout from,
+                           vk::AccessFlags fromAccess, GpuTimer* timer, const char* pass) {
   GpuBuffer staging = createHostBuffer(ctx, texels.size(), vk::BufferUsageFlagBits::eTransferSrc, "sky.staging");
   std::memcpy(staging.mapped, texels.data(), texels.size());
-
   const vk::ImageSubresourceRange range(vk::ImageAspectFlagBits::eColor, 0, 1, 0, image.layers);
   vk::raii::CommandBuffer cmd = ctx.allocateCommandBuffer();
   cmd.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
   if (timer) timer->begin(cmd);
   std::optional<GpuTimer::Section> timed;
   if (timer) timed.emplace(timer->section(cmd, pass ? pass : "upload"));
-  // Undefined -> transfer destination: discards what the image held; the
-  // source stage covers an earlier frame's shader reads.
-  const vk::ImageMemoryBarrier toTransfer({}, vk::AccessFlagBits::eTransferWrite, vk::ImageLayout::eUndefined,
-                                          vk::ImageLayout::eTransferDstOptimal, VK_QUEUE_FAMILY_IGNORED,
-                                          VK_QUEUE_FAMILY_IGNORED, *image.image, range);
-  cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eTransfer, {}, {}, {},
-                      toTransfer);
-  const vk::BufferImageCopy region(0, 0, 0, vk::ImageSubresourceLayers(vk::ImageAspectFlagBits::eColor, 0, 0, image.layers),
-                                   {0, 0, 0}, image.extent);
-  cmd.copyBufferToImage(*staging.buffer, *image.image, vk::ImageLayout::eTransferDstOptimal, region);
-  const vk::ImageMemoryBarrier toShader(vk::AccessFlagBits::eTransferWrite, vk::AccessFlagBits::eShaderRead,
-                                        vk::ImageLayout::eTransferDstOptimal, vk::ImageLayout::eShaderReadOnlyOptimal,
-                                        VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *image.image, range);
-  cmd.pipelineBarrier(vk::PipelineStageFlagBits::eTransfer, vk::PipelineStageFlagBits::eComputeShader, {}, {}, {},
-                      toShader);
-  timed.reset();
-  cmd.end();
-  const vk::raii::Fence fence(ctx.device(), vk::FenceCreateInfo());
-  return ctx.submitAndWait(cmd, fence);
-}
-
-Result<void> uploadImageRegions(const GpuContext& ctx, GpuImage& image, std::span<const std::byte> texels,
-                                std::span<const ImageRegion> regions, GpuTimer* timer, const char* pass) {
-  if (regions.empty()) return {};
-  GpuBuffer staging = createHostBuffer(ctx, texels.size(), vk::BufferUsageFlagBits::eTransferSrc, "sky.staging");
-  std::memcpy(staging.mapped, texels.data(), texels.size());
-  std::vector<vk::BufferImageCopy> copies;
-  copies.reserve(regions.size());
-  for (const ImageRegion& r : regions) {
-    SKY_ASSERT(r.layer < image.layers && r.width > 0 && r.height > 0 && r.x + r.width <= image.extent.width &&
-               r.y + r.height <= image.extent.height);
-    copies.emplace_back(r.byteOffset, 0, 0, vk::ImageSubresourceLayers(vk::ImageAspectFlagBits::eColor, 0, r.layer, 1),
-                        vk::Offset3D(std::int32_t(r.x), std::int32_t(r.y), 0), vk::Extent3D(r.width, r.height, 1));
-  }
-
-  const vk::ImageSubresourceRange range(vk::ImageAspectFlagBits::eColor, 0, 1, 0, image.layers);
-  vk::raii::CommandBuffer cmd = ctx.allocateCommandBuffer();
-  cmd.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
-  if (timer) timer->begin(cmd);
-  std::optional<GpuTimer::Section> timed;
-  if (timer) timed.emplace(timer->section(cmd, pass ? pass : "upload"));
-  // From the layout the shaders read (not eUndefined, which would let the
-  // driver discard the texels outside the regions); the source stage and
-  // access cover an earlier frame's reads.
-  const vk::ImageMemoryBarrier toTransfer(vk::AccessFlagBits::eShaderRead, vk::AccessFlagBits::eTransferWrite,
-                                          vk::ImageLayout::eShaderReadOnlyOptimal,
+  const vk::ImageMemoryBarrier toTransfer(fromAccess, vk::AccessFlagBits::eTransferWrite, from,
                                           vk::ImageLayout::eTransferDstOptimal, VK_QUEUE_FAMILY_IGNORED,
                                           VK_QUEUE_FAMILY_IGNORED, *image.image, range);
   cmd.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eTransfer, {}, {}, {},
@@ -129,6 +89,35 @@ Result<void> uploadImageRegions(const GpuContext& ctx, GpuImage& image, std::spa
   cmd.end();
   const vk::raii::Fence fence(ctx.device(), vk::FenceCreateInfo());
   return ctx.submitAndWait(cmd, fence);
+}
+
+}  // namespace
+
+Result<void> uploadImage(const GpuContext& ctx, GpuImage& image, std::span<const std::byte> texels,
+                         GpuTimer* timer, const char* pass) {
+  const vk::BufferImageCopy whole(0, 0, 0, vk::ImageSubresourceLayers(vk::ImageAspectFlagBits::eColor, 0, 0, image.layers),
+                                  {0, 0, 0}, image.extent);
+  // Undefined -> transfer destination: discards what the image held; the
+  // source stage covers an earlier frame's shader reads.
+  return copyIntoImage(ctx, image, texels, std::span(&whole, 1), vk::ImageLayout::eUndefined, {}, timer, pass);
+}
+
+Result<void> uploadImageRegions(const GpuContext& ctx, GpuImage& image, std::span<const std::byte> texels,
+                                std::span<const ImageRegion> regions, GpuTimer* timer, const char* pass) {
+  if (regions.empty()) return {};
+  std::vector<vk::BufferImageCopy> copies;
+  copies.reserve(regions.size());
+  for (const ImageRegion& r : regions) {
+    SKY_ASSERT(r.layer < image.layers && r.width > 0 && r.height > 0 && r.x + r.width <= image.extent.width &&
+               r.y + r.height <= image.extent.height);
+    copies.emplace_back(r.byteOffset, 0, 0, vk::ImageSubresourceLayers(vk::ImageAspectFlagBits::eColor, 0, r.layer, 1),
+                        vk::Offset3D(std::int32_t(r.x), std::int32_t(r.y), 0), vk::Extent3D(r.width, r.height, 1));
+  }
+  // From the layout the shaders read (not eUndefined, which would let the
+  // driver discard the texels outside the regions); the source access covers
+  // an earlier frame's reads.
+  return copyIntoImage(ctx, image, texels, copies, vk::ImageLayout::eShaderReadOnlyOptimal,
+                       vk::AccessFlagBits::eShaderRead, timer, pass);
 }
 
 Result<std::vector<std::byte>> downloadImage(const GpuContext& ctx, const GpuImage& image,
