@@ -53,23 +53,25 @@ std::string duration(double s) {
   return buf;
 }
 
-// Waits until the weather version exceeds `after` (a snapshot or delta arrived).
-bool waitForWeather(const SharedState& state, std::uint64_t after, double timeout_s, const std::atomic<bool>* stop) {
+// Polls until `ready` holds; false on a stop request or after timeout_s.
+template <class Ready>
+bool waitUntil(Ready ready, double timeout_s, const std::atomic<bool>* stop) {
   const auto until = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
-  while (state.weatherVersion() <= after) {
+  while (!ready()) {
     if ((stop && *stop) || Clock::now() > until) return false;
     std::this_thread::sleep_for(kWeatherPoll);
   }
   return true;
 }
 
+// Waits until the weather version exceeds `after` (a snapshot or delta arrived).
+bool waitForWeather(const SharedState& state, std::uint64_t after, double timeout_s, const std::atomic<bool>* stop) {
+  return waitUntil([&] { return state.weatherVersion() > after; }, timeout_s, stop);
+}
+
+// Waits for the coarse area's first snapshot.
 bool waitForCoarse(const SharedState& state, double timeout_s, const std::atomic<bool>* stop) {
-  const auto until = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
-  while (state.coarseVersion() == 0) {
-    if ((stop && *stop) || Clock::now() > until) return false;
-    std::this_thread::sleep_for(kWeatherPoll);
-  }
-  return true;
+  return waitUntil([&] { return state.coarseVersion() > 0; }, timeout_s, stop);
 }
 
 }  // namespace

@@ -297,9 +297,4 @@ bool sameAnchor(const geo::Geodetic& a, const geo::Geodetic& b) {
   return a.lat_deg == b.lat_deg && a.lon_deg == b.lon_deg && a.alt_m == b.alt_m;
 }
 
-bool weatherFieldStale(const WeatherField& field, std::uint64_t contentKey, const geo::Geodetic& anchor) {
-  if (field.texels.empty() || field.contentKey != contentKey) return true;
-  return !sameAnchor(field.anchor, anchor);
-}
-
 }  // namespace sky::render

@@ -203,8 +203,4 @@ geo::Geodetic weatherAnchorFor(const geo::Geodetic& camera);
 // Whether two anchors are the same point, bit for bit (what cell reuse needs).
 bool sameAnchor(const geo::Geodetic& a, const geo::Geodetic& b);
 
-// True when the map must be rebuilt for this snapshot key and anchor
-// (weatherAnchorFor the camera).
-bool weatherFieldStale(const WeatherField& field, std::uint64_t contentKey, const geo::Geodetic& anchor);
-
 }  // namespace sky::render
