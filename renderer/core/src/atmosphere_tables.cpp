@@ -11,6 +11,7 @@
 #include <glm/gtc/packing.hpp>
 
 #include "sky/core/assert.hpp"
+#include "sky_light_grid.hpp"
 
 namespace sky::render {
 
@@ -117,6 +118,7 @@ AtmosphereTables buildAtmosphereTables() {
       const double h = H * double(j) / double(m.height - 1);
       store(m, i, j, core.multipleScattering(h, muSun));
     }
+  tables.skyLight = std::make_shared<SkyLightGrid>();
   return tables;
 }
 
@@ -125,8 +127,7 @@ glm::dvec3 sunTransmittanceAt(const AtmosphereTables& tables, double h_m, double
   return core.sunTransmittance(h_m, muSun, groundRadius_m);
 }
 
-SkyLight skyLightAt(const AtmosphereTables& tables, double h_m, double groundRadius_m, const glm::dvec3& sunDir,
-                    const glm::dvec3& sunIrradiance) {
+SkyDome skyDomeAt(const AtmosphereTables& tables, double h_m, double groundRadius_m, const glm::dvec3& sunDir) {
   using C = AirCore;
   AirCore core(&tables);
   const double h = std::max(h_m, 0.0);
@@ -137,8 +138,8 @@ SkyLight skyLightAt(const AtmosphereTables& tables, double h_m, double groundRad
   const double hAboveTop = h - C::kAtmosphereHeight_m;
   a.cTop = hAboveTop * (2 * a.r - hAboveTop);
   a.sunDir = sunDir;
-  a.sunIrradiance = sunIrradiance;
-  SkyLight light;
+  a.sunIrradiance = glm::dvec3(1.0);  // the inscatter is linear in it (atmosphere_core.glsl's marchAir)
+  SkyDome dome;
   const double solidAngle = 2 * C::kPi / (kSkyRings * kSkyAzimuths);
   for (int ring = 0; ring < kSkyRings; ++ring) {
     const double mu = (ring + 0.5) / kSkyRings;  // equal solid angle per ring
@@ -148,12 +149,24 @@ SkyLight skyLightAt(const AtmosphereTables& tables, double h_m, double groundRad
       const glm::dvec3 dir(s * std::cos(phi), s * std::sin(phi), mu);
       double q[C::kAirQueries] = {C::kFarAway_m};
       const C::AirPath path = core.marchAir(a, dir, C::kFarAway_m, q, 1);
-      const glm::dvec3 L = path.inscatter[0] + path.transmittance[0] * C::kNightSkyRadiance;
-      light.meanRadiance += L / double(kSkyRings * kSkyAzimuths);
-      light.irradiance += L * mu * solidAngle;
+      const glm::dvec3 night = path.transmittance[0] * C::kNightSkyRadiance;
+      dome.perSun.meanRadiance += path.inscatter[0] / double(kSkyRings * kSkyAzimuths);
+      dome.perSun.irradiance += path.inscatter[0] * mu * solidAngle;
+      dome.night.meanRadiance += night / double(kSkyRings * kSkyAzimuths);
+      dome.night.irradiance += night * mu * solidAngle;
     }
   }
-  return light;
+  return dome;
+}
+
+SkyLight SkyDome::lit(const glm::dvec3& sunIrradiance) const {
+  return SkyLight{sunIrradiance * perSun.meanRadiance + night.meanRadiance,
+                  sunIrradiance * perSun.irradiance + night.irradiance};
+}
+
+SkyLight skyLightAt(const AtmosphereTables& tables, double h_m, double groundRadius_m, const glm::dvec3& sunDir,
+                    const glm::dvec3& sunIrradiance) {
+  return skyDomeAt(tables, h_m, groundRadius_m, sunDir).lit(sunIrradiance);
 }
 
 }  // namespace sky::render

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -24,9 +25,14 @@ struct AtmosphereTable {
   glm::dvec3 sample(const glm::dvec2& uv) const;
 };
 
+class SkyLightGrid;
+
 struct AtmosphereTables {
   AtmosphereTable transmittance;        // (mu, height): transmittance to the top
   AtmosphereTable multipleScattering;   // (sun cosine, height): Hillaire 2020's multiple scattering
+  // The sky light over (height, sun cosine), filled on first use from the two
+  // tables above (sky_light_grid.hpp); copies of these tables share it.
+  std::shared_ptr<SkyLightGrid> skyLight;
 
   glm::dvec3 sampleTransmittance(const glm::dvec2& uv) const { return transmittance.sample(uv); }
   glm::dvec3 sampleMultipleScattering(const glm::dvec2& uv) const { return multipleScattering.sample(uv); }
@@ -60,10 +66,21 @@ struct SkyLight {
 };
 
 // The sky seen from height h_m above a ground sphere of radius
-// groundRadius_m, the sun towards sunDir (unit, local frame, z up) with
-// irradiance sunIrradiance at the top of the atmosphere: single-scattered sky
-// with its multiple scattering, plus the night-sky floor, over 8 x 16
-// equal-solid-angle directions.
+// groundRadius_m, the sun towards sunDir (unit, local frame, z up): its two
+// parts, the light the sun's scattering gives per unit irradiance at the top
+// of the atmosphere (single-scattered sky with its multiple scattering), and
+// the night-sky floor seen through the air; over 8 x 16 equal-solid-angle
+// directions. The direct integral: ~0.5 ms (Release).
+struct SkyDome {
+  SkyLight perSun;
+  SkyLight night;
+
+  // The sky light with the sun's irradiance sunIrradiance at the top.
+  SkyLight lit(const glm::dvec3& sunIrradiance) const;
+};
+SkyDome skyDomeAt(const AtmosphereTables& tables, double h_m, double groundRadius_m, const glm::dvec3& sunDir);
+
+// skyDomeAt(...).lit(sunIrradiance): the direct integral.
 SkyLight skyLightAt(const AtmosphereTables& tables, double h_m, double groundRadius_m, const glm::dvec3& sunDir,
                     const glm::dvec3& sunIrradiance);
 

@@ -10,6 +10,7 @@
 #include "sky/core/assert.hpp"
 #include "sky/render/ephemeris.hpp"
 #include "sky/weather/advection.hpp"
+#include "sky_light_grid.hpp"
 
 namespace sky::render {
 
@@ -261,7 +262,7 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
   };
   s.sunDir = towards(sun);
   s.sunIrradiance = glm::dvec3(kSunIrradiance);
-  s.groundIrradiance = skyLightAt(tables, 0.0, groundRadius_m, s.sunDir, s.sunIrradiance).irradiance;
+  s.groundIrradiance = skyLight(tables, 0.0, groundRadius_m, s.sunDir, s.sunIrradiance).irradiance;
   // One key light for the clouds, the air and the ground: the moon instead
   // of the sun when it puts more light on the ground (direct and through the
   // sky, by luminance): with a full moon from about the end of nautical
@@ -271,7 +272,7 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
   if (sun.elevation_deg < 0 && moon.elevation_deg > -1) {
     const glm::dvec3 moonDir = towards(moon);
     const glm::dvec3 moonIrradiance(kSunIrradiance * moonToSunIlluminance(moonPhase_deg));
-    const glm::dvec3 moonSky = skyLightAt(tables, 0.0, groundRadius_m, moonDir, moonIrradiance).irradiance;
+    const glm::dvec3 moonSky = skyLight(tables, 0.0, groundRadius_m, moonDir, moonIrradiance).irradiance;
     auto onGround = [&](const glm::dvec3& dir, const glm::dvec3& e, const glm::dvec3& sky) {
       const glm::dvec3 v = e * sunTransmittanceAt(tables, 0.0, dir.z, groundRadius_m) * std::max(dir.z, 0.0) + sky;
       return 0.2126 * v.r + 0.7152 * v.g + 0.0722 * v.b;
@@ -310,7 +311,7 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
     // The diffuse light the layer's top receives, over the camera: the sky,
     // and the sun through the air (cloud_core.glsl's diffuseLight).
     const double top_m = std::max(layer.base_m + layer.thickness_m, 0.0);
-    l.skyTop = skyLightAt(tables, top_m, groundRadius_m, s.sunDir, s.sunIrradiance).meanRadiance;
+    l.skyTop = skyLight(tables, top_m, groundRadius_m, s.sunDir, s.sunIrradiance).meanRadiance;
     l.sunCosine = std::max(s.sunDir.z, 0.0);
     l.sunDiffuseTop = s.sunIrradiance * sunTransmittanceAt(tables, top_m, s.sunDir.z, groundRadius_m) *
                       (l.sunCosine / std::numbers::pi);
