@@ -17,10 +17,13 @@
 layout(local_size_x = kReprojectLocalSizeX, local_size_y = kReprojectLocalSizeY) in;
 
 layout(std430, set = 0, binding = kReprojectBindingParams) readonly buffer ParamsBlock { SkyReproject params; };
-layout(std430, set = 0, binding = kReprojectBindingFresh) readonly buffer FreshBlock { vec4 fresh[]; };
-layout(std430, set = 0, binding = kReprojectBindingFreshDepth) readonly buffer FreshDepthBlock { float freshDepth[]; };
-layout(std430, set = 0, binding = kReprojectBindingHistory) readonly buffer HistoryBlock { vec4 history[]; };
-layout(std430, set = 0, binding = kReprojectBindingHistoryDepth) readonly buffer HistoryDepthBlock { float historyDepth[]; };
+// What it gathers from is in storage images (renderer/core/src/pixel_mirror.hpp:
+// llvmpipe loads a storage buffer at per-lane indices one lane and one
+// component at a time, with branches; an image texel whole).
+layout(set = 0, binding = kReprojectBindingFresh, rgba32f) uniform readonly image2D freshImage;  // packed: texel (b.x, b.y)
+layout(set = 0, binding = kReprojectBindingFreshDepth, r32f) uniform readonly image2D freshDepthImage;
+layout(set = 0, binding = kReprojectBindingHistory, rgba32f) uniform readonly image2D historyImage;
+layout(set = 0, binding = kReprojectBindingHistoryDepth, r32f) uniform readonly image2D historyDepthImage;
 layout(std430, set = 0, binding = kReprojectBindingOut) writeonly buffer OutBlock { vec4 outPixels[]; };
 layout(std430, set = 0, binding = kReprojectBindingOutDepth) writeonly buffer OutDepthBlock { float outDepth[]; };
 layout(std430, set = 0, binding = kReprojectBindingOutcomes) writeonly buffer OutcomeBlock { uint outcomes[]; };
@@ -40,7 +43,6 @@ vec2 gRaster;  // the image's extent for the camera rays (SkyReproject::raster)
 uint gN;       // interleave
 int gShift;    // log2(gN): n is 1, 2 or 4, and vector integer division is slow on the CPU
 uvec2 gPhase;  // this frame's drawn pixel in each block
-uint gPacked;  // packed width
 vec3 gForward, gRight, gDown;              // this camera
 vec3 gPrevForward, gPrevRight, gPrevDown;  // the previous camera
 vec3 gPrevPosition;
@@ -53,12 +55,18 @@ vec3 gMotion[kReprojectMaxLayers];
 bool gHasHistory;
 bool gStill;  // neither the camera nor any layer's air moved since the previous frame
 
-// The drawn pixel of block b, when it lies inside the image.
-bool drawnPixel(ivec2 b, out uint index) {
+// The drawn pixel of block b, when it lies inside the image; texel: where
+// the packed image holds it.
+bool drawnPixel(ivec2 b, out ivec2 texel) {
   ivec2 px = (b << gShift) + ivec2(gPhase);
-  index = uint(b.y) * gPacked + uint(b.x);
+  texel = b;
   return b.x >= 0 && b.y >= 0 && px.x < int(gSize.x) && px.y < int(gSize.y);
 }
+
+vec4 freshAt(ivec2 texel) { return imageLoad(freshImage, texel); }
+float freshDepthAt(ivec2 texel) { return imageLoad(freshDepthImage, texel).x; }
+vec4 historyAtPixel(ivec2 c) { return imageLoad(historyImage, c); }
+float historyDepthAtPixel(ivec2 c) { return imageLoad(historyDepthImage, c).x; }
 
 // This frame's drawn pixels interpolated at pixel px (bilinear over the grid
 // of drawn pixels, each block's drawn pixel at b * n + phase); depth from the
@@ -72,12 +80,12 @@ void upscale(ivec2 px, out vec4 colour, out float depth) {
   float wsum = 0.0, best = -1.0;
   for (int k = 0; k < 4; ++k) {
     ivec2 o = ivec2(k & 1, k >> 1);
-    uint i;
+    ivec2 i;
     if (!drawnPixel(b0 + o, i)) continue;
     float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
-    colour += w * fresh[i];
+    colour += w * freshAt(i);
     wsum += w;
-    if (w > best) best = w, depth = freshDepth[i];
+    if (w > best) best = w, depth = freshDepthAt(i);
   }
   if (wsum > 0.0) colour /= wsum;
 }
@@ -137,10 +145,9 @@ bool historyAt(vec2 p, float expected, out vec4 colour, out float seenDepth) {
   if (all(lessThan(abs(f - round(f)), vec2(1e-3)))) {
     ivec2 c = i0 + ivec2(round(f));
     if (!insideImage(c)) return false;
-    uint i = uint(c.y) * gSize.x + uint(c.x);
-    float hd = historyDepth[i];
+    float hd = historyDepthAtPixel(c);
     if (!agree(hd, expected)) return false;
-    colour = history[i];
+    colour = historyAtPixel(c);
     seenDepth = hd;
     return true;
   }
@@ -149,11 +156,10 @@ bool historyAt(vec2 p, float expected, out vec4 colour, out float seenDepth) {
     ivec2 o = ivec2(k & 1, k >> 1);
     ivec2 c = i0 + o;
     if (!insideImage(c)) continue;
-    uint i = uint(c.y) * gSize.x + uint(c.x);
-    float hd = historyDepth[i];
+    float hd = historyDepthAtPixel(c);
     if (!agree(hd, expected)) continue;
     float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
-    colour += w * history[i];
+    colour += w * historyAtPixel(c);
     seenDepth += w * hd;
     wsum += w;
   }
@@ -177,7 +183,7 @@ float reusedDepth(float guess, float expected, float seen) {
 // Depth of the history pixel nearest p (p inside the image).
 float historyDepthNear(vec2 p) {
   ivec2 c = clamp(ivec2(floor(p)), ivec2(0), ivec2(gSize) - 1);
-  return historyDepth[uint(c.y) * gSize.x + uint(c.x)];
+  return historyDepthAtPixel(c);
 }
 
 // The depth of the drawn pixel nearest px (its own block's, or, at the
@@ -185,9 +191,9 @@ float historyDepthNear(vec2 p) {
 // before), 0 when there is none.
 float nearestDrawnDepth(ivec2 px) {
   ivec2 b = ivec2(floor((vec2(px) - vec2(gPhase)) / float(gN) + 0.5));
-  uint i;
+  ivec2 i;
   for (int k = 0; k < 2; ++k, b -= 1)
-    if (drawnPixel(max(b, ivec2(0)), i)) return freshDepth[i];
+    if (drawnPixel(max(b, ivec2(0)), i)) return freshDepthAt(i);
   return 0.0;
 }
 
@@ -219,10 +225,10 @@ uint reuseHistory(ivec2 px, out vec4 colour, inout float depth) {
 
 uint resolvePixel(ivec2 px, out vec4 colour, out float depth) {
   ivec2 b = px >> gShift;
-  uint drawn;
+  ivec2 drawn;
   if (px == (b << gShift) + ivec2(gPhase) && drawnPixel(b, drawn)) {
-    colour = fresh[drawn];
-    depth = freshDepth[drawn];
+    colour = freshAt(drawn);
+    depth = freshDepthAt(drawn);
     // Temporal accumulation: the redrawn pixel blended with its history,
     // found through the motion at the depth just drawn (depth stays as drawn).
     if (gHasHistory && gAccumulation > 0.0) {
@@ -249,7 +255,6 @@ void main() {
   gShift = gN == 4u ? 2 : gN == 2u ? 1 : 0;
   gHasHistory = params.image.w != 0u;
   gPhase = params.phase.xy;
-  gPacked = params.phase.z;
   gLayers = params.phase.w;
   gForward = params.camForward.xyz;
   gRight = params.camRight.xyz;

@@ -9,9 +9,8 @@
 // a far cloud's depth would be a point on neither. When all four lie across
 // the horizon (a sliver of it), the nearest pixel is taken.
 // One invocation per cell between four small pixels' centres: it reads the
-// four once and writes the d x d full-size pixels inside the cell
-// (storage-buffer reads are gathers on lavapipe; read per output pixel they
-// cost 4 d^2 reads per cell instead of 4).
+// four once and writes the d x d full-size pixels inside the cell (read per
+// output pixel they would cost 4 d^2 reads per cell instead of 4).
 // Layout: include/upscale_shared.h.
 #version 450
 #extension GL_GOOGLE_include_directive : require
@@ -21,8 +20,9 @@
 layout(local_size_x = kUpscaleLocalSizeX, local_size_y = kUpscaleLocalSizeY) in;
 
 layout(std430, set = 0, binding = kUpscaleBindingParams) readonly buffer ParamsBlock { SkyUpscale params; };
-layout(std430, set = 0, binding = kUpscaleBindingSource) readonly buffer SourceBlock { vec4 source[]; };
-layout(std430, set = 0, binding = kUpscaleBindingSourceDepth) readonly buffer SourceDepthBlock { float sourceDepth[]; };
+// The small image in storage images (renderer/core/src/pixel_mirror.hpp).
+layout(set = 0, binding = kUpscaleBindingSource, rgba32f) uniform readonly image2D sourceImage;
+layout(set = 0, binding = kUpscaleBindingSourceDepth, r32f) uniform readonly image2D sourceDepthImage;
 layout(std430, set = 0, binding = kUpscaleBindingOut) writeonly buffer OutBlock { vec4 outPixels[]; };
 layout(std430, set = 0, binding = kUpscaleBindingOutDepth) writeonly buffer OutDepthBlock { float outDepth[]; };
 
@@ -70,9 +70,8 @@ void main() {
   bool tapGround[4];
   for (int k = 0; k < 4; ++k) {
     ivec2 c = clamp(cell + ivec2(k & 1, k >> 1), ivec2(0), small - 1);
-    uint i = uint(c.y * small.x + c.x);
-    tapColour[k] = source[i];
-    tapDepth[k] = sourceDepth[i];
+    tapColour[k] = imageLoad(sourceImage, c);
+    tapDepth[k] = imageLoad(sourceDepthImage, c).x;
     tapGround[k] = depthAware && seesGround(vec2(c), gRaster);
   }
   // Full-size pixel x sits at (x + 0.5) / d - 0.5 in the small image: in

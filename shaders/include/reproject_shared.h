@@ -19,10 +19,10 @@ using uvec4 = glm::uvec4;
 // Descriptor set 0 bindings of the reprojection pass. Every image is a
 // storage buffer, row-major, top row first.
 SKY_REPROJECT_CONST kReprojectBindingParams = 0u;        // read-only: one SkyReproject
-SKY_REPROJECT_CONST kReprojectBindingFresh = 1u;         // read-only vec4: this frame's drawn pixels, packed
-SKY_REPROJECT_CONST kReprojectBindingFreshDepth = 2u;    // read-only float: their cloud depth (m, 0 none)
-SKY_REPROJECT_CONST kReprojectBindingHistory = 3u;       // read-only vec4: the previous frame's full image
-SKY_REPROJECT_CONST kReprojectBindingHistoryDepth = 4u;  // read-only float: its cloud depth
+SKY_REPROJECT_CONST kReprojectBindingFresh = 1u;         // rgba32f storage image, read: this frame's drawn pixels, packed
+SKY_REPROJECT_CONST kReprojectBindingFreshDepth = 2u;    // r32f storage image, read: their cloud depth (m, 0 none)
+SKY_REPROJECT_CONST kReprojectBindingHistory = 3u;       // rgba32f storage image, read: the previous frame's full image
+SKY_REPROJECT_CONST kReprojectBindingHistoryDepth = 4u;  // r32f storage image, read: its cloud depth
 SKY_REPROJECT_CONST kReprojectBindingOut = 5u;           // vec4: this frame's full image (the next history)
 SKY_REPROJECT_CONST kReprojectBindingOutDepth = 6u;      // float: its cloud depth
 SKY_REPROJECT_CONST kReprojectBindingOutcomes = 7u;         // uint per pixel: what became of it (below)

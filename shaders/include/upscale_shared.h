@@ -19,8 +19,8 @@ using uvec4 = glm::uvec4;
 // Descriptor set 0 bindings of the upscale pass; every image a storage
 // buffer, row-major, top row first.
 SKY_UPSCALE_CONST kUpscaleBindingParams = 0u;    // read-only: one SkyUpscale
-SKY_UPSCALE_CONST kUpscaleBindingSource = 1u;    // read-only vec4: the small image, radiance + transmittance
-SKY_UPSCALE_CONST kUpscaleBindingSourceDepth = 2u;  // read-only float: its cloud depth (m, 0 none)
+SKY_UPSCALE_CONST kUpscaleBindingSource = 1u;    // rgba32f storage image, read: the small image, radiance + transmittance
+SKY_UPSCALE_CONST kUpscaleBindingSourceDepth = 2u;  // r32f storage image, read: its cloud depth (m, 0 none)
 SKY_UPSCALE_CONST kUpscaleBindingOut = 3u;       // vec4: the full-size image
 SKY_UPSCALE_CONST kUpscaleBindingOutDepth = 4u;  // float: its cloud depth
 

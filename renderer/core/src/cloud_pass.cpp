@@ -78,10 +78,11 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
 
   // A storage buffer, not a uniform buffer: see clouds.comp's FrameBlock.
   pass.uniforms_ = createHostBuffer(ctx, sizeof(gpu::SkyFrame), vk::BufferUsageFlagBits::eStorageBuffer, "sky.frameBlock");
-  pass.output_ = createHostBuffer(ctx, vk::DeviceSize(width) * height * 4 * sizeof(float),
-                                  vk::BufferUsageFlagBits::eStorageBuffer, "sky.cloudOutput");
-  pass.depth_ = createHostBuffer(ctx, vk::DeviceSize(width) * height * sizeof(float),
-                                 vk::BufferUsageFlagBits::eStorageBuffer, "sky.cloudDepth");
+  // Transfer sources: the reprojection and the upscale read copies of them
+  // (pixel_mirror.hpp).
+  const auto output = vk::BufferUsageFlagBits::eStorageBuffer | vk::BufferUsageFlagBits::eTransferSrc;
+  pass.output_ = createHostBuffer(ctx, vk::DeviceSize(width) * height * 4 * sizeof(float), output, "sky.cloudOutput");
+  pass.depth_ = createHostBuffer(ctx, vk::DeviceSize(width) * height * sizeof(float), output, "sky.cloudDepth");
   pass.coverageMip_ = createHostBuffer(ctx, vk::DeviceSize(kCoverageMipFloats * sizeof(float)),
                                        vk::BufferUsageFlagBits::eStorageBuffer, "sky.coverageMip");
   std::memset(pass.coverageMip_.mapped, 0, pass.coverageMip_.size);

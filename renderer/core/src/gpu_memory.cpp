@@ -28,27 +28,24 @@ GpuBuffer createHostBuffer(const GpuContext& ctx, vk::DeviceSize size, vk::Buffe
   return b;
 }
 
-GpuImage createSampledImage(const GpuContext& ctx, vk::ImageType type, vk::Format format, vk::Extent3D extent,
-                            std::uint32_t layers, const char* debugName) {
+namespace {
+
+// A device-local image with its memory and a view of viewType over all layers.
+GpuImage createImage(const GpuContext& ctx, vk::ImageType type, vk::ImageViewType viewType, vk::Format format,
+                     vk::Extent3D extent, std::uint32_t layers, vk::ImageUsageFlags usage, const char* debugName) {
   const auto& device = ctx.device();
   GpuImage img;
   img.format = format;
   img.extent = extent;
   img.layers = layers;
   const vk::ImageCreateInfo info({}, type, format, extent, 1, layers, vk::SampleCountFlagBits::e1,
-                                 vk::ImageTiling::eOptimal,
-                                 vk::ImageUsageFlagBits::eSampled | vk::ImageUsageFlagBits::eTransferDst |
-                                     vk::ImageUsageFlagBits::eTransferSrc);
+                                 vk::ImageTiling::eOptimal, usage);
   img.image = vk::raii::Image(device, info);
   const vk::MemoryRequirements req = img.image.getMemoryRequirements();
   img.memory = vk::raii::DeviceMemory(
       device, vk::MemoryAllocateInfo(req.size, ctx.memoryType(req.memoryTypeBits,
                                                               vk::MemoryPropertyFlagBits::eDeviceLocal)));
   img.image.bindMemory(*img.memory, 0);
-  // A view's type must match the shader's sampler (sampler2D, sampler2DArray).
-  const vk::ImageViewType viewType = type == vk::ImageType::e3D ? vk::ImageViewType::e3D
-                                     : layers > 1               ? vk::ImageViewType::e2DArray
-                                                                : vk::ImageViewType::e2D;
   img.view = vk::raii::ImageView(
       device, vk::ImageViewCreateInfo({}, *img.image, viewType, format, {},
                                       vk::ImageSubresourceRange(vk::ImageAspectFlagBits::eColor, 0, 1, 0, layers)));
@@ -56,6 +53,26 @@ GpuImage createSampledImage(const GpuContext& ctx, vk::ImageType type, vk::Forma
   ctx.name(img.memory, debugName);
   ctx.name(img.view, debugName);
   return img;
+}
+
+}  // namespace
+
+GpuImage createSampledImage(const GpuContext& ctx, vk::ImageType type, vk::Format format, vk::Extent3D extent,
+                            std::uint32_t layers, const char* debugName) {
+  // A view's type must match the shader's sampler (sampler2D, sampler2DArray).
+  const vk::ImageViewType viewType = type == vk::ImageType::e3D ? vk::ImageViewType::e3D
+                                     : layers > 1               ? vk::ImageViewType::e2DArray
+                                                                : vk::ImageViewType::e2D;
+  return createImage(ctx, type, viewType, format, extent, layers,
+                     vk::ImageUsageFlagBits::eSampled | vk::ImageUsageFlagBits::eTransferDst |
+                         vk::ImageUsageFlagBits::eTransferSrc,
+                     debugName);
+}
+
+GpuImage createStorageImage(const GpuContext& ctx, vk::Format format, std::uint32_t width, std::uint32_t height,
+                            const char* debugName) {
+  return createImage(ctx, vk::ImageType::e2D, vk::ImageViewType::e2D, format, vk::Extent3D(width, height, 1), 1,
+                     vk::ImageUsageFlagBits::eStorage | vk::ImageUsageFlagBits::eTransferDst, debugName);
 }
 
 namespace {

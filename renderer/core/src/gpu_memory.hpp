@@ -48,6 +48,11 @@ struct GpuImage {
 GpuImage createSampledImage(const GpuContext& ctx, vk::ImageType type, vk::Format format, vk::Extent3D extent,
                             std::uint32_t layers, const char* debugName);
 
+// A device-local 2D storage image (one layer) that can be a transfer
+// destination; in eUndefined until the caller moves it.
+GpuImage createStorageImage(const GpuContext& ctx, vk::Format format, std::uint32_t width, std::uint32_t height,
+                            const char* debugName);
+
 class GpuTimer;
 
 // Copies texels (tightly packed, all layers) into the whole image and leaves it

@@ -16,10 +16,13 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
   pass.height_ = height;
   const auto& device = ctx.device();
   ComputePipelineBuilder builder("sky.reproject");
-  for (std::uint32_t b : {gpu::kReprojectBindingParams, gpu::kReprojectBindingFresh, gpu::kReprojectBindingFreshDepth,
-                          gpu::kReprojectBindingHistory, gpu::kReprojectBindingHistoryDepth, gpu::kReprojectBindingOut,
-                          gpu::kReprojectBindingOutDepth, gpu::kReprojectBindingOutcomes})
+  for (std::uint32_t b : {gpu::kReprojectBindingParams, gpu::kReprojectBindingOut, gpu::kReprojectBindingOutDepth,
+                          gpu::kReprojectBindingOutcomes})
     builder.binding(b, vk::DescriptorType::eStorageBuffer);
+  // What it gathers from, as images (pixel_mirror.hpp).
+  for (std::uint32_t b : {gpu::kReprojectBindingFresh, gpu::kReprojectBindingFreshDepth, gpu::kReprojectBindingHistory,
+                          gpu::kReprojectBindingHistoryDepth})
+    builder.binding(b, vk::DescriptorType::eStorageImage);
   builder.shader("reproject.comp.spv");
   auto pipeline = builder.build(ctx);
   if (!pipeline) return tl::unexpected(pipeline.error());
@@ -27,20 +30,30 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
 
   const auto storage = vk::BufferUsageFlagBits::eStorageBuffer;
   const vk::DeviceSize pixels = vk::DeviceSize(width) * height;
+  pass.freshBuffers_ = {*fresh.buffer, *freshDepth.buffer};
+  auto freshMirror = PixelMirror::create(ctx, width, height, "sky.reproject.fresh");
+  if (!freshMirror) return tl::unexpected(freshMirror.error());
+  pass.fresh_.emplace(std::move(*freshMirror));
+  auto historyMirror = PixelMirror::create(ctx, width, height, "sky.reproject.history");
+  if (!historyMirror) return tl::unexpected(historyMirror.error());
+  pass.history_.emplace(std::move(*historyMirror));
   pass.params_ = createHostBuffer(ctx, sizeof(gpu::SkyReproject), storage, "sky.reproject.params");
   const char* colourNames[2] = {"sky.reproject.imageA", "sky.reproject.imageB"};
   const char* depthNames[2] = {"sky.reproject.depthA", "sky.reproject.depthB"};
   for (int k = 0; k < 2; ++k) {
-    pass.colour_[k] = createHostBuffer(ctx, pixels * 4 * sizeof(float), storage, colourNames[k]);
-    pass.depth_[k] = createHostBuffer(ctx, pixels * sizeof(float), storage, depthNames[k]);
+    // Transfer sources: copied into the history images, and by the upscale.
+    const auto usage = storage | vk::BufferUsageFlagBits::eTransferSrc;
+    pass.colour_[k] = createHostBuffer(ctx, pixels * 4 * sizeof(float), usage, colourNames[k]);
+    pass.depth_[k] = createHostBuffer(ctx, pixels * sizeof(float), usage, depthNames[k]);
     std::memset(pass.colour_[k].mapped, 0, pass.colour_[k].size);
     std::memset(pass.depth_[k].mapped, 0, pass.depth_[k].size);
   }
   pass.outcomes_ = createHostBuffer(ctx, pixels * sizeof(std::uint32_t), storage, "sky.reproject.outcomes");
 
-  const vk::DescriptorPoolSize poolSize(vk::DescriptorType::eStorageBuffer, 16);
+  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 8),
+                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageImage, 8)};
   pass.descriptorPool_ = vk::raii::DescriptorPool(
-      device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 2, poolSize));
+      device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 2, poolSizes));
   ctx.name(pass.descriptorPool_, "sky.reproject.descriptorPool");
   const std::array<vk::DescriptorSetLayout, 2> layouts{*pass.pipeline_.setLayout, *pass.pipeline_.setLayout};
   vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*pass.descriptorPool_, layouts));
@@ -48,20 +61,22 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
     pass.sets_[k] = std::move(sets[k]);
     ctx.name(pass.sets_[k], k == 0 ? "sky.reproject.setA" : "sky.reproject.setB");
     auto info = [](const GpuBuffer& b) { return vk::DescriptorBufferInfo(*b.buffer, 0, b.size); };
-    const std::array infos{std::pair{gpu::kReprojectBindingParams, info(pass.params_)},
-                           std::pair{gpu::kReprojectBindingFresh, info(fresh)},
-                           std::pair{gpu::kReprojectBindingFreshDepth, info(freshDepth)},
-                           std::pair{gpu::kReprojectBindingHistory, info(pass.colour_[1 - k])},
-                           std::pair{gpu::kReprojectBindingHistoryDepth, info(pass.depth_[1 - k])},
-                           std::pair{gpu::kReprojectBindingOut, info(pass.colour_[k])},
-                           std::pair{gpu::kReprojectBindingOutDepth, info(pass.depth_[k])},
-                           std::pair{gpu::kReprojectBindingOutcomes, info(pass.outcomes_)}};
+    const std::array buffers{std::pair{gpu::kReprojectBindingParams, info(pass.params_)},
+                             std::pair{gpu::kReprojectBindingOut, info(pass.colour_[k])},
+                             std::pair{gpu::kReprojectBindingOutDepth, info(pass.depth_[k])},
+                             std::pair{gpu::kReprojectBindingOutcomes, info(pass.outcomes_)}};
+    const std::array images{std::pair{gpu::kReprojectBindingFresh, pass.fresh_->colourInfo()},
+                            std::pair{gpu::kReprojectBindingFreshDepth, pass.fresh_->depthInfo()},
+                            std::pair{gpu::kReprojectBindingHistory, pass.history_->colourInfo()},
+                            std::pair{gpu::kReprojectBindingHistoryDepth, pass.history_->depthInfo()}};
     std::vector<vk::WriteDescriptorSet> writes;
-    for (const auto& [binding, bufferInfo] : infos)
+    for (const auto& [binding, bufferInfo] : buffers)
       writes.emplace_back(*pass.sets_[k], binding, 0, vk::DescriptorType::eStorageBuffer, nullptr, bufferInfo);
+    for (const auto& [binding, imageInfo] : images)
+      writes.emplace_back(*pass.sets_[k], binding, 0, vk::DescriptorType::eStorageImage, imageInfo);
     device.updateDescriptorSets(writes, {});
   }
-  pass.current_ = 1;  // the first record() writes set 0 and reads buffers 1 (zeros; unused: no history)
+  pass.current_ = 1;  // the first record() writes set 0 (its history images hold zeros; unused: no history)
   return pass;
 }
 
@@ -69,15 +84,17 @@ void ReprojectPass::record(const vk::raii::CommandBuffer& commands, GpuTimer& ti
   SKY_ASSERT(params.image.x == width_ && params.image.y == height_);
   current_ = 1 - current_;
   std::memcpy(params_.mapped, &params, sizeof params);
-  const vk::MemoryBarrier cloudsWritten(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eShaderRead);
-  commands.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {},
-                           cloudsWritten, {}, {});
+  // The pixels the cloud pass drew, packed n x n (n = params.image.z).
+  const std::uint32_t n = std::max(params.image.z, 1u);
   {
     const auto timed = timer.section(commands, "reproject");
+    fresh_->record(commands, freshBuffers_.first, freshBuffers_.second, params.phase.z, (height_ + n - 1) / n);
     commands.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_.pipeline);
     commands.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *sets_[current_], {});
     const std::uint32_t gx = gpu::kReprojectLocalSizeX, gy = gpu::kReprojectLocalSizeY;
     commands.dispatch((width_ + gx - 1) / gx, (height_ + gy - 1) / gy, 1);
+    // This frame's image is the next frame's history.
+    history_->record(commands, *colour_[current_].buffer, *depth_[current_].buffer, width_, height_);
   }
   const vk::MemoryBarrier toHost(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead);
   commands.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, toHost,

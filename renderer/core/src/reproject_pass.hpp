@@ -1,12 +1,15 @@
 // The reprojection pass (shaders/reproject.comp): recorded after the cloud
 // pass in the same command buffer, it reads the pixels the clouds drew this
 // frame and the previous frame's full image, and writes this frame's full
-// image, which the next frame reads as its history. Two image buffers
-// (radiance + transmittance, cloud depth) swap roles every frame; an outcome
-// per pixel says what became of it (reproject_shared.h), counted on the host.
+// image, which the next frame reads as its history. It writes two image
+// buffers (radiance + transmittance, cloud depth) in turn; what it reads
+// (the drawn pixels, the history) it reads from copies in storage images
+// (pixel_mirror.hpp). An outcome per pixel says what became of it
+// (reproject_shared.h), counted on the host.
 #pragma once
 
 #include <array>
+#include <optional>
 #include <cstdint>
 #include <utility>
 
@@ -14,6 +17,7 @@
 #include "gpu_context.hpp"
 #include "gpu_memory.hpp"
 #include "gpu_timer.hpp"
+#include "pixel_mirror.hpp"
 #include "reproject_shared.h"
 #include "sky/render/cloud_renderer.hpp"
 
@@ -45,6 +49,9 @@ class ReprojectPass {
 
   ComputePipeline pipeline_;
   GpuBuffer params_;
+  std::pair<vk::Buffer, vk::Buffer> freshBuffers_;  // the cloud pass's output (its handles: the pass moves)
+  std::optional<PixelMirror> fresh_;    // its copy, read by the shader
+  std::optional<PixelMirror> history_;  // the last image written, read by the shader as the history
   std::array<GpuBuffer, 2> colour_;  // full images; [current_] is written, the other read
   std::array<GpuBuffer, 2> depth_;
   GpuBuffer outcomes_;  // uint per pixel: what became of it (kStat*)

@@ -14,11 +14,14 @@ Result<UpscalePass> UpscalePass::create(const GpuContext& ctx, std::uint32_t sma
   UpscalePass pass;
   pass.width_ = width;
   pass.height_ = height;
+  pass.smallWidth_ = smallWidth;
+  pass.smallHeight_ = smallHeight;
   const auto& device = ctx.device();
   ComputePipelineBuilder builder("sky.upscale");
-  for (std::uint32_t b : {gpu::kUpscaleBindingParams, gpu::kUpscaleBindingSource, gpu::kUpscaleBindingSourceDepth,
-                          gpu::kUpscaleBindingOut, gpu::kUpscaleBindingOutDepth})
+  for (std::uint32_t b : {gpu::kUpscaleBindingParams, gpu::kUpscaleBindingOut, gpu::kUpscaleBindingOutDepth})
     builder.binding(b, vk::DescriptorType::eStorageBuffer);
+  for (std::uint32_t b : {gpu::kUpscaleBindingSource, gpu::kUpscaleBindingSourceDepth})
+    builder.binding(b, vk::DescriptorType::eStorageImage);
   builder.shader("upscale.comp.spv");
   auto pipeline = builder.build(ctx);
   if (!pipeline) return tl::unexpected(pipeline.error());
@@ -29,43 +32,45 @@ Result<UpscalePass> UpscalePass::create(const GpuContext& ctx, std::uint32_t sma
   pass.params_ = createHostBuffer(ctx, sizeof(gpu::SkyUpscale), storage, "sky.upscale.params");
   pass.colour_ = createHostBuffer(ctx, pixels * 4 * sizeof(float), storage, "sky.upscale.image");
   pass.depth_ = createHostBuffer(ctx, pixels * sizeof(float), storage, "sky.upscale.depth");
+  for (const Source& s : sources) pass.sources_.emplace_back(*s.first->buffer, *s.second->buffer);
+  auto mirror = PixelMirror::create(ctx, smallWidth, smallHeight, "sky.upscale.source");
+  if (!mirror) return tl::unexpected(mirror.error());
+  pass.source_.emplace(std::move(*mirror));
 
-  const auto count = static_cast<std::uint32_t>(sources.size());
-  const vk::DescriptorPoolSize poolSize(vk::DescriptorType::eStorageBuffer, 5 * count);
+  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 3),
+                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageImage, 2)};
   pass.descriptorPool_ = vk::raii::DescriptorPool(
-      device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, count, poolSize));
+      device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSizes));
   ctx.name(pass.descriptorPool_, "sky.upscale.descriptorPool");
-  const std::vector<vk::DescriptorSetLayout> layouts(count, *pass.pipeline_.setLayout);
-  vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*pass.descriptorPool_, layouts));
+  vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*pass.descriptorPool_, *pass.pipeline_.setLayout));
+  pass.set_ = std::move(sets[0]);
+  ctx.name(pass.set_, "sky.upscale.set");
   auto info = [](const GpuBuffer& b) { return vk::DescriptorBufferInfo(*b.buffer, 0, b.size); };
-  for (std::uint32_t k = 0; k < count; ++k) {
-    pass.sets_.push_back(std::move(sets[k]));
-    ctx.name(pass.sets_.back(), "sky.upscale.set");
-    const std::array infos{std::pair{gpu::kUpscaleBindingParams, info(pass.params_)},
-                           std::pair{gpu::kUpscaleBindingSource, info(*sources[k].first)},
-                           std::pair{gpu::kUpscaleBindingSourceDepth, info(*sources[k].second)},
+  const std::array buffers{std::pair{gpu::kUpscaleBindingParams, info(pass.params_)},
                            std::pair{gpu::kUpscaleBindingOut, info(pass.colour_)},
                            std::pair{gpu::kUpscaleBindingOutDepth, info(pass.depth_)}};
-    std::vector<vk::WriteDescriptorSet> writes;
-    for (const auto& [binding, bufferInfo] : infos)
-      writes.emplace_back(*pass.sets_.back(), binding, 0, vk::DescriptorType::eStorageBuffer, nullptr, bufferInfo);
-    device.updateDescriptorSets(writes, {});
-  }
+  const std::array images{std::pair{gpu::kUpscaleBindingSource, pass.source_->colourInfo()},
+                          std::pair{gpu::kUpscaleBindingSourceDepth, pass.source_->depthInfo()}};
+  std::vector<vk::WriteDescriptorSet> writes;
+  for (const auto& [binding, bufferInfo] : buffers)
+    writes.emplace_back(*pass.set_, binding, 0, vk::DescriptorType::eStorageBuffer, nullptr, bufferInfo);
+  for (const auto& [binding, imageInfo] : images)
+    writes.emplace_back(*pass.set_, binding, 0, vk::DescriptorType::eStorageImage, imageInfo);
+  device.updateDescriptorSets(writes, {});
   return pass;
 }
 
 void UpscalePass::record(const vk::raii::CommandBuffer& commands, GpuTimer& timer, std::size_t source,
                          const gpu::SkyUpscale& params) {
-  SKY_ASSERT(source < sets_.size());
+  SKY_ASSERT(source < sources_.size());
+  SKY_ASSERT(params.size.x == smallWidth_ && params.size.y == smallHeight_);
   SKY_ASSERT(params.size.z == width_ && params.size.w == height_);
   std::memcpy(params_.mapped, &params, sizeof params);
-  const vk::MemoryBarrier sourceWritten(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eShaderRead);
-  commands.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {},
-                           sourceWritten, {}, {});
   {
     const auto timed = timer.section(commands, "upscale");
+    source_->record(commands, sources_[source].first, sources_[source].second, smallWidth_, smallHeight_);
     commands.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_.pipeline);
-    commands.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *sets_[source], {});
+    commands.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *set_, {});
     const std::uint32_t gx = gpu::kUpscaleLocalSizeX, gy = gpu::kUpscaleLocalSizeY;
     const std::uint32_t cellsX = params.size.x + 1, cellsY = params.size.y + 1;
     commands.dispatch((cellsX + gx - 1) / gx, (cellsY + gy - 1) / gy, 1);

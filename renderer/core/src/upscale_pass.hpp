@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -13,6 +14,7 @@
 #include "gpu_context.hpp"
 #include "gpu_memory.hpp"
 #include "gpu_timer.hpp"
+#include "pixel_mirror.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky_shared.h"
 #include "upscale_shared.h"
@@ -23,16 +25,17 @@ class UpscalePass {
  public:
   // A source: the buffers of one small image (radiance + transmittance,
   // cloud depth; smallWidth * smallHeight entries each), which must outlive
-  // the pass. One descriptor set per source: the reprojection's output
-  // alternates between two.
+  // the pass; the reprojection's output alternates between two. The pass
+  // reads a copy of the one it is told in storage images (pixel_mirror.hpp).
   using Source = std::pair<const GpuBuffer*, const GpuBuffer*>;
 
   // Errors: Io/Malformed for the SPIR-V; other Vulkan failures throw.
   static Result<UpscalePass> create(const GpuContext& ctx, std::uint32_t smallWidth, std::uint32_t smallHeight,
                                     std::uint32_t width, std::uint32_t height, const std::vector<Source>& sources);
 
-  // Records the pass over sources[source] (after a barrier on its writes)
-  // and the barrier that makes the output readable by the host.
+  // Records the copy of sources[source] (after a barrier on its writes),
+  // the pass over it and the barrier that makes the output readable by the
+  // host.
   void record(const vk::raii::CommandBuffer& commands, GpuTimer& timer, std::size_t source,
               const gpu::SkyUpscale& params);
   // After the submission completed: the full-size image.
@@ -45,9 +48,12 @@ class UpscalePass {
   GpuBuffer params_;
   GpuBuffer colour_;
   GpuBuffer depth_;
+  std::vector<std::pair<vk::Buffer, vk::Buffer>> sources_;  // the sources' handles
+  std::optional<PixelMirror> source_;                       // the copy of the one being upscaled
   vk::raii::DescriptorPool descriptorPool_{nullptr};
-  std::vector<vk::raii::DescriptorSet> sets_;  // [k] reads sources[k]
-  std::uint32_t width_ = 0, height_ = 0;       // the full size
+  vk::raii::DescriptorSet set_{nullptr};
+  std::uint32_t smallWidth_ = 0, smallHeight_ = 0;
+  std::uint32_t width_ = 0, height_ = 0;  // the full size
 };
 
 // The block for one frame: the camera and Earth as the cloud pass sees them
