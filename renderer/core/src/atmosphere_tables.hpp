@@ -70,7 +70,7 @@ struct SkyLight {
 // parts, the light the sun's scattering gives per unit irradiance at the top
 // of the atmosphere (single-scattered sky with its multiple scattering), and
 // the night-sky floor seen through the air; over 8 x 16 equal-solid-angle
-// directions. The direct integral: ~0.5 ms (Release).
+// directions: 128 air marches.
 struct SkyDome {
   SkyLight perSun;
   SkyLight night;

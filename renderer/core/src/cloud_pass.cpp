@@ -159,8 +159,7 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
   }
   if (next.reproject != nullptr) next.reproject->record(commands_, timer_, *next.reprojectParams);
   if (next.upscale != nullptr)
-    next.upscale->record(commands_, timer_, next.reproject != nullptr ? next.reproject->current() : 0,
-                         *next.upscaleParams);
+    next.upscale->record(commands_, timer_, *next.upscaleParams);
   if (next.reproject == nullptr && next.upscale == nullptr) {
     const std::array toHost{
         vk::BufferMemoryBarrier(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead,

@@ -138,12 +138,12 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
     }
     std::optional<UpscalePass> upscale;
     if (divisor > 1) {
-      std::vector<UpscalePass::Source> sources;
+      UpscalePass::Input input;
       if (reproject)
-        sources = {reproject->output(0), reproject->output(1)};
+        input.images = &reproject->image();
       else
-        sources = {{&pass->output(), &pass->depth()}};
-      auto created = UpscalePass::create(**ctx, smallW, smallH, settings.width, settings.height, sources);
+        input.buffers = {&pass->output(), &pass->depth()};
+      auto created = UpscalePass::create(**ctx, smallW, smallH, settings.width, settings.height, input);
       if (!created) return tl::unexpected(created.error());
       upscale.emplace(std::move(*created));
     }

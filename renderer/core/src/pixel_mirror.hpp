@@ -4,8 +4,7 @@
 // storage-buffer load with a per-lane index as a loop over the 8 lanes with
 // a branch and a bounds check per component, and runs it whenever any lane
 // of the 8 takes that path; an image load fetches each lane's texel whole,
-// without branches. The copies cost a few hundredths of a millisecond at the
-// small sizes these passes read.
+// without branches. The passes time their copies with their own work.
 #pragma once
 
 #include <cstdint>

@@ -38,51 +38,41 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
   if (!historyMirror) return tl::unexpected(historyMirror.error());
   pass.history_.emplace(std::move(*historyMirror));
   pass.params_ = createHostBuffer(ctx, sizeof(gpu::SkyReproject), storage, "sky.reproject.params");
-  const char* colourNames[2] = {"sky.reproject.imageA", "sky.reproject.imageB"};
-  const char* depthNames[2] = {"sky.reproject.depthA", "sky.reproject.depthB"};
-  for (int k = 0; k < 2; ++k) {
-    // Transfer sources: copied into the history images, and by the upscale.
-    const auto usage = storage | vk::BufferUsageFlagBits::eTransferSrc;
-    pass.colour_[k] = createHostBuffer(ctx, pixels * 4 * sizeof(float), usage, colourNames[k]);
-    pass.depth_[k] = createHostBuffer(ctx, pixels * sizeof(float), usage, depthNames[k]);
-    std::memset(pass.colour_[k].mapped, 0, pass.colour_[k].size);
-    std::memset(pass.depth_[k].mapped, 0, pass.depth_[k].size);
-  }
+  // Transfer sources: copied into the history images.
+  const auto usage = storage | vk::BufferUsageFlagBits::eTransferSrc;
+  pass.colour_ = createHostBuffer(ctx, pixels * 4 * sizeof(float), usage, "sky.reproject.image");
+  pass.depth_ = createHostBuffer(ctx, pixels * sizeof(float), usage, "sky.reproject.depth");
   pass.outcomes_ = createHostBuffer(ctx, pixels * sizeof(std::uint32_t), storage, "sky.reproject.outcomes");
 
-  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 8),
-                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageImage, 8)};
+  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 4),
+                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageImage, 4)};
   pass.descriptorPool_ = vk::raii::DescriptorPool(
-      device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 2, poolSizes));
+      device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSizes));
   ctx.name(pass.descriptorPool_, "sky.reproject.descriptorPool");
-  const std::array<vk::DescriptorSetLayout, 2> layouts{*pass.pipeline_.setLayout, *pass.pipeline_.setLayout};
-  vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*pass.descriptorPool_, layouts));
-  for (int k = 0; k < 2; ++k) {
-    pass.sets_[k] = std::move(sets[k]);
-    ctx.name(pass.sets_[k], k == 0 ? "sky.reproject.setA" : "sky.reproject.setB");
-    auto info = [](const GpuBuffer& b) { return vk::DescriptorBufferInfo(*b.buffer, 0, b.size); };
-    const std::array buffers{std::pair{gpu::kReprojectBindingParams, info(pass.params_)},
-                             std::pair{gpu::kReprojectBindingOut, info(pass.colour_[k])},
-                             std::pair{gpu::kReprojectBindingOutDepth, info(pass.depth_[k])},
-                             std::pair{gpu::kReprojectBindingOutcomes, info(pass.outcomes_)}};
-    const std::array images{std::pair{gpu::kReprojectBindingFresh, pass.fresh_->colourInfo()},
-                            std::pair{gpu::kReprojectBindingFreshDepth, pass.fresh_->depthInfo()},
-                            std::pair{gpu::kReprojectBindingHistory, pass.history_->colourInfo()},
-                            std::pair{gpu::kReprojectBindingHistoryDepth, pass.history_->depthInfo()}};
-    std::vector<vk::WriteDescriptorSet> writes;
-    for (const auto& [binding, bufferInfo] : buffers)
-      writes.emplace_back(*pass.sets_[k], binding, 0, vk::DescriptorType::eStorageBuffer, nullptr, bufferInfo);
-    for (const auto& [binding, imageInfo] : images)
-      writes.emplace_back(*pass.sets_[k], binding, 0, vk::DescriptorType::eStorageImage, imageInfo);
-    device.updateDescriptorSets(writes, {});
-  }
-  pass.current_ = 1;  // the first record() writes set 0 (its history images hold zeros; unused: no history)
+  vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*pass.descriptorPool_, *pass.pipeline_.setLayout));
+  pass.set_ = std::move(sets[0]);
+  ctx.name(pass.set_, "sky.reproject.set");
+  auto info = [](const GpuBuffer& b) { return vk::DescriptorBufferInfo(*b.buffer, 0, b.size); };
+  const std::array buffers{std::pair{gpu::kReprojectBindingParams, info(pass.params_)},
+                           std::pair{gpu::kReprojectBindingOut, info(pass.colour_)},
+                           std::pair{gpu::kReprojectBindingOutDepth, info(pass.depth_)},
+                           std::pair{gpu::kReprojectBindingOutcomes, info(pass.outcomes_)}};
+  // The history images hold zeros until the first record() (unused then: no history).
+  const std::array images{std::pair{gpu::kReprojectBindingFresh, pass.fresh_->colourInfo()},
+                          std::pair{gpu::kReprojectBindingFreshDepth, pass.fresh_->depthInfo()},
+                          std::pair{gpu::kReprojectBindingHistory, pass.history_->colourInfo()},
+                          std::pair{gpu::kReprojectBindingHistoryDepth, pass.history_->depthInfo()}};
+  std::vector<vk::WriteDescriptorSet> writes;
+  for (const auto& [binding, bufferInfo] : buffers)
+    writes.emplace_back(*pass.set_, binding, 0, vk::DescriptorType::eStorageBuffer, nullptr, bufferInfo);
+  for (const auto& [binding, imageInfo] : images)
+    writes.emplace_back(*pass.set_, binding, 0, vk::DescriptorType::eStorageImage, imageInfo);
+  device.updateDescriptorSets(writes, {});
   return pass;
 }
 
 void ReprojectPass::record(const vk::raii::CommandBuffer& commands, GpuTimer& timer, const gpu::SkyReproject& params) {
   SKY_ASSERT(params.image.x == width_ && params.image.y == height_);
-  current_ = 1 - current_;
   std::memcpy(params_.mapped, &params, sizeof params);
   // The pixels the cloud pass drew, packed n x n (n = params.image.z).
   const std::uint32_t n = std::max(params.image.z, 1u);
@@ -90,18 +80,18 @@ void ReprojectPass::record(const vk::raii::CommandBuffer& commands, GpuTimer& ti
     const auto timed = timer.section(commands, "reproject");
     fresh_->record(commands, freshBuffers_.first, freshBuffers_.second, params.phase.z, (height_ + n - 1) / n);
     commands.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_.pipeline);
-    commands.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *sets_[current_], {});
+    commands.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *set_, {});
     const std::uint32_t gx = gpu::kReprojectLocalSizeX, gy = gpu::kReprojectLocalSizeY;
     commands.dispatch((width_ + gx - 1) / gx, (height_ + gy - 1) / gy, 1);
-    // This frame's image is the next frame's history.
-    history_->record(commands, *colour_[current_].buffer, *depth_[current_].buffer, width_, height_);
+    // This frame's image is the next frame's history (and the upscale's source).
+    history_->record(commands, *colour_.buffer, *depth_.buffer, width_, height_);
   }
   const vk::MemoryBarrier toHost(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead);
   commands.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, toHost,
                            {}, {});
 }
 
-Image ReprojectPass::readBack() const { return readImage(colour_[current_], depth_[current_], width_, height_); }
+Image ReprojectPass::readBack() const { return readImage(colour_, depth_, width_, height_); }
 
 TemporalReport ReprojectPass::counts() const {
   std::uint64_t c[gpu::kReprojectStatCount + 1] = {};

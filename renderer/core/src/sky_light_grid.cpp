@@ -38,40 +38,38 @@ SkyLight SkyLightGrid::at(const AtmosphereTables& tables, double h_m, double gro
   const double h0 = std::floor(h);
   const double u0 = std::min(std::floor(u), 2 * kSkyGridPerSunCosine - 1);
   const double fh = h - h0, fu = u - u0;
+  const double weight[2][2] = {{(1 - fh) * (1 - fu), (1 - fh) * fu}, {fh * (1 - fu), fh * fu}};
   SkyDome corner[2][2];
   for (int dh = 0; dh <= 1; ++dh)
     for (int du = 0; du <= 1; ++du)
-      if ((dh ? fh : 1 - fh) * (du ? fu : 1 - fu) > 0)  // a node not needed (h on a node: the ground) is not computed
+      if (weight[dh][du] > 0)  // a node not needed (h on a node: the ground) is not computed
         corner[dh][du] = node(tables, radiusKey, std::int64_t(h0) + dh, std::int64_t(u0) + du);
-  SkyDome sum;
-  auto blend = [&](glm::dvec3 SkyLight::*value, SkyLight SkyDome::*part) {
+  // Geometric between the nodes where all four are positive: the light falls
+  // off about exponentially with height and, through twilight, with the
+  // sun's depression (linear gave 4 % at -6 degrees); linear where one is 0.
+  auto blend = [&](auto value) {
     glm::dvec3 out(0.0);
     for (int c = 0; c < 3; ++c) {
-      // Geometric between the nodes where all four are positive: the light
-      // falls off about exponentially with height and, through twilight,
-      // with the sun's depression (linear gave 4 % at -6 degrees); linear
-      // where one is zero.
       bool positive = true;
       double linear = 0, logSum = 0;
       for (int dh = 0; dh <= 1; ++dh)
         for (int du = 0; du <= 1; ++du) {
-          const double w = (dh ? fh : 1 - fh) * (du ? fu : 1 - fu);
+          const double w = weight[dh][du];
           if (w <= 0) continue;
-          const double v = ((corner[dh][du].*part).*value)[c];
+          const double v = value(corner[dh][du])[c];
           linear += w * v;
-          if (v > 0)
-            logSum += w * std::log(v);
-          else
-            positive = false;
+          positive = positive && v > 0;
+          if (v > 0) logSum += w * std::log(v);
         }
       out[c] = positive ? std::exp(logSum) : linear;
     }
     return out;
   };
-  for (SkyLight SkyDome::*part : {&SkyDome::perSun, &SkyDome::night}) {
-    (sum.*part).meanRadiance = blend(&SkyLight::meanRadiance, part);
-    (sum.*part).irradiance = blend(&SkyLight::irradiance, part);
-  }
+  SkyDome sum;
+  sum.perSun.meanRadiance = blend([](const SkyDome& d) { return d.perSun.meanRadiance; });
+  sum.perSun.irradiance = blend([](const SkyDome& d) { return d.perSun.irradiance; });
+  sum.night.meanRadiance = blend([](const SkyDome& d) { return d.night.meanRadiance; });
+  sum.night.irradiance = blend([](const SkyDome& d) { return d.night.irradiance; });
   return sum.lit(sunIrradiance);
 }
 

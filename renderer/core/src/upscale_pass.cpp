@@ -3,14 +3,16 @@
 
 #include <array>
 #include <cstring>
+#include <vector>
 
 #include "sky/core/assert.hpp"
 
 namespace sky::render {
 
 Result<UpscalePass> UpscalePass::create(const GpuContext& ctx, std::uint32_t smallWidth, std::uint32_t smallHeight,
-                                        std::uint32_t width, std::uint32_t height, const std::vector<Source>& sources) {
-  SKY_ASSERT(!sources.empty() && smallWidth <= width && smallHeight <= height);
+                                        std::uint32_t width, std::uint32_t height, const Input& input) {
+  SKY_ASSERT(smallWidth <= width && smallHeight <= height);
+  SKY_ASSERT(input.images != nullptr || (input.buffers.first != nullptr && input.buffers.second != nullptr));
   UpscalePass pass;
   pass.width_ = width;
   pass.height_ = height;
@@ -32,10 +34,14 @@ Result<UpscalePass> UpscalePass::create(const GpuContext& ctx, std::uint32_t sma
   pass.params_ = createHostBuffer(ctx, sizeof(gpu::SkyUpscale), storage, "sky.upscale.params");
   pass.colour_ = createHostBuffer(ctx, pixels * 4 * sizeof(float), storage, "sky.upscale.image");
   pass.depth_ = createHostBuffer(ctx, pixels * sizeof(float), storage, "sky.upscale.depth");
-  for (const Source& s : sources) pass.sources_.emplace_back(*s.first->buffer, *s.second->buffer);
-  auto mirror = PixelMirror::create(ctx, smallWidth, smallHeight, "sky.upscale.source");
-  if (!mirror) return tl::unexpected(mirror.error());
-  pass.source_.emplace(std::move(*mirror));
+  const PixelMirror* source = input.images;
+  if (source == nullptr) {
+    pass.sourceBuffers_ = {*input.buffers.first->buffer, *input.buffers.second->buffer};
+    auto mirror = PixelMirror::create(ctx, smallWidth, smallHeight, "sky.upscale.source");
+    if (!mirror) return tl::unexpected(mirror.error());
+    source = &pass.ownImages_.emplace(std::move(*mirror));
+  }
+  SKY_ASSERT(source->width() == smallWidth && source->height() == smallHeight);
 
   const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 3),
                              vk::DescriptorPoolSize(vk::DescriptorType::eStorageImage, 2)};
@@ -49,8 +55,8 @@ Result<UpscalePass> UpscalePass::create(const GpuContext& ctx, std::uint32_t sma
   const std::array buffers{std::pair{gpu::kUpscaleBindingParams, info(pass.params_)},
                            std::pair{gpu::kUpscaleBindingOut, info(pass.colour_)},
                            std::pair{gpu::kUpscaleBindingOutDepth, info(pass.depth_)}};
-  const std::array images{std::pair{gpu::kUpscaleBindingSource, pass.source_->colourInfo()},
-                          std::pair{gpu::kUpscaleBindingSourceDepth, pass.source_->depthInfo()}};
+  const std::array images{std::pair{gpu::kUpscaleBindingSource, source->colourInfo()},
+                          std::pair{gpu::kUpscaleBindingSourceDepth, source->depthInfo()}};
   std::vector<vk::WriteDescriptorSet> writes;
   for (const auto& [binding, bufferInfo] : buffers)
     writes.emplace_back(*pass.set_, binding, 0, vk::DescriptorType::eStorageBuffer, nullptr, bufferInfo);
@@ -60,15 +66,13 @@ Result<UpscalePass> UpscalePass::create(const GpuContext& ctx, std::uint32_t sma
   return pass;
 }
 
-void UpscalePass::record(const vk::raii::CommandBuffer& commands, GpuTimer& timer, std::size_t source,
-                         const gpu::SkyUpscale& params) {
-  SKY_ASSERT(source < sources_.size());
+void UpscalePass::record(const vk::raii::CommandBuffer& commands, GpuTimer& timer, const gpu::SkyUpscale& params) {
   SKY_ASSERT(params.size.x == smallWidth_ && params.size.y == smallHeight_);
   SKY_ASSERT(params.size.z == width_ && params.size.w == height_);
   std::memcpy(params_.mapped, &params, sizeof params);
   {
     const auto timed = timer.section(commands, "upscale");
-    source_->record(commands, sources_[source].first, sources_[source].second, smallWidth_, smallHeight_);
+    if (ownImages_) ownImages_->record(commands, sourceBuffers_.first, sourceBuffers_.second, smallWidth_, smallHeight_);
     commands.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_.pipeline);
     commands.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *set_, {});
     const std::uint32_t gx = gpu::kUpscaleLocalSizeX, gy = gpu::kUpscaleLocalSizeY;

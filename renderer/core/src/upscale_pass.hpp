@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <optional>
 #include <utility>
-#include <vector>
 
 #include "compute_pipeline.hpp"
 #include "gpu_context.hpp"
@@ -23,21 +22,24 @@ namespace sky::render {
 
 class UpscalePass {
  public:
-  // A source: the buffers of one small image (radiance + transmittance,
-  // cloud depth; smallWidth * smallHeight entries each), which must outlive
-  // the pass; the reprojection's output alternates between two. The pass
-  // reads a copy of the one it is told in storage images (pixel_mirror.hpp).
-  using Source = std::pair<const GpuBuffer*, const GpuBuffer*>;
+  // What it upscales, smallWidth x smallHeight, read from storage images
+  // (pixel_mirror.hpp): either images another pass keeps up to date (the
+  // reprojection's image(), which must outlive the pass), or the cloud
+  // pass's output buffers (radiance + transmittance, cloud depth), which
+  // the pass copies into images of its own at each record().
+  struct Input {
+    const PixelMirror* images = nullptr;
+    std::pair<const GpuBuffer*, const GpuBuffer*> buffers{nullptr, nullptr};  // when images is null
+  };
 
   // Errors: Io/Malformed for the SPIR-V; other Vulkan failures throw.
   static Result<UpscalePass> create(const GpuContext& ctx, std::uint32_t smallWidth, std::uint32_t smallHeight,
-                                    std::uint32_t width, std::uint32_t height, const std::vector<Source>& sources);
+                                    std::uint32_t width, std::uint32_t height, const Input& input);
 
-  // Records the copy of sources[source] (after a barrier on its writes),
-  // the pass over it and the barrier that makes the output readable by the
+  // Records (with buffers as input, their copy after a barrier on their
+  // writes) the pass and the barrier that makes the output readable by the
   // host.
-  void record(const vk::raii::CommandBuffer& commands, GpuTimer& timer, std::size_t source,
-              const gpu::SkyUpscale& params);
+  void record(const vk::raii::CommandBuffer& commands, GpuTimer& timer, const gpu::SkyUpscale& params);
   // After the submission completed: the full-size image.
   Image readBack() const;
 
@@ -48,8 +50,8 @@ class UpscalePass {
   GpuBuffer params_;
   GpuBuffer colour_;
   GpuBuffer depth_;
-  std::vector<std::pair<vk::Buffer, vk::Buffer>> sources_;  // the sources' handles
-  std::optional<PixelMirror> source_;                       // the copy of the one being upscaled
+  std::pair<vk::Buffer, vk::Buffer> sourceBuffers_;  // with buffers as input: their handles (the owner moves)
+  std::optional<PixelMirror> ownImages_;              // with buffers as input: their copy
   vk::raii::DescriptorPool descriptorPool_{nullptr};
   vk::raii::DescriptorSet set_{nullptr};
   std::uint32_t smallWidth_ = 0, smallHeight_ = 0;
