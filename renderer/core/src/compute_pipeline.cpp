@@ -35,4 +35,27 @@ Result<ComputePipeline> ComputePipelineBuilder::build(const GpuContext& ctx) con
   return p;
 }
 
+StorageSet createStorageSet(const GpuContext& ctx, const ComputePipeline& pipeline, const std::string& name,
+                            const std::vector<std::pair<std::uint32_t, vk::DescriptorBufferInfo>>& buffers,
+                            const std::vector<std::pair<std::uint32_t, vk::DescriptorImageInfo>>& images) {
+  const auto& device = ctx.device();
+  std::vector<vk::DescriptorPoolSize> sizes;
+  if (!buffers.empty()) sizes.emplace_back(vk::DescriptorType::eStorageBuffer, std::uint32_t(buffers.size()));
+  if (!images.empty()) sizes.emplace_back(vk::DescriptorType::eStorageImage, std::uint32_t(images.size()));
+  StorageSet s;
+  s.pool = vk::raii::DescriptorPool(
+      device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, sizes));
+  ctx.name(s.pool, (name + ".descriptorPool").c_str());
+  vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*s.pool, *pipeline.setLayout));
+  s.set = std::move(sets[0]);
+  ctx.name(s.set, (name + ".set").c_str());
+  std::vector<vk::WriteDescriptorSet> writes;
+  for (const auto& [binding, info] : buffers)
+    writes.emplace_back(*s.set, binding, 0, vk::DescriptorType::eStorageBuffer, nullptr, info);
+  for (const auto& [binding, info] : images)
+    writes.emplace_back(*s.set, binding, 0, vk::DescriptorType::eStorageImage, info);
+  device.updateDescriptorSets(writes, {});
+  return s;
+}
+
 }  // namespace sky::render

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <vulkan/vulkan_raii.hpp>
@@ -38,5 +39,18 @@ class ComputePipelineBuilder {
   std::string shaderFile_;
   std::vector<vk::DescriptorSetLayoutBinding> bindings_;
 };
+
+// One descriptor set of a pipeline's layout, from a pool of its own.
+struct StorageSet {
+  // Destroyed in reverse order: the set before its pool.
+  vk::raii::DescriptorPool pool{nullptr};
+  vk::raii::DescriptorSet set{nullptr};
+};
+
+// The set for a pass that binds storage buffers and storage images only
+// (the reprojection, the upscale), written with these bindings.
+StorageSet createStorageSet(const GpuContext& ctx, const ComputePipeline& pipeline, const std::string& name,
+                            const std::vector<std::pair<std::uint32_t, vk::DescriptorBufferInfo>>& buffers,
+                            const std::vector<std::pair<std::uint32_t, vk::DescriptorImageInfo>>& images);
 
 }  // namespace sky::render

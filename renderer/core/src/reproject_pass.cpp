@@ -14,7 +14,6 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
   ReprojectPass pass;
   pass.width_ = width;
   pass.height_ = height;
-  const auto& device = ctx.device();
   ComputePipelineBuilder builder("sky.reproject");
   for (std::uint32_t b : {gpu::kReprojectBindingParams, gpu::kReprojectBindingOut, gpu::kReprojectBindingOutDepth,
                           gpu::kReprojectBindingOutcomes})
@@ -44,30 +43,19 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
   pass.depth_ = createHostBuffer(ctx, pixels * sizeof(float), usage, "sky.reproject.depth");
   pass.outcomes_ = createHostBuffer(ctx, pixels * sizeof(std::uint32_t), storage, "sky.reproject.outcomes");
 
-  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 4),
-                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageImage, 4)};
-  pass.descriptorPool_ = vk::raii::DescriptorPool(
-      device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSizes));
-  ctx.name(pass.descriptorPool_, "sky.reproject.descriptorPool");
-  vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*pass.descriptorPool_, *pass.pipeline_.setLayout));
-  pass.set_ = std::move(sets[0]);
-  ctx.name(pass.set_, "sky.reproject.set");
   auto info = [](const GpuBuffer& b) { return vk::DescriptorBufferInfo(*b.buffer, 0, b.size); };
-  const std::array buffers{std::pair{gpu::kReprojectBindingParams, info(pass.params_)},
-                           std::pair{gpu::kReprojectBindingOut, info(pass.colour_)},
-                           std::pair{gpu::kReprojectBindingOutDepth, info(pass.depth_)},
-                           std::pair{gpu::kReprojectBindingOutcomes, info(pass.outcomes_)}};
+  const std::vector<std::pair<std::uint32_t, vk::DescriptorBufferInfo>> buffers{
+      std::pair{gpu::kReprojectBindingParams, info(pass.params_)},
+      std::pair{gpu::kReprojectBindingOut, info(pass.colour_)},
+      std::pair{gpu::kReprojectBindingOutDepth, info(pass.depth_)},
+      std::pair{gpu::kReprojectBindingOutcomes, info(pass.outcomes_)}};
   // The history images hold zeros until the first record() (unused then: no history).
-  const std::array images{std::pair{gpu::kReprojectBindingFresh, pass.fresh_->colourInfo()},
-                          std::pair{gpu::kReprojectBindingFreshDepth, pass.fresh_->depthInfo()},
-                          std::pair{gpu::kReprojectBindingHistory, pass.history_->colourInfo()},
-                          std::pair{gpu::kReprojectBindingHistoryDepth, pass.history_->depthInfo()}};
-  std::vector<vk::WriteDescriptorSet> writes;
-  for (const auto& [binding, bufferInfo] : buffers)
-    writes.emplace_back(*pass.set_, binding, 0, vk::DescriptorType::eStorageBuffer, nullptr, bufferInfo);
-  for (const auto& [binding, imageInfo] : images)
-    writes.emplace_back(*pass.set_, binding, 0, vk::DescriptorType::eStorageImage, imageInfo);
-  device.updateDescriptorSets(writes, {});
+  const std::vector<std::pair<std::uint32_t, vk::DescriptorImageInfo>> images{
+      std::pair{gpu::kReprojectBindingFresh, pass.fresh_->colourInfo()},
+      std::pair{gpu::kReprojectBindingFreshDepth, pass.fresh_->depthInfo()},
+      std::pair{gpu::kReprojectBindingHistory, pass.history_->colourInfo()},
+      std::pair{gpu::kReprojectBindingHistoryDepth, pass.history_->depthInfo()}};
+  pass.set_ = createStorageSet(ctx, pass.pipeline_, "sky.reproject", buffers, images);
   return pass;
 }
 
@@ -80,15 +68,15 @@ void ReprojectPass::record(const vk::raii::CommandBuffer& commands, GpuTimer& ti
     const auto timed = timer.section(commands, "reproject");
     fresh_->record(commands, freshBuffers_.first, freshBuffers_.second, params.phase.z, (height_ + n - 1) / n);
     commands.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_.pipeline);
-    commands.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *set_, {});
+    commands.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *set_.set, {});
     const std::uint32_t gx = gpu::kReprojectLocalSizeX, gy = gpu::kReprojectLocalSizeY;
     commands.dispatch((width_ + gx - 1) / gx, (height_ + gy - 1) / gy, 1);
     // This frame's image is the next frame's history (and the upscale's source).
     history_->record(commands, *colour_.buffer, *depth_.buffer, width_, height_);
   }
   const vk::MemoryBarrier toHost(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead);
-  commands.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, toHost,
-                           {}, {});
+  commands.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, toHost, {},
+                           {});
 }
 
 Image ReprojectPass::readBack() const { return readImage(colour_, depth_, width_, height_); }

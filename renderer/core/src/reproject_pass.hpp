@@ -54,8 +54,7 @@ class ReprojectPass {
   GpuBuffer colour_;                    // the image it writes (read back by the host)
   GpuBuffer depth_;
   GpuBuffer outcomes_;  // uint per pixel: what became of it (kStat*)
-  vk::raii::DescriptorPool descriptorPool_{nullptr};
-  vk::raii::DescriptorSet set_{nullptr};
+  StorageSet set_;
   std::uint32_t width_ = 0, height_ = 0;
 };
 

@@ -18,7 +18,6 @@ Result<UpscalePass> UpscalePass::create(const GpuContext& ctx, std::uint32_t sma
   pass.height_ = height;
   pass.smallWidth_ = smallWidth;
   pass.smallHeight_ = smallHeight;
-  const auto& device = ctx.device();
   ComputePipelineBuilder builder("sky.upscale");
   for (std::uint32_t b : {gpu::kUpscaleBindingParams, gpu::kUpscaleBindingOut, gpu::kUpscaleBindingOutDepth})
     builder.binding(b, vk::DescriptorType::eStorageBuffer);
@@ -43,26 +42,14 @@ Result<UpscalePass> UpscalePass::create(const GpuContext& ctx, std::uint32_t sma
   }
   SKY_ASSERT(source->width() == smallWidth && source->height() == smallHeight);
 
-  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 3),
-                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageImage, 2)};
-  pass.descriptorPool_ = vk::raii::DescriptorPool(
-      device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSizes));
-  ctx.name(pass.descriptorPool_, "sky.upscale.descriptorPool");
-  vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*pass.descriptorPool_, *pass.pipeline_.setLayout));
-  pass.set_ = std::move(sets[0]);
-  ctx.name(pass.set_, "sky.upscale.set");
   auto info = [](const GpuBuffer& b) { return vk::DescriptorBufferInfo(*b.buffer, 0, b.size); };
-  const std::array buffers{std::pair{gpu::kUpscaleBindingParams, info(pass.params_)},
-                           std::pair{gpu::kUpscaleBindingOut, info(pass.colour_)},
-                           std::pair{gpu::kUpscaleBindingOutDepth, info(pass.depth_)}};
-  const std::array images{std::pair{gpu::kUpscaleBindingSource, source->colourInfo()},
-                          std::pair{gpu::kUpscaleBindingSourceDepth, source->depthInfo()}};
-  std::vector<vk::WriteDescriptorSet> writes;
-  for (const auto& [binding, bufferInfo] : buffers)
-    writes.emplace_back(*pass.set_, binding, 0, vk::DescriptorType::eStorageBuffer, nullptr, bufferInfo);
-  for (const auto& [binding, imageInfo] : images)
-    writes.emplace_back(*pass.set_, binding, 0, vk::DescriptorType::eStorageImage, imageInfo);
-  device.updateDescriptorSets(writes, {});
+  const std::vector<std::pair<std::uint32_t, vk::DescriptorBufferInfo>> buffers{
+      std::pair{gpu::kUpscaleBindingParams, info(pass.params_)}, std::pair{gpu::kUpscaleBindingOut, info(pass.colour_)},
+      std::pair{gpu::kUpscaleBindingOutDepth, info(pass.depth_)}};
+  const std::vector<std::pair<std::uint32_t, vk::DescriptorImageInfo>> images{
+      std::pair{gpu::kUpscaleBindingSource, source->colourInfo()},
+      std::pair{gpu::kUpscaleBindingSourceDepth, source->depthInfo()}};
+  pass.set_ = createStorageSet(ctx, pass.pipeline_, "sky.upscale", buffers, images);
   return pass;
 }
 
@@ -72,16 +59,17 @@ void UpscalePass::record(const vk::raii::CommandBuffer& commands, GpuTimer& time
   std::memcpy(params_.mapped, &params, sizeof params);
   {
     const auto timed = timer.section(commands, "upscale");
-    if (ownImages_) ownImages_->record(commands, sourceBuffers_.first, sourceBuffers_.second, smallWidth_, smallHeight_);
+    if (ownImages_)
+      ownImages_->record(commands, sourceBuffers_.first, sourceBuffers_.second, smallWidth_, smallHeight_);
     commands.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_.pipeline);
-    commands.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *set_, {});
+    commands.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *set_.set, {});
     const std::uint32_t gx = gpu::kUpscaleLocalSizeX, gy = gpu::kUpscaleLocalSizeY;
     const std::uint32_t cellsX = params.size.x + 1, cellsY = params.size.y + 1;
     commands.dispatch((cellsX + gx - 1) / gx, (cellsY + gy - 1) / gy, 1);
   }
   const vk::MemoryBarrier toHost(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead);
-  commands.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, toHost,
-                           {}, {});
+  commands.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eHost, {}, toHost, {},
+                           {});
 }
 
 Image UpscalePass::readBack() const { return readImage(colour_, depth_, width_, height_); }

@@ -52,8 +52,7 @@ class UpscalePass {
   GpuBuffer depth_;
   std::pair<vk::Buffer, vk::Buffer> sourceBuffers_;  // with buffers as input: their handles (the owner moves)
   std::optional<PixelMirror> ownImages_;              // with buffers as input: their copy
-  vk::raii::DescriptorPool descriptorPool_{nullptr};
-  vk::raii::DescriptorSet set_{nullptr};
+  StorageSet set_;
   std::uint32_t smallWidth_ = 0, smallHeight_ = 0;
   std::uint32_t width_ = 0, height_ = 0;  // the full size
 };
