@@ -18,6 +18,11 @@ if(SKY_FUZZ)
   endif()
   target_compile_options(sky_settings INTERFACE -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer)
   target_link_options(sky_settings INTERFACE -fsanitize=address,undefined)
+elseif(SKY_TSAN)
+  # ThreadSanitizer (deploy/test --long): the processes of the integration
+  # tests, built apart from the ASan tree since the two cannot be combined.
+  target_compile_options(sky_settings INTERFACE -fsanitize=thread -fno-omit-frame-pointer)
+  target_link_options(sky_settings INTERFACE -fsanitize=thread)
 elseif(SKY_SANITIZE)
   target_compile_options(sky_settings INTERFACE
     -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer)

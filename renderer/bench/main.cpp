@@ -54,7 +54,7 @@ std::string defaultOutDir() {
 
 int reportError(const sky::Error& e) {
   std::fprintf(stderr, "skyshell-bench: %s\n", sky::describe(e).c_str());
-  return e.code == sky::ErrorCode::Unsupported ? kExitUnsupported : 1;
+  return e.code == sky::ErrorCode::NoDevice ? kExitUnsupported : 1;
 }
 
 }  // namespace

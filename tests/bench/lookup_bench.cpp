@@ -143,7 +143,7 @@ int main(int argc, char** argv) {
                                  volumeTexels(check), SKY_LOOKUP_BENCH_SPV);
     if (!gpu) {
       std::fprintf(stderr, "sky_lookup_bench: %s\n", sky::describe(gpu.error()).c_str());
-      return gpu.error().code == sky::ErrorCode::Unsupported ? kExitUnsupported : 1;
+      return gpu.error().code == sky::ErrorCode::NoDevice ? kExitUnsupported : 1;
     }
     devices.push_back(std::move(*gpu));
     LookupGpu* device = devices.back().get();

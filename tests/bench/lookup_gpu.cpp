@@ -157,7 +157,7 @@ Result<std::unique_ptr<LookupGpu>> LookupGpu::create(VolumeFormat format, Volume
     try {
       g.instance = vk::raii::Instance(g.context, vk::InstanceCreateInfo({}, &app));
     } catch (const vk::SystemError& e) {
-      return fail(ErrorCode::Unsupported, std::string("no Vulkan driver: ") + e.what());
+      return fail(ErrorCode::NoDevice, std::string("no Vulkan driver: ") + e.what());
     }
     const char* wanted = std::getenv("SKY_VULKAN_DEVICE");
     vk::raii::PhysicalDevices devices(g.instance);
@@ -171,7 +171,7 @@ Result<std::unique_ptr<LookupGpu>> LookupGpu::create(VolumeFormat format, Volume
       g.timestampPeriod_ns = props.limits.timestampPeriod;
       break;
     }
-    if (g.name.empty()) return fail(ErrorCode::Unsupported, "no Vulkan 1.2 device with compute and timestamps");
+    if (g.name.empty()) return fail(ErrorCode::NoDevice, "no Vulkan 1.2 device with compute and timestamps");
     g.family = *computeFamily(g.physical);
     const float priority = 1.0f;
     const vk::DeviceQueueCreateInfo queueInfo({}, g.family, 1, &priority);

@@ -130,7 +130,7 @@ int main(int argc, char** argv) {
   auto renderer = sky::render::CloudRenderer::create(settings);
   if (!renderer) {
     std::fprintf(stderr, "sky_render_bench: %s\n", sky::describe(renderer.error()).c_str());
-    return renderer.error().code == sky::ErrorCode::Unsupported ? 77 : 1;
+    return renderer.error().code == sky::ErrorCode::NoDevice ? 77 : 1;
   }
   sky::weather::WeatherSnapshot weather;
   sky::weather::CloudLayer layer;

@@ -1,14 +1,14 @@
 // Browser tests of the operator console (server/console/) against a real
 // skyshell-weatherd: node console_test.mjs <case>. ctest runs each case as
 // its own test (label console); a case that cannot run here (no Chromium, no
-// playwright-core, a server without the WebSocket it needs) exits 77 and is
-// reported skipped.
+// playwright-core) exits 77 and is reported skipped, unless SKY_REQUIRE_DEPS=1
+// (deploy/test, which installed both) makes that a failure.
 import { execFileSync } from "node:child_process";
 import dgram from "node:dgram";
 import fs from "node:fs";
 import path from "node:path";
 import {
-  assert, child, config, launch, near, openConsole, run, skip, TOKEN, until, Weatherd, withoutWebSocketAllowances,
+  assert, child, config, launch, near, openConsole, run, TOKEN, until, Weatherd,
 } from "./harness.mjs";
 
 const R = 6371008.8;  // the console's sphere (mean Earth radius)
@@ -21,10 +21,12 @@ async function setup(name, cleanup, options = {}) {
   await import("./harness.mjs").then((h) => h.loadPlaywright());
   const w = await new Weatherd(name, options).start();
   cleanup(() => w.stop());
-  const hasWs = await w.hasWebSocket();
+  // Every case needs the console's WebSocket: a server without it fails the
+  // case instead of skipping it.
+  assert(await w.hasWebSocket(), "GET /api/ws does not upgrade to a WebSocket");
   const browser = await launch();
   cleanup(() => browser.close());
-  return { w, hasWs, browser };
+  return { w, browser };
 }
 
 function noProblems(...lists) {
@@ -36,8 +38,8 @@ const cases = {
   // A layer edited in one console appears in another and in GET /api/state;
   // a change made through the API appears in both consoles.
   async two_pages(cleanup) {
-    const { w, hasWs, browser } = await setup("two_pages", cleanup);
-    const allowed = withoutWebSocketAllowances(hasWs);
+    const { w, browser } = await setup("two_pages", cleanup);
+    const allowed = [];
     const a = await openConsole(browser, w, { token: TOKEN, allowed, name: "A" });
     const b = await openConsole(browser, w, { allowed, name: "B" });
     console.log(`  link: A ${await a.page.getAttribute("body", "data-link")}, B ${await b.page.getAttribute("body", "data-link")}`);
@@ -68,8 +70,7 @@ const cases = {
   // The live path: the console is on the WebSocket (not polling), a change
   // reaches it by push, and it does not poll the state meanwhile.
   async live_ws(cleanup) {
-    const { w, hasWs, browser } = await setup("live_ws", cleanup);
-    if (!hasWs) skip("this skyshell-weatherd has no WebSocket at /api/ws yet (GET /api/ws does not upgrade)");
+    const { w, browser } = await setup("live_ws", cleanup);
     const a = await openConsole(browser, w, { name: "A" });
     await until("the console to be live", async () => (await a.page.getAttribute("body", "data-link")) === "live");
     let statePolls = 0;
@@ -91,8 +92,7 @@ const cases = {
   // within a second; the bound is wider for a loaded 2-core machine and the
   // measured time is printed.
   async cigi(cleanup) {
-    const { w, hasWs, browser } = await setup("cigi", cleanup);
-    if (!hasWs) skip("this skyshell-weatherd has no WebSocket at /api/ws yet");
+    const { w, browser } = await setup("cigi", cleanup);
     const a = await openConsole(browser, w, { name: "A" });
     const b = await openConsole(browser, w, { name: "B" });
     for (const c of [a, b])
@@ -137,8 +137,8 @@ const cases = {
   // METAR: a preview lists each report's layers (or why it does not parse)
   // and changes nothing; apply puts the station's weather in the state.
   async metar(cleanup) {
-    const { w, hasWs, browser } = await setup("metar", cleanup);
-    const a = await openConsole(browser, w, { token: TOKEN, allowed: withoutWebSocketAllowances(hasWs), name: "A" });
+    const { w, browser } = await setup("metar", cleanup);
+    const a = await openConsole(browser, w, { token: TOKEN, name: "A" });
     const before = await w.state();
     // LJLJ (Ljubljana, 388 m in deploy/metar/stations.csv): broken at 3000 ft
     // above the station; the second report's cloud group is malformed.
@@ -166,9 +166,9 @@ const cases = {
   // A storm cell placed by clicking on the map, resized by its handle,
   // appears in the API where it was clicked.
   async region_click(cleanup) {
-    const { w, hasWs, browser } = await setup("region_click", cleanup);
+    const { w, browser } = await setup("region_click", cleanup);
     const lat0 = 46, lon0 = 13, scale = 100;  // m per CSS px
-    const a = await openConsole(browser, w, { token: TOKEN, allowed: withoutWebSocketAllowances(hasWs), name: "A",
+    const a = await openConsole(browser, w, { token: TOKEN, name: "A",
       hash: `#focus=${lat0},${lon0}&scale=${scale}` });
     const box = await a.page.locator("#map").boundingBox();
     const cx = box.x + box.width / 2, cy = box.y + box.height / 2;
@@ -225,8 +225,8 @@ const cases = {
   // The weather clock: pause, a jump, a rate; a layer change scheduled as a
   // ramp shows on the timeline and in the API's pending changes.
   async clock(cleanup) {
-    const { w, hasWs, browser } = await setup("clock", cleanup);
-    const a = await openConsole(browser, w, { token: TOKEN, allowed: withoutWebSocketAllowances(hasWs), name: "A" });
+    const { w, browser } = await setup("clock", cleanup);
+    const a = await openConsole(browser, w, { token: TOKEN, name: "A" });
     await a.page.click('[data-rate="0"]');
     await until("paused", async () => (await w.state()).clock_rate === 0);
     await until("the page says paused", async () => /paused/.test(await a.page.textContent("#clock-rate")));
@@ -256,8 +256,8 @@ const cases = {
   // a refusal from the server (the layer was removed meanwhile by someone
   // else) lands next to the field it names; the state stays as it was.
   async invalid(cleanup) {
-    const { w, hasWs, browser } = await setup("invalid", cleanup);
-    const allowed = [...withoutWebSocketAllowances(hasWs),
+    const { w, browser } = await setup("invalid", cleanup);
+    const allowed = [
       { text: /status of 400/, url: /\/api\/changes$/, why: "the server's refusal this test provokes" }];
     const a = await openConsole(browser, w, { token: TOKEN, allowed, name: "A" });
     const before = await w.state();
@@ -295,8 +295,8 @@ const cases = {
   // Without the token the page is read-only; the token is asked once per
   // tab session and kept across a reload; a wrong one is refused.
   async readonly(cleanup) {
-    const { w, hasWs, browser } = await setup("readonly", cleanup);
-    const allowed = [...withoutWebSocketAllowances(hasWs),
+    const { w, browser } = await setup("readonly", cleanup);
+    const allowed = [
       { text: /status of 401/, url: /\/api\/changes$/, why: "the wrong token this test tries" }];
     const a = await openConsole(browser, w, { allowed, name: "A" });
     for (const sel of ["#layer-apply", "#mode-storm", "#metar-apply", '[data-rate="60"]', '#layer-form [name="coverage_pct"]'])
@@ -331,8 +331,8 @@ const cases = {
   // The server goes away and comes back on the same port with the same
   // database: the page says offline, then recovers by itself and works.
   async restart(cleanup) {
-    const { w, hasWs, browser } = await setup("restart", cleanup, { db: true });
-    const allowed = [...withoutWebSocketAllowances(hasWs),
+    const { w, browser } = await setup("restart", cleanup, { db: true });
+    const allowed = [
       { text: /ERR_CONNECTION_REFUSED|ERR_EMPTY_RESPONSE|ERR_CONNECTION_RESET|WebSocket connection to .* failed/,
         why: "the server is stopped on purpose" }];
     const a = await openConsole(browser, w, { token: TOKEN, allowed, name: "A" });
@@ -351,10 +351,10 @@ const cases = {
   // card takes its clicks: the scenario Load button once sat under the
   // renderer list). Hit-tests the centre of each visible control.
   async layout(cleanup) {
-    const { w, hasWs, browser } = await setup("layout", cleanup);
+    const { w, browser } = await setup("layout", cleanup);
     for (const viewport of [{ width: 1920, height: 1080 }, { width: 1600, height: 1000 }, { width: 1366, height: 768 },
       { width: 1280, height: 800 }, { width: 1024, height: 768 }]) {
-      const a = await openConsole(browser, w, { token: TOKEN, allowed: withoutWebSocketAllowances(hasWs),
+      const a = await openConsole(browser, w, { token: TOKEN,
         name: `${viewport.width}x${viewport.height}`, viewport });
       const controls = await a.page.$$("button, input, select, textarea");
       let checked = 0;
@@ -385,7 +385,7 @@ const cases = {
   // A screenshot of a busy console: the artefact in the build tree (and
   // docs/images/console.png when SKY_CONSOLE_DOCS_SCREENSHOT names it).
   async screenshot(cleanup) {
-    const { w, hasWs, browser } = await setup("screenshot", cleanup);
+    const { w, browser } = await setup("screenshot", cleanup);
     const layer = (id, type, base_m, thickness_m, coverage, speed, from) => ({ op: "set_layer", layer: {
       id, type, base_m, thickness_m, transition_band_m: 100, coverage, density: 1,
       wind: { speed_mps: speed, from_deg: from, vertical_mps: 0 } } });
@@ -403,7 +403,7 @@ const cases = {
       { ...layer(1, "cumulus", 1500, 1800, 0.8, 12, 280), at_s: now + 600, ramp_s: 900 },
       { op: "remove_layer", id: 2, at_s: now + 1800, ramp_s: 600 }] });
     assert(later.status === 200, later.text);
-    const a = await openConsole(browser, w, { token: TOKEN, allowed: withoutWebSocketAllowances(hasWs), name: "A",
+    const a = await openConsole(browser, w, { token: TOKEN, name: "A",
       hash: "#focus=46.0,13.0&scale=90" });
     await a.page.fill('[name="reports"]', "METAR LJLJ 221150Z 24008KT 9999 FEW025 SCT045 BKN090 12/06 Q1018");
     await a.page.click("#metar-preview");
@@ -428,9 +428,9 @@ const cases = {
 // skyshell-replay over CIGI appears in the renderer list and as an aircraft
 // on the map where the flight is.
 cases.renderers = async (cleanup) => {
-  const { w, hasWs, browser } = await setup("renderers", cleanup);
-  if ((await w.api("GET", "/api/renderers")).status === 404)
-    skip("this skyshell-weatherd has no GET /api/renderers yet (it comes with the WebSocket)");
+  const { w, browser } = await setup("renderers", cleanup);
+  const list = await w.api("GET", "/api/renderers");
+  assert(list.status === 200, `GET /api/renderers: ${list.status} ${list.text}`);
   if (!config.render || !config.replay || !config.flight) throw new Error("SKY_RENDER, SKY_REPLAY, SKY_TEST_FLIGHT must be set");
   // lavapipe's JIT leaves allocations no suppression can name: no leak
   // check for the renderer process (as in tests/integration).
@@ -453,7 +453,7 @@ cases.renderers = async (cleanup) => {
   near(listed.lon_deg, 12.8, 0.02, "renderer longitude");
   near(listed.heading_deg, 90, 2, "renderer heading");
   const lat0 = 46.2, lon0 = 12.8, scale = 20;
-  const a = await openConsole(browser, w, { allowed: withoutWebSocketAllowances(hasWs), name: "A",
+  const a = await openConsole(browser, w, { name: "A",
     hash: `#focus=${lat0},${lon0}&scale=${scale}` });
   await until("the renderer row", async () => /46\.2/.test(await a.page.textContent("#renderers tbody")), 30000);
   // The aircraft symbol is yellow (#ffe14d): look for it where the flight is
@@ -481,9 +481,9 @@ cases.renderers = async (cleanup) => {
 // A scenario file chosen in the page is loaded (its start replaces the
 // weather, its timeline is pending); a bad one is refused naming its line.
 cases.scenario = async (cleanup) => {
-  const { w, hasWs, browser } = await setup("scenario", cleanup);
-  if ((await w.api("POST", "/api/scenario", "not toml = ")).status === 404)
-    skip("this skyshell-weatherd has no POST /api/scenario yet (it comes with the WebSocket work)");
+  const { w, browser } = await setup("scenario", cleanup);
+  const probe = await w.api("POST", "/api/scenario", "not toml = ");
+  assert(probe.status === 400, `POST /api/scenario with a bad body: ${probe.status} ${probe.text}`);
   const start = "[clock]\nstart_s = 1000.0\nrate = 1.0\n\n[[layer]]\nid = 3\ntype = \"stratus\"\nbase_m = 300.0\n" +
     "thickness_m = 400.0\ntransition_band_m = 50.0\ncoverage = 0.7\ndensity = 1.0\n" +
     "wind = { speed_mps = 4.0, from_deg = 90.0, vertical_mps = 0.0 }\n";
@@ -493,7 +493,7 @@ cases.scenario = async (cleanup) => {
   const badText = start.replace("coverage = 0.7", "coverage = 1.7");
   fs.writeFileSync(bad, badText);
   const badLine = badText.split("\n").findIndex((l) => l.startsWith("coverage")) + 1;
-  const allowed = [...withoutWebSocketAllowances(hasWs),
+  const allowed = [
     { text: /status of 400/, url: /\/api\/scenario$/, why: "the bad scenario this test loads" }];
   const a = await openConsole(browser, w, { token: TOKEN, allowed, name: "A" });
   await a.page.setInputFiles('#scenario-form [name="scenario"]', good);

@@ -33,7 +33,7 @@ inline render::CloudRenderer* sharedRenderer(std::uint32_t width, std::uint32_t 
     settings.height = height;
     auto created = render::CloudRenderer::create(settings);
     if (!created) {
-      if (created.error().code == ErrorCode::Unsupported) {
+      if (created.error().code == ErrorCode::NoDevice) {
         noDevice = "no Vulkan device: " + describe(created.error());
         *skipReason = noDevice;
         return nullptr;

@@ -56,7 +56,7 @@ std::unique_ptr<render::CloudRenderer> makeRenderer(std::uint32_t interleave, co
   s.temporal.interleave = interleave;
   auto r = render::CloudRenderer::create(s);
   if (!r) {
-    if (r.error().code == ErrorCode::Unsupported) *skip = describe(r.error());
+    if (r.error().code == ErrorCode::NoDevice) *skip = describe(r.error());
     else ADD_FAILURE() << describe(r.error());
     return nullptr;
   }
@@ -183,7 +183,7 @@ TEST(Temporal, PixelJitterAveragesOverThePixel) {
   big.march = render::findPreset("high")->march;
   auto super = render::CloudRenderer::create(big);
   if (!super) {
-    if (super.error().code == ErrorCode::Unsupported) GTEST_SKIP() << describe(super.error());
+    if (super.error().code == ErrorCode::NoDevice) GTEST_SKIP() << describe(super.error());
     FAIL() << describe(super.error());
   }
   const weather::WeatherSnapshot snap = cumulus();

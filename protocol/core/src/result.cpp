@@ -12,6 +12,7 @@ const char* toString(ErrorCode code) {
     case ErrorCode::Io: return "Io";
     case ErrorCode::Timeout: return "Timeout";
     case ErrorCode::Device: return "Device";
+    case ErrorCode::NoDevice: return "NoDevice";
   }
   return "Unknown";
 }

@@ -92,9 +92,9 @@ Result<std::unique_ptr<GpuContext>> GpuContext::create(const GpuOptions& options
   try {
     ctx->instance_ = vk::raii::Instance(ctx->context_, instanceInfo);
   } catch (const vk::IncompatibleDriverError& e) {
-    return fail(ErrorCode::Unsupported, std::string("no Vulkan driver: ") + e.what());
+    return fail(ErrorCode::NoDevice, std::string("no Vulkan driver: ") + e.what());
   } catch (const vk::InitializationFailedError& e) {
-    return fail(ErrorCode::Unsupported, std::string("no Vulkan driver: ") + e.what());
+    return fail(ErrorCode::NoDevice, std::string("no Vulkan driver: ") + e.what());
   } catch (const vk::ExtensionNotPresentError& e) {
     return fail(ErrorCode::Unsupported, std::string("Vulkan instance extension missing: ") + e.what());
   }
@@ -131,8 +131,10 @@ Result<std::unique_ptr<GpuContext>> GpuContext::create(const GpuOptions& options
     const int rank = typeRank(props.deviceType);
     if (rank > bestRank) bestRank = rank, best = i, bestFamily = *family;
   }
+  // No device at all is a missing dependency (NoDevice); devices that are
+  // there but unfit, or not the one asked for, are not.
   if (bestRank < 0)
-    return fail(ErrorCode::Unsupported,
+    return fail(seen.empty() ? ErrorCode::NoDevice : ErrorCode::Unsupported,
                 std::string("no Vulkan 1.2 device with a compute queue") +
                     (options.window ? " that can present to the window" : "") +
                     (wanted ? std::string(" matching SKY_VULKAN_DEVICE=") + wanted : std::string()) +

@@ -18,6 +18,7 @@ enum class ErrorCode {
   Io,               // the operating system said no
   Timeout,
   Device,           // the GPU (or its driver) failed
+  NoDevice,         // no Vulkan driver or device at all: a missing dependency, not a fault
 };
 
 const char* toString(ErrorCode code);
