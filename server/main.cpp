@@ -90,6 +90,11 @@ int main(int argc, char** argv) {
   app.add_option("--http-port-file", httpPortFile, "Write the HTTP port here once listening");
   app.add_option("--token-file", tokenFile,
                  "File whose first line is the token that changes need (without it the API is read-only)");
+  app.add_option("--http-allowed-host", http.allowedHosts,
+                 "A host name that reaches the HTTP API besides localhost and the listen address (repeatable; "
+                 "other Host headers get 403, see server/API.md)");
+  app.add_option("--http-allowed-origin", http.allowedOrigins,
+                 "A browser Origin allowed besides the server's own page, e.g. http://ops-console:8080 (repeatable)");
   std::string stationsPath;
   app.add_option("--metar-stations", stationsPath,
                  "METAR station table for POST /api/metar: CSV icao,lat_deg,lon_deg,elevation_m "

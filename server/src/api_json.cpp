@@ -3,6 +3,7 @@
 
 #include <initializer_list>
 
+#include "sky/core/utf8.hpp"
 #include "sky/weather/region.hpp"
 
 namespace sky::server {
@@ -210,7 +211,9 @@ Result<ChangeRequest> parseChangeRequest(std::string_view body) {
   ChangeRequest req;
   if (doc.contains("author")) {
     if (!doc.at("author").is_string()) return bad("author", "expected a string");
-    req.author = doc.at("author").get<std::string>().substr(0, 200);
+    // Issue 18: a byte cut here split a character, the broken name was stored
+    // and every later GET /api/events threw while writing it.
+    req.author = std::string(utf8::cut(doc.at("author").get<std::string>(), kMaxAuthor_bytes));
   }
   if (!doc.contains("changes") || !doc.at("changes").is_array()) return bad("changes", "expected an array");
   const json& list = doc.at("changes");
@@ -299,7 +302,22 @@ nlohmann::json toJson(const WeatherView& v) {
 
 nlohmann::json toJson(const ChangeEvent& e) {
   return {{"sequence", e.sequence}, {"clock_s", e.clock_s}, {"wall_time_ms", e.wallTime_ms},
-          {"author", e.author}, {"source", e.source}, {"summary", e.summary}};
+          {"author", utf8::sanitise(e.author)}, {"source", utf8::sanitise(e.source)},
+          {"summary", utf8::sanitise(e.summary)}};
+}
+
+std::string dumpJson(const nlohmann::json& value) {
+  return value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+std::string errorJson(std::string_view detail) {
+  // Long enough for any message of ours with the value it quotes.
+  constexpr std::size_t kMaxDetail_bytes = 1024;
+  const std::string text = utf8::sanitiseAndCut(detail, kMaxDetail_bytes);
+  json j = {{"error", text}};
+  // "path: what" -> field = path, for the console to show next to the field.
+  if (const auto colon = text.find(": "); colon != std::string::npos) j["field"] = text.substr(0, colon);
+  return dumpJson(j);
 }
 
 }  // namespace sky::server

@@ -15,7 +15,7 @@ namespace {
 // JSON text as it goes out. Strings the server did not write itself (an
 // author name, a channel) are valid UTF-8 by the time they get here, but a
 // replacement character is better than an exception if one is not.
-std::string dump(const nlohmann::json& j) { return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace); }
+std::string dump(const nlohmann::json& j) { return dumpJson(j); }
 
 WsText shared(std::string text) { return std::make_shared<const std::string>(std::move(text)); }
 

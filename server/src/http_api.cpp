@@ -1,20 +1,18 @@
-// The weather server's HTTP API (see http_api.hpp).
+// The weather server's HTTP API: the listening socket, the connections in
+// flight and their cap (see http_api.hpp). What a request means is decided by
+// HttpExchange (http_exchange.cpp) and the endpoints (http_endpoints.cpp).
 #include "sky/server/http_api.hpp"
 
-#include <charconv>
 #include <chrono>
 
 #include <boost/asio/ip/address.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
-#include <boost/beast/websocket/rfc6455.hpp>
 #include <spdlog/spdlog.h>
 
+#include "sky/core/utf8.hpp"
 #include "sky/server/api_json.hpp"
-#include "sky/server/conditions_api.hpp"
-#include "sky/server/console_files.hpp"
-#include "sky/server/metar_api.hpp"
-#include "sky/server/scenario_api.hpp"
+#include "sky/server/http_exchange.hpp"
 
 namespace sky::server {
 
@@ -25,88 +23,131 @@ using tcp = asio::ip::tcp;
 
 namespace {
 
-constexpr std::size_t kMaxBody = 64 * 1024;
-// A scenario may carry up to 1024 timeline entries of a few hundred bytes.
-constexpr std::size_t kMaxScenarioBody = 1024 * 1024;
+// A whole request (header and body) must arrive within this long: a client
+// that trickles bytes (slowloris) holds a slot no longer.
 constexpr auto kClientDeadline = std::chrono::seconds(10);
-constexpr std::size_t kDefaultEvents = 100, kMaxEvents = 10000;
+// After an answer the client's unread bytes (a refused body) are read and
+// dropped for up to this long and this many bytes before the socket is
+// closed: closing with unread data makes the kernel send a reset, which can
+// destroy the answer before the client reads it.
+constexpr auto kLingerTime = std::chrono::seconds(2);
+constexpr std::size_t kLinger_bytes = 256 * 1024;
+// accept() failing (EMFILE, ENFILE, ENOBUFS) is retried after this long
+// instead of at once: at the descriptor limit an immediate retry fails
+// again and spins a core.
+constexpr auto kAcceptRetry = std::chrono::milliseconds(100);
 
-class Connection : public std::enable_shared_from_this<Connection> {
+// The answer to a connection past the cap, written without waiting: the
+// socket is new, its send buffer empty.
+const std::string kBusyReply = [] {
+  const std::string body = errorJson("server: too many HTTP connections in flight; try again");
+  return "HTTP/1.1 503 Service Unavailable\r\nServer: skyshell-weatherd\r\nContent-Type: application/json\r\n"
+         "Connection: close\r\nRetry-After: 1\r\nX-Content-Type-Options: nosniff\r\nContent-Length: " +
+         std::to_string(body.size()) + "\r\n\r\n" + body;
+}();
+
+void refuseBusy(tcp::socket& socket) {
+  boost::system::error_code ignored;
+  socket.non_blocking(true, ignored);
+  socket.write_some(asio::buffer(kBusyReply), ignored);
+  socket.shutdown(tcp::socket::shutdown_both, ignored);
+  socket.close(ignored);
+}
+
+}  // namespace
+
+struct HttpApi::Registry {
+  HttpApi* api = nullptr;  // null once the API is closed: handlers that run later do nothing
+  // Open connections by id (accept order): the eviction scan finds the oldest first.
+  std::map<std::uint64_t, std::weak_ptr<HttpConnection>> open;
+  std::uint64_t nextId = 1;
+};
+
+// One accepted connection: one request read through an HttpExchange, its
+// answer written, then a short lingering read, then closed.
+class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
  public:
-  Connection(tcp::socket socket, HttpApi& api) : stream_(std::move(socket)), api_(api) {}
+  HttpConnection(tcp::socket socket, std::shared_ptr<HttpApi::Registry> registry, std::uint64_t id)
+      : stream_(std::move(socket)), registry_(std::move(registry)), id_(id), exchange_(*registry_->api) {}
+  ~HttpConnection() { registry_->open.erase(id_); }
+
   void start() {
     stream_.expires_after(kClientDeadline);
-    // The header first: the body limit depends on the path.
-    http::async_read_header(stream_, buffer_, parser_,
-                            [self = shared_from_this()](beast::error_code ec, std::size_t) { self->onHeader(ec); });
+    http::async_read_header(stream_, buffer_, exchange_.parser(),
+                            [self = shared_from_this()](beast::error_code ec, std::size_t) { self->onRead(ec, false); });
+  }
+  // Still waiting for its header: the first to go when the cap is reached.
+  bool waitingForHeader() const { return !headerDone_; }
+  // Past the cap: answered 503 now, its slot freed.
+  void evict() {
+    stopped_ = true;
+    refuseBusy(stream_.socket());
+  }
+  void stop() {
+    stopped_ = true;
+    beast::error_code ignored;
+    stream_.socket().close(ignored);
   }
 
  private:
-  void onHeader(beast::error_code ec) {
-    if (ec) return;  // the client went away, was too slow or sent no HTTP
-    const std::string_view target(parser_.get().target().data(), parser_.get().target().size());
-    bodyLimit_ = target.substr(0, target.find('?')) == "/api/scenario" ? kMaxScenarioBody : kMaxBody;
-    parser_.body_limit(bodyLimit_);
-    http::async_read(stream_, buffer_, parser_,
-                     [self = shared_from_this()](beast::error_code e, std::size_t) { self->onRead(e); });
-  }
-
-  void onRead(beast::error_code ec) {
-    HttpApi::Reply reply;
-    if (ec == http::error::body_limit) {
-      reply = {413, "application/json",
-               nlohmann::json{{"error", "body: over " + std::to_string(bodyLimit_ / 1024) + " KiB"}, {"field", "body"}}
-                   .dump()};
-    } else if (ec) {
-      return;  // the client went away or was too slow: nothing to answer
-    } else if (isFeedUpgrade(parser_.get())) {
-      if (!api_.feed().full()) {
-        // The console's WebSocket takes the connection over.
-        stream_.expires_never();
-        api_.feed().accept(stream_.release_socket(), parser_.release());
-        return;
-      }
-      reply = api_.refuseFeed();
-    } else {
-      const auto& req = parser_.get();
-      reply = api_.handle(std::string(req.method_string()), std::string(req.target()),
-                          std::string(req[http::field::authorization]), req.body());
+  // The header (body false) or the body has been read, or reading failed:
+  // one step of the exchange, then what it says. A handler that runs after
+  // the API closed, or after an eviction, does nothing.
+  void onRead(beast::error_code ec, bool body) {
+    if (!registry_->api || stopped_) return;
+    headerDone_ = true;
+    HttpExchange::Next next = HttpExchange::Next::Close;
+    try {
+      next = ec ? exchange_.afterError(ec) : body ? exchange_.afterBody() : exchange_.afterHeader();
+    } catch (const std::exception& e) {
+      // HttpExchange answers its own failures; this is the last resort (a
+      // failure while building that answer): close, and count it.
+      registry_->api->refused(RejectReason::HttpInternal, e.what());
     }
-    response_.result(static_cast<unsigned>(reply.status));
-    response_.version(11);
-    response_.set(http::field::content_type, reply.contentType);
-    response_.set(http::field::server, "skyshell-weatherd");
-    response_.keep_alive(false);
-    response_.body() = std::move(reply.body);
-    response_.prepare_payload();
-    http::async_write(stream_, response_, [self = shared_from_this()](beast::error_code, std::size_t) {
-      beast::error_code ignored;
-      self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
-    });
+    switch (next) {
+      case HttpExchange::Next::ReadBody:
+        http::async_read(stream_, buffer_, exchange_.parser(),
+                         [self = shared_from_this()](beast::error_code e, std::size_t) { self->onRead(e, true); });
+        return;
+      case HttpExchange::Next::Answer:
+        http::async_write(stream_, exchange_.response(), [self = shared_from_this()](beast::error_code e, std::size_t) {
+          if (!e) self->linger();
+        });
+        return;
+      case HttpExchange::Next::Upgrade:
+        // The console's WebSocket takes the connection over (and its slot
+        // is the feed's from now on).
+        stream_.expires_never();
+        registry_->api->feed_.accept(stream_.release_socket(), exchange_.parser().release());
+        return;
+      case HttpExchange::Next::Close: return;
+    }
   }
 
-  static bool isFeedUpgrade(const http::request<http::string_body>& req) {
-    const std::string_view target(req.target().data(), req.target().size());
-    return beast::websocket::is_upgrade(req) && target.substr(0, target.find('?')) == "/api/ws";
+  void linger() {
+    beast::error_code ignored;
+    stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+    stream_.expires_after(kLingerTime);
+    drain();
+  }
+
+  void drain() {
+    stream_.async_read_some(asio::buffer(discard_), [self = shared_from_this()](beast::error_code ec, std::size_t n) {
+      self->lingered_ += n;
+      if (!ec && self->lingered_ < kLinger_bytes && !self->stopped_) self->drain();
+    });
   }
 
   beast::tcp_stream stream_;
   beast::flat_buffer buffer_;
-  http::request_parser<http::string_body> parser_;
-  std::size_t bodyLimit_ = kMaxBody;
-  http::response<http::string_body> response_;
-  HttpApi& api_;
+  std::shared_ptr<HttpApi::Registry> registry_;
+  std::uint64_t id_;
+  HttpExchange exchange_;
+  std::array<char, 4096> discard_;
+  std::size_t lingered_ = 0;
+  bool headerDone_ = false;
+  bool stopped_ = false;
 };
-
-std::string errorJson(const std::string& detail) {
-  // "path: what" -> field = path, for the console to show next to the field.
-  const auto colon = detail.find(": ");
-  nlohmann::json j = {{"error", detail}};
-  if (colon != std::string::npos) j["field"] = detail.substr(0, colon);
-  return j.dump();
-}
-
-}  // namespace
 
 HttpApi::HttpApi(asio::io_context& io, HttpApiOptions options, LiveWeather& weather, HttpApiHooks hooks)
     : io_(io),
@@ -122,7 +163,10 @@ HttpApi::HttpApi(asio::io_context& io, HttpApiOptions options, LiveWeather& weat
                                 return weather_.rampRunning(now) || weather_.drifting(now);
                               }},
             options_.log),
-      acceptor_(io) {
+      acceptor_(io),
+      acceptRetry_(io),
+      registry_(std::make_shared<Registry>()) {
+  registry_->api = this;
   // Every accepted change, from whichever input, goes to the console.
   weatherListener_ = weather_.addListener([this](const ChangeEvent& e) { feed_.changeAccepted(e); });
 }
@@ -132,19 +176,13 @@ HttpApi::~HttpApi() {
   weather_.removeListener(weatherListener_);
 }
 
-HttpApi::Reply HttpApi::refuseFeed() {
-  ++counters_.requests;
-  reject(RejectReason::WsRefused);
-  return {503, "application/json",
-          errorJson("ws: " + std::to_string(feed_.clients()) + " console clients connected, at most " +
-                    std::to_string(options_.feed.maxClients))};
-}
-
 nlohmann::json HttpApi::healthJson() const {
   return {{"subscribers", hooks_.subscribers ? hooks_.subscribers() : 0},
           {"changes_applied", weather_.accepted()},
           {"rejected", hooks_.rejections ? hooks_.rejections->json() : nlohmann::json::object()}};
 }
+
+std::size_t HttpApi::connectionsInFlight() const { return registry_->open.size(); }
 
 Result<std::unique_ptr<HttpApi>> HttpApi::create(asio::io_context& io, HttpApiOptions options, LiveWeather& weather,
                                                  HttpApiHooks hooks) {
@@ -152,6 +190,7 @@ Result<std::unique_ptr<HttpApi>> HttpApi::create(asio::io_context& io, HttpApiOp
   boost::system::error_code ec;
   const auto address = asio::ip::make_address(api->options_.listenAddress, ec);
   if (ec) return fail(ErrorCode::InvalidArgument, "HTTP listen address '" + api->options_.listenAddress + "': " + ec.message());
+  if (api->options_.maxConnections == 0) return fail(ErrorCode::InvalidArgument, "HTTP maxConnections: 0");
   const tcp::endpoint endpoint(address, api->options_.port);
   api->acceptor_.open(endpoint.protocol(), ec);
   if (!ec) api->acceptor_.set_option(tcp::acceptor::reuse_address(true), ec);
@@ -161,6 +200,7 @@ Result<std::unique_ptr<HttpApi>> HttpApi::create(asio::io_context& io, HttpApiOp
     return fail(ErrorCode::Io, "HTTP API on " + api->options_.listenAddress + ":" + std::to_string(api->options_.port) +
                                    ": " + ec.message());
   api->port_ = api->acceptor_.local_endpoint().port();
+  api->hostRules_ = {api->port_, address.to_string(), api->options_.allowedHosts, api->options_.allowedOrigins};
   api->accept();
   return api;
 }
@@ -170,172 +210,67 @@ void HttpApi::close() {
   closed_ = true;
   boost::system::error_code ignored;
   acceptor_.close(ignored);
+  acceptRetry_.cancel();
+  registry_->api = nullptr;
+  const auto open = registry_->open;  // a copy: stopping may end a connection
+  for (auto& [id, weak] : open)
+    if (auto c = weak.lock()) c->stop();
   feed_.close();
 }
 
 void HttpApi::accept() {
   acceptor_.async_accept([this](boost::system::error_code ec, tcp::socket socket) {
     if (closed_) return;
-    if (!ec) std::make_shared<Connection>(std::move(socket), *this)->start();
-    accept();
+    if (!ec) {
+      acceptErrorLogged_ = false;
+      admit(std::move(socket));
+      accept();
+      return;
+    }
+    if (!acceptErrorLogged_ && options_.log)
+      options_.log->warn("event=http_accept_failed error={:?}; retrying every {} ms", ec.message(),
+                         std::chrono::duration_cast<std::chrono::milliseconds>(kAcceptRetry).count());
+    acceptErrorLogged_ = true;
+    acceptRetry_.expires_after(kAcceptRetry);
+    acceptRetry_.async_wait([this](const boost::system::error_code& e) {
+      if (!e && !closed_) accept();
+    });
   });
 }
 
-HttpApi::Reply HttpApi::handle(const std::string& method, const std::string& target,
-                               const std::string& authorization, const std::string& body) {
-  ++counters_.requests;
-  const std::string path = target.substr(0, target.find('?'));
-  const std::string query = target.find('?') == std::string::npos ? "" : target.substr(target.find('?') + 1);
-  if (method == "GET" && path == "/healthz") return {200, "text/plain", "ok\n"};
-  if (method == "GET" && path == "/metrics") {
-    std::string m;
-    auto line = [&m](const char* name, const char* help, const char* type, std::uint64_t v) {
-      m += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " " + type + "\n" + name + " " +
-           std::to_string(v) + "\n";
-    };
-    line("skyshell_http_requests_total", "HTTP requests handled", "counter", counters_.requests);
-    line("skyshell_changes_applied_total", "weather changes applied (every input)", "counter", weather_.accepted());
-    line("skyshell_changes_rejected_total", "weather changes refused as invalid", "counter", counters_.rejected);
-    line("skyshell_changes_unauthorized_total", "change requests without the token", "counter", counters_.unauthorized);
-    line("skyshell_subscribers", "weather stream subscribers connected", "gauge",
-         hooks_.subscribers ? hooks_.subscribers() : 0);
-    line("skyshell_ws_clients", "console WebSocket clients connected", "gauge", feed_.clients());
-    line("skyshell_ws_clients_dropped_total", "console WebSocket clients dropped for not reading", "counter",
-         feed_.dropped());
-    if (hooks_.rejections) m += hooks_.rejections->metrics();
-    if (hooks_.extraMetrics) m += hooks_.extraMetrics();
-    return {200, "text/plain; version=0.0.4", m};
-  }
-  if (method == "GET" && path == "/api/state") return {200, "application/json", toJson(weather_.view()).dump()};
-  if (method == "GET" && path == "/api/renderers") {
-    const nlohmann::json list = hooks_.renderers ? hooks_.renderers() : nlohmann::json::array();
-    return {200, "application/json",
-            nlohmann::json{{"renderers", list}}.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)};
-  }
-  if (method == "GET" && path == "/api/conditions") {
-    auto q = parseConditionsQuery(query);
-    if (!q) return {400, "application/json", errorJson(q.error().detail)};
-    return {200, "application/json", conditionsJson(weather_, *q).dump()};
-  }
-  if (path == "/api/ws")
-    return {426, "application/json", errorJson("upgrade: GET /api/ws is a WebSocket (send Upgrade: websocket)")};
-  if (method == "GET" && path == "/api/events") {
-    std::size_t limit = kDefaultEvents;
-    if (query.rfind("limit=", 0) == 0) {
-      const std::string v = query.substr(6);
-      std::size_t n = 0;
-      const auto [end, err] = std::from_chars(v.data(), v.data() + v.size(), n);
-      if (err != std::errc() || end != v.data() + v.size() || n == 0 || n > kMaxEvents)
-        return {400, "application/json", errorJson("limit: '" + v + "' is not in 1..10000")};
-      limit = n;
-    }
-    nlohmann::json list = nlohmann::json::array();
-    for (const auto& e : weather_.events(limit)) list.push_back(toJson(e));
-    return {200, "application/json", nlohmann::json{{"events", list}}.dump()};
-  }
-  if (path == "/api/changes") {
-    if (method != "POST") return {405, "application/json", errorJson("method: use POST")};
-    if (options_.token.empty() || authorization != "Bearer " + options_.token) {
-      ++counters_.unauthorized;
-      reject(RejectReason::Unauthorized);
-      return {401, "application/json",
-              errorJson(std::string("authorization: ") +
-                        (options_.token.empty() ? "this server has no token: read-only" : "missing or wrong token"))};
-    }
-    auto request = parseChangeRequest(body);
-    if (!request) {
-      ++counters_.rejected;
-      reject(RejectReason::HttpInvalid);
-      return {400, "application/json", errorJson(request.error().detail)};
-    }
-    request->source = "api";
-    if (request->author.empty()) request->author = "api";
-    auto applied = weather_.submit(*request);
-    if (!applied) {
-      ++counters_.rejected;
-      reject(RejectReason::HttpInvalid);
-      if (options_.log)
-        options_.log->info("event=change_refused source=api author={:?} detail={:?}", request->author,
-                           applied.error().detail);
-      return {applied.error().code == ErrorCode::Unsupported ? 501 : 400, "application/json",
-              errorJson(applied.error().detail)};
-    }
-    ++counters_.applied;
-    if (options_.log)
-      options_.log->info("event=change_applied source=api sequence={} author={:?} summary={:?}", applied->sequence,
-                         request->author, applied->summary);
-    return {200, "application/json",
-            nlohmann::json{{"sequence", applied->sequence}, {"clock_s", applied->clock_s}, {"summary", applied->summary}}
-                .dump()};
-  }
-  if (path == "/api/scenario") {
-    if (method != "POST") return {405, "application/json", errorJson("method: use POST")};
-    if (options_.token.empty() || authorization != "Bearer " + options_.token) {
-      ++counters_.unauthorized;
-      reject(RejectReason::Unauthorized);
-      return {401, "application/json", errorJson("authorization: loading a scenario needs the token")};
-    }
-    auto upload = parseScenarioUpload(body);
-    if (!upload) {
-      reject(RejectReason::ScenarioInvalid);
-      return {400, "application/json", errorJson(upload.error().detail)};
-    }
-    auto scenario = parseScenario(upload->toml, upload->name);
-    Result<AppliedChange> applied =
-        scenario ? weather_.loadScenario(*scenario, upload->name, upload->author.empty() ? "api" : upload->author)
-                 : Result<AppliedChange>(tl::unexpected(scenario.error()));
-    if (!applied) {
-      reject(RejectReason::ScenarioInvalid);
-      if (options_.log)
-        options_.log->info("event=scenario_refused name={:?} detail={:?}", upload->name, applied.error().detail);
-      return {400, "application/json", scenarioErrorJson(applied.error().detail, upload->name).dump()};
-    }
-    if (options_.log)
-      options_.log->info("event=change_applied source=scenario sequence={} author={:?} summary={:?}", applied->sequence,
-                         upload->author, applied->summary);
-    return {200, "application/json",
-            nlohmann::json{{"sequence", applied->sequence},
-                           {"clock_s", applied->clock_s},
-                           {"summary", applied->summary},
-                           {"layers", scenario->layers.size()},
-                           {"timeline", scenario->timeline.size()}}
-                .dump()};
-  }
-  if (path == "/api/metar") {
-    if (method != "POST") return {405, "application/json", errorJson("method: use POST")};
-    auto request = parseMetarRequest(body);
-    if (!request) {
-      ++counters_.rejected;
-      reject(RejectReason::HttpInvalid);
-      return {400, "application/json", errorJson(request.error().detail)};
-    }
-    // A preview reads; applying changes the weather and needs the token.
-    if (request->apply && (options_.token.empty() || authorization != "Bearer " + options_.token)) {
-      ++counters_.unauthorized;
-      reject(RejectReason::Unauthorized);
-      return {401, "application/json", errorJson("authorization: applying METAR needs the token")};
-    }
-    const MetarReply reply = handleMetar(*request, options_.stations, weather_);
-    if (reply.body.contains("reports"))
-      for (const auto& r : reply.body["reports"])
-        if (r.value("ok", true) == false) reject(RejectReason::MetarUnparsed);
-    if (request->apply) {
-      if (reply.status == 200) {
-        ++counters_.applied;
-        if (options_.log)
-          options_.log->info("event=change_applied source=metar sequence={} summary={:?}",
-                             reply.body["applied"]["sequence"].get<std::uint64_t>(),
-                             reply.body["applied"]["summary"].get<std::string>());
-      } else {
-        ++counters_.rejected;
-        reject(RejectReason::HttpInvalid);
+void HttpApi::admit(tcp::socket socket) {
+  if (registry_->open.size() >= options_.maxConnections) {
+    // The slot of the connection that has waited longest without sending a
+    // whole header (an idle or trickling client) goes to the new one; when
+    // every slot is past its header, the new one is refused.
+    std::shared_ptr<HttpConnection> idle;
+    for (auto& [id, weak] : registry_->open)
+      if (auto c = weak.lock(); c && c->waitingForHeader()) {
+        idle = std::move(c);
+        registry_->open.erase(id);
+        break;
       }
+    refused(RejectReason::HttpBusy, "over " + std::to_string(options_.maxConnections) + " HTTP connections in flight");
+    if (idle) {
+      idle->evict();
+    } else {
+      refuseBusy(socket);
+      return;
     }
-    return {reply.status, "application/json", reply.body.dump()};
   }
-  if (method == "GET" && options_.console)
-    if (const ConsoleFile* f = options_.console->find(path)) return {200, f->contentType, f->body};
-  return {404, "application/json", errorJson("path: no " + method + " " + path)};
+  const std::uint64_t id = registry_->nextId++;
+  auto c = std::make_shared<HttpConnection>(std::move(socket), registry_, id);
+  registry_->open[id] = c;
+  c->start();
+}
+
+void HttpApi::refused(RejectReason reason, std::string_view detail) {
+  if (hooks_.rejections) hooks_.rejections->count(reason);
+  auto& logged = logged_[static_cast<std::size_t>(reason)];
+  if (logged || !options_.log) return;
+  logged = true;
+  options_.log->warn("event=http_refused reason={} detail={:?} (the first; later ones are counted in /metrics)",
+                     toString(reason), utf8::sanitiseAndCut(detail, 300));
 }
 
 }  // namespace sky::server

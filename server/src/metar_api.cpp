@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "sky/core/utf8.hpp"
 #include "sky/server/api_json.hpp"
 
 namespace sky::server {
@@ -91,7 +92,7 @@ Result<MetarRequest> parseMetarRequest(std::string_view body) {
       r.apply = v.get<bool>();
     } else if (key == "author") {
       if (!v.is_string()) return bad(key, "expected a string");
-      r.author = v.get<std::string>().substr(0, 200);
+      r.author = std::string(utf8::cut(v.get<std::string>(), kMaxAuthor_bytes));
     } else {
       return bad(key, "unknown key (expected one of: reports, stations, radius_m, ramp_s, at_s, apply, author)");
     }

@@ -14,6 +14,13 @@ const char* toString(RejectReason reason) {
     case RejectReason::ScenarioInvalid: return "scenario_invalid";
     case RejectReason::TimelineRefused: return "timeline_refused";
     case RejectReason::WsRefused: return "ws_refused";
+    case RejectReason::HttpMalformed: return "http_malformed";
+    case RejectReason::HttpTooLarge: return "http_too_large";
+    case RejectReason::HttpHeaderTooLarge: return "http_header_too_large";
+    case RejectReason::HttpForbidden: return "http_forbidden";
+    case RejectReason::HttpBusy: return "http_busy";
+    case RejectReason::HttpTimeout: return "http_timeout";
+    case RejectReason::HttpInternal: return "http_internal";
     case RejectReason::Count_: break;
   }
   return "?";

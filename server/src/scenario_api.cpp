@@ -3,6 +3,8 @@
 
 #include <charconv>
 
+#include "sky/core/utf8.hpp"
+
 namespace sky::server {
 
 namespace {
@@ -40,7 +42,7 @@ Result<ScenarioUpload> parseScenarioUpload(std::string_view body) {
     if (out.name.empty() || out.name.size() > kMaxNameBytes || !printable(out.name))
       return fail(ErrorCode::InvalidArgument, "name: 1 to 200 printable characters");
   }
-  if (doc.contains("author")) out.author = doc.at("author").get<std::string>().substr(0, kMaxNameBytes);
+  if (doc.contains("author")) out.author = std::string(utf8::cut(doc.at("author").get<std::string>(), kMaxNameBytes));
   return out;
 }
 

@@ -23,6 +23,7 @@
 //            with its first layer's wind from where it was placed.
 #pragma once
 
+#include <string>
 #include <string_view>
 
 #include <nlohmann/json.hpp>
@@ -31,6 +32,18 @@
 #include "sky/server/change.hpp"
 
 namespace sky::server {
+
+// The longest author name kept, in bytes (cut on a character boundary).
+inline constexpr std::size_t kMaxAuthor_bytes = 200;
+
+// JSON text of a value that may hold text from outside: never throws; an
+// invalid UTF-8 sequence that got this far is written as U+FFFD.
+std::string dumpJson(const nlohmann::json& value);
+
+// {"error": detail, "field": <detail up to its first ": ">}: the API's error
+// body. The detail is made valid UTF-8 and cut to 1 KiB, so echoed input
+// can neither break the JSON nor make the answer large.
+std::string errorJson(std::string_view detail);
 
 // Parses a POST /api/changes body. Malformed (not JSON, wrong shape); the
 // values' ranges are the WeatherService's to check.
@@ -48,6 +61,8 @@ nlohmann::json toJson(const WeatherView& view);
 // this form). Errors name `path`; ranges are not checked.
 nlohmann::json toJson(const WeatherChange& change);
 Result<WeatherChange> changeFromJson(const nlohmann::json& object, const std::string& path);
+// Author, source and summary come from outside (and from databases written
+// by older versions): made valid UTF-8 here.
 nlohmann::json toJson(const ChangeEvent& event);
 
 }  // namespace sky::server

@@ -3,30 +3,41 @@
 //   GET  /metrics        Prometheus text: changes applied and rejected, subscribers
 //   GET  /api/state      the weather now (layers, pending ramps, clock)
 //   GET  /api/events?limit=N   the newest N change events
-//   POST /api/changes    a change request (api_json.hpp); needs
-//                        "Authorization: Bearer <token>"; 200 once applied,
-//                        400 {"error": ...} naming the field, 401 without the token
+//   POST /api/changes    a change request (api_json.hpp); needs the token
+//   POST /api/scenario   a scenario file; needs the token
 //   POST /api/metar      METAR reports previewed, or applied with the token
 //                        (metar_api.hpp)
 //   GET  /, /console/*   the operator console's files, when options.console is set
 //                        (console_files.hpp)
 //   GET  /api/renderers  the weather-stream subscribers and their cameras
+//   GET  /api/conditions the weather at points (conditions_api.hpp)
 //   GET  /api/ws         WebSocket upgrade: the console's live feed (console_feed.hpp)
-// Every endpoint, with its JSON, is in server/API.md.
-// One request per connection (Connection: close); bodies over 64 KiB and
-// clients slower than 10 s are dropped. Loopback unless configured otherwise.
+// Routes, their methods, body limits and token rules are one table
+// (http_routes.hpp); each request goes through HttpExchange
+// (http_exchange.hpp), which checks Host, Origin, the token and the body
+// limit before the body is read. Every endpoint, with its JSON, status codes
+// and caps, is in server/API.md. One request per connection; connections in
+// flight are capped. Loopback unless configured otherwise.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
+#include <string_view>
+#include <vector>
 
+#include <utility>  // before asio: Boost 1.74 asio uses std::exchange without including it
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include "sky/core/result.hpp"
 #include "sky/server/console_feed.hpp"
+#include "sky/server/http_guard.hpp"
+#include "sky/server/http_routes.hpp"
 #include "sky/server/live_weather.hpp"
 #include "sky/server/metar.hpp"
 #include "sky/server/rejections.hpp"
@@ -38,6 +49,8 @@ class logger;
 namespace sky::server {
 
 class ConsoleFiles;
+class HttpConnection;
+class HttpExchange;
 
 struct HttpApiOptions {
   std::string listenAddress = "127.0.0.1";
@@ -47,6 +60,15 @@ struct HttpApiOptions {
   std::shared_ptr<const ConsoleFiles> console;  // null: no console pages
   std::string serverId = "skyshell-weatherd";  // in the WebSocket hello
   ConsoleFeedOptions feed;
+  // Connections being read or answered at once (WebSocket clients are the
+  // feed's and count there). 256: a few consoles and tools need a handful;
+  // the cap keeps a flood of idle connections from using every descriptor.
+  std::size_t maxConnections = 256;
+  // Host names besides localhost, 127.0.0.1, [::1] and the listen address
+  // that reach this server (no port), and more allowed Origins (as browsers
+  // send them: "http://ops-console:8080"). See http_guard.hpp.
+  std::vector<std::string> allowedHosts;
+  std::vector<std::string> allowedOrigins;
   std::shared_ptr<spdlog::logger> log;
 };
 
@@ -65,7 +87,8 @@ class HttpApi {
                                                  LiveWeather& weather, HttpApiHooks hooks);
   ~HttpApi();
   std::uint16_t port() const { return port_; }
-  // Stops accepting and closes the console's WebSocket clients.
+  // Stops accepting, closes the connections in flight and the console's
+  // WebSocket clients.
   void close();
   // The renderer list changed (a subscriber came, went or reported).
   void renderersChanged() { feed_.renderersChanged(); }
@@ -75,35 +98,48 @@ class HttpApi {
     std::uint64_t requests = 0, applied = 0, rejected = 0, unauthorized = 0;
   };
   const Counters& counters() const { return counters_; }
-
-  // The response to one request (exposed for the connection class).
-  struct Reply {
-    int status = 200;
-    std::string contentType = "application/json";
-    std::string body;
-  };
-  Reply handle(const std::string& method, const std::string& target, const std::string& authorization,
-               const std::string& body);
-  // The answer to a WebSocket upgrade while the feed is full (503).
-  Reply refuseFeed();
+  std::size_t connectionsInFlight() const;
 
  private:
+  friend class HttpExchange;
+  friend class HttpConnection;
+  struct Registry;
+
   HttpApi(boost::asio::io_context& io, HttpApiOptions options, LiveWeather& weather, HttpApiHooks hooks);
   void accept();
-  void reject(RejectReason reason) {
-    if (hooks_.rejections) hooks_.rejections->count(reason);
-  }
+  void admit(boost::asio::ip::tcp::socket socket);
+  // Counts a refused input; logs the first of each reason (the rest are in /metrics).
+  void refused(RejectReason reason, std::string_view detail);
   nlohmann::json healthJson() const;
+
+  // The endpoints (http_endpoints.cpp), behind HttpExchange's checks.
+  HttpReply serve(Endpoint endpoint, const ApiRequest& request);
+  HttpReply metrics();
+  HttpReply events(std::string_view query);
+  HttpReply changes(const ApiRequest& request);
+  HttpReply scenario(const ApiRequest& request);
+  HttpReply metar(const ApiRequest& request);
+  HttpReply unauthorized(const char* what);
+  HttpReply consoleFile(std::string_view method, std::string_view path) const;
+  // The answer to a WebSocket upgrade while the feed is full (503).
+  HttpReply refuseFeed();
 
   boost::asio::io_context& io_;
   HttpApiOptions options_;
+  HostRules hostRules_;
   LiveWeather& weather_;
   HttpApiHooks hooks_;
   ConsoleFeed feed_;
   std::size_t weatherListener_ = 0;
   boost::asio::ip::tcp::acceptor acceptor_;
+  boost::asio::steady_timer acceptRetry_;
+  // Shared with the connections, which may outlive the API (their handlers
+  // are destroyed with the io_context).
+  std::shared_ptr<Registry> registry_;
   std::uint16_t port_ = 0;
   Counters counters_;
+  std::array<bool, kRejectReasons> logged_{};
+  bool acceptErrorLogged_ = false;
   bool closed_ = false;
 };
 

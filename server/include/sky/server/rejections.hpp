@@ -24,6 +24,14 @@ enum class RejectReason : std::size_t {
   ScenarioInvalid,  // a scenario (POST /api/scenario) that does not parse or whose timeline the model refuses
   TimelineRefused,  // a scenario timeline entry the model refused when it came due
   WsRefused,        // a WebSocket client over the bound, or an upgrade that failed
+  // The HTTP API's transport: one count per refused request or connection.
+  HttpMalformed,    // not HTTP, or a target or header that is not valid UTF-8 (400)
+  HttpTooLarge,     // a body over its route's limit, refused before it is read (413)
+  HttpHeaderTooLarge,  // a request line and header over 8 KiB (431)
+  HttpForbidden,    // a foreign Origin or a Host that is not this server's (403)
+  HttpBusy,         // a connection past the cap on connections in flight (503)
+  HttpTimeout,      // a client that did not finish its request within the deadline (dropped)
+  HttpInternal,     // a request whose handling failed inside the server (500/503)
   Count_
 };
 

@@ -1,0 +1,184 @@
+// The HTTP API's endpoints (see http_api.hpp): what each route does once
+// HttpExchange has checked Host, Origin, the token rule and the body limit.
+#include <charconv>
+
+#include <spdlog/spdlog.h>
+
+#include "sky/core/utf8.hpp"
+#include "sky/server/api_json.hpp"
+#include "sky/server/conditions_api.hpp"
+#include "sky/server/console_files.hpp"
+#include "sky/server/http_api.hpp"
+#include "sky/server/metar_api.hpp"
+#include "sky/server/scenario_api.hpp"
+
+namespace sky::server {
+
+namespace {
+
+constexpr std::size_t kDefaultEvents = 100, kMaxEvents = 10000;
+
+HttpReply json(const nlohmann::json& body) { return {200, "application/json", dumpJson(body)}; }
+HttpReply error(int status, std::string_view detail) { return {status, "application/json", errorJson(detail)}; }
+
+}  // namespace
+
+HttpReply HttpApi::serve(Endpoint endpoint, const ApiRequest& r) {
+  switch (endpoint) {
+    case Endpoint::Healthz: return {200, "text/plain", "ok\n"};
+    case Endpoint::Metrics: return metrics();
+    case Endpoint::State: return json(toJson(weather_.view()));
+    case Endpoint::Renderers:
+      return json({{"renderers", hooks_.renderers ? hooks_.renderers() : nlohmann::json::array()}});
+    case Endpoint::Conditions: {
+      auto q = parseConditionsQuery(r.query);
+      if (!q) return error(400, q.error().detail);
+      return json(conditionsJson(weather_, *q));
+    }
+    case Endpoint::Events: return events(r.query);
+    case Endpoint::Changes: return changes(r);
+    case Endpoint::Scenario: return scenario(r);
+    case Endpoint::Metar: return metar(r);
+    case Endpoint::Feed: break;  // an upgrade: HttpExchange hands it to the feed
+  }
+  return error(426, "upgrade: GET /api/ws is a WebSocket (send Upgrade: websocket)");
+}
+
+HttpReply HttpApi::metrics() {
+  std::string m;
+  auto line = [&m](const char* name, const char* help, const char* type, std::uint64_t v) {
+    m += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " " + type + "\n" + name + " " +
+         std::to_string(v) + "\n";
+  };
+  line("skyshell_http_requests_total", "HTTP requests handled", "counter", counters_.requests);
+  line("skyshell_http_connections", "HTTP connections in flight", "gauge", connectionsInFlight());
+  line("skyshell_changes_applied_total", "weather changes applied (every input)", "counter", weather_.accepted());
+  line("skyshell_changes_rejected_total", "weather changes refused as invalid", "counter", counters_.rejected);
+  line("skyshell_changes_unauthorized_total", "change requests without the token", "counter", counters_.unauthorized);
+  line("skyshell_subscribers", "weather stream subscribers connected", "gauge",
+       hooks_.subscribers ? hooks_.subscribers() : 0);
+  line("skyshell_ws_clients", "console WebSocket clients connected", "gauge", feed_.clients());
+  line("skyshell_ws_clients_dropped_total", "console WebSocket clients dropped for not reading", "counter",
+       feed_.dropped());
+  if (hooks_.rejections) m += hooks_.rejections->metrics();
+  if (hooks_.extraMetrics) m += hooks_.extraMetrics();
+  return {200, "text/plain; version=0.0.4", m};
+}
+
+HttpReply HttpApi::events(std::string_view query) {
+  std::size_t limit = kDefaultEvents;
+  if (query.rfind("limit=", 0) == 0) {
+    const std::string_view v = query.substr(6);
+    std::size_t n = 0;
+    const auto [end, err] = std::from_chars(v.data(), v.data() + v.size(), n);
+    if (err != std::errc() || end != v.data() + v.size() || n == 0 || n > kMaxEvents)
+      return error(400, "limit: '" + std::string(utf8::cut(v, 64)) + "' is not in 1..10000");
+    limit = n;
+  }
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& e : weather_.events(limit)) list.push_back(toJson(e));
+  return json({{"events", list}});
+}
+
+HttpReply HttpApi::unauthorized(const char* what) {
+  ++counters_.unauthorized;
+  refused(RejectReason::Unauthorized, what);
+  return error(401, std::string("authorization: ") +
+                        (options_.token.empty() ? "this server has no token: read-only" : what));
+}
+
+HttpReply HttpApi::changes(const ApiRequest& r) {
+  auto request = parseChangeRequest(r.body);
+  if (!request) {
+    ++counters_.rejected;
+    refused(RejectReason::HttpInvalid, request.error().detail);
+    return error(400, request.error().detail);
+  }
+  request->source = "api";
+  if (request->author.empty()) request->author = "api";
+  auto applied = weather_.submit(*request);
+  if (!applied) {
+    ++counters_.rejected;
+    refused(RejectReason::HttpInvalid, applied.error().detail);
+    if (options_.log)
+      options_.log->info("event=change_refused source=api author={:?} detail={:?}", request->author,
+                         applied.error().detail);
+    return error(applied.error().code == ErrorCode::Unsupported ? 501 : 400, applied.error().detail);
+  }
+  ++counters_.applied;
+  if (options_.log)
+    options_.log->info("event=change_applied source=api sequence={} author={:?} summary={:?}", applied->sequence,
+                       request->author, applied->summary);
+  return json({{"sequence", applied->sequence}, {"clock_s", applied->clock_s}, {"summary", applied->summary}});
+}
+
+HttpReply HttpApi::scenario(const ApiRequest& r) {
+  auto upload = parseScenarioUpload(r.body);
+  if (!upload) {
+    refused(RejectReason::ScenarioInvalid, upload.error().detail);
+    return error(400, upload.error().detail);
+  }
+  auto parsed = parseScenario(upload->toml, upload->name);
+  Result<AppliedChange> applied =
+      parsed ? weather_.loadScenario(*parsed, upload->name, upload->author.empty() ? "api" : upload->author)
+             : Result<AppliedChange>(tl::unexpected(parsed.error()));
+  if (!applied) {
+    refused(RejectReason::ScenarioInvalid, applied.error().detail);
+    if (options_.log)
+      options_.log->info("event=scenario_refused name={:?} detail={:?}", upload->name, applied.error().detail);
+    // The detail may quote the TOML, which is not JSON and may be any bytes.
+    return {400, "application/json",
+            dumpJson(scenarioErrorJson(utf8::sanitiseAndCut(applied.error().detail, 1024), upload->name))};
+  }
+  if (options_.log)
+    options_.log->info("event=change_applied source=scenario sequence={} author={:?} summary={:?}", applied->sequence,
+                       upload->author, applied->summary);
+  return json({{"sequence", applied->sequence},
+               {"clock_s", applied->clock_s},
+               {"summary", applied->summary},
+               {"layers", parsed->layers.size()},
+               {"timeline", parsed->timeline.size()}});
+}
+
+HttpReply HttpApi::metar(const ApiRequest& r) {
+  auto request = parseMetarRequest(r.body);
+  if (!request) {
+    ++counters_.rejected;
+    refused(RejectReason::HttpInvalid, request.error().detail);
+    return error(400, request.error().detail);
+  }
+  // The route's TokenRule::WhenApplying: a preview reads; applying changes
+  // the weather and needs the token.
+  if (request->apply && !r.hasToken) return unauthorized("applying METAR needs the token");
+  const MetarReply reply = handleMetar(*request, options_.stations, weather_);
+  if (reply.body.contains("reports"))
+    for (const auto& report : reply.body["reports"])
+      if (report.value("ok", true) == false) refused(RejectReason::MetarUnparsed, "a METAR report did not parse");
+  if (request->apply) {
+    if (reply.status == 200) {
+      ++counters_.applied;
+      if (options_.log)
+        options_.log->info("event=change_applied source=metar sequence={} summary={:?}",
+                           reply.body["applied"]["sequence"].get<std::uint64_t>(),
+                           reply.body["applied"]["summary"].get<std::string>());
+    } else {
+      ++counters_.rejected;
+      refused(RejectReason::HttpInvalid, "METAR not applied");
+    }
+  }
+  return {reply.status, "application/json", dumpJson(reply.body)};
+}
+
+HttpReply HttpApi::consoleFile(std::string_view method, std::string_view path) const {
+  if (method == "GET" && options_.console)
+    if (const ConsoleFile* f = options_.console->find(std::string(path))) return {200, f->contentType, f->body};
+  return error(404, "path: no " + std::string(method) + " " + std::string(path));
+}
+
+HttpReply HttpApi::refuseFeed() {
+  refused(RejectReason::WsRefused, "console feed full");
+  return error(503, "ws: " + std::to_string(feed_.clients()) + " console clients connected, at most " +
+                        std::to_string(options_.feed.maxClients));
+}
+
+}  // namespace sky::server
