@@ -14,6 +14,8 @@ const char* toString(RejectReason reason) {
     case RejectReason::ScenarioInvalid: return "scenario_invalid";
     case RejectReason::TimelineRefused: return "timeline_refused";
     case RejectReason::WsRefused: return "ws_refused";
+    case RejectReason::SubscriberCap: return "subscriber_cap";
+    case RejectReason::HandlerFailed: return "handler_failed";
     case RejectReason::Count_: break;
   }
   return "?";

@@ -24,6 +24,8 @@ enum class RejectReason : std::size_t {
   ScenarioInvalid,  // a scenario (POST /api/scenario) that does not parse or whose timeline the model refuses
   TimelineRefused,  // a scenario timeline entry the model refused when it came due
   WsRefused,        // a WebSocket client over the bound, or an upgrade that failed
+  SubscriberCap,    // a stream connection past ServerOptions::maxSubscribers (sent an Error, closed)
+  HandlerFailed,    // a handler threw: the peer's connection or datagram was dropped, the server runs on
   Count_
 };
 
