@@ -50,6 +50,17 @@ Result<std::unique_ptr<Server>> Server::create(ServerOptions options, WeatherSta
   SKY_ASSERT(options.heartbeatInterval.count() > 0);
   std::unique_ptr<Server> server(new Server(std::move(options), std::move(state)));
   if (auto r = server->listen(); !r) return tl::unexpected(r.error());
+  if (server->options_.handleSignals) {
+    // From here, not from run(): a SIGTERM that comes while the main still
+    // sets up (its port files already written) waits for run() and shuts
+    // down cleanly, instead of killing the process by the default action.
+    server->signals_.emplace(server->io_, SIGINT, SIGTERM);
+    server->signals_->async_wait([s = server.get()](const boost::system::error_code& ec, int signal) {
+      if (ec) return;
+      s->log_->info("event=shutdown signal={}", signal);
+      s->shutdown();
+    });
+  }
   return server;
 }
 
@@ -97,14 +108,6 @@ Result<void> Server::listen() {
 }
 
 void Server::run() {
-  if (options_.handleSignals) {
-    signals_.emplace(io_, SIGINT, SIGTERM);
-    signals_->async_wait([this](const boost::system::error_code& ec, int signal) {
-      if (ec) return;
-      log_->info("event=shutdown signal={}", signal);
-      shutdown();
-    });
-  }
   accept();
   scheduleHeartbeat();
   armTimeline();

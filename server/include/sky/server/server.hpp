@@ -45,7 +45,7 @@ struct ServerOptions {
   std::chrono::milliseconds heartbeatInterval{1000};  // > 0
   std::string serverId = "skyshell-weatherd";         // sent in Hello
   std::size_t maxCellsPerSnapshot = kDefaultMaxCells;
-  bool handleSignals = true;  // SIGINT/SIGTERM stop the server (off in tests)
+  bool handleSignals = true;  // SIGINT/SIGTERM stop the server (off in tests); caught from create() on
   // A subscriber whose frame has not gone out in this long has stopped
   // reading and is dropped (its weather was coalesced until then).
   std::chrono::milliseconds stallTimeout{10000};
