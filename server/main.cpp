@@ -28,9 +28,14 @@
 namespace {
 
 // Exit codes: 0 clean shutdown, 1 runtime failure (bind, port file), 2 bad
-// input (command line, config file, scenario).
+// input (command line, config file, scenario), 3 the weather database cannot
+// be used (corrupt, not a database, locked by another process, unreadable
+// saved state). 3 needs an operator: deploy/skyshell-weatherd.service does
+// not restart on it (RestartPreventExitStatus=3), where a restart loop would
+// only repeat the error.
 constexpr int kExitRuntime = 1;
 constexpr int kExitBadInput = 2;
+constexpr int kExitStorage = 3;
 
 // Writes `port` to `path` via a temporary file and a rename, so a reader
 // polling for the file never sees it half written.
@@ -177,28 +182,24 @@ int main(int argc, char** argv) {
 
   std::optional<sky::server::WeatherStore> store;
   if (!dbPath.empty()) {
+    auto storageFailed = [&](const sky::Error& e) {
+      log->error("event=database_unusable db={:?} detail={:?}; exiting with {} (not restarted)", dbPath,
+                 sky::describe(e), kExitStorage);
+      std::cerr << "skyshell-weatherd: weather database " << dbPath << ": " << sky::describe(e) << std::endl;
+      return kExitStorage;
+    };
     auto opened = sky::server::WeatherStore::open(dbPath);
-    if (!opened) {
-      log->error("{}", sky::describe(opened.error()));
-      return kExitRuntime;
-    }
+    if (!opened) return storageFailed(opened.error());
     store.emplace(std::move(*opened));
     auto saved = store->load();
-    if (!saved) {
-      log->error("{}", sky::describe(saved.error()));
-      return kExitRuntime;
-    }
+    if (!saved) return storageFailed(saved.error());
     auto& weather = (*server)->weather();
     if (*saved) {
-      if (auto r = weather.restore((*saved)->state, std::move((*saved)->events)); !r) {
-        log->error("{}: {}", dbPath, sky::describe(r.error()));
-        return kExitRuntime;
-      }
+      if (auto r = weather.restore((*saved)->state, std::move((*saved)->events)); !r) return storageFailed(r.error());
       log->info("event=restored db={:?} sequence={} layers={} state_hash={:016x}", dbPath,
                 weather.view().lastSequence, weather.view().layers.size(), weather.stateHash());
     } else if (auto r = store->save(weather.toJson(), nullptr); !r) {
-      log->error("{}", sky::describe(r.error()));
-      return kExitRuntime;
+      return storageFailed(r.error());
     } else {
       log->info("event=new_db db={:?}", dbPath);
     }
@@ -271,6 +272,9 @@ int main(int argc, char** argv) {
       line("skyshell_cigi_malformed_total", "CIGI weather datagrams dropped as malformed", c.malformed);
       line("skyshell_cigi_rejected_total", "CIGI weather refused by the model", c.rejected);
       line("skyshell_cigi_applied_total", "CIGI weather datagrams that changed the weather", c.applied);
+      line("skyshell_cigi_senders_refused_total", "CIGI datagrams dropped: a new sender past the sender cap",
+           c.senderRefused);
+      line("skyshell_cigi_commits_total", "batched commits of CIGI changes", c.commits);
       return m;
     };
     sky::server::HttpApiHooks hooks;

@@ -181,6 +181,9 @@ Result<std::vector<WeatherChange>> CigiWeatherMapper::map(const cigi::Datagram& 
     changes.push_back(SetRegion{std::move(full), {}});
   }
 
+  if (regions.size() > kMaxCigiRegionsPerSender)
+    return fail(ErrorCode::InvalidArgument, "regions: this host would have " + std::to_string(regions.size()) +
+                                                " regions, at most " + std::to_string(kMaxCigiRegionsPerSender));
   globalSent_ = std::move(global);
   regions_ = std::move(regions);
   ignoredLayers_ += ignored;

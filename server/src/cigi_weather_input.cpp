@@ -1,6 +1,8 @@
 // CIGI weather input on UDP (see cigi_weather_input.hpp).
 #include "sky/server/cigi_weather_input.hpp"
 
+#include <algorithm>
+
 #include <boost/asio/ip/address.hpp>
 #include <spdlog/spdlog.h>
 
@@ -17,14 +19,18 @@ namespace {
 // digit (packet indices and values differ between occurrences).
 std::string kindOf(const std::string& reason) {
   const auto digit = reason.find_first_of("0123456789");
-  return reason.substr(0, digit == std::string::npos ? reason.size() : digit);
+  return reason.substr(0, std::min<std::size_t>(digit, 80));
 }
+
+// Kinds of drop logged once each; the texts are bounded, this is a second
+// guard against a log flood.
+constexpr std::size_t kMaxLoggedKinds = 256;
 
 }  // namespace
 
 CigiWeatherInput::CigiWeatherInput(asio::io_context& io, WeatherService& weather,
                                    Rejections* rejections, std::shared_ptr<spdlog::logger> log)
-    : socket_(io), weather_(weather), rejections_(rejections), log_(std::move(log)) {}
+    : socket_(io), weather_(weather), rejections_(rejections), log_(std::move(log)), commitTimer_(io) {}
 
 Result<std::unique_ptr<CigiWeatherInput>> CigiWeatherInput::create(asio::io_context& io, const std::string& address,
                                                                    std::uint16_t port, WeatherService& weather,
@@ -49,6 +55,48 @@ Result<std::unique_ptr<CigiWeatherInput>> CigiWeatherInput::create(asio::io_cont
 void CigiWeatherInput::close() {
   boost::system::error_code ec;
   socket_.close(ec);
+  commitTimer_.cancel();
+  if (commitPending_) commitBatch();
+}
+
+void CigiWeatherInput::scheduleCommit() {
+  if (commitPending_) return;
+  commitPending_ = true;
+  commitTimer_.expires_after(kCigiCommitBatch);
+  commitTimer_.async_wait([this](const boost::system::error_code& ec) {
+    if (!ec) commitBatch();
+  });
+}
+
+void CigiWeatherInput::commitBatch() {
+  commitPending_ = false;
+  try {
+    if (auto r = weather_.flush(); !r) {
+      ++counters_.commitFailures;
+      logOnce("commit failed", "CIGI weather: committing a batch failed (retrying): " + r.error().detail);
+      if (socket_.is_open()) scheduleCommit();
+      return;
+    }
+    ++counters_.commits;
+  } catch (const std::exception& e) {
+    ++counters_.commitFailures;
+    if (rejections_) rejections_->count(RejectReason::HandlerFailed);
+    logOnce("commit exception", std::string("CIGI weather: committing a batch threw: ") + e.what());
+  }
+}
+
+CigiWeatherMapper* CigiWeatherInput::mapperFor(const std::string& sender) {
+  const auto now = std::chrono::steady_clock::now();
+  if (auto it = mappers_.find(sender); it != mappers_.end()) {
+    it->second.lastSeen = now;
+    return &it->second.mapper;
+  }
+  if (mappers_.size() >= kMaxCigiSenders)
+    std::erase_if(mappers_, [&](const auto& entry) { return now - entry.second.lastSeen > kCigiSenderIdle; });
+  if (mappers_.size() >= kMaxCigiSenders) return nullptr;
+  Sender& made = mappers_[sender];
+  made.lastSeen = now;
+  return &made.mapper;
 }
 
 void CigiWeatherInput::receive() {
@@ -62,12 +110,23 @@ void CigiWeatherInput::receive() {
 }
 
 void CigiWeatherInput::logOnce(const std::string& kind, const std::string& message) {
-  if (logged_.insert(kind).second)
+  if (logged_.size() < kMaxLoggedKinds && logged_.insert(kind).second)
     log_->warn("event=cigi_dropped kind={:?} detail={:?} (further ones of this kind are only counted)", kind, message);
 }
 
 void CigiWeatherInput::onDatagram(std::span<const std::uint8_t> bytes, const std::string& sender) {
   ++counters_.datagrams;
+  // The boundary of one datagram: whatever handling it throws drops it.
+  try {
+    handle(bytes, sender);
+  } catch (const std::exception& e) {
+    if (rejections_) rejections_->count(RejectReason::HandlerFailed);
+    logOnce("exception " + kindOf(e.what()),
+            "CIGI weather from " + sender + ": dropped a datagram: handling it threw: " + e.what());
+  }
+}
+
+void CigiWeatherInput::handle(std::span<const std::uint8_t> bytes, const std::string& sender) {
   auto datagram = cigi::decodeDatagram(bytes);
   if (!datagram) {
     ++counters_.malformed;
@@ -83,7 +142,16 @@ void CigiWeatherInput::onDatagram(std::span<const std::uint8_t> bytes, const std
                          "the weather input takes host datagrams only");
     return;
   }
-  CigiWeatherMapper& mapper = mappers_[sender];
+  CigiWeatherMapper* const known = mapperFor(sender);
+  if (!known) {
+    ++counters_.senderRefused;
+    if (rejections_) rejections_->count(RejectReason::CigiRefused);
+    logOnce("senders", "CIGI weather from " + sender + ": dropped: already " + std::to_string(kMaxCigiSenders) +
+                           " senders (one silent for " + std::to_string(kCigiSenderIdle.count()) +
+                           " s is forgotten)");
+    return;
+  }
+  CigiWeatherMapper& mapper = *known;
   auto changes = mapper.map(*datagram);
   if (!changes) {
     ++counters_.rejected;
@@ -96,7 +164,7 @@ void CigiWeatherInput::onDatagram(std::span<const std::uint8_t> bytes, const std
     ++counters_.unchanged;
     return;
   }
-  auto applied = weather_.submit(ChangeRequest{std::move(*changes), "cigi:" + sender, "cigi"});
+  auto applied = weather_.submitBatched(ChangeRequest{std::move(*changes), "cigi:" + sender, "cigi"});
   if (!applied) {
     ++counters_.rejected;
     if (rejections_) rejections_->count(RejectReason::CigiRefused);
@@ -108,6 +176,7 @@ void CigiWeatherInput::onDatagram(std::span<const std::uint8_t> bytes, const std
     return;
   }
   ++counters_.applied;
+  scheduleCommit();
   log_->info("event=change_applied source=cigi sender={} sequence={} summary={:?}", sender, applied->sequence,
              applied->summary);
 }

@@ -7,6 +7,7 @@
 #include "sky/server/api_json.hpp"
 #include "sky/server/live_weather.hpp"
 #include "sky/server/weather_store.hpp"
+#include "ramp_math.hpp"
 
 namespace sky::server {
 
@@ -73,6 +74,14 @@ std::vector<LiveWeather::TimelineItem> LiveWeather::timelineItems(const Scenario
 }
 
 Result<void> LiveWeather::dryRun(State s, const std::vector<TimelineItem>& items) const {
+  // The timeline starts from the clock of the weather it is given (the
+  // scenario's start, or now); an entry past the horizon would wait forever.
+  const double start_s = s.clock.at(wallNow_());
+  for (const TimelineItem& item : items)
+    if (item.at_s > start_s + kMaxScheduleAhead_s)
+      return fail(ErrorCode::InvalidArgument, item.where + ".at_s: " + fmt("%.1f", item.at_s) + " is more than " +
+                                                  fmt("%.0f", kMaxScheduleAhead_s) + " s (30 days) after clock " +
+                                                  fmt("%.1f", start_s));
   // Each entry meets the weather the ones before it left, at its own clock.
   for (const TimelineItem& item : items)
     if (auto r = apply(s, item.change, item.where, item.at_s, 0); !r)

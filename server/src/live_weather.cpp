@@ -168,7 +168,26 @@ Result<std::string> LiveWeather::apply(State& s, const WeatherChange& change, co
   return applyRegion(s, change, at, now_s, sequence);
 }
 
-Result<AppliedChange> LiveWeather::submit(const ChangeRequest& request) {
+Result<AppliedChange> LiveWeather::submit(const ChangeRequest& request) { return submitImpl(request, true); }
+
+Result<AppliedChange> LiveWeather::submitBatched(const ChangeRequest& request) {
+  return submitImpl(request, unsaved_.size() >= kMaxUnsavedEvents);
+}
+
+Result<void> LiveWeather::flush() {
+  if (!store_ || unsaved_.empty()) return {};
+  const auto started = std::chrono::steady_clock::now();
+  auto ok = store_->save(toJson(), unsaved_);
+  const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  ++commitStats_.count;
+  commitStats_.total_s += took_s;
+  commitStats_.max_s = std::max(commitStats_.max_s, took_s);
+  if (!ok) return ok;
+  unsaved_.clear();
+  return {};
+}
+
+Result<AppliedChange> LiveWeather::submitImpl(const ChangeRequest& request, bool durableNow) {
   if (request.changes.empty() || request.changes.size() > 256) {
     ++rejected_;
     return fail(ErrorCode::InvalidArgument,
@@ -187,21 +206,35 @@ Result<AppliedChange> LiveWeather::submit(const ChangeRequest& request) {
     }
     summary += (summary.empty() ? "" : "; ") + *one;
   }
-  return commit(std::move(next), timeline_, request.author, request.source, summary, now_s);
+  if (const std::size_t pending = next.ramps.size() + next.regionRamps.size(); pending > kMaxPendingRamps) {
+    ++rejected_;
+    return fail(ErrorCode::InvalidArgument, "changes: " + std::to_string(pending) +
+                                                " changes would be scheduled or ramping, at most " +
+                                                std::to_string(kMaxPendingRamps));
+  }
+  return commit(std::move(next), timeline_, request.author, request.source, summary, now_s, durableNow);
 }
 
 Result<AppliedChange> LiveWeather::commit(State next, std::vector<TimelineItem> timeline, const std::string& author,
-                                          const std::string& source, const std::string& summary, double now_s) {
+                                          const std::string& source, const std::string& summary, double now_s,
+                                          bool durableNow) {
   ChangeEvent e{sequence_ + 1, now_s, unixNowMs_(), author, source, summary};
-  if (store_) {
-    // Commit first: only a change on disk is acknowledged and applied.
+  if (store_ && durableNow) {
+    // Commit first: only a change on disk is acknowledged and applied. The
+    // state saved holds every batched change applied before it, so their
+    // events go in the same transaction.
+    std::vector<ChangeEvent> events = unsaved_;
+    events.push_back(e);
     const auto started = std::chrono::steady_clock::now();
-    auto ok = store_->save(stateJson(next, timeline, sequence_ + 1, version_ + 1), &e);
+    auto ok = store_->save(stateJson(next, timeline, sequence_ + 1, version_ + 1), events);
     const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     ++commitStats_.count;
     commitStats_.total_s += took_s;
     commitStats_.max_s = std::max(commitStats_.max_s, took_s);
     if (!ok) return tl::unexpected(ok.error());
+    unsaved_.clear();
+  } else if (store_) {
+    unsaved_.push_back(e);
   }
   layers_ = std::move(next.layers);
   ramps_ = std::move(next.ramps);

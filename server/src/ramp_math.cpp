@@ -45,6 +45,10 @@ Result<void> checkTiming(const Timing& t, const std::string& at, double now_s) {
   if (t.at_s && (!std::isfinite(*t.at_s) || *t.at_s < now_s - kPastTolerance_s))
     return fail(ErrorCode::InvalidArgument,
                 at + ".at_s: " + fmt("%.1f", *t.at_s) + " is in the past (weather clock now " + fmt("%.1f", now_s) + ")");
+  if (t.at_s && *t.at_s > now_s + kMaxScheduleAhead_s)
+    return fail(ErrorCode::InvalidArgument, at + ".at_s: " + fmt("%.1f", *t.at_s) + " is more than " +
+                                                fmt("%.0f", kMaxScheduleAhead_s) +
+                                                " s (30 days) ahead of the weather clock now (" + fmt("%.1f", now_s) + ")");
   return {};
 }
 

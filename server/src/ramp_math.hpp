@@ -13,8 +13,15 @@
 
 namespace sky::server {
 
+// Furthest ahead of the weather clock now that a change or a timeline entry
+// may be scheduled, weather seconds (30 days). A training exercise spans
+// hours to days; a start beyond a month is a mistake (or a hostile value
+// that would sit in memory and on disk forever), refused with the field named.
+inline constexpr double kMaxScheduleAhead_s = 30.0 * 86400.0;
+
 // A change's timing against the weather clock now: ramp in [0, 86400] s, a
-// start not in the past (beyond a few seconds of slack). Errors name `at`.
+// start not in the past (beyond a few seconds of slack) and at most
+// kMaxScheduleAhead_s ahead. Errors name `at`.
 Result<void> checkTiming(const Timing& timing, const std::string& at, double now_s);
 
 // Layer ids in use by the global layers and every region's layers together

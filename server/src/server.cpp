@@ -19,8 +19,27 @@ using asio::ip::tcp;
 namespace {
 
 // Pause before accepting again after a failed accept (e.g. out of file
-// descriptors), so a persistent failure does not spin the loop.
-constexpr std::chrono::milliseconds kAcceptRetryDelay{100};
+// descriptors: the pending connection stays in the backlog, so accept fails
+// again at once). The pause doubles from the first to the longest while the
+// failures go on, and resets after a success: a persistent EMFILE costs a
+// few accept calls a second, not a core, and a freed descriptor is used
+// within a second.
+constexpr std::chrono::milliseconds kAcceptRetryFirst{10};
+constexpr std::chrono::milliseconds kAcceptRetryLongest{1000};
+// Refused connections (past maxSubscribers) waiting for their Error to go
+// out; past this many, further ones are closed without a word, so a flood of
+// connections cannot hold descriptors for the drain time.
+constexpr std::size_t kMaxRefusing = 64;
+// Kinds of warning logged once each; past this many distinct kinds (the
+// texts are bounded, this is a second guard), only counters grow.
+constexpr std::size_t kMaxWarnedKinds = 256;
+
+// The kind of an error detail, for logging each kind once: its text up to the
+// first digit (indices and values differ between occurrences).
+std::string kindOf(const std::string& detail) {
+  const auto digit = detail.find_first_of("0123456789");
+  return detail.substr(0, std::min<std::size_t>(digit, 80));
+}
 // Longest sleep of the timeline timer: the weather clock is re-read at least
 // this often, so an entry is never late by more than the timer's own slack.
 constexpr std::chrono::seconds kMaxTimelineSleep{60};
@@ -31,6 +50,17 @@ Result<std::unique_ptr<Server>> Server::create(ServerOptions options, WeatherSta
   SKY_ASSERT(options.heartbeatInterval.count() > 0);
   std::unique_ptr<Server> server(new Server(std::move(options), std::move(state)));
   if (auto r = server->listen(); !r) return tl::unexpected(r.error());
+  if (server->options_.handleSignals) {
+    // From here, not from run(): a SIGTERM that comes while the main still
+    // sets up (its port files already written) waits for run() and shuts
+    // down cleanly, instead of killing the process by the default action.
+    server->signals_.emplace(server->io_, SIGINT, SIGTERM);
+    server->signals_->async_wait([s = server.get()](const boost::system::error_code& ec, int signal) {
+      if (ec) return;
+      s->log_->info("event=shutdown signal={}", signal);
+      s->shutdown();
+    });
+  }
   return server;
 }
 
@@ -78,21 +108,36 @@ Result<void> Server::listen() {
 }
 
 void Server::run() {
-  if (options_.handleSignals) {
-    signals_.emplace(io_, SIGINT, SIGTERM);
-    signals_->async_wait([this](const boost::system::error_code& ec, int signal) {
-      if (ec) return;
-      log_->info("event=shutdown signal={}", signal);
-      shutdown();
-    });
-  }
   accept();
   scheduleHeartbeat();
   armTimeline();
   log_->info("event=serving layers={} clock_s={:.3f} rate={}", weather_.layersAt(clockNow()).size(),
              clockNow(), weather_.clock().rate());
-  io_.run();
+  // The last boundary: every input has its own (session.cpp, the CIGI input,
+  // the HTTP API); an exception that still escapes a handler is caught here
+  // and run() is called again, which asio allows after a handler threw.
+  for (;;) {
+    try {
+      io_.run();
+      break;
+    } catch (const std::exception& e) {
+      handlerFailed(e.what());
+    } catch (...) {
+      handlerFailed("unknown exception");
+    }
+  }
   log_->info("event=stopped");
+}
+
+void Server::handlerFailed(const std::string& what) {
+  streamCounters_.handlerExceptions.fetch_add(1, std::memory_order_relaxed);
+  rejections_.count(RejectReason::HandlerFailed);
+  warnOnce("handler " + kindOf(what), "event=handler_exception detail=\"" + what + "\"; serving on");
+}
+
+void Server::warnOnce(const std::string& kind, const std::string& message) {
+  if (warned_.size() >= kMaxWarnedKinds || !warned_.insert(kind).second) return;
+  log_->warn("{} (further ones of this kind are only counted)", message);
 }
 
 void Server::stop() {
@@ -109,6 +154,7 @@ void Server::shutdown() {
   timelineTimer_.cancel();
   if (signals_) signals_->cancel(ignored);
   registry_.closeAll();
+  refused_.closeAll();
   for (const auto& f : onShutdown_) f();
 }
 
@@ -121,16 +167,38 @@ void Server::accept() {
 void Server::onAccept(const boost::system::error_code& ec, tcp::socket socket) {
   if (stopped_) return;
   if (ec) {
-    log_->warn("event=accept_failed error={:?}; retrying", ec.message());
-    acceptRetry_.expires_after(kAcceptRetryDelay);
+    streamCounters_.acceptFailures.fetch_add(1, std::memory_order_relaxed);
+    acceptDelay_ = std::clamp(acceptDelay_ * 2, kAcceptRetryFirst, kAcceptRetryLongest);
+    warnOnce("accept " + ec.message(), "event=accept_failed error=\"" + ec.message() + "\"; retrying with back-off up to " +
+                                           std::to_string(kAcceptRetryLongest.count()) + " ms");
+    acceptRetry_.expires_after(acceptDelay_);
     acceptRetry_.async_wait([this](const boost::system::error_code& e) {
       if (!e && !stopped_) accept();
     });
     return;
   }
+  acceptDelay_ = std::chrono::milliseconds{0};
   boost::system::error_code ignored;
   // Frames are whole messages: send each as soon as it is written.
   socket.set_option(tcp::no_delay(true), ignored);
+  if (registry_.size() >= options_.maxSubscribers) {
+    rejections_.count(RejectReason::SubscriberCap);
+    if (refused_.size() >= kMaxRefusing) {
+      socket.close(ignored);  // already telling enough others; this one gets no Error
+    } else {
+      auto session = std::make_shared<Session>(std::move(socket), nextSessionId_++,
+                                               static_cast<SessionHandler&>(*this), *log_, options_.stallTimeout);
+      warnOnce("subscriber cap", "event=subscriber_refused peer=" + session->peer() + " subscribers=" +
+                                     std::to_string(registry_.size()) + " cap=" +
+                                     std::to_string(options_.maxSubscribers));
+      refused_.add(session);
+      session->refuse(Error{ErrorCode::TooLarge, "server full: " + std::to_string(registry_.size()) +
+                                                     " subscribers, at most " +
+                                                     std::to_string(options_.maxSubscribers)});
+    }
+    accept();
+    return;
+  }
   auto session = std::make_shared<Session>(std::move(socket), nextSessionId_++,
                                            static_cast<SessionHandler&>(*this), *log_, options_.stallTimeout);
   log_->info("event=session_connected session={} peer={} subscribers={}", session->id(), session->peer(),
@@ -225,10 +293,18 @@ std::string Server::streamMetrics() const {
   line("skyshell_stream_bytes_total", "weather stream bytes sent", streamCounters_.bytes.load());
   line("skyshell_subscribers_dropped_total", "subscribers dropped for not reading",
        streamCounters_.stalledDropped.load());
+  line("skyshell_accept_failures_total", "stream accept() calls that failed (retried with back-off)",
+       streamCounters_.acceptFailures.load());
+  line("skyshell_handler_exceptions_total", "exceptions caught by the io loop's last boundary",
+       streamCounters_.handlerExceptions.load());
   return m;
 }
 
 void Server::sessionClosed(Session& session) {
+  if (refused_.contains(session)) {
+    refused_.remove(session);
+    return;
+  }
   log_->info("event=session_closed session={} peer={} subscribers={}", session.id(), session.peer(),
              registry_.size() - 1);
   registry_.remove(session);
@@ -237,7 +313,18 @@ void Server::sessionClosed(Session& session) {
 
 void Server::rendererChanged(Session&) { renderersChanged(); }
 
-void Server::protocolRejected(Session&, const Error&) { rejections_.count(RejectReason::StreamMalformed); }
+void Server::protocolRejected(Session& session, const Error& error) {
+  rejections_.count(RejectReason::StreamMalformed);
+  warnOnce("stream " + kindOf(error.detail), "event=stream_malformed session=" + std::to_string(session.id()) +
+                                                 " peer=" + session.peer() + " detail=\"" + describe(error) +
+                                                 "\"; sent Error, closing");
+}
+
+void Server::sessionFailed(Session& session, const std::string& what) {
+  rejections_.count(RejectReason::HandlerFailed);
+  warnOnce("session " + kindOf(what), "event=session_exception session=" + std::to_string(session.id()) +
+                                          " peer=" + session.peer() + " detail=\"" + what + "\"; closed");
+}
 
 void Server::renderersChanged() {
   // Not while shutting down: the listeners' owners may be closing too.

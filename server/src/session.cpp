@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <exception>
 #include <span>
 #include <type_traits>
 #include <utility>
@@ -50,10 +51,36 @@ Session::Session(asio::ip::tcp::socket socket, std::uint64_t id, SessionHandler&
   peer_ = ec ? std::string("?") : remote.address().to_string() + ":" + std::to_string(remote.port());
 }
 
+template <class F>
+void Session::guarded(const char* where, F&& f) {
+  // The boundary of one peer: whatever a handler throws (a bad_alloc from a
+  // hostile size, a bug) ends this session, never the server's io thread.
+  try {
+    f();
+  } catch (const std::exception& e) {
+    handler_.sessionFailed(*this, std::string(where) + ": " + e.what());
+    close();
+  } catch (...) {
+    handler_.sessionFailed(*this, std::string(where) + ": unknown exception");
+    close();
+  }
+}
+
 void Session::start(Frame hello) {
-  outbox_.pushControl(std::move(hello));
-  writeNext();
-  readMore();
+  guarded("start", [&] {
+    outbox_.pushControl(std::move(hello));
+    writeNext();
+    readMore();
+  });
+}
+
+void Session::refuse(const Error& error) {
+  guarded("refuse", [&] {
+    state_ = State::ErrorQueued;
+    outbox_.pushControl(encodeErrorFrame(error));
+    writeNext();
+    readMore();
+  });
 }
 
 void Session::sendHeartbeat(const Frame& heartbeat) {
@@ -90,6 +117,10 @@ void Session::readMore() {
 }
 
 void Session::onRead(const boost::system::error_code& ec, std::size_t bytes) {
+  guarded("read", [&] { handleRead(ec, bytes); });
+}
+
+void Session::handleRead(const boost::system::error_code& ec, std::size_t bytes) {
   if (state_ == State::Closed) return;
   if (ec) {
     if (ec == asio::error::eof)
@@ -160,8 +191,9 @@ RendererInfo Session::info(std::chrono::steady_clock::time_point now) const {
 }
 
 void Session::protocolError(const Error& error) {
-  log_.warn("event=stream_malformed session={} peer={} detail={:?}; sending Error and closing", id_, peer_,
-            describe(error));
+  // The handler logs the first of each kind; every one is here at debug.
+  log_.debug("event=stream_malformed session={} peer={} detail={:?}; sending Error and closing", id_, peer_,
+             describe(error));
   handler_.protocolRejected(*this, error);
   state_ = State::ErrorQueued;
   outbox_.dropWeather();
@@ -188,18 +220,21 @@ void Session::writeNext() {
   const std::uint64_t generation = ++writeGeneration_;
   asio::async_write(socket_, asio::buffer(writing_),
                     [self = shared_from_this()](const boost::system::error_code& ec, std::size_t) {
-                      self->onWritten(ec);
+                      self->guarded("write", [&] { self->onWritten(ec); });
                     });
   stallTimer_.expires_after(stallTimeout_);
   stallTimer_.async_wait([self = shared_from_this(), generation](const boost::system::error_code& ec) {
-    // Cancelled, superseded by a later write, or that write has completed.
-    if (ec || generation != self->writeGeneration_ || !self->writeInFlight_ || self->state_ == State::Closed)
-      return;
-    self->log_.warn("event=subscriber_stalled session={} peer={} frame_bytes={} stall_ms={}; dropped", self->id_,
-                    self->peer_, self->writing_.size(), self->stallTimeout_.count());
-    self->handler_.sessionStalled(*self);
-    self->close();
+    self->guarded("stall timer", [&] { self->onStallTimer(ec, generation); });
   });
+}
+
+void Session::onStallTimer(const boost::system::error_code& ec, std::uint64_t generation) {
+  // Cancelled, superseded by a later write, or that write has completed.
+  if (ec || generation != writeGeneration_ || !writeInFlight_ || state_ == State::Closed) return;
+  log_.warn("event=subscriber_stalled session={} peer={} frame_bytes={} stall_ms={}; dropped", id_, peer_,
+            writing_.size(), stallTimeout_.count());
+  handler_.sessionStalled(*this);
+  close();
 }
 
 Frame Session::weatherFrame(const stream::Subscribe& request) {
@@ -238,7 +273,7 @@ void Session::beginDrain() {
   socket_.shutdown(asio::ip::tcp::socket::shutdown_send, ignored);
   drainTimer_.expires_after(kDrainTimeout);
   drainTimer_.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
-    if (!ec) self->close();
+    if (!ec) self->guarded("drain timer", [&] { self->close(); });
   });
 }
 

@@ -49,30 +49,47 @@ Result<void> WeatherStore::exec(const char* sql) const {
   return {};
 }
 
-Result<WeatherStore> WeatherStore::open(const std::filesystem::path& path) {
+Result<WeatherStore> WeatherStore::open(const std::filesystem::path& path, std::chrono::milliseconds lockWait) {
   sqlite3* raw = nullptr;
   const int rc = sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
   std::unique_ptr<sqlite3, Closer> db(raw);
   if (rc != SQLITE_OK)
     return fail(ErrorCode::Io, path.string() + ": cannot open: " + (raw ? sqlite3_errmsg(raw) : "out of memory"));
-  sqlite3_busy_timeout(raw, 5000);
+  // Another connection's lock (a second server on the same file) is waited
+  // for this long, then reported: better a clear error at start than a
+  // server that fails every commit later.
+  sqlite3_busy_timeout(raw, static_cast<int>(lockWait.count()));
   WeatherStore store(path, std::move(db));
+  // Says what went wrong in words an operator acts on: garbage bytes are
+  // "not a database" (Malformed), a lock is "locked" (Io).
+  auto explain = [&store](const Error& e) {
+    const int code = sqlite3_errcode(store.db_.get()) & 0xff;
+    if (code == SQLITE_NOTADB || code == SQLITE_CORRUPT)
+      return fail(ErrorCode::Malformed, e.detail + " (the file is corrupt or not a Skyshell weather database)");
+    if (code == SQLITE_BUSY || code == SQLITE_LOCKED)
+      return fail(ErrorCode::Io, e.detail + " (another process holds a lock on it: is a second server running?)");
+    return tl::unexpected(e);
+  };
   // WAL: a crash never leaves a half-written state; FULL: a commit survives
   // the machine losing power, not only the process dying.
-  if (auto r = store.exec("PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;"); !r) return tl::unexpected(r.error());
+  if (auto r = store.exec("PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;"); !r) return explain(r.error());
   if (auto r = store.exec("CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);"
                           "CREATE TABLE IF NOT EXISTS events (sequence INTEGER PRIMARY KEY, clock_s REAL NOT NULL,"
                           " wall_ms INTEGER NOT NULL, author TEXT NOT NULL, source TEXT NOT NULL, summary TEXT NOT NULL);");
       !r)
-    return tl::unexpected(r.error());
+    return explain(r.error());
+  // The first change must not be the first to find out the file cannot be
+  // written: take the write lock once now.
+  if (auto r = store.exec("BEGIN IMMEDIATE;"); !r) return explain(r.error());
+  if (auto r = store.exec("COMMIT;"); !r) return explain(r.error());
   Statement version(store.db_.get(), "SELECT value FROM meta WHERE key = 'schema'");
-  if (!version.ok()) return fail(ErrorCode::Io, path.string() + ": " + sqlite3_errmsg(store.db_.get()));
+  if (!version.ok()) return explain(Error{ErrorCode::Io, path.string() + ": " + sqlite3_errmsg(store.db_.get())});
   if (sqlite3_step(version.get()) == SQLITE_ROW) {
     if (text(version.get(), 0) != std::to_string(kSchemaVersion))
       return fail(ErrorCode::Unsupported, path.string() + ": schema version " + text(version.get(), 0) +
                                               ", this server knows " + std::to_string(kSchemaVersion));
   } else if (auto r = store.exec("INSERT INTO meta (key, value) VALUES ('schema', '1');"); !r) {
-    return tl::unexpected(r.error());
+    return explain(r.error());
   }
   return store;
 }
@@ -85,7 +102,11 @@ Result<std::optional<WeatherStore::Saved>> WeatherStore::load() const {
   saved.state = nlohmann::json::parse(text(st.get(), 0), nullptr, false);
   if (saved.state.is_discarded() || !saved.state.is_object())
     return fail(ErrorCode::Malformed, path_.string() + ": the saved state is not a JSON object");
-  Statement ev(db_.get(), "SELECT sequence, clock_s, wall_ms, author, source, summary FROM events ORDER BY sequence");
+  // The newest kMaxStoredEvents only: a file from before the bound (or
+  // written by hand) must not make a restore load unbounded history.
+  Statement ev(db_.get(), "SELECT sequence, clock_s, wall_ms, author, source, summary FROM "
+                          "(SELECT * FROM events ORDER BY sequence DESC LIMIT ?1) ORDER BY sequence");
+  if (ev.ok()) sqlite3_bind_int64(ev.get(), 1, static_cast<sqlite3_int64>(kMaxStoredEvents));
   if (!ev.ok()) return fail(ErrorCode::Io, path_.string() + ": " + sqlite3_errmsg(db_.get()));
   while (sqlite3_step(ev.get()) == SQLITE_ROW)
     saved.events.push_back({static_cast<std::uint64_t>(sqlite3_column_int64(ev.get(), 0)),
@@ -95,6 +116,10 @@ Result<std::optional<WeatherStore::Saved>> WeatherStore::load() const {
 }
 
 Result<void> WeatherStore::save(const nlohmann::json& state, const ChangeEvent* event) {
+  return event ? save(state, std::span<const ChangeEvent>(event, 1)) : save(state, std::span<const ChangeEvent>());
+}
+
+Result<void> WeatherStore::save(const nlohmann::json& state, std::span<const ChangeEvent> events) {
   if (auto r = exec("BEGIN IMMEDIATE;"); !r) return r;
   auto rollback = [this](const std::string& what) {
     const std::string detail = path_.string() + ": " + what + ": " + sqlite3_errmsg(db_.get());
@@ -109,23 +134,43 @@ Result<void> WeatherStore::save(const nlohmann::json& state, const ChangeEvent* 
         sqlite3_step(st.get()) != SQLITE_DONE)
       return rollback("saving the state");
   }
-  if (event) {
+  if (!events.empty()) {
     Statement st(db_.get(), "INSERT INTO events (sequence, clock_s, wall_ms, author, source, summary) "
                             "VALUES (?1, ?2, ?3, ?4, ?5, ?6)");
-    if (!st.ok() || sqlite3_bind_int64(st.get(), 1, static_cast<sqlite3_int64>(event->sequence)) != SQLITE_OK ||
-        sqlite3_bind_double(st.get(), 2, event->clock_s) != SQLITE_OK ||
-        sqlite3_bind_int64(st.get(), 3, event->wallTime_ms) != SQLITE_OK ||
-        sqlite3_bind_text(st.get(), 4, event->author.c_str(), -1, SQLITE_TRANSIENT) != SQLITE_OK ||
-        sqlite3_bind_text(st.get(), 5, event->source.c_str(), -1, SQLITE_TRANSIENT) != SQLITE_OK ||
-        sqlite3_bind_text(st.get(), 6, event->summary.c_str(), -1, SQLITE_TRANSIENT) != SQLITE_OK ||
-        sqlite3_step(st.get()) != SQLITE_DONE)
-      return rollback("saving the event");
+    if (!st.ok()) return rollback("saving the events");
+    for (const ChangeEvent& event : events) {
+      sqlite3_reset(st.get());
+      if (sqlite3_bind_int64(st.get(), 1, static_cast<sqlite3_int64>(event.sequence)) != SQLITE_OK ||
+          sqlite3_bind_double(st.get(), 2, event.clock_s) != SQLITE_OK ||
+          sqlite3_bind_int64(st.get(), 3, event.wallTime_ms) != SQLITE_OK ||
+          sqlite3_bind_text(st.get(), 4, event.author.c_str(), -1, SQLITE_TRANSIENT) != SQLITE_OK ||
+          sqlite3_bind_text(st.get(), 5, event.source.c_str(), -1, SQLITE_TRANSIENT) != SQLITE_OK ||
+          sqlite3_bind_text(st.get(), 6, event.summary.c_str(), -1, SQLITE_TRANSIENT) != SQLITE_OK ||
+          sqlite3_step(st.get()) != SQLITE_DONE)
+        return rollback("saving event " + std::to_string(event.sequence));
+    }
+    // Retention: sequences grow by one per event, so everything at or below
+    // newest - kMaxStoredEvents is older than the newest kMaxStoredEvents.
+    // One range delete on the primary key, no scan of what is kept.
+    Statement prune(db_.get(), "DELETE FROM events WHERE sequence <= ?1");
+    const auto newest = static_cast<sqlite3_int64>(events.back().sequence);
+    if (!prune.ok() ||
+        sqlite3_bind_int64(prune.get(), 1, newest - static_cast<sqlite3_int64>(kMaxStoredEvents)) != SQLITE_OK ||
+        sqlite3_step(prune.get()) != SQLITE_DONE)
+      return rollback("pruning the event log");
   }
   if (auto r = exec("COMMIT;"); !r) {
     (void)exec("ROLLBACK;");
     return r;
   }
   return {};
+}
+
+Result<std::size_t> WeatherStore::storedEvents() const {
+  Statement st(db_.get(), "SELECT COUNT(*) FROM events");
+  if (!st.ok() || sqlite3_step(st.get()) != SQLITE_ROW)
+    return fail(ErrorCode::Io, path_.string() + ": " + sqlite3_errmsg(db_.get()));
+  return static_cast<std::size_t>(sqlite3_column_int64(st.get(), 0));
 }
 
 }  // namespace sky::server

@@ -35,10 +35,10 @@ Result<std::optional<std::vector<std::uint8_t>>> FrameDecoder::next() {
   const std::uint8_t* h = buffer_.data() + consumed_;
   const std::size_t n = (std::size_t{h[0]} << 24) | (std::size_t{h[1]} << 16) |
                         (std::size_t{h[2]} << 8) | std::size_t{h[3]};
-  if (n > kMaxFrameBytes) {
+  if (n > maxFrameBytes_) {
     failed_ = true;
     return fail(ErrorCode::TooLarge, "frame announces " + std::to_string(n) +
-                                         " bytes, cap is " + std::to_string(kMaxFrameBytes));
+                                         " bytes, cap is " + std::to_string(maxFrameBytes_));
   }
   if (available < kFrameHeaderBytes + n) return std::optional<std::vector<std::uint8_t>>{};
   std::vector<std::uint8_t> payload(h + kFrameHeaderBytes, h + kFrameHeaderBytes + n);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "sky/core/overloaded.hpp"
+#include "sky/stream/framing.hpp"
 #include "weather_stream_generated.h"
 
 namespace sky::stream {
@@ -98,19 +99,38 @@ Result<weather::CloudLayer> decodeLayer(const char* message, const fbs::Layer& l
   return layer;
 }
 
+Result<void> checkCount(const char* message, const char* field, std::size_t n, std::size_t cap) {
+  if (n <= cap) return {};
+  return fail(ErrorCode::TooLarge, std::string(message) + "." + field + ": " + std::to_string(n) + ", at most " +
+                                       std::to_string(cap));
+}
+
+// The layer ids of `layers`, sorted; an error when one appears twice. Sorting
+// keeps this O(n log n) (a pairwise check was quadratic in a crafted frame).
+Result<std::vector<std::uint32_t>> sortedUniqueIds(const char* message,
+                                                   const std::vector<weather::CloudLayer>& layers) {
+  std::vector<std::uint32_t> ids;
+  ids.reserve(layers.size());
+  for (const auto& l : layers) ids.push_back(l.id);
+  std::sort(ids.begin(), ids.end());
+  if (const auto twice = std::adjacent_find(ids.begin(), ids.end()); twice != ids.end())
+    return fail(ErrorCode::InvalidArgument,
+                std::string(message) + ".layers: id " + std::to_string(*twice) + " appears twice");
+  return ids;
+}
+
 Result<std::vector<weather::CloudLayer>> decodeLayers(
     const char* message, const flatbuffers::Vector<flatbuffers::Offset<fbs::Layer>>* layers) {
   std::vector<weather::CloudLayer> out;
   if (!layers) return out;
+  if (auto r = checkCount(message, "layers", layers->size(), kMaxMessageLayers); !r) return tl::unexpected(r.error());
+  out.reserve(layers->size());
   for (const fbs::Layer* l : *layers) {
     auto layer = decodeLayer(message, *l);
     if (!layer) return tl::unexpected(layer.error());
-    for (const auto& seen : out)
-      if (seen.id == layer->id)
-        return fail(ErrorCode::InvalidArgument,
-                    std::string(message) + ".layers: id " + std::to_string(layer->id) + " appears twice");
     out.push_back(*layer);
   }
+  if (auto ids = sortedUniqueIds(message, out); !ids) return tl::unexpected(ids.error());
   return out;
 }
 
@@ -118,6 +138,7 @@ Result<std::vector<weather::CoverageTile>> decodeTiles(const char* message, int 
                                                        const flatbuffers::Vector<const fbs::Tile*>* tiles) {
   std::vector<weather::CoverageTile> out;
   if (!tiles) return out;
+  if (auto r = checkCount(message, "tiles", tiles->size(), kMaxMessageTiles); !r) return tl::unexpected(r.error());
   out.reserve(tiles->size());
   // The FlatBuffers verifier checks a vector's length prefix (4-byte aligned)
   // but not the alignment of 8-byte-aligned struct elements; a crafted buffer
@@ -160,8 +181,11 @@ Result<Message> decodeSnapshot(const fbs::Snapshot& s) {
   auto tiles = decodeTiles("Snapshot", out.tileLevel, s.tiles());
   if (!tiles) return tl::unexpected(tiles.error());
   out.tiles = std::move(*tiles);
+  // Every tile's layer by binary search in the sorted ids: O(tiles log layers).
+  const auto ids = sortedUniqueIds("Snapshot", out.layers);
+  if (!ids) return tl::unexpected(ids.error());
   for (const auto& t : out.tiles)
-    if (std::none_of(out.layers.begin(), out.layers.end(), [&](const auto& l) { return l.id == t.layerId; }))
+    if (!std::binary_search(ids->begin(), ids->end(), t.layerId))
       return fail(ErrorCode::InvalidArgument,
                   "Snapshot.tiles: a tile of layer " + std::to_string(t.layerId) + ", which the Snapshot does not have");
   return Message(std::move(out));
@@ -179,7 +203,11 @@ Result<Message> decodeDelta(const fbs::Delta& d) {
   auto layers = decodeLayers("Delta", d.layers());
   if (!layers) return tl::unexpected(layers.error());
   out.layers = std::move(*layers);
-  if (d.removed_layer_ids()) out.removedLayerIds.assign(d.removed_layer_ids()->begin(), d.removed_layer_ids()->end());
+  if (d.removed_layer_ids()) {
+    if (auto r = checkCount("Delta", "removed_layer_ids", d.removed_layer_ids()->size(), kMaxMessageLayers); !r)
+      return tl::unexpected(r.error());
+    out.removedLayerIds.assign(d.removed_layer_ids()->begin(), d.removed_layer_ids()->end());
+  }
   auto tiles = decodeTiles("Delta", out.tileLevel, d.tiles());
   if (!tiles) return tl::unexpected(tiles.error());
   out.tiles = std::move(*tiles);
@@ -257,6 +285,7 @@ std::vector<fbs::Tile> encodeTiles(const std::vector<weather::CoverageTile>& til
 }
 
 static_assert(sizeof(fbs::Tile) == kTileWireBytes, "kTileWireBytes must match the schema's Tile");
+static_assert(kMaxMessageTiles * kTileWireBytes == kMaxFrameBytes, "kMaxMessageTiles: the tiles of one full frame");
 
 }  // namespace
 

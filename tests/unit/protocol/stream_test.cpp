@@ -1,5 +1,6 @@
 // Weather stream: frames split anywhere reassemble; oversize frames and
 // corrupted buffers are rejected; every message kind round-trips.
+#include <chrono>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -432,6 +433,98 @@ TEST(Areas, ADeltaAppliesOnlyToItsOwnArea) {
   const auto same = weather::diffSnapshots(coarse, coarse);
   ASSERT_TRUE(same);
   EXPECT_EQ(same->areaIndex, 1);
+}
+
+// Issue 18: the server reads with the subscriber's cap, so a peer announcing
+// a snapshot-sized frame is refused from its 4-byte header alone.
+TEST(Framing, TheSubscriberCapRefusesFromTheHeader) {
+  FrameDecoder atCap(kMaxSubscriberFrameBytes);
+  const std::uint8_t fits[4] = {0, 0, 0x10, 0x00};  // 4096 bytes: waits for them
+  atCap.append(fits);
+  ASSERT_TRUE(atCap.next());
+  FrameDecoder over(kMaxSubscriberFrameBytes);
+  const std::uint8_t tooMany[4] = {0, 0, 0x10, 0x01};  // 4097 bytes
+  over.append(tooMany);
+  auto r = over.next();
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::TooLarge);
+  EXPECT_NE(r.error().detail.find("cap is 4096"), std::string::npos) << r.error().detail;
+  EXPECT_LT(kMaxSubscriberFrameBytes, kMaxFrameBytes);
+  // Both kinds a subscriber sends fit with room, the longest channel name too.
+  CameraReport report;
+  report.channel = std::string(kMaxChannelBytes, 'c');
+  EXPECT_LT(encodeFrame(encodeMessage(report)).size(), kMaxSubscriberFrameBytes / 4);
+  EXPECT_LT(encodeFrame(encodeMessage(Subscribe{})).size(), kMaxSubscriberFrameBytes / 4);
+}
+
+weather::WeatherSnapshot snapshotWithLayers(std::size_t n) {
+  weather::WeatherSnapshot s = sampleSnapshot();
+  s.tiles.clear();
+  const weather::CloudLayer base = s.layers[0];
+  s.layers.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    weather::CloudLayer l = base;
+    l.id = static_cast<std::uint32_t>(i + 1);
+    s.layers.push_back(l);
+  }
+  return s;
+}
+
+// Issue 18: a snapshot of 60 000 distinct layers took a pairwise duplicate
+// check (1.8e9 comparisons) before this cap; now it is refused by its count.
+TEST(Messages, LayerCountIsCappedAndCheckedBeforeDecoding) {
+  auto m = decodeMessage(encodeMessage(snapshotWithLayers(kMaxMessageLayers)));
+  ASSERT_TRUE(m) << m.error().detail;
+  EXPECT_EQ(std::get<weather::WeatherSnapshot>(*m).layers.size(), kMaxMessageLayers);
+
+  m = decodeMessage(encodeMessage(snapshotWithLayers(kMaxMessageLayers + 1)));
+  ASSERT_FALSE(m);
+  EXPECT_EQ(m.error().code, ErrorCode::TooLarge);
+  EXPECT_NE(m.error().detail.find("Snapshot.layers: 257, at most 256"), std::string::npos) << m.error().detail;
+
+  const auto huge = encodeMessage(snapshotWithLayers(60000));
+  const auto started = std::chrono::steady_clock::now();
+  m = decodeMessage(huge);
+  const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  ASSERT_FALSE(m);
+  EXPECT_EQ(m.error().code, ErrorCode::TooLarge);
+  // The verifier's linear pass over ~2 MB; the sanitizer build is slow, so
+  // the bound is loose (the quadratic check took minutes).
+  EXPECT_LT(took_s, 1.0);
+
+  // A duplicate at the far end of a full list is still found (after sorting).
+  weather::WeatherSnapshot dup = snapshotWithLayers(kMaxMessageLayers);
+  dup.layers.back().id = 1;
+  m = decodeMessage(encodeMessage(dup));
+  ASSERT_FALSE(m);
+  EXPECT_NE(m.error().detail.find("id 1 appears twice"), std::string::npos) << m.error().detail;
+
+  weather::WeatherDelta delta;
+  delta.tileLevel = 9;
+  delta.removedLayerIds.assign(kMaxMessageLayers + 1, 7);
+  m = decodeMessage(encodeMessage(delta));
+  ASSERT_FALSE(m);
+  EXPECT_NE(m.error().detail.find("Delta.removed_layer_ids: 257, at most 256"), std::string::npos)
+      << m.error().detail;
+}
+
+TEST(Messages, TileCountIsCappedAtWhatOneFrameHolds) {
+  weather::WeatherSnapshot s = sampleSnapshot();
+  // Any cell will do: the count is checked before the first tile is looked at.
+  s.tiles.assign(kMaxMessageTiles + 1, s.tiles[0]);
+  auto m = decodeMessage(encodeMessage(s));
+  ASSERT_FALSE(m);
+  EXPECT_EQ(m.error().code, ErrorCode::TooLarge);
+  EXPECT_NE(m.error().detail.find("Snapshot.tiles: 262145, at most 262144"), std::string::npos) << m.error().detail;
+  // Every tile of a full snapshot is matched to its layer by binary search.
+  s = snapshotWithLayers(kMaxMessageLayers);
+  const auto cell = weather::cellAt(46.2, 12.8, 9);
+  for (std::uint32_t i = 0; i < 100000; ++i)
+    s.tiles.push_back({cell, 1 + i % static_cast<std::uint32_t>(kMaxMessageLayers), 0.5f, 1.0f,
+                       weather::CloudType::Cumulus, 0.0f});
+  m = decodeMessage(encodeMessage(s));
+  ASSERT_TRUE(m) << m.error().detail;
+  EXPECT_EQ(std::get<weather::WeatherSnapshot>(*m).tiles.size(), 100000u);
 }
 
 }  // namespace

@@ -109,6 +109,14 @@ class WeatherService {
   // error names the change and field: "changes[1].layer.coverage: 1.4 outside
   // [0, 1]" (InvalidArgument), or Io when the commit failed.
   virtual Result<AppliedChange> submit(const ChangeRequest& request) = 0;
+  // As submit, for inputs that acknowledge nothing (CIGI datagrams): the
+  // change is applied at once and reaches disk with the next flush() (or the
+  // next submit), so a burst of changes costs one commit. Only changes not
+  // yet flushed can be lost in a crash. Default: submit.
+  virtual Result<AppliedChange> submitBatched(const ChangeRequest& request) { return submit(request); }
+  // Commits whatever submitBatched applied since the last commit. Io when
+  // the commit failed (the changes stay pending for the next try).
+  virtual Result<void> flush() { return {}; }
   // The state at the current clock.
   virtual WeatherView view() const = 0;
   // The newest `limit` events, oldest first.

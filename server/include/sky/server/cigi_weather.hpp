@@ -40,12 +40,20 @@
 
 namespace sky::server {
 
+// Regions one sending host may have this input remember (active, inactive
+// or placed by Weather Control before its Environmental Region Control).
+// CIGI region ids run to 65535; a host describes the few around its ownship
+// (the CIGI 3.3 ICD's examples use a handful), so 64 is generous and bounds
+// what one host's datagrams can make the server hold.
+inline constexpr std::size_t kMaxCigiRegionsPerSender = 64;
+
 class CigiWeatherMapper {
  public:
   // The changes in `datagram` that differ from what this mapper produced
   // before; an empty vector when nothing changed. A packet out of our ranges
   // rejects the whole datagram (InvalidArgument naming the packet index, the
-  // packet and the field) and leaves the remembered state as it was.
+  // packet and the field) and leaves the remembered state as it was; so does
+  // a datagram that would make more than kMaxCigiRegionsPerSender regions.
   Result<std::vector<WeatherChange>> map(const cigi::Datagram& datagram);
 
   // Forget everything remembered (after a submit failed, so the next

@@ -20,6 +20,16 @@
 
 namespace sky::server {
 
+// Changes scheduled or ramping at once (layer and region ramps together).
+// Each holds two layers or regions in memory and in every saved state; a
+// cockpit's weather has a few, a scenario at most kMaxTimelineEntries (1024)
+// waiting in its timeline (not ramps), so 1024 is far above use and bounds
+// the state's size.
+inline constexpr std::size_t kMaxPendingRamps = 1024;
+// Batched (CIGI) changes that may wait for their commit before a batched
+// submit commits at once: bounds memory when commits keep failing.
+inline constexpr std::size_t kMaxUnsavedEvents = 256;
+
 class LiveWeather final : public WeatherService {
  public:
   using WallNow = std::function<WallClock::time_point()>;
@@ -29,6 +39,13 @@ class LiveWeather final : public WeatherService {
   LiveWeather(const Scenario& scenario, WallClock::time_point wallStart, WallNow wallNow, UnixNowMs unixNowMs);
 
   Result<AppliedChange> submit(const ChangeRequest& request) override;
+  // Applied now, on disk with the next flush() or submit() (change.hpp).
+  // With more than kMaxUnsavedEvents changes waiting (the disk keeps
+  // failing), it commits at once like submit, and fails like it.
+  Result<AppliedChange> submitBatched(const ChangeRequest& request) override;
+  Result<void> flush() override;
+  // Changes applied by submitBatched and not yet on disk.
+  std::size_t unsaved() const { return unsaved_.size(); }
   WeatherView view() const override;
 
   // Scenario timelines (live_timeline.cpp). An entry waits here until the
@@ -153,8 +170,12 @@ class LiveWeather final : public WeatherService {
   void settle(double clock_s);
   // Commits `next` (with `timeline` as the timeline to come) and its event,
   // then makes it the weather and tells the listeners.
+  // durableNow false (a batched submit): applied, its event kept in unsaved_
+  // for the next commit.
   Result<AppliedChange> commit(State next, std::vector<TimelineItem> timeline, const std::string& author,
-                               const std::string& source, const std::string& summary, double now_s);
+                               const std::string& source, const std::string& summary, double now_s,
+                               bool durableNow = true);
+  Result<AppliedChange> submitImpl(const ChangeRequest& request, bool durableNow);
   Result<void> dryRun(State s, const std::vector<TimelineItem>& items) const;
   static std::vector<TimelineItem> timelineItems(const Scenario& scenario, const std::string& name);
   static nlohmann::json timelineJson(const std::vector<TimelineItem>& timeline);
@@ -172,6 +193,7 @@ class LiveWeather final : public WeatherService {
   WeatherClock clock_;
   std::vector<TimelineItem> timeline_;  // by at_s
   std::vector<ChangeEvent> events_;
+  std::vector<ChangeEvent> unsaved_;  // applied by submitBatched, not yet on disk (oldest first)
   std::uint64_t sequence_ = 0;
   std::uint64_t version_ = 1;
   std::uint64_t rejected_ = 0;

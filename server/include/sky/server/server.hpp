@@ -11,6 +11,7 @@
 #include <vector>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 
 #include <boost/asio/io_context.hpp>
@@ -32,16 +33,25 @@ class logger;
 
 namespace sky::server {
 
+// Subscribers one server serves at once. One cockpit has one to six display
+// channels, each one connection; 64 serves ten such cockpits from one server
+// and bounds what a flood of connections costs (each holds a socket, a read
+// buffer of 64 KiB and its areas' snapshots).
+inline constexpr std::size_t kDefaultMaxSubscribers = 64;
+
 struct ServerOptions {
   std::string listenAddress = "127.0.0.1";  // loopback unless a deployment opens it
   std::uint16_t port = 0;                   // 0: an ephemeral port (see Server::port)
   std::chrono::milliseconds heartbeatInterval{1000};  // > 0
   std::string serverId = "skyshell-weatherd";         // sent in Hello
   std::size_t maxCellsPerSnapshot = kDefaultMaxCells;
-  bool handleSignals = true;  // SIGINT/SIGTERM stop the server (off in tests)
+  bool handleSignals = true;  // SIGINT/SIGTERM stop the server (off in tests); caught from create() on
   // A subscriber whose frame has not gone out in this long has stopped
   // reading and is dropped (its weather was coalesced until then).
   std::chrono::milliseconds stallTimeout{10000};
+  // A connection past this many subscribers is sent an Error (TooLarge,
+  // "server full") and closed.
+  std::size_t maxSubscribers = kDefaultMaxSubscribers;
   std::function<WallClock::time_point()> wallNow = [] { return WallClock::now(); };
   std::shared_ptr<spdlog::logger> log;  // null: log nothing
 };
@@ -74,6 +84,8 @@ class Server final : private SessionHandler {
   // Stream counters (readable from any thread, for /metrics and tests).
   struct StreamCounters {
     std::atomic<std::uint64_t> frames{0}, bytes{0}, stalledDropped{0};
+    std::atomic<std::uint64_t> acceptFailures{0};  // accept() calls that failed (e.g. EMFILE)
+    std::atomic<std::uint64_t> handlerExceptions{0};  // exceptions that reached run() (the last boundary)
   };
   const StreamCounters& streamCounters() const { return streamCounters_; }
   // Prometheus text of the stream counters.
@@ -83,7 +95,10 @@ class Server final : private SessionHandler {
   // can return. Every function added runs, in the order added.
   void onShutdown(std::function<void()> f) { onShutdown_.push_back(std::move(f)); }
 
-  // Serves until stop() or a signal. Call from one thread only.
+  // Serves until stop() or a signal. Call from one thread only. An exception
+  // a handler throws past every inner boundary is caught here, counted
+  // (handler_failed), logged, and the loop runs on: one bad input must not
+  // end the process.
   void run();
   // Asks the server to shut down; safe from any thread and from signal-free
   // tests. run() returns once every session is closed.
@@ -108,7 +123,12 @@ class Server final : private SessionHandler {
   void sessionStalled(Session& session) override;
   void rendererChanged(Session& session) override;
   void protocolRejected(Session& session, const Error& error) override;
+  void sessionFailed(Session& session, const std::string& what) override;
   void renderersChanged();
+  // Logs `message` at warn the first time its kind is seen; later ones of
+  // the kind are only counted (a hostile peer must not flood the log).
+  void warnOnce(const std::string& kind, const std::string& message);
+  void handlerFailed(const std::string& what);
 
   // Member order is destruction order in reverse: the io_context goes last,
   // destroying handlers (and the sessions they keep alive) after the rest.
@@ -122,6 +142,10 @@ class Server final : private SessionHandler {
   boost::asio::steady_timer timelineTimer_;
   std::optional<boost::asio::signal_set> signals_;
   SessionRegistry registry_;
+  // Connections past maxSubscribers, being sent their Error: not subscribers.
+  SessionRegistry refused_;
+  std::set<std::string> warned_;  // kinds warnOnce has logged
+  std::chrono::milliseconds acceptDelay_{0};  // current back-off after failed accepts
   StreamCounters streamCounters_;
   Rejections rejections_;
   std::vector<std::function<void()>> onRenderersChanged_;

@@ -1,7 +1,9 @@
 // One subscriber's TCP connection: frames in through an incremental decoder,
 // out through a bounded Outbox with one write in flight. A protocol error is
 // answered with an Error message, after which the session closes; other
-// sessions and the server are not affected.
+// sessions and the server are not affected. Every callback runs inside a
+// boundary that turns an exception into closing this session (counted by
+// the handler), so no input reaches the io_context's run() as an exception.
 #pragma once
 
 #include <array>
@@ -45,6 +47,8 @@ class SessionHandler {
   // The peer sent something the stream refuses (a bad frame or message, or a
   // kind clients must not send); the session is closing.
   virtual void protocolRejected(Session& session, const Error& error) = 0;
+  // Handling this session's I/O threw (`what`); the session is closing.
+  virtual void sessionFailed(Session& session, const std::string& what) = 0;
 
  protected:
   ~SessionHandler() = default;
@@ -61,6 +65,9 @@ class Session : public std::enable_shared_from_this<Session> {
 
   // Sends `hello` (an encoded frame) first and starts reading.
   void start(Frame hello);
+  // Instead of start: sends only an Error saying why (e.g. the server is
+  // full), then waits briefly for the peer's EOF and closes.
+  void refuse(const Error& error);
   // Queues a heartbeat frame, replacing one not yet sent. Ignored once closing.
   void sendHeartbeat(const Frame& heartbeat);
   // The weather changed: fresh weather for each area subscribed (if any)
@@ -85,12 +92,17 @@ class Session : public std::enable_shared_from_this<Session> {
 
   void readMore();
   void onRead(const boost::system::error_code& ec, std::size_t bytes);
+  void handleRead(const boost::system::error_code& ec, std::size_t bytes);
+  void onStallTimer(const boost::system::error_code& ec, std::uint64_t generation);
   void handleMessage(const stream::Message& message);
   void protocolError(const Error& error);
   void writeNext();
   Frame weatherFrame(const stream::Subscribe& request);
   void onWritten(const boost::system::error_code& ec);
   void beginDrain();
+  // Runs f; an exception closes the session and is reported to the handler.
+  template <class F>
+  void guarded(const char* where, F&& f);
 
   boost::asio::ip::tcp::socket socket_;
   boost::asio::steady_timer drainTimer_;
@@ -102,7 +114,9 @@ class Session : public std::enable_shared_from_this<Session> {
   SessionHandler& handler_;
   spdlog::logger& log_;
   State state_ = State::Open;
-  stream::FrameDecoder decoder_;
+  // A subscriber sends only small messages: a frame announcing more is
+  // refused from its header (framing.hpp).
+  stream::FrameDecoder decoder_{stream::kMaxSubscriberFrameBytes};
   // Per area index (Subscribe::areaIndex), each on its own: the latest
   // subscription asked for; what the peer holds, the last snapshot sent (or
   // reached by deltas), and the subscription it answered. A new snapshot of

@@ -23,6 +23,7 @@ class SessionRegistry {
   // Closes every session (cancelling their I/O): part of server shutdown.
   void closeAll();
   std::size_t size() const { return sessions_.size(); }
+  bool contains(const Session& session) const { return sessions_.count(session.id()) > 0; }
 
  private:
   std::map<std::uint64_t, std::shared_ptr<Session>> sessions_;  // by session id

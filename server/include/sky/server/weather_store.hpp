@@ -2,12 +2,17 @@
 // state (layers, ramps in progress, the clock anchor, the sequence) and the
 // event log. Every accepted change is one transaction (synchronous = FULL),
 // committed before the change is acknowledged; a restart restores exactly the
-// state committed last. SQLite handles are owned by RAII types.
+// state committed last. The event log keeps the newest kMaxStoredEvents
+// events (older ones are pruned in the commit that passes the bound), so
+// neither the file nor a restore grows without end. SQLite handles are
+// owned by RAII types.
 #pragma once
 
+#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -20,11 +25,20 @@ struct sqlite3;
 
 namespace sky::server {
 
+// Events the store keeps (and a restore loads): the newest this many. The
+// console shows the recent history; at a change a second for a whole
+// exercise day that is the last few hours, and the file stays a few MB.
+inline constexpr std::size_t kMaxStoredEvents = 10000;
+
 class WeatherStore {
  public:
-  // Opens or creates the file. Io (cannot open, not a database, locked),
-  // Unsupported (a schema version we do not know), naming the file.
-  static Result<WeatherStore> open(const std::filesystem::path& path);
+  // Opens or creates the file and checks that this process can write it.
+  // Io (cannot open), Malformed (not a database: garbage bytes, a truncated
+  // file), Busy-like Io when another connection holds a lock on it (another
+  // server) for longer than lockWait; Unsupported (a schema version we do not
+  // know). Every error names the file.
+  static Result<WeatherStore> open(const std::filesystem::path& path,
+                                   std::chrono::milliseconds lockWait = std::chrono::milliseconds{2000});
   WeatherStore(WeatherStore&&) noexcept;
   WeatherStore& operator=(WeatherStore&&) noexcept;
   ~WeatherStore();
@@ -37,6 +51,11 @@ class WeatherStore {
   Result<std::optional<Saved>> load() const;
   // Commits the state and, when given, its event, atomically.
   Result<void> save(const nlohmann::json& state, const ChangeEvent* event);
+  // Commits the state and its events (oldest first) atomically, pruning the
+  // log to the newest kMaxStoredEvents in the same transaction.
+  Result<void> save(const nlohmann::json& state, std::span<const ChangeEvent> events);
+  // Events in the file (for tests of the retention bound).
+  Result<std::size_t> storedEvents() const;
 
   const std::filesystem::path& path() const { return path_; }
 

@@ -24,6 +24,14 @@ inline constexpr std::uint16_t kProtocolVersion = 2;
 // for budgeting tiles against kMaxFrameBytes.
 inline constexpr std::size_t kTileWireBytes = 16;
 
+// Caps on one Snapshot or Delta, checked before anything is decoded, so a
+// crafted frame costs O(n log n) in its counts and no more. Layers: a server
+// sends at most weather::kMaxScenarioLayers (32) distinct layers; 256 leaves
+// room for a newer server and is still nothing to sort. Tiles: as many as fit
+// in the largest frame (kMaxFrameBytes / kTileWireBytes = 262144).
+inline constexpr std::size_t kMaxMessageLayers = 256;
+inline constexpr std::size_t kMaxMessageTiles = (4u << 20) / kTileWireBytes;
+
 // Bits of Hello::features: what a server takes beyond the base protocol of
 // its major version. A server from before the field sends 0.
 inline constexpr std::uint32_t kFeatureCameraReports = 1u << 0;  // takes CameraReport
@@ -93,7 +101,8 @@ std::vector<std::uint8_t> encodeMessage(const Message& message);
 // Verifies and range-checks one frame's payload: finite numbers, fractions in
 // [0, 1], latitudes, longitudes and altitudes in range, every tile a valid S2
 // cell of the stated level, every Snapshot tile of a layer the Snapshot has,
-// layer ids unique, a CameraReport's pose in range and its channel valid
+// layer ids unique, at most kMaxMessageLayers layers (and removed ids) and
+// kMaxMessageTiles tiles (TooLarge otherwise), a CameraReport's pose in range and its channel valid
 // UTF-8. A Hello or Subscribe of another protocol version is an Unsupported
 // error that says both versions. A body of a kind we do not know is an
 // UnknownKind (to ignore), not an error; a missing body is Malformed.
