@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 #include <boost/asio.hpp>
 
+#include "sky/flight/utf8_text.hpp"
 #include "sky/sim/flight_file.hpp"
 #include "sky/sim/http_client.hpp"
 #include "sky/sim/replay_session.hpp"
@@ -29,6 +30,10 @@ namespace {
 // input (command line, scenario, flight), 3 the server refused an action or
 // could not be reached.
 constexpr int kExitRuntime = 1, kExitBadInput = 2, kExitActionFailed = 3;
+// A server's answer is echoed up to this many bytes (ill-formed UTF-8 and
+// control characters replaced): enough for any error the API gives, and a
+// misbehaving server cannot flood the log.
+constexpr std::size_t kMaxEchoedBody = 2000;
 
 // Sends actions in order on their own thread, so a slow server never delays
 // the host's frames.
@@ -88,11 +93,12 @@ class ActionSender {
       } else if (response->status != 200) {
         ++failures_;
         std::printf("scenario: t=%.1f s: %s: REFUSED (HTTP %d, scenario line %zu): %s\n", item.flightTime_s,
-                    item.action.what.c_str(), response->status, item.action.line, response->body.c_str());
+                    item.action.what.c_str(), response->status, item.action.line,
+                    sky::flight::messageText(response->body, kMaxEchoedBody).c_str());
       } else {
         ++accepted_;
         std::printf("scenario: t=%.1f s: %s: accepted %s\n", item.flightTime_s, item.action.what.c_str(),
-                    response->body.c_str());
+                    sky::flight::messageText(response->body, kMaxEchoedBody).c_str());
       }
       std::fflush(stdout);
     }
@@ -145,7 +151,7 @@ int main(int argc, char** argv) {
   }
   auto flight = sky::sim::loadFlight(scenario->flightFile.string());
   if (!flight) {
-    std::fprintf(stderr, "skyshell-scenario: %s: flight: %s\n", scenarioPath.c_str(),
+    std::fprintf(stderr, "skyshell-scenario: %s: flight: %s\n", sky::flight::messageText(scenarioPath).c_str(),
                  sky::describe(flight.error()).c_str());
     return kExitBadInput;
   }

@@ -4,11 +4,13 @@
 #include <fstream>
 #include <sstream>
 
+#include "sky/flight/utf8_text.hpp"
+
 namespace sky::sim {
 
 Result<flight::ParsedFlight> loadFlight(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) return fail(ErrorCode::Io, path + ": cannot open for reading");
+  if (!in) return fail(ErrorCode::Io, flight::messageText(path) + ": cannot open for reading");
   std::ostringstream text;
   text << in.rdbuf();
   return flight::parseFlight(text.str(), path);

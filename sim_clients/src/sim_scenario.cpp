@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "sky/config/toml_fields.hpp"
+#include "sky/flight/utf8_text.hpp"
 
 namespace sky::sim {
 
@@ -58,7 +59,17 @@ Result<ScenarioAction> parseAction(const toml::table& t, std::size_t index, cons
 
 Result<SimScenario> parseSimScenario(std::string_view text, std::string_view sourceName,
                                      const std::filesystem::path& baseDir) {
-  const Where where(sourceName);
+  const Where where(flight::messageText(sourceName));
+  // TOML is UTF-8 (TOML 1.0 "Spec"): ill-formed bytes are refused before the
+  // parser sees them, so no message and no JSON body can carry them on.
+  if (const auto bad = flight::firstInvalidUtf8(text)) {
+    const std::string_view before = text.substr(0, *bad);
+    const auto lineStart = before.rfind('\n');
+    const std::size_t line = 1 + static_cast<std::size_t>(std::count(before.begin(), before.end(), '\n'));
+    const std::size_t column = *bad - (lineStart == std::string_view::npos ? 0 : lineStart + 1) + 1;
+    return fail(ErrorCode::Malformed, where.source() + ":" + std::to_string(line) + ":" + std::to_string(column) +
+                                          ": not UTF-8");
+  }
   auto parsed = config::parseText(text, where);
   if (!parsed) return tl::unexpected(parsed.error());
   const toml::table& root = *parsed;
@@ -116,7 +127,7 @@ Result<SimScenario> parseSimScenario(std::string_view text, std::string_view sou
 
 Result<SimScenario> loadSimScenario(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) return fail(ErrorCode::Io, path.string() + ": cannot open for reading");
+  if (!in) return fail(ErrorCode::Io, flight::messageText(path.string()) + ": cannot open for reading");
   std::ostringstream text;
   text << in.rdbuf();
   return parseSimScenario(text.str(), path.string(), path.parent_path());

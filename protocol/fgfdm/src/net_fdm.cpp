@@ -3,6 +3,7 @@
 #include "sky/fgfdm/net_fdm.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <string>
 
@@ -105,9 +106,36 @@ std::size_t walk(NetFdm& f, std::uint8_t* bytes, bool write) {
   return c.offset();
 }
 
-Result<void> check(bool ok, const std::string& what) {
-  if (ok) return {};
-  return fail(ErrorCode::InvalidArgument, "FGNetFDM: " + what);
+constexpr double kPi = 3.14159265358979323846;
+// Small slack over pi for the wire's float rounding of angles.
+constexpr double kAngleSlack_rad = 1e-3;
+constexpr double kMetresPerFoot = 0.3048;  // international foot, exact
+constexpr double kMetresPerSecondPerKnot = 1852.0 / 3600.0;
+// Fastest a FlightGear vehicle can move inside the altitude range we take
+// (< 1e7 m): escape velocity at the surface is 11.2 km/s, so 12 km/s bounds
+// even the Space Shuttle; anything faster is a broken sender, not a flight.
+constexpr double kMaxSpeed_mps = 12000.0;
+constexpr double kMaxSpeed_fps = kMaxSpeed_mps / kMetresPerFoot;
+constexpr double kMaxSpeed_kt = kMaxSpeed_mps / kMetresPerSecondPerKnot;
+// Body rates: 100 rad/s is ten times the fastest aerobatic roll (~7 rad/s,
+// 420 deg/s) and more than any tumbling flight model produces.
+constexpr double kMaxRate_rps = 100.0;
+// Accelerations felt by the pilot: 1000 ft/s^2 is ~31 g, past any airframe
+// and past a crash that FlightGear keeps flying through.
+constexpr double kMaxAcceleration_fps2 = 1000.0;
+
+// One range check of a decoded field: the field's wire name, unit, value and
+// closed bounds. A non-finite value is always out of range.
+struct Bound {
+  const char* field;
+  const char* unit;
+  double value, lo, hi;
+};
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
 }
 
 }  // namespace
@@ -124,26 +152,52 @@ Result<NetFdm> decodeNetFdm(std::span<const std::uint8_t> bytes) {
   if (f.version != kVersion)
     return fail(ErrorCode::Unsupported, "FGNetFDM: field 'version' is " + std::to_string(f.version) +
                                             ", we decode version 24 only");
-  constexpr double kPi = 3.14159265358979323846;
-  // Small slack over pi for the wire's float rounding of angles.
-  constexpr double kAngleSlack_rad = 1e-3;
-  Result<void> r;
-  if (!(r = check(std::isfinite(f.lat_rad) && std::abs(f.lat_rad) <= kPi / 2 + kAngleSlack_rad,
-                  "field 'latitude' " + std::to_string(f.lat_rad) + " rad outside [-pi/2, pi/2]")) ||
-      !(r = check(std::isfinite(f.lon_rad) && std::abs(f.lon_rad) <= 2 * kPi + kAngleSlack_rad,
-                  "field 'longitude' " + std::to_string(f.lon_rad) + " rad outside [-2pi, 2pi]")) ||
-      !(r = check(std::isfinite(f.alt_m) && f.alt_m > -12000 && f.alt_m < 1.0e7,
-                  "field 'altitude' " + std::to_string(f.alt_m) + " m outside (-12000, 1e7)")) ||
-      !(r = check(std::isfinite(f.phi_rad) && std::abs(f.phi_rad) <= 2 * kPi + kAngleSlack_rad, "field 'phi' out of range")) ||
-      !(r = check(std::isfinite(f.theta_rad) && std::abs(f.theta_rad) <= kPi / 2 + kAngleSlack_rad, "field 'theta' out of range")) ||
-      !(r = check(std::isfinite(f.psi_rad) && std::abs(f.psi_rad) <= 2 * kPi + kAngleSlack_rad, "field 'psi' out of range")) ||
-      !(r = check(f.numEngines <= kMaxEngines, "field 'num_engines' " + std::to_string(f.numEngines) + " above 4")) ||
-      !(r = check(f.numTanks <= kMaxTanks, "field 'num_tanks' " + std::to_string(f.numTanks) + " above 4")) ||
-      !(r = check(f.numWheels <= kMaxWheels, "field 'num_wheels' " + std::to_string(f.numWheels) + " above 3")))
-    return tl::unexpected(r.error());
+  constexpr double kHalfPi = kPi / 2 + kAngleSlack_rad, kTwoPi = 2 * kPi + kAngleSlack_rad;
+  // The fields a renderer reads or could read: position, attitude, rates,
+  // velocities, accelerations, time and visibility. The rest (engines, gear,
+  // controls) is carried as it comes.
+  const Bound bounds[] = {
+      {"latitude", "rad", f.lat_rad, -kHalfPi, kHalfPi},
+      {"longitude", "rad", f.lon_rad, -kTwoPi, kTwoPi},
+      {"altitude", "m", f.alt_m, -12000, 1.0e7},
+      {"agl", "m", f.agl_m, -1.0e7, 1.0e7},
+      {"phi", "rad", f.phi_rad, -kTwoPi, kTwoPi},
+      {"theta", "rad", f.theta_rad, -kHalfPi, kHalfPi},
+      {"psi", "rad", f.psi_rad, -kTwoPi, kTwoPi},
+      {"alpha", "rad", f.alpha_rad, -kTwoPi, kTwoPi},
+      {"beta", "rad", f.beta_rad, -kTwoPi, kTwoPi},
+      {"phidot", "rad/s", f.phidot_rps, -kMaxRate_rps, kMaxRate_rps},
+      {"thetadot", "rad/s", f.thetadot_rps, -kMaxRate_rps, kMaxRate_rps},
+      {"psidot", "rad/s", f.psidot_rps, -kMaxRate_rps, kMaxRate_rps},
+      {"vcas", "kt", f.vcas_kt, -kMaxSpeed_kt, kMaxSpeed_kt},
+      {"climb_rate", "ft/s", f.climbRate_fps, -kMaxSpeed_fps, kMaxSpeed_fps},
+      {"v_north", "ft/s", f.vNorth_fps, -kMaxSpeed_fps, kMaxSpeed_fps},
+      {"v_east", "ft/s", f.vEast_fps, -kMaxSpeed_fps, kMaxSpeed_fps},
+      {"v_down", "ft/s", f.vDown_fps, -kMaxSpeed_fps, kMaxSpeed_fps},
+      {"v_body_u", "ft/s", f.vWindBodyNorth_fps, -kMaxSpeed_fps, kMaxSpeed_fps},
+      {"v_body_v", "ft/s", f.vWindBodyEast_fps, -kMaxSpeed_fps, kMaxSpeed_fps},
+      {"v_body_w", "ft/s", f.vWindBodyDown_fps, -kMaxSpeed_fps, kMaxSpeed_fps},
+      {"A_X_pilot", "ft/s^2", f.aXPilot_fps2, -kMaxAcceleration_fps2, kMaxAcceleration_fps2},
+      {"A_Y_pilot", "ft/s^2", f.aYPilot_fps2, -kMaxAcceleration_fps2, kMaxAcceleration_fps2},
+      {"A_Z_pilot", "ft/s^2", f.aZPilot_fps2, -kMaxAcceleration_fps2, kMaxAcceleration_fps2},
+      // Simulated time, cur_time + warp: not before 1970 nor past the end of
+      // the 32-bit unix time the field holds (2106).
+      {"cur_time + warp", "s", static_cast<double>(f.curTime_unix) + f.warp_s, 0, 4294967295.0},
+      {"visibility", "m", f.visibility_m, 0, 1.0e9},
+  };
+  for (const Bound& b : bounds)
+    if (!(std::isfinite(b.value) && b.value >= b.lo && b.value <= b.hi))
+      return fail(ErrorCode::InvalidArgument, std::string("FGNetFDM: field '") + b.field + "' " + number(b.value) +
+                                                  " " + b.unit + " outside [" + number(b.lo) + ", " +
+                                                  number(b.hi) + "]");
+  if (f.numEngines > kMaxEngines)
+    return fail(ErrorCode::InvalidArgument, "FGNetFDM: field 'num_engines' " + std::to_string(f.numEngines) + " above 4");
+  if (f.numTanks > kMaxTanks)
+    return fail(ErrorCode::InvalidArgument, "FGNetFDM: field 'num_tanks' " + std::to_string(f.numTanks) + " above 4");
+  if (f.numWheels > kMaxWheels)
+    return fail(ErrorCode::InvalidArgument, "FGNetFDM: field 'num_wheels' " + std::to_string(f.numWheels) + " above 3");
   return f;
 }
-
 std::array<std::uint8_t, kPacketBytes> encodeNetFdm(const NetFdm& fdm) {
   std::array<std::uint8_t, kPacketBytes> out{};
   NetFdm copy = fdm;

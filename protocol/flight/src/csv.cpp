@@ -6,7 +6,9 @@
 #include <cmath>
 #include <string>
 
+#include "reader_common.hpp"
 #include "sky/flight/flight.hpp"
+#include "sky/flight/utf8_text.hpp"
 
 namespace sky::flight {
 
@@ -51,7 +53,16 @@ Result<ParsedFlight> parseCsv(std::string_view text, std::string_view sourceName
   bool headerSeen = false;
   std::size_t lineNo = 0;
   std::size_t pos = 0;
-  const std::string src(sourceName);
+  const std::string src = messageText(sourceName);
+  // Our own format is ASCII in practice; any ill-formed UTF-8 (a binary
+  // file, a Latin-1 comment) is refused, not echoed.
+  if (const auto bad = firstInvalidUtf8(text)) {
+    const std::string_view before = text.substr(0, *bad);
+    const std::size_t line = 1 + static_cast<std::size_t>(std::count(before.begin(), before.end(), '\n'));
+    const std::size_t column = *bad - (before.rfind('\n') == std::string_view::npos ? 0 : before.rfind('\n') + 1);
+    return fail(ErrorCode::Malformed, src + ":" + std::to_string(line) + ": byte " + std::to_string(column + 1) +
+                                          " of the line is not UTF-8");
+  }
   while (pos <= text.size()) {
     const std::size_t end = std::min(text.find('\n', pos), text.size());
     const std::string_view line = trim(text.substr(pos, end - pos));
@@ -79,16 +90,16 @@ Result<ParsedFlight> parseCsv(std::string_view text, std::string_view sourceName
       const auto [ptr, ec] = std::from_chars(f.data(), f.data() + f.size(), v[i]);
       if (ec != std::errc() || ptr != f.data() + f.size() || !std::isfinite(v[i]))
         return fail(ErrorCode::Malformed,
-                    at + "field '" + std::string(kColumns[i]) + "': '" + std::string(f) + "' is not a number");
+                    at + "field '" + std::string(kColumns[i]) + "': '" + detail::printable(f) + "' is not a number");
       if (v[i] < kRanges[i].lo || v[i] > kRanges[i].hi)
         return fail(ErrorCode::InvalidArgument, at + "field '" + std::string(kColumns[i]) + "': " +
-                                                    std::string(f) + " outside [" +
+                                                    detail::printable(f) + " outside [" +
                                                     std::to_string(kRanges[i].lo) + ", " +
                                                     std::to_string(kRanges[i].hi) + "]");
     }
     if (!flight.fixes.empty() && v[0] <= flight.fixes.back().time_s)
       return fail(ErrorCode::InvalidArgument,
-                  at + "field 'time_s': " + std::string(fields[0]) + " does not increase");
+                  at + "field 'time_s': " + detail::printable(fields[0]) + " does not increase");
     flight.fixes.push_back(Fix{v[0], {{v[1], v[2], v[3]}, v[4], v[5], v[6]}});
     if (end == text.size()) break;
   }

@@ -13,6 +13,7 @@
 
 #include "reader_common.hpp"
 #include "sky/flight/flight.hpp"
+#include "sky/flight/utf8_text.hpp"
 
 namespace sky::flight {
 
@@ -203,7 +204,7 @@ struct ParserFree {
 }  // namespace
 
 Result<ParsedFlight> parseGpx(std::string_view text, std::string_view sourceName) {
-  const std::string src(sourceName);
+  const std::string src = messageText(sourceName);
   const std::unique_ptr<XML_ParserStruct, ParserFree> parser(XML_ParserCreate(nullptr));
   if (!parser) return fail(ErrorCode::Io, src + ": cannot create an XML parser (out of memory)");
   GpxReader reader(parser.get(), sourceName);

@@ -224,7 +224,7 @@ Result<ParsedFlight> parseIgc(std::string_view text, std::string_view sourceName
 
   if (!dateSeen) warnings.add(WarningKind::Other, 0, "no HFDTE date record, no start date");
   if (flight.fixes.size() < 2)
-    return fail(ErrorCode::Malformed, std::string(sourceName) + ": " + std::to_string(flight.fixes.size()) +
+    return fail(ErrorCode::Malformed, warnings.source() + ": " + std::to_string(flight.fixes.size()) +
                                           " usable B fixes, a flight needs at least two");
   const double first_s = flight.fixes.front().time_s;
   for (Fix& f : flight.fixes) f.time_s -= first_s;

@@ -1,6 +1,8 @@
 // Capped warnings and the time-order rules shared by the IGC and GPX readers.
 #include "reader_common.hpp"
 
+#include "sky/flight/utf8_text.hpp"
+
 #include <cstdio>
 #include <utility>
 
@@ -29,6 +31,8 @@ std::string printable(std::string_view s) {
   if (s.size() > kMaxFieldChars) out += "...";
   return out;
 }
+
+Warnings::Warnings(std::string_view source) : source_(messageText(source)) {}
 
 void Warnings::add(WarningKind kind, std::size_t line, const std::string& text) {
   const std::size_t n = ++counts_[static_cast<std::size_t>(kind)];
@@ -77,7 +81,7 @@ Result<ParsedFlight> parseFlight(std::string_view text, std::string_view sourceN
   if (ext == "csv") return parseCsv(text, sourceName);
   if (ext == "igc") return parseIgc(text, sourceName);
   if (ext == "gpx") return parseGpx(text, sourceName);
-  return fail(ErrorCode::Unsupported, std::string(sourceName) + ": unknown flight format '." + detail::printable(ext) +
+  return fail(ErrorCode::Unsupported, messageText(sourceName) + ": unknown flight format '." + detail::printable(ext) +
                                           "' (expected .csv, .igc or .gpx)");
 }
 

@@ -57,7 +57,8 @@ enum class WarningKind : std::size_t {
 // Warnings of one reader; at most kMaxWarningsPerKind per kind are listed.
 class Warnings {
  public:
-  explicit Warnings(std::string_view source) : source_(source) {}
+  // source is shown as messageText shows it (utf8_text.hpp).
+  explicit Warnings(std::string_view source);
   // "source:line: text" (line 0: "source: text").
   void add(WarningKind kind, std::size_t line, const std::string& text);
   // Appends the "N more ..." summaries and hands the list over.

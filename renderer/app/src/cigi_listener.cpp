@@ -2,6 +2,7 @@
 #include "sky/app/cigi_listener.hpp"
 
 #include <algorithm>
+#include <charconv>
 
 #include "sky/weather/query.hpp"
 
@@ -12,17 +13,6 @@ namespace sky::app {
 namespace asio = boost::asio;
 
 namespace {
-// The part of an error detail before the first digit-bearing position
-// ("packet 1 (Entity Control) at byte 24: latitude 95 outside ...") becomes
-// the kind we log once: the packet name and field, not the values.
-std::string reasonKind(const std::string& detail) {
-  std::string kind;
-  for (char c : detail) {
-    if (c >= '0' && c <= '9') continue;
-    kind += c;
-  }
-  return kind.substr(0, 80);
-}
 
 // The ownship the areas of interest follow, when a pose has come.
 std::optional<geo::Geodetic> ownship(const SharedState& state) {
@@ -32,9 +22,44 @@ std::optional<geo::Geodetic> ownship(const SharedState& state) {
 }
 }  // namespace
 
+Result<CigiHost> parseCigiHost(std::string_view text) {
+  std::string_view addressText = text, portText;
+  if (!text.empty() && text.front() == '[') {
+    const auto close = text.find(']');
+    if (close == std::string_view::npos)
+      return fail(ErrorCode::InvalidArgument, "--cigi-host: '[' without ']' (IPv6 is written [ADDR]:PORT)");
+    addressText = text.substr(1, close - 1);
+    const std::string_view rest = text.substr(close + 1);
+    if (!rest.empty()) {
+      if (rest.front() != ':')
+        return fail(ErrorCode::InvalidArgument, "--cigi-host: after ']' only ':PORT' may follow");
+      portText = rest.substr(1);
+      if (portText.empty()) return fail(ErrorCode::InvalidArgument, "--cigi-host: ':' without a port");
+    }
+  } else if (const auto colon = text.find(':');
+             colon != std::string_view::npos && text.find(':', colon + 1) == std::string_view::npos) {
+    // One colon: IPv4 ADDR:PORT. More than one: a bare IPv6 address.
+    addressText = text.substr(0, colon);
+    portText = text.substr(colon + 1);
+    if (portText.empty()) return fail(ErrorCode::InvalidArgument, "--cigi-host: ':' without a port");
+  }
+  CigiHost host;
+  boost::system::error_code ec;
+  host.address = asio::ip::make_address(std::string(addressText), ec);
+  if (ec) return fail(ErrorCode::InvalidArgument, "--cigi-host: the address is not an IPv4 or IPv6 address");
+  if (!portText.empty()) {
+    unsigned port = 0;
+    const auto [end, pec] = std::from_chars(portText.data(), portText.data() + portText.size(), port);
+    if (pec != std::errc() || end != portText.data() + portText.size() || port == 0 || port > 65535)
+      return fail(ErrorCode::InvalidArgument, "--cigi-host: the port is not in 1..65535");
+    host.port = static_cast<unsigned short>(port);
+  }
+  return host;
+}
+
 CigiListener::CigiListener(asio::io_context& io, SharedState& state, const std::string& address,
-                           unsigned short port)
-    : socket_(io), state_(state) {
+                           unsigned short port, std::optional<CigiHost> host)
+    : socket_(io), state_(state), host_(std::move(host)) {
   const asio::ip::udp::endpoint ep(asio::ip::make_address(address), port);
   socket_.open(ep.protocol());
   socket_.bind(ep);
@@ -48,30 +73,55 @@ void CigiListener::stop() {
   socket_.close(ec);
 }
 
+std::optional<CigiHost> CigiListener::host() const {
+  std::lock_guard lock(hostMutex_);
+  return host_;
+}
+
 void CigiListener::receive() {
   socket_.async_receive_from(asio::buffer(rx_), from_, [this](boost::system::error_code ec, std::size_t n) {
     if (ec == asio::error::operation_aborted) return;
-    if (!ec) onDatagram(std::span(rx_.data(), n));
+    if (!ec) {
+      const auto reply = handleDatagram(std::span(rx_.data(), n), from_);
+      boost::system::error_code sendError;
+      if (!reply.empty()) socket_.send_to(asio::buffer(reply), from_, 0, sendError);
+    }
     receive();
   });
 }
 
-void CigiListener::dropped(const std::string& reason) {
-  ++dropped_;
-  if (loggedReasons_.insert(reasonKind(reason)).second)
-    spdlog::warn("CIGI: dropped a datagram: {} (further drops of this kind are only counted)", reason);
+void CigiListener::dropped(DropReason reason, const std::string& detail) {
+  drops_.add(reason);
+  if (loggedReasons_.insert(dropKind(reason, detail)).second)
+    spdlog::warn("CIGI: dropped a datagram ({}): {} (further drops of this kind are only counted)",
+                 toString(reason), detail);
 }
 
-void CigiListener::onDatagram(std::span<const std::uint8_t> bytes) {
+std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint8_t> bytes,
+                                                       const asio::ip::udp::endpoint& from) {
+  // Senders other than the host are dropped before their bytes are looked
+  // at, and never answered: the port is no reflector.
+  std::optional<CigiHost> host = this->host();
+  if (host && !host->matches(from)) {
+    dropped(DropReason::ForeignSender, "from " + from.address().to_string() + " (port " +
+                                           std::to_string(from.port()) + "), not the host this port answers");
+    return {};
+  }
   auto datagram = cigi::decodeDatagram(bytes);
   if (!datagram) {
-    dropped(datagram.error().detail);
-    return;
+    dropped(dropReasonOf(datagram.error().code), datagram.error().detail);
+    return {};
   }
   const auto* ig = std::get_if<cigi::IgControl>(&datagram->packets.front());
   if (!ig) {
-    dropped("datagram starts with Start of Frame: an IG accepts host datagrams only");
-    return;
+    dropped(DropReason::NotFromHost, "datagram starts with Start of Frame: an IG accepts host datagrams only");
+    return {};
+  }
+  if (!host) {
+    std::lock_guard lock(hostMutex_);
+    host_ = CigiHost{from.address(), from.port()};
+    spdlog::info("CIGI: answering host {} port {} (the first valid datagram's sender); other senders are dropped",
+                 from.address().to_string(), from.port());
   }
   ++accepted_;
   for (const auto& packet : datagram->packets) {
@@ -100,8 +150,7 @@ void CigiListener::onDatagram(std::span<const std::uint8_t> bytes) {
       for (const auto& reply :
            answerConditions(*request, state_.weather(), std::chrono::steady_clock::now(), ownship(state_)))
         w.add(reply);
-  boost::system::error_code ec;
-  socket_.send_to(asio::buffer(w.bytes()), from_, 0, ec);
+  return w.bytes();
 }
 
 std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRequest& r, const WeatherView& view,

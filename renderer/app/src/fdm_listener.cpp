@@ -12,15 +12,6 @@ namespace asio = boost::asio;
 namespace {
 constexpr double kMetresPerFoot = 0.3048;  // international foot, exact
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
-
-// The decoder's detail without its digits ("field lat_rad: 7.2 outside ...")
-// is the kind we log once: the field, not the values.
-std::string reasonKind(const std::string& detail) {
-  std::string kind;
-  for (char c : detail)
-    if (c < '0' || c > '9') kind += c;
-  return kind.substr(0, 80);
-}
 }  // namespace
 
 PoseSample poseSampleFrom(const fgfdm::NetFdm& fdm, SteadyTime receivedAt) {
@@ -59,29 +50,33 @@ std::uint64_t FdmListener::outliersDropped() const {
 void FdmListener::receive() {
   socket_.async_receive_from(asio::buffer(rx_), from_, [this](boost::system::error_code ec, std::size_t n) {
     if (ec == asio::error::operation_aborted) return;
-    if (!ec) onDatagram(std::span(rx_.data(), n));
+    if (!ec) handleDatagram(std::span(rx_.data(), n), std::chrono::steady_clock::now());
     receive();
   });
 }
 
-void FdmListener::dropped(const std::string& reason) {
-  ++dropped_;
-  if (loggedReasons_.insert(reasonKind(reason)).second)
-    spdlog::warn("FlightGear FDM: dropped a datagram: {} (further drops of this kind are only counted)", reason);
+void FdmListener::dropped(DropReason reason, const std::string& detail) {
+  drops_.add(reason);
+  if (loggedReasons_.insert(dropKind(reason, detail)).second)
+    spdlog::warn("FlightGear FDM: dropped a datagram ({}): {} (further drops of this kind are only counted)",
+                 toString(reason), detail);
 }
 
-void FdmListener::onDatagram(std::span<const std::uint8_t> bytes) {
-  const auto now = std::chrono::steady_clock::now();
+void FdmListener::handleDatagram(std::span<const std::uint8_t> bytes, std::chrono::steady_clock::time_point now) {
   auto fdm = fgfdm::decodeNetFdm(bytes);
   if (!fdm) {
-    dropped(fdm.error().detail);
+    dropped(dropReasonOf(fdm.error().code), fdm.error().detail);
     return;
   }
-  ++accepted_;
-  std::lock_guard lock(mutex_);
+  std::unique_lock lock(mutex_);
+  if (!smoother_.add(poseSampleFrom(*fdm, now))) {
+    lock.unlock();
+    dropped(DropReason::Unusable, "the pose smoother cannot take its pose (a value outside the ranges it takes)");
+    return;
+  }
   if (!firstAt_) firstAt_ = now;
   newestAt_ = now;
-  smoother_.add(poseSampleFrom(*fdm, now));
+  ++accepted_;
 }
 
 std::optional<HostPose> FdmListener::poseAt(std::chrono::steady_clock::time_point now) {

@@ -33,6 +33,20 @@ geo::GeodeticPose interpolate(const geo::GeodeticPose& a, const geo::GeodeticPos
   return p;
 }
 
+// Bounds of a usable sample (see PoseSmoother::add): the decoders' ranges,
+// with a little slack for float rounding; beyond them a value is garbage.
+constexpr double kMinAlt_m = -12000.0, kMaxAlt_m = 1.0e7;
+constexpr double kMaxLon_deg = 360.0;
+constexpr double kMaxPitch_deg = 90.1;
+constexpr double kMaxYawRoll_deg = 720.0;
+
+bool usable(const geo::GeodeticPose& p) {
+  const auto within = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
+  return within(p.position.lat_deg, -90.0, 90.0) && within(p.position.lon_deg, -kMaxLon_deg, kMaxLon_deg) &&
+         within(p.position.alt_m, kMinAlt_m, kMaxAlt_m) && within(p.pitch_deg, -kMaxPitch_deg, kMaxPitch_deg) &&
+         within(p.yaw_deg, -kMaxYawRoll_deg, kMaxYawRoll_deg) && within(p.roll_deg, -kMaxYawRoll_deg, kMaxYawRoll_deg);
+}
+
 geo::Vec3d nedToEcef(const geo::Geodetic& at, const geo::Vec3d& ned) {
   const geo::EnuFrame f = geo::enuFrameAt(at);
   return f.north * ned.x + f.east * ned.y - f.up * ned.z;
@@ -48,18 +62,39 @@ bool PoseSmoother::plausible(const PoseSample& from, const PoseSample& to) const
   return distance_m <= config_.maxPlausibleSpeed_mps * dt_s + config_.plausibleSlack_m;
 }
 
-void PoseSmoother::add(const PoseSample& in) {
+bool PoseSmoother::add(const PoseSample& in) {
+  if (!usable(in.pose)) {
+    ++invalid_;
+    return false;
+  }
   PoseSample s = in;
-  const PoseSample* newest = !candidates_.empty() ? &candidates_.back() : !track_.empty() ? &track_.back() : nullptr;
+  s.pose.pitch_deg = std::clamp(s.pose.pitch_deg, -90.0, 90.0);
+  if (s.velocityNed_mps) {
+    const geo::Vec3d& v = *s.velocityNed_mps;
+    const double speed_mps = geo::length(v);
+    if (!(std::isfinite(speed_mps) && speed_mps <= config_.maxPlausibleSpeed_mps)) s.velocityNed_mps.reset();
+  }
+  const auto backstep = std::chrono::duration_cast<SteadyTime::duration>(
+      std::chrono::duration<double>(config_.maxBackstep_s));
+  // A stamp far before the newest: another time base, never a continuation
+  // of the track (nor of candidates stamped in the old one).
+  const bool trackInPast = !track_.empty() && s.receivedAt + backstep < track_.back().receivedAt;
+  if (!candidates_.empty() && s.receivedAt + backstep < candidates_.back().receivedAt) {
+    outliers_ += candidates_.size();
+    candidates_.clear();
+  }
+  const PoseSample* newest = !candidates_.empty()            ? &candidates_.back()
+                             : !track_.empty() && !trackInPast ? &track_.back()
+                                                               : nullptr;
   if (newest && s.receivedAt <= newest->receivedAt) s.receivedAt = newest->receivedAt + kMinSampleSpacing;
 
-  if (!track_.empty() && plausible(track_.back(), s)) {
+  if (!trackInPast && !track_.empty() && plausible(track_.back(), s)) {
     outliers_ += candidates_.size();  // the jump was not confirmed
     candidates_.clear();
     track_.push_back(s);
     while (track_.size() > std::max<std::size_t>(config_.historySamples, 2)) track_.pop_front();
     ++trackVersion_;
-    return;
+    return true;
   }
   // Implausible from the track (or no track yet): a candidate for a new one.
   if (!candidates_.empty() && !plausible(candidates_.back(), s)) {
@@ -71,11 +106,13 @@ void PoseSmoother::add(const PoseSample& in) {
     if (!track_.empty()) {
       ++teleports_;
       teleported_ = true;
+      newTimeBase_ = candidates_.front().receivedAt + backstep < track_.back().receivedAt;
     }
     track_.assign(candidates_.begin(), candidates_.end());
     candidates_.clear();
     ++trackVersion_;
   }
+  return true;
 }
 
 PoseSmoother::RawPose PoseSmoother::rawAt(SteadyTime t) const {
@@ -121,6 +158,10 @@ PoseSmoother::RawPose PoseSmoother::rawAt(SteadyTime t) const {
 
 std::optional<SmoothedPose> PoseSmoother::poseAt(SteadyTime now) {
   if (track_.empty()) return std::nullopt;
+  // After a change of time base the last render time belongs to the old
+  // clock: holding to it would freeze the camera until that clock's time.
+  if (newTimeBase_) last_.reset();
+  newTimeBase_ = false;
   SteadyTime r = now - std::chrono::duration_cast<SteadyTime::duration>(
                            std::chrono::duration<double>(config_.renderDelay_s));
   if (last_ && r < last_->renderTime) r = last_->renderTime;

@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include "sky/core/overloaded.hpp"
+#include "sky/flight/utf8_text.hpp"
 
 namespace sky::app {
 
@@ -19,6 +20,9 @@ namespace {
 // Reconnect backoff grows to this cap: short enough that a restarted server
 // is picked up within seconds, long enough not to spin on a dead one.
 constexpr std::chrono::milliseconds kMaxBackoff{2000};
+// A server's id and error text are logged up to this many bytes, ill-formed
+// UTF-8 and control characters replaced: the stream does not check them.
+constexpr std::size_t kMaxEchoedServerText = 200;
 
 std::string defaultChannel() {
   char name[256] = {};
@@ -151,7 +155,8 @@ void WeatherClient::onFrame(std::span<const std::uint8_t> payload) {
                    reportNow_ = reports;
                    const bool areas = (h.features & stream::kFeatureAreas) != 0;
                    serverTakesAreas_ = areas;
-                   spdlog::info("weather server '{}' protocol {} clock {:.1f} s x{}{}{}", h.serverId,
+                   spdlog::info("weather server '{}' protocol {} clock {:.1f} s x{}{}{}",
+                                flight::messageText(h.serverId, kMaxEchoedServerText),
                                 h.protocolVersion, h.weatherClock_s, h.clockRate,
                                 reports ? "; reporting the camera as '" + channel_ + "'" : "",
                                 areas ? "" : "; it takes one area only: the coarse ring holds what the detailed area brings");
@@ -176,7 +181,8 @@ void WeatherClient::onFrame(std::span<const std::uint8_t> payload) {
                  },
                  [&](const stream::Heartbeat& h) { state_.setClock(h.weatherClock_s, clockRate_, now); },
                  [&](const stream::StreamError& e) {
-                   spdlog::warn("weather server error {}: {}", e.code, e.detail);
+                   spdlog::warn("weather server error {}: {}", e.code,
+                                flight::messageText(e.detail, kMaxEchoedServerText));
                  },
                  [&](const stream::Subscribe&) {
                    ++malformed_;

@@ -46,9 +46,11 @@ struct NetFdm {
         rudder = 0, noseWheel = 0, speedbrake = 0, spoilers = 0;
 };
 
-// Decodes one datagram. Rejects other sizes and versions, non-finite or
-// out-of-range position and attitude, and engine/tank/wheel counts above
-// FlightGear's array sizes, with the field named.
+// Decodes one datagram. Rejects, with the field named: other sizes
+// (Malformed) and versions (Unsupported); non-finite or absurd position,
+// attitude, body rates, velocities (above 12 km/s), accelerations, simulated
+// time (cur_time + warp before 1970 or past 2106) or visibility, and
+// engine/tank/wheel counts above FlightGear's array sizes (InvalidArgument).
 Result<NetFdm> decodeNetFdm(std::span<const std::uint8_t> bytes);
 
 // Encodes (for tests and for tools that stand in for FlightGear).

@@ -55,6 +55,7 @@ inline constexpr std::size_t kMaxWarningsPerKind = 8;
 // (altitude MSL; yaw = true heading; pitch nose-up +; roll right-wing-down +),
 // then one fix per line. Blank lines and lines starting with '#' are ignored.
 // Errors name the source, line and field: "climb.csv:7: field 'lat_deg': ...".
+// Ill-formed UTF-8 anywhere in the text is an error naming line and byte.
 // Never warns; startUtc_s stays empty.
 Result<ParsedFlight> parseCsv(std::string_view text, std::string_view sourceName);
 
@@ -103,6 +104,12 @@ Result<ParsedFlight> parseGpx(std::string_view text, std::string_view sourceName
 // Any of the three, chosen by the extension of sourceName in any letter case
 // (.csv, .igc, .gpx); Unsupported for another extension, naming it.
 Result<ParsedFlight> parseFlight(std::string_view text, std::string_view sourceName);
+
+// Text from the file is never echoed raw: a field quoted in a message shows
+// only printable ASCII ('?' for other bytes, cut at 40), and the source name
+// is shown with ill-formed UTF-8 replaced (utf8_text.hpp: messageText). GPX
+// text that is not well-formed in its declared encoding (UTF-8 by default) is
+// an XML error; IGC bytes beyond ASCII are allowed in records we do not read.
 
 // Fills yaw, pitch and roll of every fix from the track alone:
 //  * yaw: geodesic azimuth of the chord through the neighbouring fixes;

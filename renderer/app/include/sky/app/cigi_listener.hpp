@@ -2,19 +2,28 @@
 // host datagram (IG Control + Entity Control for entity 0) into SharedState
 // and answers with Start of Frame, plus a Weather Conditions Response and
 // Aerosol Concentration Responses for each Environmental Conditions Request.
-// Malformed datagrams are dropped, counted, and logged once per reason.
+// It answers one host only: the one it is told (--cigi-host) or else the
+// first sender of a valid host datagram. Malformed datagrams and datagrams
+// from any other sender are dropped unanswered, counted by reason, and
+// logged once per kind.
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
+#include <mutex>
+#include <optional>
 #include <set>
+#include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <utility>  // before asio: Boost 1.74 asio uses std::exchange without including it
 #include <boost/asio.hpp>
 
 #include "sky/app/area_of_interest.hpp"
+#include "sky/app/drop_counts.hpp"
 #include "sky/app/shared_state.hpp"
 #include "sky/cigi/codec.hpp"
 
@@ -45,33 +54,62 @@ std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRe
 // the distance the camera goes before it is asked again (area_of_interest.hpp).
 inline constexpr double kDetailedReach_m = kSubscribeRadius_m - kResubscribeDistance_m;
 
+// The host a CIGI port answers: an address, and a port when one is given
+// (without one, any port of that address).
+struct CigiHost {
+  boost::asio::ip::address address;
+  std::optional<unsigned short> port;
+
+  bool matches(const boost::asio::ip::udp::endpoint& from) const {
+    return from.address() == address && (!port || from.port() == *port);
+  }
+};
+
+// Parses --cigi-host: "ADDR" or "ADDR:PORT" for IPv4, "ADDR" or "[ADDR]:PORT"
+// for IPv6; PORT in 1..65535. The error does not echo the text.
+Result<CigiHost> parseCigiHost(std::string_view text);
+
 class CigiListener {
  public:
-  // Binds to address:port (port 0 = ephemeral; see port()).
+  // Binds to address:port (port 0 = ephemeral; see port()). host: the only
+  // sender answered; none = the first sender of a valid host datagram
+  // (address and port) becomes it.
   CigiListener(boost::asio::io_context& io, SharedState& state, const std::string& address,
-               unsigned short port);
+               unsigned short port, std::optional<CigiHost> host = std::nullopt);
 
   void start();
   void stop();
   unsigned short port() const { return port_; }
 
-  std::uint64_t datagramsAccepted() const { return accepted_; }
-  std::uint64_t datagramsDropped() const { return dropped_; }
+  // Takes one datagram from `from`: the pose into SharedState when it comes
+  // from the host, and the reply to send back to `from` (empty: none, the
+  // datagram was dropped). What the socket's receive handler calls; public so
+  // that tests can drive it without sockets. io thread (or one test thread).
+  std::vector<std::uint8_t> handleDatagram(std::span<const std::uint8_t> bytes,
+                                           const boost::asio::ip::udp::endpoint& from);
+
+  // Thread-safe.
+  std::uint64_t datagramsAccepted() const { return accepted_.load(); }
+  std::uint64_t datagramsDropped() const { return drops_.total(); }
+  const DropCounts& drops() const { return drops_; }
+  // The host this port answers, once known. Thread-safe.
+  std::optional<CigiHost> host() const;
 
  private:
   void receive();
-  void onDatagram(std::span<const std::uint8_t> bytes);
-  void dropped(const std::string& reason);
+  void dropped(DropReason reason, const std::string& detail);
 
   boost::asio::ip::udp::socket socket_;
   boost::asio::ip::udp::endpoint from_;
   std::array<std::uint8_t, 65536> rx_{};
   SharedState& state_;
   unsigned short port_ = 0;
-  std::uint32_t igFrame_ = 0;
-  std::uint64_t accepted_ = 0;
-  std::uint64_t dropped_ = 0;
-  std::set<std::string> loggedReasons_;
+  std::uint32_t igFrame_ = 0;  // io thread only
+  std::atomic<std::uint64_t> accepted_{0};
+  DropCounts drops_;
+  std::set<std::string> loggedReasons_;  // io thread only
+  mutable std::mutex hostMutex_;         // guards host_ (written by the io thread, read by any)
+  std::optional<CigiHost> host_;
 };
 
 }  // namespace sky::app

@@ -1,8 +1,10 @@
 // The renderer's FlightGear endpoint on UDP: decodes each --native-fdm
 // datagram (FGNetFDM v24) into a pose sample for a PoseSmoother, which the
 // render loop asks for the camera at its render time. The second way a
-// simulator drives a channel, besides CIGI. Malformed datagrams are dropped,
-// counted, and logged once per kind.
+// simulator drives a channel, besides CIGI. Malformed datagrams (a wrong
+// size or version, a non-finite or absurd field) and poses the smoother
+// cannot take are dropped, counted by reason, and logged once per kind; the
+// channel keeps drawing from the samples it has.
 #pragma once
 
 #include <array>
@@ -18,6 +20,7 @@
 #include <utility>  // before asio: Boost 1.74 asio uses std::exchange without including it
 #include <boost/asio.hpp>
 
+#include "sky/app/drop_counts.hpp"
 #include "sky/app/pose_smoother.hpp"
 #include "sky/app/shared_state.hpp"
 #include "sky/fgfdm/net_fdm.hpp"
@@ -46,21 +49,26 @@ class FdmListener {
   // nullopt until a position is confirmed (see PoseSmoother). Thread-safe.
   std::optional<HostPose> poseAt(std::chrono::steady_clock::time_point now);
 
+  // Takes one datagram received at `now` (what the socket's receive handler
+  // calls; public so that tests can drive it without sockets). io thread.
+  void handleDatagram(std::span<const std::uint8_t> bytes, std::chrono::steady_clock::time_point now);
+
+  // Thread-safe.
   std::uint64_t datagramsAccepted() const { return accepted_; }
-  std::uint64_t datagramsDropped() const { return dropped_; }
+  std::uint64_t datagramsDropped() const { return drops_.total(); }
+  const DropCounts& drops() const { return drops_; }
   std::uint64_t outliersDropped() const;
 
  private:
   void receive();
-  void onDatagram(std::span<const std::uint8_t> bytes);
-  void dropped(const std::string& reason);
+  void dropped(DropReason reason, const std::string& detail);
 
   boost::asio::ip::udp::socket socket_;
   boost::asio::ip::udp::endpoint from_;
   std::array<std::uint8_t, 65536> rx_{};
   unsigned short port_ = 0;
   std::atomic<std::uint64_t> accepted_{0};
-  std::atomic<std::uint64_t> dropped_{0};
+  DropCounts drops_;
   std::set<std::string> loggedReasons_;  // io thread only
 
   mutable std::mutex mutex_;  // guards the members below

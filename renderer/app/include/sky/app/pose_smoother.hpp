@@ -60,6 +60,12 @@ struct PoseSmootherConfig {
   double maxBlendDistance_m = 1000.0;
   // Samples kept; the render time only ever needs the last few. 64.
   std::size_t historySamples = 64;
+  // A sample stamped earlier than the newest by more than this is not a late
+  // packet but another clock (or a bogus stamp before it): it starts a
+  // candidate track in the new time base, confirmed like a teleport. 1 s:
+  // ten FlightGear packet intervals, far beyond the reordering of loopback
+  // or a LAN.
+  double maxBackstep_s = 1.0;
 };
 
 enum class SmoothingMode { Interpolated, Extrapolated, Held };
@@ -74,11 +80,20 @@ class PoseSmoother {
  public:
   explicit PoseSmoother(PoseSmootherConfig config = {});
 
-  // Adds a received sample. Samples must arrive in receivedAt order; one not
-  // later than the newest replaces it. An implausible jump is kept apart
-  // until confirmSamples consecutive samples confirm it (then it replaces
-  // the track: a teleport) or a plausible sample shows it was an outlier.
-  void add(const PoseSample& sample);
+  // Adds a received sample. Samples should arrive in receivedAt order; one
+  // not later than the newest is moved just after it, unless it is more than
+  // maxBackstep_s earlier (then it is a candidate in a new time base, as
+  // below). An implausible jump is kept apart until confirmSamples
+  // consecutive samples confirm it (then it replaces the track: a teleport)
+  // or a plausible sample shows it was an outlier.
+  // A sample with a non-finite or out-of-range value (latitude outside
+  // [-90, 90], longitude outside [-360, 360], altitude outside (-12000 m,
+  // 1e7 m), pitch beyond +-90.1 deg, yaw or roll beyond +-720 deg) is
+  // dropped and counted (invalidDropped) and changes nothing; a velocity that
+  // is non-finite or faster than maxPlausibleSpeed_mps is ignored (the
+  // velocity is estimated from the track instead). Returns whether the
+  // sample was taken (into the track or as a candidate).
+  bool add(const PoseSample& sample);
 
   // The camera at render time now - renderDelay_s (clamped so it never goes
   // back), or nullopt while no position has been confirmed. Not const: it
@@ -88,6 +103,7 @@ class PoseSmoother {
   const PoseSmootherConfig& config() const { return config_; }
   std::uint64_t outliersDropped() const { return outliers_; }
   std::uint64_t teleports() const { return teleports_; }
+  std::uint64_t invalidDropped() const { return invalid_; }
 
  private:
   struct RawPose {
@@ -102,6 +118,7 @@ class PoseSmoother {
   std::vector<PoseSample> candidates_;    // an unconfirmed jump away from the track
   std::uint64_t trackVersion_ = 0;        // changes whenever track_ does
   bool teleported_ = false;               // the track was replaced since the last poseAt
+  bool newTimeBase_ = false;              // ... by one in another time base: render time restarts
 
   // Continuity: the last output, and the correction fading out since.
   std::optional<SmoothedPose> last_;
@@ -112,6 +129,7 @@ class PoseSmoother {
 
   std::uint64_t outliers_ = 0;
   std::uint64_t teleports_ = 0;
+  std::uint64_t invalid_ = 0;
 };
 
 }  // namespace sky::app

@@ -59,7 +59,7 @@ class WeatherClient {
 
   std::uint64_t reportsSent() const { return reportsSent_.load(); }
 
-  std::uint64_t malformedFrames() const { return malformed_; }
+  std::uint64_t malformedFrames() const { return malformed_.load(); }
 
  private:
   void connect();
@@ -95,9 +95,9 @@ class WeatherClient {
   std::mutex reportMutex_;
   std::optional<stream::CameraReport> lastReport_;
   std::chrono::steady_clock::time_point lastReportAt_{};
-  double clockRate_ = 1;
-  std::uint64_t malformed_ = 0;
-  bool stopped_ = false;
+  double clockRate_ = 1;               // io thread only
+  std::atomic<std::uint64_t> malformed_{0};  // written by the io thread, read by the render loop
+  bool stopped_ = false;               // io thread only (stop() posts)
 };
 
 }  // namespace sky::app
