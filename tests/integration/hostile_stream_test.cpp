@@ -79,7 +79,7 @@ class StreamPeer {
   tcp::socket socket_;
 };
 
-class HostileStream : public ::testing::Test {
+class HostileWeatherd : public ::testing::Test {
  protected:
   void SetUp() override {
     weatherd_.emplace("hostile-stream", SKY_SCENARIO_CLOUDY, true);
@@ -121,7 +121,7 @@ class HostileStream : public ::testing::Test {
   std::optional<Weatherd> weatherd_;
 };
 
-TEST_F(HostileStream, EveryProbeIsRefusedAndTheServerStaysUp) {
+TEST_F(HostileWeatherd, EveryProbeIsRefusedAndTheServerStaysUp) {
   const unsigned port = weatherd_->streamPort;
   expectHealthy("start");
 
