@@ -13,13 +13,17 @@
 #include <string_view>
 
 // GCC 12 reports a boost::optional inside Beast's parser as maybe
-// uninitialized at -O2: a false positive.
+// uninitialized at -O2: a false positive (clang has no such warning).
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <boost/beast/core/error.hpp>
 #include <boost/beast/http/parser.hpp>
 #include <boost/beast/http/string_body.hpp>
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 
 #include "sky/server/http_routes.hpp"
 #include "sky/server/rejections.hpp"
