@@ -57,7 +57,8 @@ class HttpExchange {
   Next afterHeader();
   // The body has been read (afterHeader said ReadBody).
   Next afterBody();
-  // Reading the header (headerDone false) or the body failed with `ec`.
+  // Reading the header or the body failed with `ec`: an answer (400, 413,
+  // 431) or Close (the client left or was too slow).
   Next afterError(boost::beast::error_code ec);
 
   // Feeds a client's bytes through the same steps as the socket does, the
