@@ -64,8 +64,7 @@ class ConsoleFeed::Handler final : public WsClientHandler {
 
 ConsoleFeed::ConsoleFeed(asio::io_context& io, ConsoleFeedOptions options, ConsoleFeedSource source,
                          std::shared_ptr<spdlog::logger> log)
-    : io_(io),
-      options_(options),
+    : options_(options),
       source_(std::move(source)),
       log_(log ? std::move(log) : std::make_shared<spdlog::logger>("sky_console_feed")),
       handler_(std::make_unique<Handler>(*this)),

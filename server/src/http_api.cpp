@@ -150,8 +150,7 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
 };
 
 HttpApi::HttpApi(asio::io_context& io, HttpApiOptions options, LiveWeather& weather, HttpApiHooks hooks)
-    : io_(io),
-      options_(std::move(options)),
+    : options_(std::move(options)),
       weather_(weather),
       hooks_(std::move(hooks)),
       feed_(io, options_.feed,

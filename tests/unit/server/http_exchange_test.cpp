@@ -191,6 +191,25 @@ TEST_F(HttpExchangeTest, ForeignHostOrOriginIsForbidden) {
   EXPECT_EQ(rejections_.get(RejectReason::HttpForbidden), 4u);
 }
 
+// The console feed's cap refuses an upgrade with a 503 that says why.
+TEST_F(HttpExchangeTest, AFullConsoleFeedRefusesTheUpgradeClearly) {
+  HttpApiOptions options;
+  options.feed.maxClients = 0;
+  HttpApiHooks hooks;
+  hooks.rejections = &rejections_;
+  auto full = HttpApi::create(io_, options, weather_, hooks);
+  ASSERT_TRUE(full);
+  HttpExchange exchange(**full);
+  const auto next = exchange.feed("GET /api/ws HTTP/1.1\r\nHost: localhost\r\nUpgrade: websocket\r\n"
+                                  "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+                                  "Sec-WebSocket-Version: 13\r\n\r\n");
+  ASSERT_EQ(next, HttpExchange::Next::Answer);
+  EXPECT_EQ(exchange.response().result_int(), 503u);
+  EXPECT_EQ(nlohmann::json::parse(exchange.response().body())["error"],
+            "ws: 0 console clients connected, at most 0");
+  EXPECT_EQ(rejections_.get(RejectReason::WsRefused), 1u);
+}
+
 TEST_F(HttpExchangeTest, CapsAndMethods) {
   // Header over 8 KiB: 431.
   EXPECT_EQ(request("GET", "/healthz", "", "X-Bloat: " + std::string(9000, 'b') + "\r\n").status, 431);

@@ -96,7 +96,6 @@ class ConsoleFeed {
   WsText healthMessage() const;
   void clientClosed(WsClient& client, bool dropped);
 
-  boost::asio::io_context& io_;
   ConsoleFeedOptions options_;
   ConsoleFeedSource source_;
   std::shared_ptr<spdlog::logger> log_;

@@ -124,7 +124,6 @@ class HttpApi {
   // The answer to a WebSocket upgrade while the feed is full (503).
   HttpReply refuseFeed();
 
-  boost::asio::io_context& io_;
   HttpApiOptions options_;
   HostRules hostRules_;
   LiveWeather& weather_;

@@ -13,13 +13,17 @@
 #include <string_view>
 
 // GCC 12 reports a boost::optional inside Beast's parser as maybe
-// uninitialized at -O2: a false positive.
+// uninitialized at -O2: a false positive (clang has no such warning).
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <boost/beast/core/error.hpp>
 #include <boost/beast/http/parser.hpp>
 #include <boost/beast/http/string_body.hpp>
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 
 #include "sky/server/http_routes.hpp"
 #include "sky/server/rejections.hpp"
@@ -53,7 +57,8 @@ class HttpExchange {
   Next afterHeader();
   // The body has been read (afterHeader said ReadBody).
   Next afterBody();
-  // Reading the header (headerDone false) or the body failed with `ec`.
+  // Reading the header or the body failed with `ec`: an answer (400, 413,
+  // 431) or Close (the client left or was too slow).
   Next afterError(boost::beast::error_code ec);
 
   // Feeds a client's bytes through the same steps as the socket does, the
