@@ -31,6 +31,7 @@
 #include "sky/app/timed_render.hpp"
 #include "sky/app/weather_client.hpp"
 #include "sky/app/window_display.hpp"
+#include "sky/flight/utf8_text.hpp"
 #include "sky/geo/geodetic.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky/render/noise_cache.hpp"
@@ -43,6 +44,7 @@ namespace {
 struct Options {
   std::string server = "127.0.0.1:47800";
   std::string cigiAddress = "127.0.0.1";
+  std::string cigiHost;  // empty: the first sender of a valid host datagram
   unsigned cigiPort = 8004;
   std::string portFile;
   std::string fdmAddress = "127.0.0.1";
@@ -82,6 +84,10 @@ struct Options {
 std::atomic<bool> gReplayStop{false};
 extern "C" void onReplaySignal(int) { gReplayStop = true; }
 
+// A command-line value as an error message may quote it (ill-formed UTF-8
+// and control characters replaced, cut at 200 bytes).
+std::string shown(const std::string& value) { return sky::flight::messageText(value); }
+
 bool writePortFile(const std::string& path, unsigned port) {
   const std::string tmp = path + ".tmp";
   {
@@ -106,6 +112,10 @@ int main(int argc, char** argv) {
   app.add_option("--cigi-address", o.cigiAddress, "address to receive CIGI on");
   app.add_option("--cigi-port", o.cigiPort, "UDP port to receive CIGI on (0 = any free port)")
       ->check(CLI::Range(0, 65535));
+  app.add_option("--cigi-host", o.cigiHost,
+                 "the only CIGI host this channel answers, ADDR[:PORT] ([ADDR]:PORT for IPv6; without PORT, any "
+                 "port of ADDR). Default: the sender of the first valid host datagram (its address and port). "
+                 "Datagrams from any other sender are dropped, counted and never answered");
   app.add_option("--port-file", o.portFile, "write the CIGI port here once listening");
   app.add_option("--fdm-port", o.fdmPort,
                  "take the camera from FlightGear --native-fdm datagrams on this UDP port (0 = any free port) "
@@ -171,7 +181,7 @@ int main(int argc, char** argv) {
   }
   const auto colon = o.server.rfind(':');
   if (colon == std::string::npos) {
-    std::fprintf(stderr, "skyshell-render: --server '%s' must be HOST:PORT\n", o.server.c_str());
+    std::fprintf(stderr, "skyshell-render: --server '%s' must be HOST:PORT\n", shown(o.server).c_str());
     return 2;
   }
   const std::string serverHost = o.server.substr(0, colon);
@@ -180,10 +190,21 @@ int main(int argc, char** argv) {
     const std::string portText = o.server.substr(colon + 1);
     const auto [end, ec] = std::from_chars(portText.data(), portText.data() + portText.size(), serverPort);
     if (ec != std::errc() || end != portText.data() + portText.size() || serverPort == 0 || serverPort > 65535) {
-      std::fprintf(stderr, "skyshell-render: --server '%s': port '%s' is not in 1..65535\n", o.server.c_str(),
-                   portText.c_str());
+      std::fprintf(stderr, "skyshell-render: --server '%s': port '%s' is not in 1..65535\n", shown(o.server).c_str(),
+                   shown(portText).c_str());
       return 2;
     }
+  }
+
+  // Checked before the GPU starts: a typo should not cost a device start-up.
+  std::optional<sky::app::CigiHost> cigiHost;
+  if (!o.cigiHost.empty()) {
+    auto parsed = sky::app::parseCigiHost(o.cigiHost);
+    if (!parsed) {
+      std::fprintf(stderr, "skyshell-render: %s\n", parsed.error().detail.c_str());
+      return 2;
+    }
+    cigiHost = *parsed;
   }
 
   // Windowed only: the metadata is written, the images are not.
@@ -273,9 +294,9 @@ int main(int argc, char** argv) {
   });
   std::optional<sky::app::CigiListener> cigi;
   try {
-    cigi.emplace(io, state, o.cigiAddress, static_cast<unsigned short>(o.cigiPort));
+    cigi.emplace(io, state, o.cigiAddress, static_cast<unsigned short>(o.cigiPort), cigiHost);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "skyshell-render: cannot listen for CIGI on %s:%u: %s\n", o.cigiAddress.c_str(),
+    std::fprintf(stderr, "skyshell-render: cannot listen for CIGI on %s:%u: %s\n", shown(o.cigiAddress).c_str(),
                  o.cigiPort, e.what());
     return 2;
   }
@@ -288,7 +309,7 @@ int main(int argc, char** argv) {
       fdm.emplace(io, o.fdmAddress, static_cast<unsigned short>(o.fdmPort));
     } catch (const std::exception& e) {
       std::fprintf(stderr, "skyshell-render: cannot listen for FlightGear FDM on %s:%d: %s\n",
-                   o.fdmAddress.c_str(), o.fdmPort, e.what());
+                   shown(o.fdmAddress).c_str(), o.fdmPort, e.what());
       return 2;
     }
     fdm->start();
@@ -432,24 +453,25 @@ int main(int argc, char** argv) {
     if (after - lastReport > std::chrono::seconds(1)) {
       lastReport = after;
       const double elapsed = std::chrono::duration<double>(after - start).count();
-      std::printf("render: %llu frames, %.1f frames/s, last %.0f ms, host frame %u, CIGI dropped %llu\n",
+      std::printf("render: %llu frames, %.1f frames/s, last %.0f ms, host frame %u, CIGI dropped %llu%s\n",
                   static_cast<unsigned long long>(frames), frames / elapsed, record.render_ms,
-                  pose->hostFrame, static_cast<unsigned long long>(cigi->datagramsDropped()));
+                  pose->hostFrame, static_cast<unsigned long long>(cigi->datagramsDropped()),
+                  fdm ? (", FlightGear FDM dropped " + std::to_string(fdm->datagramsDropped())).c_str() : "");
       std::fflush(stdout);
     }
     if (o.maxFrames > 0 && frames >= o.maxFrames) break;
   }
   const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-  std::printf("render: wrote %llu frames to %s in %.1f s; CIGI datagrams accepted %llu, dropped %llu; "
+  std::printf("render: wrote %llu frames to %s in %.1f s; CIGI datagrams accepted %llu, dropped %llu (%s); "
               "weather frames dropped %llu\n",
               static_cast<unsigned long long>(frames), o.outDir.c_str(), elapsed,
               static_cast<unsigned long long>(cigi->datagramsAccepted()),
-              static_cast<unsigned long long>(cigi->datagramsDropped()),
+              static_cast<unsigned long long>(cigi->datagramsDropped()), cigi->drops().summary().c_str(),
               static_cast<unsigned long long>(weather.malformedFrames()));
   if (fdm)
-    std::printf("render: FlightGear FDM datagrams accepted %llu, dropped %llu, outliers discarded %llu\n",
+    std::printf("render: FlightGear FDM datagrams accepted %llu, dropped %llu (%s), outliers discarded %llu\n",
                 static_cast<unsigned long long>(fdm->datagramsAccepted()),
-                static_cast<unsigned long long>(fdm->datagramsDropped()),
+                static_cast<unsigned long long>(fdm->datagramsDropped()), fdm->drops().summary().c_str(),
                 static_cast<unsigned long long>(fdm->outliersDropped()));
   std::fflush(stdout);
   shutdown();
