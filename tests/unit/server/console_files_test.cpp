@@ -12,6 +12,7 @@
 
 #include "sky/server/console_files.hpp"
 #include "sky/server/http_api.hpp"
+#include "sky/server/http_exchange.hpp"
 #include "sky/server/live_weather.hpp"
 
 namespace sky::server {
@@ -83,6 +84,21 @@ TEST(ConsoleFiles, DefaultFolderIsRelativeToTheExecutable) {
             (exe.parent_path() / "../share/skyshell/console").lexically_normal());
 }
 
+// Whole requests through the same request handling as the socket path
+// (HttpExchange): status and content type of the answer.
+struct Served {
+  int status = 0;
+  std::string contentType;
+};
+Served serve(HttpApi& api, const std::string& method, const std::string& target) {
+  HttpExchange exchange(api);
+  const std::string host = "127.0.0.1:" + std::to_string(api.port());
+  if (exchange.feed(method + " " + target + " HTTP/1.1\r\nHost: " + host + "\r\n\r\n") != HttpExchange::Next::Answer)
+    return {};
+  const auto& r = exchange.response();
+  return {static_cast<int>(r.result_int()), std::string(r[boost::beast::http::field::content_type])};
+}
+
 TEST(ConsoleFiles, TheHttpApiServesThemAndKeepsItsOwnPaths) {
   ConsoleDir d;
   auto files = ConsoleFiles::load(d.dir);
@@ -95,17 +111,17 @@ TEST(ConsoleFiles, TheHttpApiServesThemAndKeepsItsOwnPaths) {
   options.console = std::make_shared<const ConsoleFiles>(std::move(*files));
   auto api = HttpApi::create(io, options, weather, {});
   ASSERT_TRUE(api) << api.error().detail;
-  const auto root = (*api)->handle("GET", "/", "", "");
+  const Served root = serve(**api, "GET", "/");
   EXPECT_EQ(root.status, 200);
   EXPECT_EQ(root.contentType, "text/html; charset=utf-8");
-  EXPECT_EQ((*api)->handle("GET", "/console/app.js?v=2", "", "").status, 200);
-  EXPECT_EQ((*api)->handle("GET", "/console/missing.js", "", "").status, 404);
-  EXPECT_EQ((*api)->handle("POST", "/", "", "").status, 404);
-  EXPECT_EQ((*api)->handle("GET", "/api/state", "", "").contentType, "application/json");
+  EXPECT_EQ(serve(**api, "GET", "/console/app.js?v=2").status, 200);
+  EXPECT_EQ(serve(**api, "GET", "/console/missing.js").status, 404);
+  EXPECT_EQ(serve(**api, "POST", "/").status, 404);
+  EXPECT_EQ(serve(**api, "GET", "/api/state").contentType, "application/json");
   // Without console files the root is simply not found.
   auto bare = HttpApi::create(io, HttpApiOptions{}, weather, {});
   ASSERT_TRUE(bare);
-  EXPECT_EQ((*bare)->handle("GET", "/", "", "").status, 404);
+  EXPECT_EQ(serve(**bare, "GET", "/").status, 404);
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // UTF-8 checks for text read from outside (flight files, scenario files,
 // bodies from a server) and for echoing such text in a message without
 // passing on bytes a terminal or a log reader would choke on.
-// Kept small and local to protocol/flight until one shared helper exists.
+// Thin names over sky::utf8 (protocol/core), plus messageText.
 #pragma once
 
 #include <cstddef>
