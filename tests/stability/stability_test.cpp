@@ -35,8 +35,12 @@ namespace {
 constexpr double kRelativeRmseTolerance = 0.05;
 constexpr double kRelativeMeanTolerance = 0.01;
 // The relative difference of the blue channel between the top and the bottom
-// row of a view that sees the sky at its top. MEASURED_BELOW
-constexpr double kMinSkyContrast = 0.05;
+// row of a view that sees the sky at its top. Measured (ASan tree,
+// lavapipe, 2026-12-02): 0.043 at the top of a layer looking level (cloud
+// on both rows), 0.071 in clear air pitched up 20 degrees (coverage 0, density
+// 1e-6), 0.52-0.99 in the other scenes; a one-colour image gives 0. The bound
+// is half the lowest measured value.
+constexpr double kMinSkyContrast = 0.02;
 constexpr std::uint32_t kW = 64, kH = 36;
 
 struct Extreme {
