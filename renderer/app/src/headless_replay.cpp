@@ -23,12 +23,21 @@
 #include "sky/app/timed_render.hpp"
 #include "sky/app/weather_client.hpp"
 #include "sky/flight/flight.hpp"
-#include "sky/sim/flight_file.hpp"
+#include "sky/flight/utf8_text.hpp"
 #include "sky/weather/scenario.hpp"
 
 namespace sky::app {
 
 namespace {
+
+// The whole file at `path`; the error names it (cleaned for a message).
+Result<std::string> readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return fail(ErrorCode::Io, flight::messageText(path) + ": cannot open for reading");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
 
 namespace asio = boost::asio;
 using Clock = std::chrono::steady_clock;
@@ -77,7 +86,10 @@ bool waitForCoarse(const SharedState& state, double timeout_s, const std::atomic
 }  // namespace
 
 int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, const std::atomic<bool>* stop) {
-  auto flight = sim::loadFlight(o.flightPath);
+  // Flight files are read here and parsed by protocol/ (the renderer does
+  // not link sim_clients/).
+  auto text = readFile(o.flightPath);
+  auto flight = text ? flight::parseFlight(*text, o.flightPath) : Result<flight::ParsedFlight>(tl::unexpected(text.error()));
   if (!flight) {
     std::fprintf(stderr, "skyshell-render: %s\n", describe(flight.error()).c_str());
     return 2;
@@ -108,11 +120,9 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   std::optional<WeatherClient> weather;
   std::string weatherSource;
   if (!o.weatherFile.empty()) {
-    std::ifstream in(o.weatherFile, std::ios::binary);
-    std::ostringstream text;
-    text << in.rdbuf();
-    auto scenario = in ? weather::parseScenario(text.str(), o.weatherFile)
-                       : Result<weather::Scenario>(fail(ErrorCode::Io, o.weatherFile + ": cannot open"));
+    auto text = readFile(o.weatherFile);
+    auto scenario = text ? weather::parseScenario(*text, o.weatherFile)
+                         : Result<weather::Scenario>(tl::unexpected(text.error()));
     if (!scenario) {
       std::fprintf(stderr, "skyshell-render: --weather-file: %s\n", describe(scenario.error()).c_str());
       return 2;
