@@ -9,40 +9,17 @@
 #include <gtest/gtest.h>
 
 #include "sky/app/pose_smoother.hpp"
+#include "east_track.hpp"
 
 namespace sky::app {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-const SteadyTime kT0 = SteadyTime{} + std::chrono::hours(1);
+using test::at;
+using test::distance_m;
+using test::EastTrack;
+using test::kT0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-SteadyTime at(double t_s) {
-  return kT0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(t_s));
-}
-
-// Due east at 50 m/s from a point off Oahu (as in pose_smoother_test.cpp).
-struct EastTrack {
-  geo::Geodetic origin{20.6, -158.3, 900};
-  double speed_mps = 50;
-  geo::Geodetic positionAt(double t_s) const {
-    const geo::EnuFrame f = geo::enuFrameAt(origin);
-    return geo::fromEcef(geo::toEcef(origin) + f.east * (speed_mps * t_s));
-  }
-  PoseSample sample(double t_s) const {
-    PoseSample s;
-    s.receivedAt = at(t_s);
-    s.pose.position = positionAt(t_s);
-    s.pose.yaw_deg = 90;
-    s.velocityNed_mps = geo::Vec3d{0, speed_mps, 0};
-    return s;
-  }
-};
-
-double distance_m(const geo::Geodetic& a, const geo::Geodetic& b) {
-  return geo::length(geo::toEcef(a) - geo::toEcef(b));
-}
 
 bool finitePose(const geo::GeodeticPose& p) {
   return std::isfinite(p.position.lat_deg) && std::isfinite(p.position.lon_deg) && std::isfinite(p.position.alt_m) &&
