@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "child_process.hpp"
+#include "input_channel.hpp"
 #include "sky/fgfdm/net_fdm.hpp"
 #include "sky/geo/geodetic.hpp"
 
@@ -177,27 +178,13 @@ TEST(FlightGear, RendererCameraFollowsAReplayedNativeFdmCapture) {
   ASSERT_GT(window.size(), 60u);
   const double t0 = window.front()->t_s;
 
-  const fs::path dir = fs::path(SKY_TEST_OUTPUT_DIR) / "flightgear";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const std::string d = dir.string();
-  ChildProcess weatherd({SKY_WEATHERD, "--scenario", SKY_SCENARIO_CLOUDY, "--port", "0", "--port-file",
-                         d + "/weatherd.port", "--heartbeat-ms", "200"},
-                        d + "/weatherd.log");
-  const unsigned weatherPort = waitForPortFile(d + "/weatherd.port", 20s);
-  ASSERT_GT(weatherPort, 0u) << weatherd.log();
-  // Leak checking off for the renderer only, as in skeleton_test.cpp: lavapipe's
-  // JIT leaves allocations no suppression can name.
-  ChildProcess render({SKY_RENDER, "--headless", "--server", "127.0.0.1:" + std::to_string(weatherPort),
-                       "--cigi-port", "0", "--fdm-port", "0", "--fdm-port-file", d + "/fdm.port", "--out",
-                       // 64x36: this test is about the camera path, and a small
-                       // frame keeps the frame rate up on a loaded 2-core machine
-                       // (ASan + lavapipe).
-                       d + "/frames", "--width", "64", "--height", "36", "--idle-exit", kIdleExit_s,
-                       "--weather-timeout", "60"},
-                      d + "/render.log", {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
-  const unsigned fdmPort = waitForPortFile(d + "/fdm.port", 60s);
-  ASSERT_GT(fdmPort, 0u) << render.log();
+  InputChannel channel("flightgear", kIdleExit_s);
+  ASSERT_GT(channel.weatherPort, 0u) << channel.weatherd->log();
+  ASSERT_GT(channel.fdmPort, 0u) << channel.render->log();
+  ChildProcess& render = *channel.render;
+  ChildProcess& weatherd = *channel.weatherd;
+  const unsigned fdmPort = channel.fdmPort;
+  const std::string d = channel.dir.string();
 
   // Replay with the capture's own timing.
   const int sock = ::socket(AF_INET, SOCK_DGRAM, 0);

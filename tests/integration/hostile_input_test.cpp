@@ -24,6 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include "child_process.hpp"
+#include "input_channel.hpp"
 #include "sky/cigi/codec.hpp"
 #include "sky/fgfdm/net_fdm.hpp"
 #include "sky/geo/geodetic.hpp"
@@ -42,10 +43,16 @@ constexpr double kRate_hz = 10.0;
 constexpr double kSpeed_mps = 50.0;
 const geo::Geodetic kOrigin{46.2, 12.8, 1500};
 
-// One UDP socket on loopback, as one sender.
+// One UDP socket on loopback, as one sender; `from` is its own address
+// (host order), any of 127/8.
 class UdpSender {
  public:
-  UdpSender() : fd_(::socket(AF_INET, SOCK_DGRAM, 0)) {}
+  explicit UdpSender(std::uint32_t from = INADDR_LOOPBACK) : fd_(::socket(AF_INET, SOCK_DGRAM, 0)) {
+    sockaddr_in self{};
+    self.sin_family = AF_INET;
+    self.sin_addr.s_addr = htonl(from);
+    ::bind(fd_, reinterpret_cast<const sockaddr*>(&self), sizeof self);
+  }
   ~UdpSender() { ::close(fd_); }
   void send(unsigned port, std::span<const std::uint8_t> bytes) const {
     sockaddr_in to{};
@@ -171,29 +178,18 @@ std::uint64_t countIn(const std::string& summary, const std::string& name) {
 }
 
 TEST(HostileInput, RendererKeepsDrawingAndAnswersOnlyItsHost) {
-  const fs::path dir = fs::path(SKY_TEST_OUTPUT_DIR) / "hostile_input";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const std::string d = dir.string();
-  ChildProcess weatherd({SKY_WEATHERD, "--scenario", SKY_SCENARIO_CLOUDY, "--port", "0", "--port-file",
-                         d + "/weatherd.port", "--heartbeat-ms", "200"},
-                        d + "/weatherd.log");
-  const unsigned weatherPort = waitForPortFile(d + "/weatherd.port", 20s);
-  ASSERT_GT(weatherPort, 0u) << weatherd.log();
-  // As in flightgear_test.cpp: leak checking off for the renderer (lavapipe's
-  // JIT), and a 64x36 frame that keeps the frame rate up under ASan on
-  // lavapipe (this test is about the inputs, not the image).
-  ChildProcess render({SKY_RENDER, "--headless", "--server", "127.0.0.1:" + std::to_string(weatherPort),
-                       "--cigi-port", "0", "--port-file", d + "/cigi.port", "--fdm-port", "0", "--fdm-port-file",
-                       d + "/fdm.port", "--out", d + "/frames", "--width", "64", "--height", "36", "--no-exr",
-                       "--idle-exit", "3", "--weather-timeout", "60"},
-                      d + "/render.log", {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
-  const unsigned fdmPort = waitForPortFile(d + "/fdm.port", 90s);
-  ASSERT_GT(fdmPort, 0u) << render.log();
-  const unsigned cigiPort = waitForPortFile(d + "/cigi.port", 5s);
-  ASSERT_GT(cigiPort, 0u) << render.log();
+  InputChannel channel("hostile_input", "3", {"--no-exr"});
+  ASSERT_GT(channel.weatherPort, 0u) << channel.weatherd->log();
+  ASSERT_GT(channel.fdmPort, 0u) << channel.render->log();
+  ASSERT_GT(channel.cigiPort, 0u) << channel.render->log();
+  ChildProcess& render = *channel.render;
+  ChildProcess& weatherd = *channel.weatherd;
+  const unsigned fdmPort = channel.fdmPort, cigiPort = channel.cigiPort;
+  const std::string d = channel.dir.string();
 
-  UdpSender flightgear, host, intruder;
+  // The intruder has its own address: a channel answers its host's address
+  // on any port (a restarted host is answered again).
+  UdpSender flightgear, host, intruder(INADDR_LOOPBACK + 1);
   std::size_t hostAnswers = 0, intruderAnswers = 0;
   std::uint32_t frame = 0;
   const auto start = std::chrono::steady_clock::now();

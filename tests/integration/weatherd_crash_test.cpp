@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "child_process.hpp"
+#include "change_storm.hpp"
 #include "sky/sim/http_client.hpp"
 
 namespace fs = std::filesystem;
@@ -31,43 +32,6 @@ constexpr int kCycles = 20;
 // Events GET /api/events returns at most (server/src/live_weather.cpp's kMaxEvents).
 constexpr std::size_t kEventWindow = 10000;
 
-struct Acked {
-  int client = 0;
-  int marker = 0;
-  std::uint64_t sequence = 0;
-};
-
-std::string batch(int client, int marker) {
-  // Layers 10+c and 20+c both get base_m = 1000 + marker.
-  auto layer = [&](int id) {
-    return nlohmann::json{{"id", id},
-                          {"type", "stratocumulus"},
-                          {"base_m", 1000 + marker},
-                          {"thickness_m", 500},
-                          {"transition_band_m", 0},
-                          {"coverage", 0.5},
-                          {"density", 1},
-                          {"wind", {{"speed_mps", 5}, {"from_deg", 270}, {"vertical_mps", 0}}}};
-  };
-  return nlohmann::json{{"author", "client" + std::to_string(client)},
-                        {"changes",
-                         {{{"op", "set_layer"}, {"layer", layer(10 + client)}},
-                          {{"op", "set_layer"}, {"layer", layer(20 + client)}}}}}
-      .dump();
-}
-
-Result<sim::HttpResponse> call(unsigned port, const std::string& method, const std::string& target,
-                               const std::string& body = "") {
-  sim::HttpRequest r;
-  r.method = method;
-  r.port = static_cast<unsigned short>(port);
-  r.target = target;
-  r.body = body;
-  r.bearerToken = kToken;
-  r.timeout = 3000ms;
-  return sim::httpRequest(r);
-}
-
 TEST(WeatherdCrash, AcknowledgedChangesSurviveKillNineAndNoBatchIsHalfApplied) {
   const fs::path dir = fs::path(SKY_TEST_OUTPUT_DIR) / "weatherd-crash";
   fs::remove_all(dir);
@@ -77,10 +41,9 @@ TEST(WeatherdCrash, AcknowledgedChangesSurviveKillNineAndNoBatchIsHalfApplied) {
   std::mt19937 rng(seed);
   SCOPED_TRACE("seed " + std::to_string(seed));
 
-  std::vector<Acked> acked;
-  std::map<int, int> lastAttempt;  // client -> highest marker sent (answered or not)
+  StormRecord record;
+  const std::vector<Acked>& acked = record.acked;
   std::uint64_t lastSequence = 0;
-  std::size_t unanswered = 0;
   for (int cycle = 0; cycle < kCycles; ++cycle) {
     const fs::path portFile = dir / ("http." + std::to_string(cycle) + ".port");
     ChildProcess server({SKY_WEATHERD, "--scenario", SKY_SCENARIO_CLOUDY, "--port", "0", "--http-port", "0",
@@ -91,18 +54,16 @@ TEST(WeatherdCrash, AcknowledgedChangesSurviveKillNineAndNoBatchIsHalfApplied) {
     ASSERT_GT(port, 0u) << server.log();
 
     // What survived the last crash.
-    auto stateReply = call(port, "GET", "/api/state");
-    ASSERT_TRUE(stateReply && stateReply->status == 200) << server.log();
-    const auto state = nlohmann::json::parse(stateReply->body);
-    const std::uint64_t sequence = state["sequence"].get<std::uint64_t>();
+    auto survivors = readSurvivors(port, kToken, kEventWindow);
+    ASSERT_TRUE(survivors) << describe(survivors.error()) << server.log();
+    const std::uint64_t sequence = survivors->sequence;
     EXPECT_GE(sequence, lastSequence) << "cycle " << cycle << ": the sequence went back";
-    std::map<int, double> base;
-    for (const auto& l : state["layers"]) base[l["id"].get<int>()] = l["base_m"].get<double>();
+    std::map<int, double>& base = survivors->base;
     for (int c = 0; c < kClients; ++c) {
       EXPECT_EQ(base.count(10 + c), base.count(20 + c)) << "cycle " << cycle << " client " << c << ": half a batch";
       if (base.count(10 + c)) {
         EXPECT_EQ(base[10 + c], base[20 + c]) << "cycle " << cycle << " client " << c << ": half a batch";
-        EXPECT_LE(base[10 + c], 1000 + lastAttempt[c]) << "a marker never sent";
+        EXPECT_LE(base[10 + c], 1000 + record.lastAttempt[c]) << "a marker never sent";
       }
     }
     for (const Acked& a : acked) {
@@ -111,14 +72,9 @@ TEST(WeatherdCrash, AcknowledgedChangesSurviveKillNineAndNoBatchIsHalfApplied) {
           << "cycle " << cycle << ": client " << a.client << " marker " << a.marker << " (sequence " << a.sequence
           << ") was acknowledged and is lost";
     }
-    auto eventsReply = call(port, "GET", "/api/events?limit=10000");
-    ASSERT_TRUE(eventsReply && eventsReply->status == 200);
-    std::map<std::uint64_t, std::string> events;
-    const auto eventList = nlohmann::json::parse(eventsReply->body);
-    for (const auto& e : eventList["events"])
-      events[e["sequence"].get<std::uint64_t>()] = e["author"].get<std::string>();
-    // The server keeps the newest kEventWindow events for the API (the
-    // database keeps them all): an acknowledged change older than the
+    const std::map<std::uint64_t, std::string>& events = survivors->authors;
+    // The server and its database keep the newest kEventWindow events
+    // (kMaxStoredEvents): an acknowledged change older than the
     // window is checked through the state above, and then the window must
     // be full and reach up to the current sequence.
     const std::uint64_t oldest = events.empty() ? 0 : events.begin()->first;
@@ -143,35 +99,14 @@ TEST(WeatherdCrash, AcknowledgedChangesSurviveKillNineAndNoBatchIsHalfApplied) {
     }
 
     // The storm, and a SIGKILL at a random moment in it.
-    std::mutex mutex;
-    std::atomic<bool> killed{false};
-    std::vector<std::thread> clients;
-    for (int c = 0; c < kClients; ++c)
-      clients.emplace_back([&, c] {
-        while (!killed) {
-          int marker = 0;
-          {
-            std::lock_guard lock(mutex);
-            marker = ++lastAttempt[c];
-          }
-          auto reply = call(port, "POST", "/api/changes", batch(c, marker));
-          std::lock_guard lock(mutex);
-          if (reply && reply->status == 200) {
-            acked.push_back({c, marker, nlohmann::json::parse(reply->body)["sequence"].get<std::uint64_t>()});
-          } else {
-            ++unanswered;
-            if (reply) ADD_FAILURE() << "client " << c << ": HTTP " << reply->status << " " << reply->body;
-          }
-        }
-      });
+    ChangeStorm storm(port, kToken, kClients, 2, record);
     std::this_thread::sleep_for(std::chrono::milliseconds(std::uniform_int_distribution<int>(100, 600)(rng)));
     server.killNow();
-    killed = true;
-    for (auto& t : clients) t.join();
+    storm.stop();
   }
   std::printf("crash test: %d kills, %zu acknowledged batches checked after each, %zu unanswered, "
               "last sequence %llu, seed %u\n",
-              kCycles - 1, acked.size(), unanswered, static_cast<unsigned long long>(lastSequence), seed);
+              kCycles - 1, acked.size(), record.unanswered, static_cast<unsigned long long>(lastSequence), seed);
   EXPECT_GT(acked.size(), 50u) << "the storm hardly ran";
 }
 

@@ -23,6 +23,7 @@
 
 #include "child_process.hpp"
 #include "sky/cigi/codec.hpp"
+#include "change_storm.hpp"
 #include "sky/sim/http_client.hpp"
 
 namespace fs = std::filesystem;
@@ -49,16 +50,8 @@ std::vector<std::string> weatherdArgs(const fs::path& dir, const std::string& ta
           (dir / "weather.db").string()};
 }
 
-Result<sim::HttpResponse> call(unsigned port, const std::string& method, const std::string& target,
-                               const std::string& body = "") {
-  sim::HttpRequest r;
-  r.method = method;
-  r.port = static_cast<unsigned short>(port);
-  r.target = target;
-  r.body = body;
-  r.bearerToken = kToken;
-  r.timeout = 3000ms;
-  return sim::httpRequest(r);
+Result<sim::HttpResponse> call(unsigned port, const std::string& method, const std::string& target) {
+  return callWeatherd(port, kToken, method, target);
 }
 
 TEST(WeatherdLifecycle, ADatabaseOfGarbageExitsWithThreeNamingTheFile) {
@@ -95,32 +88,10 @@ TEST(WeatherdLifecycle, ALockedDatabaseExitsWithThreeNamingTheFile) {
   EXPECT_NE(second.log().find("lock"), std::string::npos) << second.log();
 }
 
-std::string batch(int client, int marker) {
-  auto layer = [&](int id) {
-    return nlohmann::json{{"id", id},
-                          {"type", "stratocumulus"},
-                          {"base_m", 1000 + marker},
-                          {"thickness_m", 500},
-                          {"transition_band_m", 0},
-                          {"coverage", 0.5},
-                          {"density", 1},
-                          {"wind", {{"speed_mps", 5}, {"from_deg", 270}, {"vertical_mps", 0}}}};
-  };
-  return nlohmann::json{{"author", "client" + std::to_string(client)},
-                        {"changes", {{{"op", "set_layer"}, {"layer", layer(10 + client)}}}}}
-      .dump();
-}
-
 TEST(WeatherdLifecycle, SigtermInAStormExitsZeroPromptlyAndLosesNoAcknowledgedChange) {
   const fs::path dir = freshDir("weatherd-sigterm");
   constexpr int kClients = 3, kCycles = 3;
-  struct Acked {
-    int client, marker;
-    std::uint64_t sequence;
-  };
-  std::vector<Acked> acked;
-  std::map<int, int> lastAcked;
-  int marker = 0;
+  StormRecord record;
   for (int cycle = 0; cycle <= kCycles; ++cycle) {
     const std::string tag = std::to_string(cycle);
     ChildProcess server(weatherdArgs(dir, tag), (dir / ("weatherd." + tag + ".log")).string());
@@ -128,57 +99,30 @@ TEST(WeatherdLifecycle, SigtermInAStormExitsZeroPromptlyAndLosesNoAcknowledgedCh
     ASSERT_GT(port, 0u) << server.log();
 
     // Everything acknowledged before the last SIGTERM is here.
-    auto state = call(port, "GET", "/api/state");
-    ASSERT_TRUE(state && state->status == 200) << server.log();
-    std::map<int, double> base;
-    const auto stateJson = nlohmann::json::parse(state->body);
-    for (const auto& l : stateJson["layers"]) base[l["id"].get<int>()] = l["base_m"].get<double>();
+    auto survivors = readSurvivors(port, kToken);
+    ASSERT_TRUE(survivors) << describe(survivors.error()) << server.log();
     // A change may be committed and its answer lost in the shutdown: a
     // client's layer holds its last acknowledged marker or a later one.
-    for (const auto& [client, m] : lastAcked)
-      EXPECT_GE(base[10 + client], 1000 + m) << "cycle " << cycle << ": client " << client << "'s last acknowledged change";
-    auto events = call(port, "GET", "/api/events?limit=10000");
-    ASSERT_TRUE(events && events->status == 200);
-    std::map<std::uint64_t, std::string> log;
-    const auto eventsJson = nlohmann::json::parse(events->body);
-    for (const auto& e : eventsJson["events"])
-      log[e["sequence"].get<std::uint64_t>()] = e["author"].get<std::string>();
-    for (const Acked& a : acked)
-      EXPECT_EQ(log[a.sequence], "client" + std::to_string(a.client))
+    for (const auto& [client, m] : record.lastAcked)
+      EXPECT_GE(survivors->base[10 + client], 1000 + m)
+          << "cycle " << cycle << ": client " << client << "'s last acknowledged change";
+    for (const Acked& a : record.acked)
+      EXPECT_EQ(survivors->authors[a.sequence], "client" + std::to_string(a.client))
           << "cycle " << cycle << ": acknowledged sequence " << a.sequence << " is not in the event log";
     if (cycle == kCycles) break;
 
-    std::mutex mutex;
-    std::atomic<bool> stop{false};
-    std::vector<std::thread> clients;
-    for (int c = 0; c < kClients; ++c)
-      clients.emplace_back([&, c] {
-        while (!stop) {
-          int m = 0;
-          {
-            std::lock_guard lock(mutex);
-            m = ++marker;  // markers only grow, over every client and cycle
-          }
-          auto reply = call(port, "POST", "/api/changes", batch(c, m));
-          if (reply && reply->status == 200) {
-            std::lock_guard lock(mutex);
-            acked.push_back({c, m, nlohmann::json::parse(reply->body)["sequence"].get<std::uint64_t>()});
-            lastAcked[c] = m;
-          }
-        }
-      });
+    ChangeStorm storm(port, kToken, kClients, 1, record);
     std::this_thread::sleep_for(700ms);
     const auto signalled = std::chrono::steady_clock::now();
     const int code = server.stop();  // SIGTERM; SIGKILL (exit 137) only after 5 s
     const auto took = std::chrono::steady_clock::now() - signalled;
-    stop = true;
-    for (auto& t : clients) t.join();
+    storm.stop();
     EXPECT_EQ(code, 0) << server.log();
     EXPECT_LT(took, 2s) << "SIGTERM to exit: " << std::chrono::duration<double>(took).count() << " s";
     std::printf("cycle %d: SIGTERM to exit %.0f ms, %zu acknowledged so far\n", cycle,
-                std::chrono::duration<double, std::milli>(took).count(), acked.size());
+                std::chrono::duration<double, std::milli>(took).count(), record.acked.size());
   }
-  EXPECT_GT(acked.size(), 30u) << "the storm hardly ran";
+  EXPECT_GT(record.acked.size(), 30u) << "the storm hardly ran";
 }
 
 // CIGI changes have no acknowledgement; what a client can see (the state

@@ -119,9 +119,11 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
   }
   if (!host) {
     std::lock_guard lock(hostMutex_);
-    host_ = CigiHost{from.address(), from.port()};
-    spdlog::info("CIGI: answering host {} port {} (the first valid datagram's sender); other senders are dropped",
-                 from.address().to_string(), from.port());
+    // The address only: a host that restarts comes back on a new ephemeral
+    // port and must be answered again; --cigi-host ADDR:PORT pins a port.
+    host_ = CigiHost{from.address(), std::nullopt};
+    spdlog::info("CIGI: answering host {} (the first valid datagram's sender, any port); other senders are dropped",
+                 from.address().to_string());
   }
   ++accepted_;
   for (const auto& packet : datagram->packets) {

@@ -114,7 +114,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 65535));
   app.add_option("--cigi-host", o.cigiHost,
                  "the only CIGI host this channel answers, ADDR[:PORT] ([ADDR]:PORT for IPv6; without PORT, any "
-                 "port of ADDR). Default: the sender of the first valid host datagram (its address and port). "
+                 "port of ADDR). Default: the address of the first valid host datagram's sender (any port). "
                  "Datagrams from any other sender are dropped, counted and never answered");
   app.add_option("--port-file", o.portFile, "write the CIGI port here once listening");
   app.add_option("--fdm-port", o.fdmPort,

@@ -19,6 +19,7 @@
 #include "sky/server/cigi_weather_input.hpp"
 #include "sky/server/live_weather.hpp"
 #include "sky/server/weather_store.hpp"
+#include "store_files.hpp"
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
@@ -26,28 +27,11 @@ using namespace std::chrono_literals;
 namespace sky::server {
 namespace {
 
-const WallClock::time_point kT0{std::chrono::hours(1000)};
+const WallClock::time_point kT0 = test::kStoreT0;
 
-Scenario scenario() {
-  Scenario s;
-  s.clock = {1000.0, 1.0};
-  weather::CloudLayer l;
-  l.id = 1;
-  l.base_m = 1500;
-  l.thickness_m = 1000;
-  l.coverage = 0.3;
-  l.density = 1;
-  s.layers = {l};
-  return s;
-}
+Scenario scenario() { return test::oneLayerScenario(); }
 
-fs::path freshFile(const char* name) {
-  const fs::path dir = fs::temp_directory_path() / "skyshell-bounds-test";
-  fs::create_directories(dir);
-  const fs::path p = dir / name;
-  for (const char* suffix : {"", "-wal", "-shm", "-journal"}) fs::remove(p.string() + suffix);
-  return p;
-}
+fs::path freshFile(const char* name) { return test::freshDatabase("skyshell-bounds-test", name); }
 
 weather::CloudLayer layerWithCoverage(double coverage) {
   weather::CloudLayer l = scenario().layers[0];

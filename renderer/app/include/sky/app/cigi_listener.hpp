@@ -3,7 +3,8 @@
 // and answers with Start of Frame, plus a Weather Conditions Response and
 // Aerosol Concentration Responses for each Environmental Conditions Request.
 // It answers one host only: the one it is told (--cigi-host) or else the
-// first sender of a valid host datagram. Malformed datagrams and datagrams
+// address of the first sender of a valid host datagram (any port, so a host
+// that restarts is answered again). Malformed datagrams and datagrams
 // from any other sender are dropped unanswered, counted by reason, and
 // logged once per kind.
 #pragma once
@@ -72,8 +73,8 @@ Result<CigiHost> parseCigiHost(std::string_view text);
 class CigiListener {
  public:
   // Binds to address:port (port 0 = ephemeral; see port()). host: the only
-  // sender answered; none = the first sender of a valid host datagram
-  // (address and port) becomes it.
+  // sender answered; none = the address of the first sender of a valid host
+  // datagram becomes it (any port of that address).
   CigiListener(boost::asio::io_context& io, SharedState& state, const std::string& address,
                unsigned short port, std::optional<CigiHost> host = std::nullopt);
 
