@@ -132,8 +132,8 @@ inline Result<Survivors> readSurvivors(unsigned port, const std::string& token, 
   const auto stateJson = nlohmann::json::parse(state->body);
   s.sequence = stateJson["sequence"].get<std::uint64_t>();
   for (const auto& l : stateJson["layers"]) s.base[l["id"].get<int>()] = l["base_m"].get<double>();
-  for (const auto& e : nlohmann::json::parse(events->body)["events"])
-    s.authors[e["sequence"].get<std::uint64_t>()] = e["author"].get<std::string>();
+  const auto eventsJson = nlohmann::json::parse(events->body);
+  for (const auto& e : eventsJson["events"]) s.authors[e["sequence"].get<std::uint64_t>()] = e["author"].get<std::string>();
   return s;
 }
 

@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "child_process.hpp"
+#include "pcap.hpp"
 #include "input_channel.hpp"
 #include "sky/fgfdm/net_fdm.hpp"
 #include "sky/geo/geodetic.hpp"
@@ -67,40 +68,7 @@ double maxBackStep_m(double frameInterval_s) {
   return std::max(kMinBackStep_m, lead_m * (1.0 - std::exp(-frameInterval_s / kConvergenceTimeConstant_s)));
 }
 
-struct Packet {
-  double t_s;  // capture time, s after the first packet
-  std::vector<std::uint8_t> payload;
-};
-
-// The UDP payloads of a little-endian, microsecond, Ethernet pcap.
-std::vector<Packet> readPcap(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::vector<std::uint8_t> d((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-  auto u32 = [&](std::size_t at) {
-    std::uint32_t v;
-    std::memcpy(&v, &d[at], 4);
-    return v;
-  };
-  std::vector<Packet> out;
-  if (d.size() < 24 || u32(0) != 0xa1b2c3d4u || u32(20) != 1) {
-    ADD_FAILURE() << path << ": not a little-endian microsecond Ethernet pcap";
-    return out;
-  }
-  double first = -1;
-  for (std::size_t at = 24; at + 16 <= d.size();) {
-    const double t = u32(at) + u32(at + 4) * 1e-6;
-    const std::size_t len = u32(at + 8);
-    const std::size_t frame = at + 16;
-    at = frame + len;
-    if (at > d.size()) break;
-    const std::size_t ip = frame + 14;  // Ethernet II header
-    const std::size_t udp = ip + (d[ip] & 0x0f) * 4u;
-    const std::size_t payload = udp + 8;
-    if (first < 0) first = t;
-    out.push_back({t - first, std::vector<std::uint8_t>(d.begin() + payload, d.begin() + frame + len)});
-  }
-  return out;
-}
+using Packet = CapturedDatagram;
 
 struct Fix {
   double t_s;
@@ -180,10 +148,10 @@ TEST(FlightGear, RendererCameraFollowsAReplayedNativeFdmCapture) {
 
   InputChannel channel("flightgear", kIdleExit_s);
   ASSERT_GT(channel.weatherPort, 0u) << channel.weatherd->log();
-  ASSERT_GT(channel.fdmPort, 0u) << channel.render->log();
+  ASSERT_GT(channel.inputPort, 0u) << channel.render->log();
   ChildProcess& render = *channel.render;
   ChildProcess& weatherd = *channel.weatherd;
-  const unsigned fdmPort = channel.fdmPort;
+  const unsigned fdmPort = channel.inputPort;
   const std::string d = channel.dir.string();
 
   // Replay with the capture's own timing.

@@ -180,11 +180,11 @@ std::uint64_t countIn(const std::string& summary, const std::string& name) {
 TEST(HostileInput, RendererKeepsDrawingAndAnswersOnlyItsHost) {
   InputChannel channel("hostile_input", "3", {"--no-exr"});
   ASSERT_GT(channel.weatherPort, 0u) << channel.weatherd->log();
-  ASSERT_GT(channel.fdmPort, 0u) << channel.render->log();
+  ASSERT_GT(channel.inputPort, 0u) << channel.render->log();
   ASSERT_GT(channel.cigiPort, 0u) << channel.render->log();
   ChildProcess& render = *channel.render;
   ChildProcess& weatherd = *channel.weatherd;
-  const unsigned fdmPort = channel.fdmPort, cigiPort = channel.cigiPort;
+  const unsigned fdmPort = channel.inputPort, cigiPort = channel.cigiPort;
   const std::string d = channel.dir.string();
 
   // The intruder has its own address: a channel answers its host's address

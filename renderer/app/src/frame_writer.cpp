@@ -61,6 +61,7 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
       {"weather_clock_s", r.weatherClock_s},
       {"weather_version", r.weatherVersion},
       {"weather_connected", r.weatherConnected},
+      {"weather_source", r.weatherSource},
       {"layers", r.layerCount},
       {"weather_areas", areasJson(r.weatherAreas)},
       {"weather_map",

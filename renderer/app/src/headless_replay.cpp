@@ -17,6 +17,7 @@
 
 #include "sky/app/area_of_interest.hpp"
 #include "sky/app/drawable_weather.hpp"
+#include "sky/app/fallback_weather.hpp"
 #include "sky/app/frame_writer.hpp"
 #include "sky/app/replay_outputs.hpp"
 #include "sky/app/shared_state.hpp"
@@ -29,15 +30,6 @@
 namespace sky::app {
 
 namespace {
-
-// The whole file at `path`; the error names it (cleaned for a message).
-Result<std::string> readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return fail(ErrorCode::Io, flight::messageText(path) + ": cannot open for reading");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
 
 namespace asio = boost::asio;
 using Clock = std::chrono::steady_clock;
@@ -120,19 +112,14 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   std::optional<WeatherClient> weather;
   std::string weatherSource;
   if (!o.weatherFile.empty()) {
-    auto text = readFile(o.weatherFile);
-    auto scenario = text ? weather::parseScenario(*text, o.weatherFile)
-                         : Result<weather::Scenario>(tl::unexpected(text.error()));
-    if (!scenario) {
-      std::fprintf(stderr, "skyshell-render: --weather-file: %s\n", describe(scenario.error()).c_str());
+    const auto now = Clock::now();
+    auto view = scenarioWeather(o.weatherFile, now);
+    if (!view) {
+      std::fprintf(stderr, "skyshell-render: --weather-file: %s\n", describe(view.error()).c_str());
       return 2;
     }
-    weather::WeatherSnapshot snapshot;
-    snapshot.weatherClock_s = scenario->clock.start_s;
-    snapshot.layers = scenario->layers;
-    const auto now = Clock::now();
-    state.setSnapshot(std::move(snapshot), now);
-    state.setClock(scenario->clock.start_s, scenario->clock.rate, now);
+    state.setSnapshot(std::move(view->snapshot), now);
+    state.setClock(view->clock.at(now), view->clock.rate(), now);
     weatherSource = o.weatherFile;
   } else {
     weather.emplace(io, state, o.serverHost, o.serverPort);
@@ -263,6 +250,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     record.weatherClock_s = in.weatherClock_s;
     record.weatherVersion = view.version;
     record.weatherConnected = view.connected;
+    record.weatherSource = o.weatherFile.empty() ? "server" : "file";
     record.layerCount = view.snapshot.layers.size();
     record.weatherAreas = {{view.snapshot.tileLevel, view.snapshot.tiles.size()}};
     if (view.coarse) record.weatherAreas.push_back({view.coarse->tileLevel, view.coarse->tiles.size()});

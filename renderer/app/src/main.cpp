@@ -1,5 +1,6 @@
 // skyshell-render: one image-generator channel. Takes its camera from a CIGI
-// host over UDP (or, with --fdm-port, from FlightGear's --native-fdm stream,
+// host over UDP (or, with --fdm-port, from FlightGear's --native-fdm stream, or with
+// --foreflight-port from ForeFlight XGPS/XATT lines, as X-Plane sends them;
 // smoothed), its weather from skyshell-weatherd over TCP, and renders the
 // clouds on Vulkan. Headless: writes a PNG, an EXR and metadata per frame;
 // windowed: shows the frames in a GLFW window (and writes their metadata).
@@ -23,7 +24,9 @@
 #include "sky/app/area_of_interest.hpp"
 #include "sky/app/cigi_listener.hpp"
 #include "sky/app/drawable_weather.hpp"
+#include "sky/app/fallback_weather.hpp"
 #include "sky/app/fdm_listener.hpp"
+#include "sky/app/foreflight_listener.hpp"
 #include "sky/app/frame_writer.hpp"
 #include "sky/app/glfw_window.hpp"
 #include "sky/app/headless_replay.hpp"
@@ -51,6 +54,9 @@ struct Options {
   int fdmPort = -1;  // -1: no FlightGear input
   std::string fdmPortFile;
   double fdmFrameRate_hz = 30;
+  std::string foreflightAddress = "127.0.0.1";
+  int foreflightPort = -1;  // -1: no ForeFlight input
+  std::string foreflightPortFile;
   std::string outDir = "skyshell-frames";
   bool headless = false;
   bool window = false;
@@ -124,9 +130,16 @@ int main(int argc, char** argv) {
   app.add_option("--fdm-address", o.fdmAddress, "address to receive FlightGear native FDM on");
   app.add_option("--fdm-port-file", o.fdmPortFile, "write the FlightGear FDM port here once listening");
   app.add_option("--fdm-frame-rate", o.fdmFrameRate_hz,
-                 "with --fdm-port: render at most this many frames per second (the camera is smoothed, so "
-                 "frames are not tied to packets)")
+                 "with --fdm-port or --foreflight-port: render at most this many frames per second (the camera "
+                 "is smoothed, so frames are not tied to packets)")
       ->check(CLI::Range(0.1, 1000.0));
+  app.add_option("--foreflight-port", o.foreflightPort,
+                 "take the camera from ForeFlight XGPS/XATT lines on this UDP port (X-Plane 11/12 'Send to "
+                 "ForeFlight', FlightGear foreflight-xgps; the format's port is 49002; 0 = any free port) "
+                 "instead of from CIGI")
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--foreflight-address", o.foreflightAddress, "address to receive ForeFlight lines on");
+  app.add_option("--foreflight-port-file", o.foreflightPortFile, "write the ForeFlight port here once listening");
   app.add_flag("--headless", o.headless, "render off-screen and write frames (PNG, EXR, metadata) to --out");
   app.add_flag("--window", o.window,
                "show the frames in a window (X11: DISPLAY; works under Xvfb); with --headless, also write them");
@@ -149,7 +162,10 @@ int main(int argc, char** argv) {
   app.add_option("--max-frames", o.maxFrames, "stop after this many frames (0 = no limit)");
   app.add_option("--idle-exit", o.idleExit_s,
                  "stop when no pose (CIGI or FDM) arrived for this many seconds after the first (0 = never)");
-  app.add_option("--weather-timeout", o.weatherTimeout_s, "seconds to wait for the first weather");
+  app.add_option("--weather-timeout", o.weatherTimeout_s,
+                 "live: seconds a connected server may send no weather before the channel draws clear sky or "
+                 "--weather-file (with no server it does so after 1 s, and switches to the server's weather when "
+                 "it comes); --replay: seconds to wait for the first weather");
   app.add_option("--replay", o.replayFlight,
                  "render this flight file (.csv, .igc, .gpx) headless, one frame per --step of flight time, "
                  "then write a video, a contact sheet and report.json into --out");
@@ -167,8 +183,8 @@ int main(int argc, char** argv) {
                  "byte-identical re-renders");
   app.add_flag("--no-video", o.noVideo, "with --replay: skip the MP4");
   app.add_option("--weather-file", o.weatherFile,
-                 "with --replay: render the weather of this scenario file (deploy/scenarios/*.toml) instead of "
-                 "asking --server");
+                 "a scenario file (deploy/scenarios/*.toml): with --replay, the weather rendered instead of asking "
+                 "--server; live, the weather drawn until the server's comes (default: clear sky)");
   app.add_flag("--fixed-sun", o.fixedSun,
                "with --replay: light from --sun-azimuth/--sun-elevation even when the flight has a date");
   app.set_config("--config", "", "config file (TOML keys named like the long options)");
@@ -284,6 +300,17 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  std::optional<sky::app::WeatherView> fileWeather;
+  if (!o.weatherFile.empty()) {
+    auto loaded = sky::app::scenarioWeather(o.weatherFile, Clock::now());
+    if (!loaded) {
+      std::fprintf(stderr, "skyshell-render: --weather-file: %s\n", sky::describe(loaded.error()).c_str());
+      return 2;
+    }
+    fileWeather = std::move(*loaded);
+  }
+  sky::app::FallbackWeather fallback(std::move(fileWeather), o.weatherFile, o.server, o.weatherTimeout_s, Clock::now());
+
   sky::app::SharedState state;
   asio::io_context io;
   auto guard = asio::make_work_guard(io);
@@ -304,6 +331,21 @@ int main(int argc, char** argv) {
   // With --fdm-port the camera comes from FlightGear only; the CIGI endpoint
   // stays open (and answers Start of Frame) but its pose is not used.
   std::optional<sky::app::FdmListener> fdm;
+  std::optional<sky::app::ForeFlightListener> foreflight;
+  if (o.fdmPort >= 0 && o.foreflightPort >= 0) {
+    std::fprintf(stderr, "skyshell-render: choose one of --fdm-port and --foreflight-port\n");
+    return 2;
+  }
+  if (o.foreflightPort >= 0) {
+    try {
+      foreflight.emplace(io, o.foreflightAddress, static_cast<unsigned short>(o.foreflightPort));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "skyshell-render: cannot listen for ForeFlight on %s:%d: %s\n",
+                   shown(o.foreflightAddress).c_str(), o.foreflightPort, e.what());
+      return 2;
+    }
+    foreflight->start();
+  }
   if (o.fdmPort >= 0) {
     try {
       fdm.emplace(io, o.fdmAddress, static_cast<unsigned short>(o.fdmPort));
@@ -322,6 +364,7 @@ int main(int argc, char** argv) {
     asio::post(io, [&] {
       cigi->stop();
       if (fdm) fdm->stop();
+      if (foreflight) foreflight->stop();
       signals.cancel();
     });
     guard.reset();
@@ -338,12 +381,20 @@ int main(int argc, char** argv) {
     shutdown();
     return 2;
   }
+  if (foreflight && !o.foreflightPortFile.empty() && !writePortFile(o.foreflightPortFile, foreflight->port())) {
+    std::fprintf(stderr, "skyshell-render: cannot write --foreflight-port-file %s\n", o.foreflightPortFile.c_str());
+    shutdown();
+    return 2;
+  }
   std::printf("skyshell-render: device '%s', CIGI on %s:%u, weather from %s, frames to %s\n",
               (*renderer)->deviceName().c_str(), o.cigiAddress.c_str(), cigi->port(), o.server.c_str(),
               o.outDir.c_str());
   if (fdm)
     std::printf("skyshell-render: camera from FlightGear native FDM on %s:%u\n", o.fdmAddress.c_str(),
                 fdm->port());
+  if (foreflight)
+    std::printf("skyshell-render: camera from ForeFlight XGPS/XATT on %s:%u\n", o.foreflightAddress.c_str(),
+                foreflight->port());
   std::fflush(stdout);
 
   std::uint64_t frames = 0, lastSequence = 0, droppedWarnedAt = 0;
@@ -351,15 +402,18 @@ int main(int argc, char** argv) {
   const auto start = Clock::now();
   auto lastReport = start;
   Clock::time_point lastPoseAt{};
-  // FDM frames are paced by this clock, CIGI frames by the host's datagrams.
+  // Smoothed inputs (FlightGear FDM, ForeFlight) pace frames by this clock,
+  // CIGI frames come with the host's datagrams.
+  const bool smoothed = fdm || foreflight;
+  const char* inputName = fdm ? "FlightGear FDM" : foreflight ? "ForeFlight" : "CIGI";
   const auto fdmFramePeriod = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(1.0 / o.fdmFrameRate_hz));
   Clock::time_point nextFdmFrameAt{};
   int exitCode = 0;
   while (!stopRequested) {
-    if (fdm && Clock::now() < nextFdmFrameAt) std::this_thread::sleep_until(nextFdmFrameAt);
+    if (smoothed && Clock::now() < nextFdmFrameAt) std::this_thread::sleep_until(nextFdmFrameAt);
     const auto now = Clock::now();
-    const auto pose = fdm ? fdm->poseAt(now) : state.pose();
+    const auto pose = fdm ? fdm->poseAt(now) : foreflight ? foreflight->poseAt(now) : state.pose();
     if (pose)
       for (const auto& area : areas.update(pose->pose)) weather.subscribe(area);
     if (pose) lastPoseAt = pose->receivedAt;
@@ -367,20 +421,13 @@ int main(int argc, char** argv) {
     // skip the host's last pose (seen in CI under load: the final fix of the
     // replay arrived while a frame took longer than --idle-exit).
     // (FDM frames are rendered continuously from the smoother: always current.)
-    if (o.idleExit_s > 0 && pose && (fdm || pose->sequence == lastSequence) &&
+    if (o.idleExit_s > 0 && pose && (smoothed || pose->sequence == lastSequence) &&
         std::chrono::duration<double>(now - lastPoseAt).count() > o.idleExit_s) {
-      spdlog::info("no {} for {:.1f} s: stopping", fdm ? "FlightGear FDM" : "CIGI", o.idleExit_s);
+      spdlog::info("no {} for {:.1f} s: stopping", inputName, o.idleExit_s);
       break;
     }
-    const auto view = state.weather();
-    if (view.version == 0) {
-      if (std::chrono::duration<double>(now - start).count() > o.weatherTimeout_s) {
-        std::fprintf(stderr, "skyshell-render: no weather from %s within %.0f s\n", o.server.c_str(),
-                     o.weatherTimeout_s);
-        exitCode = 4;
-        break;
-      }
-    }
+    const auto streamed = state.weather();
+    const auto weatherSource = fallback.choose(streamed, now);
     if (display) {
       display->poll();
       if (display->closed()) {
@@ -388,12 +435,13 @@ int main(int argc, char** argv) {
         break;
       }
     }
-    if (!pose || pose->sequence == lastSequence || view.version == 0) {
+    if (!pose || pose->sequence == lastSequence || weatherSource == sky::app::WeatherSource::None) {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
       continue;
     }
     lastSequence = pose->sequence;
     nextFdmFrameAt = now + fdmFramePeriod;
+    const sky::app::WeatherView& view = fallback.view(weatherSource, streamed);
 
     std::vector<std::uint32_t> dropped;
     const auto drawable = sky::app::drawableWeather(view.snapshot, sky::render::kMaxLayers, &dropped);
@@ -422,10 +470,11 @@ int main(int argc, char** argv) {
     }
     record.frame = frames;
     record.host = *pose;
-    record.source = fdm ? "fdm" : "cigi";
+    record.source = fdm ? "fdm" : foreflight ? "foreflight" : "cigi";
     record.weatherClock_s = in.weatherClock_s;
     record.weatherVersion = view.version;
-    record.weatherConnected = view.connected;
+    record.weatherConnected = streamed.connected;
+    record.weatherSource = toString(weatherSource);
     record.layerCount = view.snapshot.layers.size();
     record.weatherAreas = {{view.snapshot.tileLevel, view.snapshot.tiles.size()}};
     if (view.coarse) record.weatherAreas.push_back({view.coarse->tileLevel, view.coarse->tiles.size()});
@@ -473,6 +522,14 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(fdm->datagramsAccepted()),
                 static_cast<unsigned long long>(fdm->datagramsDropped()), fdm->drops().summary().c_str(),
                 static_cast<unsigned long long>(fdm->outliersDropped()));
+  if (foreflight)
+    std::printf("render: ForeFlight positions %llu, attitudes %llu, other lines %llu, datagrams dropped %llu (%s), "
+                "outliers discarded %llu\n",
+                static_cast<unsigned long long>(foreflight->positionsAccepted()),
+                static_cast<unsigned long long>(foreflight->attitudesAccepted()),
+                static_cast<unsigned long long>(foreflight->otherLines()),
+                static_cast<unsigned long long>(foreflight->datagramsDropped()), foreflight->drops().summary().c_str(),
+                static_cast<unsigned long long>(foreflight->outliersDropped()));
   std::fflush(stdout);
   shutdown();
   return exitCode;

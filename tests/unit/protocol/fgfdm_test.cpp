@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "pcap.hpp"
 #include "sky/fgfdm/net_fdm.hpp"
 
 namespace sky::fgfdm {
@@ -21,35 +22,16 @@ std::string readFile(const std::string& path) {
   return s.str();
 }
 
-// UDP payloads of a classic pcap with Ethernet link type and IPv4.
-std::vector<std::vector<std::uint8_t>> udpPayloads(const std::string& pcap) {
+// UDP payloads of the capture.
+std::vector<std::vector<std::uint8_t>> udpPayloads(const std::string& path) {
   std::vector<std::vector<std::uint8_t>> out;
-  auto u32 = [&](std::size_t off) {
-    std::uint32_t v;
-    std::memcpy(&v, pcap.data() + off, 4);
-    return v;  // the capture is little-endian (magic d4 c3 b2 a1)
-  };
-  EXPECT_EQ(u32(0), 0xa1b2c3d4u);
-  EXPECT_EQ(u32(20), 1u) << "Ethernet link type";
-  std::size_t off = 24;
-  while (off + 16 <= pcap.size()) {
-    const std::uint32_t caplen = u32(off + 8);
-    const auto* pkt = reinterpret_cast<const std::uint8_t*>(pcap.data() + off + 16);
-    off += 16 + caplen;
-    if (off > pcap.size()) break;
-    const std::size_t ipOff = 14;
-    const std::size_t ihl = (pkt[ipOff] & 0x0f) * 4u;
-    if (pkt[12] != 0x08 || pkt[13] != 0x00 || pkt[ipOff + 9] != 17) continue;  // IPv4 UDP only
-    const std::size_t udpOff = ipOff + ihl;
-    const std::size_t udpLen = (pkt[udpOff + 4] << 8) | pkt[udpOff + 5];
-    out.emplace_back(pkt + udpOff + 8, pkt + udpOff + udpLen);
-  }
+  for (auto& d : test::readPcap(path)) out.push_back(std::move(d.payload));
   return out;
 }
 
 TEST(FlightGearFdm, DecodesTheRealCaptureFieldByField) {
   const std::string dir = SKY_TEST_DATA_DIR "/flightgear/";
-  const auto packets = udpPayloads(readFile(dir + "fgfs-c172p-native-fdm-excerpt.pcap"));
+  const auto packets = udpPayloads(dir + "fgfs-c172p-native-fdm-excerpt.pcap");
   ASSERT_EQ(packets.size(), 300u);
   std::istringstream csv(readFile(dir + "fgfs-c172p-native-fdm-excerpt-decoded.csv"));
   std::string header;

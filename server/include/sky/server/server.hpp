@@ -71,6 +71,7 @@ class Server final : private SessionHandler {
   // Every subscriber gets fresh weather for its area (call on the io
   // thread). Every change the LiveWeather accepts does this already.
   void weatherChanged();
+  // Call on the io thread (the registry is its own).
   std::size_t subscribers() const { return registry_.size(); }
   // Every subscriber as the console sees it (area, last camera report), by
   // session id. Call on the io thread.

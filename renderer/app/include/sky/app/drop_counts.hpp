@@ -18,7 +18,7 @@ enum class DropReason : std::size_t {
   OutOfRange,     // a field non-finite or outside its range
   NotFromHost,    // CIGI: an IG's datagram (Start of Frame first), not a host's
   ForeignSender,  // CIGI: from a sender other than the host the port is bound to
-  Unusable,       // FlightGear: a pose the smoother cannot take
+  Unusable,       // FlightGear, ForeFlight: a pose the smoother cannot take
   Count_,
 };
 

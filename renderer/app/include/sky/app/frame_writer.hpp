@@ -42,6 +42,9 @@ struct FrameRecord {
   double weatherClock_s = 0;
   std::uint64_t weatherVersion = 0;  // this channel's count of weather updates applied (snapshots, deltas)
   bool weatherConnected = false;     // the stream to the server was up when the frame was drawn
+  // What the weather drawn came from: "server", "file" (--weather-file) or
+  // "clear" (live, before a server's weather; fallback_weather.hpp).
+  std::string weatherSource = "server";
   std::size_t layerCount = 0;
   // The weather each area of interest brought (index 0 detailed, 1 coarse;
   // one entry without a coarse area): S2 level and tiles of the snapshot held.

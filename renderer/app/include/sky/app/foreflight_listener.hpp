@@ -1,0 +1,113 @@
+// The renderer's ForeFlight endpoint on UDP (--foreflight-port; the format's
+// port is 49002): XGPS position lines, and XATT attitude lines when the
+// sender has them (X-Plane does; FlightGear's foreflight-xgps does not), as
+// the pose samples of a PoseSmoother, like the FlightGear FDM input. With
+// this an X-Plane 11/12 user points "Send to ForeFlight" (Settings > Network)
+// at the renderer and sees its clouds around their aircraft.
+//
+// Senders are sparse (about 1 Hz for XGPS) and coarse (FlightGear writes
+// 0.001 deg, ~110 m), so the smoother extrapolates along the sent track and
+// ground speed rather than waiting a second for the next fix; corrections
+// fade in. Without XATT the attitude is derived from the track as for an
+// IGC file: heading = track (held below kMinTrackSpeed_mps), pitch = climb
+// angle, bank = a coordinated turn's at the track's rate of turn.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <span>
+#include <string>
+
+#include <utility>  // before asio: Boost 1.74 asio uses std::exchange without including it
+#include <boost/asio.hpp>
+
+#include "sky/app/drop_counts.hpp"
+#include "sky/app/pose_smoother.hpp"
+#include "sky/app/shared_state.hpp"
+#include "sky/foreflight/foreflight.hpp"
+
+namespace sky::app {
+
+// The smoothing a ~1 Hz feed needs: no render delay (waiting for the next
+// fix would cost a second of latency), extrapolation along the sent
+// velocity for up to 3 s (two missed fixes), then held.
+PoseSmootherConfig foreflightSmoothing();
+
+// Turns ForeFlight messages into pose samples. Pure: arrival times are
+// passed in. One per sender stream.
+class ForeFlightTrack {
+ public:
+  // Below this ground speed the track is noise (a parked aircraft sends
+  // 0.000): the heading is held. 2 m/s.
+  static constexpr double kMinTrackSpeed_mps = 2.0;
+  // An XATT older than this no longer gives the attitude (the sender stopped
+  // sending it): derived again. 2 s.
+  static constexpr double kAttitudeFresh_s = 2.0;
+  // Derived angles are clamped: pitch to +-30 deg, bank to +-60 deg (a 2 g
+  // coordinated turn), as for flight files (protocol/flight/src/attitude.cpp).
+  static constexpr double kMaxDerivedPitch_deg = 30.0, kMaxDerivedBank_deg = 60.0;
+
+  // The sample an XGPS gives, or none for an XATT (kept for the next XGPS)
+  // and other kinds.
+  std::optional<PoseSample> take(const foreflight::Message& message, SteadyTime receivedAt);
+
+ private:
+  std::optional<foreflight::Attitude> attitude_;
+  SteadyTime attitudeAt_{};
+  std::optional<foreflight::Position> previous_;
+  SteadyTime previousAt_{};
+  double heading_deg = 0;
+  double climb_mps = 0, turnRate_degps = 0;
+};
+
+class ForeFlightListener {
+ public:
+  // Binds to address:port (port 0 = ephemeral; see port()).
+  ForeFlightListener(boost::asio::io_context& io, const std::string& address, unsigned short port,
+                     PoseSmootherConfig smoothing = foreflightSmoothing());
+
+  void start();
+  void stop();
+  unsigned short port() const { return port_; }
+
+  // As FdmListener::poseAt: the smoothed camera at `now`; hostFrame = XGPS
+  // lines taken so far. Thread-safe.
+  std::optional<HostPose> poseAt(SteadyTime now);
+
+  // Takes one datagram received at `now`. io thread (public for tests).
+  void handleDatagram(std::span<const std::uint8_t> bytes, SteadyTime now);
+
+  // Thread-safe.
+  std::uint64_t positionsAccepted() const { return accepted_; }
+  std::uint64_t attitudesAccepted() const { return attitudes_; }
+  std::uint64_t otherLines() const { return others_; }
+  std::uint64_t datagramsDropped() const { return drops_.total(); }
+  const DropCounts& drops() const { return drops_; }
+  std::uint64_t outliersDropped() const;
+
+ private:
+  void receive();
+  void dropped(DropReason reason, const std::string& detail);
+
+  boost::asio::ip::udp::socket socket_;
+  boost::asio::ip::udp::endpoint from_;
+  std::array<std::uint8_t, 65536> rx_{};
+  unsigned short port_ = 0;
+  std::atomic<std::uint64_t> accepted_{0}, attitudes_{0}, others_{0};
+  DropCounts drops_;
+  std::set<std::string> loggedReasons_;  // io thread only
+  ForeFlightTrack track_;                // io thread only
+
+  mutable std::mutex mutex_;  // guards the members below
+  PoseSmoother smoother_;
+  std::optional<SteadyTime> firstAt_, newestAt_;
+  std::uint64_t sequence_ = 0;
+};
+
+}  // namespace sky::app
