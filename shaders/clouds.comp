@@ -170,7 +170,7 @@ void main() {
 
   CoreFrame f;
   f.air = AirFrame(frame.earth.x, frame.earth.y, frame.earth.z, frame.earth.w, frame.sunDir.xyz,
-                   frame.sunIrradiance.rgb, int(frame.dispatch.w));
+                   frame.sunIrradiance.rgb, int(frame.dispatch.w), frame.sunDir.w);
   f.groundIrradiance = frame.groundIrradiance.rgb;
   f.march = MarchParams(int(frame.dispatch.y), int(frame.dispatch.z), frame.weatherMap.z, frame.weatherMap.w,
                         frame.steps.x, frame.steps.y, frame.steps.z);

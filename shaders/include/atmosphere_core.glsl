@@ -71,6 +71,12 @@ SKY_CORE_CONST real kFarAway_m = 1.0e9;
 // night finite and not exactly zero.
 SKY_CORE_CONST real kNightSkyRadiance = 1.0e-8;
 
+// Koschmieder's visual range: an object's contrast falls to the 2 %
+// threshold after an optical depth of -ln 0.02 = 3.912, so V = 3.912 / beta
+// for the extinction beta at 550 nm (Koschmieder 1924; WMO-No. 8 uses this
+// threshold for meteorological visibility).
+SKY_CORE_CONST real kKoschmiederDepth = 3.912;
+
 struct AirFrame {
   real r;             // camera distance from the local ground sphere's centre, m
   real h;             // camera height above the ground sphere, m (>= 0)
@@ -79,7 +85,23 @@ struct AirFrame {
   real3 sunDir;       // unit, local frame
   real3 sunIrradiance;  // at the top of the atmosphere, linear units
   int airSteps;         // steps of marchAir (MarchSettings::airSteps); 0: kAirSteps
+  // Aerosol along the view ray beyond the standard profile, as a fraction of
+  // it (0: the standard Mie profile; -1: none): what a host's visibility
+  // makes of the haze (aerosolExcessForVisibility). Only the view ray's
+  // march sees it; the tables (sunlight, multiple scattering) keep the
+  // standard aerosol.
+  real aerosolExcess;
 };
+
+// The aerosol excess (AirFrame::aerosolExcess) that gives sea-level air a
+// Koschmieder visibility of visibility_m (> 0) in green: Rayleigh G plus the
+// scaled Mie extinction equal 3.912 / V. The standard profile's own
+// visibility is 3.912 / (13.558e-6 + 4.40e-6) = 218 km; a longer one gives
+// pure Rayleigh air (-1), the clearest this model has.
+real aerosolExcessForVisibility(real visibility_m) {
+  real beta = kKoschmiederDepth / max(visibility_m, 1.0);
+  return max(beta - kRayleighG_perm, 0.0) / kMieExtinction_perm - 1.0;
+}
 
 // Cumulative single scattering and transmittance of the air from the camera
 // to each queried distance (inscatter[i] is radiance per unit sun irradiance
@@ -282,13 +304,13 @@ AirPath marchAir(AirFrame a, real3 dir, real tEnd, real q[kAirQueries], int coun
     real tm = 0.5 * (s0 + s1);
     real3 p = dir * tm;
     real h = heightAboveCameraSphere(p, a.r) + a.h;
-    real3 sigmaT = airExtinction(h);
+    real3 sigmaT = airExtinction(h) + real3(a.aerosolExcess * kMieExtinction_perm * mieDensity(h));
     real muSun = dot(upAt(p, a.r), a.sunDir);
     real3 sun = a.sunIrradiance * sunTransmittance(h, muSun, groundRadius);
     // Source per unit length: sigma_s p E_sun T_sun for both scatterers, and
     // sigma_s times the multiple-scattering radiance (Hillaire 2020, eq. 11).
     real3 rayleigh = rayleighScattering(h);
-    real mie = kMieScattering_perm * mieDensity(h);
+    real mie = (1.0 + a.aerosolExcess) * kMieScattering_perm * mieDensity(h);
     real3 source = (rayleigh * pR + real3(mie * pM)) * sun +
                    (rayleigh + real3(mie)) * sampleMultipleScatteringLut(multipleScatteringUv(h, muSun)) *
                        a.sunIrradiance;

@@ -3,29 +3,9 @@
 
 #include <cmath>
 
-namespace sky::sim {
+#include "sky/cigi/celestial_time.hpp"
 
-cigi::CelestialSphereControl celestialAt(std::int64_t utc_s) {
-  // Civil date from days since 1970-01-01 (H. Hinnant's civil_from_days).
-  const std::int64_t days = utc_s >= 0 ? utc_s / 86400 : (utc_s - 86399) / 86400;
-  const std::int64_t secs = utc_s - days * 86400;
-  const std::int64_t z = days + 719468;
-  const std::int64_t era = (z >= 0 ? z : z - 146096) / 146097;
-  const std::int64_t doe = z - era * 146097;
-  const std::int64_t yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
-  const std::int64_t doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-  const std::int64_t mp = (5 * doy + 2) / 153;
-  const std::int64_t day = doy - (153 * mp + 2) / 5 + 1;
-  const std::int64_t month = mp < 10 ? mp + 3 : mp - 9;
-  const std::int64_t year = yoe + era * 400 + (month <= 2 ? 1 : 0);
-  cigi::CelestialSphereControl c;
-  c.hour = static_cast<std::uint8_t>(secs / 3600);
-  c.minute = static_cast<std::uint8_t>(secs / 60 % 60);
-  c.dateTimeValid = true;
-  c.ephemerisEnable = true;
-  c.dateMmddyyyy = static_cast<std::uint32_t>(month * 1000000 + day * 10000 + year);
-  return c;
-}
+namespace sky::sim {
 
 std::vector<std::uint8_t> CigiHost::nextFrame(const geo::GeodeticPose& pose, double flightTime_s,
                                               const std::optional<cigi::EnvironmentalConditionsRequest>& request) {
@@ -67,7 +47,7 @@ std::vector<std::uint8_t> CigiHost::nextFrame(const geo::GeodeticPose& pose, dou
     const auto utc = *options_.startUtc_s + static_cast<std::int64_t>(std::floor(flightTime_s));
     if (!lastCelestialMinute_ || *lastCelestialMinute_ != utc / 60) {
       lastCelestialMinute_ = utc / 60;
-      w.add(celestialAt(utc));
+      w.add(cigi::celestialAt(utc));
     }
   }
   if (request) w.add(*request);

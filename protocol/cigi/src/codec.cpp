@@ -86,6 +86,36 @@ const char* packetName(const Packet& packet) {
   return std::visit([](const auto& p) { return Codec<std::decay_t<decltype(p)>>::kName; }, packet);
 }
 
+std::uint8_t packetId(const Packet& packet) {
+  return std::visit([](const auto& p) { return std::decay_t<decltype(p)>::kId; }, packet);
+}
+
+const char* packetIdName(std::uint8_t id) {
+  // CIGI 3.3 host->IG ids 1-35 and IG->host ids 101-117 (cigi.md §1.6).
+  static constexpr std::array<const char*, 35> kHost = {
+      "IG Control", "Entity Control", "Conformal Clamped Entity Control", "Component Control",
+      "Short Component Control", "Articulated Part Control", "Short Articulated Part Control", "Rate Control",
+      "Celestial Sphere Control", "Atmosphere Control", "Environmental Region Control", "Weather Control",
+      "Maritime Surface Conditions Control", "Wave Control", "Terrestrial Surface Conditions Control",
+      "View Control", "Sensor Control", "Motion Tracker Control", "Earth Reference Model Definition",
+      "Trajectory Definition", "View Definition", "Collision Detection Segment Definition",
+      "Collision Detection Volume Definition", "HAT/HOT Request", "LOS Segment Request", "LOS Vector Request",
+      "Position Request", "Environmental Conditions Request", "Symbol Surface Definition",
+      "Symbol Text Definition", "Symbol Circle Definition", "Symbol Line Definition", "Symbol Clone",
+      "Symbol Control", "Short Symbol Control"};
+  static constexpr std::array<const char*, 17> kIg = {
+      "Start of Frame", "HAT/HOT Response", "HAT/HOT Extended Response", "LOS Response", "LOS Extended Response",
+      "Sensor Response", "Sensor Extended Response", "Position Response", "Weather Conditions Response",
+      "Aerosol Concentration Response", "Maritime Surface Conditions Response",
+      "Terrestrial Surface Conditions Response", "Collision Detection Segment Notification",
+      "Collision Detection Volume Notification", "Animation Stop Notification", "Event Notification",
+      "Image Generator Message"};
+  if (id >= 1 && id <= kHost.size()) return kHost[id - 1];
+  if (id >= 101 && id < 101 + kIg.size()) return kIg[id - 101];
+  if (id >= 201) return "user-defined";
+  return "unassigned";
+}
+
 Result<Datagram> decodeDatagram(std::span<const std::uint8_t> bytes) {
   if (bytes.size() < 24)
     return fail(ErrorCode::Malformed, "datagram of " + std::to_string(bytes.size()) +
@@ -136,7 +166,7 @@ Result<Datagram> decodeDatagram(std::span<const std::uint8_t> bytes) {
                                                  ? " is an IG-to-host packet inside a host datagram"
                                                  : " is a host-to-IG packet inside an IG datagram"));
     if (!k) {
-      ++out.skippedPackets;
+      out.skippedIds.push_back(id);
       offset += size;
       continue;
     }

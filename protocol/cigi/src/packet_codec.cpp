@@ -2,6 +2,8 @@
 // the decoder enforces (../shared/reference/cigi.md §3-§7).
 #include "packet_codec.hpp"
 
+#include "sky/cigi/celestial_time.hpp"
+
 namespace sky::cigi::detail {
 
 namespace {
@@ -147,9 +149,11 @@ Result<CelestialSphereControl> Codec<CelestialSphereControl>::read(PacketReader&
   p.starIntensity_pct = r.f32(12);
   r.range(2, "hour", p.hour, 0, 23);
   r.range(3, "minute", p.minute, 0, 59);
-  const std::uint32_t month = p.dateMmddyyyy / 1000000, day = p.dateMmddyyyy / 10000 % 100;
-  if (p.dateTimeValid && (month < 1 || month > 12 || day < 1 || day > 31))
-    r.invalid(8, "date " + std::to_string(p.dateMmddyyyy) + " is not MMDDYYYY");
+  // A date the host says is valid must be a calendar date of a year the
+  // ephemeris serves (30 February, month 13 and year 20250 are dropped).
+  if (p.dateTimeValid && !celestialUtc(p))
+    r.invalid(8, "date " + std::to_string(p.dateMmddyyyy) + " is not a MMDDYYYY date of years " +
+                     std::to_string(kCelestialMinYear) + "-" + std::to_string(kCelestialMaxYear));
   r.range(12, "star intensity", p.starIntensity_pct, 0, 100);
   return r.result(p);
 }

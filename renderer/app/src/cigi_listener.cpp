@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <charconv>
 
+#include "sky/cigi/celestial_time.hpp"
+#include "sky/render/haze.hpp"
 #include "sky/weather/query.hpp"
 
 #include <spdlog/spdlog.h>
@@ -90,6 +92,24 @@ void CigiListener::receive() {
   });
 }
 
+void CigiListener::ignore(std::uint8_t id) {
+  ignored_.add(id);
+  if (loggedIgnored_.insert(id).second)
+    spdlog::info("CIGI: ignoring {} (id {}) packets: accepted, not used, counted", cigi::packetIdName(id), id);
+}
+
+std::string CigiListener::ignoredSummary() const {
+  std::string out;
+  for (unsigned id = 0; id < 256; ++id) {
+    const std::uint64_t n = ignored_.of(static_cast<std::uint8_t>(id));
+    if (n == 0) continue;
+    if (!out.empty()) out += ", ";
+    out += std::string(cigi::packetIdName(static_cast<std::uint8_t>(id))) + " (" + std::to_string(id) + ") " +
+           std::to_string(n);
+  }
+  return out.empty() ? "none" : out;
+}
+
 void CigiListener::dropped(DropReason reason, const std::string& detail) {
   drops_.add(reason);
   if (loggedReasons_.insert(dropKind(reason, detail)).second)
@@ -126,9 +146,41 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
                  from.address().to_string());
   }
   ++accepted_;
+  const auto now = std::chrono::steady_clock::now();
+  clock_.advanceTo(timeline_.advance(ig->timestampValid, ig->timestamp_10us, now));
+  // Reset/Standby forgets the pose once, on entry; no pose is taken while in it.
+  const bool standby = ig->mode == cigi::IgMode::ResetStandby;
+  if (standby && !standby_.load()) {
+    state_.resetChannel();
+    spdlog::info("CIGI: the host put the IG in Reset/Standby: pose and temporal history forgotten");
+  }
+  standby_ = standby;
+  for (const std::uint8_t id : datagram->skippedIds) ignore(id);
+  // Time and atmosphere first: the ownship pose of this datagram carries them.
   for (const auto& packet : datagram->packets) {
+    if (const auto* c = std::get_if<cigi::CelestialSphereControl>(&packet)) {
+      // The decoder passed only calendar dates; a date the host marks
+      // invalid changes nothing.
+      if (const auto minute = cigi::celestialUtc(*c); c->dateTimeValid && minute)
+        clock_.set(double(*minute), 60.0, TimeSource::Cigi);
+    } else if (const auto* a = std::get_if<cigi::AtmosphereControl>(&packet)) {
+      state_.setAtmosphere(atmosphereFrom(*a));
+    }
+  }
+  for (std::size_t i = 1; i < datagram->packets.size(); ++i) {
+    const auto& packet = datagram->packets[i];
     const auto* entity = std::get_if<cigi::EntityControl>(&packet);
-    if (!entity || entity->entityId != 0 || entity->attached) continue;
+    if (!entity) {
+      if (!std::holds_alternative<cigi::CelestialSphereControl>(packet) &&
+          !std::holds_alternative<cigi::AtmosphereControl>(packet) &&
+          !std::holds_alternative<cigi::EnvironmentalConditionsRequest>(packet))
+        ignore(cigi::packetId(packet));
+      continue;
+    }
+    if (entity->entityId != 0 || entity->attached || standby) {
+      ignore(cigi::EntityControl::kId);
+      continue;
+    }
     HostPose p;
     p.pose.position = {entity->lat_deg, entity->lon_deg, entity->alt_m};
     p.pose.yaw_deg = entity->yaw_deg;
@@ -136,11 +188,13 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
     p.pose.roll_deg = entity->roll_deg;
     p.hostFrame = ig->hostFrame;
     p.hostTime_s = ig->timestampValid ? ig->timestamp_10us * 1.0e-5 : 0.0;
-    p.receivedAt = std::chrono::steady_clock::now();
+    p.receivedAt = now;
+    p.utc_s = clock_.utc_s();
+    p.timeSource = clock_.source();
     state_.setPose(p);
   }
   cigi::StartOfFrame sof;
-  sof.mode = cigi::IgMode::Operate;
+  sof.mode = standby ? cigi::IgMode::ResetStandby : cigi::IgMode::Operate;
   sof.igFrame = igFrame_++;
   sof.lastHostFrame = ig->hostFrame;
   cigi::DatagramWriter w;
@@ -150,14 +204,14 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
   for (const auto& packet : datagram->packets)
     if (const auto* request = std::get_if<cigi::EnvironmentalConditionsRequest>(&packet))
       for (const auto& reply :
-           answerConditions(*request, state_.weather(), std::chrono::steady_clock::now(), ownship(state_)))
+           answerConditions(*request, state_.weather(), now, ownship(state_), state_.atmosphere()))
         w.add(reply);
   return w.bytes();
 }
 
 std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRequest& r, const WeatherView& view,
                                           std::chrono::steady_clock::time_point now,
-                                          const std::optional<geo::Geodetic>& camera) {
+                                          const std::optional<geo::Geodetic>& camera, const HostAtmosphere& air) {
   std::vector<cigi::Packet> out;
   // The layers (and their winds) are the same in both areas' snapshots; the
   // tiles come from the area that reaches the point.
@@ -169,15 +223,18 @@ std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRe
     const weather::PointWeather pw = weather::weatherAt(layers, lookup, r.lat_deg, r.lon_deg, r.alt_m);
     cigi::WeatherConditionsResponse wcr;
     wcr.requestId = r.requestId;
-    wcr.humidity_pct = static_cast<std::uint8_t>(pw.cloudDensity > 0 ? 100 : kClearAirHumidity_pct);
-    wcr.airTemperature_c = static_cast<float>(weather::isaTemperature_c(r.alt_m));
-    // Koschmieder: visual range 3.912 / extinction.
-    const double sigma = kExtinctionPerDensity_perm * pw.cloudDensity;
-    wcr.visibility_m = static_cast<float>(sigma > 0 ? std::min(kClearVisibility_m, 3.912 / sigma) : kClearVisibility_m);
+    wcr.humidity_pct = static_cast<std::uint8_t>(pw.cloudDensity > 0 ? 100 : air.humidity_pct);
+    // The ISA's lapse from the host's sea-level temperature and pressure.
+    wcr.airTemperature_c = static_cast<float>(weather::isaTemperature_c(r.alt_m) +
+                                              (air.seaLevelTemperature_c - kIsaSeaLevelTemperature_c));
+    // In cloud the Koschmieder range of its extinction, never longer than the clear air's.
+    const double cloud_m = render::koschmiederVisibility_m(kExtinctionPerDensity_perm * pw.cloudDensity);
+    wcr.visibility_m = static_cast<float>(std::min(air.visibility_m, cloud_m));
     wcr.horizontalWind_mps = static_cast<float>(pw.wind.speed_mps);
     wcr.verticalWind_mps = static_cast<float>(pw.wind.vertical_mps);
     wcr.windDirection_deg = static_cast<float>(pw.wind.fromDirection_deg);
-    wcr.pressure_hpa = static_cast<float>(weather::isaPressure_hpa(r.alt_m));
+    wcr.pressure_hpa =
+        static_cast<float>(weather::isaPressure_hpa(r.alt_m) * air.seaLevelPressure_hpa / kIsaSeaLevelPressure_hpa);
     out.push_back(wcr);
   }
   if (r.requestType & cigi::kRequestAerosol) {

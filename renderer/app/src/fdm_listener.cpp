@@ -12,6 +12,10 @@ namespace asio = boost::asio;
 namespace {
 constexpr double kMetresPerFoot = 0.3048;  // international foot, exact
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+// A steady instant as the FlightGear clock's host time line, s.
+double secondsOf(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(t.time_since_epoch()).count();
+}
 }  // namespace
 
 PoseSample poseSampleFrom(const fgfdm::NetFdm& fdm, SteadyTime receivedAt) {
@@ -40,6 +44,11 @@ void FdmListener::start() { receive(); }
 void FdmListener::stop() {
   boost::system::error_code ec;
   socket_.close(ec);
+}
+
+HostAtmosphere FdmListener::atmosphere() const {
+  std::lock_guard lock(mutex_);
+  return atmosphere_;
 }
 
 std::uint64_t FdmListener::outliersDropped() const {
@@ -76,6 +85,9 @@ void FdmListener::handleDatagram(std::span<const std::uint8_t> bytes, std::chron
   }
   if (!firstAt_) firstAt_ = now;
   newestAt_ = now;
+  clock_.advanceTo(secondsOf(now));
+  clock_.set(double(fdm->curTime_unix) + fdm->warp_s, 1.0, TimeSource::FlightGear);
+  atmosphere_ = withFlightGearVisibility(atmosphere_, fdm->visibility_m);
   ++accepted_;
 }
 
@@ -89,6 +101,8 @@ std::optional<HostPose> FdmListener::poseAt(std::chrono::steady_clock::time_poin
   p.hostTime_s = std::chrono::duration<double>(smoothed->renderTime - *firstAt_).count();
   p.sequence = ++sequence_;
   p.receivedAt = *newestAt_;
+  p.utc_s = clock_.utcAt(secondsOf(smoothed->renderTime));
+  p.timeSource = clock_.source();
   return p;
 }
 

@@ -18,6 +18,8 @@ constexpr double kGravity_mps2 = 9.80665;
 // Successive fixes closer in time than this give no rates (a burst of two):
 // the last rates are kept. 0.2 s.
 constexpr double kMinRateBaseline_s = 0.2;
+
+double secondsOf(SteadyTime t) { return std::chrono::duration<double>(t.time_since_epoch()).count(); }
 }  // namespace
 
 PoseSmootherConfig foreflightSmoothing() {
@@ -78,8 +80,8 @@ std::optional<PoseSample> ForeFlightTrack::take(const foreflight::Message& messa
 }
 
 ForeFlightListener::ForeFlightListener(asio::io_context& io, const std::string& address, unsigned short port,
-                                       PoseSmootherConfig smoothing)
-    : socket_(io), smoother_(smoothing) {
+                                       std::optional<double> startUtc_s, PoseSmootherConfig smoothing)
+    : socket_(io), smoother_(smoothing), clock_(startUtc_s) {
   const asio::ip::udp::endpoint ep(asio::ip::make_address(address), port);
   socket_.open(ep.protocol());
   socket_.bind(ep);
@@ -135,6 +137,7 @@ void ForeFlightListener::handleDatagram(std::span<const std::uint8_t> bytes, Ste
     }
     if (!firstAt_) firstAt_ = now;
     newestAt_ = now;
+    clock_.advanceTo(secondsOf(now));
     ++accepted_;
   }
 }
@@ -149,6 +152,8 @@ std::optional<HostPose> ForeFlightListener::poseAt(SteadyTime now) {
   p.hostTime_s = std::chrono::duration<double>(smoothed->renderTime - *firstAt_).count();
   p.sequence = ++sequence_;
   p.receivedAt = *newestAt_;
+  p.utc_s = clock_.utcAt(secondsOf(smoothed->renderTime));
+  p.timeSource = clock_.source();
   return p;
 }
 

@@ -97,6 +97,16 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
       {"cpu_ms", r.cpu_ms},
   };
   if (r.utc_s) line["utc_s"] = *r.utc_s;
+  line["utc_source"] = toString(r.utcSource);
+  line["moon_azimuth_deg"] = r.moonAzimuth_deg;
+  line["moon_elevation_deg"] = r.moonElevation_deg;
+  const HostAtmosphere& a = r.atmosphere;
+  line["atmosphere"] = {{"source", toString(a.source)},
+                        {"visibility_m", a.visibility_m},
+                        {"humidity_pct", a.humidity_pct},
+                        {"sea_level_temperature_c", a.seaLevelTemperature_c},
+                        {"sea_level_pressure_hpa", a.seaLevelPressure_hpa},
+                        {"haze_visibility_m", r.visibility_m ? nlohmann::json(*r.visibility_m) : nlohmann::json()}};
   nlohmann::json gpu = nlohmann::json::object();
   for (const auto& t : r.gpu) gpu[t.pass] = gpu.value(t.pass, 0.0) + t.gpu_ms;
   line["gpu_ms"] = gpu;

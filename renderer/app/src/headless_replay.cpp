@@ -247,6 +247,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     record.host.hostFrame = static_cast<std::uint32_t>(i);
     record.host.hostTime_s = t - first_s;
     record.source = "replay";
+    record.utcSource = sunFromDate ? TimeSource::FlightFile : TimeSource::Fixed;
     record.weatherClock_s = in.weatherClock_s;
     record.weatherVersion = view.version;
     record.weatherConnected = view.connected;

@@ -81,6 +81,7 @@ struct Options {
   double replayWeatherClock_s = std::numeric_limits<double>::quiet_NaN();
   bool noVideo = false;
   bool fixedSun = false;
+  std::string utc;  // --utc: the time of day at the host's first datagram
   std::string weatherFile;
   std::string channel;  // name in the operator console; empty: render@<host>
 };
@@ -159,6 +160,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--sun-azimuth", o.sunAzimuth_deg, "deg from true north");
   app.add_option("--sun-elevation", o.sunElevation_deg, "deg above the horizon");
+  app.add_option("--utc", o.utc,
+                 "YYYY-MM-DDTHH:MM:SSZ: the time of day (sun and moon by ephemeris) from the host's first datagram "
+                 "on, advanced by the host's time, until a CIGI Celestial Sphere Control sets one (FlightGear "
+                 "always sends its own). Without it and without a host time: the --sun-azimuth/--sun-elevation angles");
   app.add_option("--max-frames", o.maxFrames, "stop after this many frames (0 = no limit)");
   app.add_option("--idle-exit", o.idleExit_s,
                  "stop when no pose (CIGI or FDM) arrived for this many seconds after the first (0 = never)");
@@ -221,6 +226,15 @@ int main(int argc, char** argv) {
       return 2;
     }
     cigiHost = *parsed;
+  }
+  std::optional<double> startUtc_s;
+  if (!o.utc.empty()) {
+    startUtc_s = sky::app::parseUtc(o.utc.c_str());
+    if (!startUtc_s) {
+      std::fprintf(stderr, "skyshell-render: --utc '%s' is not YYYY-MM-DDTHH:MM:SSZ of years 1900-2100\n",
+                   shown(o.utc).c_str());
+      return 2;
+    }
   }
 
   // Windowed only: the metadata is written, the images are not.
@@ -327,6 +341,7 @@ int main(int argc, char** argv) {
                  o.cigiPort, e.what());
     return 2;
   }
+  if (startUtc_s) cigi->setStartUtc(*startUtc_s);
   cigi->start();
   // With --fdm-port the camera comes from FlightGear only; the CIGI endpoint
   // stays open (and answers Start of Frame) but its pose is not used.
@@ -338,7 +353,7 @@ int main(int argc, char** argv) {
   }
   if (o.foreflightPort >= 0) {
     try {
-      foreflight.emplace(io, o.foreflightAddress, static_cast<unsigned short>(o.foreflightPort));
+      foreflight.emplace(io, o.foreflightAddress, static_cast<unsigned short>(o.foreflightPort), startUtc_s);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "skyshell-render: cannot listen for ForeFlight on %s:%d: %s\n",
                    shown(o.foreflightAddress).c_str(), o.foreflightPort, e.what());
@@ -397,7 +412,7 @@ int main(int argc, char** argv) {
                 foreflight->port());
   std::fflush(stdout);
 
-  std::uint64_t frames = 0, lastSequence = 0, droppedWarnedAt = 0;
+  std::uint64_t frames = 0, lastSequence = 0, droppedWarnedAt = 0, resetsSeen = 0;
   sky::app::AreaTracker areas;
   const auto start = Clock::now();
   auto lastReport = start;
@@ -442,6 +457,11 @@ int main(int argc, char** argv) {
     lastSequence = pose->sequence;
     nextFdmFrameAt = now + fdmFramePeriod;
     const sky::app::WeatherView& view = fallback.view(weatherSource, streamed);
+    if (const auto resets = state.resets(); resets != resetsSeen) {
+      resetsSeen = resets;
+      (*renderer)->resetHistory("IG reset by the host");
+    }
+    const auto atmosphere = fdm ? fdm->atmosphere() : state.atmosphere();
 
     std::vector<std::uint32_t> dropped;
     const auto drawable = sky::app::drawableWeather(view.snapshot, sky::render::kMaxLayers, &dropped);
@@ -459,6 +479,8 @@ int main(int argc, char** argv) {
     in.weatherClock_s = view.clockNow(now);
     in.sunAzimuth_deg = o.sunAzimuth_deg;
     in.sunElevation_deg = o.sunElevation_deg;
+    in.utc_s = pose->utc_s;
+    in.visibility_m = atmosphere.hazeVisibility_m();
     in.frameIndex = frames;
     sky::app::FrameRecord record;
     auto image = sky::app::timedRender(**renderer, in, record);
@@ -471,6 +493,8 @@ int main(int argc, char** argv) {
     record.frame = frames;
     record.host = *pose;
     record.source = fdm ? "fdm" : foreflight ? "foreflight" : "cigi";
+    record.utcSource = pose->timeSource;
+    record.atmosphere = atmosphere;
     record.weatherClock_s = in.weatherClock_s;
     record.weatherVersion = view.version;
     record.weatherConnected = streamed.connected;
@@ -502,21 +526,23 @@ int main(int argc, char** argv) {
     if (after - lastReport > std::chrono::seconds(1)) {
       lastReport = after;
       const double elapsed = std::chrono::duration<double>(after - start).count();
-      std::printf("render: %llu frames, %.1f frames/s, last %.0f ms, host frame %u, CIGI dropped %llu%s\n",
+      std::printf("render: %llu frames, %.1f frames/s, last %.0f ms, host frame %u, CIGI dropped %llu, "
+                  "ignored packets %llu%s\n",
                   static_cast<unsigned long long>(frames), frames / elapsed, record.render_ms,
                   pose->hostFrame, static_cast<unsigned long long>(cigi->datagramsDropped()),
+                  static_cast<unsigned long long>(cigi->ignored().total()),
                   fdm ? (", FlightGear FDM dropped " + std::to_string(fdm->datagramsDropped())).c_str() : "");
       std::fflush(stdout);
     }
     if (o.maxFrames > 0 && frames >= o.maxFrames) break;
   }
   const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-  std::printf("render: wrote %llu frames to %s in %.1f s; CIGI datagrams accepted %llu, dropped %llu (%s); "
-              "weather frames dropped %llu\n",
+  std::printf("render: wrote %llu frames to %s in %.1f s; CIGI datagrams accepted %llu, dropped %llu (%s), "
+              "ignored packets by id: %s; weather frames dropped %llu\n",
               static_cast<unsigned long long>(frames), o.outDir.c_str(), elapsed,
               static_cast<unsigned long long>(cigi->datagramsAccepted()),
               static_cast<unsigned long long>(cigi->datagramsDropped()), cigi->drops().summary().c_str(),
-              static_cast<unsigned long long>(weather.malformedFrames()));
+              cigi->ignoredSummary().c_str(), static_cast<unsigned long long>(weather.malformedFrames()));
   if (fdm)
     std::printf("render: FlightGear FDM datagrams accepted %llu, dropped %llu (%s), outliers discarded %llu\n",
                 static_cast<unsigned long long>(fdm->datagramsAccepted()),

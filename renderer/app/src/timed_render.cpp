@@ -33,13 +33,19 @@ Result<render::Image> timedRender(render::CloudRenderer& renderer, const render:
   // frame has a date, else the given angles.
   if (in.utc_s) {
     const auto sun = render::sunDirection(*in.utc_s, in.camera.position.lat_deg, in.camera.position.lon_deg);
+    const auto moon = render::moonDirection(*in.utc_s, in.camera.position.lat_deg, in.camera.position.lon_deg);
     record.sunAzimuth_deg = sun.azimuth_deg;
     record.sunElevation_deg = sun.elevation_deg;
+    record.moonAzimuth_deg = moon.azimuth_deg;
+    record.moonElevation_deg = moon.elevation_deg;
     record.utc_s = in.utc_s;
   } else {
     record.sunAzimuth_deg = in.sunAzimuth_deg;
     record.sunElevation_deg = in.sunElevation_deg;
+    record.moonAzimuth_deg = in.moonAzimuth_deg;
+    record.moonElevation_deg = in.moonElevation_deg;
   }
+  record.visibility_m = in.visibility_m;
   return image;
 }
 

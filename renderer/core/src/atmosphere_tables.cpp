@@ -11,6 +11,7 @@
 #include <glm/gtc/packing.hpp>
 
 #include "sky/core/assert.hpp"
+#include "sky/render/haze.hpp"
 #include "sky_light_grid.hpp"
 
 namespace sky::render {
@@ -69,6 +70,12 @@ glm::dvec3 AtmosphereTable::sample(const glm::dvec2& uv) const {
 }
 
 double atmosphereHeight_m() { return AirCore::kAtmosphereHeight_m; }
+double aerosolExcessForVisibility(double visibility_m) {
+  return AirCore(nullptr).aerosolExcessForVisibility(visibility_m);
+}
+double koschmiederVisibility_m(double extinction_perm) {
+  return extinction_perm > 0 ? AirCore::kKoschmiederDepth / extinction_perm : AirCore::kFarAway_m;
+}
 
 namespace {
 

@@ -240,6 +240,8 @@ const TemporalReport& CloudRenderer::lastTemporal() const { return impl_->tempor
 
 const WeatherMapReport& CloudRenderer::lastWeatherMap() const { return impl_->weather.lastUpdate(); }
 
+void CloudRenderer::resetHistory(const std::string& reason) { impl_->planner.forget(reason); }
+
 std::vector<std::string> CloudRenderer::takeValidationMessages() { return impl_->ctx->takeValidationMessages(); }
 
 ValidationCounts CloudRenderer::validationCounts() { return impl_->ctx->validationCounts(); }

@@ -64,6 +64,7 @@ class CpuCore {
     f.air.sunDir = setup_.sunDir;
     f.air.sunIrradiance = setup_.sunIrradiance;
     f.air.airSteps = int(setup_.march.airSteps);
+    f.air.aerosolExcess = setup_.aerosolExcess;
     f.groundIrradiance = setup_.groundIrradiance;
     f.march = MarchParams{int(setup_.march.primarySteps), int(setup_.march.lightSteps), setup_.march.minTransmittance,
                           double(setup_.march.emptyStride), setup_.march.cloudStep_m, setup_.march.emptyStep_m,

@@ -9,6 +9,7 @@
 
 #include "sky/core/assert.hpp"
 #include "sky/render/ephemeris.hpp"
+#include "sky/render/haze.hpp"
 #include "sky/weather/advection.hpp"
 #include "sky_light_grid.hpp"
 
@@ -193,8 +194,10 @@ Result<void> validateInputs(const FrameInputs& in) {
   const auto& p = c.position;
   for (double v : {p.lat_deg, p.lon_deg, p.alt_m, c.yaw_deg, c.pitch_deg, c.roll_deg, in.weatherClock_s,
                    in.sunAzimuth_deg, in.sunElevation_deg, in.utc_s.value_or(0.0), in.moonAzimuth_deg,
-                   in.moonElevation_deg, in.moonPhaseAngle_deg})
+                   in.moonElevation_deg, in.moonPhaseAngle_deg, in.visibility_m.value_or(1.0)})
     if (!std::isfinite(v)) return fail(ErrorCode::InvalidArgument, "frame inputs: non-finite value");
+  if (in.visibility_m && !(*in.visibility_m > 0))
+    return fail(ErrorCode::InvalidArgument, "frame inputs: visibility_m " + num(*in.visibility_m) + " is not > 0");
   if (in.moonPhaseAngle_deg < 0 || in.moonPhaseAngle_deg > 180)
     return fail(ErrorCode::InvalidArgument,
                 "frame inputs: moonPhaseAngle_deg " + num(in.moonPhaseAngle_deg) + " outside [0, 180]");
@@ -284,6 +287,8 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
       s.moonLit = true;
     }
   }
+
+  if (in.visibility_m) s.aerosolExcess = aerosolExcessForVisibility(*in.visibility_m);
 
   if (in.weather == nullptr) return s;
   const double sinceSnapshot_s = in.weatherClock_s - in.weather->weatherClock_s;
@@ -378,7 +383,7 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
                              float(s.march.minTransmittance), float(s.march.emptyStride));
   f.weatherRings = gpu::vec4(float(1.0 / (2 * s.coarseHalfExtent_m)), float(kRingBlendStart), float(kRingBlendEnd), 0.0f);
   f.earth = gpu::vec4(float(s.r_m), float(s.hGround_m), float(s.cGround_m2), float(s.cAtmosphereTop_m2));
-  f.sunDir = v4(s.sunDir);
+  f.sunDir = v4(s.sunDir, s.aerosolExcess);
   f.sunIrradiance = v4(s.sunIrradiance);
   f.groundIrradiance = v4(s.groundIrradiance);
 

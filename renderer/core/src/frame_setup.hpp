@@ -78,6 +78,9 @@ struct FrameSetup {
   glm::dvec3 sunDir{0, 0, 1};
   glm::dvec3 sunIrradiance{0};     // at the top of the atmosphere, linear units
   bool moonLit = false;
+  // The view ray's aerosol beyond the standard profile (AirFrame::aerosolExcess):
+  // from FrameInputs::visibility_m, 0 without it.
+  double aerosolExcess = 0;
   glm::dvec3 groundIrradiance{0};  // sky irradiance on the ground, linear units
   std::vector<LayerSetup> layers;
   MarchSettings march;  // the march's cost knobs, as set

@@ -87,7 +87,7 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
 
   TemporalPlan plan;
   const std::uint32_t n = settings_.interleave;
-  const std::string reason = previous_ ? resetReason(*previous_, now) : std::string("first frame");
+  const std::string reason = previous_ ? resetReason(*previous_, now) : forgottenBecause_;
   plan.drawWhole = !reason.empty();
   plan.reason = reason;
   plan.interleave = plan.drawWhole ? 1 : n;

@@ -52,8 +52,12 @@ class TemporalPlanner {
   // Plans the frame with this setup (inputs: its clock and weather) and
   // remembers it as the previous frame for the next call.
   TemporalPlan plan(const FrameSetup& setup, const FrameInputs& inputs);
-  // Forgets the previous frame (after a frame that failed on the GPU).
-  void forget() { previous_.reset(); }
+  // Forgets the previous frame (after a frame that failed on the GPU, or on
+  // a host's reset): the next frame is drawn whole, for `reason`.
+  void forget(std::string reason = "first frame") {
+    previous_.reset();
+    forgottenBecause_ = std::move(reason);
+  }
 
  private:
   struct Remembered {
@@ -71,6 +75,7 @@ class TemporalPlanner {
 
   TemporalSettings settings_;
   std::optional<Remembered> previous_;
+  std::string forgottenBecause_ = "first frame";  // the reason of a frame without previous_
   std::uint64_t frames_ = 0;  // frames planned: the place in the interleave cycle
 };
 

@@ -87,7 +87,7 @@ WeatherControl goldenWeather() {
 
 void expectGoldenFrame1(const Datagram& d) {
   ASSERT_EQ(d.packets.size(), 3u);
-  EXPECT_EQ(d.skippedPackets, 0u);
+  EXPECT_TRUE(d.skippedIds.empty());
   EXPECT_EQ(std::get<WeatherControl>(d.packets[2]), goldenWeather());
   const auto& ig = std::get<IgControl>(d.packets[0]);
   EXPECT_EQ(ig.databaseNumber, 5);
@@ -260,7 +260,36 @@ TEST(Cigi, SkipsUserDefinedPacketsBySize) {
   bytes.insert(bytes.end(), user.begin(), user.end());
   auto r = decodeDatagram(bytes);
   ASSERT_TRUE(r);
-  EXPECT_EQ(r->skippedPackets, 1u);
+  ASSERT_EQ(r->skippedIds.size(), 1u);
+  EXPECT_EQ(r->skippedIds[0], 201);
+  EXPECT_STREQ(packetIdName(201), "user-defined");
+}
+
+// Host packets we do not decode (Component Control 4, 32 bytes; Rate Control
+// 8, 32 bytes; Short Articulated Part Control 7, 24 bytes) are skipped by
+// their size byte and reported by id, in both byte orders, and the packets
+// after them are still decoded.
+TEST(Cigi, SkipsUndecodedHostPacketsByIdInBothOrders) {
+  for (const ByteOrder order : {ByteOrder::Big, ByteOrder::Little}) {
+    auto bytes = DatagramWriter(order).add(IgControl{}).bytes();
+    for (const auto& [id, size] : {std::pair<std::uint8_t, std::uint8_t>{4, 32}, {8, 32}, {7, 24}}) {
+      std::vector<std::uint8_t> packet(size, 0x5a);
+      packet[0] = id;
+      packet[1] = size;
+      bytes.insert(bytes.end(), packet.begin(), packet.end());
+    }
+    const auto tail = DatagramWriter(order).add(IgControl{}).add(EntityControl{}).bytes();
+    bytes.insert(bytes.end(), tail.begin() + 24, tail.end());
+    const auto r = decodeDatagram(bytes);
+    ASSERT_TRUE(r) << r.error().detail;
+    EXPECT_EQ(r->skippedIds, (std::vector<std::uint8_t>{4, 8, 7}));
+    ASSERT_EQ(r->packets.size(), 2u);
+    EXPECT_TRUE(std::holds_alternative<EntityControl>(r->packets[1]));
+  }
+  EXPECT_STREQ(packetIdName(4), "Component Control");
+  EXPECT_STREQ(packetIdName(8), "Rate Control");
+  EXPECT_STREQ(packetIdName(117), "Image Generator Message");
+  EXPECT_EQ(packetId(Packet(AtmosphereControl{})), 10);
 }
 
 }  // namespace

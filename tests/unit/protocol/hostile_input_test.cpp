@@ -35,7 +35,7 @@ TEST(CigiHostile, SizeBytesZeroOneAndPastTheEndAreMalformedAtEveryPacket) {
   auto decoded = cigi::decodeDatagram(good);
   ASSERT_TRUE(decoded) << decoded.error().detail;
   EXPECT_EQ(decoded->packets.size(), 3u);
-  EXPECT_EQ(decoded->skippedPackets, 1u);
+  EXPECT_EQ(decoded->skippedIds.size(), 1u);
   for (const std::size_t packetAt : {std::size_t{0}, std::size_t{24}, std::size_t{72}, std::size_t{80}}) {
     const std::size_t pastEnd = good.size() - packetAt + 1;
     for (const std::size_t size : {std::size_t{0}, std::size_t{1}, pastEnd, std::size_t{255}}) {

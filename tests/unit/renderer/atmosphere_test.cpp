@@ -21,6 +21,7 @@
 #include "frame_setup.hpp"
 #include "sky_light_grid.hpp"
 #include "sky/render/ephemeris.hpp"
+#include "sky/render/haze.hpp"
 #include "weather_field.hpp"
 
 namespace sky::render {
@@ -496,6 +497,40 @@ TEST(Atmosphere, TheMoonIsTheKeyLightOnAMoonlitNight) {
   auto bad = validateInputs(in);
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.error().detail.find("moonPhaseAngle_deg"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sky::render
+
+namespace sky::render {
+namespace {
+
+// A host's visibility V (issue 19) as the view ray's haze: a horizontal ray
+// from the ground, through the march the shader runs, keeps Koschmieder's 2 %
+// contrast threshold (transmittance e^-3.912 in green) at distance V, less
+// what the curved Earth takes: a horizontal ray rises t^2 / 2R, on average
+// V^2 / 6R over [0, V], where the aerosol (scale height 1.2 km) is thinner
+// by that over 1.2 km, so the optical depth falls short by at most
+// 3.912 V^2 / (6 R 1200) (0.034 at 20 km; measured 0.032; 0.0002 at 5 km,
+// measured 0.002), plus 0.003 for the 64-step march.
+TEST(Atmosphere, HostVisibilityIsTheKoschmiederRangeOfTheViewRay) {
+  Air air(&tables());
+  for (const double visibility_m : {500.0, 5000.0, 20000.0}) {
+    Air::AirFrame a = groundCamera(0, 40);
+    a.aerosolExcess = aerosolExcessForVisibility(visibility_m);
+    a.airSteps = 64;
+    const glm::dvec3 t = sky(air, a, glm::dvec3(0, 1, 0), visibility_m).transmittance[0];
+    std::printf("[ haze     ] visibility %.0f m: aerosol excess %.1f, green transmittance at that range %.5f "
+                "(Koschmieder 0.02000)\n",
+                visibility_m, a.aerosolExcess, t.g);
+    const double curvature = 3.912 * visibility_m * visibility_m / (6 * kEarth_m * 1200.0);
+    EXPECT_GE(std::log(t.g / 0.02), -0.003);
+    EXPECT_LE(std::log(t.g / 0.02), curvature + 0.003);
+  }
+  // The standard aerosol's own range, and past it pure Rayleigh air.
+  EXPECT_NEAR(aerosolExcessForVisibility(3.912 / (13.558e-6 + 4.40e-6)), 0.0, 1e-9);
+  EXPECT_DOUBLE_EQ(aerosolExcessForVisibility(1e7), -1.0);
+  EXPECT_DOUBLE_EQ(koschmiederVisibility_m(0.01), 391.2);
 }
 
 }  // namespace

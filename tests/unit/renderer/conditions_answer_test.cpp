@@ -104,3 +104,43 @@ TEST(ConditionsAnswer, FarPointsFromTheCoarseArea) {
 
 }  // namespace
 }  // namespace sky::app
+
+namespace sky::app {
+namespace {
+
+// With the host's Atmosphere Control (issue 19): clear air has its
+// humidity and visibility, temperature and pressure lapse from its sea-level
+// values by the ISA; in cloud humidity is 100 % and the visibility the
+// cloud's Koschmieder range, never longer than the host's clear air.
+TEST(ConditionsAnswer, TheHostsAtmosphereInClearAirAndInCloud) {
+  const WeatherView v = viewWithOneLayer();
+  cigi::AtmosphereControl control;
+  control.humidity_pct = 85;
+  control.airTemperature_c = 25;
+  control.visibility_m = 3000;
+  control.pressure_hpa = 1000;
+  const HostAtmosphere air = atmosphereFrom(control);
+  cigi::EnvironmentalConditionsRequest r;
+  r.requestType = cigi::kRequestWeather;
+  r.alt_m = 500;  // clear air under the layer
+  auto replies = answerConditions(r, v, std::chrono::steady_clock::now(), std::nullopt, air);
+  ASSERT_EQ(replies.size(), 1u);
+  auto w = std::get<cigi::WeatherConditionsResponse>(replies[0]);
+  EXPECT_EQ(w.humidity_pct, 85);
+  EXPECT_FLOAT_EQ(w.visibility_m, 3000.0f);
+  EXPECT_FLOAT_EQ(w.airTemperature_c, 21.75f);  // 25 - 6.5 x 0.5
+  // ISA at 500 m is 954.61 hPa; x 1000 / 1013.25.
+  EXPECT_NEAR(w.pressure_hpa, 954.61f * 1000.0f / 1013.25f, 0.05f);
+  r.alt_m = 2000;  // inside the layer, density 0.6: 130.4 m, shorter than 3 km
+  replies = answerConditions(r, v, std::chrono::steady_clock::now(), std::nullopt, air);
+  w = std::get<cigi::WeatherConditionsResponse>(replies[0]);
+  EXPECT_EQ(w.humidity_pct, 100);
+  EXPECT_NEAR(w.visibility_m, 130.4f, 0.1f);
+  // A host visibility shorter than the cloud's (fog of 100 m) wins in cloud too.
+  control.visibility_m = 100;
+  replies = answerConditions(r, v, std::chrono::steady_clock::now(), std::nullopt, atmosphereFrom(control));
+  EXPECT_FLOAT_EQ(std::get<cigi::WeatherConditionsResponse>(replies[0]).visibility_m, 100.0f);
+}
+
+}  // namespace
+}  // namespace sky::app

@@ -1,29 +1,11 @@
 // The replay's CIGI host frames: what a simulator host sends, decoded by our
-// own (tshark-checked) CIGI reader; the UTC-to-CIGI date conversion against
-// dates computed independently (Python's datetime).
+// own (tshark-checked) CIGI reader.
 #include <gtest/gtest.h>
 
 #include "sky/sim/cigi_host.hpp"
 
 namespace sky::sim {
 namespace {
-
-TEST(CelestialAt, ConvertsUtcToCigiDateAndTime) {
-  auto c = celestialAt(0);
-  EXPECT_EQ(c.dateMmddyyyy, 1011970u);
-  EXPECT_EQ(c.hour, 0);
-  // 2026-11-21 22:21:24 UTC (the FlightGear capture's cur_time).
-  c = celestialAt(1795299684);
-  EXPECT_EQ(c.dateMmddyyyy, 11212026u);
-  EXPECT_EQ(c.hour, 22);
-  EXPECT_EQ(c.minute, 21);
-  // 2000-02-29 23:59:59: a leap day of a century year divisible by 400.
-  c = celestialAt(951782400 + 86399);
-  EXPECT_EQ(c.dateMmddyyyy, 2292000u);
-  EXPECT_EQ(c.hour, 23);
-  EXPECT_EQ(c.minute, 59);
-  EXPECT_TRUE(c.dateTimeValid);
-}
 
 TEST(CigiHost, FirstFrameCarriesViewDefinitionAndCelestial) {
   CigiHost host({cigi::ByteOrder::Little, 60, 2.0, 1795299684});

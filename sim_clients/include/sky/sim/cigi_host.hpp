@@ -22,10 +22,6 @@ struct HostOptions {
   std::optional<std::int64_t> startUtc_s;
 };
 
-// UTC seconds since 1970 -> CIGI's Celestial Sphere Control fields (hour,
-// minute, MMDDYYYY date). Proleptic Gregorian, valid for any year >= 1970.
-cigi::CelestialSphereControl celestialAt(std::int64_t utc_s);
-
 class CigiHost {
  public:
   explicit CigiHost(HostOptions options = {}) : options_(options) {}

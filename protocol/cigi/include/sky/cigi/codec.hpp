@@ -38,7 +38,10 @@ struct Datagram {
   ByteOrder order = ByteOrder::Big;
   Direction direction = Direction::HostToIg;
   std::vector<Packet> packets;     // the packets we decode, in datagram order
-  std::size_t skippedPackets = 0;  // well-sized packets of ids we do not decode (incl. user-defined 201-255)
+  // Ids of the well-sized packets we do not decode (Component Control, Rate
+  // Control, user-defined 201-255, ...), in datagram order: skipped by their
+  // size byte.
+  std::vector<std::uint8_t> skippedIds;
 };
 
 // Decodes a whole datagram, or rejects it with the packet index, byte offset
@@ -49,5 +52,10 @@ Result<Datagram> decodeDatagram(std::span<const std::uint8_t> bytes);
 
 // Packet name for logs ("Weather Control").
 const char* packetName(const Packet& packet);
+// The CIGI 3.3 name of a packet id (cigi.md §1.6), decoded or not
+// ("Component Control"); "user-defined" for 201-255, "unassigned" otherwise.
+const char* packetIdName(std::uint8_t id);
+// The id of a decoded packet.
+std::uint8_t packetId(const Packet& packet);
 
 }  // namespace sky::cigi

@@ -1,12 +1,15 @@
 // The renderer's CIGI 3.3 endpoint on UDP: takes the ownship pose from each
-// host datagram (IG Control + Entity Control for entity 0) into SharedState
-// and answers with Start of Frame, plus a Weather Conditions Response and
+// host datagram (IG Control + Entity Control for entity 0), with the time of
+// day (Celestial Sphere Control, advanced by the host's time line:
+// host_clock.hpp), the host's atmosphere (Atmosphere Control) and its IG
+// mode (Reset/Standby forgets the pose) into SharedState and answers with
+// Start of Frame (reporting that mode), plus a Weather Conditions Response and
 // Aerosol Concentration Responses for each Environmental Conditions Request.
 // It answers one host only: the one it is told (--cigi-host) or else the
 // address of the first sender of a valid host datagram (any port, so a host
 // that restarts is answered again). Malformed datagrams and datagrams
 // from any other sender are dropped unanswered, counted by reason, and
-// logged once per kind.
+// logged once per kind; packets the channel does not use are counted by id.
 #pragma once
 
 #include <array>
@@ -25,31 +28,32 @@
 
 #include "sky/app/area_of_interest.hpp"
 #include "sky/app/drop_counts.hpp"
+#include "sky/app/host_atmosphere.hpp"
+#include "sky/app/host_clock.hpp"
 #include "sky/app/shared_state.hpp"
 #include "sky/cigi/codec.hpp"
 
 namespace sky::app {
 
-// What the weather model has no field for, in a Weather Conditions Response:
-// humidity outside cloud (50 %; 100 % in cloud), visibility in clear air
-// (50 km; in cloud the Koschmieder range of its extinction).
-inline constexpr int kClearAirHumidity_pct = 50;
-inline constexpr double kClearVisibility_m = 50000.0;
 // Extinction per unit cloud density, 1/m: the renderer's (cloud_core.glsl).
 inline constexpr double kExtinctionPerDensity_perm = 0.05;
 // Liquid water of cloud at density 1, g/m^3 (cumulus 0.3-1, formulas.md).
 inline constexpr double kCloudLiquidWater_gpm3 = 0.5;
 
-// The replies to one Environmental Conditions Request from the weather held:
-// wind, temperature and pressure (standard atmosphere), humidity and
-// visibility at the point (weather bit); each cloud layer 1-3's liquid water
-// there (aerosol bit). Pure: the clock comes in as `now`. A point farther
-// than kDetailedReach_m from `camera` (the ownship the areas of interest
-// follow) is answered from the coarse area's tiles when the view has them:
-// the detailed area does not reach it.
+// The replies to one Environmental Conditions Request from the weather held
+// and the host's atmosphere: wind (the layers'), temperature and pressure
+// (the atmosphere's sea-level values lapsed by the ISA to the point),
+// humidity and visibility at the point (in cloud 100 % and the Koschmieder
+// range of its extinction, at most the clear air's; in clear air the
+// atmosphere's) (weather bit); each cloud layer 1-3's liquid water there
+// (aerosol bit). Pure: the clock comes in as `now`. A point farther than
+// kDetailedReach_m from `camera` (the ownship the areas of interest follow)
+// is answered from the coarse area's tiles when the view has them: the
+// detailed area does not reach it.
 std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRequest& request,
                                           const WeatherView& view, std::chrono::steady_clock::time_point now,
-                                          const std::optional<geo::Geodetic>& camera = std::nullopt);
+                                          const std::optional<geo::Geodetic>& camera = std::nullopt,
+                                          const HostAtmosphere& atmosphere = {});
 
 // How far from the camera the detailed area always reaches: its radius less
 // the distance the camera goes before it is asked again (area_of_interest.hpp).
@@ -81,6 +85,9 @@ class CigiListener {
   void start();
   void stop();
   unsigned short port() const { return port_; }
+  // --utc: the time of day at the host's first datagram, until a Celestial
+  // Sphere Control sets one. Call before start().
+  void setStartUtc(double utc_s) { clock_ = HostClock(utc_s); }
 
   // Takes one datagram from `from`: the pose into SharedState when it comes
   // from the host, and the reply to send back to `from` (empty: none, the
@@ -93,12 +100,19 @@ class CigiListener {
   std::uint64_t datagramsAccepted() const { return accepted_.load(); }
   std::uint64_t datagramsDropped() const { return drops_.total(); }
   const DropCounts& drops() const { return drops_; }
+  // Packets of accepted datagrams the channel does not use, by id.
+  const IgnoredPackets& ignored() const { return ignored_; }
+  // "Component Control (4) 3, Rate Control (8) 1"; "none".
+  std::string ignoredSummary() const;
+  // Whether the host holds this IG in Reset/Standby (IG Control's mode).
+  bool standby() const { return standby_.load(); }
   // The host this port answers, once known. Thread-safe.
   std::optional<CigiHost> host() const;
 
  private:
   void receive();
   void dropped(DropReason reason, const std::string& detail);
+  void ignore(std::uint8_t id);
 
   boost::asio::ip::udp::socket socket_;
   boost::asio::ip::udp::endpoint from_;
@@ -109,6 +123,11 @@ class CigiListener {
   std::atomic<std::uint64_t> accepted_{0};
   DropCounts drops_;
   std::set<std::string> loggedReasons_;  // io thread only
+  IgnoredPackets ignored_;
+  std::set<std::uint8_t> loggedIgnored_;  // io thread only
+  std::atomic<bool> standby_{false};
+  HostTimeline timeline_;  // io thread only
+  HostClock clock_;        // io thread only
   mutable std::mutex hostMutex_;         // guards host_ (written by the io thread, read by any)
   std::optional<CigiHost> host_;
 };

@@ -82,4 +82,21 @@ class DropCounts {
   std::array<std::atomic<std::uint64_t>, static_cast<std::size_t>(DropReason::Count_)> counts_{};
 };
 
+// Packets a host sent that a channel accepts and does not use (Component
+// Control, Rate Control, articulated parts, entities other than the
+// ownship, user-defined packets, ...), counted by packet id: never an error.
+class IgnoredPackets {
+ public:
+  void add(std::uint8_t id) { counts_[id].fetch_add(1, std::memory_order_relaxed); }
+  std::uint64_t of(std::uint8_t id) const { return counts_[id].load(std::memory_order_relaxed); }
+  std::uint64_t total() const {
+    std::uint64_t n = 0;
+    for (const auto& c : counts_) n += c.load(std::memory_order_relaxed);
+    return n;
+  }
+
+ private:
+  std::array<std::atomic<std::uint64_t>, 256> counts_{};
+};
+
 }  // namespace sky::app

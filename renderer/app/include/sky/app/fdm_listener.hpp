@@ -1,6 +1,8 @@
 // The renderer's FlightGear endpoint on UDP: decodes each --native-fdm
 // datagram (FGNetFDM v24) into a pose sample for a PoseSmoother, which the
-// render loop asks for the camera at its render time. The second way a
+// render loop asks for the camera at its render time, and into the time of
+// day (cur_time + warp, so the sun matches FlightGear's sky) and the
+// visibility (the haze). The second way a
 // simulator drives a channel, besides CIGI. Malformed datagrams (a wrong
 // size or version, a non-finite or absurd field) and poses the smoother
 // cannot take are dropped, counted by reason, and logged once per kind; the
@@ -21,6 +23,8 @@
 #include <boost/asio.hpp>
 
 #include "sky/app/drop_counts.hpp"
+#include "sky/app/host_atmosphere.hpp"
+#include "sky/app/host_clock.hpp"
 #include "sky/app/pose_smoother.hpp"
 #include "sky/app/shared_state.hpp"
 #include "sky/fgfdm/net_fdm.hpp"
@@ -45,7 +49,8 @@ class FdmListener {
   // The smoothed camera for a frame rendered at `now`, as a HostPose:
   // hostTime_s = render time in seconds since the first accepted datagram
   // arrived, hostFrame = datagrams accepted so far, receivedAt = arrival of
-  // the newest one, sequence increments with every call that returns a pose.
+  // the newest one, sequence increments with every call that returns a pose,
+  // utc_s = FlightGear's cur_time + warp at the render time (source FlightGear).
   // nullopt until a position is confirmed (see PoseSmoother). Thread-safe.
   std::optional<HostPose> poseAt(std::chrono::steady_clock::time_point now);
 
@@ -58,6 +63,9 @@ class FdmListener {
   std::uint64_t datagramsDropped() const { return drops_.total(); }
   const DropCounts& drops() const { return drops_; }
   std::uint64_t outliersDropped() const;
+  // The newest datagram's visibility as the channel's atmosphere (source
+  // FlightGear); the default one before any. Thread-safe.
+  HostAtmosphere atmosphere() const;
 
  private:
   void receive();
@@ -75,6 +83,10 @@ class FdmListener {
   PoseSmoother smoother_;
   std::optional<std::chrono::steady_clock::time_point> firstAt_, newestAt_;
   std::uint64_t sequence_ = 0;
+  // FlightGear's simulated time, cur_time + warp (whole seconds), advanced
+  // between datagrams by their arrival times (host_clock.hpp).
+  HostClock clock_;
+  HostAtmosphere atmosphere_;
 };
 
 }  // namespace sky::app

@@ -28,6 +28,7 @@
 #include <boost/asio.hpp>
 
 #include "sky/app/drop_counts.hpp"
+#include "sky/app/host_clock.hpp"
 #include "sky/app/pose_smoother.hpp"
 #include "sky/app/shared_state.hpp"
 #include "sky/foreflight/foreflight.hpp"
@@ -68,8 +69,11 @@ class ForeFlightTrack {
 
 class ForeFlightListener {
  public:
-  // Binds to address:port (port 0 = ephemeral; see port()).
+  // Binds to address:port (port 0 = ephemeral; see port()). The format
+  // carries no time of day: startUtc_s (--utc) is the time at the first
+  // line, advanced in real time; none: the fixed sun.
   ForeFlightListener(boost::asio::io_context& io, const std::string& address, unsigned short port,
+                     std::optional<double> startUtc_s = std::nullopt,
                      PoseSmootherConfig smoothing = foreflightSmoothing());
 
   void start();
@@ -106,6 +110,7 @@ class ForeFlightListener {
 
   mutable std::mutex mutex_;  // guards the members below
   PoseSmoother smoother_;
+  HostClock clock_;
   std::optional<SteadyTime> firstAt_, newestAt_;
   std::uint64_t sequence_ = 0;
 };

@@ -2,7 +2,7 @@
 // (linear radiance, cloud transmittance, cloud depth) per frame, optionally
 // PFMs, and one JSON line of metadata per frame in frames.jsonl, the frames'
 // sidecar: camera pose and its source, host frame, weather clock and version,
-// the sun, the settings in use (preset, resolution, field of view, noise
+// the time of day and its source, the sun and the moon, the atmosphere, the settings in use (preset, resolution, field of view, noise
 // seeds), GPU time per pass, image statistics, and the files written.
 #pragma once
 
@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "sky/app/host_atmosphere.hpp"
+#include "sky/app/host_clock.hpp"
 #include "sky/app/shared_state.hpp"
 #include "sky/core/result.hpp"
 #include "sky/render/cloud_renderer.hpp"
@@ -53,8 +55,12 @@ struct FrameRecord {
     std::size_t tiles = 0;
   };
   std::vector<Area> weatherAreas;
-  double sunAzimuth_deg = 0, sunElevation_deg = 0;  // the sun the frame was lit by, local ENU
-  std::optional<double> utc_s;                      // when the sun came from the date (s since 1970)
+  double sunAzimuth_deg = 0, sunElevation_deg = 0;    // the sun the frame was lit by, local ENU
+  double moonAzimuth_deg = 0, moonElevation_deg = -90;  // the moon, local ENU
+  std::optional<double> utc_s;                        // when the sun came from the date (s since 1970)
+  TimeSource utcSource = TimeSource::Fixed;           // where utc_s came from ("fixed": the --sun angles)
+  HostAtmosphere atmosphere;                          // the host's atmosphere in force
+  std::optional<double> visibility_m;                 // the haze drawn (FrameInputs::visibility_m)
   render::ImageStats stats;
   double render_ms = 0;     // wall time of CloudRenderer::render
   double cpu_ms = 0;        // process CPU time during it (all threads: lavapipe's workers too)

@@ -1,5 +1,6 @@
 // What the network side of a renderer channel hands to its render loop: the
-// latest ownship pose from the host and the latest weather from the server.
+// latest ownship pose from the host (with its time of day), the host's
+// atmosphere, and the latest weather from the server.
 // Written by the io thread, read by the render loop; guarded by one mutex.
 #pragma once
 
@@ -9,6 +10,8 @@
 #include <optional>
 #include <string>
 
+#include "sky/app/host_atmosphere.hpp"
+#include "sky/app/host_clock.hpp"
 #include "sky/geo/geodetic.hpp"
 #include "sky/weather/clock.hpp"
 #include "sky/weather/model.hpp"
@@ -21,6 +24,10 @@ struct HostPose {
   double hostTime_s = 0;  // CIGI IG Control timestamp, s (0 when not valid)
   std::uint64_t sequence = 0;  // increments with every pose received
   std::chrono::steady_clock::time_point receivedAt;
+  // The time of day at this pose (s since 1970) and where it came from
+  // (host_clock.hpp); none: the fixed --sun angles light the frame.
+  std::optional<double> utc_s;
+  TimeSource timeSource = TimeSource::Fixed;
 };
 
 struct WeatherView {
@@ -43,12 +50,35 @@ class SharedState {
   void setPose(const HostPose& p) {
     std::lock_guard lock(mutex_);
     HostPose next = p;
-    next.sequence = pose_ ? pose_->sequence + 1 : 1;
+    next.sequence = (pose_ ? pose_->sequence : lastSequence_) + 1;
     pose_ = next;
   }
   std::optional<HostPose> pose() const {
     std::lock_guard lock(mutex_);
     return pose_;
+  }
+  // The host put the IG in Reset/Standby: forgets the pose (no frame is
+  // drawn until the next one) and counts a reset, after which the render
+  // loop drops the renderer's temporal history.
+  void resetChannel() {
+    std::lock_guard lock(mutex_);
+    if (pose_) lastSequence_ = pose_->sequence;
+    pose_.reset();
+    ++resets_;
+  }
+  std::uint64_t resets() const {
+    std::lock_guard lock(mutex_);
+    return resets_;
+  }
+
+  // The host's global atmosphere (Atmosphere Control), latest wins.
+  void setAtmosphere(const HostAtmosphere& a) {
+    std::lock_guard lock(mutex_);
+    atmosphere_ = a;
+  }
+  HostAtmosphere atmosphere() const {
+    std::lock_guard lock(mutex_);
+    return atmosphere_;
   }
 
   // Takes the snapshot of its area (WeatherSnapshot::areaIndex: 0 detailed,
@@ -110,6 +140,9 @@ class SharedState {
  private:
   mutable std::mutex mutex_;
   std::optional<HostPose> pose_;
+  std::uint64_t lastSequence_ = 0;  // of the pose a reset forgot: sequences never repeat
+  std::uint64_t resets_ = 0;
+  HostAtmosphere atmosphere_;
   WeatherView weather_;
   bool detailedSeen_ = false;  // a Snapshot of area 0 has arrived
 };

@@ -1,7 +1,7 @@
 // One frame through the renderer with what the metadata says about it: wall
 // time, process CPU time (lavapipe runs the GPU work on CPU threads, so wall
 // time alone doubles when another process takes a core), GPU time per pass,
-// and the sun the frame was lit by.
+// and the sun and moon the frame was lit by.
 #pragma once
 
 #include "sky/app/frame_writer.hpp"
@@ -10,7 +10,7 @@
 namespace sky::app {
 
 // Renders `in` and, on success, fills record's render_ms, cpu_ms, gpu, stats
-// and sun fields.
+// and sun, moon and haze fields.
 Result<render::Image> timedRender(render::CloudRenderer& renderer, const render::FrameInputs& in, FrameRecord& record);
 
 // CPU time of the whole process (every thread), ms.

@@ -163,6 +163,11 @@ struct FrameInputs {
   // angle, 0 full to 180 new. The clouds are lit by one key light: the sun,
   // or the moon when it lights the ground more (frame_setup.cpp).
   double moonAzimuth_deg = 0, moonElevation_deg = -90, moonPhaseAngle_deg = 180;
+  // Sea-level visibility of the clear air (m, > 0), from a host (CIGI
+  // Atmosphere Control, FlightGear): the haze of the view ray's air,
+  // Koschmieder's range at 550 nm (haze.hpp). nullopt: the standard aerosol
+  // (Bruneton 2017's profile, 218 km).
+  std::optional<double> visibility_m;
   std::uint64_t frameIndex = 0;  // the caller's frame number, for its metadata; the image does not depend on it
 };
 
@@ -240,6 +245,9 @@ class CloudRenderer {
   const TemporalReport& lastTemporal() const;
   // What the weather map's update did for the last render().
   const WeatherMapReport& lastWeatherMap() const;
+  // Drops the temporal history: the next render() is drawn whole, with
+  // `reason` in its TemporalReport (a host's IG reset).
+  void resetHistory(const std::string& reason);
 
   // Validation messages since the last call, and the totals (nothing
   // without GpuOptions::validation).
