@@ -79,6 +79,7 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   now.forward = setup.camForward;
   now.right = setup.camRight;
   now.down = setup.camDown;
+  now.frustum = setup.frustum;
   now.keyLightEcef = setup.localToEcef * setup.sunDir;
   now.moonLit = setup.moonLit;
   now.clock_s = inputs.weatherClock_s;
@@ -110,8 +111,10 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
 
   gpu::SkyReproject& p = plan.params;
   p.camForward = v4(setup.camForward);
-  p.camRight = v4(setup.camRight, setup.tanHalfFov);
-  p.camDown = v4(setup.camDown, setup.aspect);
+  p.camRight = v4(setup.camRight);
+  p.camDown = v4(setup.camDown);
+  p.frustum = gpu::vec4(setup.frustum);
+  p.prevFrustum = p.frustum;
   p.image = gpu::uvec4(setup.width, setup.height, plan.interleave, plan.drawWhole ? 0u : 1u);
   p.raster = gpu::vec4(float(setup.rasterWidth), float(setup.rasterHeight), 0.0f, 0.0f);
   const std::uint32_t packedW = (setup.width + plan.interleave - 1) / plan.interleave;
@@ -128,6 +131,7 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
     p.prevForward = v4(prevToLocal * prev.forward);
     p.prevRight = v4(prevToLocal * prev.right);
     p.prevDown = v4(prevToLocal * prev.down);
+    p.prevFrustum = gpu::vec4(prev.frustum);
     p.prevPosition = v4(toLocal * (prev.cameraEcef_m - setup.cameraEcef_m), setup.r_m);
     const double step_s = now.clock_s - prev.clock_s;
     SKY_ASSERT(setup.layers.size() <= gpu::kReprojectMaxLayers);

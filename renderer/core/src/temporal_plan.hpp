@@ -60,6 +60,7 @@ class TemporalPlanner {
     glm::dvec3 cameraEcef_m{0};
     glm::dmat3 localToEcef{1};
     glm::dvec3 forward{0}, right{0}, down{0};  // local frame of that frame
+    glm::dvec4 frustum{0};                     // FrameSetup::frustum
     glm::dvec3 keyLightEcef{0};
     bool moonLit = false;
     double clock_s = 0;
