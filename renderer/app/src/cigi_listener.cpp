@@ -127,6 +127,10 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
   }
   ++accepted_;
   for (const auto& packet : datagram->packets) {
+    if (const auto* definition = std::get_if<cigi::ViewDefinition>(&packet)) takeView(*definition, "View Definition");
+    if (const auto* control = std::get_if<cigi::ViewControl>(&packet)) takeView(*control, "View Control");
+  }
+  for (const auto& packet : datagram->packets) {
     const auto* entity = std::get_if<cigi::EntityControl>(&packet);
     if (!entity || entity->entityId != 0 || entity->attached) continue;
     HostPose p;
@@ -136,6 +140,7 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
     p.pose.roll_deg = entity->roll_deg;
     p.hostFrame = ig->hostFrame;
     p.hostTime_s = ig->timestampValid ? ig->timestamp_10us * 1.0e-5 : 0.0;
+    p.hostTimeValid = ig->timestampValid;
     p.receivedAt = std::chrono::steady_clock::now();
     state_.setPose(p);
   }
@@ -153,6 +158,27 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
            answerConditions(*request, state_.weather(), std::chrono::steady_clock::now(), ownship(state_)))
         w.add(reply);
   return w.bytes();
+}
+
+template <class ViewPacket>
+void CigiListener::takeView(const ViewPacket& packet, const char* name) {
+  const ViewUpdate u = state_.applyView(packet);
+  switch (u.outcome) {
+    case ViewPacketOutcome::OtherView: otherViewPackets_.fetch_add(1, std::memory_order_relaxed); return;
+    case ViewPacketOutcome::Rejected:
+      // The packet only: the rest of its datagram (the pose) still counts.
+      drops_.add(DropReason::OutOfRange);
+      if (loggedReasons_.insert(dropKind(DropReason::OutOfRange, u.detail)).second)
+        spdlog::warn("CIGI: ignored a {} ({}) (further ones of this kind are only counted)", name, u.detail);
+      return;
+    case ViewPacketOutcome::Applied:
+      for (const auto& part : u.unsupported) {
+        unsupportedViewParts_.fetch_add(1, std::memory_order_relaxed);
+        if (loggedReasons_.insert("view: " + part).second)
+          spdlog::warn("CIGI: {} for this channel's view asks for {}: not supported, counted", name, part);
+      }
+      return;
+  }
 }
 
 std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRequest& r, const WeatherView& view,

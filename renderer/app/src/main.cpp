@@ -27,6 +27,8 @@
 #include "sky/app/frame_writer.hpp"
 #include "sky/app/glfw_window.hpp"
 #include "sky/app/headless_replay.hpp"
+#include "sky/app/host_clock.hpp"
+#include "sky/app/view_state.hpp"
 #include "sky/render/presets.hpp"
 #include "sky/app/timed_render.hpp"
 #include "sky/app/weather_client.hpp"
@@ -61,6 +63,7 @@ struct Options {
   bool noExr = false;
   unsigned width = 320, height = 180;
   double fov_deg = 60;
+  unsigned viewId = 0;
   std::string preset = sky::app::kDefaultPreset;
   double sunAzimuth_deg = 135, sunElevation_deg = 40;
   std::uint64_t maxFrames = 0;
@@ -140,7 +143,15 @@ int main(int argc, char** argv) {
                "headless: skip the per-frame EXR (linear radiance, cloud transmittance, cloud depth)");
   app.add_option("--width", o.width)->check(CLI::Range(16, 8192));
   app.add_option("--height", o.height)->check(CLI::Range(16, 8192));
-  app.add_option("--fov", o.fov_deg, "vertical field of view, deg")->check(CLI::Range(1.0, 170.0));
+  app.add_option("--fov", o.fov_deg,
+                 "vertical field of view, deg (symmetric; a View Definition for --view-id replaces the half-angles "
+                 "it enables)")
+      ->check(CLI::Range(1.0, 170.0));
+  app.add_option("--view-id", o.viewId,
+                 "the CIGI view this channel draws: View Definition (frustum) and View Control (eyepoint offset and "
+                 "rotation on the ownship) for this view id are applied, those for other views ignored (counted)")
+      ->check(CLI::Range(0, 65535))
+      ->capture_default_str();
   app.add_option("--preset", o.preset,
                  "quality preset: reference, high, medium, low, realtime (README.md, \"Quality presets\")")
       ->capture_default_str();
@@ -285,6 +296,12 @@ int main(int argc, char** argv) {
   }
 
   sky::app::SharedState state;
+  {
+    sky::app::ChannelView initial;
+    initial.viewId = static_cast<std::uint16_t>(o.viewId);
+    initial.frustum = sky::render::symmetricFrustum((*renderer)->settings());
+    state.setView(initial);
+  }
   asio::io_context io;
   auto guard = asio::make_work_guard(io);
   std::atomic<bool> stopRequested{false};
@@ -355,6 +372,7 @@ int main(int argc, char** argv) {
   const auto fdmFramePeriod = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(1.0 / o.fdmFrameRate_hz));
   Clock::time_point nextFdmFrameAt{};
+  sky::app::HostLockedClock hostClock;
   int exitCode = 0;
   while (!stopRequested) {
     if (fdm && Clock::now() < nextFdmFrameAt) std::this_thread::sleep_until(nextFdmFrameAt);
@@ -404,11 +422,21 @@ int main(int argc, char** argv) {
     }
     const auto coarse =
         view.coarse ? std::optional(sky::app::drawableCoarse(*view.coarse, drawable)) : std::nullopt;
+    const sky::app::ChannelView channelView = state.view();
     sky::render::FrameInputs in;
-    in.camera = pose->pose;
+    in.camera = sky::app::viewCamera(pose->pose, channelView);
+    in.frustum = channelView.frustum;
     in.weather = &drawable;
     in.coarseWeather = coarse ? &*coarse : nullptr;
-    in.weatherClock_s = view.clockNow(now);
+    // CIGI frames: the clock and the interleave pattern follow the host
+    // frame, so every channel draws a host frame alike (host_clock.hpp).
+    if (fdm) {
+      in.weatherClock_s = view.clockNow(now);
+    } else {
+      in.weatherClock_s = hostClock.at(pose->hostTimeValid ? std::optional(pose->hostTime_s) : std::nullopt,
+                                       view.clock, pose->receivedAt);
+      in.patternIndex = pose->hostFrame;
+    }
     in.sunAzimuth_deg = o.sunAzimuth_deg;
     in.sunElevation_deg = o.sunElevation_deg;
     in.frameIndex = frames;
@@ -420,8 +448,10 @@ int main(int argc, char** argv) {
       exitCode = 3;
       break;
     }
+    sky::app::mirrorImage(*image, channelView.mirror);
     record.frame = frames;
     record.host = *pose;
+    record.view = sky::app::FrameRecord::View{channelView, in.camera};
     record.source = fdm ? "fdm" : "cigi";
     record.weatherClock_s = in.weatherClock_s;
     record.weatherVersion = view.version;
@@ -442,7 +472,7 @@ int main(int argc, char** argv) {
         if (pass.pass == "present") record.gpu.push_back(pass);
     }
     sky::app::logValidationMessages(**renderer);
-    weather.reportCamera(pose->pose, frames, view.version, in.weatherClock_s);
+    weather.reportCamera(in.camera, frames, view.version, in.weatherClock_s);
     if (auto ok = writer->write(*image, record); !ok) {
       std::fprintf(stderr, "skyshell-render: %s\n", sky::describe(ok.error()).c_str());
       exitCode = 2;
@@ -468,6 +498,12 @@ int main(int argc, char** argv) {
               static_cast<unsigned long long>(cigi->datagramsAccepted()),
               static_cast<unsigned long long>(cigi->datagramsDropped()), cigi->drops().summary().c_str(),
               static_cast<unsigned long long>(weather.malformedFrames()));
+  std::printf("render: view %u: %llu View Definition and %llu View Control applied, %llu packets for other views "
+              "ignored, %llu unsupported parts\n",
+              o.viewId, static_cast<unsigned long long>(state.view().definitions),
+              static_cast<unsigned long long>(state.view().controls),
+              static_cast<unsigned long long>(cigi->otherViewPackets()),
+              static_cast<unsigned long long>(cigi->unsupportedViewParts()));
   if (fdm)
     std::printf("render: FlightGear FDM datagrams accepted %llu, dropped %llu (%s), outliers discarded %llu\n",
                 static_cast<unsigned long long>(fdm->datagramsAccepted()),

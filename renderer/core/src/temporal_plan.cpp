@@ -92,12 +92,13 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   plan.drawWhole = !reason.empty();
   plan.reason = reason;
   plan.interleave = plan.drawWhole ? 1 : n;
-  plan.phase = plan.drawWhole ? glm::uvec2(0) : interleavePhase(n, std::uint32_t(frames_ % (n * n)));
+  const std::uint64_t index = inputs.patternIndex.value_or(frames_);
+  plan.phase = plan.drawWhole ? glm::uvec2(0) : interleavePhase(n, std::uint32_t(index % (n * n)));
   // With accumulation each cycle of n^2 frames shifts the step offsets by
   // the golden ratio: the additive recurrence spreads any number of
   // consecutive cycles' offsets evenly over [0, 1).
   if (settings_.accumulation > 0) {
-    const double cycle = double(frames_ / (std::uint64_t(n) * n));
+    const double cycle = double(index / (std::uint64_t(n) * n));
     plan.jitterShift = cycle * kGoldenRatioConjugate - std::floor(cycle * kGoldenRatioConjugate);
     // Roberts' R2 sequence (the plastic number's generalised golden ratio):
     // consecutive cycles' 2D shifts cover the pixel evenly.

@@ -72,7 +72,7 @@ class TemporalPlanner {
 
   TemporalSettings settings_;
   std::optional<Remembered> previous_;
-  std::uint64_t frames_ = 0;  // frames planned: the place in the interleave cycle
+  std::uint64_t frames_ = 0;  // frames planned: the place in the interleave cycle (without patternIndex)
 };
 
 }  // namespace sky::render

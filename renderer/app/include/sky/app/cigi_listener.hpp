@@ -1,5 +1,8 @@
 // The renderer's CIGI 3.3 endpoint on UDP: takes the ownship pose from each
-// host datagram (IG Control + Entity Control for entity 0) into SharedState
+// host datagram (IG Control + Entity Control for entity 0) and the View
+// Definition and View Control of this channel's view into SharedState (other
+// views' are ignored and counted; one that would give no valid view is
+// dropped and counted as out of range, the rest of its datagram kept)
 // and answers with Start of Frame, plus a Weather Conditions Response and
 // Aerosol Concentration Responses for each Environmental Conditions Request.
 // It answers one host only: the one it is told (--cigi-host) or else the
@@ -93,12 +96,18 @@ class CigiListener {
   std::uint64_t datagramsAccepted() const { return accepted_.load(); }
   std::uint64_t datagramsDropped() const { return drops_.total(); }
   const DropCounts& drops() const { return drops_; }
+  // View packets for other channels' views, ignored; parts of this view's
+  // View Definitions not drawn (orthographic, pixel replication). Thread-safe.
+  std::uint64_t otherViewPackets() const { return otherViewPackets_.load(); }
+  std::uint64_t unsupportedViewParts() const { return unsupportedViewParts_.load(); }
   // The host this port answers, once known. Thread-safe.
   std::optional<CigiHost> host() const;
 
  private:
   void receive();
   void dropped(DropReason reason, const std::string& detail);
+  template <class ViewPacket>
+  void takeView(const ViewPacket& packet, const char* name);
 
   boost::asio::ip::udp::socket socket_;
   boost::asio::ip::udp::endpoint from_;
@@ -107,6 +116,7 @@ class CigiListener {
   unsigned short port_ = 0;
   std::uint32_t igFrame_ = 0;  // io thread only
   std::atomic<std::uint64_t> accepted_{0};
+  std::atomic<std::uint64_t> otherViewPackets_{0}, unsupportedViewParts_{0};
   DropCounts drops_;
   std::set<std::string> loggedReasons_;  // io thread only
   mutable std::mutex hostMutex_;         // guards host_ (written by the io thread, read by any)

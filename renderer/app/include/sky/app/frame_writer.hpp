@@ -59,6 +59,14 @@ struct FrameRecord {
   render::TemporalReport temporal;    // what the reprojection did (interleaved presets)
   render::WeatherMapReport weatherMap;  // what this frame changed in the weather map (per tile, or rebuilt and why)
   std::optional<bool> presented;      // windowed: whether the frame reached the window
+  // The channel's view (CIGI View Definition / View Control) and the camera
+  // it gave: the ownship pose (host) with the eyepoint composed on. Unset
+  // where the camera is the pose itself (--replay).
+  struct View {
+    ChannelView view;
+    geo::GeodeticPose camera;
+  };
+  std::optional<View> view;
 };
 
 class FrameWriter {

@@ -1,5 +1,6 @@
 // What the network side of a renderer channel hands to its render loop: the
-// latest ownship pose from the host and the latest weather from the server.
+// latest ownship pose from the host, the latest state of the channel's view
+// (View Definition, View Control) and the latest weather from the server.
 // Written by the io thread, read by the render loop; guarded by one mutex.
 #pragma once
 
@@ -9,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "sky/app/view_state.hpp"
 #include "sky/geo/geodetic.hpp"
 #include "sky/weather/clock.hpp"
 #include "sky/weather/model.hpp"
@@ -19,6 +21,7 @@ struct HostPose {
   geo::GeodeticPose pose;
   std::uint32_t hostFrame = 0;
   double hostTime_s = 0;  // CIGI IG Control timestamp, s (0 when not valid)
+  bool hostTimeValid = false;  // the host marked its timestamp valid
   std::uint64_t sequence = 0;  // increments with every pose received
   std::chrono::steady_clock::time_point receivedAt;
 };
@@ -49,6 +52,23 @@ class SharedState {
   std::optional<HostPose> pose() const {
     std::lock_guard lock(mutex_);
     return pose_;
+  }
+
+  // The view this channel draws; main sets its id and the command line's
+  // frustum before the listener starts.
+  void setView(const ChannelView& v) {
+    std::lock_guard lock(mutex_);
+    view_ = v;
+  }
+  ChannelView view() const {
+    std::lock_guard lock(mutex_);
+    return view_;
+  }
+  // Applies a View Definition or View Control (applyViewPacket) to the view held.
+  template <class ViewPacket>
+  ViewUpdate applyView(const ViewPacket& packet) {
+    std::lock_guard lock(mutex_);
+    return applyViewPacket(view_, packet);
   }
 
   // Takes the snapshot of its area (WeatherSnapshot::areaIndex: 0 detailed,
@@ -110,6 +130,7 @@ class SharedState {
  private:
   mutable std::mutex mutex_;
   std::optional<HostPose> pose_;
+  ChannelView view_;
   WeatherView weather_;
   bool detailedSeen_ = false;  // a Snapshot of area 0 has arrived
 };

@@ -183,6 +183,11 @@ struct FrameInputs {
   // This frame's view frustum (a channel's View Definition); unset: the
   // settings' symmetric one (symmetricFrustum).
   std::optional<ViewFrustum> frustum;
+  // The frame's place in the interleave and accumulation cycles
+  // (TemporalSettings): channels of one display that draw the same host
+  // frame pass its number, so they draw the same pixels of each block with
+  // the same offsets. Unset: the frames this renderer has planned so far.
+  std::optional<std::uint64_t> patternIndex;
   std::uint64_t frameIndex = 0;  // the caller's frame number, for its metadata; the image does not depend on it
 };
 
