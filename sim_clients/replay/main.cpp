@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 64));
   app.add_option("--channel-width-deg", o.channelWidth_deg,
                  "horizontal field of view of each channel, deg; channel i looks (i - (N-1)/2) x W right of the nose")
-      ->check(CLI::Range(0.0, 178.0));
+      ->check(CLI::Range(0.0, 176.0));  // half-angles within the renderer's +-89 deg
   app.add_option("--channel-aspect", o.aspect,
                  "width / height of each channel (the vertical half-angles: atan(tan(W/2) / aspect))")
       ->check(CLI::Range(0.05, 20.0));
