@@ -191,26 +191,44 @@ void writeContactSheet(const DisplayRun& run, const std::array<nlohmann::json, k
 
 void checkDisplay(const std::string& name, double sunAzimuth_deg, double sunElevation_deg) {
   const DisplayRun run = runDisplay(name, sunAzimuth_deg, sunElevation_deg);
-  ASSERT_GE(run.frames.size(), 3u) << "too few host frames drawn by all three channels in " << run.dir;
+  ASSERT_GE(run.frames.size(), 4u) << "too few host frames drawn by all three channels in " << run.dir;
 
   // The angular width of one pixel at the image centre, where pixels are
   // widest in angle (tangent spacing): the bound for rays "a pixel apart".
   const double pixel_deg = std::atan(2 * std::tan(kChannelWidth_deg / 2 / kRadToDeg) / kWidth) * kRadToDeg;
   double worstEdge_deg = 0, worstCentres_deg = 0, worstRatio = 0, worstExcess = -1;
   std::size_t checked = 0;
+  std::size_t startUp = 0;
+  double arrivalSpread_s = 0, lockedOff_s = 0;  // the host clock lock's inputs and result
   for (const auto& [host, trio] : run.frames) {
     SCOPED_TRACE("host frame " + std::to_string(host));
+    bool settled = true;
     for (int i = 0; i < kChannels; ++i) {
       EXPECT_EQ(trio[i]["view"]["id"], i);
       EXPECT_TRUE(trio[i]["view"]["frustum_from_host"].get<bool>());
       EXPECT_NEAR(trio[i]["view"]["rotation_deg"]["yaw"].get<double>(), (i - 1) * kChannelWidth_deg, 1e-4);
       EXPECT_NEAR(trio[i]["fov_deg"]["horizontal"].get<double>(), kChannelWidth_deg, 1e-4);
-      // One shared picture: the same weather (version), clock and seeds.
-      EXPECT_EQ(trio[i]["weather_version"], trio[0]["weather_version"]);
+      // One shared picture: the same clock (host_clock.hpp) and seeds.
       EXPECT_EQ(trio[i]["weather_clock_s"], trio[0]["weather_clock_s"]);
       EXPECT_EQ(trio[i]["noise_seeds"], trio[0]["noise_seeds"]);
       EXPECT_EQ(trio[i]["host_time_s"], trio[0]["host_time_s"]);
+      settled = settled && trio[i]["weather_areas"].size() == 2;
+      // The server's clock at each channel's arrival of the frame: their
+      // spread is what the lock's grid must absorb (host_clock.hpp).
+      const double server_s = trio[i]["weather_clock_server_s"].get<double>();
+      arrivalSpread_s = std::max(arrivalSpread_s, std::abs(server_s - trio[0]["weather_clock_server_s"].get<double>()));
+      lockedOff_s = std::max(lockedOff_s, std::abs(trio[i]["weather_clock_s"].get<double>() - server_s));
     }
+    // A channel subscribes at its first pose and draws once the detailed
+    // area has come; the coarse area comes a moment later, so a channel may
+    // draw its first frame a version behind the others. Frames from when
+    // every channel holds both areas on must agree on the version and are
+    // the ones compared below.
+    if (!settled) {
+      ++startUp;
+      continue;
+    }
+    for (int i = 0; i < kChannels; ++i) EXPECT_EQ(trio[i]["weather_version"], trio[0]["weather_version"]);
     for (int i = 0; i + 1 < kChannels; ++i) {
       const auto &left = trio[i], &right = trio[i + 1];
       // Geometry from the metadata: the left channel's right edge is the
@@ -238,9 +256,14 @@ void checkDisplay(const std::string& name, double sunAzimuth_deg, double sunElev
     }
     ++checked;
   }
-  std::printf("[ seams    ] %s: %zu host frames; edge rays %.2e deg apart, centre rays at most %.4f deg apart "
+  EXPECT_GE(checked, 3u) << startUp << " host frames of start-up";
+  std::printf("[ clock    ] %s: the server's clock at the channels' arrivals of a host frame %.2f ms apart at most; "
+              "the locked clock within %.3f s of it\n",
+              name.c_str(), 1e3 * arrivalSpread_s, lockedOff_s);
+  EXPECT_LE(lockedOff_s, 0.5 * 1.0 + 0.05);  // half kHostClockGrid_s (1 s), plus the arrival spread
+  std::printf("[ seams    ] %s: %zu host frames (and %zu of start-up); edge rays %.2e deg apart, centre rays at most %.4f deg apart "
               "(a centre pixel: %.4f deg); colour step across a seam at most %.2f x its neighbours'\n",
-              name.c_str(), checked, worstEdge_deg, worstCentres_deg, pixel_deg, worstRatio);
+              name.c_str(), checked, startUp, worstEdge_deg, worstCentres_deg, pixel_deg, worstRatio);
   // Half-angles travel as CIGI floats and the pose through double geodesy:
   // the edges agree to float's 1e-7 relative (6e-6 deg); 1e-4 deg is 0.0002 px.
   EXPECT_LT(worstEdge_deg, 1e-4);

@@ -125,6 +125,7 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
       {"cpu_ms", r.cpu_ms},
   };
   if (r.utc_s) line["utc_s"] = *r.utc_s;
+  if (r.serverClockAtArrival_s) line["weather_clock_server_s"] = *r.serverClockAtArrival_s;
   if (r.view) line.update(viewJson(*r.view));
   nlohmann::json gpu = nlohmann::json::object();
   for (const auto& t : r.gpu) gpu[t.pass] = gpu.value(t.pass, 0.0) + t.gpu_ms;

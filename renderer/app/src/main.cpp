@@ -454,6 +454,7 @@ int main(int argc, char** argv) {
     record.view = sky::app::FrameRecord::View{channelView, in.camera};
     record.source = fdm ? "fdm" : "cigi";
     record.weatherClock_s = in.weatherClock_s;
+    if (!fdm) record.serverClockAtArrival_s = view.clock.at(pose->receivedAt);
     record.weatherVersion = view.version;
     record.weatherConnected = view.connected;
     record.layerCount = view.snapshot.layers.size();

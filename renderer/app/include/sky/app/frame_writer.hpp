@@ -40,6 +40,10 @@ struct FrameRecord {
   HostPose host;
   std::string source = "cigi";  // where the camera came from: "cigi", "fdm" (FlightGear) or "replay"
   double weatherClock_s = 0;
+  // CIGI frames: the server's weather clock as this channel held it when the
+  // host frame arrived; weatherClock_s is locked to the host's time instead
+  // (host_clock.hpp), and the two differ by at most half its grid.
+  std::optional<double> serverClockAtArrival_s;
   std::uint64_t weatherVersion = 0;  // this channel's count of weather updates applied (snapshots, deltas)
   bool weatherConnected = false;     // the stream to the server was up when the frame was drawn
   std::size_t layerCount = 0;

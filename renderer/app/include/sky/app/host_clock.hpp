@@ -18,11 +18,11 @@ namespace sky::app {
 
 // The grid the offset snaps to, in wall seconds of the server's clock (times
 // its rate in weather seconds). 1 s: channels' estimates differ by their
-// arrival spread, measured under 5 ms on loopback with three channels
-// (tests/integration/three_channel_test.cpp), so they snap to different
-// points only when one lies within that spread of a grid line (under 0.5 %
-// of starts); the price is a frame's clock up to 0.5 s from the server's,
-// 5 m of cloud drift at 10 m/s wind, far below a cloud's size.
+// arrival spread, measured 1.5-1.7 ms on loopback with three channels
+// (tests/integration/three_channel_test.cpp prints it), so they snap to
+// different points only when one lies within that spread of a grid line
+// (about 0.2 % of starts); the price is a frame's clock up to 0.5 s from the
+// server's, 5 m of cloud drift at 10 m/s wind, far below a cloud's size.
 inline constexpr double kHostClockGrid_s = 1.0;
 // The offset is estimated anew each frame and kept until the estimate moves
 // more than this many grid steps from it: the server's clock was set, or the
