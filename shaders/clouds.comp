@@ -186,8 +186,8 @@ void main() {
     vec2 noise = vec2(blueNoise[tileIndex], blueNoise[q.y * kBlueNoiseSize + q.x]);
     at += fract(noise + frame.pixelJitter.xy) - 0.5;
   }
-  vec3 dir = cameraRay(frame.camForward.xyz, frame.camRight.xyz, frame.camDown.xyz, frame.camRight.w,
-                       frame.camDown.w, at.x, at.y, frame.raster.x, frame.raster.y);
+  vec3 dir = cameraRay(frame.camForward.xyz, frame.camRight.xyz, frame.camDown.xyz, frame.frustum, at.x, at.y,
+                       frame.raster.x, frame.raster.y);
   float jitter = frame.steps.w > 0.5 ? blueNoise[tileIndex] : pixelJitter(px.x, px.y);
   jitter = fract(jitter + frame.raster.z);
   PixelResult r = shadePixel(f, dir, jitter);

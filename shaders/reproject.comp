@@ -46,7 +46,8 @@ uvec2 gPhase;  // this frame's drawn pixel in each block
 vec3 gForward, gRight, gDown;              // this camera
 vec3 gPrevForward, gPrevRight, gPrevDown;  // the previous camera
 vec3 gPrevPosition;
-float gRadius, gTanHalf, gAspect;
+float gRadius;
+vec4 gFrustum, gPrevFrustum;  // this frame's and the previous frame's view frusta
 float gRelTolerance, gAbsTolerance, gBandMargin;
 float gAccumulation;  // the history's share of a redrawn pixel
 uint gLayers;
@@ -120,9 +121,8 @@ bool previousPixel(vec3 dir, float d, out vec2 p, out float expected) {
   }
   float z = dot(v, gPrevForward);
   if (z <= 0.0) return false;
-  float sx = dot(v, gPrevRight) / z;
-  float sy = -dot(v, gPrevDown) / z;
-  p = vec2((sx / (gTanHalf * gAspect) + 1.0) * 0.5 * gRaster.x, (1.0 - sy / gTanHalf) * 0.5 * gRaster.y);
+  vec2 s = vec2(dot(v, gPrevRight), -dot(v, gPrevDown)) / z;
+  p = frustumPixel(gPrevFrustum, s, gRaster.x, gRaster.y);
   return true;
 }
 
@@ -202,7 +202,7 @@ float nearestDrawnDepth(ivec2 px) {
 // depth the history holds there. `depth` becomes the reused pixel's depth
 // (reusedDepth).
 uint reuseHistory(ivec2 px, out vec4 colour, inout float depth) {
-  vec3 dir = cameraRay(gForward, gRight, gDown, gTanHalf, gAspect, float(px.x), float(px.y), gRaster.x, gRaster.y);
+  vec3 dir = cameraRay(gForward, gRight, gDown, gFrustum, float(px.x), float(px.y), gRaster.x, gRaster.y);
   // First guess of the pixel's cloud depth: its own block's drawn pixel's
   // (upscale's nearest); then what the history holds where that leads.
   vec2 p;
@@ -259,8 +259,8 @@ void main() {
   gForward = params.camForward.xyz;
   gRight = params.camRight.xyz;
   gDown = params.camDown.xyz;
-  gTanHalf = params.camRight.w;
-  gAspect = params.camDown.w;
+  gFrustum = params.frustum;
+  gPrevFrustum = params.prevFrustum;
   gPrevForward = params.prevForward.xyz;
   gPrevRight = params.prevRight.xyz;
   gPrevDown = params.prevDown.xyz;
@@ -274,7 +274,7 @@ void main() {
     gBand[l] = params.layerBand[l];
     gMotion[l] = params.layerMotion[l].xyz;
   }
-  gStill = gPrevPosition == vec3(0.0) && gPrevForward == gForward && gPrevRight == gRight && gPrevDown == gDown;
+  gStill = gPrevPosition == vec3(0.0) && gPrevFrustum == gFrustum && gPrevForward == gForward && gPrevRight == gRight && gPrevDown == gDown;
   for (uint l = 0u; l < kReprojectMaxLayers; ++l) gStill = gStill && (l >= gLayers || gMotion[l] == vec3(0.0));
   ivec2 px = ivec2(gl_GlobalInvocationID.xy);
   if (px.x < int(gSize.x) && px.y < int(gSize.y)) {

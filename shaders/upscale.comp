@@ -35,13 +35,14 @@ layout(std430, set = 0, binding = kUpscaleBindingOutDepth) writeonly buffer OutD
 
 // The block's numbers, read once (storage loads are gathers on lavapipe).
 vec3 gForward, gRight, gDown;
-float gTanHalf, gAspect, gRadius, gGroundC;
+vec4 gFrustum;
+float gRadius, gGroundC;
 vec2 gRaster;  // the small image's extent for the camera rays
 
 // Whether the ray through pixel (x, y) of a width x height image hits the
 // ground: the cloud pass's test (cloud_core.glsl, shadePixel).
 bool seesGround(vec2 px, vec2 size) {
-  vec3 dir = cameraRay(gForward, gRight, gDown, gTanHalf, gAspect, px.x, px.y, size.x, size.y);
+  vec3 dir = cameraRay(gForward, gRight, gDown, gFrustum, px.x, px.y, size.x, size.y);
   Roots ground = intersectSphere(gRadius, gGroundC, dir.z);
   return ground.hit && ground.t1 > 0.0;
 }
@@ -50,8 +51,7 @@ void main() {
   gForward = params.camForward.xyz;
   gRight = params.camRight.xyz;
   gDown = params.camDown.xyz;
-  gTanHalf = params.camRight.w;
-  gAspect = params.camDown.w;
+  gFrustum = params.frustum;
   gRadius = params.earth.x;
   gGroundC = params.earth.y;
   gRaster = params.earth.zw;

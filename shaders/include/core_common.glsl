@@ -30,13 +30,28 @@ real pixelJitter(uint px, uint py) {
   return real(hashPcg(px + hashPcg(py)) >> 8u) * kInv2Pow24;
 }
 
+// An image's view frustum as the tangents of its four edges' angles from the
+// view axis: x left, y right, z up, w down, left and down negative (CIGI 3.3
+// View Definition's half-angles, tan of each); a symmetric view of vertical
+// field of view v and aspect a is (-t a, t a, t, -t) with t = tan(v / 2).
+// The image plane at unit distance along the axis spans [x, y] to the right
+// and [w, z] up; image position (u, v) in pixels (0 at the top-left corner,
+// of a width x height image) lies at its point frustumPoint.
+real2 frustumPoint(real4 frustum, real u, real v, real width, real height) {
+  return real2(mix(frustum.x, frustum.y, u / width), mix(frustum.z, frustum.w, v / height));
+}
+
+// The inverse of frustumPoint: the image position (pixels, continuous, pixel
+// centres at +0.5) of the image-plane point s (tangents right and up).
+real2 frustumPixel(real4 frustum, real2 s, real width, real height) {
+  return real2((s.x - frustum.x) / (frustum.y - frustum.x) * width, (frustum.z - s.y) / (frustum.z - frustum.w) * height);
+}
+
 // View ray through the centre of pixel (px, py), top row first; camera axes in
-// the local frame, tanHalfFov of the vertical field of view, aspect = w / h.
-real3 cameraRay(real3 forward, real3 right, real3 down, real tanHalfFov, real aspect,
-                real px, real py, real width, real height) {
-  real sx = ((px + 0.5) / width * 2.0 - 1.0) * tanHalfFov * aspect;
-  real sy = (1.0 - (py + 0.5) / height * 2.0) * tanHalfFov;
-  return normalize(forward + right * sx - down * sy);
+// the local frame, the frustum as above.
+real3 cameraRay(real3 forward, real3 right, real3 down, real4 frustum, real px, real py, real width, real height) {
+  real2 s = frustumPoint(frustum, px + 0.5, py + 0.5, width, height);
+  return normalize(forward + right * s.x - down * s.y);
 }
 
 // Ray from a point at distance r from the centre against the sphere with

@@ -44,8 +44,8 @@ SKY_REPROJECT_CONST kReprojectMaxLayers = 4u;  // = kMaxLayers of sky_shared.h
 
 struct SkyReproject {
   vec4 camForward;   // xyz: this frame's camera axes in its local frame (x east, y north, z up)
-  vec4 camRight;     // w: tan(vertical fov / 2)
-  vec4 camDown;      // w: width / height
+  vec4 camRight;     // w: unused
+  vec4 camDown;      // w: unused
   vec4 prevForward;  // xyz: the previous frame's camera axes, in this frame's local frame
   vec4 prevRight;
   vec4 prevDown;
@@ -59,10 +59,12 @@ struct SkyReproject {
                      // (added), z: margin around a layer band its wind applies in (m), w: the history's
                      // share of a redrawn pixel (TemporalSettings::accumulation; 0: none)
   vec4 raster;       // xy: the image's extent in its pixels for the camera rays (SkyFrame::raster); zw: unused
+  vec4 frustum;      // this frame's view frustum (SkyFrame::frustum)
+  vec4 prevFrustum;  // the previous frame's, which the history was drawn with
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(SkyReproject) == 16 * (9 + 2 * kReprojectMaxLayers + 2));
+static_assert(sizeof(SkyReproject) == 16 * (9 + 2 * kReprojectMaxLayers + 4));
 static_assert(offsetof(SkyReproject, image) == 112);
 static_assert(offsetof(SkyReproject, layerBand) == 144);
 }  // namespace sky::gpu

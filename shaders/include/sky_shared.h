@@ -75,8 +75,8 @@ struct SkyLayer {
 
 struct SkyFrame {
   vec4 camForward;      // xyz: camera forward in the local frame (x east, y north, z up)
-  vec4 camRight;        // xyz: camera right; w: tan(vertical fov / 2)
-  vec4 camDown;         // xyz: camera down; w: width / height
+  vec4 camRight;        // xyz: camera right; w: unused
+  vec4 camDown;         // xyz: camera down; w: unused
   vec4 localToEcef[3];  // rows of the rotation local -> ECEF
   vec4 camToAnchor[3];  // rows of the rotation camera-local -> weather-anchor-local
   vec4 camInAnchor;     // xyz: camera relative to the anchor sphere centre, anchor frame (m);
@@ -106,6 +106,8 @@ struct SkyFrame {
                         // offset (TemporalSettings::accumulation); w: unused
   vec4 pixelJitter;     // xy: added (mod 1) to the pixel's two blue-noise values for where in the pixel
                         // its ray goes; z: 1 to jitter (TemporalSettings::pixelJitter), 0 for the centre
+  vec4 frustum;         // tangents of the view's left, right, up and down half-angles (left and down
+                        // negative; core_common.glsl, frustumPoint)
 };
 
 #ifdef __cplusplus
@@ -128,7 +130,8 @@ static_assert(offsetof(SkyFrame, weatherRings) == 272 + 256 * kMaxLayers);
 static_assert(offsetof(SkyFrame, steps) == 272 + 256 * kMaxLayers + 16);
 static_assert(offsetof(SkyFrame, interleave) == 272 + 256 * kMaxLayers + 32);
 static_assert(offsetof(SkyFrame, raster) == 272 + 256 * kMaxLayers + 48);
-static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 80);
+static_assert(offsetof(SkyFrame, frustum) == 272 + 256 * kMaxLayers + 80);
+static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 96);
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

@@ -32,17 +32,18 @@ SKY_UPSCALE_CONST kUpscaleLocalSizeY = 2u;
 
 struct SkyUpscale {
   vec4 camForward;  // xyz: camera axes in the local frame (x east, y north, z up); w: unused
-  vec4 camRight;    // w: tan(vertical fov / 2)
-  vec4 camDown;     // w: width / height (the same for both sizes)
+  vec4 camRight;    // w: unused
+  vec4 camDown;     // w: unused
   vec4 earth;       // x: camera radius r (m), y: hGround (2r - hGround) (m^2), as the cloud pass's;
                     // zw: the small image's extent for the camera rays (SkyFrame::raster)
   uvec4 size;       // x, y: the small image's width and height (the full size / divisor, rounded up);
                     // z, w: the full image's
   uvec4 mode;       // x: divisor (full / small), y: 1 depth-aware, 0 plain bilinear; zw: unused
+  vec4 frustum;     // the view frustum (SkyFrame::frustum), the same for both sizes
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(SkyUpscale) == 16 * 6);
+static_assert(sizeof(SkyUpscale) == 16 * 7);
 static_assert(offsetof(SkyUpscale, size) == 64);
 }  // namespace sky::gpu
 #endif

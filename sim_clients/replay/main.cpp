@@ -27,6 +27,19 @@ int main(int argc, char** argv) {
       ->required();
   app.add_option("--host", o.host, "IG (renderer) address");
   app.add_option("--port", o.port, "IG (renderer) CIGI UDP port")->check(CLI::Range(1, 65535));
+  app.add_option("--ig", o.igs,
+                 "an IG (renderer channel) to send every host datagram to, ADDR:PORT or [ADDR]:PORT; repeat for "
+                 "each channel of a display (replaces --host/--port; conditions requests go to the first)");
+  app.add_option("--channels", o.channels,
+                 "channels of the display, side by side: with --channel-width-deg every frame carries View "
+                 "Definition and View Control for view ids 0..N-1, left to right")
+      ->check(CLI::Range(1, 64));
+  app.add_option("--channel-width-deg", o.channelWidth_deg,
+                 "horizontal field of view of each channel, deg; channel i looks (i - (N-1)/2) x W right of the nose")
+      ->check(CLI::Range(0.0, 176.0));  // half-angles within the renderer's +-89 deg
+  app.add_option("--channel-aspect", o.aspect,
+                 "width / height of each channel (the vertical half-angles: atan(tan(W/2) / aspect))")
+      ->check(CLI::Range(0.05, 20.0));
   app.add_option("--rate", o.rate_hz, "host frames per second")->check(CLI::Range(1.0, 1000.0));
   app.add_option("--speed", o.speed, "replay speed factor")->check(CLI::Range(0.05, 100.0));
   app.add_option("--start", o.start_s, "start offset into the flight, s")->check(CLI::NonNegativeNumber);

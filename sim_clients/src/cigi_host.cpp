@@ -7,6 +7,32 @@
 
 namespace sky::sim {
 
+namespace {
+constexpr double kDegPerRad = 57.29577951308232;
+}  // namespace
+
+cigi::ViewDefinition channelViewDefinition(std::uint32_t i, double channelWidth_deg, double aspect) {
+  const double halfH_deg = channelWidth_deg / 2;
+  const double halfV_deg = std::atan(std::tan(halfH_deg / kDegPerRad) / aspect) * kDegPerRad;
+  cigi::ViewDefinition vd;
+  vd.viewId = static_cast<std::uint16_t>(i);
+  vd.leftEnable = vd.rightEnable = vd.topEnable = vd.bottomEnable = true;
+  vd.left_deg = static_cast<float>(-halfH_deg);
+  vd.right_deg = static_cast<float>(halfH_deg);
+  vd.top_deg = static_cast<float>(halfV_deg);
+  vd.bottom_deg = static_cast<float>(-halfV_deg);
+  return vd;
+}
+
+cigi::ViewControl channelViewControl(std::uint32_t i, std::uint32_t channels, double channelWidth_deg) {
+  cigi::ViewControl vc;
+  vc.viewId = static_cast<std::uint16_t>(i);
+  vc.entityId = 0;
+  vc.xEnable = vc.yEnable = vc.zEnable = vc.rollEnable = vc.pitchEnable = vc.yawEnable = true;
+  vc.yaw_deg = static_cast<float>((double(i) - (double(channels) - 1) / 2) * channelWidth_deg);
+  return vc;
+}
+
 std::vector<std::uint8_t> CigiHost::nextFrame(const geo::GeodeticPose& pose, double flightTime_s,
                                               const std::optional<cigi::EnvironmentalConditionsRequest>& request) {
   cigi::IgControl ig;
@@ -30,9 +56,12 @@ std::vector<std::uint8_t> CigiHost::nextFrame(const geo::GeodeticPose& pose, dou
 
   cigi::DatagramWriter w(options_.order);
   w.add(ig).add(own);
-  if (ig.hostFrame == 0) {
+  if (options_.channelWidth_deg > 0) {
+    for (std::uint32_t i = 0; i < options_.channels; ++i)
+      w.add(channelViewDefinition(i, options_.channelWidth_deg, options_.aspect))
+          .add(channelViewControl(i, options_.channels, options_.channelWidth_deg));
+  } else if (ig.hostFrame == 0) {
     // Symmetric frustum from the vertical field of view and the aspect ratio.
-    constexpr double kDegPerRad = 57.29577951308232;
     const double halfV_deg = options_.verticalFov_deg / 2;
     const double halfH_deg = std::atan(std::tan(halfV_deg / kDegPerRad) * options_.aspect) * kDegPerRad;
     cigi::ViewDefinition vd;

@@ -2,6 +2,7 @@
 #include "sky/sim/replay_session.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
 #include <span>
 #include <stdexcept>
@@ -13,17 +14,46 @@ namespace sky::sim {
 
 namespace asio = boost::asio;
 
+asio::ip::udp::endpoint parseIgEndpoint(const std::string& text) {
+  std::string address = text, port;
+  if (!text.empty() && text.front() == '[') {
+    const auto close = text.find("]:");
+    if (close == std::string::npos) throw std::runtime_error("--ig '" + text + "': IPv6 is written [ADDR]:PORT");
+    address = text.substr(1, close - 1);
+    port = text.substr(close + 2);
+  } else {
+    const auto colon = text.rfind(':');
+    if (colon == std::string::npos) throw std::runtime_error("--ig '" + text + "': not ADDR:PORT");
+    address = text.substr(0, colon);
+    port = text.substr(colon + 1);
+  }
+  boost::system::error_code ec;
+  const auto a = asio::ip::make_address(address, ec);
+  if (ec) throw std::runtime_error("--ig '" + text + "': '" + address + "' is not an IP address");
+  unsigned value = 0;
+  const auto [end, pec] = std::from_chars(port.data(), port.data() + port.size(), value);
+  if (pec != std::errc() || end != port.data() + port.size() || value == 0 || value > 65535)
+    throw std::runtime_error("--ig '" + text + "': the port is not in 1..65535");
+  return {a, static_cast<unsigned short>(value)};
+}
+
 ReplaySession::ReplaySession(asio::io_context& io, ReplayOptions o, flight::Flight flight,
                              std::function<void()> onDone)
     : o_(std::move(o)), flight_(std::move(flight)), onDone_(std::move(onDone)), socket_(io), timer_(io),
-      host_(HostOptions{o_.littleEndian ? cigi::ByteOrder::Little : cigi::ByteOrder::Big, 60, 16.0 / 9.0,
-                        flight_.startUtc_s}) {
-  boost::system::error_code ec;
-  const auto address = asio::ip::make_address(o_.host, ec);
-  if (ec) throw std::runtime_error("IG address '" + o_.host + "': " + ec.message());
-  socket_.open(address.is_v6() ? asio::ip::udp::v6() : asio::ip::udp::v4());
-  socket_.bind({address, 0});
-  target_ = {address, static_cast<unsigned short>(o_.port)};
+      host_(HostOptions{o_.littleEndian ? cigi::ByteOrder::Little : cigi::ByteOrder::Big, 60, o_.aspect,
+                        flight_.startUtc_s, o_.channels, o_.channelWidth_deg}) {
+  if (o_.igs.empty()) {
+    boost::system::error_code ec;
+    const auto address = asio::ip::make_address(o_.host, ec);
+    if (ec) throw std::runtime_error("IG address '" + o_.host + "': " + ec.message());
+    targets_.push_back({address, static_cast<unsigned short>(o_.port)});
+  }
+  for (const auto& text : o_.igs) targets_.push_back(parseIgEndpoint(text));
+  for (const auto& t : targets_)
+    if (t.address().is_v6() != targets_.front().address().is_v6())
+      throw std::runtime_error("--ig: IPv4 and IPv6 IGs mixed; one socket sends to all");
+  socket_.open(targets_.front().protocol());
+  socket_.bind({targets_.front().address(), 0});
   if (o_.conditionsRate_hz > 0) probe_.emplace(o_.conditionsRate_hz);
   if (!o_.conditionsCsv.empty()) {
     csv_.open(o_.conditionsCsv, std::ios::trunc);
@@ -64,14 +94,18 @@ void ReplaySession::tick() {
   if (tickHook_) tickHook_(flightTime_s_);
   const auto request = probe_ ? probe_->due(flightTime_s_, pose.position) : std::nullopt;
   const auto bytes = host_.nextFrame(pose, flightTime_s_, request);
-  boost::system::error_code ec;
-  socket_.send_to(asio::buffer(bytes), target_, 0, ec);
-  if (ec) {
-    std::fprintf(stderr, "skyshell-%s: send to %s:%u failed: %s\n", o_.name.c_str(), o_.host.c_str(), o_.port,
-                 ec.message().c_str());
-    exitCode_ = 1;
-    finish();
-    return;
+  // The request (appended last) to the first IG only: one answer each.
+  const std::size_t common = request ? bytes.size() - cigi::EnvironmentalConditionsRequest::kSize : bytes.size();
+  for (std::size_t i = 0; i < targets_.size(); ++i) {
+    boost::system::error_code ec;
+    socket_.send_to(asio::buffer(bytes.data(), i == 0 ? bytes.size() : common), targets_[i], 0, ec);
+    if (ec) {
+      std::fprintf(stderr, "skyshell-%s: send to %s:%u failed: %s\n", o_.name.c_str(),
+                   targets_[i].address().to_string().c_str(), unsigned(targets_[i].port()), ec.message().c_str());
+      exitCode_ = 1;
+      finish();
+      return;
+    }
   }
   report(t, done && !o_.loop);
   if (done && !o_.loop) {

@@ -40,21 +40,23 @@ EnuFrame enuFrameAt(const Geodetic& g) {
   return f;
 }
 
+Axes rotatedAxes(const Axes& base, double yaw_deg, double pitch_deg, double roll_deg) {
+  const double cy = std::cos(yaw_deg * kDegToRad), sy = std::sin(yaw_deg * kDegToRad);
+  const double cp = std::cos(pitch_deg * kDegToRad), sp = std::sin(pitch_deg * kDegToRad);
+  const double cr = std::cos(roll_deg * kDegToRad), sr = std::sin(roll_deg * kDegToRad);
+  // Yaw about down, then pitch about the new right axis, then roll about the
+  // new forward axis.
+  const Vec3d f1 = base.forward * cy + base.right * sy;
+  const Vec3d r1 = base.right * cy - base.forward * sy;
+  const Vec3d forward = f1 * cp - base.down * sp;
+  const Vec3d d2 = base.down * cp + f1 * sp;
+  return {forward, r1 * cr + d2 * sr, d2 * cr - r1 * sr};
+}
+
 BodyAxes bodyAxes(const GeodeticPose& pose) {
   const EnuFrame enu = enuFrameAt(pose.position);
-  const Vec3d north = enu.north, east = enu.east, down = -enu.up;
-  const double cy = std::cos(pose.yaw_deg * kDegToRad), sy = std::sin(pose.yaw_deg * kDegToRad);
-  const double cp = std::cos(pose.pitch_deg * kDegToRad), sp = std::sin(pose.pitch_deg * kDegToRad);
-  const double cr = std::cos(pose.roll_deg * kDegToRad), sr = std::sin(pose.roll_deg * kDegToRad);
-  // Yaw about down, then pitch about the new right axis, then roll about the
-  // new forward axis (aerospace z-y-x sequence in NED).
-  const Vec3d f1 = north * cy + east * sy;
-  const Vec3d r1 = east * cy - north * sy;
-  const Vec3d forward = f1 * cp - down * sp;
-  const Vec3d d2 = down * cp + f1 * sp;
-  const Vec3d right = r1 * cr + d2 * sr;
-  const Vec3d bodyDown = d2 * cr - r1 * sr;
-  return {enu.originEcef_m, forward, right, bodyDown};
+  const Axes a = rotatedAxes({enu.north, enu.east, -enu.up}, pose.yaw_deg, pose.pitch_deg, pose.roll_deg);
+  return {enu.originEcef_m, a.forward, a.right, a.down};
 }
 
 double normalizeLon_deg(double lon_deg) {

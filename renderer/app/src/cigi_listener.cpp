@@ -165,6 +165,10 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
         clock_.set(double(*minute), 60.0, TimeSource::Cigi);
     } else if (const auto* a = std::get_if<cigi::AtmosphereControl>(&packet)) {
       state_.setAtmosphere(atmosphereFrom(*a));
+    } else if (const auto* definition = std::get_if<cigi::ViewDefinition>(&packet)) {
+      takeView(*definition, "View Definition");
+    } else if (const auto* control = std::get_if<cigi::ViewControl>(&packet)) {
+      takeView(*control, "View Control");
     }
   }
   for (std::size_t i = 1; i < datagram->packets.size(); ++i) {
@@ -173,6 +177,7 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
     if (!entity) {
       if (!std::holds_alternative<cigi::CelestialSphereControl>(packet) &&
           !std::holds_alternative<cigi::AtmosphereControl>(packet) &&
+          !std::holds_alternative<cigi::ViewDefinition>(packet) && !std::holds_alternative<cigi::ViewControl>(packet) &&
           !std::holds_alternative<cigi::EnvironmentalConditionsRequest>(packet))
         ignore(cigi::packetId(packet));
       continue;
@@ -188,6 +193,7 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
     p.pose.roll_deg = entity->roll_deg;
     p.hostFrame = ig->hostFrame;
     p.hostTime_s = ig->timestampValid ? ig->timestamp_10us * 1.0e-5 : 0.0;
+    p.hostTimeValid = ig->timestampValid;
     p.receivedAt = now;
     p.utc_s = clock_.utc_s();
     p.timeSource = clock_.source();
@@ -207,6 +213,27 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
            answerConditions(*request, state_.weather(), now, ownship(state_), state_.atmosphere()))
         w.add(reply);
   return w.bytes();
+}
+
+template <class ViewPacket>
+void CigiListener::takeView(const ViewPacket& packet, const char* name) {
+  const ViewUpdate u = state_.applyView(packet);
+  switch (u.outcome) {
+    case ViewPacketOutcome::OtherView: otherViewPackets_.fetch_add(1, std::memory_order_relaxed); return;
+    case ViewPacketOutcome::Rejected:
+      // The packet only: the rest of its datagram (the pose) still counts.
+      drops_.add(DropReason::OutOfRange);
+      if (loggedReasons_.insert(dropKind(DropReason::OutOfRange, u.detail)).second)
+        spdlog::warn("CIGI: ignored a {} ({}) (further ones of this kind are only counted)", name, u.detail);
+      return;
+    case ViewPacketOutcome::Applied:
+      for (const auto& part : u.unsupported) {
+        unsupportedViewParts_.fetch_add(1, std::memory_order_relaxed);
+        if (loggedReasons_.insert("view: " + part).second)
+          spdlog::warn("CIGI: {} for this channel's view asks for {}: not supported, counted", name, part);
+      }
+      return;
+  }
 }
 
 std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRequest& r, const WeatherView& view,

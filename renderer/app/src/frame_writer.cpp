@@ -31,6 +31,35 @@ nlohmann::json areasJson(const std::vector<FrameRecord::Area>& areas) {
     out.push_back({{"area", i}, {"tile_level", areas[i].tileLevel}, {"tiles", areas[i].tiles}});
   return out;
 }
+// The view's packets as applied and the camera they gave: enough to compute
+// any pixel's ray (core_common.glsl, cameraRay) from the metadata alone.
+nlohmann::json viewJson(const FrameRecord::View& v) {
+  const ChannelView& c = v.view;
+  const render::ViewFrustum& f = c.frustum;
+  nlohmann::json view = {
+      {"id", c.viewId},
+      {"offset_m", {c.eyepoint.x_m, c.eyepoint.y_m, c.eyepoint.z_m}},
+      {"rotation_deg", {{"yaw", c.eyepoint.yaw_deg}, {"pitch", c.eyepoint.pitch_deg}, {"roll", c.eyepoint.roll_deg}}},
+      {"half_angles_deg", {{"left", f.left_deg}, {"right", f.right_deg}, {"top", f.up_deg}, {"bottom", f.down_deg}}},
+      {"frustum_from_host", c.frustumFromHost},
+      {"mirror", static_cast<int>(c.mirror)},
+      {"definitions", c.definitions},
+      {"controls", c.controls},
+  };
+  if (c.near_m) view["near_m"] = *c.near_m;
+  if (c.far_m) view["far_m"] = *c.far_m;
+  const geo::GeodeticPose& p = v.camera;
+  return {{"view", view},
+          {"camera",
+           {{"lat_deg", p.position.lat_deg},
+            {"lon_deg", p.position.lon_deg},
+            {"alt_m", p.position.alt_m},
+            {"yaw_deg", p.yaw_deg},
+            {"pitch_deg", p.pitch_deg},
+            {"roll_deg", p.roll_deg}}},
+          {"fov_deg", {{"horizontal", f.right_deg - f.left_deg}, {"vertical", f.up_deg - f.down_deg}}}};
+}
+
 }  // namespace
 
 Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r) {
@@ -107,6 +136,8 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
                         {"sea_level_temperature_c", a.seaLevelTemperature_c},
                         {"sea_level_pressure_hpa", a.seaLevelPressure_hpa},
                         {"haze_visibility_m", r.visibility_m ? nlohmann::json(*r.visibility_m) : nlohmann::json()}};
+  if (r.serverClockAtArrival_s) line["weather_clock_server_s"] = *r.serverClockAtArrival_s;
+  if (r.view) line.update(viewJson(*r.view));
   nlohmann::json gpu = nlohmann::json::object();
   for (const auto& t : r.gpu) gpu[t.pass] = gpu.value(t.pass, 0.0) + t.gpu_ms;
   line["gpu_ms"] = gpu;

@@ -30,6 +30,9 @@
 #include "sky/app/frame_writer.hpp"
 #include "sky/app/glfw_window.hpp"
 #include "sky/app/headless_replay.hpp"
+#include "sky/app/host_clock.hpp"
+#include "sky/app/host_locked_clock.hpp"
+#include "sky/app/view_state.hpp"
 #include "sky/render/presets.hpp"
 #include "sky/app/timed_render.hpp"
 #include "sky/app/weather_client.hpp"
@@ -67,6 +70,7 @@ struct Options {
   bool noExr = false;
   unsigned width = 320, height = 180;
   double fov_deg = 60;
+  unsigned viewId = 0;
   std::string preset = sky::app::kDefaultPreset;
   double sunAzimuth_deg = 135, sunElevation_deg = 40;
   std::uint64_t maxFrames = 0;
@@ -154,7 +158,15 @@ int main(int argc, char** argv) {
                "headless: skip the per-frame EXR (linear radiance, cloud transmittance, cloud depth)");
   app.add_option("--width", o.width)->check(CLI::Range(16, 8192));
   app.add_option("--height", o.height)->check(CLI::Range(16, 8192));
-  app.add_option("--fov", o.fov_deg, "vertical field of view, deg")->check(CLI::Range(1.0, 170.0));
+  app.add_option("--fov", o.fov_deg,
+                 "vertical field of view, deg (symmetric; a View Definition for --view-id replaces the half-angles "
+                 "it enables)")
+      ->check(CLI::Range(1.0, 170.0));
+  app.add_option("--view-id", o.viewId,
+                 "the CIGI view this channel draws: View Definition (frustum) and View Control (eyepoint offset and "
+                 "rotation on the ownship) for this view id are applied, those for other views ignored (counted)")
+      ->check(CLI::Range(0, 65535))
+      ->capture_default_str();
   app.add_option("--preset", o.preset,
                  "quality preset: reference, high, medium, low, realtime (README.md, \"Quality presets\")")
       ->capture_default_str();
@@ -326,6 +338,12 @@ int main(int argc, char** argv) {
   sky::app::FallbackWeather fallback(std::move(fileWeather), o.weatherFile, o.server, o.weatherTimeout_s, Clock::now());
 
   sky::app::SharedState state;
+  {
+    sky::app::ChannelView initial;
+    initial.viewId = static_cast<std::uint16_t>(o.viewId);
+    initial.frustum = sky::render::symmetricFrustum((*renderer)->settings());
+    state.setView(initial);
+  }
   asio::io_context io;
   auto guard = asio::make_work_guard(io);
   std::atomic<bool> stopRequested{false};
@@ -424,6 +442,7 @@ int main(int argc, char** argv) {
   const auto fdmFramePeriod = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(1.0 / o.fdmFrameRate_hz));
   Clock::time_point nextFdmFrameAt{};
+  sky::app::HostLockedClock hostClock;
   int exitCode = 0;
   while (!stopRequested) {
     if (smoothed && Clock::now() < nextFdmFrameAt) std::this_thread::sleep_until(nextFdmFrameAt);
@@ -472,11 +491,21 @@ int main(int argc, char** argv) {
     }
     const auto coarse =
         view.coarse ? std::optional(sky::app::drawableCoarse(*view.coarse, drawable)) : std::nullopt;
+    const sky::app::ChannelView channelView = state.view();
     sky::render::FrameInputs in;
-    in.camera = pose->pose;
+    in.camera = sky::app::viewCamera(pose->pose, channelView);
+    in.frustum = channelView.frustum;
     in.weather = &drawable;
     in.coarseWeather = coarse ? &*coarse : nullptr;
-    in.weatherClock_s = view.clockNow(now);
+    // CIGI frames: the clock and the interleave pattern follow the host
+    // frame, so every channel draws a host frame alike (host_locked_clock.hpp).
+    if (smoothed) {
+      in.weatherClock_s = view.clockNow(now);
+    } else {
+      in.weatherClock_s = hostClock.at(pose->hostTimeValid ? std::optional(pose->hostTime_s) : std::nullopt,
+                                       view.clock, pose->receivedAt);
+      in.patternIndex = pose->hostFrame;
+    }
     in.sunAzimuth_deg = o.sunAzimuth_deg;
     in.sunElevation_deg = o.sunElevation_deg;
     in.utc_s = pose->utc_s;
@@ -490,12 +519,15 @@ int main(int argc, char** argv) {
       exitCode = 3;
       break;
     }
+    sky::app::mirrorImage(*image, channelView.mirror);
     record.frame = frames;
     record.host = *pose;
+    record.view = sky::app::FrameRecord::View{channelView, in.camera};
     record.source = fdm ? "fdm" : foreflight ? "foreflight" : "cigi";
     record.utcSource = pose->timeSource;
     record.atmosphere = atmosphere;
     record.weatherClock_s = in.weatherClock_s;
+    if (!smoothed) record.serverClockAtArrival_s = view.clock.at(pose->receivedAt);
     record.weatherVersion = view.version;
     record.weatherConnected = streamed.connected;
     record.weatherSource = toString(weatherSource);
@@ -515,7 +547,7 @@ int main(int argc, char** argv) {
         if (pass.pass == "present") record.gpu.push_back(pass);
     }
     sky::app::logValidationMessages(**renderer);
-    weather.reportCamera(pose->pose, frames, view.version, in.weatherClock_s);
+    weather.reportCamera(in.camera, frames, view.version, in.weatherClock_s);
     if (auto ok = writer->write(*image, record); !ok) {
       std::fprintf(stderr, "skyshell-render: %s\n", sky::describe(ok.error()).c_str());
       exitCode = 2;
@@ -543,6 +575,12 @@ int main(int argc, char** argv) {
               static_cast<unsigned long long>(cigi->datagramsAccepted()),
               static_cast<unsigned long long>(cigi->datagramsDropped()), cigi->drops().summary().c_str(),
               cigi->ignoredSummary().c_str(), static_cast<unsigned long long>(weather.malformedFrames()));
+  std::printf("render: view %u: %llu View Definition and %llu View Control applied, %llu packets for other views "
+              "ignored, %llu unsupported parts\n",
+              o.viewId, static_cast<unsigned long long>(state.view().definitions),
+              static_cast<unsigned long long>(state.view().controls),
+              static_cast<unsigned long long>(cigi->otherViewPackets()),
+              static_cast<unsigned long long>(cigi->unsupportedViewParts()));
   if (fdm)
     std::printf("render: FlightGear FDM datagrams accepted %llu, dropped %llu (%s), outliers discarded %llu\n",
                 static_cast<unsigned long long>(fdm->datagramsAccepted()),

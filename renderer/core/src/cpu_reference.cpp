@@ -92,8 +92,8 @@ class CpuCore {
   std::uint64_t lookups() const { return lookups_; }
 
   PixelResult shade(std::uint32_t px, std::uint32_t py, const CoreFrame& f) {
-    const real3 dir = cameraRay(setup_.camForward, setup_.camRight, setup_.camDown, setup_.tanHalfFov,
-                                setup_.aspect, real(px), real(py), setup_.rasterWidth, setup_.rasterHeight);
+    const real3 dir = cameraRay(setup_.camForward, setup_.camRight, setup_.camDown, setup_.frustum, real(px),
+                                real(py), setup_.rasterWidth, setup_.rasterHeight);
     // The step offset as clouds.comp takes it (a float of the tile, or the hash).
     const real jitter = setup_.march.blueNoise
                             ? real(blueNoise_[(py % kBlueNoiseSize) * kBlueNoiseSize + px % kBlueNoiseSize])

@@ -189,6 +189,30 @@ Result<void> validateSnapshot(const weather::WeatherSnapshot& w, const std::stri
 
 }  // namespace
 
+ViewFrustum symmetricFrustum(const RenderSettings& settings) {
+  const double halfV_deg = 0.5 * settings.verticalFov_deg;
+  const double aspect = double(settings.width) / double(settings.height);
+  const double halfH_deg = std::atan(std::tan(halfV_deg * kDegToRad) * aspect) / kDegToRad;
+  return {-halfH_deg, halfH_deg, halfV_deg, -halfV_deg};
+}
+
+namespace {
+
+Result<void> validateFrustum(const ViewFrustum& f) {
+  for (double a : {f.left_deg, f.right_deg, f.up_deg, f.down_deg})
+    if (!(std::abs(a) < kMaxFrustumHalfAngle_deg))
+      return fail(ErrorCode::InvalidArgument, "frame inputs: frustum half-angle " + num(a) + " deg outside (-" +
+                                                  num(kMaxFrustumHalfAngle_deg) + ", " +
+                                                  num(kMaxFrustumHalfAngle_deg) + ")");
+  if (!(f.left_deg < f.right_deg) || !(f.down_deg < f.up_deg))
+    return fail(ErrorCode::InvalidArgument, "frame inputs: frustum left " + num(f.left_deg) + " right " +
+                                                num(f.right_deg) + " up " + num(f.up_deg) + " down " +
+                                                num(f.down_deg) + " deg: needs left < right and down < up");
+  return {};
+}
+
+}  // namespace
+
 Result<void> validateInputs(const FrameInputs& in) {
   const auto& c = in.camera;
   const auto& p = c.position;
@@ -205,6 +229,8 @@ Result<void> validateInputs(const FrameInputs& in) {
     return fail(ErrorCode::InvalidArgument, "frame inputs: camera lat_deg " + num(p.lat_deg) + " outside [-90, 90]");
   if (p.alt_m < -1000 || p.alt_m > 1e6)
     return fail(ErrorCode::InvalidArgument, "frame inputs: camera alt_m " + num(p.alt_m) + " outside [-1000, 1e6]");
+  if (in.frustum)
+    if (auto ok = validateFrustum(*in.frustum); !ok) return ok;
   if (in.weather == nullptr) return {};
   if (auto ok = validateSnapshot(*in.weather, ""); !ok) return ok;
   if (in.coarseWeather != nullptr)
@@ -220,8 +246,9 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
   s.height = drawnExtent(settings.height, d);
   s.rasterWidth = double(settings.width) / d;
   s.rasterHeight = double(settings.height) / d;
-  s.tanHalfFov = std::tan(0.5 * settings.verticalFov_deg * kDegToRad);
-  s.aspect = double(settings.width) / double(settings.height);
+  const ViewFrustum frustum = in.frustum.value_or(symmetricFrustum(settings));
+  s.frustum = {std::tan(frustum.left_deg * kDegToRad), std::tan(frustum.right_deg * kDegToRad),
+               std::tan(frustum.up_deg * kDegToRad), std::tan(frustum.down_deg * kDegToRad)};
   s.march = settings.march;
 
   const geo::EnuFrame enu = geo::enuFrameAt(in.camera.position);
@@ -372,8 +399,9 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   gpu::SkyFrame f{};
   auto v4 = [](const glm::dvec3& v, double w = 0) { return gpu::vec4(glm::dvec4(v, w)); };
   f.camForward = v4(s.camForward);
-  f.camRight = v4(s.camRight, s.tanHalfFov);
-  f.camDown = v4(s.camDown, s.aspect);
+  f.camRight = v4(s.camRight);
+  f.camDown = v4(s.camDown);
+  f.frustum = gpu::vec4(s.frustum);
   for (int row = 0; row < 3; ++row) {
     f.localToEcef[row] = v4(glm::dvec3(s.localToEcef[0][row], s.localToEcef[1][row], s.localToEcef[2][row]));
     f.camToAnchor[row] = v4(glm::dvec3(s.camToAnchor[0][row], s.camToAnchor[1][row], s.camToAnchor[2][row]));

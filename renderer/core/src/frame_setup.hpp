@@ -61,7 +61,9 @@ struct FrameSetup {
   // settings' size / d, not whole when the size is not a multiple of d).
   std::uint32_t width = 0, height = 0;
   double rasterWidth = 0, rasterHeight = 0;
-  double tanHalfFov = 0, aspect = 1;  // the full image's: vertical, and width / height
+  // The full image's view frustum: tangents of its left, right, up and down
+  // half-angles (core_common.glsl, frustumPoint).
+  glm::dvec4 frustum{-1, 1, 1, -1};
   glm::dvec3 camForward{0}, camRight{0}, camDown{0};  // local frame: x east, y north, z up
   glm::dmat3 localToEcef{1};   // columns: the camera's east, north, up in ECEF
   glm::dvec3 cameraEcef_m{0};  // the local frame's origin

@@ -79,6 +79,7 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   now.forward = setup.camForward;
   now.right = setup.camRight;
   now.down = setup.camDown;
+  now.frustum = setup.frustum;
   now.keyLightEcef = setup.localToEcef * setup.sunDir;
   now.moonLit = setup.moonLit;
   now.clock_s = inputs.weatherClock_s;
@@ -91,12 +92,13 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   plan.drawWhole = !reason.empty();
   plan.reason = reason;
   plan.interleave = plan.drawWhole ? 1 : n;
-  plan.phase = plan.drawWhole ? glm::uvec2(0) : interleavePhase(n, std::uint32_t(frames_ % (n * n)));
+  const std::uint64_t index = inputs.patternIndex.value_or(frames_);
+  plan.phase = plan.drawWhole ? glm::uvec2(0) : interleavePhase(n, std::uint32_t(index % (n * n)));
   // With accumulation each cycle of n^2 frames shifts the step offsets by
   // the golden ratio: the additive recurrence spreads any number of
   // consecutive cycles' offsets evenly over [0, 1).
   if (settings_.accumulation > 0) {
-    const double cycle = double(frames_ / (std::uint64_t(n) * n));
+    const double cycle = double(index / (std::uint64_t(n) * n));
     plan.jitterShift = cycle * kGoldenRatioConjugate - std::floor(cycle * kGoldenRatioConjugate);
     // Roberts' R2 sequence (the plastic number's generalised golden ratio):
     // consecutive cycles' 2D shifts cover the pixel evenly.
@@ -110,8 +112,10 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
 
   gpu::SkyReproject& p = plan.params;
   p.camForward = v4(setup.camForward);
-  p.camRight = v4(setup.camRight, setup.tanHalfFov);
-  p.camDown = v4(setup.camDown, setup.aspect);
+  p.camRight = v4(setup.camRight);
+  p.camDown = v4(setup.camDown);
+  p.frustum = gpu::vec4(setup.frustum);
+  p.prevFrustum = p.frustum;
   p.image = gpu::uvec4(setup.width, setup.height, plan.interleave, plan.drawWhole ? 0u : 1u);
   p.raster = gpu::vec4(float(setup.rasterWidth), float(setup.rasterHeight), 0.0f, 0.0f);
   const std::uint32_t packedW = (setup.width + plan.interleave - 1) / plan.interleave;
@@ -128,6 +132,7 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
     p.prevForward = v4(prevToLocal * prev.forward);
     p.prevRight = v4(prevToLocal * prev.right);
     p.prevDown = v4(prevToLocal * prev.down);
+    p.prevFrustum = gpu::vec4(prev.frustum);
     p.prevPosition = v4(toLocal * (prev.cameraEcef_m - setup.cameraEcef_m), setup.r_m);
     const double step_s = now.clock_s - prev.clock_s;
     SKY_ASSERT(setup.layers.size() <= gpu::kReprojectMaxLayers);

@@ -64,6 +64,7 @@ class TemporalPlanner {
     glm::dvec3 cameraEcef_m{0};
     glm::dmat3 localToEcef{1};
     glm::dvec3 forward{0}, right{0}, down{0};  // local frame of that frame
+    glm::dvec4 frustum{0};                     // FrameSetup::frustum
     glm::dvec3 keyLightEcef{0};
     bool moonLit = false;
     double clock_s = 0;
@@ -76,7 +77,7 @@ class TemporalPlanner {
   TemporalSettings settings_;
   std::optional<Remembered> previous_;
   std::string forgottenBecause_ = "first frame";  // the reason of a frame without previous_
-  std::uint64_t frames_ = 0;  // frames planned: the place in the interleave cycle
+  std::uint64_t frames_ = 0;  // frames planned: the place in the interleave cycle (without patternIndex)
 };
 
 }  // namespace sky::render

@@ -80,6 +80,7 @@ gpu::SkyUpscale upscaleParams(const gpu::SkyFrame& frame, const ResolutionSettin
   u.camForward = frame.camForward;
   u.camRight = frame.camRight;
   u.camDown = frame.camDown;
+  u.frustum = frame.frustum;
   u.earth = gpu::vec4(frame.earth.x, frame.earth.z, frame.raster.x, frame.raster.y);
   u.size = gpu::uvec4(frame.image.x, frame.image.y, width, height);
   u.mode = gpu::uvec4(resolution.divisor, resolution.depthAware ? 1u : 0u, 0u, 0u);

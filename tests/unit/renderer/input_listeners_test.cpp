@@ -99,6 +99,60 @@ TEST_F(CigiFixture, OutOfRangeAndIgDatagramsAreDroppedByReason) {
 // Without --cigi-host the first sender of a valid datagram is the host: a
 // second sender is dropped, counted and never answered (no reflector). The
 // host's address on another port is the host restarted, and is answered.
+// View packets (issue 19): a View Definition with a NaN or out-of-range
+// half-angle fails the decoder, and its whole datagram is dropped as out of
+// range; one whose half-angles are each fine but give no frustum (left
+// right of right) is dropped alone, counted as out of range, and the pose
+// in its datagram still taken; packets for other views are ignored and
+// counted; this view's are applied.
+TEST_F(CigiFixture, BadViewPacketsAreDroppedAndCounted) {
+  ChannelView initial;
+  initial.viewId = 1;
+  initial.frustum = {-30, 30, 20, -20};
+  state.setView(initial);
+  CigiListener cigi(io, state, "127.0.0.1", 0);
+  auto withView = [](double lat, auto... packets) {
+    cigi::IgControl ig;
+    cigi::EntityControl e;
+    e.lat_deg = lat;
+    e.alt_m = 900;
+    cigi::DatagramWriter w;
+    w.add(ig).add(e);
+    (w.add(packets), ...);
+    return w.bytes();
+  };
+  cigi::ViewDefinition vd;
+  vd.viewId = 1;
+  vd.leftEnable = vd.rightEnable = true;
+  for (const float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(), 95.0f}) {
+    vd.left_deg = bad;
+    EXPECT_TRUE(cigi.handleDatagram(withView(46.0, vd), kHostA).empty());
+  }
+  EXPECT_EQ(cigi.drops().of(DropReason::OutOfRange), 3u);
+  EXPECT_TRUE(std::isnan(poseLat()));
+  vd.left_deg = 40;  // right of right (30)
+  vd.right_deg = 30;
+  EXPECT_FALSE(cigi.handleDatagram(withView(46.5, vd), kHostA).empty());
+  EXPECT_EQ(poseLat(), 46.5);
+  EXPECT_EQ(cigi.drops().of(DropReason::OutOfRange), 4u);
+  EXPECT_EQ(state.view().frustum, initial.frustum);
+  cigi::ViewControl vc;
+  vc.viewId = 2;
+  vc.yawEnable = true;
+  vc.yaw_deg = 60;
+  vd.viewId = 2;
+  EXPECT_FALSE(cigi.handleDatagram(withView(46.6, vd, vc), kHostA).empty());
+  EXPECT_EQ(cigi.otherViewPackets(), 2u);
+  vc.viewId = 1;
+  vd.viewId = 1;
+  vd.left_deg = -10;
+  vd.right_deg = 50;
+  EXPECT_FALSE(cigi.handleDatagram(withView(46.7, vd, vc), kHostA).empty());
+  EXPECT_EQ(state.view().frustum, (render::ViewFrustum{-10, 50, 20, -20}));
+  EXPECT_EQ(state.view().eyepoint.yaw_deg, 60);
+  EXPECT_EQ(cigi.drops().of(DropReason::OutOfRange), 4u);
+}
+
 TEST_F(CigiFixture, TheFirstValidSenderIsTheOnlyHostAnswered) {
   CigiListener cigi(io, state, "127.0.0.1", 0);
   EXPECT_FALSE(cigi.host());

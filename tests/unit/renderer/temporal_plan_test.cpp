@@ -44,5 +44,33 @@ TEST(InterleavePhase, EachFourFramesOfSixteenCoverEveryQuadrant) {
   }
 }
 
+// Channels of one display pass the host frame as the pattern index: two
+// planners that have planned different numbers of frames (a channel started
+// later) draw the same pixel of each block with the same step-offset shift
+// for the same host frame; without it each follows its own count.
+TEST(TemporalPlanner, PatternIndexOverridesTheLocalCount) {
+  TemporalSettings t;
+  t.interleave = 4;
+  t.accumulation = 0.5;
+  FrameSetup setup;  // a still camera looking north
+  setup.camForward = {0, 1, 0};
+  setup.camRight = {1, 0, 0};
+  setup.camDown = {0, 0, -1};
+  FrameInputs in;
+  TemporalPlanner early(t), late(t);
+  for (int i = 0; i < 5; ++i) early.plan(setup, in);  // five frames ahead
+  late.plan(setup, in);
+  for (std::uint64_t hostFrame : {37u, 38u, 55u}) {
+    in.patternIndex = hostFrame;
+    const TemporalPlan a = early.plan(setup, in), b = late.plan(setup, in);
+    ASSERT_FALSE(a.drawWhole || b.drawWhole) << a.reason << b.reason;
+    EXPECT_EQ(a.phase, b.phase) << hostFrame;
+    EXPECT_EQ(a.phase, interleavePhase(4, std::uint32_t(hostFrame % 16)));
+    EXPECT_EQ(a.jitterShift, b.jitterShift) << hostFrame;
+  }
+  in.patternIndex.reset();
+  EXPECT_NE(early.plan(setup, in).phase, late.plan(setup, in).phase);  // 9th and 5th frames: 4 apart
+}
+
 }  // namespace
 }  // namespace sky::render

@@ -1,5 +1,7 @@
 // The replay's CIGI host frames: what a simulator host sends, decoded by our
 // own (tshark-checked) CIGI reader.
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "sky/sim/cigi_host.hpp"
@@ -35,6 +37,37 @@ TEST(CigiHost, FirstFrameCarriesViewDefinitionAndCelestial) {
   ASSERT_TRUE(later);
   ASSERT_EQ(later->packets.size(), 3u);
   EXPECT_EQ(std::get<cigi::CelestialSphereControl>(later->packets[2]).minute, 22);
+}
+
+// Three channels 60 deg wide: every frame carries, per view id, a View
+// Definition of +-30 deg horizontally and atan(tan 30 / aspect) vertically,
+// and a View Control turning the view -60, 0, +60 deg.
+TEST(CigiHost, ChannelsCarryTheirViewsEveryFrame) {
+  HostOptions o;
+  o.aspect = 120.0 / 68.0;
+  o.channels = 3;
+  o.channelWidth_deg = 60;
+  CigiHost host(o);
+  const geo::GeodeticPose pose{{46.2, 12.8, 900}, 90, 0, 0};
+  for (double t : {0.0, 0.5}) {
+    auto d = cigi::decodeDatagram(host.nextFrame(pose, t));
+    ASSERT_TRUE(d) << d.error().detail;
+    ASSERT_EQ(d->packets.size(), 2u + 2 * 3);
+    for (std::uint16_t i = 0; i < 3; ++i) {
+      const auto& vd = std::get<cigi::ViewDefinition>(d->packets[2 + 2 * i]);
+      const auto& vc = std::get<cigi::ViewControl>(d->packets[3 + 2 * i]);
+      EXPECT_EQ(vd.viewId, i);
+      EXPECT_EQ(vc.viewId, i);
+      EXPECT_FLOAT_EQ(vd.left_deg, -30.0f);
+      EXPECT_FLOAT_EQ(vd.right_deg, 30.0f);
+      EXPECT_NEAR(vd.top_deg, std::atan(std::tan(M_PI / 6) * 68.0 / 120.0) * 180 / M_PI, 1e-5);
+      EXPECT_FLOAT_EQ(vd.bottom_deg, -vd.top_deg);
+      EXPECT_TRUE(vd.leftEnable && vd.rightEnable && vd.topEnable && vd.bottomEnable);
+      EXPECT_FLOAT_EQ(vc.yaw_deg, -60.0f + 60.0f * i);
+      EXPECT_TRUE(vc.yawEnable && vc.xEnable);
+      EXPECT_EQ(vc.entityId, 0);
+    }
+  }
 }
 
 TEST(CigiHost, TracksStartOfFrameAndCountsJunk) {

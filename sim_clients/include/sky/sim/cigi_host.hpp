@@ -1,6 +1,7 @@
 // The CIGI host side of a replay: turns a flight and a host frame counter
 // into the datagrams a simulator host would send (IG Control + ownship Entity
-// Control), and keeps count of the IG's Start of Frame replies.
+// Control, and the views of a multi-channel display), and keeps count of the
+// IGs' Start of Frame replies.
 #pragma once
 
 #include <cstdint>
@@ -20,7 +21,20 @@ struct HostOptions {
   // UTC (s since 1970) at flight time 0, when the record has a date: then
   // Celestial Sphere Control carries the recorded date and time.
   std::optional<std::int64_t> startUtc_s;
+  // A display of `channels` side-by-side channels, each channelWidth_deg
+  // wide (> 0; 0: one channel, the View Definition above): every frame
+  // carries, for channel i (view id i), a View Definition of half-angles
+  // +-W/2 horizontally and +-atan(tan(W/2) / aspect) vertically, and a View
+  // Control turning it (i - (N - 1) / 2) W to the right of the nose.
+  std::uint32_t channels = 1;
+  double channelWidth_deg = 0;
 };
+
+// Channel i's View Definition and View Control (view id i) for a display of
+// `channels` channels of width channelWidth_deg (0 < W < 178) and aspect
+// width / height (HostOptions).
+cigi::ViewDefinition channelViewDefinition(std::uint32_t i, double channelWidth_deg, double aspect);
+cigi::ViewControl channelViewControl(std::uint32_t i, std::uint32_t channels, double channelWidth_deg);
 
 class CigiHost {
  public:
@@ -28,9 +42,11 @@ class CigiHost {
 
   // The datagram for the next host frame, showing the ownship at `pose`.
   // flightTime_s becomes the CIGI timestamp (10 us ticks). The first frame
-  // also carries View Definition; with a start date, every frame whose UTC
-  // minute changed (and the first) carries Celestial Sphere Control.
-  // `request`, when given, is appended (an Environmental Conditions Request).
+  // also carries View Definition (with channels, every frame carries each
+  // channel's, so a channel started late gets its view with its first pose);
+  // with a start date, every frame whose UTC minute changed (and the first)
+  // carries Celestial Sphere Control. `request`, when given, is appended
+  // last (an Environmental Conditions Request, kSize bytes at the end).
   std::vector<std::uint8_t> nextFrame(const geo::GeodeticPose& pose, double flightTime_s,
                                       const std::optional<cigi::EnvironmentalConditionsRequest>& request = {});
 

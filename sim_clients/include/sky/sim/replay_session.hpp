@@ -13,6 +13,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/udp.hpp>
@@ -27,6 +28,13 @@ namespace sky::sim {
 struct ReplayOptions {
   std::string host = "127.0.0.1";  // the IG (renderer)
   unsigned port = 8004;            // its CIGI UDP port
+  // Several IGs (the channels of one display), each "ADDR:PORT" (IPv4) or
+  // "[ADDR]:PORT", all of one address family; every host datagram goes to
+  // each, the conditions requests to the first only. Empty: host:port.
+  std::vector<std::string> igs;
+  std::uint32_t channels = 1;      // HostOptions::channels
+  double channelWidth_deg = 0;     // HostOptions::channelWidth_deg; 0: one channel, no View Control
+  double aspect = 16.0 / 9.0;      // width / height of each channel (the vertical half-angles)
   double rate_hz = 60;             // host frames per wall second
   double speed = 1;                // flight seconds per wall second
   double start_s = 0;              // offset into the flight
@@ -38,6 +46,10 @@ struct ReplayOptions {
   std::string conditionsCsv;       // empty: answers are only printed
   std::string name = "replay";     // progress line prefix
 };
+
+// Parses an --ig value, "ADDR:PORT" or "[ADDR]:PORT" (PORT 1..65535);
+// throws std::runtime_error saying what is wrong.
+boost::asio::ip::udp::endpoint parseIgEndpoint(const std::string& text);
 
 class ReplaySession {
  public:
@@ -71,7 +83,8 @@ class ReplaySession {
   std::function<void(double)> tickHook_;
   boost::asio::ip::udp::socket socket_;
   boost::asio::steady_timer timer_;
-  boost::asio::ip::udp::endpoint target_, from_;
+  std::vector<boost::asio::ip::udp::endpoint> targets_;
+  boost::asio::ip::udp::endpoint from_;
   CigiHost host_;
   std::array<std::uint8_t, 2048> rx_{};
   std::optional<ConditionsProbe> probe_;

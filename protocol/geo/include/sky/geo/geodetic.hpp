@@ -42,6 +42,16 @@ struct BodyAxes {
   Vec3d forward, right, down;
 };
 
+// Three orthonormal axes (ECEF unit vectors): x forward, y right, z down.
+struct Axes {
+  Vec3d forward, right, down;
+};
+
+// `base` turned by yaw about its down axis, then pitch about the new right
+// axis, then roll about the new forward axis (deg; the aerospace z-y-x
+// sequence). bodyAxes is this applied to north, east, down.
+Axes rotatedAxes(const Axes& base, double yaw_deg, double pitch_deg, double roll_deg);
+
 Vec3d toEcef(const Geodetic& g);
 Geodetic fromEcef(const Vec3d& ecef_m);
 EnuFrame enuFrameAt(const Geodetic& g);

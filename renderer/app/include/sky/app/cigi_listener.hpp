@@ -1,9 +1,12 @@
 // The renderer's CIGI 3.3 endpoint on UDP: takes the ownship pose from each
 // host datagram (IG Control + Entity Control for entity 0), with the time of
 // day (Celestial Sphere Control, advanced by the host's time line:
-// host_clock.hpp), the host's atmosphere (Atmosphere Control) and its IG
-// mode (Reset/Standby forgets the pose) into SharedState and answers with
-// Start of Frame (reporting that mode), plus a Weather Conditions Response and
+// host_clock.hpp), the host's atmosphere (Atmosphere Control), its IG mode
+// (Reset/Standby forgets the pose), and the View Definition and View Control
+// of this channel's view (other views' are ignored and counted; one that
+// would give no valid view is dropped and counted as out of range, the rest
+// of its datagram kept) into SharedState and answers with Start of Frame
+// (reporting the IG mode), plus a Weather Conditions Response and
 // Aerosol Concentration Responses for each Environmental Conditions Request.
 // It answers one host only: the one it is told (--cigi-host) or else the
 // address of the first sender of a valid host datagram (any port, so a host
@@ -106,6 +109,10 @@ class CigiListener {
   std::string ignoredSummary() const;
   // Whether the host holds this IG in Reset/Standby (IG Control's mode).
   bool standby() const { return standby_.load(); }
+  // View packets for other channels' views, ignored; parts of this view's
+  // View Definitions not drawn (orthographic, pixel replication). Thread-safe.
+  std::uint64_t otherViewPackets() const { return otherViewPackets_.load(); }
+  std::uint64_t unsupportedViewParts() const { return unsupportedViewParts_.load(); }
   // The host this port answers, once known. Thread-safe.
   std::optional<CigiHost> host() const;
 
@@ -113,6 +120,8 @@ class CigiListener {
   void receive();
   void dropped(DropReason reason, const std::string& detail);
   void ignore(std::uint8_t id);
+  template <class ViewPacket>
+  void takeView(const ViewPacket& packet, const char* name);
 
   boost::asio::ip::udp::socket socket_;
   boost::asio::ip::udp::endpoint from_;
@@ -121,6 +130,7 @@ class CigiListener {
   unsigned short port_ = 0;
   std::uint32_t igFrame_ = 0;  // io thread only
   std::atomic<std::uint64_t> accepted_{0};
+  std::atomic<std::uint64_t> otherViewPackets_{0}, unsupportedViewParts_{0};
   DropCounts drops_;
   std::set<std::string> loggedReasons_;  // io thread only
   IgnoredPackets ignored_;

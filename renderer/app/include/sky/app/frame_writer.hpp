@@ -42,6 +42,10 @@ struct FrameRecord {
   HostPose host;
   std::string source = "cigi";  // where the camera came from: "cigi", "fdm" (FlightGear) or "replay"
   double weatherClock_s = 0;
+  // CIGI frames: the server's weather clock as this channel held it when the
+  // host frame arrived; weatherClock_s is locked to the host's time instead
+  // (host_locked_clock.hpp), and the two differ by at most half its grid.
+  std::optional<double> serverClockAtArrival_s;
   std::uint64_t weatherVersion = 0;  // this channel's count of weather updates applied (snapshots, deltas)
   bool weatherConnected = false;     // the stream to the server was up when the frame was drawn
   // What the weather drawn came from: "server", "file" (--weather-file) or
@@ -68,6 +72,14 @@ struct FrameRecord {
   render::TemporalReport temporal;    // what the reprojection did (interleaved presets)
   render::WeatherMapReport weatherMap;  // what this frame changed in the weather map (per tile, or rebuilt and why)
   std::optional<bool> presented;      // windowed: whether the frame reached the window
+  // The channel's view (CIGI View Definition / View Control) and the camera
+  // it gave: the ownship pose (host) with the eyepoint composed on. Unset
+  // where the camera is the pose itself (--replay).
+  struct View {
+    ChannelView view;
+    geo::GeodeticPose camera;
+  };
+  std::optional<View> view;
 };
 
 class FrameWriter {

@@ -1,6 +1,7 @@
 // What the network side of a renderer channel hands to its render loop: the
 // latest ownship pose from the host (with its time of day), the host's
-// atmosphere, and the latest weather from the server.
+// atmosphere, the latest state of the channel's view (View Definition, View
+// Control) and the latest weather from the server.
 // Written by the io thread, read by the render loop; guarded by one mutex.
 #pragma once
 
@@ -12,6 +13,7 @@
 
 #include "sky/app/host_atmosphere.hpp"
 #include "sky/app/host_clock.hpp"
+#include "sky/app/view_state.hpp"
 #include "sky/geo/geodetic.hpp"
 #include "sky/weather/clock.hpp"
 #include "sky/weather/model.hpp"
@@ -22,6 +24,7 @@ struct HostPose {
   geo::GeodeticPose pose;
   std::uint32_t hostFrame = 0;
   double hostTime_s = 0;  // CIGI IG Control timestamp, s (0 when not valid)
+  bool hostTimeValid = false;  // the host marked its timestamp valid
   std::uint64_t sequence = 0;  // increments with every pose received
   std::chrono::steady_clock::time_point receivedAt;
   // The time of day at this pose (s since 1970) and where it came from
@@ -79,6 +82,23 @@ class SharedState {
   HostAtmosphere atmosphere() const {
     std::lock_guard lock(mutex_);
     return atmosphere_;
+  }
+
+  // The view this channel draws; main sets its id and the command line's
+  // frustum before the listener starts.
+  void setView(const ChannelView& v) {
+    std::lock_guard lock(mutex_);
+    view_ = v;
+  }
+  ChannelView view() const {
+    std::lock_guard lock(mutex_);
+    return view_;
+  }
+  // Applies a View Definition or View Control (applyViewPacket) to the view held.
+  template <class ViewPacket>
+  ViewUpdate applyView(const ViewPacket& packet) {
+    std::lock_guard lock(mutex_);
+    return applyViewPacket(view_, packet);
   }
 
   // Takes the snapshot of its area (WeatherSnapshot::areaIndex: 0 detailed,
@@ -143,6 +163,7 @@ class SharedState {
   std::uint64_t lastSequence_ = 0;  // of the pose a reset forgot: sequences never repeat
   std::uint64_t resets_ = 0;
   HostAtmosphere atmosphere_;
+  ChannelView view_;
   WeatherView weather_;
   bool detailedSeen_ = false;  // a Snapshot of area 0 has arrived
 };

@@ -126,9 +126,22 @@ struct ResolutionSettings {
   bool depthAware = true;     // false: plain bilinear over the four nearest pixels
 };
 
+// A view frustum by the angles of the image's four edges from the view axis,
+// deg: CIGI 3.3 View Definition's half-angles, left and down negative (an
+// off-axis channel of a multi-channel display has, e.g., left -10, right 50).
+// Each in (-kMaxFrustumHalfAngle_deg, kMaxFrustumHalfAngle_deg), left < right,
+// down < up. The rays: core_common.glsl, frustumPoint and cameraRay.
+struct ViewFrustum {
+  double left_deg = -30, right_deg = 30, up_deg = 30, down_deg = -30;
+  bool operator==(const ViewFrustum&) const = default;
+};
+// Past 89 deg the tangent grows past 57 and the edge pixels' rays cover tens
+// of degrees each; no display channel is that wide.
+inline constexpr double kMaxFrustumHalfAngle_deg = 89;
+
 struct RenderSettings {
   std::uint32_t width = 320, height = 180;  // pixels, [1, 8192]
-  double verticalFov_deg = 60;              // (0, 179)
+  double verticalFov_deg = 60;              // (0, 179); a symmetric frustum (symmetricFrustum)
   std::uint32_t noiseSeed = 1;              // shape noise; same seed, same clouds
   // Where noise textures are cached between starts (noise_cache.hpp);
   // empty: generated at every start.
@@ -137,6 +150,10 @@ struct RenderSettings {
   TemporalSettings temporal;
   ResolutionSettings resolution;
 };
+
+// The symmetric frustum of the settings: verticalFov_deg up and down, the
+// horizontal half-angle from it and the aspect width / height.
+ViewFrustum symmetricFrustum(const RenderSettings& settings);
 
 struct FrameInputs {
   geo::GeodeticPose camera;  // CIGI pose: lat/lon/alt (m above the ellipsoid, >= 0), yaw/pitch/roll deg
@@ -168,6 +185,14 @@ struct FrameInputs {
   // Koschmieder's range at 550 nm (haze.hpp). nullopt: the standard aerosol
   // (Bruneton 2017's profile, 218 km).
   std::optional<double> visibility_m;
+  // This frame's view frustum (a channel's View Definition); unset: the
+  // settings' symmetric one (symmetricFrustum).
+  std::optional<ViewFrustum> frustum;
+  // The frame's place in the interleave and accumulation cycles
+  // (TemporalSettings): channels of one display that draw the same host
+  // frame pass its number, so they draw the same pixels of each block with
+  // the same offsets. Unset: the frames this renderer has planned so far.
+  std::optional<std::uint64_t> patternIndex;
   std::uint64_t frameIndex = 0;  // the caller's frame number, for its metadata; the image does not depend on it
 };
 
