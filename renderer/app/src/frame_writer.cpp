@@ -142,6 +142,8 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
   for (const auto& t : r.gpu) gpu[t.pass] = gpu.value(t.pass, 0.0) + t.gpu_ms;
   line["gpu_ms"] = gpu;
   if (r.presented) line["presented"] = *r.presented;
+  if (r.transportDelay_ms) line["transport_delay_ms"] = *r.transportDelay_ms;
+  if (r.presentDelay_ms) line["present_delay_ms"] = *r.presentDelay_ms;
   if (s.temporal.interleave > 1) {
     const render::TemporalReport& t = r.temporal;
     line["temporal"] = {{"drawn_whole", t.drawnWhole}, {"reason", t.reason},     {"drawn", t.drawn},

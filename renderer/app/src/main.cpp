@@ -32,6 +32,7 @@
 #include "sky/app/headless_replay.hpp"
 #include "sky/app/host_clock.hpp"
 #include "sky/app/host_locked_clock.hpp"
+#include "sky/app/latency_histogram.hpp"
 #include "sky/app/view_state.hpp"
 #include "sky/render/presets.hpp"
 #include "sky/app/timed_render.hpp"
@@ -431,6 +432,7 @@ int main(int argc, char** argv) {
   std::fflush(stdout);
 
   std::uint64_t frames = 0, lastSequence = 0, droppedWarnedAt = 0, resetsSeen = 0;
+  sky::app::LatencyHistogram transportDelay, presentDelay;
   sky::app::AreaTracker areas;
   const auto start = Clock::now();
   auto lastReport = start;
@@ -519,6 +521,11 @@ int main(int argc, char** argv) {
       exitCode = 3;
       break;
     }
+    const auto delay_ms = [&] {
+      return std::chrono::duration<double, std::milli>(Clock::now() - pose->receivedAt).count();
+    };
+    record.transportDelay_ms = delay_ms();
+    transportDelay.add(*record.transportDelay_ms);
     sky::app::mirrorImage(*image, channelView.mirror);
     record.frame = frames;
     record.host = *pose;
@@ -543,6 +550,8 @@ int main(int argc, char** argv) {
         break;
       }
       record.presented = *shown;
+      record.presentDelay_ms = delay_ms();
+      presentDelay.add(*record.presentDelay_ms);
       for (const auto& pass : (*renderer)->lastPassTimes())
         if (pass.pass == "present") record.gpu.push_back(pass);
     }
@@ -575,6 +584,13 @@ int main(int argc, char** argv) {
               static_cast<unsigned long long>(cigi->datagramsAccepted()),
               static_cast<unsigned long long>(cigi->datagramsDropped()), cigi->drops().summary().c_str(),
               cigi->ignoredSummary().c_str(), static_cast<unsigned long long>(weather.malformedFrames()));
+  // Host datagram to finished frame (and to the window): p50, p99, max.
+  std::printf("render: transport delay over %llu frames: p50 %.1f ms, p99 %.1f ms, max %.1f ms\n",
+              static_cast<unsigned long long>(transportDelay.count()), transportDelay.percentile_ms(50),
+              transportDelay.percentile_ms(99), transportDelay.max_ms());
+  if (presentDelay.count() > 0)
+    std::printf("render: to presentation: p50 %.1f ms, p99 %.1f ms, max %.1f ms\n", presentDelay.percentile_ms(50),
+                presentDelay.percentile_ms(99), presentDelay.max_ms());
   std::printf("render: view %u: %llu View Definition and %llu View Control applied, %llu packets for other views "
               "ignored, %llu unsupported parts\n",
               o.viewId, static_cast<unsigned long long>(state.view().definitions),

@@ -72,6 +72,10 @@ struct FrameRecord {
   render::TemporalReport temporal;    // what the reprojection did (interleaved presets)
   render::WeatherMapReport weatherMap;  // what this frame changed in the weather map (per tile, or rebuilt and why)
   std::optional<bool> presented;      // windowed: whether the frame reached the window
+  // Transport delay: from the arrival of the host datagram whose pose the
+  // frame draws (for a smoothed input, the newest) to the frame's completion
+  // (image read back), and, windowed, to its presentation. Live frames only.
+  std::optional<double> transportDelay_ms, presentDelay_ms;
   // The channel's view (CIGI View Definition / View Control) and the camera
   // it gave: the ownship pose (host) with the eyepoint composed on. Unset
   // where the camera is the pose itself (--replay).
