@@ -47,6 +47,9 @@ int main(int argc, char** argv) {
   app.add_flag("--loop", o.loop, "start again at the end");
   app.add_flag("--little-endian", o.littleEndian, "send little-endian CIGI (default big-endian)");
   app.add_flag("--quiet", o.quiet, "no progress lines");
+  app.add_flag("--sync", o.sync,
+               "synchronous: send each host frame once every IG answered the one before with Start of Frame "
+               "(renderers run with --cigi-sync); the flight advances 1/--rate x --speed per frame");
   app.add_option("--conditions-rate", o.conditionsRate_hz,
                  "Environmental Conditions Requests (weather + aerosol) at the ownship per second of flight; "
                  "0: none")

@@ -91,6 +91,7 @@ bool CigiHost::onIgDatagram(std::span<const std::uint8_t> bytes) {
   }
   const auto& sof = std::get<cigi::StartOfFrame>(d->packets[0]);
   lastIgFrame_ = sof.igFrame;
+  lastSofHostFrame_ = sof.lastHostFrame;
   if (!lastAckedHostFrame_ || sof.lastHostFrame > *lastAckedHostFrame_) lastAckedHostFrame_ = sof.lastHostFrame;
   ++sofReceived_;
   lastReplies_.assign(d->packets.begin() + 1, d->packets.end());

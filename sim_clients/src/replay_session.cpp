@@ -81,12 +81,15 @@ void ReplaySession::stop() {
 
 void ReplaySession::tick() {
   if (finished_) return;
-  const double elapsed = std::chrono::duration<double>(Clock::now() - wallStart_).count();
+  // Synchronous: sim time, one step per frame; else wall time.
+  const double elapsed = o_.sync ? double(ticks_) / o_.rate_hz
+                                 : std::chrono::duration<double>(Clock::now() - wallStart_).count();
   double t = t0_ + elapsed * o_.speed;
   const bool done = t >= t1_;
   if (done && o_.loop) {
     wallStart_ = Clock::now();
     t = t0_;
+    if (o_.sync) ticks_ = 0;
   }
   if (done && !o_.loop) t = t1_;
   const auto pose = flight::sample(flight_, t);
@@ -112,8 +115,22 @@ void ReplaySession::tick() {
     finish();
     return;
   }
-  // Absolute deadlines, so the rate does not drift.
   ++ticks_;
+  if (o_.sync) {
+    // The frame just sent is host frame framesSent() - 1; the next goes
+    // when every IG has drawn it, or after the timeout.
+    awaited_ = host_.framesSent() - 1;
+    answered_.assign(targets_.size(), false);
+    timer_.expires_after(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o_.syncTimeout_s)));
+    timer_.async_wait([this](boost::system::error_code e) {
+      if (e) return;
+      ++syncTimeouts_;
+      awaited_.reset();
+      tick();
+    });
+    return;
+  }
+  // Absolute deadlines, so the rate does not drift.
   timer_.expires_at(tick0_ + std::chrono::duration_cast<Clock::duration>(
                                  std::chrono::duration<double>(double(ticks_) / o_.rate_hz)));
   timer_.async_wait([this](boost::system::error_code e) {
@@ -135,6 +152,9 @@ void ReplaySession::report(double t, bool final) {
               wall > 0 ? host_.framesSent() / wall : 0.0,
               static_cast<unsigned long long>(host_.startOfFramesReceived()), host_.igLagFrames(),
               final ? ", done" : "");
+  if (o_.sync && final)
+    std::printf("%s: synchronous: %llu host frames sent on after a %.1f s wait for Start of Frame\n", o_.name.c_str(),
+                static_cast<unsigned long long>(syncTimeouts_), o_.syncTimeout_s);
   if (probe_ && lastConditions_ && lastConditions_->weather) {
     const auto& w = *lastConditions_->weather;
     std::printf("%s: conditions at %.0f m: wind %.1f m/s from %.0f deg, vertical %.1f m/s", o_.name.c_str(),
@@ -161,11 +181,21 @@ void ReplaySession::finish() {
 void ReplaySession::receive() {
   socket_.async_receive_from(asio::buffer(rx_), from_, [this](boost::system::error_code ec, std::size_t n) {
     if (ec) return;
-    if (host_.onIgDatagram(std::span(rx_.data(), n)) && probe_)
+    const bool sof = host_.onIgDatagram(std::span(rx_.data(), n));
+    if (sof && probe_)
       for (auto& row : probe_->onIgPackets(host_.lastReplies(), flightTime_s_)) {
         if (csv_.is_open()) csv_ << ConditionsProbe::csvLine(row) << '\n';
         lastConditions_ = std::move(row);
       }
+    if (sof && awaited_ && host_.lastStartOfFrameHostFrame() == awaited_) {
+      for (std::size_t i = 0; i < targets_.size(); ++i)
+        if (targets_[i] == from_) answered_[i] = true;
+      if (std::all_of(answered_.begin(), answered_.end(), [](bool b) { return b; })) {
+        awaited_.reset();
+        timer_.cancel();
+        asio::post(socket_.get_executor(), [this] { tick(); });
+      }
+    }
     receive();
   });
 }

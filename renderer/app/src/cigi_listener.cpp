@@ -199,20 +199,41 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
     p.timeSource = clock_.source();
     state_.setPose(p);
   }
+  // Environmental Conditions Requests, answered with Start of Frame from the
+  // weather this channel holds, by the query every process shares.
+  std::vector<cigi::Packet> replies;
+  for (const auto& packet : datagram->packets)
+    if (const auto* request = std::get_if<cigi::EnvironmentalConditionsRequest>(&packet))
+      for (auto& reply : answerConditions(*request, state_.weather(), now, ownship(state_), state_.atmosphere()))
+        replies.push_back(std::move(reply));
+  if (synchronous_ && !standby) {
+    pendingReplies_ = std::move(replies);
+    syncHost_ = from;
+    return {};
+  }
+  return startOfFrame(ig->hostFrame, standby, replies);
+}
+
+std::vector<std::uint8_t> CigiListener::startOfFrame(std::uint32_t lastHostFrame, bool standby,
+                                                     const std::vector<cigi::Packet>& replies) {
   cigi::StartOfFrame sof;
   sof.mode = standby ? cigi::IgMode::ResetStandby : cigi::IgMode::Operate;
   sof.igFrame = igFrame_++;
-  sof.lastHostFrame = ig->hostFrame;
+  sof.lastHostFrame = lastHostFrame;
   cigi::DatagramWriter w;
   w.add(sof);
-  // Environmental Conditions Requests, answered in the same datagram from the
-  // weather this channel holds, by the query every process shares.
-  for (const auto& packet : datagram->packets)
-    if (const auto* request = std::get_if<cigi::EnvironmentalConditionsRequest>(&packet))
-      for (const auto& reply :
-           answerConditions(*request, state_.weather(), now, ownship(state_), state_.atmosphere()))
-        w.add(reply);
+  for (const auto& reply : replies) w.add(reply);
   return w.bytes();
+}
+
+void CigiListener::frameDrawn(std::uint32_t hostFrame) {
+  asio::post(socket_.get_executor(), [this, hostFrame] {
+    if (!syncHost_ || !socket_.is_open()) return;
+    const auto bytes = startOfFrame(hostFrame, standby_.load(), pendingReplies_);
+    pendingReplies_.clear();
+    boost::system::error_code ec;
+    socket_.send_to(asio::buffer(bytes), *syncHost_, 0, ec);
+  });
 }
 
 template <class ViewPacket>

@@ -54,6 +54,7 @@ struct Options {
   std::string cigiHost;  // empty: the first sender of a valid host datagram
   unsigned cigiPort = 8004;
   std::string portFile;
+  bool cigiSync = false;
   std::string fdmAddress = "127.0.0.1";
   int fdmPort = -1;  // -1: no FlightGear input
   std::string fdmPortFile;
@@ -129,6 +130,9 @@ int main(int argc, char** argv) {
                  "port of ADDR). Default: the address of the first valid host datagram's sender (any port). "
                  "Datagrams from any other sender are dropped, counted and never answered");
   app.add_option("--port-file", o.portFile, "write the CIGI port here once listening");
+  app.add_flag("--cigi-sync", o.cigiSync,
+               "synchronous CIGI: Start of Frame for a host frame goes only once its frame is drawn, so a host "
+               "that waits for it draws exactly one frame per host frame (default: asynchronous, answered at once)");
   app.add_option("--fdm-port", o.fdmPort,
                  "take the camera from FlightGear --native-fdm datagrams on this UDP port (0 = any free port) "
                  "instead of from CIGI")
@@ -361,6 +365,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (startUtc_s) cigi->setStartUtc(*startUtc_s);
+  cigi->setSynchronous(o.cigiSync && o.fdmPort < 0 && o.foreflightPort < 0);
   cigi->start();
   // With --fdm-port the camera comes from FlightGear only; the CIGI endpoint
   // stays open (and answers Start of Frame) but its pose is not used.
@@ -562,6 +567,8 @@ int main(int argc, char** argv) {
       exitCode = 2;
       break;
     }
+    // Synchronous: the host hears of this host frame only now.
+    if (o.cigiSync && !smoothed) cigi->frameDrawn(pose->hostFrame);
     ++frames;
     const auto after = Clock::now();
     if (after - lastReport > std::chrono::seconds(1)) {

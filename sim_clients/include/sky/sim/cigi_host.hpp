@@ -63,6 +63,8 @@ class CigiHost {
   std::uint64_t startOfFramesReceived() const { return sofReceived_; }
   std::uint64_t malformedReceived() const { return malformed_; }
   std::optional<std::uint32_t> lastIgFrame() const { return lastIgFrame_; }
+  // The Last Host Frame Number of the newest valid Start of Frame.
+  std::optional<std::uint32_t> lastStartOfFrameHostFrame() const { return lastSofHostFrame_; }
 
  private:
   HostOptions options_;
@@ -70,6 +72,7 @@ class CigiHost {
   std::optional<std::int64_t> lastCelestialMinute_;
   std::optional<std::uint32_t> lastAckedHostFrame_;
   std::optional<std::uint32_t> lastIgFrame_;
+  std::optional<std::uint32_t> lastSofHostFrame_;
   std::uint64_t sofReceived_ = 0;
   std::uint64_t malformed_ = 0;
   std::vector<cigi::Packet> lastReplies_;

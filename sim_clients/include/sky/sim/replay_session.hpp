@@ -45,6 +45,12 @@ struct ReplayOptions {
   double conditionsRate_hz = 1;    // 0: no Environmental Conditions Requests
   std::string conditionsCsv;       // empty: answers are only printed
   std::string name = "replay";     // progress line prefix
+  // Synchronous (the IGs run --cigi-sync): each host frame goes once every
+  // IG's Start of Frame for the one before has come (or syncTimeout_s has
+  // passed, counted), and the flight advances 1/rate_hz x speed per frame:
+  // the host runs at the IGs' pace, every frame drawn exactly once.
+  bool sync = false;
+  double syncTimeout_s = 2.0;
 };
 
 // Parses an --ig value, "ADDR:PORT" or "[ADDR]:PORT" (PORT 1..65535);
@@ -66,6 +72,8 @@ class ReplaySession {
   void stop();
 
   int exitCode() const { return exitCode_; }
+  // Synchronous: host frames sent on before every IG's Start of Frame came.
+  std::uint64_t syncTimeouts() const { return syncTimeouts_; }
   double flightTime_s() const { return flightTime_s_; }
   const CigiHost& host() const { return host_; }
   const std::optional<ConditionsProbe>& probe() const { return probe_; }
@@ -94,6 +102,10 @@ class ReplaySession {
   double t0_ = 0, t1_ = 0;
   Clock::time_point wallStart_, lastReport_, tick0_;
   std::uint64_t ticks_ = 0;
+  // Synchronous: the host frame waited for, and which IGs have answered it.
+  std::optional<std::uint32_t> awaited_;
+  std::vector<bool> answered_;
+  std::uint64_t syncTimeouts_ = 0;
   int exitCode_ = 0;
   bool finished_ = false;
 };

@@ -91,6 +91,16 @@ class CigiListener {
   // --utc: the time of day at the host's first datagram, until a Celestial
   // Sphere Control sets one. Call before start().
   void setStartUtc(double utc_s) { clock_ = HostClock(utc_s); }
+  // --cigi-sync: synchronous operation. A host datagram is not answered at
+  // once (except in Reset/Standby, where no frame is drawn): the render loop
+  // calls frameDrawn() once the frame of that host frame is finished, and
+  // only then goes Start of Frame (with the answers to its conditions
+  // requests), so a host that waits for it is locked to the frames. Call
+  // before start().
+  void setSynchronous(bool on) { synchronous_ = on; }
+  // Synchronous: the frame drawing host frame `hostFrame` is done; sends its
+  // Start of Frame to the host. Thread-safe (posted to the io thread).
+  void frameDrawn(std::uint32_t hostFrame);
 
   // Takes one datagram from `from`: the pose into SharedState when it comes
   // from the host, and the reply to send back to `from` (empty: none, the
@@ -120,6 +130,8 @@ class CigiListener {
   void receive();
   void dropped(DropReason reason, const std::string& detail);
   void ignore(std::uint8_t id);
+  std::vector<std::uint8_t> startOfFrame(std::uint32_t lastHostFrame, bool standby,
+                                         const std::vector<cigi::Packet>& replies);
   template <class ViewPacket>
   void takeView(const ViewPacket& packet, const char* name);
 
@@ -138,6 +150,12 @@ class CigiListener {
   std::atomic<bool> standby_{false};
   HostTimeline timeline_;  // io thread only
   HostClock clock_;        // io thread only
+  bool synchronous_ = false;
+  // Synchronous: the answers waiting for their frame's Start of Frame, and
+  // where to send it (io thread only). At most one host frame's: a host
+  // locked to us sends the next only after it.
+  std::vector<cigi::Packet> pendingReplies_;
+  std::optional<boost::asio::ip::udp::endpoint> syncHost_;
   mutable std::mutex hostMutex_;         // guards host_ (written by the io thread, read by any)
   std::optional<CigiHost> host_;
 };
