@@ -5,11 +5,7 @@
 #include <cmath>
 #include <numbers>
 
-#include <spdlog/spdlog.h>
-
 namespace sky::app {
-
-namespace asio = boost::asio;
 
 namespace {
 constexpr double kDegToRad = std::numbers::pi / 180.0;
@@ -18,8 +14,6 @@ constexpr double kGravity_mps2 = 9.80665;
 // Successive fixes closer in time than this give no rates (a burst of two):
 // the last rates are kept. 0.2 s.
 constexpr double kMinRateBaseline_s = 0.2;
-
-double secondsOf(SteadyTime t) { return std::chrono::duration<double>(t.time_since_epoch()).count(); }
 }  // namespace
 
 PoseSmootherConfig foreflightSmoothing() {
@@ -79,42 +73,6 @@ std::optional<PoseSample> ForeFlightTrack::take(const foreflight::Message& messa
   return s;
 }
 
-ForeFlightListener::ForeFlightListener(asio::io_context& io, const std::string& address, unsigned short port,
-                                       std::optional<double> startUtc_s, PoseSmootherConfig smoothing)
-    : socket_(io), smoother_(smoothing), clock_(startUtc_s) {
-  const asio::ip::udp::endpoint ep(asio::ip::make_address(address), port);
-  socket_.open(ep.protocol());
-  socket_.bind(ep);
-  port_ = socket_.local_endpoint().port();
-}
-
-void ForeFlightListener::start() { receive(); }
-
-void ForeFlightListener::stop() {
-  boost::system::error_code ec;
-  socket_.close(ec);
-}
-
-std::uint64_t ForeFlightListener::outliersDropped() const {
-  std::lock_guard lock(mutex_);
-  return smoother_.outliersDropped();
-}
-
-void ForeFlightListener::receive() {
-  socket_.async_receive_from(asio::buffer(rx_), from_, [this](boost::system::error_code ec, std::size_t n) {
-    if (ec == asio::error::operation_aborted) return;
-    if (!ec) handleDatagram(std::span(rx_.data(), n), std::chrono::steady_clock::now());
-    receive();
-  });
-}
-
-void ForeFlightListener::dropped(DropReason reason, const std::string& detail) {
-  drops_.add(reason);
-  if (loggedReasons_.insert(dropKind(reason, detail)).second)
-    spdlog::warn("ForeFlight: dropped a datagram ({}): {} (further drops of this kind are only counted)",
-                 toString(reason), detail);
-}
-
 void ForeFlightListener::handleDatagram(std::span<const std::uint8_t> bytes, SteadyTime now) {
   auto messages = foreflight::parseDatagram(bytes);
   if (!messages) {
@@ -127,34 +85,8 @@ void ForeFlightListener::handleDatagram(std::span<const std::uint8_t> bytes, Ste
       continue;
     }
     if (std::holds_alternative<foreflight::Attitude>(m)) ++attitudes_;
-    const auto sample = track_.take(m, now);
-    if (!sample) continue;
-    std::unique_lock lock(mutex_);
-    if (!smoother_.add(*sample)) {
-      lock.unlock();
-      dropped(DropReason::Unusable, "the pose smoother cannot take its pose (a value outside the ranges it takes)");
-      continue;
-    }
-    if (!firstAt_) firstAt_ = now;
-    newestAt_ = now;
-    clock_.advanceTo(secondsOf(now));
-    ++accepted_;
+    if (const auto sample = track_.take(m, now)) addSample(*sample, now);
   }
-}
-
-std::optional<HostPose> ForeFlightListener::poseAt(SteadyTime now) {
-  std::lock_guard lock(mutex_);
-  const auto smoothed = smoother_.poseAt(now);
-  if (!smoothed) return std::nullopt;
-  HostPose p;
-  p.pose = smoothed->pose;
-  p.hostFrame = static_cast<std::uint32_t>(accepted_.load());
-  p.hostTime_s = std::chrono::duration<double>(smoothed->renderTime - *firstAt_).count();
-  p.sequence = ++sequence_;
-  p.receivedAt = *newestAt_;
-  p.utc_s = clock_.utcAt(secondsOf(smoothed->renderTime));
-  p.timeSource = clock_.source();
-  return p;
 }
 
 }  // namespace sky::app

@@ -16,12 +16,11 @@
 #include <nlohmann/json.hpp>
 
 #include "sky/app/area_of_interest.hpp"
-#include "sky/app/drawable_weather.hpp"
+#include "sky/app/channel_frame.hpp"
 #include "sky/app/fallback_weather.hpp"
 #include "sky/app/frame_writer.hpp"
 #include "sky/app/replay_outputs.hpp"
 #include "sky/app/shared_state.hpp"
-#include "sky/app/timed_render.hpp"
 #include "sky/app/weather_client.hpp"
 #include "sky/flight/flight.hpp"
 #include "sky/flight/utf8_text.hpp"
@@ -176,7 +175,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   auto lastReport = start;
   int exitCode = 0;
   std::size_t done = 0;
-  std::uint64_t droppedWarnedAt = 0;
+  ChannelFrames frames(renderer, *writer, o.display);
   for (std::size_t i = 0; i < frameCount; ++i) {
     if (stop && *stop) {
       exitCode = 1;
@@ -205,67 +204,35 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
                              "drawing the old area's\n", i, o.weatherTimeout_s);
     }
     const WeatherView view = state.weather();
-    std::vector<std::uint32_t> dropped;
-    const auto drawable = drawableWeather(view.snapshot, render::kMaxLayers, &dropped);
-    if (!dropped.empty() && view.version != droppedWarnedAt) {
-      droppedWarnedAt = view.version;
-      std::fprintf(stderr, "skyshell-render: warning: frame %zu: weather has %zu layers, drawing the %zu with most cloud\n",
-                   i, view.snapshot.layers.size(), render::kMaxLayers);
-    }
-    const auto coarse = view.coarse ? std::optional(drawableCoarse(*view.coarse, drawable)) : std::nullopt;
-    render::FrameInputs in;
-    in.camera = pose;
-    in.weather = &drawable;
-    in.coarseWeather = coarse ? &*coarse : nullptr;
-    in.weatherClock_s = clockBase_s + (t - t0) * clockRate;
-    in.sunAzimuth_deg = o.sunAzimuth_deg;
-    in.sunElevation_deg = o.sunElevation_deg;
-    if (sunFromDate) in.utc_s = double(*flight->startUtc_s) + (t - first_s);
-    in.frameIndex = i;
-    FrameRecord record;
-    auto image = timedRender(renderer, in, record);
-    if (!image) {
-      std::fprintf(stderr, "skyshell-render: frame %zu: %s\n", i, describe(image.error()).c_str());
-      exitCode = 3;
+    FrameRequest request;
+    request.host.pose = pose;
+    request.host.hostFrame = static_cast<std::uint32_t>(i);
+    request.host.hostTime_s = t - first_s;
+    request.source = "replay";
+    request.camera = pose;
+    request.weather = &view;
+    request.weatherSource = o.weatherFile.empty() ? "server" : "file";
+    request.weatherConnected = view.connected;
+    request.weatherClock_s = clockBase_s + (t - t0) * clockRate;
+    request.sunAzimuth_deg = o.sunAzimuth_deg;
+    request.sunElevation_deg = o.sunElevation_deg;
+    if (sunFromDate) request.utc_s = double(*flight->startUtc_s) + (t - first_s);
+    request.utcSource = sunFromDate ? TimeSource::FlightFile : TimeSource::Fixed;
+    request.frameIndex = i;
+    auto drawn = frames.draw(request);
+    if (!drawn) {
+      std::fprintf(stderr, "skyshell-render: %s\n", drawn.error().message.c_str());
+      exitCode = drawn.error().exitCode;
       break;
     }
-    if (o.display) {
-      auto shown = o.display->show(*image);
-      if (!shown) {
-        std::fprintf(stderr, "skyshell-render: frame %zu: %s\n", i, describe(shown.error()).c_str());
-        exitCode = 3;
-        break;
-      }
-      record.presented = *shown;
-      for (const auto& pass : renderer.lastPassTimes())
-        if (pass.pass == "present") record.gpu.push_back(pass);
-    }
-    logValidationMessages(renderer);
-    if (weather) weather->reportCamera(pose, i, view.version, in.weatherClock_s);
-    record.frame = i;
-    record.host.pose = pose;
-    record.host.hostFrame = static_cast<std::uint32_t>(i);
-    record.host.hostTime_s = t - first_s;
-    record.source = "replay";
-    record.utcSource = sunFromDate ? TimeSource::FlightFile : TimeSource::Fixed;
-    record.weatherClock_s = in.weatherClock_s;
-    record.weatherVersion = view.version;
-    record.weatherConnected = view.connected;
-    record.weatherSource = o.weatherFile.empty() ? "server" : "file";
-    record.layerCount = view.snapshot.layers.size();
-    record.weatherAreas = {{view.snapshot.tileLevel, view.snapshot.tiles.size()}};
-    if (view.coarse) record.weatherAreas.push_back({view.coarse->tileLevel, view.coarse->tiles.size()});
-    if (auto ok = writer->write(*image, record); !ok) {
-      std::fprintf(stderr, "skyshell-render: %s\n", describe(ok.error()).c_str());
-      exitCode = 2;
-      break;
-    }
+    if (weather) weather->reportCamera(pose, i, view.version, request.weatherClock_s);
+    const FrameRecord& record = drawn->record;
     renderMs.push_back(record.render_ms);
     for (const auto& pass : record.gpu) gpuMs[pass.pass].push_back(pass.gpu_ms);
     versionsSeen.insert(view.version);
     nonFinite += record.stats.nonFinite;
     if (nextPick < picks.size() && picks[nextPick] == i) {
-      sheet.add(*image);
+      sheet.add(drawn->image);
       ++nextPick;
     }
     done = i + 1;

@@ -18,17 +18,17 @@
 #include <CLI/CLI.hpp>
 #include <boost/asio.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
-#include <spdlog/fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "sky/app/area_of_interest.hpp"
 #include "sky/app/cigi_listener.hpp"
-#include "sky/app/drawable_weather.hpp"
+#include "sky/app/channel_frame.hpp"
 #include "sky/app/fallback_weather.hpp"
 #include "sky/app/fdm_listener.hpp"
 #include "sky/app/foreflight_listener.hpp"
 #include "sky/app/frame_writer.hpp"
 #include "sky/app/glfw_window.hpp"
+#include "sky/app/pose_source.hpp"
 #include "sky/app/headless_replay.hpp"
 #include "sky/app/host_clock.hpp"
 #include "sky/app/host_locked_clock.hpp"
@@ -436,35 +436,44 @@ int main(int argc, char** argv) {
                 foreflight->port());
   std::fflush(stdout);
 
-  std::uint64_t frames = 0, lastSequence = 0, droppedWarnedAt = 0, resetsSeen = 0;
+  // The one pose source this channel draws from.
+  std::unique_ptr<sky::app::PoseSource> source;
+  if (fdm)
+    source = std::make_unique<sky::app::FdmPoseSource>(*fdm);
+  else if (foreflight)
+    source = std::make_unique<sky::app::ForeFlightPoseSource>(*foreflight, state);
+  else
+    source = std::make_unique<sky::app::CigiPoseSource>(state, *cigi, o.cigiSync);
+  sky::app::ChannelFrames channelFrames(**renderer, *writer, display ? &*display : nullptr);
+
+  std::uint64_t frames = 0, lastSequence = 0, resetsSeen = 0;
   sky::app::LatencyHistogram transportDelay, presentDelay;
   sky::app::AreaTracker areas;
   const auto start = Clock::now();
   auto lastReport = start;
   Clock::time_point lastPoseAt{};
-  // Smoothed inputs (FlightGear FDM, ForeFlight) pace frames by this clock,
-  // CIGI frames come with the host's datagrams.
-  const bool smoothed = fdm || foreflight;
-  const char* inputName = fdm ? "FlightGear FDM" : foreflight ? "ForeFlight" : "CIGI";
-  const auto fdmFramePeriod = std::chrono::duration_cast<Clock::duration>(
+  // Smoothed sources are sampled at this period; CIGI frames come with the
+  // host's datagrams.
+  const bool smoothed = source->smoothed();
+  const auto framePeriod = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(1.0 / o.fdmFrameRate_hz));
-  Clock::time_point nextFdmFrameAt{};
+  Clock::time_point nextFrameAt{};
   sky::app::HostLockedClock hostClock;
   int exitCode = 0;
   while (!stopRequested) {
-    if (smoothed && Clock::now() < nextFdmFrameAt) std::this_thread::sleep_until(nextFdmFrameAt);
+    if (smoothed && Clock::now() < nextFrameAt) std::this_thread::sleep_until(nextFrameAt);
     const auto now = Clock::now();
-    const auto pose = fdm ? fdm->poseAt(now) : foreflight ? foreflight->poseAt(now) : state.pose();
+    const auto pose = source->poseAt(now);
     if (pose)
       for (const auto& area : areas.update(pose->pose)) weather.subscribe(area);
     if (pose) lastPoseAt = pose->receivedAt;
     // Idle only once the newest pose has been rendered: a slow frame must not
     // skip the host's last pose (seen in CI under load: the final fix of the
-    // replay arrived while a frame took longer than --idle-exit).
-    // (FDM frames are rendered continuously from the smoother: always current.)
+    // replay arrived while a frame took longer than --idle-exit). (Smoothed
+    // sources are rendered continuously: always current.)
     if (o.idleExit_s > 0 && pose && (smoothed || pose->sequence == lastSequence) &&
         std::chrono::duration<double>(now - lastPoseAt).count() > o.idleExit_s) {
-      spdlog::info("no {} for {:.1f} s: stopping", inputName, o.idleExit_s);
+      spdlog::info("no {} for {:.1f} s: stopping", source->name(), o.idleExit_s);
       break;
     }
     const auto streamed = state.weather();
@@ -481,94 +490,53 @@ int main(int argc, char** argv) {
       continue;
     }
     lastSequence = pose->sequence;
-    nextFdmFrameAt = now + fdmFramePeriod;
-    const sky::app::WeatherView& view = fallback.view(weatherSource, streamed);
+    nextFrameAt = now + framePeriod;
     if (const auto resets = state.resets(); resets != resetsSeen) {
       resetsSeen = resets;
       (*renderer)->resetHistory("IG reset by the host");
     }
-    const auto atmosphere = fdm ? fdm->atmosphere() : state.atmosphere();
 
-    std::vector<std::uint32_t> dropped;
-    const auto drawable = sky::app::drawableWeather(view.snapshot, sky::render::kMaxLayers, &dropped);
-    if (!dropped.empty() && view.version != droppedWarnedAt) {
-      droppedWarnedAt = view.version;
-      spdlog::warn("weather has {} layers, this channel draws {}: leaving out layer(s) {}", view.snapshot.layers.size(),
-                   sky::render::kMaxLayers, fmt::join(dropped, ", "));
-    }
-    const auto coarse =
-        view.coarse ? std::optional(sky::app::drawableCoarse(*view.coarse, drawable)) : std::nullopt;
+    const sky::app::WeatherView& view = fallback.view(weatherSource, streamed);
     const sky::app::ChannelView channelView = state.view();
-    sky::render::FrameInputs in;
-    in.camera = sky::app::viewCamera(pose->pose, channelView);
-    in.frustum = channelView.frustum;
-    in.weather = &drawable;
-    in.coarseWeather = coarse ? &*coarse : nullptr;
+    sky::app::FrameRequest request;
+    request.host = *pose;
+    request.source = source->source();
+    request.camera = sky::app::viewCamera(pose->pose, channelView);
+    request.view = sky::app::FrameRecord::View{channelView, request.camera};
+    request.frustum = channelView.frustum;
+    request.mirror = channelView.mirror;
+    request.weather = &view;
+    request.weatherSource = toString(weatherSource);
+    request.weatherConnected = streamed.connected;
     // CIGI frames: the clock and the interleave pattern follow the host
     // frame, so every channel draws a host frame alike (host_locked_clock.hpp).
     if (smoothed) {
-      in.weatherClock_s = view.clockNow(now);
+      request.weatherClock_s = view.clockNow(now);
     } else {
-      in.weatherClock_s = hostClock.at(pose->hostTimeValid ? std::optional(pose->hostTime_s) : std::nullopt,
-                                       view.clock, pose->receivedAt);
-      in.patternIndex = pose->hostFrame;
+      request.weatherClock_s = hostClock.at(pose->hostTimeValid ? std::optional(pose->hostTime_s) : std::nullopt,
+                                            view.clock, pose->receivedAt);
+      request.patternIndex = pose->hostFrame;
+      request.serverClockAtArrival_s = view.clock.at(pose->receivedAt);
     }
-    in.sunAzimuth_deg = o.sunAzimuth_deg;
-    in.sunElevation_deg = o.sunElevation_deg;
-    in.utc_s = pose->utc_s;
-    in.visibility_m = atmosphere.hazeVisibility_m();
-    in.frameIndex = frames;
-    sky::app::FrameRecord record;
-    auto image = sky::app::timedRender(**renderer, in, record);
-    if (!image) {
-      std::fprintf(stderr, "skyshell-render: frame %llu: %s\n", static_cast<unsigned long long>(frames),
-                   sky::describe(image.error()).c_str());
-      exitCode = 3;
+    request.sunAzimuth_deg = o.sunAzimuth_deg;
+    request.sunElevation_deg = o.sunElevation_deg;
+    request.utc_s = pose->utc_s;
+    request.utcSource = pose->timeSource;
+    request.atmosphere = source->atmosphere();
+    request.frameIndex = frames;
+    request.live = true;
+    auto drawn = channelFrames.draw(request);
+    if (!drawn) {
+      std::fprintf(stderr, "skyshell-render: %s\n", drawn.error().message.c_str());
+      exitCode = drawn.error().exitCode;
       break;
     }
-    const auto delay_ms = [&] {
-      return std::chrono::duration<double, std::milli>(Clock::now() - pose->receivedAt).count();
-    };
-    record.transportDelay_ms = delay_ms();
-    transportDelay.add(*record.transportDelay_ms);
-    sky::app::mirrorImage(*image, channelView.mirror);
-    record.frame = frames;
-    record.host = *pose;
-    record.view = sky::app::FrameRecord::View{channelView, in.camera};
-    record.source = fdm ? "fdm" : foreflight ? "foreflight" : "cigi";
-    record.utcSource = pose->timeSource;
-    record.atmosphere = atmosphere;
-    record.weatherClock_s = in.weatherClock_s;
-    if (!smoothed) record.serverClockAtArrival_s = view.clock.at(pose->receivedAt);
-    record.weatherVersion = view.version;
-    record.weatherConnected = streamed.connected;
-    record.weatherSource = toString(weatherSource);
-    record.layerCount = view.snapshot.layers.size();
-    record.weatherAreas = {{view.snapshot.tileLevel, view.snapshot.tiles.size()}};
-    if (view.coarse) record.weatherAreas.push_back({view.coarse->tileLevel, view.coarse->tiles.size()});
-    if (display) {
-      auto shown = display->show(*image);
-      if (!shown) {
-        std::fprintf(stderr, "skyshell-render: frame %llu: %s\n", static_cast<unsigned long long>(frames),
-                     sky::describe(shown.error()).c_str());
-        exitCode = 3;
-        break;
-      }
-      record.presented = *shown;
-      record.presentDelay_ms = delay_ms();
-      presentDelay.add(*record.presentDelay_ms);
-      for (const auto& pass : (*renderer)->lastPassTimes())
-        if (pass.pass == "present") record.gpu.push_back(pass);
-    }
-    sky::app::logValidationMessages(**renderer);
-    weather.reportCamera(in.camera, frames, view.version, in.weatherClock_s);
-    if (auto ok = writer->write(*image, record); !ok) {
-      std::fprintf(stderr, "skyshell-render: %s\n", sky::describe(ok.error()).c_str());
-      exitCode = 2;
-      break;
-    }
-    // Synchronous: the host hears of this host frame only now.
-    if (o.cigiSync && !smoothed) cigi->frameDrawn(pose->hostFrame);
+    const sky::app::FrameRecord& record = drawn->record;
+    if (record.transportDelay_ms) transportDelay.add(*record.transportDelay_ms);
+    if (record.presentDelay_ms) presentDelay.add(*record.presentDelay_ms);
+    weather.reportCamera(request.camera, frames, view.version, request.weatherClock_s);
+    // Synchronous CIGI: the host hears of this host frame only now.
+    source->frameDrawn(pose->hostFrame);
     ++frames;
     const auto after = Clock::now();
     if (after - lastReport > std::chrono::seconds(1)) {
@@ -576,10 +544,9 @@ int main(int argc, char** argv) {
       const double elapsed = std::chrono::duration<double>(after - start).count();
       std::printf("render: %llu frames, %.1f frames/s, last %.0f ms, host frame %u, CIGI dropped %llu, "
                   "ignored packets %llu%s\n",
-                  static_cast<unsigned long long>(frames), frames / elapsed, record.render_ms,
-                  pose->hostFrame, static_cast<unsigned long long>(cigi->datagramsDropped()),
-                  static_cast<unsigned long long>(cigi->ignored().total()),
-                  fdm ? (", FlightGear FDM dropped " + std::to_string(fdm->datagramsDropped())).c_str() : "");
+                  static_cast<unsigned long long>(frames), frames / elapsed, record.render_ms, pose->hostFrame,
+                  static_cast<unsigned long long>(cigi->datagramsDropped()),
+                  static_cast<unsigned long long>(cigi->ignored().total()), source->progress().c_str());
       std::fflush(stdout);
     }
     if (o.maxFrames > 0 && frames >= o.maxFrames) break;
@@ -604,19 +571,7 @@ int main(int argc, char** argv) {
               static_cast<unsigned long long>(state.view().controls),
               static_cast<unsigned long long>(cigi->otherViewPackets()),
               static_cast<unsigned long long>(cigi->unsupportedViewParts()));
-  if (fdm)
-    std::printf("render: FlightGear FDM datagrams accepted %llu, dropped %llu (%s), outliers discarded %llu\n",
-                static_cast<unsigned long long>(fdm->datagramsAccepted()),
-                static_cast<unsigned long long>(fdm->datagramsDropped()), fdm->drops().summary().c_str(),
-                static_cast<unsigned long long>(fdm->outliersDropped()));
-  if (foreflight)
-    std::printf("render: ForeFlight positions %llu, attitudes %llu, other lines %llu, datagrams dropped %llu (%s), "
-                "outliers discarded %llu\n",
-                static_cast<unsigned long long>(foreflight->positionsAccepted()),
-                static_cast<unsigned long long>(foreflight->attitudesAccepted()),
-                static_cast<unsigned long long>(foreflight->otherLines()),
-                static_cast<unsigned long long>(foreflight->datagramsDropped()), foreflight->drops().summary().c_str(),
-                static_cast<unsigned long long>(foreflight->outliersDropped()));
+  if (const auto line = source->summary(); !line.empty()) std::printf("%s\n", line.c_str());
   std::fflush(stdout);
   shutdown();
   return exitCode;

@@ -9,24 +9,13 @@
 // channel keeps drawing from the samples it has.
 #pragma once
 
-#include <array>
-#include <atomic>
-#include <chrono>
 #include <cstdint>
-#include <mutex>
-#include <optional>
-#include <set>
 #include <span>
 #include <string>
 
-#include <utility>  // before asio: Boost 1.74 asio uses std::exchange without including it
-#include <boost/asio.hpp>
-
-#include "sky/app/drop_counts.hpp"
 #include "sky/app/host_atmosphere.hpp"
-#include "sky/app/host_clock.hpp"
 #include "sky/app/pose_smoother.hpp"
-#include "sky/app/shared_state.hpp"
+#include "sky/app/smoothed_input.hpp"
 #include "sky/fgfdm/net_fdm.hpp"
 
 namespace sky::app {
@@ -36,57 +25,25 @@ namespace sky::app {
 // applied: the weather layers are MSL-referenced the same way).
 PoseSample poseSampleFrom(const fgfdm::NetFdm& fdm, SteadyTime receivedAt);
 
-class FdmListener {
+class FdmListener : public SmoothedInput {
  public:
   // Binds to address:port (port 0 = ephemeral; see port()).
   FdmListener(boost::asio::io_context& io, const std::string& address, unsigned short port,
-              PoseSmootherConfig smoothing = {});
+              PoseSmootherConfig smoothing = {})
+      : SmoothedInput(io, address, port, smoothing, std::nullopt, "FlightGear FDM") {}
 
-  void start();
-  void stop();
-  unsigned short port() const { return port_; }
-
-  // The smoothed camera for a frame rendered at `now`, as a HostPose:
-  // hostTime_s = render time in seconds since the first accepted datagram
-  // arrived, hostFrame = datagrams accepted so far, receivedAt = arrival of
-  // the newest one, sequence increments with every call that returns a pose,
-  // utc_s = FlightGear's cur_time + warp at the render time (source FlightGear).
-  // nullopt until a position is confirmed (see PoseSmoother). Thread-safe.
-  std::optional<HostPose> poseAt(std::chrono::steady_clock::time_point now);
-
-  // Takes one datagram received at `now` (what the socket's receive handler
-  // calls; public so that tests can drive it without sockets). io thread.
-  void handleDatagram(std::span<const std::uint8_t> bytes, std::chrono::steady_clock::time_point now);
+  // poseAt (smoothed_input.hpp): utc_s is FlightGear's cur_time + warp at
+  // the render time (source FlightGear).
+  void handleDatagram(std::span<const std::uint8_t> bytes, SteadyTime now) override;
 
   // Thread-safe.
-  std::uint64_t datagramsAccepted() const { return accepted_; }
-  std::uint64_t datagramsDropped() const { return drops_.total(); }
-  const DropCounts& drops() const { return drops_; }
-  std::uint64_t outliersDropped() const;
+  std::uint64_t datagramsAccepted() const { return samplesTaken(); }
   // The newest datagram's visibility as the channel's atmosphere (source
   // FlightGear); the default one before any. Thread-safe.
   HostAtmosphere atmosphere() const;
 
  private:
-  void receive();
-  void dropped(DropReason reason, const std::string& detail);
-
-  boost::asio::ip::udp::socket socket_;
-  boost::asio::ip::udp::endpoint from_;
-  std::array<std::uint8_t, 65536> rx_{};
-  unsigned short port_ = 0;
-  std::atomic<std::uint64_t> accepted_{0};
-  DropCounts drops_;
-  std::set<std::string> loggedReasons_;  // io thread only
-
-  mutable std::mutex mutex_;  // guards the members below
-  PoseSmoother smoother_;
-  std::optional<std::chrono::steady_clock::time_point> firstAt_, newestAt_;
-  std::uint64_t sequence_ = 0;
-  // FlightGear's simulated time, cur_time + warp (whole seconds), advanced
-  // between datagrams by their arrival times (host_clock.hpp).
-  HostClock clock_;
-  HostAtmosphere atmosphere_;
+  HostAtmosphere atmosphere_;  // guarded by mutex_
 };
 
 }  // namespace sky::app

@@ -13,24 +13,14 @@
 // angle, bank = a coordinated turn's at the track's rate of turn.
 #pragma once
 
-#include <array>
 #include <atomic>
-#include <chrono>
 #include <cstdint>
-#include <map>
-#include <mutex>
 #include <optional>
-#include <set>
 #include <span>
 #include <string>
 
-#include <utility>  // before asio: Boost 1.74 asio uses std::exchange without including it
-#include <boost/asio.hpp>
-
-#include "sky/app/drop_counts.hpp"
-#include "sky/app/host_clock.hpp"
 #include "sky/app/pose_smoother.hpp"
-#include "sky/app/shared_state.hpp"
+#include "sky/app/smoothed_input.hpp"
 #include "sky/foreflight/foreflight.hpp"
 
 namespace sky::app {
@@ -67,52 +57,27 @@ class ForeFlightTrack {
   double climb_mps = 0, turnRate_degps = 0;
 };
 
-class ForeFlightListener {
+class ForeFlightListener : public SmoothedInput {
  public:
   // Binds to address:port (port 0 = ephemeral; see port()). The format
   // carries no time of day: startUtc_s (--utc) is the time at the first
   // line, advanced in real time; none: the fixed sun.
   ForeFlightListener(boost::asio::io_context& io, const std::string& address, unsigned short port,
                      std::optional<double> startUtc_s = std::nullopt,
-                     PoseSmootherConfig smoothing = foreflightSmoothing());
+                     PoseSmootherConfig smoothing = foreflightSmoothing())
+      : SmoothedInput(io, address, port, smoothing, startUtc_s, "ForeFlight") {}
 
-  void start();
-  void stop();
-  unsigned short port() const { return port_; }
-
-  // As FdmListener::poseAt: the smoothed camera at `now`; hostFrame = XGPS
-  // lines taken so far. Thread-safe.
-  std::optional<HostPose> poseAt(SteadyTime now);
-
-  // Takes one datagram received at `now`. io thread (public for tests).
-  void handleDatagram(std::span<const std::uint8_t> bytes, SteadyTime now);
+  // poseAt (smoothed_input.hpp): hostFrame counts XGPS lines taken.
+  void handleDatagram(std::span<const std::uint8_t> bytes, SteadyTime now) override;
 
   // Thread-safe.
-  std::uint64_t positionsAccepted() const { return accepted_; }
+  std::uint64_t positionsAccepted() const { return samplesTaken(); }
   std::uint64_t attitudesAccepted() const { return attitudes_; }
   std::uint64_t otherLines() const { return others_; }
-  std::uint64_t datagramsDropped() const { return drops_.total(); }
-  const DropCounts& drops() const { return drops_; }
-  std::uint64_t outliersDropped() const;
 
  private:
-  void receive();
-  void dropped(DropReason reason, const std::string& detail);
-
-  boost::asio::ip::udp::socket socket_;
-  boost::asio::ip::udp::endpoint from_;
-  std::array<std::uint8_t, 65536> rx_{};
-  unsigned short port_ = 0;
-  std::atomic<std::uint64_t> accepted_{0}, attitudes_{0}, others_{0};
-  DropCounts drops_;
-  std::set<std::string> loggedReasons_;  // io thread only
-  ForeFlightTrack track_;                // io thread only
-
-  mutable std::mutex mutex_;  // guards the members below
-  PoseSmoother smoother_;
-  HostClock clock_;
-  std::optional<SteadyTime> firstAt_, newestAt_;
-  std::uint64_t sequence_ = 0;
+  std::atomic<std::uint64_t> attitudes_{0}, others_{0};
+  ForeFlightTrack track_;  // io thread only
 };
 
 }  // namespace sky::app

@@ -1,0 +1,72 @@
+// One frame of a channel, from a pose and the weather to draw to a finished
+// image and its record in frames.jsonl: the work every loop of a channel
+// shares (the live loop of skyshell-render, whatever its pose source, and
+// the headless replay of a flight file). The loops differ only in where the
+// pose, the time and the weather clock come from and when a frame is due.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "sky/app/frame_writer.hpp"
+#include "sky/app/shared_state.hpp"
+#include "sky/app/view_state.hpp"
+#include "sky/app/window_display.hpp"
+#include "sky/render/cloud_renderer.hpp"
+
+namespace sky::app {
+
+// What a loop decided about a frame.
+struct FrameRequest {
+  HostPose host;                 // the pose drawn, as the source gave it
+  std::string source;            // "cigi", "fdm", "foreflight" or "replay"
+  geo::GeodeticPose camera;      // the eye: the host pose through the channel's view
+  std::optional<FrameRecord::View> view;           // the channel's view, when it has one
+  std::optional<render::ViewFrustum> frustum;      // unset: the settings' symmetric one
+  const WeatherView* weather = nullptr;            // drawn (never null)
+  std::string weatherSource = "server";            // "server", "file" or "clear"
+  bool weatherConnected = false;
+  double weatherClock_s = 0;
+  std::optional<double> serverClockAtArrival_s;    // CIGI frames (host_locked_clock.hpp)
+  std::optional<std::uint64_t> patternIndex;       // CIGI frames: the host frame
+  double sunAzimuth_deg = 135, sunElevation_deg = 40;
+  std::optional<double> utc_s;
+  TimeSource utcSource = TimeSource::Fixed;
+  HostAtmosphere atmosphere;
+  std::uint64_t frameIndex = 0;
+  MirrorMode mirror = MirrorMode::None;
+  bool live = false;  // record the transport delay from host.receivedAt
+};
+
+// Why a frame could not be finished, and the exit code that says so (3: the
+// GPU or the window, 2: the output files).
+struct FrameFailure {
+  int exitCode = 3;
+  std::string message;
+};
+
+struct DrawnFrame {
+  render::Image image;
+  FrameRecord record;
+};
+
+class ChannelFrames {
+ public:
+  // display: the window, or none (headless). All must outlive this.
+  ChannelFrames(render::CloudRenderer& renderer, FrameWriter& writer, WindowDisplay* display)
+      : renderer_(renderer), writer_(writer), display_(display) {}
+
+  // Draws the frame: the layers this channel can draw (warning once per
+  // weather version about those left out), the frame inputs, the render,
+  // the window, the record, the files.
+  tl::expected<DrawnFrame, FrameFailure> draw(const FrameRequest& request);
+
+ private:
+  render::CloudRenderer& renderer_;
+  FrameWriter& writer_;
+  WindowDisplay* display_;
+  std::uint64_t droppedWarnedAt_ = 0;
+};
+
+}  // namespace sky::app

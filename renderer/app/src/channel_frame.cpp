@@ -1,0 +1,76 @@
+// One frame of a channel (see channel_frame.hpp).
+#include "sky/app/channel_frame.hpp"
+
+#include <chrono>
+#include <vector>
+
+#include <spdlog/fmt/ranges.h>
+#include <spdlog/spdlog.h>
+
+#include "sky/app/drawable_weather.hpp"
+#include "sky/app/timed_render.hpp"
+
+namespace sky::app {
+
+tl::expected<DrawnFrame, FrameFailure> ChannelFrames::draw(const FrameRequest& r) {
+  const WeatherView& view = *r.weather;
+  std::vector<std::uint32_t> dropped;
+  const auto drawable = drawableWeather(view.snapshot, render::kMaxLayers, &dropped);
+  if (!dropped.empty() && view.version != droppedWarnedAt_) {
+    droppedWarnedAt_ = view.version;
+    spdlog::warn("weather has {} layers, this channel draws {}: leaving out layer(s) {}", view.snapshot.layers.size(),
+                 render::kMaxLayers, fmt::join(dropped, ", "));
+  }
+  const auto coarse = view.coarse ? std::optional(drawableCoarse(*view.coarse, drawable)) : std::nullopt;
+  render::FrameInputs in;
+  in.camera = r.camera;
+  in.frustum = r.frustum;
+  in.weather = &drawable;
+  in.coarseWeather = coarse ? &*coarse : nullptr;
+  in.weatherClock_s = r.weatherClock_s;
+  in.patternIndex = r.patternIndex;
+  in.sunAzimuth_deg = r.sunAzimuth_deg;
+  in.sunElevation_deg = r.sunElevation_deg;
+  in.utc_s = r.utc_s;
+  in.visibility_m = r.atmosphere.hazeVisibility_m();
+  in.frameIndex = r.frameIndex;
+
+  DrawnFrame out;
+  FrameRecord& record = out.record;
+  auto image = timedRender(renderer_, in, record);
+  const std::string frameName = "frame " + std::to_string(r.frameIndex) + ": ";
+  if (!image) return tl::unexpected(FrameFailure{3, frameName + describe(image.error())});
+  out.image = std::move(*image);
+  const auto delay_ms = [&] {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r.host.receivedAt).count();
+  };
+  if (r.live) record.transportDelay_ms = delay_ms();
+  mirrorImage(out.image, r.mirror);
+  record.frame = r.frameIndex;
+  record.host = r.host;
+  record.view = r.view;
+  record.source = r.source;
+  record.utcSource = r.utcSource;
+  record.atmosphere = r.atmosphere;
+  record.weatherClock_s = r.weatherClock_s;
+  record.serverClockAtArrival_s = r.serverClockAtArrival_s;
+  record.weatherVersion = view.version;
+  record.weatherConnected = r.weatherConnected;
+  record.weatherSource = r.weatherSource;
+  record.layerCount = view.snapshot.layers.size();
+  record.weatherAreas = {{view.snapshot.tileLevel, view.snapshot.tiles.size()}};
+  if (view.coarse) record.weatherAreas.push_back({view.coarse->tileLevel, view.coarse->tiles.size()});
+  if (display_) {
+    auto shown = display_->show(out.image);
+    if (!shown) return tl::unexpected(FrameFailure{3, frameName + describe(shown.error())});
+    record.presented = *shown;
+    if (r.live) record.presentDelay_ms = delay_ms();
+    for (const auto& pass : renderer_.lastPassTimes())
+      if (pass.pass == "present") record.gpu.push_back(pass);
+  }
+  logValidationMessages(renderer_);
+  if (auto ok = writer_.write(out.image, record); !ok) return tl::unexpected(FrameFailure{2, describe(ok.error())});
+  return out;
+}
+
+}  // namespace sky::app
