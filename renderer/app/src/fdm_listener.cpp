@@ -33,7 +33,7 @@ void FdmListener::handleDatagram(std::span<const std::uint8_t> bytes, SteadyTime
     dropped(dropReasonOf(fdm.error().code), fdm.error().detail);
     return;
   }
-  if (!addSample(poseSampleFrom(*fdm, now), now)) return;
+  if (!addSample(poseSampleFrom(*fdm, now))) return;
   setTimeOfDay(double(fdm->curTime_unix) + fdm->warp_s, 1.0, TimeSource::FlightGear, now);
   std::lock_guard lock(mutex_);
   atmosphere_ = withFlightGearVisibility(atmosphere_, fdm->visibility_m);

@@ -85,7 +85,7 @@ void ForeFlightListener::handleDatagram(std::span<const std::uint8_t> bytes, Ste
       continue;
     }
     if (std::holds_alternative<foreflight::Attitude>(m)) ++attitudes_;
-    if (const auto sample = track_.take(m, now)) addSample(*sample, now);
+    if (const auto sample = track_.take(m, now)) addSample(*sample);
   }
 }
 

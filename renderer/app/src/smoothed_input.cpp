@@ -48,7 +48,8 @@ void SmoothedInput::dropped(DropReason reason, const std::string& detail) {
                  toString(reason), detail);
 }
 
-bool SmoothedInput::addSample(const PoseSample& sample, SteadyTime now) {
+bool SmoothedInput::addSample(const PoseSample& sample) {
+  const SteadyTime now = sample.receivedAt;
   std::unique_lock lock(mutex_);
   if (!smoother_.add(sample)) {
     lock.unlock();

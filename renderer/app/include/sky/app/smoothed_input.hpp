@@ -62,9 +62,9 @@ class SmoothedInput {
  protected:
   // A datagram dropped: counted, logged once per kind. io thread.
   void dropped(DropReason reason, const std::string& detail);
-  // Feeds a sample to the smoother; false (counted as unusable) when it
-  // cannot take it. io thread.
-  bool addSample(const PoseSample& sample, SteadyTime now);
+  // Feeds a sample (arrived at sample.receivedAt) to the smoother; false
+  // (counted as unusable) when it cannot take it. io thread.
+  bool addSample(const PoseSample& sample);
   // The format's own time of day (UTC s, to resolution_s), at `now`. io thread.
   void setTimeOfDay(double utc_s, double resolution_s, TimeSource source, SteadyTime now);
 
