@@ -278,9 +278,12 @@ std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRe
     // In cloud the Koschmieder range of its extinction, never longer than the clear air's.
     const double cloud_m = render::koschmiederVisibility_m(kExtinctionPerDensity_perm * pw.cloudDensity);
     wcr.visibility_m = static_cast<float>(std::min(air.visibility_m, cloud_m));
-    wcr.horizontalWind_mps = static_cast<float>(pw.wind.speed_mps);
-    wcr.verticalWind_mps = static_cast<float>(pw.wind.vertical_mps);
-    wcr.windDirection_deg = static_cast<float>(pw.wind.fromDirection_deg);
+    // The weather's layer winds where it has layers; with none (clear sky,
+    // no server yet), the host's Atmosphere Control wind when it sent one.
+    const bool hostWind = layers.empty() && air.source != AtmosphereSource::Default;
+    wcr.horizontalWind_mps = static_cast<float>(hostWind ? air.windSpeed_mps : pw.wind.speed_mps);
+    wcr.verticalWind_mps = static_cast<float>(hostWind ? air.verticalWind_mps : pw.wind.vertical_mps);
+    wcr.windDirection_deg = static_cast<float>(hostWind ? air.windFrom_deg : pw.wind.fromDirection_deg);
     wcr.pressure_hpa =
         static_cast<float>(weather::isaPressure_hpa(r.alt_m) * air.seaLevelPressure_hpa / kIsaSeaLevelPressure_hpa);
     out.push_back(wcr);

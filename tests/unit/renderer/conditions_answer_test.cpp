@@ -65,6 +65,35 @@ TEST(ConditionsAnswer, ClearAirBelowAndOnlyWhatIsAsked) {
   EXPECT_TRUE(answerConditions(r, v, std::chrono::steady_clock::now()).empty());
 }
 
+// The host's global wind answers where the weather has no layers (clear
+// sky, or no server yet); where it has layers their winds win.
+TEST(ConditionsAnswer, TheHostsWindWhereTheWeatherHasNoLayers) {
+  cigi::AtmosphereControl control;
+  control.horizontalWind_mps = 7.5f;
+  control.windDirection_deg = 300;
+  control.verticalWind_mps = -0.5f;
+  const HostAtmosphere air = atmosphereFrom(control);
+  cigi::EnvironmentalConditionsRequest r;
+  r.requestType = cigi::kRequestWeather;
+  r.alt_m = 2000;
+  WeatherView clear;
+  clear.version = 1;
+  auto w = std::get<cigi::WeatherConditionsResponse>(
+      answerConditions(r, clear, std::chrono::steady_clock::now(), std::nullopt, air)[0]);
+  EXPECT_FLOAT_EQ(w.horizontalWind_mps, 7.5f);
+  EXPECT_FLOAT_EQ(w.windDirection_deg, 300.0f);
+  EXPECT_FLOAT_EQ(w.verticalWind_mps, -0.5f);
+  // Without Atmosphere Control: calm, as before.
+  w = std::get<cigi::WeatherConditionsResponse>(
+      answerConditions(r, clear, std::chrono::steady_clock::now(), std::nullopt, HostAtmosphere{})[0]);
+  EXPECT_FLOAT_EQ(w.horizontalWind_mps, 0.0f);
+  // With layers: the layer's wind (12 m/s from 250 in viewWithOneLayer).
+  w = std::get<cigi::WeatherConditionsResponse>(
+      answerConditions(r, viewWithOneLayer(), std::chrono::steady_clock::now(), std::nullopt, air)[0]);
+  EXPECT_FLOAT_EQ(w.horizontalWind_mps, 12.0f);
+  EXPECT_FLOAT_EQ(w.windDirection_deg, 250.0f);
+}
+
 }  // namespace
 }  // namespace sky::app
 

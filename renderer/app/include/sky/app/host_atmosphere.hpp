@@ -35,8 +35,9 @@ struct HostAtmosphere {
   // At sea level; the answers lapse them with the ISA to the asked altitude.
   double seaLevelTemperature_c = kIsaSeaLevelTemperature_c;
   double seaLevelPressure_hpa = kIsaSeaLevelPressure_hpa;
-  // Atmosphere Control's global wind (metadata only: the clouds move with
-  // the weather server's layer winds, and the answers give those).
+  // Atmosphere Control's global wind: the answers' wind where the weather
+  // has no layers (the clouds move with the server's layer winds, and where
+  // there are layers the answers give those).
   double windSpeed_mps = 0, windFrom_deg = 0, verticalWind_mps = 0;
 
   // The haze the image is drawn with: the host's visibility, none (the
