@@ -27,6 +27,12 @@ tl::expected<DrawnFrame, FrameFailure> ChannelFrames::draw(const FrameRequest& r
   in.frustum = r.frustum;
   in.weather = &drawable;
   in.coarseWeather = coarse ? &*coarse : nullptr;
+  if (drawnVersion_ == 0 || r.weatherSource != versionSource_ || view.version != sourceVersion_) {
+    versionSource_ = r.weatherSource;
+    sourceVersion_ = view.version;
+    ++drawnVersion_;
+  }
+  in.weatherVersion = drawnVersion_;
   in.weatherClock_s = r.weatherClock_s;
   in.patternIndex = r.patternIndex;
   in.sunAzimuth_deg = r.sunAzimuth_deg;

@@ -83,7 +83,11 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   now.keyLightEcef = setup.localToEcef * setup.sunDir;
   now.moonLit = setup.moonLit;
   now.clock_s = inputs.weatherClock_s;
-  now.sceneKey = weatherSceneKey(inputs.weather, inputs.coarseWeather);
+  if (!inputs.weatherVersion || inputs.weatherVersion != keyVersion_) {
+    versionKey_ = weatherSceneKey(inputs.weather, inputs.coarseWeather);
+    keyVersion_ = inputs.weatherVersion;
+  }
+  now.sceneKey = versionKey_;
   for (const LayerSetup& l : setup.layers) now.layerSide.push_back(l.hTop_m > 0 ? 1 : l.hBase_m < 0 ? -1 : 0);
 
   TemporalPlan plan;

@@ -76,6 +76,9 @@ class TemporalPlanner {
 
   TemporalSettings settings_;
   std::optional<Remembered> previous_;
+  // The scene key of the last weather version seen (FrameInputs::weatherVersion).
+  std::optional<std::uint64_t> keyVersion_;
+  std::uint64_t versionKey_ = 0;
   std::string forgottenBecause_ = "first frame";  // the reason of a frame without previous_
   std::uint64_t frames_ = 0;  // frames planned: the place in the interleave cycle (without patternIndex)
 };

@@ -103,8 +103,11 @@ std::string WeatherFieldUpdater::tileReason(const WeatherTiles& next, const std:
 }
 
 WeatherFieldChange WeatherFieldUpdater::update(const weather::WeatherSnapshot* fine,
-                                               const weather::WeatherSnapshot* coarse, const geo::Geodetic& anchor) {
+                                               const weather::WeatherSnapshot* coarse, const geo::Geodetic& anchor,
+                                               std::optional<std::uint64_t> version) {
   WeatherFieldChange change;
+  if (built_ && version && version == version_ && sameAnchor(field_.anchor, anchor)) return change;
+  version_ = version;
   const WeatherKeys keys = weatherKeys(fine, coarse);
   if (built_ && keys.content == field_.contentKey && sameAnchor(field_.anchor, anchor)) return change;
 

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -45,8 +46,11 @@ class WeatherFieldUpdater {
   // Makes the map the one buildWeatherField(fine, coarse, anchor) gives,
   // rewriting only what changed where it can. Both snapshots validated
   // (frame_setup.cpp, validateInputs); anchor from weatherAnchorFor.
+  // `version` (FrameInputs::weatherVersion): when it is the last call's, at
+  // the same anchor, the snapshots are taken to be the last call's and not
+  // read at all.
   WeatherFieldChange update(const weather::WeatherSnapshot* fine, const weather::WeatherSnapshot* coarse,
-                            const geo::Geodetic& anchor);
+                            const geo::Geodetic& anchor, std::optional<std::uint64_t> version = std::nullopt);
 
   const WeatherField& field() const { return field_; }
 
@@ -86,6 +90,7 @@ class WeatherFieldUpdater {
   WeatherField field_;
   WeatherTiles tiles_;  // what field_ was filled from (a ring moved out while an update reuses it)
   WeatherKeys keys_;    // and its keys: a snapshot whose tiles key is the same needs no new index
+  std::optional<std::uint64_t> version_;  // the caller's version of what field_ was made from
   // The fine snapshot's layers as field_ has them (id, type, coverage and
   // density matter to the map), and which snapshots there were.
   std::vector<weather::CloudLayer> layers_;

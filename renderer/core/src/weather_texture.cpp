@@ -23,7 +23,8 @@ Result<void> WeatherTexture::update(const GpuContext& ctx, const FrameInputs& in
   lastUpdate_ = {};
   lastRects_.clear();
   const WeatherFieldChange change =
-      updater_.update(inputs.weather, inputs.coarseWeather, weatherAnchorFor(inputs.camera.position));
+      updater_.update(inputs.weather, inputs.coarseWeather, weatherAnchorFor(inputs.camera.position),
+                      inputs.weatherVersion);
   lastUpdate_.texelsRewritten = change.texelsRewritten;
   // After a failed upload the image may lag the field anywhere: whole again.
   if (imageBehind_ && change.kind != WeatherFieldChange::Kind::Rebuilt) {

@@ -72,5 +72,40 @@ TEST(TemporalPlanner, PatternIndexOverridesTheLocalCount) {
   EXPECT_NE(early.plan(setup, in).phase, late.plan(setup, in).phase);  // 9th and 5th frames: 4 apart
 }
 
+// The history's scene key follows FrameInputs::weatherVersion: a layer that
+// moved under the same version is not looked at (the version promises the
+// same weather), a new version compares the weather and drops the history
+// only when the scene changed; without versions every frame compares.
+TEST(TemporalPlanner, TheWeatherVersionDecidesWhenTheSceneIsCompared) {
+  TemporalSettings t;
+  t.interleave = 2;
+  FrameSetup setup;
+  setup.camForward = {0, 1, 0};
+  setup.camRight = {1, 0, 0};
+  setup.camDown = {0, 0, -1};
+  weather::WeatherSnapshot w;
+  weather::CloudLayer l;
+  l.id = 1;
+  l.base_m = 1000;
+  l.thickness_m = 500;
+  w.layers = {l};
+  FrameInputs in;
+  in.weather = &w;
+  in.weatherVersion = 1;
+  TemporalPlanner planner(t);
+  EXPECT_TRUE(planner.plan(setup, in).drawWhole);
+  w.layers[0].base_m = 1200;
+  EXPECT_FALSE(planner.plan(setup, in).drawWhole) << "same version: not compared";
+  in.weatherVersion = 2;
+  const TemporalPlan changed = planner.plan(setup, in);
+  EXPECT_TRUE(changed.drawWhole);
+  EXPECT_EQ(changed.reason, "weather changed");
+  in.weatherVersion = 3;  // a new version with the same weather keeps the history
+  EXPECT_FALSE(planner.plan(setup, in).drawWhole);
+  in.weatherVersion.reset();
+  w.layers[0].base_m = 1400;
+  EXPECT_EQ(planner.plan(setup, in).reason, "weather changed");
+}
+
 }  // namespace
 }  // namespace sky::render

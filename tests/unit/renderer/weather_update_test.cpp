@@ -9,8 +9,10 @@
 // change that is more than tiles (layers, levels, a tile removed, the blend
 // type, a coarse snapshot appearing) rebuilds.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <random>
 #include <set>
 
@@ -237,6 +239,48 @@ TEST(WeatherUpdate, OneTileRewritesItsCellsTexels) {
   const WeatherFieldChange none = updater.update(&s, nullptr, moved);
   EXPECT_EQ(none.kind, Kind::Unchanged);
   EXPECT_EQ(none.texelsRewritten, 0u);
+}
+
+// FrameInputs::weatherVersion: a version seen before stands for the same
+// snapshots, so the updater does not read them (a changed tile under the
+// old version is not drawn: the caller broke its promise, and the test
+// shows the snapshots were not compared); a new version compares them and
+// takes the change tile by tile; the same version at a new anchor still
+// rebuilds. Prints what the skipped comparison costs per frame.
+TEST(WeatherUpdate, AKnownVersionSkipsTheSnapshots) {
+  const geo::Geodetic anchor = weatherAnchorFor(kCamera);
+  weather::WeatherSnapshot s;
+  s.tileLevel = kFineLevel;
+  s.layers = {layer(1, 0.0)};
+  for (std::uint64_t cell : weather::coverCap({kCamera.lat_deg, kCamera.lon_deg, 200000.0}, kFineLevel, 40000))
+    s.tiles.push_back({cell, 1, 0.5f, 1.0f});
+  WeatherFieldUpdater updater;
+  ASSERT_EQ(updater.update(&s, nullptr, anchor, 7).kind, Kind::Rebuilt);
+  const WeatherField before = updater.field();
+
+  s.tiles[s.tiles.size() / 2].coverage = 0.9f;
+  const auto timed = [&](std::optional<std::uint64_t> version, int times) {
+    const auto t0 = std::chrono::steady_clock::now();
+    WeatherFieldChange c;
+    for (int i = 0; i < times; ++i) c = updater.update(&s, nullptr, anchor, version);
+    return std::pair(c, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count() / times);
+  };
+  const auto [kept, keptMs] = timed(7, 50);
+  EXPECT_EQ(kept.kind, Kind::Unchanged);
+  EXPECT_TRUE(updater.field().texels == before.texels) << "the old version's map stays";
+
+  const auto [taken, takenMs] = timed(8, 1);
+  EXPECT_EQ(taken.kind, Kind::Tiles);
+  expectSameField(updater.field(), buildWeatherField(&s, anchor));
+  // Without a version every call compares the snapshots (nothing changed: Unchanged).
+  const auto [compared, comparedMs] = timed(std::nullopt, 50);
+  EXPECT_EQ(compared.kind, Kind::Unchanged);
+  std::printf("[ version  ] %zu tiles: an unchanged frame costs %.4f ms with a known version, %.3f ms comparing\n",
+              s.tiles.size(), keptMs, comparedMs);
+
+  const geo::Geodetic moved = weatherAnchorFor({kCamera.lat_deg + 0.5, kCamera.lon_deg, 3000.0});
+  EXPECT_EQ(updater.update(&s, nullptr, moved, 8).kind, Kind::Rebuilt);
+  expectSameField(updater.field(), buildWeatherField(&s, moved));
 }
 
 TEST(WeatherUpdate, MoreThanTilesRebuilds) {

@@ -67,6 +67,11 @@ class ChannelFrames {
   FrameWriter& writer_;
   WindowDisplay* display_;
   std::uint64_t droppedWarnedAt_ = 0;
+  // The renderer's weather version (FrameInputs::weatherVersion): a new one
+  // whenever the source ("server", "file", "clear") or its version changes,
+  // since the sources count their versions apart.
+  std::string versionSource_;
+  std::uint64_t sourceVersion_ = 0, drawnVersion_ = 0;
 };
 
 }  // namespace sky::app

@@ -170,6 +170,12 @@ struct FrameInputs {
   // drawn are `weather`'s, in its order). nullptr: ring 1 is filled from
   // `weather`. Ignored without `weather`.
   const weather::WeatherSnapshot* coarseWeather = nullptr;
+  // The caller's version of *weather and *coarseWeather together: a value
+  // seen before promises the same content as then, so the renderer reuses
+  // what it derived from them (the weather map, the history's scene key)
+  // without comparing tens of thousands of tiles; a new value makes it
+  // compare. Unset: it compares every frame.
+  std::optional<std::uint64_t> weatherVersion;
   double weatherClock_s = 0;  // clouds advect with each layer's wind by this clock
   double sunAzimuth_deg = 135, sunElevation_deg = 40;  // in the camera's local ENU frame
   // When set (UTC, s since 1970), the sun is where it is at that instant seen
