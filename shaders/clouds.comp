@@ -52,6 +52,10 @@ vec3 sampleMultipleScatteringLut(vec2 uv) {
 
 #include "cloud_core.glsl"
 
+vec2 airCloudShadow(AirFrame a, vec3 p, float h, float muSun) {
+  return cloudShadow(a, a.shadowLayers, -1, p, h, muSun);
+}
+
 // Weather map lookup: camera-local point -> weather anchor frame -> gnomonic
 // plane of the anchor sphere (x = R q.x / q.z) -> texture coordinates of the
 // rings: the fine ring inside its blend band, the coarse ring beyond, linear
@@ -170,7 +174,8 @@ void main() {
 
   CoreFrame f;
   f.air = AirFrame(frame.earth.x, frame.earth.y, frame.earth.z, frame.earth.w, frame.sunDir.xyz,
-                   frame.sunIrradiance.rgb, int(frame.dispatch.w), frame.sunDir.w);
+                   frame.sunIrradiance.rgb, int(frame.dispatch.w), frame.sunDir.w,
+                   frame.sunIrradiance.w > 0.5 ? int(frame.weatherMap.y) : 0);
   f.groundIrradiance = frame.groundIrradiance.rgb;
   f.march = MarchParams(int(frame.dispatch.y), int(frame.dispatch.z), frame.weatherMap.z, frame.weatherMap.w,
                         frame.steps.x, frame.steps.y, frame.steps.z);

@@ -91,6 +91,11 @@ struct AirFrame {
   // march sees it; the tables (sunlight, multiple scattering) keep the
   // standard aerosol.
   real aerosolExcess;
+  // Cloud layers whose shadow the march's sunlight passes through (the
+  // clouds' shadow in the air: the shade under an overcast, light shafts);
+  // 0: none. Only with cloud_core.glsl, which defines SKY_CLOUD_SHADOWED_AIR
+  // (and lets the layers shadow each other by the same count).
+  int shadowLayers;
 };
 
 // The aerosol excess (AirFrame::aerosolExcess) that gives sea-level air a
@@ -266,6 +271,15 @@ real3 multipleScattering(real h, real muSun) {
   return L2 / (real3(1.0) - f);
 }
 
+#ifdef SKY_CLOUD_SHADOWED_AIR
+// Hook (defined by cloud_core.glsl's includers): how much of the sunlight
+// reaches the air at p (camera-relative, height h above the ground sphere,
+// sun cosine muSun there) through the clouds above it: x the direct beam,
+// y the light the clouds scatter on (what the multiple-scattering term of
+// the air carries).
+real2 airCloudShadow(AirFrame a, real3 p, real h, real muSun);
+#endif
+
 // Sunlight scattered by the air along dir from the camera, with
 // the camera's air to distance tEnd (the ground, or past the atmosphere),
 // reported at the queried distances q[0..count) (ascending, any values: a
@@ -307,13 +321,19 @@ AirPath marchAir(AirFrame a, real3 dir, real tEnd, real q[kAirQueries], int coun
     real3 sigmaT = airExtinction(h) + real3(a.aerosolExcess * kMieExtinction_perm * mieDensity(h));
     real muSun = dot(upAt(p, a.r), a.sunDir);
     real3 sun = a.sunIrradiance * sunTransmittance(h, muSun, groundRadius);
+#ifdef SKY_CLOUD_SHADOWED_AIR
+    real2 shade = a.shadowLayers > 0 ? airCloudShadow(a, p, h, muSun) : real2(1.0);
+#else
+    real2 shade = real2(1.0);
+#endif
     // Source per unit length: sigma_s p E_sun T_sun for both scatterers, and
-    // sigma_s times the multiple-scattering radiance (Hillaire 2020, eq. 11).
+    // sigma_s times the multiple-scattering radiance (Hillaire 2020, eq. 11),
+    // each through the clouds' shadow.
     real3 rayleigh = rayleighScattering(h);
     real mie = (1.0 + a.aerosolExcess) * kMieScattering_perm * mieDensity(h);
-    real3 source = (rayleigh * pR + real3(mie * pM)) * sun +
+    real3 source = (rayleigh * pR + real3(mie * pM)) * sun * shade.x +
                    (rayleigh + real3(mie)) * sampleMultipleScatteringLut(multipleScatteringUv(h, muSun)) *
-                       a.sunIrradiance;
+                       a.sunIrradiance * shade.y;
     // Queries inside this step: the exact part of the step up to each.
     while (next < count && q[next] < s1) {
       real d = q[next] - s0;

@@ -15,9 +15,13 @@
 //   real  sampleDetail(LayerSampling s, real3 pLocal)    // Worley detail noise in [0, 1]
 //   real  sampleMaxCoverage(LayerSampling s, real3 pLocal) // the weather map's max-coverage mip cell:
 //                                                          // >= any coverage sampleWeather gives in it
+//   real2 airCloudShadow(AirFrame a, real3 p, real h, real muSun) // cloudShadow(a, a.shadowLayers, -1, p, h, muSun)
 // pLocal is camera-relative, local frame: x east, y north, z up (m).
 
 #include "core_common.glsl"
+// The air march sees the clouds' shadow (atmosphere_core.glsl's
+// airCloudShadow hook; the includer defines it as cloudShadow below).
+#define SKY_CLOUD_SHADOWED_AIR
 #include "atmosphere_core.glsl"
 #include "cloud_density.glsl"
 
@@ -338,6 +342,48 @@ CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
   return cs;
 }
 
+// Transmission of sunlight and sky light down through the first `count`
+// layers to the point p (camera-relative, height hp above the ground
+// sphere): each layer above p (the part above p where p is inside it) by
+// its coverage c and density where the sun ray crosses the middle of that
+// part. A fraction c of the sun rays there meets a cloud column of optical
+// depth tau (the type's mean column depth times the density), the rest
+// passes clear, so the mean transmittance is 1 - c (1 - T(tau)) with the
+// two-stream split of diffuseLight: T = e^(-tau/mu) for the direct beam,
+// t(tau) for the light the clouds diffuse (the mean of the transmittance
+// over a broken field, not the transmittance of its mean depth, which at
+// half cover of a cumulus kilometres deep would be dark). x: direct sun
+// factor, y: diffuse factor for the sun's scattered part and the sky.
+// Shadows at the weather map's scale (~1 km), without the noise's shapes:
+// on the ground, and in the air (the shade under an overcast, the light
+// shafts between regions of cloud).
+// `skip`: a layer left out (the one p is marched in, whose own shadow the
+// light march gives), or -1.
+real2 cloudShadow(AirFrame a, int count, int skip, real3 p, real hp, real muSun) {
+  real direct = 1.0;
+  real diffuse = 1.0;
+  real mu = max(muSun, kMinSunCosine);
+  real groundRadius = a.r - a.h;
+  real rp = groundRadius + hp;
+  for (int k = 0; k < count; ++k) {
+    CoreLayer L = layerAt(k);
+    real top = a.h - L.hTop;
+    if (k == skip || L.absent || hp >= top) continue;
+    real lo = max(hp, a.h - L.hBase);
+    real hMid = 0.5 * (lo + top);
+    // Distance along the sun from p up to the height hMid (stable sphere root).
+    real c2 = (hMid - hp) * (2.0 * groundRadius + hMid + hp);
+    real d = c2 / (rp * mu + sqrt(rp * rp * mu * mu + c2));
+    real3 weather = sampleWeather(L.sampling, p + a.sunDir * d);
+    CloudType t = L.blends ? mixCloudType(L.primary, L.secondary, weather.z) : L.primary;
+    real tau = t.extinction_perm * weather.y * t.columnFill * (top - lo);
+    real c = clamp(weather.x, 0.0, 1.0);
+    direct *= 1.0 - c * (1.0 - exp(-tau / mu));
+    diffuse *= 1.0 - c * (1.0 - 1.0 / (1.0 + 0.75 * (1.0 - kDiffuseAsymmetry) * tau));
+  }
+  return real2(direct, diffuse);
+}
+
 // Marches one layer's span front to back; transmittanceBefore (what the
 // layers in front left) only decides the early exit. Each sample stands for
 // a segment of the span (evenly: span / primarySteps; in metres: the step
@@ -418,10 +464,13 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
                                     p, ph, cs.coverage, cs.peakNoise, cs.densityScale, f.march.lightSteps,
                                     cs.rho > 0.0 ? f.march.lightSteps : 0);
     // Sunlight at p through the clear air above it (reddened at low sun,
-    // none in the Earth's shadow), and the sky's light from all around.
+    // none in the Earth's shadow) and the other layers' clouds above it
+    // (cirrus over cumulus, a deck over a layer), and the sky's light from
+    // all around, dimmed by those layers as well.
     real3 sun = mix(mix(sunBaseStart, sunTopStart, ph), mix(sunBaseEnd, sunTopEnd, ph), u);
-    real3 scattered = sun * octaveSum(mix(phases1, phases2, cs.blend), tauSun) +
-                      diffuseLight(L, ct, ph, cs.coverage, cs.densityScale);
+    real2 shade = cloudShadow(f.air, f.air.shadowLayers, li, p, f.air.h + h, mix(muStart, muEnd, u));
+    real3 scattered = sun * (shade.x * octaveSum(mix(phases1, phases2, cs.blend), tauSun)) +
+                      diffuseLight(L, ct, ph, cs.coverage, cs.densityScale) * shade.y;
     // Hillaire 2016 energy-conserving step: integral over the step of
     // sigma_s L e^{-sigma_t s} = albedo L (1 - e^{-sigma_t len}); its limit
     // as sigma_t -> 0 is sigma_s L len (scatterFraction).
@@ -437,44 +486,13 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
   return res;
 }
 
-// Transmission of sunlight and sky light down through every layer to the
-// ground point p (camera-relative): each layer's coverage and density where
-// the sun ray crosses its middle, its type's mean column depth, and the same
-// two-stream split as diffuseLight (direct e^(-tau/mu), the rest diffused
-// by t(tau)). x: direct sun factor, y: diffuse factor for the sun's
-// scattered part and the sky. Shadows at the weather map's scale (~1 km),
-// without the noise's shapes.
-real2 groundShadow(CoreFrame f, real3 p, real muSun) {
-  real direct = 1.0;
-  real diffuse = 1.0;
-  real mu = max(muSun, kMinSunCosine);
-  real groundRadius = f.air.r - f.air.h;
-  for (int k = 0; k < f.layerCount; ++k) {
-    CoreLayer L = layerAt(k);
-    if (L.absent) continue;
-    // Height of the layer's middle above the ground, and the distance to it
-    // along the sun from the ground (stable sphere root).
-    real hMid = max(f.air.h - 0.5 * (L.hBase + L.hTop), 0.0);
-    real c2 = hMid * (2.0 * groundRadius + hMid);
-    real d = c2 / (groundRadius * mu + sqrt(groundRadius * groundRadius * mu * mu + c2));
-    real3 weather = sampleWeather(L.sampling, p + f.air.sunDir * d);
-    CloudType t = L.blends ? mixCloudType(L.primary, L.secondary, weather.z) : L.primary;
-    real tau = t.extinction_perm * weather.y * weather.x * t.columnFill * L.thickness;
-    real beam = exp(-tau / mu);
-    real spread = 1.0 / (1.0 + 0.75 * (1.0 - kDiffuseAsymmetry) * tau);
-    direct *= beam;
-    diffuse *= spread;
-  }
-  return real2(direct, diffuse);
-}
-
 // Lambertian ground at distance t along dir: sunlight and sky light through
 // the air and the cloud layers above it.
 real3 groundRadiance(CoreFrame f, real3 dir, real t) {
   real3 p = dir * t;
   real muSun = dot(upAt(p, f.air.r), f.air.sunDir);
   real3 sun = f.air.sunIrradiance * sunTransmittance(0.0, muSun, f.air.r - f.air.h) * max(muSun, 0.0);
-  real2 shadow = groundShadow(f, p, muSun);
+  real2 shadow = cloudShadow(f.air, f.layerCount, -1, p, 0.0, muSun);
   real3 light = sun * (shadow.x + (1.0 - shadow.x) * shadow.y) + f.groundIrradiance * shadow.y;
   return light * (kGroundAlbedo / kPi);
 }

@@ -87,7 +87,8 @@ struct SkyFrame {
                         // z: hGround (2r - hGround) (m^2), w: the same for the atmosphere top (m^2)
   vec4 sunDir;          // xyz: unit vector towards the sun, local frame; w: the view ray's aerosol
                         // excess (AirFrame::aerosolExcess, 0: the standard haze)
-  vec4 sunIrradiance;   // rgb: sun irradiance at the top of the atmosphere (linear units); w: unused
+  vec4 sunIrradiance;   // rgb: sun irradiance at the top of the atmosphere (linear units); w: 1 when the
+                        // air and the lower layers see the clouds' shadow (MarchSettings::cloudShadows), else 0
   vec4 groundIrradiance;  // rgb: sky irradiance on horizontal ground (linear units); w: unused
   uvec4 image;          // x: width, y: height, z: tiles per row, w: tile count
   uvec4 dispatch;       // x: tile permutation stride (coprime to the tile count), y: primary steps per

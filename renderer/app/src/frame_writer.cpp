@@ -112,6 +112,7 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
         {"coverage_step_min", s.march.coverageStepMin},
         {"density_step_min", s.march.densityStepMin},
         {"air_steps", s.march.airSteps},
+        {"cloud_shadows", s.march.cloudShadows},
         {"blue_noise", s.march.blueNoise}}},
       {"interleave", s.temporal.interleave},
       {"accumulation", s.temporal.accumulation},

@@ -114,13 +114,15 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     else if (key == "divisor" && (v == 1 || v == 2 || v == 4)) c.settings.resolution.divisor = std::uint32_t(v);
     else if (key == "depth-aware" && (v == 0 || v == 1)) c.settings.resolution.depthAware = v == 1;
     else if (key == "blue" && (v == 0 || v == 1)) m.blueNoise = v == 1;
+    else if (key == "cloud-shadows" && (v == 0 || v == 1)) m.cloudShadows = v == 1;
     else if (key == "accumulate" && v <= 0.95) c.settings.temporal.accumulation = v;
     else if (key == "pixel-jitter" && (v == 0 || v == 1)) c.settings.temporal.pixelJitter = v == 1;
     else
       return fail(ErrorCode::InvalidArgument,
                   "custom configuration '" + spec + "': unknown key '" + key +
                       "' (base, primary, light, exit, stride, cloud, empty, growth, air, multmin, divmin, scale, "
-                      "interleave 1|2|4, divisor 1|2|4, depth-aware 0|1, blue 0|1, accumulate 0..0.95, pixel-jitter 0|1)");
+                      "interleave 1|2|4, divisor 1|2|4, depth-aware 0|1, blue 0|1, cloud-shadows 0|1, accumulate 0..0.95, "
+                      "pixel-jitter 0|1)");
   }
   // Accumulation blends redraws with the history: without interleaving
   // there is none (a base preset's accumulation goes with its interleave).

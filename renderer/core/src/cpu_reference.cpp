@@ -70,6 +70,7 @@ class CpuCore {
                           double(setup_.march.emptyStride), setup_.march.cloudStep_m, setup_.march.emptyStep_m,
                           setup_.march.stepGrowth};
     f.layerCount = int(setup_.layers.size());
+    f.air.shadowLayers = setup_.march.cloudShadows ? f.layerCount : 0;
     const CloudType cumulus = coreType(cloudTypeParams(weather::CloudType::Cumulus));
     for (std::size_t i = 0; i < kMaxLayers; ++i) {
       CoreLayer& c = layers_[i];
@@ -114,6 +115,9 @@ class CpuCore {
 };
 
 CpuCore::CoreLayer CpuCore::layerAt(int li) { return layers_[li]; }
+CpuCore::real2 CpuCore::airCloudShadow(AirFrame a, real3 p, real h, real muSun) {
+  return cloudShadow(a, a.shadowLayers, -1, p, h, muSun);
+}
 
 // The hooks mirror those of shaders/clouds.comp.
 CpuCore::real3 CpuCore::sampleWeather(LayerSampling s, real3 p) {

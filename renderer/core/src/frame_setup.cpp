@@ -412,7 +412,7 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   f.weatherRings = gpu::vec4(float(1.0 / (2 * s.coarseHalfExtent_m)), float(kRingBlendStart), float(kRingBlendEnd), 0.0f);
   f.earth = gpu::vec4(float(s.r_m), float(s.hGround_m), float(s.cGround_m2), float(s.cAtmosphereTop_m2));
   f.sunDir = v4(s.sunDir, s.aerosolExcess);
-  f.sunIrradiance = v4(s.sunIrradiance);
+  f.sunIrradiance = v4(s.sunIrradiance, s.march.cloudShadows ? 1.0 : 0.0);
   f.groundIrradiance = v4(s.groundIrradiance);
 
   // The tiles cover the packed image of the pixels this frame draws.

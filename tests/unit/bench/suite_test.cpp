@@ -44,9 +44,9 @@ TEST(Suite, ShippedSuiteLoadsEveryScene) {
     paths += s.scene.isPath();
     EXPECT_FALSE(s.weather.snapshot.layers.empty()) << s.scene.name;
   }
-  // The suite: eight stills and two paths.
+  // The suite: nine stills and two paths.
   for (const char* n : {"cumulus-midday", "sunset-backlit", "overcast-below", "inside-cloud", "above-deck-10km",
-                        "cumulonimbus", "cirrus-over-cumulus", "polar", "fast-turn", "cumulus-fly-through"})
+                        "cumulonimbus", "cirrus-over-cumulus", "polar", "godrays", "fast-turn", "cumulus-fly-through"})
     EXPECT_TRUE(names.count(n)) << n;
   EXPECT_EQ(paths, 2u);
   auto two = loadSuite(SKY_BENCH_SUITE_FILE, {"polar", "fast-turn"});

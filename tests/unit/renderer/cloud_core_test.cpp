@@ -8,7 +8,7 @@
 // has its sigma -> 0 limit; Haggstrom's height functions and anvils at
 // hand-computed points; the diffuse light's two-stream depth; ray-shell
 // distances for vertical, horizontal and grazing rays; cloud shadows on the
-// ground by the layers' two-stream depth.
+// ground, in the air and on lower layers by the layers' two-stream depth.
 #include <cmath>
 #include <cstdint>
 
@@ -249,11 +249,11 @@ TEST(CloudCore, DiffuseLightFollowsTheTwoStreamDepth) {
   EXPECT_GT(c.diffuseLight(L, cu, 0.0, 0.3, 1.0).x / (0.3 + 4.0), c.diffuseLight(L, cu, 0.0, 1.0, 1.0).x / (0.3 + 4.0));
 }
 
-// Cloud shadows on the ground: each layer's optical depth where the sun
-// ray crosses it, tau = extinction x density x coverage x column fill x
-// thickness; the beam e^(-tau / mu) and the diffuse part 1 / (1 + 0.75 (1 -
-// g) tau), multiplied over the layers; no cloud, no shadow; and the
-// ground's radiance from them by hand.
+// Cloud shadows on the ground: each layer's cloud column depth where the sun
+// ray crosses it, tau = extinction x density x column fill x thickness; of
+// the beam e^(-tau / mu) and the diffuse part 1 / (1 + 0.75 (1 - g) tau)
+// the mean over a field of coverage c, 1 - c (1 - T), multiplied over the
+// layers; no cloud, no shadow; and the ground's radiance from them by hand.
 TEST(CloudCore, GroundShadowIsTheTwoStreamDepthOfTheLayersAbove) {
   Core c;
   const double R = 6371000, alt = 500;
@@ -265,9 +265,9 @@ TEST(CloudCore, GroundShadowIsTheTwoStreamDepthOfTheLayersAbove) {
   const Core::real3 ground(0, 0, -alt);  // the ground point under the camera
   c.coverage = 0.9;
   c.density = 0.7;
-  const double tau = 0.01 * 0.7 * 0.9 * 0.8 * 1000;
-  const double beam = std::exp(-tau / mu), spread = 1 / (1 + 0.75 * (1 - 0.85) * tau);
-  Core::real2 s = c.groundShadow(f, ground, mu);
+  const double tau = 0.01 * 0.7 * 0.8 * 1000;
+  const double beam = 1 - 0.9 * (1 - std::exp(-tau / mu)), spread = 1 - 0.9 * (1 - 1 / (1 + 0.75 * (1 - 0.85) * tau));
+  Core::real2 s = c.cloudShadow(f.air, f.layerCount, -1, ground, 0.0, mu);
   EXPECT_NEAR(s.x, beam, 1e-12);
   EXPECT_NEAR(s.y, spread, 1e-12);
   // A second, thinner layer higher up: the factors multiply.
@@ -281,23 +281,108 @@ TEST(CloudCore, GroundShadowIsTheTwoStreamDepthOfTheLayersAbove) {
   c.layers[1].cTop = hT * (2 * f.air.r - hT);
   c.layers[1].primary = c.layers[1].secondary = ci;
   f.layerCount = 2;
-  const double tau2 = 5e-4 * 0.7 * 0.9 * 0.3 * 1000;
-  s = c.groundShadow(f, ground, mu);
-  EXPECT_NEAR(s.x, beam * std::exp(-tau2 / mu), 1e-12);
-  EXPECT_NEAR(s.y, spread / (1 + 0.75 * (1 - 0.85) * tau2), 1e-12);
+  const double tau2 = 5e-4 * 0.7 * 0.3 * 1000;
+  const double beam2 = 1 - 0.9 * (1 - std::exp(-tau2 / mu)), spread2 = 1 - 0.9 * (1 - 1 / (1 + 0.75 * (1 - 0.85) * tau2));
+  s = c.cloudShadow(f.air, f.layerCount, -1, ground, 0.0, mu);
+  EXPECT_NEAR(s.x, beam * beam2, 1e-12);
+  EXPECT_NEAR(s.y, spread * spread2, 1e-12);
   // The ground's radiance: albedo / pi x (sun mu T (beam + (1 - beam)
   // spread) + sky spread), clear air (no table: T = 1).
   f.air.sunIrradiance = Core::real3(2.0);
   f.groundIrradiance = Core::real3(0.4);
-  const double b2 = beam * std::exp(-tau2 / mu), s2 = spread / (1 + 0.75 * (1 - 0.85) * tau2);
+  const double b2 = beam * beam2, s2 = spread * spread2;
   const double expected = 0.1 / kPi * (2.0 * mu * (b2 + (1 - b2) * s2) + 0.4 * s2);
   EXPECT_NEAR(c.groundRadiance(f, Core::real3(0, 0, -1), alt).x, expected, 1e-9);
   // No cloud: the sun and the sky reach the ground whole.
   c.coverage = 0.0;
-  s = c.groundShadow(f, ground, mu);
+  s = c.cloudShadow(f.air, f.layerCount, -1, ground, 0.0, mu);
   EXPECT_EQ(s.x, 1.0);
   EXPECT_EQ(s.y, 1.0);
   EXPECT_NEAR(c.groundRadiance(f, Core::real3(0, 0, -1), alt).x, 0.1 / kPi * (2.0 * mu + 0.4), 1e-9);
+}
+
+// The clouds' shadow in the air (cloudShadow at a point of the air, and the
+// air march through it): under a layer the whole column's depth, inside it
+// the part above the point, over it none; and the air's in-scattering under
+// a uniform overcast, with clear air and no multiple scattering, is the
+// unshadowed one times the beam e^(-tau / mu) exactly (the shadow is the
+// same at every step); with the shadow off, or without layers, it is the
+// unshadowed one.
+TEST(CloudCore, TheAirIsInTheCloudsShadow) {
+  Core c;
+  const double R = 6371000, alt = 500, base = 1500, H = 1000;
+  Core::CloudType st = uniformType(0.01);
+  st.columnFill = 0.8;
+  Core::CoreFrame f = frameAt(c, R, alt, base, H, st);
+  const double mu = 0.6;
+  f.air.sunDir = Core::real3(std::sqrt(1 - mu * mu), 0, mu);
+  f.air.sunIrradiance = Core::real3(1.0);
+  c.coverage = 1.0;  // an overcast
+  c.density = 0.7;
+  const double tau = 0.01 * 0.7 * 0.8 * H;
+  const auto spread = [](double t) { return 1 / (1 + 0.75 * (1 - 0.85) * t); };
+  const auto at = [&](double h) { return c.cloudShadow(f.air, 1, -1, Core::real3(0, 0, h - alt), h, mu); };
+  EXPECT_NEAR(at(1000).x, std::exp(-tau / mu), 1e-12) << "under the base: the whole column";
+  EXPECT_NEAR(at(1000).y, spread(tau), 1e-12);
+  // At a quarter of the way up, three quarters of the column are above (the
+  // sun cosine at the point, not at the ground: the same here to 1e-4).
+  EXPECT_NEAR(at(base + 0.25 * H).x, std::exp(-0.75 * tau / mu), 1e-9) << "inside";
+  EXPECT_NEAR(at(base + 0.25 * H).y, spread(0.75 * tau), 1e-12);
+  EXPECT_EQ(at(base + H + 10).x, 1.0) << "over the top";
+  EXPECT_EQ(at(base + H + 10).y, 1.0);
+  c.coverage = 0.4;  // broken: 60 % of the sun rays pass clear
+  EXPECT_NEAR(at(1000).x, 0.6 + 0.4 * std::exp(-tau / mu), 1e-12);
+  EXPECT_NEAR(at(1000).y, 0.6 + 0.4 * spread(tau), 1e-12);
+  c.coverage = 1.0;
+
+  // Looking down at 30 degrees from the camera under the layer: every step
+  // of the air march is in the same shade.
+  const Core::real3 dir(std::cos(30 * kPi / 180), 0, -std::sin(30 * kPi / 180));
+  const double tEnd = alt / std::sin(30 * kPi / 180);
+  Core::real q[Core::kAirQueries] = {tEnd};
+  f.air.shadowLayers = 0;
+  const Core::AirPath lit = c.marchAir(f.air, dir, tEnd, q, 1);
+  f.air.shadowLayers = 1;
+  const Core::AirPath shaded = c.marchAir(f.air, dir, tEnd, q, 1);
+  ASSERT_GT(lit.inscatter[0].x, 0.0);
+  // The sun's cosine varies by ~1e-4 over the 1 km of ground the ray spans.
+  for (int k = 0; k < 3; ++k)
+    EXPECT_NEAR(shaded.inscatter[0][k] / lit.inscatter[0][k], std::exp(-tau / mu), 1e-3 * std::exp(-tau / mu)) << k;
+  EXPECT_EQ(shaded.transmittance[0], lit.transmittance[0]) << "the shadow dims the light, not the air";
+  c.coverage = 0.0;
+  EXPECT_EQ(c.marchAir(f.air, dir, tEnd, q, 1).inscatter[0], lit.inscatter[0]) << "no cloud, no shade";
+}
+
+// A layer in the shadow of the layer above (cirrus over cumulus, a deck
+// over a layer): with no sky light its in-scattered sunlight is the
+// unshadowed one times the upper layer's mean beam transmittance, 1 - c (1 -
+// e^(-tau / mu)); its transmittance is its own; the upper layer is not
+// shadowed by the lower one, nor any layer by itself.
+TEST(CloudCore, ALayerIsInTheShadowOfTheLayersAboveIt) {
+  Core c;
+  const double R = 6371000, alt = 500;
+  Core::CoreFrame f = frameAt(c, R, alt, 1500, 1000, uniformType(2e-3));
+  Core::CloudType deck = uniformType(4e-3);
+  deck.columnFill = 0.9;
+  c.layers[1] = shellLayer(f, alt, 5000, 400, deck);
+  f.layerCount = 2;
+  const double mu = 0.8;
+  f.air.sunDir = Core::real3(std::sqrt(1 - mu * mu), 0, mu);
+  f.air.sunIrradiance = Core::real3(1.0);
+  c.coverage = 0.6;
+  const Core::real3 up(0, 0, 1);
+  const Core::Span lower = c.layerSpan(f, c.layers[0], 1.0, 1e12), upper = c.layerSpan(f, c.layers[1], 1.0, 1e12);
+  f.air.shadowLayers = 0;
+  const auto lit = c.marchLayer(f, 0, up, lower, 0.5, 1.0), litUpper = c.marchLayer(f, 1, up, upper, 0.5, 1.0);
+  f.air.shadowLayers = 2;
+  const auto shaded = c.marchLayer(f, 0, up, lower, 0.5, 1.0), shadedUpper = c.marchLayer(f, 1, up, upper, 0.5, 1.0);
+  const double tau = 4e-3 * 0.9 * 400;
+  ASSERT_GT(lit.inscatter.x, 0.0);
+  // The sun's cosine along the 1 km span and the deck's height above it
+  // vary by ~1e-4 (the Earth's curvature): the beam to that.
+  EXPECT_NEAR(shaded.inscatter.x / lit.inscatter.x, 1 - 0.6 * (1 - std::exp(-tau / mu)), 1e-3);
+  EXPECT_EQ(shaded.transmittance, lit.transmittance);
+  EXPECT_EQ(shadedUpper.inscatter, litUpper.inscatter) << "nothing above the deck";
 }
 
 TEST(CloudCore, RayShellDistancesMatchHandComputedOnes) {

@@ -70,6 +70,9 @@ inline Core::real Core::sampleDetail(LayerSampling, real3) {
   ++lookups;
   return detail;
 }
+inline Core::real2 Core::airCloudShadow(AirFrame a, real3 p, real h, real muSun) {
+  return cloudShadow(a, a.shadowLayers, -1, p, h, muSun);
+}
 
 // Scenes for the closed-form tests.
 

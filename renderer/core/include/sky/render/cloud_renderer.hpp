@@ -52,6 +52,13 @@ struct MarchSettings {
   // Steps of the clear-air march along each view ray (aerial perspective and
   // the sky; atmosphere_core.glsl); 0: its default, 16. [0, 64].
   std::uint32_t airSteps = 0;
+  // The clouds' shadow at the weather map's scale (cloud_core.glsl,
+  // cloudShadow) in the clear-air march's sunlight (the shade under an
+  // overcast, light shafts between regions of cloud) and on the clouds of
+  // the layers below (cirrus over cumulus, a deck over a layer): one weather
+  // lookup per layer above each air step and each cloud sample. false: only
+  // the ground is shadowed.
+  bool cloudShadows = true;
   // Where along its first step each pixel's samples sit (a fraction of the
   // step, fixed per pixel): false, a white-noise hash of the pixel; true, a
   // 64x64 blue-noise tile repeated over the image (renderer/core/src/blue_noise.hpp),
