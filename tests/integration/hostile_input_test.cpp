@@ -109,7 +109,7 @@ std::vector<std::vector<std::uint8_t>> hostileFdm(double t_s) {
   add([&](fgfdm::NetFdm& f) { f.lat_rad = nan; });
   add([&](fgfdm::NetFdm& f) { f.lat_rad = 1e30; });
   add([&](fgfdm::NetFdm& f) { f.alt_m = -inf; });
-  add([&](fgfdm::NetFdm& f) { f.warp_s = -2000000000; });
+  add([&](fgfdm::NetFdm& f) { f.visibility_m = -1; });
   auto shortOne = out.back();
   shortOne.resize(100);
   out.push_back(shortOne);

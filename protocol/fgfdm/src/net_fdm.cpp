@@ -180,9 +180,6 @@ Result<NetFdm> decodeNetFdm(std::span<const std::uint8_t> bytes) {
       {"A_X_pilot", "ft/s^2", f.aXPilot_fps2, -kMaxAcceleration_fps2, kMaxAcceleration_fps2},
       {"A_Y_pilot", "ft/s^2", f.aYPilot_fps2, -kMaxAcceleration_fps2, kMaxAcceleration_fps2},
       {"A_Z_pilot", "ft/s^2", f.aZPilot_fps2, -kMaxAcceleration_fps2, kMaxAcceleration_fps2},
-      // Simulated time, cur_time + warp: not before 1970 nor past the end of
-      // the 32-bit unix time the field holds (2106).
-      {"cur_time + warp", "s", static_cast<double>(f.curTime_unix) + f.warp_s, 0, 4294967295.0},
       {"visibility", "m", f.visibility_m, 0, 1.0e9},
   };
   for (const Bound& b : bounds)

@@ -34,7 +34,7 @@ void FdmListener::handleDatagram(std::span<const std::uint8_t> bytes, SteadyTime
     return;
   }
   if (!addSample(poseSampleFrom(*fdm, now))) return;
-  setTimeOfDay(double(fdm->curTime_unix) + fdm->warp_s, 1.0, TimeSource::FlightGear, now);
+  setTimeOfDay(double(fdm->curTime_unix), 1.0, TimeSource::FlightGear, now);
   std::lock_guard lock(mutex_);
   atmosphere_ = withFlightGearVisibility(atmosphere_, fdm->visibility_m);
 }

@@ -106,7 +106,7 @@ TEST(FlightGearFdm, EncodeDecodeRoundTripsEveryField) {
   f.rpm = {2400, 2300, 0, 0};
   f.numWheels = 3;
   f.wow = {1, 0, 1};
-  f.curTime_unix = 1795299684;  // with the warp, a time after 1970 (the decoder checks)
+  f.curTime_unix = 1795299684;  // simulated time, the warp in it
   f.warp_s = -13200;
   f.spoilers = 0.25f;
   const auto bytes = encodeNetFdm(f);

@@ -2,7 +2,7 @@
 // frames advancing it, pause, 10x, the timestamp's wrap, jumps, --utc), then
 // through the real CIGI decoder in both byte orders (Celestial Sphere
 // Control's valid bit, dates that are not dates, Atmosphere Control, IG
-// Reset/Standby, packets counted by id) and FlightGear's cur_time + warp.
+// Reset/Standby, packets counted by id) and FlightGear's cur_time.
 // No GPU, no sockets: the listeners are handed datagrams.
 #include <chrono>
 #include <cmath>
@@ -278,28 +278,29 @@ TEST(CigiIgnored, UnusedPacketsAreCountedById) {
 
 // --- FlightGear ------------------------------------------------------------------
 
-// cur_time + warp is FlightGear's simulated time: the frame's UTC within
-// the second it is sent to (plus the smoother's delay, under 1 s), and its
-// visibility the haze.
-TEST(FdmTime, CurTimePlusWarpAndVisibility) {
+// cur_time is FlightGear's simulated time, the warp already added in
+// (SimGear's SGTime::update: cur_time = time + warp; found with FlightGear
+// 2020.3 at --timeofday=morning, where cur_time + warp put the sun 67
+// degrees under the horizon): the frame's UTC within the second it is sent
+// to (plus the smoother's delay, under 1 s), and its visibility the haze.
+TEST(FdmTime, CurTimeIsTheSimulatedTimeAndVisibilityTheHaze) {
   asio::io_context io;
   FdmListener fdm(io, "127.0.0.1", 0);
   fgfdm::NetFdm f;
   f.lat_rad = -0.768;
   f.lon_rad = 2.958;
   f.alt_m = 1500;
-  f.curTime_unix = 1795299684;  // 2026-11-21 22:21:24 UTC, real time
-  f.warp_s = -3 * 3600;         // the user moved the sky three hours back
+  const std::uint32_t simulated = 1795299684 - 3 * 3600;  // 2026-11-21 22:21:24 UTC moved three hours back
+  f.warp_s = -3 * 3600;
   f.visibility_m = 12000;
   for (int i = 0; i < 60; ++i) {  // 2 s at 30 Hz; cur_time ticks once a second
-    f.curTime_unix = 1795299684 + i / 30;
+    f.curTime_unix = simulated + std::uint32_t(i / 30);
     fdm.handleDatagram(fgfdm::encodeNetFdm(f), at(i / 30.0));
   }
   const auto pose = fdm.poseAt(at(2.0));
   ASSERT_TRUE(pose);
   ASSERT_TRUE(pose->utc_s);
   EXPECT_EQ(pose->timeSource, TimeSource::FlightGear);
-  const double simulated = 1795299684.0 - 3 * 3600;
   // The newest datagram said second simulated + 1 at t = 59/30 s; the render
   // time is at most that, at least 1 s before it.
   EXPECT_GE(*pose->utc_s, simulated + 0.0);

@@ -257,7 +257,7 @@ TEST(FdmListenerHostile, NonFiniteAndAbsurdPacketsAreDroppedAndTheCameraHolds) {
       [](fgfdm::NetFdm& f, double, double) { f.lat_rad = 1e30; },
       [](fgfdm::NetFdm& f, double, double i) { f.alt_m = -i; },
       [](fgfdm::NetFdm& f, double n, double) { f.psi_rad = static_cast<float>(n); },
-      [](fgfdm::NetFdm& f, double, double) { f.warp_s = -2000000000; f.curTime_unix = 1000; },
+      [](fgfdm::NetFdm& f, double, double) { f.visibility_m = -1; },
   };
   int t = 0;
   for (int i = 0; i < 5; ++i) fdm.handleDatagram(fgfdm::encodeNetFdm(good), at(0.1 * t++));

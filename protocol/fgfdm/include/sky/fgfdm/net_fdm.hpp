@@ -39,8 +39,8 @@ struct NetFdm {
   std::uint32_t numWheels = 0;
   std::array<std::uint32_t, kMaxWheels> wow{};
   std::array<float, kMaxWheels> gearPos{}, gearSteer{}, gearCompression{};
-  std::uint32_t curTime_unix = 0;
-  std::int32_t warp_s = 0;
+  std::uint32_t curTime_unix = 0;  // simulated time (the warp included), unix s
+  std::int32_t warp_s = 0;         // how far the user moved the simulated time from real time, s
   float visibility_m = 0;
   float elevator = 0, elevatorTrimTab = 0, leftFlap = 0, rightFlap = 0, leftAileron = 0, rightAileron = 0,
         rudder = 0, noseWheel = 0, speedbrake = 0, spoilers = 0;
@@ -48,9 +48,11 @@ struct NetFdm {
 
 // Decodes one datagram. Rejects, with the field named: other sizes
 // (Malformed) and versions (Unsupported); non-finite or absurd position,
-// attitude, body rates, velocities (above 12 km/s), accelerations, simulated
-// time (cur_time + warp before 1970 or past 2106) or visibility, and
-// engine/tank/wheel counts above FlightGear's array sizes (InvalidArgument).
+// attitude, body rates, velocities (above 12 km/s), accelerations or
+// visibility, and engine/tank/wheel counts above FlightGear's array sizes
+// (InvalidArgument). cur_time is FlightGear's simulated time (SimGear's
+// SGTime adds the warp into it; warp only says by how much it was moved),
+// so any value of either is taken.
 Result<NetFdm> decodeNetFdm(std::span<const std::uint8_t> bytes);
 
 // Encodes (for tests and for tools that stand in for FlightGear).

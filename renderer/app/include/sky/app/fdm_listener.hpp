@@ -1,7 +1,8 @@
 // The renderer's FlightGear endpoint on UDP: decodes each --native-fdm
 // datagram (FGNetFDM v24) into a pose sample for a PoseSmoother, which the
 // render loop asks for the camera at its render time, and into the time of
-// day (cur_time + warp, so the sun matches FlightGear's sky) and the
+// day (cur_time: FlightGear's simulated time, its warp already in it, so
+// the sun matches FlightGear's sky) and the
 // visibility (the haze). The second way a
 // simulator drives a channel, besides CIGI. Malformed datagrams (a wrong
 // size or version, a non-finite or absurd field) and poses the smoother
@@ -32,7 +33,7 @@ class FdmListener : public SmoothedInput {
               PoseSmootherConfig smoothing = {})
       : SmoothedInput(io, address, port, smoothing, std::nullopt, "FlightGear FDM") {}
 
-  // poseAt (smoothed_input.hpp): utc_s is FlightGear's cur_time + warp at
+  // poseAt (smoothed_input.hpp): utc_s is FlightGear's cur_time at
   // the render time (source FlightGear).
   void handleDatagram(std::span<const std::uint8_t> bytes, SteadyTime now) override;
 

@@ -1,6 +1,6 @@
 // A channel's time of day (UTC), which places the sun and the moon
 // (FrameInputs::utc_s): set by the host (CIGI Celestial Sphere Control, to
-// the minute; FlightGear's cur_time + warp, to the second) or by --utc, and
+// the minute; FlightGear's cur_time, to the second) or by --utc, and
 // advanced between those by the host's own time line, so a paused host
 // holds the sun and a host at 10x moves it ten times as fast. The weather
 // clock is another clock (shared_state.hpp) and is not touched here.
