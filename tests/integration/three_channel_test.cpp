@@ -200,6 +200,10 @@ void checkDisplay(const std::string& name, double sunAzimuth_deg, double sunElev
   std::size_t checked = 0;
   std::size_t startUp = 0;
   double arrivalSpread_s = 0, lockedOff_s = 0;  // the host clock lock's inputs and result
+  // The server's clock at arrival minus the host's time, over the frames:
+  // how much later than its own time line the host's datagrams arrived (a
+  // loaded machine delays the host process), which the lock cannot see.
+  double lagMin_s = 1e300, lagMax_s = -1e300;
   for (const auto& [host, trio] : run.frames) {
     SCOPED_TRACE("host frame " + std::to_string(host));
     bool settled = true;
@@ -218,6 +222,8 @@ void checkDisplay(const std::string& name, double sunAzimuth_deg, double sunElev
       const double server_s = trio[i]["weather_clock_server_s"].get<double>();
       arrivalSpread_s = std::max(arrivalSpread_s, std::abs(server_s - trio[0]["weather_clock_server_s"].get<double>()));
       lockedOff_s = std::max(lockedOff_s, std::abs(trio[i]["weather_clock_s"].get<double>() - server_s));
+      lagMin_s = std::min(lagMin_s, server_s - trio[i]["host_time_s"].get<double>());
+      lagMax_s = std::max(lagMax_s, server_s - trio[i]["host_time_s"].get<double>());
     }
     // A channel subscribes at its first pose and draws once the detailed
     // area has come; the coarse area comes a moment later, so a channel may
@@ -257,10 +263,14 @@ void checkDisplay(const std::string& name, double sunAzimuth_deg, double sunElev
     ++checked;
   }
   EXPECT_GE(checked, 3u) << startUp << " host frames of start-up";
+  const double lagSwing_s = lagMax_s - lagMin_s;
   std::printf("[ clock    ] %s: the server's clock at the channels' arrivals of a host frame %.2f ms apart at most; "
-              "the locked clock within %.3f s of it\n",
-              name.c_str(), 1e3 * arrivalSpread_s, lockedOff_s);
-  EXPECT_LE(lockedOff_s, 0.5 * 1.0 + 0.05);  // half kHostClockGrid_s (1 s), plus the arrival spread
+              "the host's datagrams late by a varying %.3f s; the locked clock within %.3f s of it\n",
+              name.c_str(), 1e3 * arrivalSpread_s, lagSwing_s, lockedOff_s);
+  // Half kHostClockGrid_s (1 s), plus the arrival spread, plus how much the
+  // host's lateness varied (the lock follows the host's time, the server's
+  // clock the wall's).
+  EXPECT_LE(lockedOff_s, 0.5 * 1.0 + 0.05 + lagSwing_s);
   std::printf("[ seams    ] %s: %zu host frames (and %zu of start-up); edge rays %.2e deg apart, centre rays at most %.4f deg apart "
               "(a centre pixel: %.4f deg); colour step across a seam at most %.2f x its neighbours'\n",
               name.c_str(), checked, startUp, worstEdge_deg, worstCentres_deg, pixel_deg, worstRatio);

@@ -19,6 +19,7 @@
 #include "sky/app/channel_frame.hpp"
 #include "sky/app/fallback_weather.hpp"
 #include "sky/app/frame_writer.hpp"
+#include "sky/app/pose_source.hpp"
 #include "sky/app/replay_outputs.hpp"
 #include "sky/app/shared_state.hpp"
 #include "sky/app/weather_client.hpp"
@@ -144,7 +145,10 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
               weatherSource.c_str(), o.outDir.c_str());
   std::fflush(stdout);
 
-  geo::GeodeticPose pose = flight::sample(*flight, t0);
+  // The camera and the time of day come from the flight, as a live
+  // channel's come from its host.
+  FlightPoseSource poses(*flight, t0 - first_s, Clock::now(), o.pace > 0 ? o.pace : 1.0, o.fixedSun);
+  geo::GeodeticPose pose = poses.poseAtFlightTime(t0 - first_s, 0).pose;
   AreaTracker areas;
   if (weather)
     for (const auto& area : areas.update(pose)) weather->subscribe(area);
@@ -163,7 +167,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   const double clockRate = firstView.clock.rate();
 
   // The real sun when the record says when it was flown.
-  const bool sunFromDate = !o.fixedSun && flight->startUtc_s.has_value();
+  const bool sunFromDate = poses.poseAtFlightTime(t0 - first_s, 0).timeSource == TimeSource::FlightFile;
   const auto picks = ContactSheet::pick(frameCount, kSheetColumns * kSheetRows);
   ContactSheet sheet(kSheetColumns, kSheetRows, kSheetCellWidth, s.width, s.height);
   std::size_t nextPick = 0;
@@ -195,7 +199,8 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
       std::printf("replay: the window was closed after %zu frames\n", done);
       break;
     }
-    pose = flight::sample(*flight, t);
+    const HostPose host = poses.poseAtFlightTime(t - first_s, static_cast<std::uint32_t>(i));
+    pose = host.pose;
     if (const auto asked = weather ? areas.update(pose) : std::vector<stream::Subscribe>{}; !asked.empty()) {
       const std::uint64_t before = state.weatherVersion();
       for (const auto& area : asked) weather->subscribe(area);
@@ -205,10 +210,8 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     }
     const WeatherView view = state.weather();
     FrameRequest request;
-    request.host.pose = pose;
-    request.host.hostFrame = static_cast<std::uint32_t>(i);
-    request.host.hostTime_s = t - first_s;
-    request.source = "replay";
+    request.host = host;
+    request.source = poses.source();
     request.camera = pose;
     request.weather = &view;
     request.weatherSource = o.weatherFile.empty() ? "server" : "file";
@@ -216,8 +219,8 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     request.weatherClock_s = clockBase_s + (t - t0) * clockRate;
     request.sunAzimuth_deg = o.sunAzimuth_deg;
     request.sunElevation_deg = o.sunElevation_deg;
-    if (sunFromDate) request.utc_s = double(*flight->startUtc_s) + (t - first_s);
-    request.utcSource = sunFromDate ? TimeSource::FlightFile : TimeSource::Fixed;
+    request.utc_s = host.utc_s;
+    request.utcSource = host.timeSource;
     request.frameIndex = i;
     auto drawn = frames.draw(request);
     if (!drawn) {

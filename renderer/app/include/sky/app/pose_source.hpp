@@ -1,8 +1,8 @@
-// Where a live channel's camera comes from, behind one small interface: the
+// Where a channel's camera comes from, behind one small interface: the
 // CIGI host (the pose its listener put in SharedState), FlightGear's native
-// FDM stream, or ForeFlight lines (both smoothed). The channel loop asks a
-// source for the pose to draw now and tells it when a frame is done; a new
-// input protocol is one more source and nothing else.
+// FDM stream, ForeFlight lines (both smoothed), or a recorded flight file.
+// The channel loop asks a source for the pose to draw now and tells it when
+// a frame is done; a new input protocol is one more source and nothing else.
 #pragma once
 
 #include <cstdint>
@@ -14,6 +14,7 @@
 #include "sky/app/foreflight_listener.hpp"
 #include "sky/app/host_atmosphere.hpp"
 #include "sky/app/shared_state.hpp"
+#include "sky/flight/flight.hpp"
 
 namespace sky::app {
 
@@ -22,9 +23,9 @@ class PoseSource {
   virtual ~PoseSource() = default;
   // The pose to draw at `now` (its time of day with it), or none yet.
   virtual std::optional<HostPose> poseAt(SteadyTime now) = 0;
-  // frames.jsonl's "source": "cigi", "fdm", "foreflight".
+  // frames.jsonl's "source": "cigi", "fdm", "foreflight", "replay".
   virtual const char* source() const = 0;
-  // For messages: "CIGI", "FlightGear FDM", "ForeFlight".
+  // For messages: "CIGI", "FlightGear FDM", "ForeFlight", "flight file".
   virtual const char* name() const = 0;
   // Smoothed sources are sampled at the channel's frame rate, and a frame is
   // drawn for every sample; a CIGI frame is drawn per new host datagram,
@@ -93,6 +94,33 @@ class ForeFlightPoseSource : public PoseSource {
  private:
   ForeFlightListener& lines_;
   const SharedState& state_;
+};
+
+// A recorded flight (parsed by protocol/flight): the pose at flight time t
+// (s from the file's first fix), numbered as host frames by the caller, and
+// its time of day when the file says when it was flown (IGC's date, GPX
+// and CSV timestamps; source FlightFile), unless `fixedSun`. The headless
+// replay steps the flight time itself (poseAtFlightTime); poseAt maps a
+// steady clock onto it from `start` at `pace` (flight seconds per second),
+// past the end holding the last fix.
+class FlightPoseSource : public PoseSource {
+ public:
+  FlightPoseSource(const flight::Flight& flight, double startFlight_s, SteadyTime start, double pace, bool fixedSun)
+      : flight_(flight), startFlight_s_(startFlight_s), start_(start), pace_(pace), fixedSun_(fixedSun) {}
+  HostPose poseAtFlightTime(double t_s, std::uint32_t hostFrame) const;
+  std::optional<HostPose> poseAt(SteadyTime now) override;
+  const char* source() const override { return "replay"; }
+  const char* name() const override { return "flight file"; }
+  bool smoothed() const override { return true; }
+  HostAtmosphere atmosphere() const override { return {}; }
+
+ private:
+  const flight::Flight& flight_;
+  double startFlight_s_;
+  SteadyTime start_;
+  double pace_;
+  bool fixedSun_;
+  std::uint32_t frames_ = 0;
 };
 
 }  // namespace sky::app
