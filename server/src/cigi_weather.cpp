@@ -167,7 +167,7 @@ Result<std::vector<WeatherChange>> CigiWeatherMapper::map(const cigi::Datagram& 
     if (it == regions.end()) continue;
     if (!it->second.active || !it->second.geometry) {
       if (!it->second.active && it->second.lastSent) {
-        changes.emplace_back(std::in_place_type<RemoveRegion>, id);
+        changes.emplace_back(RemoveRegion{id, {}});
         it->second.lastSent.reset();
       }
       if (!it->second.active && !it->second.geometry && it->second.layers.empty()) regions.erase(it);
