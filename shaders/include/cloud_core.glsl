@@ -366,9 +366,10 @@ real2 cloudShadow(AirFrame a, int count, int skip, real3 p, real hp, real muSun)
   real groundRadius = a.r - a.h;
   real rp = groundRadius + hp;
   for (int k = 0; k < count; ++k) {
+    if (k == skip) continue;  // before layerAt: a layer read per cloud sample is not free
     CoreLayer L = layerAt(k);
     real top = a.h - L.hTop;
-    if (k == skip || L.absent || hp >= top) continue;
+    if (L.absent || hp >= top) continue;
     real lo = max(hp, a.h - L.hBase);
     real hMid = 0.5 * (lo + top);
     // Distance along the sun from p up to the height hMid (stable sphere root).

@@ -148,7 +148,8 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   // The camera and the time of day come from the flight, as a live
   // channel's come from its host.
   FlightPoseSource poses(*flight, t0 - first_s, Clock::now(), o.pace > 0 ? o.pace : 1.0, o.fixedSun);
-  geo::GeodeticPose pose = poses.poseAtFlightTime(t0 - first_s, 0).pose;
+  const HostPose firstHost = poses.poseAtFlightTime(t0 - first_s, 0);
+  geo::GeodeticPose pose = firstHost.pose;
   AreaTracker areas;
   if (weather)
     for (const auto& area : areas.update(pose)) weather->subscribe(area);
@@ -167,7 +168,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   const double clockRate = firstView.clock.rate();
 
   // The real sun when the record says when it was flown.
-  const bool sunFromDate = poses.poseAtFlightTime(t0 - first_s, 0).timeSource == TimeSource::FlightFile;
+  const bool sunFromDate = firstHost.timeSource == TimeSource::FlightFile;
   const auto picks = ContactSheet::pick(frameCount, kSheetColumns * kSheetRows);
   ContactSheet sheet(kSheetColumns, kSheetRows, kSheetCellWidth, s.width, s.height);
   std::size_t nextPick = 0;
@@ -280,7 +281,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   report["preset"] = o.preset;
   if (sunFromDate) {
     report["sun"] = "ephemeris at the recorded date and time";
-    report["utc_start_s"] = double(*flight->startUtc_s) + (t0 - first_s);
+    report["utc_start_s"] = *firstHost.utc_s;
   } else {
     report["sun"] = {{"azimuth_deg", o.sunAzimuth_deg}, {"elevation_deg", o.sunElevation_deg}};
   }

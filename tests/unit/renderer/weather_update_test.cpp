@@ -181,13 +181,20 @@ TEST(WeatherUpdate, RandomTileChangesGiveTheFullBuild) {
   }
 }
 
-TEST(WeatherUpdate, OneTileRewritesItsCellsTexels) {
-  const geo::Geodetic anchor = weatherAnchorFor(kCamera);
+// One uniform layer (id 1) tiled at the fine level with coverage 0.5 over a
+// cap of radius_m around the camera, at most maxCells tiles.
+weather::WeatherSnapshot tiledAroundCamera(double radius_m, std::size_t maxCells) {
   weather::WeatherSnapshot s;
   s.tileLevel = kFineLevel;
   s.layers = {layer(1, 0.0)};
-  for (std::uint64_t cell : weather::coverCap({kCamera.lat_deg, kCamera.lon_deg, 60000.0}, kFineLevel, 8000))
+  for (std::uint64_t cell : weather::coverCap({kCamera.lat_deg, kCamera.lon_deg, radius_m}, kFineLevel, maxCells))
     s.tiles.push_back({cell, 1, 0.5f, 1.0f});
+  return s;
+}
+
+TEST(WeatherUpdate, OneTileRewritesItsCellsTexels) {
+  const geo::Geodetic anchor = weatherAnchorFor(kCamera);
+  weather::WeatherSnapshot s = tiledAroundCamera(60000.0, 8000);
   WeatherFieldUpdater updater;
   const WeatherFieldChange first = updater.update(&s, nullptr, anchor);
   ASSERT_EQ(first.kind, Kind::Rebuilt);
@@ -249,11 +256,7 @@ TEST(WeatherUpdate, OneTileRewritesItsCellsTexels) {
 // rebuilds. Prints what the skipped comparison costs per frame.
 TEST(WeatherUpdate, AKnownVersionSkipsTheSnapshots) {
   const geo::Geodetic anchor = weatherAnchorFor(kCamera);
-  weather::WeatherSnapshot s;
-  s.tileLevel = kFineLevel;
-  s.layers = {layer(1, 0.0)};
-  for (std::uint64_t cell : weather::coverCap({kCamera.lat_deg, kCamera.lon_deg, 200000.0}, kFineLevel, 40000))
-    s.tiles.push_back({cell, 1, 0.5f, 1.0f});
+  weather::WeatherSnapshot s = tiledAroundCamera(200000.0, 40000);
   WeatherFieldUpdater updater;
   ASSERT_EQ(updater.update(&s, nullptr, anchor, 7).kind, Kind::Rebuilt);
   const WeatherField before = updater.field();
