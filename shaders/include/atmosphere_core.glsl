@@ -280,6 +280,62 @@ real3 multipleScattering(real h, real muSun) {
 real2 airCloudShadow(AirFrame a, real3 p, real h, real muSun);
 #endif
 
+// The part of a view ray along dir inside the atmosphere, up to tEnd (the
+// ground, or past the atmosphere): from the camera (or where the ray enters
+// from above) to where it leaves the top or meets tEnd; t1 <= t0 when the
+// ray misses the air.
+struct AirSegment {
+  real t0;
+  real t1;
+};
+
+AirSegment airSegment(AirFrame a, real3 dir, real tEnd) {
+  AirSegment s;
+  s.t0 = 0.0;
+  s.t1 = 0.0;
+  Roots top = intersectSphere(a.r, a.cTop, dir.z);
+  bool inside = a.h < kAtmosphereHeight_m;
+  if (!inside && !(top.hit && top.t1 > 0.0)) return s;
+  s.t0 = inside ? 0.0 : max(top.t0, 0.0);
+  s.t1 = min(top.hit ? top.t1 : 0.0, tEnd);
+  return s;
+}
+
+// What the air at distance t along dir adds per unit length, split by its
+// angular dependence (the phase functions depend only on the angle between
+// dir and the sun, constant along the ray, so they can multiply the sums
+// afterwards, which lets a table store the sums for every sun angle):
+// Rayleigh and aerosol single scattering without their phase, and the
+// isotropic multiple scattering (Hillaire 2020, eq. 11), each through the
+// clouds' shadow; and the extinction there.
+struct AirSource {
+  real3 extinction;  // 1/m
+  real3 rayleigh;    // times phaseRayleigh
+  real3 mie;         // times phaseCornetteShanks
+  real3 multiple;    // isotropic
+};
+
+AirSource airSourceAt(AirFrame a, real3 dir, real t) {
+  real3 p = dir * t;
+  real h = heightAboveCameraSphere(p, a.r) + a.h;
+  real muSun = dot(upAt(p, a.r), a.sunDir);
+  real3 sun = a.sunIrradiance * sunTransmittance(h, muSun, a.r - a.h);
+#ifdef SKY_CLOUD_SHADOWED_AIR
+  real2 shade = a.shadowLayers > 0 ? airCloudShadow(a, p, h, muSun) : real2(1.0);
+#else
+  real2 shade = real2(1.0);
+#endif
+  real3 rayleigh = rayleighScattering(h);
+  real mie = (1.0 + a.aerosolExcess) * kMieScattering_perm * mieDensity(h);
+  AirSource src;
+  src.extinction = airExtinction(h) + real3(a.aerosolExcess * kMieExtinction_perm * mieDensity(h));
+  src.rayleigh = rayleigh * sun * shade.x;
+  src.mie = real3(mie) * sun * shade.x;
+  src.multiple = (rayleigh + real3(mie)) * sampleMultipleScatteringLut(multipleScatteringUv(h, muSun)) *
+                 a.sunIrradiance * shade.y;
+  return src;
+}
+
 // Sunlight scattered by the air along dir from the camera, with
 // the camera's air to distance tEnd (the ground, or past the atmosphere),
 // reported at the queried distances q[0..count) (ascending, any values: a
@@ -292,15 +348,10 @@ AirPath marchAir(AirFrame a, real3 dir, real tEnd, real q[kAirQueries], int coun
     path.inscatter[k] = real3(0.0);
     path.transmittance[k] = real3(1.0);
   }
-  // The part of the ray inside the atmosphere: from the camera (or where the
-  // ray enters from above) to where it leaves the top or meets tEnd.
-  Roots top = intersectSphere(a.r, a.cTop, dir.z);
-  bool inside = a.h < kAtmosphereHeight_m;
-  if (!inside && !(top.hit && top.t1 > 0.0)) return path;
-  real tA = inside ? 0.0 : max(top.t0, 0.0);
-  real tB = min(top.hit ? top.t1 : 0.0, tEnd);
+  AirSegment seg = airSegment(a, dir, tEnd);
+  real tA = seg.t0;
+  real tB = seg.t1;
   if (tB <= tA) return path;
-  real groundRadius = a.r - a.h;
   real nu = dot(dir, a.sunDir);
   real pR = phaseRayleigh(nu);
   real pM = phaseCornetteShanks(nu, kMieG);
@@ -309,31 +360,16 @@ AirPath marchAir(AirFrame a, real3 dir, real tEnd, real q[kAirQueries], int coun
   int next = 0;
   // Queries before the air starts see nothing.
   while (next < count && q[next] <= tA) ++next;
-  int steps = a.airSteps > 0 ? a.airSteps : kAirSteps;
+  // No queries, no march (and a caller that does not want it skips it).
+  int steps = count > 0 ? (a.airSteps > 0 ? a.airSteps : kAirSteps) : 0;
   for (int i = 0; i < steps; ++i) {
     real u0 = real(i) / real(steps);
     real u1 = real(i + 1) / real(steps);
     real s0 = tA + (tB - tA) * u0 * u0;
     real s1 = tA + (tB - tA) * u1 * u1;
-    real tm = 0.5 * (s0 + s1);
-    real3 p = dir * tm;
-    real h = heightAboveCameraSphere(p, a.r) + a.h;
-    real3 sigmaT = airExtinction(h) + real3(a.aerosolExcess * kMieExtinction_perm * mieDensity(h));
-    real muSun = dot(upAt(p, a.r), a.sunDir);
-    real3 sun = a.sunIrradiance * sunTransmittance(h, muSun, groundRadius);
-#ifdef SKY_CLOUD_SHADOWED_AIR
-    real2 shade = a.shadowLayers > 0 ? airCloudShadow(a, p, h, muSun) : real2(1.0);
-#else
-    real2 shade = real2(1.0);
-#endif
-    // Source per unit length: sigma_s p E_sun T_sun for both scatterers, and
-    // sigma_s times the multiple-scattering radiance (Hillaire 2020, eq. 11),
-    // each through the clouds' shadow.
-    real3 rayleigh = rayleighScattering(h);
-    real mie = (1.0 + a.aerosolExcess) * kMieScattering_perm * mieDensity(h);
-    real3 source = (rayleigh * pR + real3(mie * pM)) * sun * shade.x +
-                   (rayleigh + real3(mie)) * sampleMultipleScatteringLut(multipleScatteringUv(h, muSun)) *
-                       a.sunIrradiance * shade.y;
+    AirSource src = airSourceAt(a, dir, 0.5 * (s0 + s1));
+    real3 sigmaT = src.extinction;
+    real3 source = src.rayleigh * pR + src.mie * pM + src.multiple;
     // Queries inside this step: the exact part of the step up to each.
     while (next < count && q[next] < s1) {
       real d = q[next] - s0;

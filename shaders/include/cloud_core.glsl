@@ -16,6 +16,7 @@
 //   real  sampleMaxCoverage(LayerSampling s, real3 pLocal) // the weather map's max-coverage mip cell:
 //                                                          // >= any coverage sampleWeather gives in it
 //   real2 airCloudShadow(AirFrame a, real3 p, real h, real muSun) // cloudShadow(a, a.shadowLayers, -1, p, h, muSun)
+//   real4 sampleAirTable(int part, real3 uvw)           // the frame's air table (air_table.glsl)
 // pLocal is camera-relative, local frame: x east, y north, z up (m).
 
 #include "core_common.glsl"
@@ -23,6 +24,7 @@
 // airCloudShadow hook; the includer defines it as cloudShadow below).
 #define SKY_CLOUD_SHADOWED_AIR
 #include "atmosphere_core.glsl"
+#include "air_table.glsl"
 #include "cloud_density.glsl"
 
 // Single-scattering albedo of cloud droplets and ice in the visible
@@ -148,6 +150,16 @@ SKY_CORE_CONST int kEmptyRunToLongSteps = 2;
 
 struct CoreFrame {
   AirFrame air;
+  // The air in front of the clouds and the ground from the frame's table
+  // (air_table.glsl, of shape airTable), or marched per pixel. A flag of its
+  // own, not airTable's azimuths: on the GPU it is a constant of the
+  // pipeline, so the way not taken is compiled out.
+  bool airFromTable;
+  AirTableShape airTable;
+  // Whether any layer has coverage somewhere on the weather map; false: a
+  // clear sky, drawn as air and ground alone (on the GPU a constant of the
+  // pipeline too: the clear sky's variant has no cloud code to run).
+  bool clouds;
   MarchParams march;
   real3 groundIrradiance;  // sky irradiance on horizontal ground, linear units
   int layerCount;
@@ -498,24 +510,59 @@ real3 groundRadiance(CoreFrame f, real3 dir, real t) {
   return light * (kGroundAlbedo / kPi);
 }
 
+// The air along dir up to tEnd (airRayEnd's), at the queried distances:
+// from the table or marched. Both are called, the one not wanted with no
+// queries, which skips its loops (lavapipe runs both sides of a branch for
+// every lane, but leaves a loop at once when no lane is in it; on the GPU
+// airFromTable is a constant, and the other is compiled out).
+AirPath airAlongRay(CoreFrame f, real3 dir, real tEnd, real q[kAirQueries], int count) {
+  AirPath fromTable = airPathFromTable(f.air, f.airTable, dir, tEnd, q, f.airFromTable ? count : 0);
+  AirPath marched = marchAir(f.air, dir, tEnd, q, f.airFromTable ? 0 : count);
+  if (f.airFromTable) return fromTable;
+  return marched;
+}
+
+// What lies behind the air along dir: the ground at tEnd, or the night sky
+// past the atmosphere. The ground in a loop run once or not at all, for the
+// same reason: a subgroup that sees only sky skips it.
+real3 backgroundRadiance(CoreFrame f, real3 dir, real tEnd) {
+  real3 background = real3(kNightSkyRadiance);
+  for (int once = tEnd < kFarAway_m ? 1 : 0; once > 0; --once) background = groundRadiance(f, dir, tEnd);
+  return background;
+}
+
+// A pixel of a clear sky: the air and what lies behind it.
+PixelResult shadeClearPixel(CoreFrame f, real3 dir) {
+  real tEnd = airRayEnd(f.air, dir.z);
+  real q[kAirQueries];
+  for (int k = 0; k < kAirQueries; ++k) q[k] = tEnd;
+  AirPath air = airAlongRay(f, dir, tEnd, q, 1);
+  return PixelResult(air.inscatter[0] + backgroundRadiance(f, dir, tEnd) * air.transmittance[0], 1.0, 0.0);
+}
+
 // Radiance along dir (unit, local frame): the layers front to back, each seen
 // through the air in front of it (aerial perspective at the layer's depth),
 // the air's own light between them, and the ground or space behind
 // (Patapom's premultiplied compositing: background times transmittance plus
 // in-scattering).
 PixelResult shadePixel(CoreFrame f, real3 dir, real jitter) {
+  if (!f.clouds) return shadeClearPixel(f, dir);
   real mu = dir.z;
-  Roots ground = intersectSphere(f.air.r, f.air.cGround, mu);
-  bool hitsGround = ground.hit && ground.t1 > 0.0;
-  real tGround = hitsGround ? max(ground.t0, 0.0) : kMaxViewDistance_m + kMaxSpan_m;
-  real tEnd = hitsGround ? tGround : kFarAway_m;
+  real tEnd = airRayEnd(f.air, mu);
+  bool hitsGround = tEnd < kFarAway_m;
+  real tGround = hitsGround ? tEnd : kMaxViewDistance_m + kMaxSpan_m;
 
   Span spans[kMaxLayers];
   int order[kMaxLayers];
+  // The layers' reads in a loop that ends at the frame's count, not in a
+  // select over all kMaxLayers slots: lavapipe evaluates both sides of a
+  // select (and every branch) for the whole subgroup, but leaves a loop once
+  // no lane is in it.
   for (int i = 0; i < int(kMaxLayers); ++i) {
-    spans[i] = i < f.layerCount ? layerSpan(f, layerAt(i), mu, tGround) : Span(0.0, 0.0);
+    spans[i] = Span(0.0, 0.0);
     order[i] = i;
   }
+  for (int i = 0; i < f.layerCount; ++i) spans[i] = layerSpan(f, layerAt(i), mu, tGround);
   // Insertion sort by entry distance, so layers composite front to back.
   for (int i = 1; i < f.layerCount; ++i) {
     for (int j = i; j > 0 && spans[order[j - 1]].t0 > spans[order[j]].t0; --j) {
@@ -539,7 +586,7 @@ PixelResult shadePixel(CoreFrame f, real3 dir, real jitter) {
     ++n;
   }
   q[n] = tEnd;
-  AirPath air = marchAir(f.air, dir, tEnd, q, n + 1);
+  AirPath air = airAlongRay(f, dir, tEnd, q, n + 1);
 
   // Cloud depth (an output, not part of the light): each layer's mean depth
   // weighted by the light it takes out of the view ray, Tbefore (1 - T), so
@@ -556,8 +603,7 @@ PixelResult shadePixel(CoreFrame f, real3 dir, real jitter) {
     airBefore = air.inscatter[k];
   }
   radiance += (air.inscatter[n] - airBefore) * transmittance;
-  real3 background = hitsGround ? groundRadiance(f, dir, tGround) : real3(kNightSkyRadiance);
-  radiance += background * air.transmittance[n] * transmittance;
+  radiance += backgroundRadiance(f, dir, tEnd) * air.transmittance[n] * transmittance;
   real depth = transmittance < 1.0 ? depthSum / (1.0 - transmittance) : 0.0;
   return PixelResult(radiance, transmittance, depth);
 }

@@ -32,6 +32,10 @@ SKY_SHARED_CONST kBindingCoverageMip = 10u;        // read-only storage buffer o
                                                    // mip, rings x kMaxLayers x kCoverageMipSize^2 (ring, slice, row north, column east)
 SKY_SHARED_CONST kBindingBlueNoise = 11u;          // read-only storage buffer of float: the blue-noise tile,
                                                    // kBlueNoiseSize^2 values in [0, 1), row-major
+SKY_SHARED_CONST kBindingAirTableOut = 12u;        // storage image3D (RGBA32F): the air table the table pass
+                                                   // writes (air_table.glsl), its three parts stacked in depth
+SKY_SHARED_CONST kBindingAirTable = 13u;           // sampler3D of the same image, read by the cloud pass
+                                                   // (linear; u repeats, v and w clamp to the edge)
 // Pixels per edge of the blue-noise tile (renderer/core/src/blue_noise.hpp).
 SKY_SHARED_CONST kBlueNoiseSize = 64u;
 // Cells per edge of the max-coverage mip (renderer/core/src/coverage_mip.hpp).
@@ -109,6 +113,8 @@ struct SkyFrame {
                         // its ray goes; z: 1 to jitter (TemporalSettings::pixelJitter), 0 for the centre
   vec4 frustum;         // tangents of the view's left, right, up and down half-angles (left and down
                         // negative; core_common.glsl, frustumPoint)
+  uvec4 airTable;       // the air table (air_table.glsl, AirTableShape): x azimuths (0: the air is marched
+                        // per pixel, no table pass), y zeniths, z slices per part; w unused
 };
 
 #ifdef __cplusplus
@@ -132,7 +138,8 @@ static_assert(offsetof(SkyFrame, steps) == 272 + 256 * kMaxLayers + 16);
 static_assert(offsetof(SkyFrame, interleave) == 272 + 256 * kMaxLayers + 32);
 static_assert(offsetof(SkyFrame, raster) == 272 + 256 * kMaxLayers + 48);
 static_assert(offsetof(SkyFrame, frustum) == 272 + 256 * kMaxLayers + 80);
-static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 96);
+static_assert(offsetof(SkyFrame, airTable) == 272 + 256 * kMaxLayers + 96);
+static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 112);
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

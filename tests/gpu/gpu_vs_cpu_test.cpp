@@ -1,8 +1,9 @@
 // GPU image against the CPU reference (the same model compiled as C++ in
 // double precision with emulated texture filtering) at 64x36, for cameras
 // below, inside and above a layer, tiled and uniform coverage, with wind,
-// tiles blending the layer's type towards another, and the march in metres
-// with Haggstrom's coverage and density step factors.
+// tiles blending the layer's type towards another, the march in metres
+// with Haggstrom's coverage and density step factors, and the air read from
+// the air table or marched per pixel.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -43,6 +44,7 @@ struct Case {
   weather::CloudType blendType = weather::CloudType::None;
   double density = 1.0;  // the layer's, or its tiles'
   std::optional<render::ViewFrustum> frustum = std::nullopt;  // unset: the settings' symmetric one
+  double sunElevation_deg = 40;  // at azimuth 135
 };
 
 // Renders each scene on the GPU and the CPU reference and checks the mean
@@ -70,6 +72,7 @@ void compareScenes(render::CloudRenderer& r, const render::CpuReference& referen
     in.weather = &snap;
     in.weatherClock_s = s.clock_s;
     in.frustum = s.frustum;
+    in.sunElevation_deg = s.sunElevation_deg;
     auto gpu = r.render(in);
     ASSERT_TRUE(gpu) << describe(gpu.error());
     auto cpu = reference.render(in);
@@ -103,6 +106,38 @@ TEST(GpuVsCpu, RmseWithinTolerance) {
       {"type_blend_to_ci", pose(47, 8, 3000, 60, 20), true, 0.6, 0, 0, weather::CloudType::Cirrus},
   };
   compareScenes(r, *reference, scenes, "", false);
+}
+
+// The sky and the aerial perspective read from the air table (the default)
+// at the extremes of its layout: the sun low (the glow and the reddened
+// light along the horizon) and below the horizon at civil twilight, a camera
+// at cruise altitude looking at the horizon, and one above the atmosphere
+// (rays entering it from above); and the same scenes with the air marched
+// per pixel (MarchSettings::airTable off), the reference's way. Within the
+// same bounds as the scenes above.
+TEST(GpuVsCpu, AirTableAndAirMarchWithinTolerance) {
+  SKY_RENDERER(shared, 64, 36);  // keeps the driver loaded (renderer_fixture.hpp)
+  (void)shared;
+  const std::vector<Case> scenes = {
+      {"low_sun_clear", pose(47, 8, 800, 135, 5), false, 0.0, 0, 0, weather::CloudType::None, 1.0, std::nullopt, 3},
+      {"twilight_clear", pose(47, 8, 800, 135, 10), false, 0.0, 0, 0, weather::CloudType::None, 1.0, std::nullopt,
+       -4},
+      {"low_sun_below_tiled", pose(47, 8, 800, 135, 5), true, 0.5, 0, 0, weather::CloudType::None, 1.0,
+       std::nullopt, 6},
+      {"cruise_horizon", pose(47, 8, 11000, 300, -2), true, 0.5, 0, 0},
+      {"above_atmosphere", pose(20, 100, 90000, 0, -50), true, 0.6, 0, 0},
+  };
+  for (const bool table : {true, false}) {
+    render::RenderSettings settings;
+    settings.width = 64;
+    settings.height = 36;
+    settings.march.airTable.enabled = table;
+    auto r = render::CloudRenderer::create(settings);
+    ASSERT_TRUE(r) << describe(r.error());
+    auto reference = render::CpuReference::create(settings);
+    ASSERT_TRUE(reference) << describe(reference.error());
+    compareScenes(**r, *reference, scenes, table ? "air_table_" : "air_march_", false);
+  }
 }
 
 // 64x36 with the march in metres: 100 m steps in cloud, 400 m in clear air,

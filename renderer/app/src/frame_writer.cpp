@@ -113,6 +113,12 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
         {"density_step_min", s.march.densityStepMin},
         {"air_steps", s.march.airSteps},
         {"cloud_shadows", s.march.cloudShadows},
+        {"air_table",
+         s.march.airTable.enabled
+             ? nlohmann::json{{"azimuths", s.march.airTable.azimuths},
+                              {"zeniths", s.march.airTable.zeniths},
+                              {"slices", s.march.airTable.slices}}
+             : nlohmann::json(nullptr)},
         {"blue_noise", s.march.blueNoise}}},
       {"interleave", s.temporal.interleave},
       {"accumulation", s.temporal.accumulation},

@@ -115,13 +115,18 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     else if (key == "depth-aware" && (v == 0 || v == 1)) c.settings.resolution.depthAware = v == 1;
     else if (key == "blue" && (v == 0 || v == 1)) m.blueNoise = v == 1;
     else if (key == "cloud-shadows" && (v == 0 || v == 1)) m.cloudShadows = v == 1;
+    else if (key == "air-table" && (v == 0 || v == 1)) m.airTable.enabled = v == 1;
+    else if (key == "air-azimuths") m.airTable.azimuths = std::uint32_t(v);
+    else if (key == "air-zeniths") m.airTable.zeniths = std::uint32_t(v);
+    else if (key == "air-slices") m.airTable.slices = std::uint32_t(v);
     else if (key == "accumulate" && v <= 0.95) c.settings.temporal.accumulation = v;
     else if (key == "pixel-jitter" && (v == 0 || v == 1)) c.settings.temporal.pixelJitter = v == 1;
     else
       return fail(ErrorCode::InvalidArgument,
                   "custom configuration '" + spec + "': unknown key '" + key +
                       "' (base, primary, light, exit, stride, cloud, empty, growth, air, multmin, divmin, scale, "
-                      "interleave 1|2|4, divisor 1|2|4, depth-aware 0|1, blue 0|1, cloud-shadows 0|1, accumulate 0..0.95, "
+                      "interleave 1|2|4, divisor 1|2|4, depth-aware 0|1, blue 0|1, cloud-shadows 0|1, air-table 0|1, "
+                      "air-azimuths, air-zeniths, air-slices, accumulate 0..0.95, "
                       "pixel-jitter 0|1)");
   }
   // Accumulation blends redraws with the history: without interleaving

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <string>
 
 #include "sky/bench/cpu_time.hpp"
 #include "sky/bench/driver_pin.hpp"
@@ -85,6 +86,14 @@ Result<void> runSideBySide(const SideBySideOptions& o, std::FILE* out, std::FILE
     const CpuUse use = cpuBetween(before, after);
     std::fprintf(out, "%s\n", cloudPassLine(o.width, o.height, wall_ms, use.cpu_ms, use.maxThread_ms).c_str());
     std::fflush(out);
+    // Per pass on the side (the CLOUDPASS line's format is the peer tools').
+    std::string passes;
+    for (const auto& pass : (*renderer)->lastPassTimes()) {
+      char part[96];
+      std::snprintf(part, sizeof part, " %s=%.3f", pass.pass.c_str(), pass.gpu_ms);
+      passes += part;
+    }
+    std::fprintf(err, "# passes (GPU ms):%s\n", passes.c_str());
   }
   return {};
 }

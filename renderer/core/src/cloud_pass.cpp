@@ -27,32 +27,65 @@ vk::raii::Sampler makeSampler(const GpuContext& ctx, vk::SamplerAddressMode mode
 Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, std::uint32_t height,
                                     const NoiseVolume& shape, const NoiseVolume& detail,
                                     const AtmosphereTables& atmosphere, const WeatherTexture& weather,
-                                    const std::vector<float>& blueNoise) {
+                                    const std::vector<float>& blueNoise, const AirTableSettings& airTable) {
   SKY_ASSERT(blueNoise.size() == std::size_t(gpu::kBlueNoiseSize) * gpu::kBlueNoiseSize);
   CloudPass pass;
   pass.width_ = width;
   pass.height_ = height;
   const auto& device = ctx.device();
 
-  ComputePipelineBuilder builder("sky.clouds");
-  builder.binding(gpu::kBindingFrame, vk::DescriptorType::eStorageBuffer)
-      .binding(gpu::kBindingShape, vk::DescriptorType::eCombinedImageSampler)
-      .binding(gpu::kBindingWeather, vk::DescriptorType::eCombinedImageSampler)
-      .binding(gpu::kBindingOutput, vk::DescriptorType::eStorageBuffer)
-      .binding(gpu::kBindingDetail, vk::DescriptorType::eCombinedImageSampler)
-      .binding(gpu::kBindingTransmittance, vk::DescriptorType::eCombinedImageSampler)
-      .binding(gpu::kBindingMultipleScattering, vk::DescriptorType::eCombinedImageSampler)
-      .binding(gpu::kBindingDepth, vk::DescriptorType::eStorageBuffer)
-      .binding(gpu::kBindingCoverageMip, vk::DescriptorType::eStorageBuffer)
-      .binding(gpu::kBindingBlueNoise, vk::DescriptorType::eStorageBuffer)
-      .shader("clouds.comp.spv");
-  auto pipeline = builder.build(ctx);
-  if (!pipeline) return tl::unexpected(pipeline.error());
-  pass.pipeline_ = std::move(*pipeline);
+  // Both passes get the same bindings, so their set layouts are identical
+  // and one descriptor set serves both (Vulkan's compatibility rule).
+  // Two variants of each (cloud_pass.glsl's specialisation constants): with
+  // the clouds, and for a frame whose layers have no coverage anywhere.
+  auto withBindings = [&](ComputePipelineBuilder builder, const char* shader, bool clouds) {
+    builder.binding(gpu::kBindingFrame, vk::DescriptorType::eStorageBuffer)
+        .binding(gpu::kBindingShape, vk::DescriptorType::eCombinedImageSampler)
+        .binding(gpu::kBindingWeather, vk::DescriptorType::eCombinedImageSampler)
+        .binding(gpu::kBindingOutput, vk::DescriptorType::eStorageBuffer)
+        .binding(gpu::kBindingDetail, vk::DescriptorType::eCombinedImageSampler)
+        .binding(gpu::kBindingTransmittance, vk::DescriptorType::eCombinedImageSampler)
+        .binding(gpu::kBindingMultipleScattering, vk::DescriptorType::eCombinedImageSampler)
+        .binding(gpu::kBindingDepth, vk::DescriptorType::eStorageBuffer)
+        .binding(gpu::kBindingCoverageMip, vk::DescriptorType::eStorageBuffer)
+        .binding(gpu::kBindingBlueNoise, vk::DescriptorType::eStorageBuffer)
+        .binding(gpu::kBindingAirTableOut, vk::DescriptorType::eStorageImage)
+        .binding(gpu::kBindingAirTable, vk::DescriptorType::eCombinedImageSampler)
+        .shader(shader)
+        .constants({clouds ? 1u : 0u, airTable.enabled ? 1u : 0u});
+    return builder.build(ctx);
+  };
+  for (const bool clouds : {true, false}) {
+    auto pipeline = withBindings(ComputePipelineBuilder(clouds ? "sky.clouds" : "sky.clouds.clear"), "clouds.comp.spv",
+                                 clouds);
+    if (!pipeline) return tl::unexpected(pipeline.error());
+    (clouds ? pass.pipeline_ : pass.clearPipeline_) = std::move(*pipeline);
+    if (!airTable.enabled) continue;
+    auto table = withBindings(ComputePipelineBuilder(clouds ? "sky.airTable" : "sky.airTable.clear"),
+                              "air_table.comp.spv", clouds);
+    if (!table) return tl::unexpected(table.error());
+    (clouds ? pass.tablePipeline_ : pass.clearTablePipeline_) = std::move(*table);
+  }
 
   pass.noiseSampler_ = makeSampler(ctx, vk::SamplerAddressMode::eRepeat, "sky.noiseSampler");
   pass.weatherSampler_ = makeSampler(ctx, vk::SamplerAddressMode::eClampToBorder, "sky.weatherSampler");
   pass.tableSampler_ = makeSampler(ctx, vk::SamplerAddressMode::eClampToEdge, "sky.tableSampler");
+  {
+    // Azimuth repeats round the turn; zenith and distance stop at the edge.
+    const vk::SamplerCreateInfo info({}, vk::Filter::eLinear, vk::Filter::eLinear, vk::SamplerMipmapMode::eNearest,
+                                     vk::SamplerAddressMode::eRepeat, vk::SamplerAddressMode::eClampToEdge,
+                                     vk::SamplerAddressMode::eClampToEdge, 0.0f, VK_FALSE, 1.0f, VK_FALSE,
+                                     vk::CompareOp::eNever, 0.0f, 0.0f, vk::BorderColor::eFloatTransparentBlack,
+                                     VK_FALSE);
+    pass.airTableSampler_ = vk::raii::Sampler(device, info);
+    ctx.name(pass.airTableSampler_, "sky.airTableSampler");
+  }
+  // Off: a token image keeps the descriptor valid.
+  pass.airTableSize_ = airTable.enabled ? airTable : AirTableSettings{false, 8, 8, 4};
+  pass.airTable_ = createStorageVolume(ctx, vk::Format::eR32G32B32A32Sfloat,
+                                       vk::Extent3D(pass.airTableSize_.azimuths, pass.airTableSize_.zeniths,
+                                                    3 * pass.airTableSize_.slices),
+                                       "sky.airTable");
 
   auto noiseImage = [&](const NoiseVolume& n, const char* name) {
     return createSampledImage(ctx, vk::ImageType::e3D, n.channels == 4 ? vk::Format::eR8G8B8A8Unorm : vk::Format::eR8Unorm,
@@ -90,8 +123,9 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
                                      vk::BufferUsageFlagBits::eStorageBuffer, "sky.blueNoise");
   std::memcpy(pass.blueNoise_.mapped, blueNoise.data(), pass.blueNoise_.size);
 
-  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eCombinedImageSampler, 5),
-                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 5)};
+  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eCombinedImageSampler, 6),
+                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 5),
+                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageImage, 1)};
   pass.descriptorPool_ = vk::raii::DescriptorPool(
       device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSizes));
   ctx.name(pass.descriptorPool_, "sky.clouds.descriptorPool");
@@ -113,6 +147,8 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
                                        vk::ImageLayout::eShaderReadOnlyOptimal);
   const vk::DescriptorImageInfo weatherInfo(*pass.weatherSampler_, *weather.image().view,
                                             vk::ImageLayout::eShaderReadOnlyOptimal);
+  const vk::DescriptorImageInfo airOutInfo({}, *pass.airTable_.view, vk::ImageLayout::eGeneral);
+  const vk::DescriptorImageInfo airInfo(*pass.airTableSampler_, *pass.airTable_.view, vk::ImageLayout::eGeneral);
   const vk::DescriptorSet set = *pass.descriptorSet_;
   const std::array writes{
       vk::WriteDescriptorSet(set, gpu::kBindingFrame, 0, vk::DescriptorType::eStorageBuffer, {}, uniformInfo),
@@ -124,10 +160,12 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
       vk::WriteDescriptorSet(set, gpu::kBindingOutput, 0, vk::DescriptorType::eStorageBuffer, {}, outputInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingDepth, 0, vk::DescriptorType::eStorageBuffer, {}, depthInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingCoverageMip, 0, vk::DescriptorType::eStorageBuffer, {}, mipInfo),
-      vk::WriteDescriptorSet(set, gpu::kBindingBlueNoise, 0, vk::DescriptorType::eStorageBuffer, {}, blueInfo)};
+      vk::WriteDescriptorSet(set, gpu::kBindingBlueNoise, 0, vk::DescriptorType::eStorageBuffer, {}, blueInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingAirTableOut, 0, vk::DescriptorType::eStorageImage, airOutInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingAirTable, 0, vk::DescriptorType::eCombinedImageSampler, airInfo)};
   device.updateDescriptorSets(writes, {});
 
-  pass.timer_ = GpuTimer(ctx, 3, "sky.clouds.timer");
+  pass.timer_ = GpuTimer(ctx, 4, "sky.clouds.timer");
   pass.commands_ = ctx.allocateCommandBuffer();
   ctx.name(pass.commands_, "sky.clouds.commands");
   pass.fence_ = vk::raii::Fence(device, vk::FenceCreateInfo());
@@ -149,10 +187,43 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
   commands_.reset();
   commands_.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
   timer_.begin(commands_);
+  // The table's old contents are never read again: from eUndefined each frame.
+  const vk::ImageSubresourceRange whole(vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1);
+  commands_.pipelineBarrier(vk::PipelineStageFlagBits::eTopOfPipe, vk::PipelineStageFlagBits::eComputeShader, {}, {},
+                            {},
+                            vk::ImageMemoryBarrier({}, vk::AccessFlagBits::eShaderWrite | vk::AccessFlagBits::eShaderRead,
+                                                   vk::ImageLayout::eUndefined, vk::ImageLayout::eGeneral,
+                                                   VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *airTable_.image,
+                                                   whole));
+  // The clear-sky variants when no layer has coverage anywhere (the same
+  // image: such layers are skipped either way).
+  bool clouds = false;
+  for (std::uint32_t i = 0; i < std::uint32_t(frame.weatherMap.y) && i < gpu::kMaxLayers; ++i)
+    clouds = clouds || frame.layers[i].ambient.w < 0.5f;
+  SKY_ASSERT(frame.airTable.x == 0 || airTableSize_.enabled);
+  if (frame.airTable.x > 0) {
+    SKY_ASSERT(airTableSize_.enabled && frame.airTable.x == airTableSize_.azimuths &&
+               frame.airTable.y == airTableSize_.zeniths && frame.airTable.z == airTableSize_.slices);
+    {
+      const ComputePipeline& table = clouds ? tablePipeline_ : clearTablePipeline_;
+      const auto timed = timer_.section(commands_, "air-table");
+      commands_.bindPipeline(vk::PipelineBindPoint::eCompute, *table.pipeline);
+      commands_.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *table.layout, 0, *descriptorSet_, {});
+      commands_.dispatch((frame.airTable.x + gpu::kLocalSize - 1) / gpu::kLocalSize,
+                         (frame.airTable.y + gpu::kLocalSize - 1) / gpu::kLocalSize, 1);
+    }
+    commands_.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {},
+                              {}, {},
+                              vk::ImageMemoryBarrier(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eShaderRead,
+                                                     vk::ImageLayout::eGeneral, vk::ImageLayout::eGeneral,
+                                                     VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED,
+                                                     *airTable_.image, whole));
+  }
   {
+    const ComputePipeline& pipeline = clouds ? pipeline_ : clearPipeline_;
     const auto timed = timer_.section(commands_, "clouds");
-    commands_.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_.pipeline);
-    commands_.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *descriptorSet_, {});
+    commands_.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline.pipeline);
+    commands_.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline.layout, 0, *descriptorSet_, {});
     // One workgroup per 8x8 tile, in a 1D grid: the shader maps ids to tiles
     // through the permutation in frame.dispatch.
     commands_.dispatch(frame.image.w, 1, 1);

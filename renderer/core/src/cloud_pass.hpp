@@ -1,5 +1,6 @@
-// The cloud pass: one compute dispatch over the image (shaders/clouds.comp)
-// with its frame block, shape and detail noise, the atmosphere's
+// The cloud pass: one compute dispatch over the image (shaders/clouds.comp),
+// after the air table's when the frame has one (shaders/air_table.comp, the
+// same descriptor set), with its frame block, shape and detail noise, the atmosphere's
 // transmittance and multiple-scattering tables, samplers, output buffers
 // (radiance + transmittance, cloud depth), descriptor set, timestamps and
 // command buffer. Blocking: run() returns the read-back image.
@@ -29,10 +30,12 @@ class CloudPass {
   // may come from (MarchSettings::blueNoise).
   // Errors: Io/Malformed for the SPIR-V, Device from the texture uploads;
   // other Vulkan failures throw.
+  // airTable sizes the air table's image (a token one when it is off; a
+  // frame may then not ask for the table).
   static Result<CloudPass> create(const GpuContext& ctx, std::uint32_t width, std::uint32_t height,
                                   const NoiseVolume& shape, const NoiseVolume& detail,
                                   const AtmosphereTables& atmosphere, const WeatherTexture& weather,
-                                  const std::vector<float>& blueNoise);
+                                  const std::vector<float>& blueNoise, const AirTableSettings& airTable);
 
   // The passes that follow the clouds in the same submission, each with
   // its block: the reprojection (with interleaving; without it the frame
@@ -56,7 +59,7 @@ class CloudPass {
   // Replaces the max-coverage mip the march reads (coverage_mip.hpp; size
   // kMaxLayers x kCoverageMipSize^2). Call between runs.
   void setCoverageMip(const std::vector<float>& mip);
-  // GPU time of the last run's dispatches ("clouds", then "reproject", "upscale").
+  // GPU time of the last run's dispatches ("air-table", "clouds", then "reproject", "upscale").
   std::vector<PassTime> lastTimes() const { return timer_.results(); }
 
  private:
@@ -65,14 +68,23 @@ class CloudPass {
   // Destroyed in reverse order: fence and command buffer first, the
   // descriptor set before its pool, buffers and images before the samplers
   // and pipeline that reference them in the set layout.
+  // Set layouts all identical to pipeline_'s (one descriptor set serves
+  // every one); the clear variants draw frames without cloud; the table's
+  // only with the air table on.
   ComputePipeline pipeline_;
+  ComputePipeline clearPipeline_;
+  ComputePipeline tablePipeline_;
+  ComputePipeline clearTablePipeline_;
   vk::raii::Sampler noiseSampler_{nullptr};
+  vk::raii::Sampler airTableSampler_{nullptr};
   vk::raii::Sampler weatherSampler_{nullptr};
   vk::raii::Sampler tableSampler_{nullptr};
   GpuImage shape_;
   GpuImage detail_;
   GpuImage transmittance_;
   GpuImage multipleScattering_;
+  GpuImage airTable_;  // written by the table pass, sampled by the clouds (eGeneral)
+  AirTableSettings airTableSize_;
   GpuBuffer uniforms_;  // the frame block (a storage buffer, see clouds.comp)
   GpuBuffer output_;
   GpuBuffer depth_;

@@ -128,7 +128,7 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
     const std::uint32_t smallW = drawnExtent(settings.width, divisor);
     const std::uint32_t smallH = drawnExtent(settings.height, divisor);
     auto pass = CloudPass::create(**ctx, smallW, smallH, shape, detail, atmosphere, *weather,
-                                  blueNoiseTile(settings.noiseSeed));
+                                  blueNoiseTile(settings.noiseSeed), settings.march.airTable);
     if (!pass) return tl::unexpected(pass.error());
     std::optional<ReprojectPass> reproject;
     if (settings.temporal.interleave > 1) {

@@ -15,6 +15,11 @@ ComputePipelineBuilder& ComputePipelineBuilder::shader(std::string fileName) {
   return *this;
 }
 
+ComputePipelineBuilder& ComputePipelineBuilder::constants(std::vector<std::uint32_t> values) {
+  constants_ = std::move(values);
+  return *this;
+}
+
 Result<ComputePipeline> ComputePipelineBuilder::build(const GpuContext& ctx) const {
   auto path = findShader(shaderFile_);
   if (!path) return tl::unexpected(path.error());
@@ -27,7 +32,13 @@ Result<ComputePipeline> ComputePipelineBuilder::build(const GpuContext& ctx) con
   const vk::DescriptorSetLayout setLayout = *p.setLayout;
   p.layout = vk::raii::PipelineLayout(device, vk::PipelineLayoutCreateInfo({}, setLayout));
   const vk::raii::ShaderModule module(device, vk::ShaderModuleCreateInfo({}, *code));
-  const vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *module, "main");
+  std::vector<vk::SpecializationMapEntry> entries;
+  for (std::uint32_t i = 0; i < constants_.size(); ++i)
+    entries.emplace_back(i, std::uint32_t(i * sizeof(std::uint32_t)), sizeof(std::uint32_t));
+  const vk::SpecializationInfo specialisation(std::uint32_t(entries.size()), entries.data(),
+                                              constants_.size() * sizeof(std::uint32_t), constants_.data());
+  const vk::PipelineShaderStageCreateInfo stage({}, vk::ShaderStageFlagBits::eCompute, *module, "main",
+                                                constants_.empty() ? nullptr : &specialisation);
   p.pipeline = vk::raii::Pipeline(device, nullptr, vk::ComputePipelineCreateInfo({}, stage, *p.layout));
   ctx.name(p.setLayout, (name_ + ".setLayout").c_str());
   ctx.name(p.layout, (name_ + ".layout").c_str());

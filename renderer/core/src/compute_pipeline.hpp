@@ -28,6 +28,9 @@ class ComputePipelineBuilder {
   ComputePipelineBuilder& binding(std::uint32_t index, vk::DescriptorType type);
   // SPIR-V file name, looked up with findShader().
   ComputePipelineBuilder& shader(std::string fileName);
+  // Specialisation constants: constant_id i takes values[i] (32 bits each;
+  // a bool is 0 or 1). Replaces any set before.
+  ComputePipelineBuilder& constants(std::vector<std::uint32_t> values);
 
   // Errors: Io/Malformed from the SPIR-V lookup; Vulkan failures throw.
   Result<ComputePipeline> build(const GpuContext& ctx) const;
@@ -38,6 +41,7 @@ class ComputePipelineBuilder {
   std::string name_;
   std::string shaderFile_;
   std::vector<vk::DescriptorSetLayoutBinding> bindings_;
+  std::vector<std::uint32_t> constants_;
 };
 
 // One descriptor set of a pipeline's layout, from a pool of its own.

@@ -3,11 +3,13 @@
 // inside a class whose members emulate the GPU's texture lookups.
 #include "sky/render/cpu_reference.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 
 #include <glm/glm.hpp>
 
+#include "air_table_texels.hpp"
 #include "atmosphere_tables.hpp"
 #include "blue_noise.hpp"
 #include "coverage_mip.hpp"
@@ -49,7 +51,9 @@ class CpuCore {
   real3 sampleMultipleScatteringLut(real2 uv) const { return atmosphere_.sampleMultipleScattering(uv); }
 
 #define SKY_CORE_CONST static constexpr
+#define SKY_AIR_TABLE_BUILDER
 #include "cloud_core.glsl"
+#undef SKY_AIR_TABLE_BUILDER
 #undef SKY_CORE_CONST
 
   static CloudType coreType(const CloudTypeParams& p) { return coreCloudType<CloudType>(p); }
@@ -71,6 +75,11 @@ class CpuCore {
                           setup_.march.stepGrowth};
     f.layerCount = int(setup_.layers.size());
     f.air.shadowLayers = setup_.march.cloudShadows ? f.layerCount : 0;
+    const AirTableSettings& table = setup_.march.airTable;
+    f.clouds = std::any_of(setup_.layers.begin(), setup_.layers.end(), [](const LayerSetup& l) { return !l.absent; });
+    f.airFromTable = table.enabled;
+    f.airTable = table.enabled ? AirTableShape{int(table.azimuths), int(table.zeniths), int(table.slices)}
+                               : AirTableShape{0, 0, 0};
     const CloudType cumulus = coreType(cloudTypeParams(weather::CloudType::Cumulus));
     for (std::size_t i = 0; i < kMaxLayers; ++i) {
       CoreLayer& c = layers_[i];
@@ -90,6 +99,16 @@ class CpuCore {
     return f;
   }
 
+  // Builds the frame's air table as the table pass does, when f has one
+  // (after coreFrame: the cloud shadow in it reads the layers).
+  void buildAirTable(const CoreFrame& f) {
+    if (!f.airFromTable) return;
+    airTable_ = AirTableTexels(f.airTable.azimuths, f.airTable.zeniths, f.airTable.slices);
+    for (column_.y = 0; column_.y < f.airTable.zeniths; ++column_.y)
+      for (column_.x = 0; column_.x < f.airTable.azimuths; ++column_.x)
+        buildAirTableColumn(f.air, f.airTable, airTableDirection(f.air, f.airTable, column_.x, column_.y));
+  }
+
   std::uint64_t lookups() const { return lookups_; }
 
   PixelResult shade(std::uint32_t px, std::uint32_t py, const CoreFrame& f) {
@@ -104,6 +123,8 @@ class CpuCore {
 
  private:
   CoreLayer layers_[kMaxLayers]{};
+  AirTableTexels airTable_;
+  glm::ivec2 column_{0};  // the air-table column being built
   std::uint64_t lookups_ = 0;  // the cloud model's texture lookups so far
   const FrameSetup& setup_;
   const NoiseVolume& shape_;
@@ -118,6 +139,11 @@ CpuCore::CoreLayer CpuCore::layerAt(int li) { return layers_[li]; }
 CpuCore::real2 CpuCore::airCloudShadow(AirFrame a, real3 p, real h, real muSun) {
   return cloudShadow(a, a.shadowLayers, -1, p, h, muSun);
 }
+
+void CpuCore::storeAirTable(int slice, real4 part0, real4 part1, real4 part2) {
+  airTable_.store(column_.x, column_.y, slice, part0, part1, part2);
+}
+CpuCore::real4 CpuCore::sampleAirTable(int part, real3 uvw) { return airTable_.sample(part, uvw); }
 
 // The hooks mirror those of shaders/clouds.comp.
 CpuCore::real3 CpuCore::sampleWeather(LayerSampling s, real3 p) {
@@ -186,6 +212,7 @@ Result<std::vector<std::array<float, 4>>> CpuReference::renderPixels(const Frame
   const FrameSetup setup = prepareFrame(settings_, inputs, field, tables_->atmosphere);
   CpuCore core(setup, tables_->shape, tables_->detail, tables_->atmosphere, field, tables_->blueNoise);
   const auto frame = core.coreFrame();
+  core.buildAirTable(frame);
   std::vector<std::array<float, 4>> out;
   out.reserve(pixels.size());
   for (const PixelCoord& p : pixels) {
@@ -202,6 +229,7 @@ Result<Image> CpuReference::render(const FrameInputs& inputs, std::uint64_t* den
   const FrameSetup setup = prepareFrame(settings_, inputs, field, tables_->atmosphere);
   CpuCore core(setup, tables_->shape, tables_->detail, tables_->atmosphere, field, tables_->blueNoise);
   const auto frame = core.coreFrame();
+  core.buildAirTable(frame);
   Image image;
   image.width = settings_.width;
   image.height = settings_.height;

@@ -126,6 +126,13 @@ Result<void> validateSettings(const RenderSettings& s) {
   if (m.airSteps > 64)
     return fail(ErrorCode::InvalidArgument,
                 "render settings: march.airSteps " + std::to_string(m.airSteps) + " outside [0, 64]");
+  if (m.airTable.enabled &&
+      (m.airTable.azimuths < 8 || m.airTable.azimuths > 256 || m.airTable.zeniths < 8 ||
+       m.airTable.zeniths > 256 || m.airTable.zeniths % 2 != 0 || m.airTable.slices < 4 || m.airTable.slices > 64))
+    return fail(ErrorCode::InvalidArgument, "render settings: march.airTable " + std::to_string(m.airTable.azimuths) +
+                                                "x" + std::to_string(m.airTable.zeniths) + "x" +
+                                                std::to_string(m.airTable.slices) +
+                                                " outside azimuths [8, 256] x zeniths [8, 256] (even) x slices [4, 64]");
   if (!(m.stepGrowth >= 0 && m.stepGrowth <= 1))
     return fail(ErrorCode::InvalidArgument,
                 "render settings: march.stepGrowth " + num(m.stepGrowth) + " outside [0, 1]");
@@ -433,6 +440,8 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   f.interleave = gpu::uvec4(s.interleave, s.phase.x, s.phase.y, 0u);
   f.raster = gpu::vec4(float(s.rasterWidth), float(s.rasterHeight), float(s.jitterShift), 0.0f);
   f.pixelJitter = gpu::vec4(float(s.pixelShift.x), float(s.pixelShift.y), s.pixelJitter ? 1.0f : 0.0f, 0.0f);
+  const AirTableSettings& table = s.march.airTable;
+  f.airTable = table.enabled ? gpu::uvec4(table.azimuths, table.zeniths, table.slices, 0u) : gpu::uvec4(0u);
 
   for (std::size_t i = 0; i < s.layers.size(); ++i) {
     const LayerSetup& l = s.layers[i];

@@ -75,6 +75,11 @@ GpuImage createStorageImage(const GpuContext& ctx, vk::Format format, std::uint3
                      vk::ImageUsageFlagBits::eStorage | vk::ImageUsageFlagBits::eTransferDst, debugName);
 }
 
+GpuImage createStorageVolume(const GpuContext& ctx, vk::Format format, vk::Extent3D extent, const char* debugName) {
+  return createImage(ctx, vk::ImageType::e3D, vk::ImageViewType::e3D, format, extent, 1,
+                     vk::ImageUsageFlagBits::eStorage | vk::ImageUsageFlagBits::eSampled, debugName);
+}
+
 namespace {
 
 // Copies texels (staged whole) into the image by `copies`, timed as `pass`,

@@ -53,6 +53,10 @@ GpuImage createSampledImage(const GpuContext& ctx, vk::ImageType type, vk::Forma
 GpuImage createStorageImage(const GpuContext& ctx, vk::Format format, std::uint32_t width, std::uint32_t height,
                             const char* debugName);
 
+// A device-local 3D image that a pass writes (storage) and a later pass
+// samples, both in eGeneral; in eUndefined until the writer moves it.
+GpuImage createStorageVolume(const GpuContext& ctx, vk::Format format, vk::Extent3D extent, const char* debugName);
+
 class GpuTimer;
 
 // Copies texels (tightly packed, all layers) into the whole image and leaves it

@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "air_table_texels.hpp"
 #include "sky_shared.h"
 
 namespace sky::test {
@@ -41,10 +42,23 @@ class Core {
   }
 
 #define SKY_CORE_CONST static constexpr
+#define SKY_AIR_TABLE_BUILDER
 #include "cloud_core.glsl"
+#undef SKY_AIR_TABLE_BUILDER
 #undef SKY_CORE_CONST
 
   CoreLayer layers[kMaxLayers]{};
+  // The air table a test built (buildAirTable), read by shadePixel when the
+  // frame asks for it.
+  sky::render::AirTableTexels airTexels;
+  glm::ivec2 airColumn{0};
+
+  void buildAirTable(const CoreFrame& f) {
+    airTexels = sky::render::AirTableTexels(f.airTable.azimuths, f.airTable.zeniths, f.airTable.slices);
+    for (airColumn.y = 0; airColumn.y < f.airTable.zeniths; ++airColumn.y)
+      for (airColumn.x = 0; airColumn.x < f.airTable.azimuths; ++airColumn.x)
+        buildAirTableColumn(f.air, f.airTable, airTableDirection(f.air, f.airTable, airColumn.x, airColumn.y));
+  }
 };
 
 inline Core::CoreLayer Core::layerAt(int li) { return layers[li]; }
@@ -73,6 +87,10 @@ inline Core::real Core::sampleDetail(LayerSampling, real3) {
 inline Core::real2 Core::airCloudShadow(AirFrame a, real3 p, real h, real muSun) {
   return cloudShadow(a, a.shadowLayers, -1, p, h, muSun);
 }
+inline void Core::storeAirTable(int slice, real4 part0, real4 part1, real4 part2) {
+  airTexels.store(airColumn.x, airColumn.y, slice, part0, part1, part2);
+}
+inline Core::real4 Core::sampleAirTable(int part, real3 uvw) { return airTexels.sample(part, uvw); }
 
 // Scenes for the closed-form tests.
 
@@ -117,6 +135,7 @@ inline Core::CloudType haggstromCumulus(double extinction_perm = 0.06) {
 // `sun` (0: none), no ground light, no layer yet, the core's default march.
 inline Core::CoreFrame frameOver(double R, double alt, double sun) {
   Core::CoreFrame f{};
+  f.clouds = true;
   f.march = Core::MarchParams{Core::kPrimarySteps, Core::kLightSteps, Core::kMinTransmittance, Core::kEmptyStride,
                               Core::kCloudStep_m, Core::kEmptyStep_m, Core::kStepGrowth};
   f.air.r = R + alt;

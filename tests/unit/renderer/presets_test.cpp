@@ -77,7 +77,10 @@ TEST(Presets, HighIsTheDefaultAndReferenceTheMostExpensive) {
   EXPECT_EQ(all[0].march.emptyStride, 1u) << "reference: every sample";
   EXPECT_GE(all[0].march.lightSteps, 6u);
   EXPECT_EQ(all[0].march.cloudStep_m, 0.0) << "reference: evenly placed samples";
-  EXPECT_EQ(all[0].march.airSteps, 0u) << "reference: the default air march";
+  EXPECT_FALSE(all[0].march.airTable.enabled) << "reference: the air marched per pixel";
+  EXPECT_EQ(all[0].march.airSteps, 64u) << "reference: the air march's most steps";
+  for (std::size_t i = 1; i < all.size(); ++i)
+    EXPECT_TRUE(all[i].march.airTable.enabled) << all[i].name << ": the air from the table";
   EXPECT_EQ(all[0].temporal.interleave, 1u) << "reference: every pixel of every frame";
   EXPECT_EQ(high->temporal.interleave, 1u) << "high: every pixel of every frame";
   // Cheaper presets never reproject fewer pixels. Between two presets that

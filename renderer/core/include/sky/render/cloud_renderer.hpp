@@ -20,6 +20,21 @@ namespace sky::render {
 // Cloud layers one frame can draw (the shaders' kMaxLayers, checked there).
 inline constexpr std::size_t kMaxLayers = 4;
 
+// The sky and the aerial perspective from a table built once per frame
+// (shaders/include/air_table.glsl; Hillaire 2020's sky-view table and
+// aerial-perspective volume in one) instead of a clear-air march per pixel:
+// for azimuths x zeniths directions around the camera, the air's light and
+// transmittance at `slices` distances along each, with the clouds' shadow.
+// Its image takes 3 x azimuths x zeniths x slices x 16 bytes (RGBA32F; 6 MiB
+// at the defaults). The pixel then reads the air in front of each cloud layer
+// and the ground from it; its error against the march: docs/light-transport.md.
+struct AirTableSettings {
+  bool enabled = true;
+  std::uint32_t azimuths = 64;  // [8, 256]
+  std::uint32_t zeniths = 64;   // even, [8, 256]
+  std::uint32_t slices = 32;    // [4, 64] (at most 192 MiB)
+};
+
 // The cloud march's cost knobs (shaders/include/cloud_core.glsl), carried
 // in the frame block as run-time numbers. The defaults are the `high`
 // preset (presets.hpp), the march as it was before presets.
@@ -50,8 +65,10 @@ struct MarchSettings {
   double coverageStepMin = 1;  // (0, 1]
   double densityStepMin = 1;   // (0, 1]
   // Steps of the clear-air march along each view ray (aerial perspective and
-  // the sky; atmosphere_core.glsl); 0: its default, 16. [0, 64].
+  // the sky; atmosphere_core.glsl) where it is marched per pixel (without the
+  // air table); 0: its default, 16. [0, 64].
   std::uint32_t airSteps = 0;
+  AirTableSettings airTable;
   // The clouds' shadow at the weather map's scale (cloud_core.glsl,
   // cloudShadow) in the clear-air march's sunlight (the shade under an
   // overcast, light shafts between regions of cloud) and on the clouds of
