@@ -37,6 +37,17 @@ MarchSettings marched(MarchSettings m) {
   return m;
 }
 
+// A smaller air table: it is built for every frame whatever the share of
+// pixels drawn, so at a few milliseconds a frame the cheap presets feel its
+// size (skyshell-bench 320x180: realtime 12.6 -> 5.2 ms on cumulus-midday
+// with 32 x 32 x 16, PSNR 40.92 -> 40.93 dB; on a clear sunset 50.0 -> 48.0).
+MarchSettings withAirTable(MarchSettings m, std::uint32_t azimuths, std::uint32_t zeniths, std::uint32_t slices) {
+  m.airTable.azimuths = azimuths;
+  m.airTable.zeniths = zeniths;
+  m.airTable.slices = slices;
+  return m;
+}
+
 // Interleaved, n x n, with temporal accumulation (TemporalSettings).
 TemporalSettings interleaved(std::uint32_t n, double accumulation) {
   TemporalSettings t;
@@ -74,13 +85,14 @@ const std::vector<Preset>& presets() {
        metres(256, 4, 0.002, 40, 80, 0.005, 12), interleaved(4, 0.75)},
       {"low",
        "steps of 40 m in cloud, 80 m in clear air, +1 % of the distance; 3 light steps, exit at 3 %; "
-       "1 pixel of 16 per frame, the rest reprojected, redraws accumulated (history 0.75)",
-       metres(256, 3, 0.03, 40, 80, 0.01, 8), interleaved(4, 0.75)},
+       "the air from a 48 x 48 x 24 table; 1 pixel of 16 per frame, the rest reprojected, redraws accumulated "
+       "(history 0.75)",
+       withAirTable(metres(256, 3, 0.03, 40, 80, 0.01, 8), 48, 48, 24), interleaved(4, 0.75)},
       {"realtime",
        "steps of 40 m in cloud, 80 m in clear air, +2 % of the distance; 3 light steps, exit at 5 %; "
-       "the clouds drawn at 1/2 the width and height (depth-aware upscale); 1 pixel of 16 per frame, the rest "
-       "reprojected, redraws accumulated (history 0.75)",
-       metres(256, 3, 0.05, 40, 80, 0.02, 8), interleaved(4, 0.75), divided(2)},
+       "the air from a 32 x 32 x 16 table; the clouds drawn at 1/2 the width and height (depth-aware upscale); 1 "
+       "pixel of 16 per frame, the rest reprojected, redraws accumulated (history 0.75)",
+       withAirTable(metres(256, 3, 0.05, 40, 80, 0.02, 8), 32, 32, 16), interleaved(4, 0.75), divided(2)},
   };
   return all;
 }

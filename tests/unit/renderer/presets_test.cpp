@@ -79,8 +79,16 @@ TEST(Presets, HighIsTheDefaultAndReferenceTheMostExpensive) {
   EXPECT_EQ(all[0].march.cloudStep_m, 0.0) << "reference: evenly placed samples";
   EXPECT_FALSE(all[0].march.airTable.enabled) << "reference: the air marched per pixel";
   EXPECT_EQ(all[0].march.airSteps, 64u) << "reference: the air march's most steps";
-  for (std::size_t i = 1; i < all.size(); ++i)
+  for (std::size_t i = 1; i < all.size(); ++i) {
     EXPECT_TRUE(all[i].march.airTable.enabled) << all[i].name << ": the air from the table";
+    // Cheaper presets never build a larger table.
+    if (i > 1) {
+      const render::AirTableSettings &t = all[i].march.airTable, &before = all[i - 1].march.airTable;
+      EXPECT_LE(std::uint64_t(t.azimuths) * t.zeniths * t.slices,
+                std::uint64_t(before.azimuths) * before.zeniths * before.slices)
+          << all[i].name;
+    }
+  }
   EXPECT_EQ(all[0].temporal.interleave, 1u) << "reference: every pixel of every frame";
   EXPECT_EQ(high->temporal.interleave, 1u) << "high: every pixel of every frame";
   // Cheaper presets never reproject fewer pixels. Between two presets that
