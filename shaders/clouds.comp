@@ -31,6 +31,7 @@ void main() {
   f.air = frameAir();
   f.airFromTable = kUseAirTable;
   f.clouds = kDrawClouds;
+  f.layerShadows = frameLayerShadows();
   f.airTable = frameAirTable();
   f.groundIrradiance = frame.groundIrradiance.rgb;
   f.march = MarchParams(int(frame.dispatch.y), int(frame.dispatch.z), frame.weatherMap.z, frame.weatherMap.w,

@@ -160,6 +160,12 @@ struct CoreFrame {
   // clear sky, drawn as air and ground alone (on the GPU a constant of the
   // pipeline too: the clear sky's variant has no cloud code to run).
   bool clouds;
+  // Layers whose shadow falls on the clouds of the others (cloudShadow in
+  // the march): air.shadowLayers, or 0 where at most one layer is drawn and
+  // there is no other to shadow (on the GPU a constant of the pipeline: the
+  // shadow's loop is then compiled out, where a loop that would skip the
+  // layer a sample is in still runs one turn of it on lavapipe).
+  int layerShadows;
   MarchParams march;
   real3 groundIrradiance;  // sky irradiance on horizontal ground, linear units
   int layerCount;
@@ -481,7 +487,7 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
     // (cirrus over cumulus, a deck over a layer), and the sky's light from
     // all around, dimmed by those layers as well.
     real3 sun = mix(mix(sunBaseStart, sunTopStart, ph), mix(sunBaseEnd, sunTopEnd, ph), u);
-    real2 shade = cloudShadow(f.air, f.air.shadowLayers, li, p, f.air.h + h, mix(muStart, muEnd, u));
+    real2 shade = cloudShadow(f.air, f.layerShadows, li, p, f.air.h + h, mix(muStart, muEnd, u));
     real3 scattered = sun * (shade.x * octaveSum(mix(phases1, phases2, cs.blend), tauSun)) +
                       diffuseLight(L, ct, ph, cs.coverage, cs.densityScale) * shade.y;
     // Hillaire 2016 energy-conserving step: integral over the step of
@@ -563,12 +569,22 @@ PixelResult shadePixel(CoreFrame f, real3 dir, real jitter) {
     order[i] = i;
   }
   for (int i = 0; i < f.layerCount; ++i) spans[i] = layerSpan(f, layerAt(i), mu, tGround);
-  // Insertion sort by entry distance, so layers composite front to back.
-  for (int i = 1; i < f.layerCount; ++i) {
-    for (int j = i; j > 0 && spans[order[j - 1]].t0 > spans[order[j]].t0; --j) {
-      int tmp = order[j];
-      order[j] = order[j - 1];
-      order[j - 1] = tmp;
+  // Sorted by entry distance, so layers composite front to back: a bubble
+  // sort over all slots with fixed bounds and swaps by select (the unused
+  // slots last), which compiles to straight-line code. With the insertion
+  // sort's data-dependent inner loop lavapipe left the layers unsorted for
+  // a camera above two of them (GpuVsCpu.TwoLayersWithinTolerance).
+  real key[kMaxLayers];
+  for (int i = 0; i < int(kMaxLayers); ++i) key[i] = i < f.layerCount ? spans[i].t0 : kFarAway_m;
+  for (int pass = 0; pass < int(kMaxLayers) - 1; ++pass) {
+    for (int j = 0; j < int(kMaxLayers) - 1 - pass; ++j) {
+      bool swap = key[j] > key[j + 1];
+      real k0 = key[j], k1 = key[j + 1];
+      int o0 = order[j], o1 = order[j + 1];
+      key[j] = swap ? k1 : k0;
+      key[j + 1] = swap ? k0 : k1;
+      order[j] = swap ? o1 : o0;
+      order[j + 1] = swap ? o0 : o1;
     }
   }
   LayerResult layers[kMaxLayers];

@@ -31,6 +31,9 @@ layout(std430, set = 0, binding = kBindingBlueNoise) readonly buffer BlueNoiseBl
 // kUseAirTable false for the air marched per pixel.
 layout(constant_id = 0) const bool kDrawClouds = true;
 layout(constant_id = 1) const bool kUseAirTable = true;
+// kLayersShadowLayers false for frames with at most one layer drawn: the
+// layers' shadow on each other's clouds is compiled out (CoreFrame::layerShadows).
+layout(constant_id = 2) const bool kLayersShadowLayers = true;
 
 #define real float
 #define real2 vec2
@@ -181,6 +184,10 @@ AirFrame frameAir() {
 
 int frameLayerCount() {
   return kDrawClouds ? int(frame.weatherMap.y) : 0;
+}
+
+int frameLayerShadows() {
+  return kLayersShadowLayers && frame.sunIrradiance.w > 0.5 ? frameLayerCount() : 0;
 }
 
 AirTableShape frameAirTable() {

@@ -1,9 +1,11 @@
 // Cloud pass resources and dispatch (see cloud_pass.hpp).
 #include "cloud_pass.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstring>
 #include <span>
+#include <string>
 
 #include "coverage_mip.hpp"
 #include "frame_setup.hpp"
@@ -34,38 +36,11 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
   pass.height_ = height;
   const auto& device = ctx.device();
 
-  // Both passes get the same bindings, so their set layouts are identical
-  // and one descriptor set serves both (Vulkan's compatibility rule).
-  // Two variants of each (cloud_pass.glsl's specialisation constants): with
-  // the clouds, and for a frame whose layers have no coverage anywhere.
-  auto withBindings = [&](ComputePipelineBuilder builder, const char* shader, bool clouds) {
-    builder.binding(gpu::kBindingFrame, vk::DescriptorType::eStorageBuffer)
-        .binding(gpu::kBindingShape, vk::DescriptorType::eCombinedImageSampler)
-        .binding(gpu::kBindingWeather, vk::DescriptorType::eCombinedImageSampler)
-        .binding(gpu::kBindingOutput, vk::DescriptorType::eStorageBuffer)
-        .binding(gpu::kBindingDetail, vk::DescriptorType::eCombinedImageSampler)
-        .binding(gpu::kBindingTransmittance, vk::DescriptorType::eCombinedImageSampler)
-        .binding(gpu::kBindingMultipleScattering, vk::DescriptorType::eCombinedImageSampler)
-        .binding(gpu::kBindingDepth, vk::DescriptorType::eStorageBuffer)
-        .binding(gpu::kBindingCoverageMip, vk::DescriptorType::eStorageBuffer)
-        .binding(gpu::kBindingBlueNoise, vk::DescriptorType::eStorageBuffer)
-        .binding(gpu::kBindingAirTableOut, vk::DescriptorType::eStorageImage)
-        .binding(gpu::kBindingAirTable, vk::DescriptorType::eCombinedImageSampler)
-        .shader(shader)
-        .constants({clouds ? 1u : 0u, airTable.enabled ? 1u : 0u});
-    return builder.build(ctx);
-  };
-  for (const bool clouds : {true, false}) {
-    auto pipeline = withBindings(ComputePipelineBuilder(clouds ? "sky.clouds" : "sky.clouds.clear"), "clouds.comp.spv",
-                                 clouds);
-    if (!pipeline) return tl::unexpected(pipeline.error());
-    (clouds ? pass.pipeline_ : pass.clearPipeline_) = std::move(*pipeline);
-    if (!airTable.enabled) continue;
-    auto table = withBindings(ComputePipelineBuilder(clouds ? "sky.airTable" : "sky.airTable.clear"),
-                              "air_table.comp.spv", clouds);
-    if (!table) return tl::unexpected(table.error());
-    (clouds ? pass.tablePipeline_ : pass.clearTablePipeline_) = std::move(*table);
-  }
+  pass.airTableSize_ = airTable.enabled ? airTable : AirTableSettings{false, 8, 8, 4};
+  // The one-layer variant now (its set layout is the descriptor set's), the
+  // others when a frame first needs them.
+  auto first = pass.pipelineFor(ctx, false, 1);
+  if (!first) return tl::unexpected(first.error());
 
   pass.noiseSampler_ = makeSampler(ctx, vk::SamplerAddressMode::eRepeat, "sky.noiseSampler");
   pass.weatherSampler_ = makeSampler(ctx, vk::SamplerAddressMode::eClampToBorder, "sky.weatherSampler");
@@ -81,7 +56,6 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
     ctx.name(pass.airTableSampler_, "sky.airTableSampler");
   }
   // Off: a token image keeps the descriptor valid.
-  pass.airTableSize_ = airTable.enabled ? airTable : AirTableSettings{false, 8, 8, 4};
   pass.airTable_ = createStorageVolume(ctx, vk::Format::eR32G32B32A32Sfloat,
                                        vk::Extent3D(pass.airTableSize_.azimuths, pass.airTableSize_.zeniths,
                                                     3 * pass.airTableSize_.slices),
@@ -129,7 +103,7 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
   pass.descriptorPool_ = vk::raii::DescriptorPool(
       device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSizes));
   ctx.name(pass.descriptorPool_, "sky.clouds.descriptorPool");
-  const vk::DescriptorSetLayout setLayout = *pass.pipeline_.setLayout;
+  const vk::DescriptorSetLayout setLayout = *(*first)->setLayout;
   vk::raii::DescriptorSets sets(device, vk::DescriptorSetAllocateInfo(*pass.descriptorPool_, setLayout));
   pass.descriptorSet_ = std::move(sets.front());
   ctx.name(pass.descriptorSet_, "sky.clouds.descriptorSet");
@@ -173,6 +147,35 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
   return pass;
 }
 
+Result<const ComputePipeline*> CloudPass::pipelineFor(const GpuContext& ctx, bool table, std::uint32_t layersDrawn) {
+  std::optional<ComputePipeline>& slot =
+      table ? tablePipelines_[layersDrawn > 0 ? 1 : 0] : cloudPipelines_[std::min<std::uint32_t>(layersDrawn, 2)];
+  if (slot) return &*slot;
+  // Every variant of both shaders gets the same bindings, so their set
+  // layouts are identical and one descriptor set serves them all (Vulkan's
+  // compatibility rule).
+  ComputePipelineBuilder builder(std::string(table ? "sky.airTable" : "sky.clouds") + ".layers" +
+                                 std::to_string(std::min<std::uint32_t>(layersDrawn, 2)));
+  builder.binding(gpu::kBindingFrame, vk::DescriptorType::eStorageBuffer)
+      .binding(gpu::kBindingShape, vk::DescriptorType::eCombinedImageSampler)
+      .binding(gpu::kBindingWeather, vk::DescriptorType::eCombinedImageSampler)
+      .binding(gpu::kBindingOutput, vk::DescriptorType::eStorageBuffer)
+      .binding(gpu::kBindingDetail, vk::DescriptorType::eCombinedImageSampler)
+      .binding(gpu::kBindingTransmittance, vk::DescriptorType::eCombinedImageSampler)
+      .binding(gpu::kBindingMultipleScattering, vk::DescriptorType::eCombinedImageSampler)
+      .binding(gpu::kBindingDepth, vk::DescriptorType::eStorageBuffer)
+      .binding(gpu::kBindingCoverageMip, vk::DescriptorType::eStorageBuffer)
+      .binding(gpu::kBindingBlueNoise, vk::DescriptorType::eStorageBuffer)
+      .binding(gpu::kBindingAirTableOut, vk::DescriptorType::eStorageImage)
+      .binding(gpu::kBindingAirTable, vk::DescriptorType::eCombinedImageSampler)
+      .shader(table ? "air_table.comp.spv" : "clouds.comp.spv")
+      .constants({layersDrawn > 0 ? 1u : 0u, airTableSize_.enabled ? 1u : 0u, layersDrawn > 1 ? 1u : 0u});
+  auto built = builder.build(ctx);
+  if (!built) return tl::unexpected(built.error());
+  slot = std::move(*built);
+  return &*slot;
+}
+
 void CloudPass::setCoverageMip(const std::vector<float>& mip) {
   SKY_ASSERT(mip.size() * sizeof(float) == coverageMip_.size);
   std::memcpy(coverageMip_.mapped, mip.data(), coverageMip_.size);
@@ -183,6 +186,19 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
   SKY_ASSERT((next.upscale == nullptr) == (next.upscaleParams == nullptr));
   SKY_ASSERT(next.reproject != nullptr || frame.interleave.x == 1);
   std::memcpy(uniforms_.mapped, &frame, sizeof frame);
+  // The variants for the layers this frame draws (with coverage somewhere:
+  // the others are skipped either way, so the image is the same).
+  std::uint32_t layersDrawn = 0;
+  for (std::uint32_t i = 0; i < std::uint32_t(frame.weatherMap.y) && i < gpu::kMaxLayers; ++i)
+    layersDrawn += frame.layers[i].ambient.w < 0.5f ? 1 : 0;
+  auto cloudPipeline = pipelineFor(ctx, false, layersDrawn);
+  if (!cloudPipeline) return tl::unexpected(cloudPipeline.error());
+  const ComputePipeline* tablePipeline = nullptr;
+  if (frame.airTable.x > 0) {
+    auto built = pipelineFor(ctx, true, layersDrawn);
+    if (!built) return tl::unexpected(built.error());
+    tablePipeline = *built;
+  }
 
   commands_.reset();
   commands_.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
@@ -195,17 +211,12 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
                                                    vk::ImageLayout::eUndefined, vk::ImageLayout::eGeneral,
                                                    VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *airTable_.image,
                                                    whole));
-  // The clear-sky variants when no layer has coverage anywhere (the same
-  // image: such layers are skipped either way).
-  bool clouds = false;
-  for (std::uint32_t i = 0; i < std::uint32_t(frame.weatherMap.y) && i < gpu::kMaxLayers; ++i)
-    clouds = clouds || frame.layers[i].ambient.w < 0.5f;
   SKY_ASSERT(frame.airTable.x == 0 || airTableSize_.enabled);
   if (frame.airTable.x > 0) {
     SKY_ASSERT(airTableSize_.enabled && frame.airTable.x == airTableSize_.azimuths &&
                frame.airTable.y == airTableSize_.zeniths && frame.airTable.z == airTableSize_.slices);
     {
-      const ComputePipeline& table = clouds ? tablePipeline_ : clearTablePipeline_;
+      const ComputePipeline& table = *tablePipeline;
       const auto timed = timer_.section(commands_, "air-table");
       commands_.bindPipeline(vk::PipelineBindPoint::eCompute, *table.pipeline);
       commands_.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *table.layout, 0, *descriptorSet_, {});
@@ -220,7 +231,7 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
                                                      *airTable_.image, whole));
   }
   {
-    const ComputePipeline& pipeline = clouds ? pipeline_ : clearPipeline_;
+    const ComputePipeline& pipeline = **cloudPipeline;
     const auto timed = timer_.section(commands_, "clouds");
     commands_.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline.pipeline);
     commands_.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline.layout, 0, *descriptorSet_, {});

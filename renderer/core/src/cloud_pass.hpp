@@ -6,7 +6,9 @@
 // command buffer. Blocking: run() returns the read-back image.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "atmosphere_tables.hpp"
@@ -64,17 +66,20 @@ class CloudPass {
 
  private:
   CloudPass() = default;
+  // The variant for a frame drawing layersDrawn layers: clouds.comp's, or
+  // with `table` air_table.comp's; built now if it is not yet. Errors:
+  // Io/Malformed for the SPIR-V; Vulkan failures throw.
+  Result<const ComputePipeline*> pipelineFor(const GpuContext& ctx, bool table, std::uint32_t layersDrawn);
 
   // Destroyed in reverse order: fence and command buffer first, the
   // descriptor set before its pool, buffers and images before the samplers
   // and pipeline that reference them in the set layout.
-  // Set layouts all identical to pipeline_'s (one descriptor set serves
-  // every one); the clear variants draw frames without cloud; the table's
-  // only with the air table on.
-  ComputePipeline pipeline_;
-  ComputePipeline clearPipeline_;
-  ComputePipeline tablePipeline_;
-  ComputePipeline clearTablePipeline_;
+  // The pass's pipelines by variant (cloud_pass.glsl's specialisation
+  // constants), built on first use: the clouds' by the layers a frame draws
+  // (none: a clear sky; one; several, which shadow each other), the air
+  // table's without and with clouds. Set layouts all identical.
+  std::array<std::optional<ComputePipeline>, 3> cloudPipelines_;
+  std::array<std::optional<ComputePipeline>, 2> tablePipelines_;
   vk::raii::Sampler noiseSampler_{nullptr};
   vk::raii::Sampler airTableSampler_{nullptr};
   vk::raii::Sampler weatherSampler_{nullptr};

@@ -75,8 +75,11 @@ class CpuCore {
                           setup_.march.stepGrowth};
     f.layerCount = int(setup_.layers.size());
     f.air.shadowLayers = setup_.march.cloudShadows ? f.layerCount : 0;
+    const auto drawn =
+        std::count_if(setup_.layers.begin(), setup_.layers.end(), [](const LayerSetup& l) { return !l.absent; });
+    f.layerShadows = drawn > 1 ? f.air.shadowLayers : 0;
     const AirTableSettings& table = setup_.march.airTable;
-    f.clouds = std::any_of(setup_.layers.begin(), setup_.layers.end(), [](const LayerSetup& l) { return !l.absent; });
+    f.clouds = drawn > 0;
     f.airFromTable = table.enabled;
     f.airTable = table.enabled ? AirTableShape{int(table.azimuths), int(table.zeniths), int(table.slices)}
                                : AirTableShape{0, 0, 0};

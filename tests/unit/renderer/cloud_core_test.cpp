@@ -372,9 +372,9 @@ TEST(CloudCore, ALayerIsInTheShadowOfTheLayersAboveIt) {
   c.coverage = 0.6;
   const Core::real3 up(0, 0, 1);
   const Core::Span lower = c.layerSpan(f, c.layers[0], 1.0, 1e12), upper = c.layerSpan(f, c.layers[1], 1.0, 1e12);
-  f.air.shadowLayers = 0;
+  f.air.shadowLayers = f.layerShadows = 0;
   const auto lit = c.marchLayer(f, 0, up, lower, 0.5, 1.0), litUpper = c.marchLayer(f, 1, up, upper, 0.5, 1.0);
-  f.air.shadowLayers = 2;
+  f.air.shadowLayers = f.layerShadows = 2;
   const auto shaded = c.marchLayer(f, 0, up, lower, 0.5, 1.0), shadedUpper = c.marchLayer(f, 1, up, upper, 0.5, 1.0);
   const double tau = 4e-3 * 0.9 * 400;
   ASSERT_GT(lit.inscatter.x, 0.0);
