@@ -230,6 +230,38 @@ TEST(HeadlessOutputs, MetadataDescribesEachFrameAndTheReportSumsGpuTimes) {
   EXPECT_EQ(run.report["preset"], "high");
 }
 
+// --frame-budget-ms: a budget no level can meet (0.1 ms) takes the frames
+// down the ladder to its cheapest level, one decision per frame, and every
+// frame's metadata says the level it was drawn at, its march and what the
+// model expected; the report counts the frames per level. (That the budget
+// is held on a real path: tests/gpu/frame_budget_test.cpp.)
+TEST(HeadlessOutputs, FrameBudgetIsRecordedPerFrame) {
+  const ReplayResult run = replay("budget", SKY_SCENARIO_CLOUDY, {"--frame-budget-ms", "0.1"});
+  ASSERT_EQ(run.frames.size(), kFrames);
+  for (std::size_t i = 0; i < kFrames; ++i) {
+    const auto& f = run.frames[i];
+    SCOPED_TRACE(f.dump());
+    ASSERT_TRUE(f.contains("budget"));
+    EXPECT_EQ(f["budget"]["target_ms"], 0.1);
+    EXPECT_EQ(f["budget"]["level"], i == 0 ? 0 : 4) << "the first frame at the preset, then the cheapest";
+    EXPECT_EQ(f["budget"]["name"], i == 0 ? "high" : "high/4");
+    EXPECT_EQ(f["budget"]["march"]["primary_steps"], i == 0 ? 48 : 12);
+    EXPECT_GT(f["budget"]["expected_psnr_db"].get<double>(), 0.0);
+    EXPECT_EQ(f["budget"]["predicted_ms"].get<double>() > 0, i > 0) << "no prediction before the first frame";
+  }
+  EXPECT_EQ(run.report["budget"]["target_ms"], 0.1);
+  EXPECT_EQ(run.report["budget"]["frames_per_level"]["high"], 1);
+  EXPECT_EQ(run.report["budget"]["frames_per_level"]["high/4"], kFrames - 1);
+  // reference has no cheaper level: refused, naming the option.
+  ChildProcess refused({SKY_RENDER, "--headless", "--replay", SKY_TEST_FLIGHT, "--weather-file", SKY_SCENARIO_CLOUDY,
+                        "--out", (fs::path(SKY_TEST_OUTPUT_DIR) / "outputs-budget-refused").string(), "--preset",
+                        "reference", "--frame-budget-ms", "20"},
+                       (fs::path(SKY_TEST_OUTPUT_DIR) / "outputs-budget-refused.log").string(),
+                       {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
+  EXPECT_EQ(refused.wait(120s).value_or(-1), 2);
+  EXPECT_NE(refused.log().find("--frame-budget-ms"), std::string::npos) << refused.log();
+}
+
 // The noise textures (the cloud model's shape and detail noise) through
 // skyshell-render's --cache-dir: the first start generates and writes them,
 // the second loads them (and draws the same bytes), a damaged cache file is

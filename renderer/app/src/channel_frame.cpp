@@ -43,9 +43,20 @@ tl::expected<DrawnFrame, FrameFailure> ChannelFrames::draw(const FrameRequest& r
 
   DrawnFrame out;
   FrameRecord& record = out.record;
-  auto image = timedRender(renderer_, in, record);
   const std::string frameName = "frame " + std::to_string(r.frameIndex) + ": ";
+  if (budget_ && budget_->level() != appliedLevel_) {
+    if (auto ok = renderer_.setMarch(budget_->current().march); !ok)
+      return tl::unexpected(FrameFailure{3, frameName + "frame budget: " + describe(ok.error())});
+    appliedLevel_ = budget_->level();
+  }
+  auto image = timedRender(renderer_, in, record);
   if (!image) return tl::unexpected(FrameFailure{3, frameName + describe(image.error())});
+  if (budget_) {
+    const render::BudgetLevel& level = budget_->current();
+    record.budget = FrameRecord::Budget{budget_->target_ms(), budget_->level(), level.name,
+                                        budget_->predicted_ms(budget_->level()), level.expectedPsnr_db, level.march};
+    budget_->update(record.render_ms);
+  }
   out.image = std::move(*image);
   const auto delay_ms = [&] {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r.host.receivedAt).count();

@@ -150,6 +150,19 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
   line["gpu_ms"] = gpu;
   if (r.presented) line["presented"] = *r.presented;
   if (r.transportDelay_ms) line["transport_delay_ms"] = *r.transportDelay_ms;
+  if (r.budget)
+    line["budget"] = {{"target_ms", r.budget->target_ms},
+                      {"level", r.budget->level},
+                      {"name", r.budget->name},
+                      {"predicted_ms", r.budget->predicted_ms},
+                      {"expected_psnr_db", r.budget->expectedPsnr_db},
+                      {"march",
+                       {{"primary_steps", r.budget->march.primarySteps},
+                        {"light_steps", r.budget->march.lightSteps},
+                        {"min_transmittance", r.budget->march.minTransmittance},
+                        {"cloud_step_m", r.budget->march.cloudStep_m},
+                        {"empty_step_m", r.budget->march.emptyStep_m},
+                        {"step_growth", r.budget->march.stepGrowth}}}};
   if (r.presentDelay_ms) line["present_delay_ms"] = *r.presentDelay_ms;
   if (s.temporal.interleave > 1) {
     const render::TemporalReport& t = r.temporal;

@@ -181,6 +181,8 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   int exitCode = 0;
   std::size_t done = 0;
   ChannelFrames frames(renderer, *writer, o.display);
+  frames.setBudget(o.budget);
+  std::map<std::string, std::size_t> framesPerLevel;
   for (std::size_t i = 0; i < frameCount; ++i) {
     if (stop && *stop) {
       exitCode = 1;
@@ -232,6 +234,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     if (weather) weather->reportCamera(pose, i, view.version, request.weatherClock_s);
     const FrameRecord& record = drawn->record;
     renderMs.push_back(record.render_ms);
+    if (record.budget) ++framesPerLevel[record.budget->name];
     for (const auto& pass : record.gpu) gpuMs[pass.pass].push_back(pass.gpu_ms);
     versionsSeen.insert(view.version);
     nonFinite += record.stats.nonFinite;
@@ -279,6 +282,9 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   report["vertical_fov_deg"] = s.verticalFov_deg;
   report["noise_seed"] = s.noiseSeed;
   report["preset"] = o.preset;
+  if (o.budget) {
+    report["budget"] = {{"target_ms", o.budget->target_ms()}, {"frames_per_level", framesPerLevel}};
+  }
   if (sunFromDate) {
     report["sun"] = "ephemeris at the recorded date and time";
     report["utc_start_s"] = *firstHost.utc_s;

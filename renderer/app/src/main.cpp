@@ -74,6 +74,7 @@ struct Options {
   double fov_deg = 60;
   unsigned viewId = 0;
   std::string preset = sky::app::kDefaultPreset;
+  double frameBudget_ms = 0;  // --frame-budget-ms; 0: none
   double sunAzimuth_deg = 135, sunElevation_deg = 40;
   std::uint64_t maxFrames = 0;
   double idleExit_s = 0;
@@ -175,6 +176,10 @@ int main(int argc, char** argv) {
   app.add_option("--preset", o.preset,
                  "quality preset: reference, high, medium, low, realtime (README.md, \"Quality presets\")")
       ->capture_default_str();
+  app.add_option("--frame-budget-ms", o.frameBudget_ms,
+                 "hold frames to this many ms: each frame drawn at the most accurate of the preset's cheaper "
+                 "marches predicted to fit (frame_budget.hpp; every frame's metadata says which)")
+      ->check(CLI::Range(0.1, 1e6));
   app.add_option("--sun-azimuth", o.sunAzimuth_deg, "deg from true north");
   app.add_option("--sun-elevation", o.sunElevation_deg, "deg above the horizon");
   app.add_option("--utc", o.utc,
@@ -276,6 +281,15 @@ int main(int argc, char** argv) {
   }
   sky::render::RenderSettings settings{o.width, o.height, o.fov_deg, 1, o.noNoiseCache ? std::string() : o.cacheDir,
                                        preset->march, preset->temporal, preset->resolution};
+  std::optional<sky::render::FrameBudget> budget;
+  if (o.frameBudget_ms > 0) {
+    auto ladder = sky::render::budgetLadder(*preset);
+    if (!ladder) {
+      std::fprintf(stderr, "skyshell-render: --frame-budget-ms: %s\n", sky::describe(ladder.error()).c_str());
+      return 2;
+    }
+    budget.emplace(o.frameBudget_ms, std::move(*ladder));
+  }
   sky::render::GpuOptions gpu;
   gpu.window = window ? &window->surface() : nullptr;
   gpu.validation = o.validation;
@@ -321,6 +335,7 @@ int main(int argc, char** argv) {
     r.preset = o.preset;
     r.weatherFile = o.weatherFile;
     r.display = display ? &*display : nullptr;
+    r.budget = budget ? &*budget : nullptr;
     std::signal(SIGINT, onReplaySignal);
     std::signal(SIGTERM, onReplaySignal);
     return sky::app::runHeadlessReplay(r, **renderer, &gReplayStop);
@@ -445,6 +460,7 @@ int main(int argc, char** argv) {
   else
     source = std::make_unique<sky::app::CigiPoseSource>(state, *cigi, o.cigiSync);
   sky::app::ChannelFrames channelFrames(**renderer, *writer, display ? &*display : nullptr);
+  channelFrames.setBudget(budget ? &*budget : nullptr);
 
   std::uint64_t frames = 0, lastSequence = 0, resetsSeen = 0;
   sky::app::LatencyHistogram transportDelay, presentDelay;

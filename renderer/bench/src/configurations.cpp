@@ -4,10 +4,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
 
+#include "sky/render/frame_budget.hpp"
 #include "sky/render/presets.hpp"
 
 namespace sky::bench {
@@ -83,6 +85,7 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': name must be [a-z0-9-], not reference");
   c.description = "custom: " + spec.substr(colon + 1);
   std::stringstream in(spec.substr(colon + 1));
+  std::optional<render::Preset> base;  // the base= preset, for budget=
   for (std::string item; std::getline(in, item, ',');) {
     const auto eq = item.find('=');
     const std::string key = item.substr(0, eq), value = eq == std::string::npos ? "" : item.substr(eq + 1);
@@ -96,6 +99,7 @@ Result<Configuration> customConfiguration(const std::string& spec) {
       m = preset->march;
       c.settings.temporal = preset->temporal;
       c.settings.resolution = preset->resolution;
+      base = *preset;
       continue;
     }
     if (!number) return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': '" + item + "' is not key=number");
@@ -115,6 +119,15 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     else if (key == "depth-aware" && (v == 0 || v == 1)) c.settings.resolution.depthAware = v == 1;
     else if (key == "blue" && (v == 0 || v == 1)) m.blueNoise = v == 1;
     else if (key == "cloud-shadows" && (v == 0 || v == 1)) m.cloudShadows = v == 1;
+    else if (key == "budget" && base && v == std::floor(v) && v <= 4) {
+      // Level v of the base preset's frame-budget ladder (frame_budget.hpp).
+      auto ladder = render::budgetLadder(*base);
+      if (!ladder) return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': " + ladder.error().detail);
+      if (std::size_t(v) >= ladder->size())
+        return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': " + base->name + "'s ladder has " +
+                                                    std::to_string(ladder->size()) + " levels");
+      m = (*ladder)[std::size_t(v)].march;
+    }
     else if (key == "air-table" && (v == 0 || v == 1)) m.airTable.enabled = v == 1;
     else if (key == "air-azimuths") m.airTable.azimuths = std::uint32_t(v);
     else if (key == "air-zeniths") m.airTable.zeniths = std::uint32_t(v);
@@ -126,7 +139,7 @@ Result<Configuration> customConfiguration(const std::string& spec) {
                   "custom configuration '" + spec + "': unknown key '" + key +
                       "' (base, primary, light, exit, stride, cloud, empty, growth, air, multmin, divmin, scale, "
                       "interleave 1|2|4, divisor 1|2|4, depth-aware 0|1, blue 0|1, cloud-shadows 0|1, air-table 0|1, "
-                      "air-azimuths, air-zeniths, air-slices, accumulate 0..0.95, "
+                      "air-azimuths, air-zeniths, air-slices, budget 0..4 (after base), accumulate 0..0.95, "
                       "pixel-jitter 0|1)");
   }
   // Accumulation blends redraws with the history: without interleaving

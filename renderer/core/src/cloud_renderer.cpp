@@ -250,4 +250,16 @@ std::string CloudRenderer::deviceName() const { return impl_->ctx->deviceName();
 
 const RenderSettings& CloudRenderer::settings() const { return impl_->settings; }
 
+Result<void> CloudRenderer::setMarch(const MarchSettings& march) {
+  RenderSettings next = impl_->settings;
+  next.march = march;
+  if (auto ok = validateSettings(next); !ok) return ok;
+  const AirTableSettings &was = impl_->settings.march.airTable, &now = march.airTable;
+  if (was.enabled != now.enabled ||
+      (now.enabled && (was.azimuths != now.azimuths || was.zeniths != now.zeniths || was.slices != now.slices)))
+    return fail(ErrorCode::InvalidArgument, "CloudRenderer::setMarch: the air table is fixed when the renderer is built");
+  impl_->settings = next;
+  return {};
+}
+
 }  // namespace sky::render

@@ -4,6 +4,7 @@
 // (configurations, spreads, the side-by-side line and sun angles).
 #include <gtest/gtest.h>
 
+#include "sky/render/frame_budget.hpp"
 #include "sky/render/presets.hpp"
 
 #include <cmath>
@@ -195,6 +196,27 @@ TEST(Configurations, CustomSpecsAndTheirErrors) {
     ASSERT_FALSE(r) << bad;
     EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument) << bad;
     EXPECT_NE(r.error().detail.find(bad), std::string::npos) << r.error().detail;
+  }
+}
+
+// budget=K after base=P: level K of P's frame-budget ladder, what
+// skyshell-render --frame-budget-ms draws with at that level; refused
+// without a base, past the ladder's end and for reference.
+TEST(Configurations, BudgetLevelsOfAPresetsLadder) {
+  auto high = render::findPreset("high");
+  ASSERT_TRUE(high);
+  auto ladder = render::budgetLadder(*high);
+  ASSERT_TRUE(ladder);
+  auto c = customConfiguration("h2:base=high,budget=2");
+  ASSERT_TRUE(c) << c.error().detail;
+  EXPECT_EQ(c->settings.march.primarySteps, (*ladder)[2].march.primarySteps);
+  EXPECT_EQ(c->settings.march.lightSteps, (*ladder)[2].march.lightSteps);
+  EXPECT_EQ(c->settings.march.minTransmittance, (*ladder)[2].march.minTransmittance);
+  EXPECT_LT(c->settings.march.primarySteps, high->march.primarySteps);
+  for (const char* bad : {"x:budget=1", "x:base=realtime,budget=2", "x:base=high,budget=1.5", "x:base=reference,budget=1"}) {
+    auto r = customConfiguration(bad);
+    ASSERT_FALSE(r) << bad;
+    EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument) << bad;
   }
 }
 

@@ -14,6 +14,7 @@
 #include "sky/app/view_state.hpp"
 #include "sky/app/window_display.hpp"
 #include "sky/render/cloud_renderer.hpp"
+#include "sky/render/frame_budget.hpp"
 
 namespace sky::app {
 
@@ -62,10 +63,16 @@ class ChannelFrames {
   // the window, the record, the files.
   tl::expected<DrawnFrame, FrameFailure> draw(const FrameRequest& request);
 
+  // Holds the frames to a time budget: each frame is drawn at the budget's
+  // level, and its time moves the budget on. Not owned; null: none.
+  void setBudget(render::FrameBudget* budget) { budget_ = budget; }
+
  private:
   render::CloudRenderer& renderer_;
   FrameWriter& writer_;
   WindowDisplay* display_;
+  render::FrameBudget* budget_ = nullptr;
+  std::size_t appliedLevel_ = 0;
   std::uint64_t droppedWarnedAt_ = 0;
   // The renderer's weather version (FrameInputs::weatherVersion): a new one
   // whenever the source ("server", "file", "clear") or its version changes,

@@ -72,6 +72,17 @@ struct FrameRecord {
   render::TemporalReport temporal;    // what the reprojection did (interleaved presets)
   render::WeatherMapReport weatherMap;  // what this frame changed in the weather map (per tile, or rebuilt and why)
   std::optional<bool> presented;      // windowed: whether the frame reached the window
+  // With a frame budget (--frame-budget-ms): the level the frame was drawn
+  // at and what the model expected of it.
+  struct Budget {
+    double target_ms = 0;
+    std::size_t level = 0;
+    std::string name;              // the level's name ("medium/2")
+    double predicted_ms = 0;       // the model's time for it before the frame (0 for the first frame)
+    double expectedPsnr_db = 0;    // its error against reference on the bench
+    render::MarchSettings march;   // the march it drew with
+  };
+  std::optional<Budget> budget;
   // Transport delay: from the arrival of the host datagram whose pose the
   // frame draws (for a smoothed input, the newest) to the frame's completion
   // (image read back), and, windowed, to its presentation. Live frames only.

@@ -22,6 +22,7 @@
 #include "sky/app/frame_writer.hpp"
 #include "sky/app/window_display.hpp"
 #include "sky/render/cloud_renderer.hpp"
+#include "sky/render/frame_budget.hpp"
 
 namespace sky::app {
 
@@ -49,6 +50,9 @@ struct ReplayOptions {
   // Windowed: every frame is also shown here; closing the window ends the
   // replay (exit code 0, report written). Not owned.
   WindowDisplay* display = nullptr;
+  // Holds the frames to a time budget (--frame-budget-ms); the report
+  // counts the frames per level. Not owned; null: none.
+  render::FrameBudget* budget = nullptr;
 };
 
 // Runs the replay to the end (or until *stop turns true, or the window is

@@ -315,6 +315,12 @@ class CloudRenderer {
 
   std::string deviceName() const;
   const RenderSettings& settings() const;
+  // Changes the march for the frames from the next on (a frame budget's
+  // levels, frame_budget.hpp). What the renderer was built with stays: the
+  // air table's size and whether it is on. Errors: InvalidArgument for
+  // settings validateSettings refuses or a different air table; the
+  // settings are then as they were.
+  Result<void> setMarch(const MarchSettings& march);
 
   CloudRenderer(CloudRenderer&&) noexcept;
   CloudRenderer& operator=(CloudRenderer&&) noexcept;
