@@ -360,7 +360,8 @@ AirPath marchAir(AirFrame a, real3 dir, real tEnd, real q[kAirQueries], int coun
   int next = 0;
   // Queries before the air starts see nothing.
   while (next < count && q[next] <= tA) ++next;
-  // No queries, no march (and a caller that does not want it skips it).
+  // No queries, no march: a caller that wants the air table's answer
+  // instead passes none (compiled out where that is a constant).
   int steps = count > 0 ? (a.airSteps > 0 ? a.airSteps : kAirSteps) : 0;
   for (int i = 0; i < steps; ++i) {
     real u0 = real(i) / real(steps);

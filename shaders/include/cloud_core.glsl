@@ -518,9 +518,9 @@ real3 groundRadiance(CoreFrame f, real3 dir, real t) {
 
 // The air along dir up to tEnd (airRayEnd's), at the queried distances:
 // from the table or marched. Both are called, the one not wanted with no
-// queries, which skips its loops (lavapipe runs both sides of a branch for
-// every lane, but leaves a loop at once when no lane is in it; on the GPU
-// airFromTable is a constant, and the other is compiled out).
+// queries: on the GPU airFromTable is a pipeline constant, so its loops
+// have no turns and are compiled out (a branch would not do: lavapipe runs
+// both sides of one for every lane); on the CPU it does no work.
 AirPath airAlongRay(CoreFrame f, real3 dir, real tEnd, real q[kAirQueries], int count) {
   AirPath fromTable = airPathFromTable(f.air, f.airTable, dir, tEnd, q, f.airFromTable ? count : 0);
   AirPath marched = marchAir(f.air, dir, tEnd, q, f.airFromTable ? 0 : count);
@@ -529,8 +529,9 @@ AirPath airAlongRay(CoreFrame f, real3 dir, real tEnd, real q[kAirQueries], int 
 }
 
 // What lies behind the air along dir: the ground at tEnd, or the night sky
-// past the atmosphere. The ground in a loop run once or not at all, for the
-// same reason: a subgroup that sees only sky skips it.
+// past the atmosphere. The ground in a loop run once or not at all: on the
+// CPU a sky pixel skips it; on lavapipe it costs what a select would (one
+// turn of a loop runs even when no lane enters it).
 real3 backgroundRadiance(CoreFrame f, real3 dir, real tEnd) {
   real3 background = real3(kNightSkyRadiance);
   for (int once = tEnd < kFarAway_m ? 1 : 0; once > 0; --once) background = groundRadiance(f, dir, tEnd);
@@ -562,8 +563,8 @@ PixelResult shadePixel(CoreFrame f, real3 dir, real jitter) {
   int order[kMaxLayers];
   // The layers' reads in a loop that ends at the frame's count, not in a
   // select over all kMaxLayers slots: lavapipe evaluates both sides of a
-  // select (and every branch) for the whole subgroup, but leaves a loop once
-  // no lane is in it.
+  // select for every lane, and in the clear sky's pipeline the count is a
+  // constant 0, which compiles the loop out.
   for (int i = 0; i < int(kMaxLayers); ++i) {
     spans[i] = Span(0.0, 0.0);
     order[i] = i;

@@ -39,12 +39,15 @@ double timedFrame(render::CloudRenderer& r, const render::FrameInputs& in) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// `high` at 320x180: each level's time on the path's first frames, the
-// budget three quarters of the way from level 2's time to level 1's (so
-// level 2 is the most accurate that fits, with more than the controller's
-// 5 % to spare), then 40 frames under the budget. After 10 frames to
-// settle, the median frame is within 20 % of the budget, and the level the
-// frames are drawn at most is 2.
+// `high` at 320x180: the time of levels 0-3 on the path's first frames,
+// measured round-robin so the machine's drift falls on all alike (again,
+// up to three times, until level 3 is faster than level 1, 20 % apart on
+// the bench); the budget halfway between levels 1 and 3; then 40 frames
+// under the budget. After 10 frames to settle, the median frame fits (5 %
+// over at most) and is within 20 % of the budget, and the level the frames
+// are drawn at most is the most accurate one measured to fit or a
+// neighbour: on a shared machine two neighbouring levels' times (5-10 %
+// apart) differ by less than the noise of their separate measurement.
 TEST(FrameBudget, HoldsABudgetBetweenTwoLevelsOverAReplay) {
   SKY_RENDERER(shared, 64, 36);  // keeps the driver loaded (renderer_fixture.hpp)
   (void)shared;
@@ -61,18 +64,28 @@ TEST(FrameBudget, HoldsABudgetBetweenTwoLevelsOverAReplay) {
   weather::WeatherSnapshot snap;
   snap.layers.push_back(layer(1, 1500, 1000, 0.5, 1.0));
 
-  std::vector<double> levelMs;
-  for (std::size_t level = 0; level < 3; ++level) {
-    ASSERT_TRUE((*r)->setMarch((*ladder)[level].march));
-    std::vector<double> ms;
-    for (std::uint64_t i = 0; i < 5; ++i) ms.push_back(timedFrame(**r, pathFrame(snap, i)));
-    ms.erase(ms.begin());  // the first frame after a change of march also builds what it needs
-    levelMs.push_back(median(ms));
+  constexpr std::size_t kLevels = 4;
+  std::vector<double> levelMs(kLevels);
+  for (int attempt = 0; attempt < 3 && !(levelMs[3] > 0 && levelMs[3] < levelMs[1]); ++attempt) {
+    std::vector<std::vector<double>> ms(kLevels);
+    for (std::uint64_t round = 0; round < 5; ++round)
+      for (std::size_t level = 0; level < kLevels; ++level) {
+        ASSERT_TRUE((*r)->setMarch((*ladder)[level].march));
+        const double t = timedFrame(**r, pathFrame(snap, round));
+        if (round > 0) ms[level].push_back(t);  // the first round also builds what each level needs
+      }
+    for (std::size_t level = 0; level < kLevels; ++level) levelMs[level] = median(ms[level]);
   }
-  const double budgetMs = levelMs[2] + 0.75 * (levelMs[1] - levelMs[2]);
-  std::printf("[ budget   ] levels 0-2 %.1f / %.1f / %.1f ms; budget %.1f ms\n", levelMs[0], levelMs[1], levelMs[2],
-              budgetMs);
-  ASSERT_LT(levelMs[2], levelMs[1]) << "the ladder's levels must differ in time for the test to mean anything";
+  const double budgetMs = 0.5 * (levelMs[1] + levelMs[3]);
+  std::size_t best = kLevels - 1;
+  for (std::size_t level = 0; level < kLevels; ++level)
+    if (levelMs[level] <= budgetMs) {
+      best = level;
+      break;
+    }
+  std::printf("[ budget   ] levels 0-3 %.1f / %.1f / %.1f / %.1f ms; budget %.1f ms, level %zu fits\n", levelMs[0],
+              levelMs[1], levelMs[2], levelMs[3], budgetMs, best);
+  ASSERT_LT(levelMs[3], levelMs[1]) << "the ladder's levels must differ in time for the test to mean anything";
 
   render::FrameBudget budget(budgetMs, *ladder);
   std::size_t applied = 99;
@@ -97,7 +110,9 @@ TEST(FrameBudget, HoldsABudgetBetweenTwoLevelsOverAReplay) {
   std::printf("[ budget   ] held %.1f ms (budget %.1f); level %zu in %d of %zu frames\n", heldMs, budgetMs, most->first,
               most->second, held.size());
   EXPECT_NEAR(heldMs, budgetMs, 0.2 * budgetMs);
-  EXPECT_EQ(most->first, 2u);
+  EXPECT_LE(heldMs, 1.05 * budgetMs);
+  EXPECT_GE(most->first + 1, best);
+  EXPECT_LE(most->first, best + 1);
 }
 
 }  // namespace

@@ -25,6 +25,26 @@ Result<FrameWriter> FrameWriter::open(const std::string& directory, const FrameO
 }
 
 namespace {
+// The march numbers as frames.jsonl names them (the run's, and a budget level's).
+nlohmann::json marchJson(const render::MarchSettings& m) {
+  return {{"primary_steps", m.primarySteps},
+          {"light_steps", m.lightSteps},
+          {"min_transmittance", m.minTransmittance},
+          {"empty_stride", m.emptyStride},
+          {"cloud_step_m", m.cloudStep_m},
+          {"empty_step_m", m.emptyStep_m},
+          {"step_growth", m.stepGrowth},
+          {"coverage_step_min", m.coverageStepMin},
+          {"density_step_min", m.densityStepMin},
+          {"air_steps", m.airSteps},
+          {"cloud_shadows", m.cloudShadows},
+          {"air_table", m.airTable.enabled ? nlohmann::json{{"azimuths", m.airTable.azimuths},
+                                                            {"zeniths", m.airTable.zeniths},
+                                                            {"slices", m.airTable.slices}}
+                                           : nlohmann::json(nullptr)},
+          {"blue_noise", m.blueNoise}};
+}
+
 nlohmann::json areasJson(const std::vector<FrameRecord::Area>& areas) {
   nlohmann::json out = nlohmann::json::array();
   for (std::size_t i = 0; i < areas.size(); ++i)
@@ -101,25 +121,7 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
       {"sun_azimuth_deg", r.sunAzimuth_deg},
       {"sun_elevation_deg", r.sunElevation_deg},
       {"preset", run_.preset},
-      {"march",
-       {{"primary_steps", s.march.primarySteps},
-        {"light_steps", s.march.lightSteps},
-        {"min_transmittance", s.march.minTransmittance},
-        {"empty_stride", s.march.emptyStride},
-        {"cloud_step_m", s.march.cloudStep_m},
-        {"empty_step_m", s.march.emptyStep_m},
-        {"step_growth", s.march.stepGrowth},
-        {"coverage_step_min", s.march.coverageStepMin},
-        {"density_step_min", s.march.densityStepMin},
-        {"air_steps", s.march.airSteps},
-        {"cloud_shadows", s.march.cloudShadows},
-        {"air_table",
-         s.march.airTable.enabled
-             ? nlohmann::json{{"azimuths", s.march.airTable.azimuths},
-                              {"zeniths", s.march.airTable.zeniths},
-                              {"slices", s.march.airTable.slices}}
-             : nlohmann::json(nullptr)},
-        {"blue_noise", s.march.blueNoise}}},
+      {"march", marchJson(s.march)},
       {"interleave", s.temporal.interleave},
       {"accumulation", s.temporal.accumulation},
       {"pixel_jitter", s.temporal.pixelJitter && s.temporal.accumulation > 0},
@@ -156,13 +158,7 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
                       {"name", r.budget->name},
                       {"predicted_ms", r.budget->predicted_ms},
                       {"expected_psnr_db", r.budget->expectedPsnr_db},
-                      {"march",
-                       {{"primary_steps", r.budget->march.primarySteps},
-                        {"light_steps", r.budget->march.lightSteps},
-                        {"min_transmittance", r.budget->march.minTransmittance},
-                        {"cloud_step_m", r.budget->march.cloudStep_m},
-                        {"empty_step_m", r.budget->march.emptyStep_m},
-                        {"step_growth", r.budget->march.stepGrowth}}}};
+                      {"march", marchJson(r.budget->march)}};
   if (r.presentDelay_ms) line["present_delay_ms"] = *r.presentDelay_ms;
   if (s.temporal.interleave > 1) {
     const render::TemporalReport& t = r.temporal;

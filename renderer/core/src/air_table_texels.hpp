@@ -26,10 +26,19 @@ class AirTableTexels {
   int zeniths() const { return zeniths_; }
   int slices() const { return slices_; }
 
-  void store(int i, int j, int slice, const glm::dvec4& part0, const glm::dvec4& part1, const glm::dvec4& part2) {
-    at(i, j, slice) = part0;
-    at(i, j, slices_ + slice) = part1;
-    at(i, j, 2 * slices_ + slice) = part2;
+  // Refills the table column by column: column(i, j) marches column (i, j)
+  // and stores its slices through store() (the builder's hook).
+  template <class Column>
+  void build(Column&& column) {
+    for (current_[1] = 0; current_[1] < zeniths_; ++current_[1])
+      for (current_[0] = 0; current_[0] < azimuths_; ++current_[0]) column(current_[0], current_[1]);
+  }
+
+  // One slice of the column being built.
+  void store(int slice, const glm::dvec4& part0, const glm::dvec4& part1, const glm::dvec4& part2) {
+    at(current_[0], current_[1], slice) = part0;
+    at(current_[0], current_[1], slices_ + slice) = part1;
+    at(current_[0], current_[1], 2 * slices_ + slice) = part2;
   }
 
   // Part `part`'s trilinear value at uvw (w within the part, as air_table.glsl's sampleAirTable).
@@ -51,11 +60,6 @@ class AirTableTexels {
     return sum;
   }
 
-  // Bytes the GPU's image of this shape takes (RGBA32F).
-  static std::size_t bytes(int azimuths, int zeniths, int slices) {
-    return std::size_t(3) * std::size_t(azimuths) * std::size_t(zeniths) * std::size_t(slices) * 16;
-  }
-
  private:
   static int wrap(int i, int n) { return ((i % n) + n) % n; }
   static int clampTo(int i, int n) { return i < 0 ? 0 : (i >= n ? n - 1 : i); }
@@ -67,6 +71,7 @@ class AirTableTexels {
   }
 
   int azimuths_ = 0, zeniths_ = 0, slices_ = 0;
+  std::array<int, 2> current_{0, 0};  // the column build() is at
   std::vector<glm::dvec4> texels_;
 };
 

@@ -107,9 +107,8 @@ class CpuCore {
   void buildAirTable(const CoreFrame& f) {
     if (!f.airFromTable) return;
     airTable_ = AirTableTexels(f.airTable.azimuths, f.airTable.zeniths, f.airTable.slices);
-    for (column_.y = 0; column_.y < f.airTable.zeniths; ++column_.y)
-      for (column_.x = 0; column_.x < f.airTable.azimuths; ++column_.x)
-        buildAirTableColumn(f.air, f.airTable, airTableDirection(f.air, f.airTable, column_.x, column_.y));
+    airTable_.build(
+        [&](int i, int j) { buildAirTableColumn(f.air, f.airTable, airTableDirection(f.air, f.airTable, i, j)); });
   }
 
   std::uint64_t lookups() const { return lookups_; }
@@ -127,7 +126,6 @@ class CpuCore {
  private:
   CoreLayer layers_[kMaxLayers]{};
   AirTableTexels airTable_;
-  glm::ivec2 column_{0};  // the air-table column being built
   std::uint64_t lookups_ = 0;  // the cloud model's texture lookups so far
   const FrameSetup& setup_;
   const NoiseVolume& shape_;
@@ -144,7 +142,7 @@ CpuCore::real2 CpuCore::airCloudShadow(AirFrame a, real3 p, real h, real muSun) 
 }
 
 void CpuCore::storeAirTable(int slice, real4 part0, real4 part1, real4 part2) {
-  airTable_.store(column_.x, column_.y, slice, part0, part1, part2);
+  airTable_.store(slice, part0, part1, part2);
 }
 CpuCore::real4 CpuCore::sampleAirTable(int part, real3 uvw) { return airTable_.sample(part, uvw); }
 

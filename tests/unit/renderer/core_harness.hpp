@@ -51,13 +51,11 @@ class Core {
   // The air table a test built (buildAirTable), read by shadePixel when the
   // frame asks for it.
   sky::render::AirTableTexels airTexels;
-  glm::ivec2 airColumn{0};
 
   void buildAirTable(const CoreFrame& f) {
     airTexels = sky::render::AirTableTexels(f.airTable.azimuths, f.airTable.zeniths, f.airTable.slices);
-    for (airColumn.y = 0; airColumn.y < f.airTable.zeniths; ++airColumn.y)
-      for (airColumn.x = 0; airColumn.x < f.airTable.azimuths; ++airColumn.x)
-        buildAirTableColumn(f.air, f.airTable, airTableDirection(f.air, f.airTable, airColumn.x, airColumn.y));
+    airTexels.build(
+        [&](int i, int j) { buildAirTableColumn(f.air, f.airTable, airTableDirection(f.air, f.airTable, i, j)); });
   }
 };
 
@@ -88,7 +86,7 @@ inline Core::real2 Core::airCloudShadow(AirFrame a, real3 p, real h, real muSun)
   return cloudShadow(a, a.shadowLayers, -1, p, h, muSun);
 }
 inline void Core::storeAirTable(int slice, real4 part0, real4 part1, real4 part2) {
-  airTexels.store(airColumn.x, airColumn.y, slice, part0, part1, part2);
+  airTexels.store(slice, part0, part1, part2);
 }
 inline Core::real4 Core::sampleAirTable(int part, real3 uvw) { return airTexels.sample(part, uvw); }
 
