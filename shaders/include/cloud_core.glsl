@@ -15,8 +15,10 @@
 //   real  sampleDetail(LayerSampling s, real3 pLocal)    // Worley detail noise in [0, 1]
 //   real  sampleMaxCoverage(LayerSampling s, real3 pLocal) // the weather map's max-coverage mip cell:
 //                                                          // >= any coverage sampleWeather gives in it
-//   real2 airCloudShadow(AirFrame a, real3 p, real h, real muSun) // cloudShadow(a, a.shadowLayers, -1, p, h, muSun)
+//   real2 airCloudShadow(AirFrame a, real3 p, real h, real muSun) // airSunShadow(a, p, h, muSun)
 //   real4 sampleAirTable(int part, real3 uvw)           // the frame's air table (air_table.glsl)
+//   real4 sampleSunMap(int layer, real2 uv)             // the frame's sun map (sun_map.glsl)
+// and the frame's sun map in gSunMap (a global; a data member in C++).
 // pLocal is camera-relative, local frame: x east, y north, z up (m).
 
 #include "core_common.glsl"
@@ -403,6 +405,20 @@ real2 cloudShadow(AirFrame a, int count, int skip, real3 p, real hp, real muSun)
   return real2(direct, diffuse);
 }
 
+#include "sun_map.glsl"
+
+// The sun's shadow in the air at p (the airCloudShadow hook's body):
+// cloudShadow's, with the direct beam from the sun map where the frame has
+// one (light shafts at the scale of the clouds' shapes), or from the column
+// marched with the map's buildSteps per layer (the ground truth's).
+real2 airSunShadow(AirFrame a, real3 p, real h, real muSun) {
+  real2 shade = cloudShadow(a, a.shadowLayers, -1, p, h, muSun);
+  real tau = sunMapIsMap(gSunMap.method) ? sunMapDepth(a, gSunMap, p, muSun) : -1.0;
+  if (gSunMap.method == kSunColumn) tau = sunColumnDepth(a, gSunMap, p, muSun, gSunMap.buildSteps, a.shadowLayers);
+  shade.x = tau >= 0.0 ? exp(-tau) : shade.x;
+  return shade;
+}
+
 // Marches one layer's span front to back; transmittanceBefore (what the
 // layers in front left) only decides the early exit. Each sample stands for
 // a segment of the span (evenly: span / primarySteps; in metres: the step
@@ -479,15 +495,30 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
     emptyRun = 0;
     CloudType ct = cs.ct;
     real u = (t - s.t0) / spanLength;
-    real tauSun = lightOpticalDepth(f.air.sunDir, mix(muStart, muEnd, u), L.thickness, L.lightDistance, L.sampling, ct,
-                                    p, ph, cs.coverage, cs.peakNoise, cs.densityScale, f.march.lightSteps,
-                                    cs.rho > 0.0 ? f.march.lightSteps : 0);
+    real muHere = mix(muStart, muEnd, u);
+    // The sun's optical depth: the layer's own light march, or (a map, the
+    // column) every layer's; on the GPU the method is a pipeline constant,
+    // so the ways not taken are compiled out.
+    int sunMethod = gSunMap.method;
+    real tauSun = lightOpticalDepth(f.air.sunDir, muHere, L.thickness, L.lightDistance, L.sampling, ct, p, ph,
+                                    cs.coverage, cs.peakNoise, cs.densityScale, f.march.lightSteps,
+                                    sunMethod == kSunMarch && cs.rho > 0.0 ? f.march.lightSteps : 0);
+    if (sunMethod == kSunColumn) tauSun = sunColumnDepth(f.air, gSunMap, p, muHere, f.march.lightSteps, f.layerCount);
+    // Past the map's last cascade, the layer's own shadow at the weather
+    // map's scale (diffuseLight's column above p, as cloudShadow takes a
+    // layer's), and the other layers' from cloudShadow.
+    real mapTau = sunMapIsMap(sunMethod) ? sunMapDepth(f.air, gSunMap, p, muHere) : 0.0;
+    real ownAbove = ct.extinction_perm * cs.densityScale * ct.columnFill * (1.0 - ph) * L.thickness;
+    real ownFar = -log(max(1.0 - cs.coverage * (1.0 - exp(-ownAbove / max(muHere, kMinSunCosine))), 1e-6));
+    if (sunMapIsMap(sunMethod)) tauSun = mapTau >= 0.0 ? mapTau : ownFar;
     // Sunlight at p through the clear air above it (reddened at low sun,
     // none in the Earth's shadow) and the other layers' clouds above it
     // (cirrus over cumulus, a deck over a layer), and the sky's light from
     // all around, dimmed by those layers as well.
     real3 sun = mix(mix(sunBaseStart, sunTopStart, ph), mix(sunBaseEnd, sunTopEnd, ph), u);
-    real2 shade = cloudShadow(f.air, f.layerShadows, li, p, f.air.h + h, mix(muStart, muEnd, u));
+    real2 shade = cloudShadow(f.air, f.layerShadows, li, p, f.air.h + h, muHere);
+    // The map and the column hold the other layers' shadow in tauSun.
+    shade.x = sunMethod == kSunMarch || mapTau < 0.0 ? shade.x : 1.0;
     real3 scattered = sun * (shade.x * octaveSum(mix(phases1, phases2, cs.blend), tauSun)) +
                       diffuseLight(L, ct, ph, cs.coverage, cs.densityScale) * shade.y;
     // Hillaire 2016 energy-conserving step: integral over the step of
@@ -512,6 +543,10 @@ real3 groundRadiance(CoreFrame f, real3 dir, real t) {
   real muSun = dot(upAt(p, f.air.r), f.air.sunDir);
   real3 sun = f.air.sunIrradiance * sunTransmittance(0.0, muSun, f.air.r - f.air.h) * max(muSun, 0.0);
   real2 shadow = cloudShadow(f.air, f.layerCount, -1, p, 0.0, muSun);
+  int sunMethod = gSunMap.method;
+  if (sunMethod == kSunColumn) shadow.x = exp(-sunColumnDepth(f.air, gSunMap, p, muSun, gSunMap.buildSteps, f.layerCount));
+  real mapTau = sunMapIsMap(sunMethod) ? sunMapDepth(f.air, gSunMap, p, muSun) : -1.0;
+  shadow.x = mapTau >= 0.0 ? exp(-mapTau) : shadow.x;
   real3 light = sun * (shadow.x + (1.0 - shadow.x) * shadow.y) + f.groundIrradiance * shadow.y;
   return light * (kGroundAlbedo / kPi);
 }

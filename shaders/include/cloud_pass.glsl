@@ -35,6 +35,10 @@ layout(constant_id = 1) const bool kUseAirTable = true;
 // layers' shadow on each other's clouds is compiled out (CoreFrame::layerShadows).
 layout(constant_id = 2) const bool kLayersShadowLayers = true;
 
+// kSunMethod: how the sun's optical depth is found (sun_map.glsl: the
+// march, the column, or a map), so a frame's pipeline holds only its way.
+layout(constant_id = 3) const int kSunMethod = 0;
+
 #define real float
 #define real2 vec2
 #define real3 vec3
@@ -65,10 +69,17 @@ vec4 sampleAirTable(int part, vec3 uvw) {
   return textureLod(airTable, vec3(uvw.xy, (float(part) + uvw.z) / 3.0), 0.0);
 }
 
+layout(set = 0, binding = kBindingSunMapOut, rgba32f) uniform writeonly image2DArray sunMapOut;
+layout(set = 0, binding = kBindingSunMap) uniform sampler2DArray sunMapTex;
+
+vec4 sampleSunMap(int layer, vec2 uv) {
+  return textureLod(sunMapTex, vec3(uv, float(layer)), 0.0);
+}
+
 #include "cloud_core.glsl"
 
 vec2 airCloudShadow(AirFrame a, vec3 p, float h, float muSun) {
-  return cloudShadow(a, a.shadowLayers, -1, p, h, muSun);
+  return airSunShadow(a, p, h, muSun);
 }
 
 // Weather map lookup: camera-local point -> weather anchor frame -> gnomonic
@@ -174,6 +185,8 @@ void loadFrameGlobals() {
   gCamInAnchor = frame.camInAnchor;
   gMapScale = frame.weatherMap.x;
   gRings = frame.weatherRings;
+  gSunMap = SunMap(kSunMethod, int(frame.sunMap.y), int(frame.sunMap.z), int(frame.sunMap.w), frame.sunMapU.w,
+                   frame.sunMapU.xyz, frame.sunMapV.xyz, frame.sunMapShells.x, frame.sunMapShells.y);
 }
 
 AirFrame frameAir() {

@@ -36,6 +36,9 @@ SKY_SHARED_CONST kBindingAirTableOut = 12u;        // storage image3D (RGBA32F):
                                                    // writes (air_table.glsl), its three parts stacked in depth
 SKY_SHARED_CONST kBindingAirTable = 13u;           // sampler3D of the same image, read by the cloud pass
                                                    // (linear; u repeats, v and w clamp to the edge)
+SKY_SHARED_CONST kBindingSunMapOut = 14u;          // storage image2DArray (RGBA32F): the sun map the map pass
+                                                   // writes (sun_map.glsl), cascade c's part j in layer c * parts + j
+SKY_SHARED_CONST kBindingSunMap = 15u;             // sampler2DArray of the same image (linear, clamped to the edge)
 // Pixels per edge of the blue-noise tile (renderer/core/src/blue_noise.hpp).
 SKY_SHARED_CONST kBlueNoiseSize = 64u;
 // Cells per edge of the max-coverage mip (renderer/core/src/coverage_mip.hpp).
@@ -115,6 +118,12 @@ struct SkyFrame {
                         // negative; core_common.glsl, frustumPoint)
   uvec4 airTable;       // the air table (air_table.glsl, AirTableShape): x azimuths (0: the air is marched
                         // per pixel, no table pass), y zeniths, z slices per part; w unused
+  uvec4 sunMap;         // the sun's shadow (sun_map.glsl, SunMap): x method (SunShadow; >= 2 a map and its
+                        // pass), y texels per cascade edge, z cascades, w samples per layer along a texel's line
+  vec4 sunMapU;         // xyz: the map's first axis, local frame; w: cascade 0's half extent (m)
+  vec4 sunMapV;         // xyz: its second axis; w: unused
+  vec4 sunMapShells;    // x: the highest drawn layer's top, y: the lowest one's base, m above the ground
+                        // sphere; zw: unused
 };
 
 #ifdef __cplusplus
@@ -139,7 +148,8 @@ static_assert(offsetof(SkyFrame, interleave) == 272 + 256 * kMaxLayers + 32);
 static_assert(offsetof(SkyFrame, raster) == 272 + 256 * kMaxLayers + 48);
 static_assert(offsetof(SkyFrame, frustum) == 272 + 256 * kMaxLayers + 80);
 static_assert(offsetof(SkyFrame, airTable) == 272 + 256 * kMaxLayers + 96);
-static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 112);
+static_assert(offsetof(SkyFrame, sunMap) == 272 + 256 * kMaxLayers + 112);
+static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 176);
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

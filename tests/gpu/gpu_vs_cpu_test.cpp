@@ -314,3 +314,39 @@ TEST(GpuVsCpu, BadFrustaAreRefused) {
 
 }  // namespace
 }  // namespace sky::test
+
+namespace sky::test {
+namespace {
+
+// Every way of shadowing the clouds from the sun (sun_map.glsl): the column
+// march and the four maps, each on the GPU against the CPU reference, on a
+// scene below, inside (low sun) and above a tiled layer and with two layers
+// (the map holds both), within the same bounds. A 64-texel map of two
+// cascades with 16 steps keeps the CPU's build quick.
+TEST(GpuVsCpu, SunShadowMethodsWithinTolerance) {
+  SKY_RENDERER(shared, 64, 36);  // keeps the driver loaded (renderer_fixture.hpp)
+  (void)shared;
+  std::vector<Case> scenes = {
+      {"below_tiled", pose(47, 8, 800, 135, 20), true, 0.55, 0, 0},
+      {"inside_low_sun", pose(47, 8, 2000, 45, 0), true, 0.6, 0, 0, weather::CloudType::None, 1.0, std::nullopt, 8},
+      {"above_tiled", pose(47, 8, 5000, 300, -35), true, 0.5, 0, 0},
+      {"two_layers", pose(47, 8, 800, 30, 25), false, 0.55, 0, 0},
+  };
+  scenes.back().upperCoverage = 0.6;
+  for (const render::SunShadow method : {render::SunShadow::Column, render::SunShadow::Esm, render::SunShadow::Bsm,
+                                         render::SunShadow::Fom, render::SunShadow::Deep}) {
+    render::RenderSettings settings;
+    settings.width = 64;
+    settings.height = 36;
+    settings.march.primarySteps = 24;
+    settings.march.sunShadow = {method, 64, 2, 4000, 16};
+    auto r = render::CloudRenderer::create(settings);
+    ASSERT_TRUE(r) << describe(r.error());
+    auto reference = render::CpuReference::create(settings);
+    ASSERT_TRUE(reference) << describe(reference.error());
+    compareScenes(**r, *reference, scenes, std::string(render::sunShadowName(method)) + "_", false);
+  }
+}
+
+}  // namespace
+}  // namespace sky::test

@@ -94,6 +94,44 @@ TEST(Presets, BadMarchSettingsAreRefused) {
   r = render::CloudRenderer::create(settings);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().detail.find("minTransmittance"), std::string::npos) << r.error().detail;
+  settings.march.minTransmittance = 0.01;
+  // The sun map: a size the map pass's 8x8 groups do not tile, too many
+  // cascades, an unknown method, and the column's 1024-step limit.
+  for (auto bad : {render::SunMapSettings{render::SunShadow::Deep, 100}, render::SunMapSettings{render::SunShadow::Bsm, 128, 5},
+                   render::SunMapSettings{render::SunShadow(6)}}) {
+    settings.march.sunShadow = bad;
+    r = render::CloudRenderer::create(settings);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().detail.find("sunShadow"), std::string::npos) << r.error().detail;
+  }
+  settings.march.sunShadow = {render::SunShadow::Column};
+  settings.march.lightSteps = 1025;
+  r = render::CloudRenderer::create(settings);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().detail.find("lightSteps"), std::string::npos) << r.error().detail;
+  settings.march.sunShadow = {render::SunShadow::March};
+  settings.march.lightSteps = 65;
+  r = render::CloudRenderer::create(settings);
+  ASSERT_FALSE(r) << "65 light steps: only the column march takes more than 64";
+}
+
+// The renderer's sun map is sized when it is built: a budget level or a
+// caller may change the map's build steps and extent, not its method or size.
+TEST(Presets, SunShadowMethodIsFixedAtCreation) {
+  render::RenderSettings settings;
+  settings.width = 16;
+  settings.height = 16;
+  settings.march.sunShadow = {render::SunShadow::Deep, 64, 2};
+  auto r = render::CloudRenderer::create(settings);
+  ASSERT_TRUE(r) << describe(r.error());
+  render::MarchSettings m = settings.march;
+  m.sunShadow.buildSteps = 8;
+  m.sunShadow.extent_m = 9000;
+  EXPECT_TRUE((*r)->setMarch(m));
+  m.sunShadow.method = render::SunShadow::Fom;
+  auto refused = (*r)->setMarch(m);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().detail.find("sun shadow"), std::string::npos) << refused.error().detail;
 }
 
 }  // namespace

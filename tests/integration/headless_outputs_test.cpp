@@ -262,6 +262,33 @@ TEST(HeadlessOutputs, FrameBudgetIsRecordedPerFrame) {
   EXPECT_NE(refused.log().find("--frame-budget-ms"), std::string::npos) << refused.log();
 }
 
+// --sun-shadow: the run draws with the chosen way of shadowing the clouds,
+// at every budget level too, and every frame's metadata names it with its
+// map's size and memory (a deep map of 128^2 x 4 cascades: 2 RGBA32F parts,
+// 2 MiB, all of it filled by its 8 values a texel).
+TEST(HeadlessOutputs, SunShadowMethodIsRecordedPerFrame) {
+  const ReplayResult run =
+      replay("sun-shadow", SKY_SCENARIO_CLOUDY, {"--sun-shadow", "deep", "--frame-budget-ms", "0.1"});
+  ASSERT_EQ(run.frames.size(), kFrames);
+  for (const auto& f : run.frames) {
+    SCOPED_TRACE(f.dump());
+    const auto& sun = f["march"]["sun_shadow"];
+    EXPECT_EQ(sun["method"], "deep");
+    EXPECT_EQ(sun["size"], 128);
+    EXPECT_EQ(sun["cascades"], 4);
+    EXPECT_EQ(sun["bytes"], 128 * 128 * 4 * 2 * 16);
+    EXPECT_EQ(sun["used_bytes"], 128 * 128 * 4 * 32);
+    EXPECT_EQ(f["budget"]["march"]["sun_shadow"]["method"], "deep") << "the budget's levels keep the method";
+  }
+  ChildProcess refused({SKY_RENDER, "--headless", "--replay", SKY_TEST_FLIGHT, "--weather-file", SKY_SCENARIO_CLOUDY,
+                        "--out", (fs::path(SKY_TEST_OUTPUT_DIR) / "outputs-sun-shadow-refused").string(),
+                        "--sun-shadow", "shadowmap"},
+                       (fs::path(SKY_TEST_OUTPUT_DIR) / "outputs-sun-shadow-refused.log").string(),
+                       {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
+  EXPECT_NE(refused.wait(120s).value_or(-1), 0);
+  EXPECT_NE(refused.log().find("--sun-shadow"), std::string::npos) << refused.log();
+}
+
 // The noise textures (the cloud model's shape and detail noise) through
 // skyshell-render's --cache-dir: the first start generates and writes them,
 // the second loads them (and draws the same bytes), a damaged cache file is

@@ -26,6 +26,20 @@ Result<FrameWriter> FrameWriter::open(const std::string& directory, const FrameO
 
 namespace {
 // The march numbers as frames.jsonl names them (the run's, and a budget level's).
+// The sun shadow's method, with its map's size and bytes where it has one.
+nlohmann::json sunShadowJson(const render::SunMapSettings& s) {
+  nlohmann::json j{{"method", render::sunShadowName(s.method)}};
+  if (render::sunMapParts(s.method) > 0) {
+    j["size"] = s.size;
+    j["cascades"] = s.cascades;
+    j["extent_m"] = s.extent_m;
+    j["build_steps"] = s.buildSteps;
+    j["bytes"] = render::sunMapBytes(s);
+    j["used_bytes"] = render::sunMapUsedBytes(s);
+  }
+  return j;
+}
+
 nlohmann::json marchJson(const render::MarchSettings& m) {
   return {{"primary_steps", m.primarySteps},
           {"light_steps", m.lightSteps},
@@ -42,6 +56,7 @@ nlohmann::json marchJson(const render::MarchSettings& m) {
                                                             {"zeniths", m.airTable.zeniths},
                                                             {"slices", m.airTable.slices}}
                                            : nlohmann::json(nullptr)},
+          {"sun_shadow", sunShadowJson(m.sunShadow)},
           {"blue_noise", m.blueNoise}};
 }
 

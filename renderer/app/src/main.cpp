@@ -75,6 +75,7 @@ struct Options {
   unsigned viewId = 0;
   std::string preset = sky::app::kDefaultPreset;
   double frameBudget_ms = 0;  // --frame-budget-ms; 0: none
+  std::string sunShadow;      // --sun-shadow; empty: the preset's
   double sunAzimuth_deg = 135, sunElevation_deg = 40;
   std::uint64_t maxFrames = 0;
   double idleExit_s = 0;
@@ -180,6 +181,11 @@ int main(int argc, char** argv) {
                  "hold frames to this many ms: each frame drawn at the most accurate of the preset's cheaper "
                  "marches predicted to fit (frame_budget.hpp; every frame's metadata says which)")
       ->check(CLI::Range(0.1, 1e6));
+  app.add_option("--sun-shadow", o.sunShadow,
+                 "how clouds are shadowed from the sun: march (the preset's light march), column, esm, bsm, fom, "
+                 "deep (a sun-space map, also shadowing the ground and the air: light shafts; "
+                 "docs/light-transport.md)")
+      ->check(CLI::IsMember({"march", "column", "esm", "bsm", "fom", "deep"}));
   app.add_option("--sun-azimuth", o.sunAzimuth_deg, "deg from true north");
   app.add_option("--sun-elevation", o.sunElevation_deg, "deg above the horizon");
   app.add_option("--utc", o.utc,
@@ -279,8 +285,16 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "skyshell-render: --preset: %s\n", sky::describe(preset.error()).c_str());
     return 2;
   }
+  // The sun shadow's method holds for the whole run (the renderer's map
+  // is sized for it), at every budget level too.
+  auto withSunShadow = [&](sky::render::MarchSettings m) {
+    for (std::uint32_t k = 0; k <= std::uint32_t(sky::render::SunShadow::Deep); ++k)
+      if (o.sunShadow == sky::render::sunShadowName(sky::render::SunShadow(k)))
+        m.sunShadow.method = sky::render::SunShadow(k);
+    return m;
+  };
   sky::render::RenderSettings settings{o.width, o.height, o.fov_deg, 1, o.noNoiseCache ? std::string() : o.cacheDir,
-                                       preset->march, preset->temporal, preset->resolution};
+                                       withSunShadow(preset->march), preset->temporal, preset->resolution};
   std::optional<sky::render::FrameBudget> budget;
   if (o.frameBudget_ms > 0) {
     auto ladder = sky::render::budgetLadder(*preset);
@@ -288,6 +302,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "skyshell-render: --frame-budget-ms: %s\n", sky::describe(ladder.error()).c_str());
       return 2;
     }
+    for (sky::render::BudgetLevel& level : *ladder) level.march = withSunShadow(level.march);
     budget.emplace(o.frameBudget_ms, std::move(*ladder));
   }
   sky::render::GpuOptions gpu;

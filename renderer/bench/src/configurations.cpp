@@ -132,6 +132,11 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     else if (key == "air-azimuths") m.airTable.azimuths = std::uint32_t(v);
     else if (key == "air-zeniths") m.airTable.zeniths = std::uint32_t(v);
     else if (key == "air-slices") m.airTable.slices = std::uint32_t(v);
+    else if (key == "shadow" && v <= 5 && v == std::floor(v)) m.sunShadow.method = render::SunShadow(std::uint32_t(v));
+    else if (key == "shadow-size") m.sunShadow.size = std::uint32_t(v);
+    else if (key == "shadow-cascades") m.sunShadow.cascades = std::uint32_t(v);
+    else if (key == "shadow-extent") m.sunShadow.extent_m = v;
+    else if (key == "shadow-steps") m.sunShadow.buildSteps = std::uint32_t(v);
     else if (key == "accumulate" && v <= 0.95) c.settings.temporal.accumulation = v;
     else if (key == "pixel-jitter" && (v == 0 || v == 1)) c.settings.temporal.pixelJitter = v == 1;
     else
@@ -140,7 +145,8 @@ Result<Configuration> customConfiguration(const std::string& spec) {
                       "' (base, primary, light, exit, stride, cloud, empty, growth, air, multmin, divmin, scale, "
                       "interleave 1|2|4, divisor 1|2|4, depth-aware 0|1, blue 0|1, cloud-shadows 0|1, air-table 0|1, "
                       "air-azimuths, air-zeniths, air-slices, budget 0..4 (after base), accumulate 0..0.95, "
-                      "pixel-jitter 0|1)");
+                      "pixel-jitter 0|1, shadow 0..5 (march, column, esm, bsm, fom, deep), shadow-size, "
+                      "shadow-cascades, shadow-extent (m), shadow-steps)");
   }
   // Accumulation blends redraws with the history: without interleaving
   // there is none (a base preset's accumulation goes with its interleave).

@@ -29,7 +29,8 @@ vk::raii::Sampler makeSampler(const GpuContext& ctx, vk::SamplerAddressMode mode
 Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, std::uint32_t height,
                                     const NoiseVolume& shape, const NoiseVolume& detail,
                                     const AtmosphereTables& atmosphere, const WeatherTexture& weather,
-                                    const std::vector<float>& blueNoise, const AirTableSettings& airTable) {
+                                    const std::vector<float>& blueNoise, const AirTableSettings& airTable,
+                                    const SunMapSettings& sunMap) {
   SKY_ASSERT(blueNoise.size() == std::size_t(gpu::kBlueNoiseSize) * gpu::kBlueNoiseSize);
   CloudPass pass;
   pass.width_ = width;
@@ -37,9 +38,10 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
   const auto& device = ctx.device();
 
   pass.airTableSize_ = airTable.enabled ? airTable : AirTableSettings{false, 8, 8, 4};
+  pass.sunMapSize_ = sunMap;
   // The one-layer variant now (its set layout is the descriptor set's), the
   // others when a frame first needs them.
-  auto first = pass.pipelineFor(ctx, false, 1);
+  auto first = pass.pipelineFor(ctx, Stage::Clouds, 1);
   if (!first) return tl::unexpected(first.error());
 
   pass.noiseSampler_ = makeSampler(ctx, vk::SamplerAddressMode::eRepeat, "sky.noiseSampler");
@@ -60,6 +62,10 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
                                        vk::Extent3D(pass.airTableSize_.azimuths, pass.airTableSize_.zeniths,
                                                     3 * pass.airTableSize_.slices),
                                        "sky.airTable");
+  const std::uint32_t sunParts = sunMapParts(sunMap.method);
+  pass.sunMap_ = sunParts > 0 ? createStorageArray(ctx, vk::Format::eR32G32B32A32Sfloat, sunMap.size, sunMap.size,
+                                                   sunMap.cascades * sunParts, "sky.sunMap")
+                              : createStorageArray(ctx, vk::Format::eR32G32B32A32Sfloat, 1, 1, 1, "sky.sunMap");
 
   auto noiseImage = [&](const NoiseVolume& n, const char* name) {
     return createSampledImage(ctx, vk::ImageType::e3D, n.channels == 4 ? vk::Format::eR8G8B8A8Unorm : vk::Format::eR8Unorm,
@@ -97,9 +103,9 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
                                      vk::BufferUsageFlagBits::eStorageBuffer, "sky.blueNoise");
   std::memcpy(pass.blueNoise_.mapped, blueNoise.data(), pass.blueNoise_.size);
 
-  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eCombinedImageSampler, 6),
+  const std::array poolSizes{vk::DescriptorPoolSize(vk::DescriptorType::eCombinedImageSampler, 7),
                              vk::DescriptorPoolSize(vk::DescriptorType::eStorageBuffer, 5),
-                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageImage, 1)};
+                             vk::DescriptorPoolSize(vk::DescriptorType::eStorageImage, 2)};
   pass.descriptorPool_ = vk::raii::DescriptorPool(
       device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, poolSizes));
   ctx.name(pass.descriptorPool_, "sky.clouds.descriptorPool");
@@ -123,6 +129,8 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
                                             vk::ImageLayout::eShaderReadOnlyOptimal);
   const vk::DescriptorImageInfo airOutInfo({}, *pass.airTable_.view, vk::ImageLayout::eGeneral);
   const vk::DescriptorImageInfo airInfo(*pass.airTableSampler_, *pass.airTable_.view, vk::ImageLayout::eGeneral);
+  const vk::DescriptorImageInfo sunOutInfo({}, *pass.sunMap_.view, vk::ImageLayout::eGeneral);
+  const vk::DescriptorImageInfo sunInfo(*pass.tableSampler_, *pass.sunMap_.view, vk::ImageLayout::eGeneral);
   const vk::DescriptorSet set = *pass.descriptorSet_;
   const std::array writes{
       vk::WriteDescriptorSet(set, gpu::kBindingFrame, 0, vk::DescriptorType::eStorageBuffer, {}, uniformInfo),
@@ -136,10 +144,12 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
       vk::WriteDescriptorSet(set, gpu::kBindingCoverageMip, 0, vk::DescriptorType::eStorageBuffer, {}, mipInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingBlueNoise, 0, vk::DescriptorType::eStorageBuffer, {}, blueInfo),
       vk::WriteDescriptorSet(set, gpu::kBindingAirTableOut, 0, vk::DescriptorType::eStorageImage, airOutInfo),
-      vk::WriteDescriptorSet(set, gpu::kBindingAirTable, 0, vk::DescriptorType::eCombinedImageSampler, airInfo)};
+      vk::WriteDescriptorSet(set, gpu::kBindingAirTable, 0, vk::DescriptorType::eCombinedImageSampler, airInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingSunMapOut, 0, vk::DescriptorType::eStorageImage, sunOutInfo),
+      vk::WriteDescriptorSet(set, gpu::kBindingSunMap, 0, vk::DescriptorType::eCombinedImageSampler, sunInfo)};
   device.updateDescriptorSets(writes, {});
 
-  pass.timer_ = GpuTimer(ctx, 4, "sky.clouds.timer");
+  pass.timer_ = GpuTimer(ctx, 5, "sky.clouds.timer");
   pass.commands_ = ctx.allocateCommandBuffer();
   ctx.name(pass.commands_, "sky.clouds.commands");
   pass.fence_ = vk::raii::Fence(device, vk::FenceCreateInfo());
@@ -147,15 +157,19 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
   return pass;
 }
 
-Result<const ComputePipeline*> CloudPass::pipelineFor(const GpuContext& ctx, bool table, std::uint32_t layersDrawn) {
+Result<const ComputePipeline*> CloudPass::pipelineFor(const GpuContext& ctx, Stage stage, std::uint32_t layersDrawn) {
   std::optional<ComputePipeline>& slot =
-      table ? tablePipelines_[layersDrawn > 0 ? 1 : 0] : cloudPipelines_[std::min<std::uint32_t>(layersDrawn, 2)];
+      stage == Stage::SunMap     ? sunMapPipeline_
+      : stage == Stage::AirTable ? tablePipelines_[layersDrawn > 0 ? 1 : 0]
+                                 : cloudPipelines_[std::min<std::uint32_t>(layersDrawn, 2)];
   if (slot) return &*slot;
-  // Every variant of both shaders gets the same bindings, so their set
+  // Every variant of the three shaders gets the same bindings, so their set
   // layouts are identical and one descriptor set serves them all (Vulkan's
   // compatibility rule).
-  ComputePipelineBuilder builder(std::string(table ? "sky.airTable" : "sky.clouds") + ".layers" +
-                                 std::to_string(std::min<std::uint32_t>(layersDrawn, 2)));
+  const char* name = stage == Stage::SunMap ? "sky.sunMap" : (stage == Stage::AirTable ? "sky.airTable" : "sky.clouds");
+  const char* shader =
+      stage == Stage::SunMap ? "sun_map.comp.spv" : (stage == Stage::AirTable ? "air_table.comp.spv" : "clouds.comp.spv");
+  ComputePipelineBuilder builder(std::string(name) + ".layers" + std::to_string(std::min<std::uint32_t>(layersDrawn, 2)));
   builder.binding(gpu::kBindingFrame, vk::DescriptorType::eStorageBuffer)
       .binding(gpu::kBindingShape, vk::DescriptorType::eCombinedImageSampler)
       .binding(gpu::kBindingWeather, vk::DescriptorType::eCombinedImageSampler)
@@ -168,8 +182,11 @@ Result<const ComputePipeline*> CloudPass::pipelineFor(const GpuContext& ctx, boo
       .binding(gpu::kBindingBlueNoise, vk::DescriptorType::eStorageBuffer)
       .binding(gpu::kBindingAirTableOut, vk::DescriptorType::eStorageImage)
       .binding(gpu::kBindingAirTable, vk::DescriptorType::eCombinedImageSampler)
-      .shader(table ? "air_table.comp.spv" : "clouds.comp.spv")
-      .constants({layersDrawn > 0 ? 1u : 0u, airTableSize_.enabled ? 1u : 0u, layersDrawn > 1 ? 1u : 0u});
+      .binding(gpu::kBindingSunMapOut, vk::DescriptorType::eStorageImage)
+      .binding(gpu::kBindingSunMap, vk::DescriptorType::eCombinedImageSampler)
+      .shader(shader)
+      .constants({layersDrawn > 0 ? 1u : 0u, airTableSize_.enabled ? 1u : 0u, layersDrawn > 1 ? 1u : 0u,
+                  std::uint32_t(sunMapSize_.method)});
   auto built = builder.build(ctx);
   if (!built) return tl::unexpected(built.error());
   slot = std::move(*built);
@@ -191,26 +208,52 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
   std::uint32_t layersDrawn = 0;
   for (std::uint32_t i = 0; i < std::uint32_t(frame.weatherMap.y) && i < gpu::kMaxLayers; ++i)
     layersDrawn += frame.layers[i].ambient.w < 0.5f ? 1 : 0;
-  auto cloudPipeline = pipelineFor(ctx, false, layersDrawn);
+  auto cloudPipeline = pipelineFor(ctx, Stage::Clouds, layersDrawn);
   if (!cloudPipeline) return tl::unexpected(cloudPipeline.error());
   const ComputePipeline* tablePipeline = nullptr;
   if (frame.airTable.x > 0) {
-    auto built = pipelineFor(ctx, true, layersDrawn);
+    auto built = pipelineFor(ctx, Stage::AirTable, layersDrawn);
     if (!built) return tl::unexpected(built.error());
     tablePipeline = *built;
+  }
+  SKY_ASSERT(frame.sunMap.x == std::uint32_t(sunMapSize_.method));
+  // The map, where the frame has layers to shadow with it.
+  const ComputePipeline* sunPipeline = nullptr;
+  if (sunMapParts(sunMapSize_.method) > 0 && layersDrawn > 0) {
+    SKY_ASSERT(frame.sunMap.y == sunMapSize_.size && frame.sunMap.z == sunMapSize_.cascades);
+    auto built = pipelineFor(ctx, Stage::SunMap, layersDrawn);
+    if (!built) return tl::unexpected(built.error());
+    sunPipeline = *built;
   }
 
   commands_.reset();
   commands_.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
   timer_.begin(commands_);
-  // The table's old contents are never read again: from eUndefined each frame.
+  // The tables' old contents are never read again: from eUndefined each frame.
   const vk::ImageSubresourceRange whole(vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1);
+  const vk::ImageSubresourceRange allLayers(vk::ImageAspectFlagBits::eColor, 0, 1, 0, sunMap_.layers);
+  const auto fresh = [](vk::Image image, const vk::ImageSubresourceRange& range) {
+    return vk::ImageMemoryBarrier({}, vk::AccessFlagBits::eShaderWrite | vk::AccessFlagBits::eShaderRead,
+                                  vk::ImageLayout::eUndefined, vk::ImageLayout::eGeneral, VK_QUEUE_FAMILY_IGNORED,
+                                  VK_QUEUE_FAMILY_IGNORED, image, range);
+  };
   commands_.pipelineBarrier(vk::PipelineStageFlagBits::eTopOfPipe, vk::PipelineStageFlagBits::eComputeShader, {}, {},
-                            {},
-                            vk::ImageMemoryBarrier({}, vk::AccessFlagBits::eShaderWrite | vk::AccessFlagBits::eShaderRead,
-                                                   vk::ImageLayout::eUndefined, vk::ImageLayout::eGeneral,
-                                                   VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED, *airTable_.image,
-                                                   whole));
+                            {}, {fresh(*airTable_.image, whole), fresh(*sunMap_.image, allLayers)});
+  if (sunPipeline != nullptr) {
+    {
+      const auto timed = timer_.section(commands_, "sun-map");
+      commands_.bindPipeline(vk::PipelineBindPoint::eCompute, *sunPipeline->pipeline);
+      commands_.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *sunPipeline->layout, 0, *descriptorSet_, {});
+      const std::uint32_t groups = (sunMapSize_.size + gpu::kLocalSize - 1) / gpu::kLocalSize;
+      commands_.dispatch(groups, groups, sunMapSize_.cascades);
+    }
+    commands_.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {},
+                              {}, {},
+                              vk::ImageMemoryBarrier(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eShaderRead,
+                                                     vk::ImageLayout::eGeneral, vk::ImageLayout::eGeneral,
+                                                     VK_QUEUE_FAMILY_IGNORED, VK_QUEUE_FAMILY_IGNORED,
+                                                     *sunMap_.image, allLayers));
+  }
   if (frame.airTable.x > 0) {
     SKY_ASSERT(airTableSize_.enabled && frame.airTable.x == airTableSize_.azimuths &&
                frame.airTable.y == airTableSize_.zeniths && frame.airTable.z == airTableSize_.slices);

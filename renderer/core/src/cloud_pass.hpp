@@ -33,11 +33,13 @@ class CloudPass {
   // Errors: Io/Malformed for the SPIR-V, Device from the texture uploads;
   // other Vulkan failures throw.
   // airTable sizes the air table's image (a token one when it is off; a
-  // frame may then not ask for the table).
+  // frame may then not ask for the table); sunMap the sun map's (a token
+  // one without a map method) and fixes the method of every frame.
   static Result<CloudPass> create(const GpuContext& ctx, std::uint32_t width, std::uint32_t height,
                                   const NoiseVolume& shape, const NoiseVolume& detail,
                                   const AtmosphereTables& atmosphere, const WeatherTexture& weather,
-                                  const std::vector<float>& blueNoise, const AirTableSettings& airTable);
+                                  const std::vector<float>& blueNoise, const AirTableSettings& airTable,
+                                  const SunMapSettings& sunMap);
 
   // The passes that follow the clouds in the same submission, each with
   // its block: the reprojection (with interleaving; without it the frame
@@ -61,15 +63,17 @@ class CloudPass {
   // Replaces the max-coverage mip the march reads (coverage_mip.hpp; size
   // kMaxLayers x kCoverageMipSize^2). Call between runs.
   void setCoverageMip(const std::vector<float>& mip);
-  // GPU time of the last run's dispatches ("air-table", "clouds", then "reproject", "upscale").
+  // GPU time of the last run's dispatches ("sun-map", "air-table", "clouds", then "reproject", "upscale").
   std::vector<PassTime> lastTimes() const { return timer_.results(); }
 
  private:
   CloudPass() = default;
-  // The variant for a frame drawing layersDrawn layers: clouds.comp's, or
-  // with `table` air_table.comp's; built now if it is not yet. Errors:
-  // Io/Malformed for the SPIR-V; Vulkan failures throw.
-  Result<const ComputePipeline*> pipelineFor(const GpuContext& ctx, bool table, std::uint32_t layersDrawn);
+  // The shaders of the pass, in the order they run.
+  enum class Stage { SunMap, AirTable, Clouds };
+  // The variant of a stage's shader for a frame drawing layersDrawn layers,
+  // built now if it is not yet. Errors: Io/Malformed for the SPIR-V; Vulkan
+  // failures throw.
+  Result<const ComputePipeline*> pipelineFor(const GpuContext& ctx, Stage stage, std::uint32_t layersDrawn);
 
   // Destroyed in reverse order: fence and command buffer first, the
   // descriptor set before its pool, buffers and images before the samplers
@@ -80,6 +84,7 @@ class CloudPass {
   // table's without and with clouds. Set layouts all identical.
   std::array<std::optional<ComputePipeline>, 3> cloudPipelines_;
   std::array<std::optional<ComputePipeline>, 2> tablePipelines_;
+  std::optional<ComputePipeline> sunMapPipeline_;
   vk::raii::Sampler noiseSampler_{nullptr};
   vk::raii::Sampler airTableSampler_{nullptr};
   vk::raii::Sampler weatherSampler_{nullptr};
@@ -90,6 +95,8 @@ class CloudPass {
   GpuImage multipleScattering_;
   GpuImage airTable_;  // written by the table pass, sampled by the clouds (eGeneral)
   AirTableSettings airTableSize_;
+  GpuImage sunMap_;  // written by the map pass, sampled by the table and the clouds (eGeneral)
+  SunMapSettings sunMapSize_;
   GpuBuffer uniforms_;  // the frame block (a storage buffer, see clouds.comp)
   GpuBuffer output_;
   GpuBuffer depth_;

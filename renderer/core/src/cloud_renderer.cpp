@@ -128,7 +128,8 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
     const std::uint32_t smallW = drawnExtent(settings.width, divisor);
     const std::uint32_t smallH = drawnExtent(settings.height, divisor);
     auto pass = CloudPass::create(**ctx, smallW, smallH, shape, detail, atmosphere, *weather,
-                                  blueNoiseTile(settings.noiseSeed), settings.march.airTable);
+                                  blueNoiseTile(settings.noiseSeed), settings.march.airTable,
+                                  settings.march.sunShadow);
     if (!pass) return tl::unexpected(pass.error());
     std::optional<ReprojectPass> reproject;
     if (settings.temporal.interleave > 1) {
@@ -258,6 +259,10 @@ Result<void> CloudRenderer::setMarch(const MarchSettings& march) {
   if (was.enabled != now.enabled ||
       (now.enabled && (was.azimuths != now.azimuths || was.zeniths != now.zeniths || was.slices != now.slices)))
     return fail(ErrorCode::InvalidArgument, "CloudRenderer::setMarch: the air table is fixed when the renderer is built");
+  const SunMapSettings &sunWas = impl_->settings.march.sunShadow, &sunNow = march.sunShadow;
+  if (sunWas.method != sunNow.method || sunWas.size != sunNow.size || sunWas.cascades != sunNow.cascades)
+    return fail(ErrorCode::InvalidArgument,
+                "CloudRenderer::setMarch: the sun shadow's method and map size are fixed when the renderer is built");
   impl_->settings = next;
   return {};
 }

@@ -10,6 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "air_table_texels.hpp"
+#include "sun_map_texels.hpp"
 #include "atmosphere_tables.hpp"
 #include "blue_noise.hpp"
 #include "coverage_mip.hpp"
@@ -52,7 +53,9 @@ class CpuCore {
 
 #define SKY_CORE_CONST static constexpr
 #define SKY_AIR_TABLE_BUILDER
+#define SKY_SUN_MAP_BUILDER
 #include "cloud_core.glsl"
+#undef SKY_SUN_MAP_BUILDER
 #undef SKY_AIR_TABLE_BUILDER
 #undef SKY_CORE_CONST
 
@@ -83,6 +86,10 @@ class CpuCore {
     f.airFromTable = table.enabled;
     f.airTable = table.enabled ? AirTableShape{int(table.azimuths), int(table.zeniths), int(table.slices)}
                                : AirTableShape{0, 0, 0};
+    const SunMapSettings& sun = setup_.march.sunShadow;
+    const SunMapGeometry g = sunMapGeometry(setup_);
+    gSunMap = SunMap{int(sun.method), int(sun.size), int(sun.cascades), int(sun.buildSteps), sun.extent_m,
+                     g.axisU, g.axisV, g.top_m, g.base_m};
     const CloudType cumulus = coreType(cloudTypeParams(weather::CloudType::Cumulus));
     for (std::size_t i = 0; i < kMaxLayers; ++i) {
       CoreLayer& c = layers_[i];
@@ -111,6 +118,14 @@ class CpuCore {
         [&](int i, int j) { buildAirTableColumn(f.air, f.airTable, airTableDirection(f.air, f.airTable, i, j)); });
   }
 
+  // Builds the frame's sun map as the map pass does, when f has one and a
+  // layer to shadow (after coreFrame).
+  void buildSunMap(const CoreFrame& f) {
+    if (!sunMapIsMap(gSunMap.method) || !f.clouds) return;
+    sunMap_ = SunMapTexels(gSunMap.size, gSunMap.cascades, sunMapParts(gSunMap.method));
+    sunMap_.build([&](int cascade, int i, int j) { buildSunMapTexel(f.air, gSunMap, f.layerCount, cascade, i, j); });
+  }
+
   std::uint64_t lookups() const { return lookups_; }
 
   PixelResult shade(std::uint32_t px, std::uint32_t py, const CoreFrame& f) {
@@ -126,6 +141,8 @@ class CpuCore {
  private:
   CoreLayer layers_[kMaxLayers]{};
   AirTableTexels airTable_;
+  SunMapTexels sunMap_;
+  SunMap gSunMap{};  // sun_map.glsl's global
   std::uint64_t lookups_ = 0;  // the cloud model's texture lookups so far
   const FrameSetup& setup_;
   const NoiseVolume& shape_;
@@ -138,8 +155,10 @@ class CpuCore {
 
 CpuCore::CoreLayer CpuCore::layerAt(int li) { return layers_[li]; }
 CpuCore::real2 CpuCore::airCloudShadow(AirFrame a, real3 p, real h, real muSun) {
-  return cloudShadow(a, a.shadowLayers, -1, p, h, muSun);
+  return airSunShadow(a, p, h, muSun);
 }
+void CpuCore::storeSunMap(real4 part0, real4 part1) { sunMap_.store(part0, part1); }
+CpuCore::real4 CpuCore::sampleSunMap(int layer, real2 uv) { return sunMap_.sample(layer, uv); }
 
 void CpuCore::storeAirTable(int slice, real4 part0, real4 part1, real4 part2) {
   airTable_.store(slice, part0, part1, part2);
@@ -213,6 +232,7 @@ Result<std::vector<std::array<float, 4>>> CpuReference::renderPixels(const Frame
   const FrameSetup setup = prepareFrame(settings_, inputs, field, tables_->atmosphere);
   CpuCore core(setup, tables_->shape, tables_->detail, tables_->atmosphere, field, tables_->blueNoise);
   const auto frame = core.coreFrame();
+  core.buildSunMap(frame);
   core.buildAirTable(frame);
   std::vector<std::array<float, 4>> out;
   out.reserve(pixels.size());
@@ -230,6 +250,7 @@ Result<Image> CpuReference::render(const FrameInputs& inputs, std::uint64_t* den
   const FrameSetup setup = prepareFrame(settings_, inputs, field, tables_->atmosphere);
   CpuCore core(setup, tables_->shape, tables_->detail, tables_->atmosphere, field, tables_->blueNoise);
   const auto frame = core.coreFrame();
+  core.buildSunMap(frame);
   core.buildAirTable(frame);
   Image image;
   image.width = settings_.width;

@@ -108,7 +108,7 @@ Result<void> validateSettings(const RenderSettings& s) {
   if (m.primarySteps < 1 || m.primarySteps > 4096)
     return fail(ErrorCode::InvalidArgument,
                 "render settings: march.primarySteps " + std::to_string(m.primarySteps) + " outside [1, 4096]");
-  if (m.lightSteps < 1 || m.lightSteps > 64)
+  if (m.lightSteps < 1 || (m.lightSteps > 64 && m.sunShadow.method != SunShadow::Column))
     return fail(ErrorCode::InvalidArgument,
                 "render settings: march.lightSteps " + std::to_string(m.lightSteps) + " outside [1, 64]");
   if (!(m.minTransmittance >= 0 && m.minTransmittance < 1))
@@ -133,6 +133,21 @@ Result<void> validateSettings(const RenderSettings& s) {
                                                 "x" + std::to_string(m.airTable.zeniths) + "x" +
                                                 std::to_string(m.airTable.slices) +
                                                 " outside azimuths [8, 256] x zeniths [8, 256] (even) x slices [4, 64]");
+  const SunMapSettings& sun = m.sunShadow;
+  if (std::uint32_t(sun.method) > std::uint32_t(SunShadow::Deep))
+    return fail(ErrorCode::InvalidArgument,
+                "render settings: march.sunShadow.method " + std::to_string(std::uint32_t(sun.method)) + " outside [0, 5]");
+  if (sun.method == SunShadow::Column && m.lightSteps > 1024)
+    return fail(ErrorCode::InvalidArgument, "render settings: march.lightSteps " + std::to_string(m.lightSteps) +
+                                                " outside [1, 1024] for the column march");
+  if (sun.size < 16 || sun.size > 1024 || sun.size % 8 != 0 || sun.cascades < 1 || sun.cascades > 4 ||
+      !(sun.extent_m >= 500 && sun.extent_m <= 500000) || sun.buildSteps < 1 || sun.buildSteps > 256)
+    return fail(ErrorCode::InvalidArgument,
+                "render settings: march.sunShadow size " + std::to_string(sun.size) + ", cascades " +
+                    std::to_string(sun.cascades) + ", extent_m " + num(sun.extent_m) + ", buildSteps " +
+                    std::to_string(sun.buildSteps) +
+                    " outside size [16, 1024] (a multiple of 8), cascades [1, 4], extent_m [500, 500000], "
+                    "buildSteps [1, 256]");
   if (!(m.stepGrowth >= 0 && m.stepGrowth <= 1))
     return fail(ErrorCode::InvalidArgument,
                 "render settings: march.stepGrowth " + num(m.stepGrowth) + " outside [0, 1]");
@@ -401,6 +416,52 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
   return s;
 }
 
+SunMapGeometry sunMapGeometry(const FrameSetup& s) {
+  SunMapGeometry g;
+  // Any axis across the sun: from the local up, or east with the sun overhead.
+  const glm::dvec3 across = std::abs(s.sunDir.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0);
+  g.axisU = glm::normalize(glm::cross(across, s.sunDir));
+  g.axisV = glm::cross(s.sunDir, g.axisU);
+  bool any = false;
+  for (const LayerSetup& l : s.layers) {
+    if (l.absent) continue;
+    const double top = s.hGround_m - l.hTop_m, base = s.hGround_m - l.hBase_m;
+    g.top_m = any ? std::max(g.top_m, top) : top;
+    g.base_m = any ? std::min(g.base_m, base) : base;
+    any = true;
+  }
+  return g;
+}
+
+const char* sunShadowName(SunShadow method) {
+  switch (method) {
+    case SunShadow::March: return "march";
+    case SunShadow::Column: return "column";
+    case SunShadow::Esm: return "esm";
+    case SunShadow::Bsm: return "bsm";
+    case SunShadow::Fom: return "fom";
+    case SunShadow::Deep: return "deep";
+  }
+  return "?";
+}
+
+std::uint32_t sunMapParts(SunShadow method) {
+  return method == SunShadow::Fom || method == SunShadow::Deep ? 2 : (method >= SunShadow::Esm ? 1 : 0);
+}
+
+std::uint64_t sunMapBytes(const SunMapSettings& map) {
+  return std::uint64_t(map.size) * map.size * map.cascades * sunMapParts(map.method) * 16;
+}
+
+std::uint64_t sunMapUsedBytes(const SunMapSettings& map) {
+  const std::uint64_t perTexel = map.method == SunShadow::Esm   ? 4
+                                 : map.method == SunShadow::Bsm ? 12
+                                 : map.method == SunShadow::Fom ? 28
+                                 : map.method == SunShadow::Deep ? 32
+                                                                 : 0;
+  return std::uint64_t(map.size) * map.size * map.cascades * perTexel;
+}
+
 gpu::SkyFrame packFrame(const FrameSetup& s) {
   SKY_ASSERT(s.layers.size() <= gpu::kMaxLayers);
   gpu::SkyFrame f{};
@@ -442,6 +503,12 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   f.pixelJitter = gpu::vec4(float(s.pixelShift.x), float(s.pixelShift.y), s.pixelJitter ? 1.0f : 0.0f, 0.0f);
   const AirTableSettings& table = s.march.airTable;
   f.airTable = table.enabled ? gpu::uvec4(table.azimuths, table.zeniths, table.slices, 0u) : gpu::uvec4(0u);
+  const SunMapSettings& sun = s.march.sunShadow;
+  const SunMapGeometry g = sunMapGeometry(s);
+  f.sunMap = gpu::uvec4(std::uint32_t(sun.method), sun.size, sun.cascades, sun.buildSteps);
+  f.sunMapU = v4(g.axisU, sun.extent_m);
+  f.sunMapV = v4(g.axisV);
+  f.sunMapShells = gpu::vec4(float(g.top_m), float(g.base_m), 0.0f, 0.0f);
 
   for (std::size_t i = 0; i < s.layers.size(); ++i) {
     const LayerSetup& l = s.layers[i];

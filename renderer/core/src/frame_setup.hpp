@@ -143,6 +143,18 @@ Result<void> validateInputs(const FrameInputs& inputs);
 FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& inputs, const WeatherField& field,
                         const AtmosphereTables& tables);
 
+// The sun-space map's frame (sun_map.glsl, SunMap): two unit axes across the
+// sun in the camera's local frame, and the heights above the ground sphere
+// of the highest drawn layer's top and the lowest one's base (0, 0 with no
+// layer drawn: the map's lines then miss every shell).
+struct SunMapGeometry {
+  glm::dvec3 axisU{1, 0, 0};
+  glm::dvec3 axisV{0, 1, 0};
+  double top_m = 0;
+  double base_m = 0;
+};
+SunMapGeometry sunMapGeometry(const FrameSetup& setup);
+
 // The uniform block, including the workgroup permutation for this image size.
 gpu::SkyFrame packFrame(const FrameSetup& setup);
 

@@ -80,6 +80,12 @@ GpuImage createStorageVolume(const GpuContext& ctx, vk::Format format, vk::Exten
                      vk::ImageUsageFlagBits::eStorage | vk::ImageUsageFlagBits::eSampled, debugName);
 }
 
+GpuImage createStorageArray(const GpuContext& ctx, vk::Format format, std::uint32_t width, std::uint32_t height,
+                            std::uint32_t layers, const char* debugName) {
+  return createImage(ctx, vk::ImageType::e2D, vk::ImageViewType::e2DArray, format, vk::Extent3D(width, height, 1),
+                     layers, vk::ImageUsageFlagBits::eStorage | vk::ImageUsageFlagBits::eSampled, debugName);
+}
+
 namespace {
 
 // Copies texels (staged whole) into the image by `copies`, timed as `pass`,

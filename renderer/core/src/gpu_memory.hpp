@@ -57,6 +57,11 @@ GpuImage createStorageImage(const GpuContext& ctx, vk::Format format, std::uint3
 // samples, both in eGeneral; in eUndefined until the writer moves it.
 GpuImage createStorageVolume(const GpuContext& ctx, vk::Format format, vk::Extent3D extent, const char* debugName);
 
+// A device-local 2D array image that a pass writes (storage) and a later
+// pass samples, both in eGeneral; in eUndefined until the writer moves it.
+GpuImage createStorageArray(const GpuContext& ctx, vk::Format format, std::uint32_t width, std::uint32_t height,
+                            std::uint32_t layers, const char* debugName);
+
 class GpuTimer;
 
 // Copies texels (tightly packed, all layers) into the whole image and leaves it

@@ -10,6 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "air_table_texels.hpp"
+#include "sun_map_texels.hpp"
 #include "sky_shared.h"
 
 namespace sky::test {
@@ -43,7 +44,9 @@ class Core {
 
 #define SKY_CORE_CONST static constexpr
 #define SKY_AIR_TABLE_BUILDER
+#define SKY_SUN_MAP_BUILDER
 #include "cloud_core.glsl"
+#undef SKY_SUN_MAP_BUILDER
 #undef SKY_AIR_TABLE_BUILDER
 #undef SKY_CORE_CONST
 
@@ -51,6 +54,16 @@ class Core {
   // The air table a test built (buildAirTable), read by shadePixel when the
   // frame asks for it.
   sky::render::AirTableTexels airTexels;
+
+  // sun_map.glsl's global: the secondary march unless a test sets a map.
+  SunMap gSunMap{kSunMarch, 16, 1, 16, 4000.0, real3(1, 0, 0), real3(0, 1, 0), 0.0, 0.0};
+  sky::render::SunMapTexels sunTexels;
+
+  // Builds the sun map gSunMap describes for frame f's layers.
+  void buildSunMap(const CoreFrame& f) {
+    sunTexels = sky::render::SunMapTexels(gSunMap.size, gSunMap.cascades, sunMapParts(gSunMap.method));
+    sunTexels.build([&](int cascade, int i, int j) { buildSunMapTexel(f.air, gSunMap, f.layerCount, cascade, i, j); });
+  }
 
   void buildAirTable(const CoreFrame& f) {
     airTexels = sky::render::AirTableTexels(f.airTable.azimuths, f.airTable.zeniths, f.airTable.slices);
@@ -83,8 +96,10 @@ inline Core::real Core::sampleDetail(LayerSampling, real3) {
   return detail;
 }
 inline Core::real2 Core::airCloudShadow(AirFrame a, real3 p, real h, real muSun) {
-  return cloudShadow(a, a.shadowLayers, -1, p, h, muSun);
+  return airSunShadow(a, p, h, muSun);
 }
+inline void Core::storeSunMap(real4 part0, real4 part1) { sunTexels.store(part0, part1); }
+inline Core::real4 Core::sampleSunMap(int layer, real2 uv) { return sunTexels.sample(layer, uv); }
 inline void Core::storeAirTable(int slice, real4 part0, real4 part1, real4 part2) {
   airTexels.store(slice, part0, part1, part2);
 }

@@ -35,12 +35,48 @@ struct AirTableSettings {
   std::uint32_t slices = 32;    // [4, 64] (at most 192 MiB)
 };
 
+// How a cloud sample finds the sun's optical depth above it
+// (shaders/include/sun_map.glsl). March: Haggstrom's secondary march over
+// the layer's light distance, lightSteps samples of the shape noise (the
+// other layers' shadow from cloudShadow). Column: every layer's whole
+// column above the sample marched, lightSteps samples per layer crossed,
+// with the detail noise, and above the air and the ground with
+// SunMapSettings::buildSteps (with many steps the ground truth of the maps).
+// The maps, built once per frame in sun space over cascades around the
+// camera and read by the clouds, the ground and the air (light shafts):
+// Esm, Bsm, Fom (Wang's three) and Deep (the optical depth at 8 knots).
+enum class SunShadow : std::uint32_t { March = 0, Column = 1, Esm = 2, Bsm = 3, Fom = 4, Deep = 5 };
+
+// The sun-space map of SunShadow's map methods: `cascades` square grids of
+// size x size texels, cascade 0 covering extent_m either side of the
+// camera and each next one 4x that; each texel marches its sun line with
+// buildSteps samples per layer crossed. Memory: size^2 x cascades x parts x
+// 16 bytes (RGBA32F; parts: 1 for ESM and BSM, 2 for FOM and deep), of
+// which ESM uses 4 bytes a texel, BSM 12, FOM 28, deep 32.
+struct SunMapSettings {
+  SunShadow method = SunShadow::March;
+  std::uint32_t size = 128;       // [16, 1024], a multiple of 8
+  std::uint32_t cascades = 4;     // [1, 4]
+  double extent_m = 4000;         // [500, 500000]
+  std::uint32_t buildSteps = 16;  // [1, 256]
+};
+
+// The name of a sun shadow method ("march", "column", "esm", "bsm", "fom", "deep").
+const char* sunShadowName(SunShadow method);
+// RGBA32F parts a cascade of the method's map takes (0: no map).
+std::uint32_t sunMapParts(SunShadow method);
+// The bytes the map's image takes (0 without a map), and the bytes of it
+// the method's values fill (ESM 4, BSM 12, FOM 28, deep 32 a texel).
+std::uint64_t sunMapBytes(const SunMapSettings& map);
+std::uint64_t sunMapUsedBytes(const SunMapSettings& map);
+
 // The cloud march's cost knobs (shaders/include/cloud_core.glsl), carried
 // in the frame block as run-time numbers. The defaults are the `high`
 // preset (presets.hpp), the march as it was before presets.
 struct MarchSettings {
   std::uint32_t primarySteps = 48;  // samples per layer span, evenly spaced, [1, 4096]
-  std::uint32_t lightSteps = 4;     // samples towards the sun per lit sample, [1, 64]
+  std::uint32_t lightSteps = 4;     // samples towards the sun per lit sample, [1, 64]; [1, 1024] for
+                                    // the column march (sunShadow.method Column)
   double minTransmittance = 0.01;   // stop the view ray once it keeps less, [0, 1); 0: never
   // Samples advanced after one that met no cloud: long strides through empty
   // air, single ones inside cloud. 1 marches every sample. [1, 16].
@@ -69,6 +105,7 @@ struct MarchSettings {
   // air table); 0: its default, 16. [0, 64].
   std::uint32_t airSteps = 0;
   AirTableSettings airTable;
+  SunMapSettings sunShadow;
   // The clouds' shadow at the weather map's scale (cloud_core.glsl,
   // cloudShadow) in the clear-air march's sunlight (the shade under an
   // overcast, light shafts between regions of cloud) and on the clouds of

@@ -1,0 +1,27 @@
+// Sun-map pass: one invocation per texel of each cascade of the frame's sun
+// map (include/sun_map.glsl) marches the texel's sun line through every
+// layer and stores the method's encoding of it; the air-table and cloud
+// passes that follow read it. Frame layout and bindings:
+// include/sky_shared.h (the cloud pass's set).
+#version 450
+#extension GL_GOOGLE_include_directive : require
+
+#include "sky_shared.h"
+
+layout(local_size_x = kLocalSize, local_size_y = kLocalSize) in;
+
+#define SKY_SUN_MAP_BUILDER
+#include "cloud_pass.glsl"
+
+void storeSunMap(vec4 part0, vec4 part1) {
+  ivec3 at = ivec3(gl_GlobalInvocationID.xy, int(gl_GlobalInvocationID.z) * sunMapParts(kSunMethod));
+  imageStore(sunMapOut, at, part0);
+  if (sunMapParts(kSunMethod) > 1) imageStore(sunMapOut, at + ivec3(0, 0, 1), part1);
+}
+
+void main() {
+  ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+  if (texel.x >= int(frame.sunMap.y) || texel.y >= int(frame.sunMap.y)) return;
+  loadFrameGlobals();
+  buildSunMapTexel(frameAir(), gSunMap, frameLayerCount(), int(gl_GlobalInvocationID.z), texel.x, texel.y);
+}
