@@ -100,7 +100,8 @@ std::string reportJson(const BenchReport& report) {
                         {"gpu_ms", number(f.gpu_ms)},
                         {"cpu_ms", f.cpu_ms},
                         {"max_thread_ms", f.maxThread_ms},
-                        {"lookups", f.lookups ? json(*f.lookups) : json(nullptr)}});
+                        {"lookups", f.lookups ? json(*f.lookups) : json(nullptr)},
+                        {"passes_ms", f.passes_ms}});
     json temporal = nullptr;
     if (c.temporal) {
       json ghosting = json::array();
@@ -122,6 +123,7 @@ std::string reportJson(const BenchReport& report) {
                      {"create_ms", c.create_ms},
                      {"wall_ms", spreadJson(c.wall_ms)},
                      {"gpu_ms", c.gpu_ms ? spreadJson(*c.gpu_ms) : json(nullptr)},
+                     {"pass_median_ms", c.passMedian_ms},
                      {"cpu_ms", spreadJson(c.cpu_ms)},
                      {"max_thread_ms", spreadJson(c.maxThread_ms)},
                      {"cores", number(c.wall_ms.median > 0 ? c.cpu_ms.median / c.wall_ms.median : NAN)},

@@ -49,6 +49,7 @@ Result<Rendered> timedRender(render::CloudRenderer& renderer, const render::Fram
   const RendererCounters counters = rendererCounters(renderer, out.image);
   out.timing.gpu_ms = counters.gpuCloud_ms;
   out.timing.lookups = counters.densityLookups;
+  out.timing.passes_ms = counters.passes_ms;
   return out;
 }
 
@@ -192,6 +193,10 @@ Result<CaseResult> runCase(const LoadedScene& ls, const Configuration& config, c
   cr.cpu_ms = spreadOf(cpu);
   cr.maxThread_ms = spreadOf(busiest);
   if (gpu.size() == cr.frames.size()) cr.gpu_ms = spreadOf(gpu);
+  std::map<std::string, std::vector<double>> passes;
+  for (const FrameTiming& t : cr.frames)
+    for (const auto& [pass, ms] : t.passes_ms) passes[pass].push_back(ms);
+  for (const auto& [pass, times] : passes) cr.passMedian_ms[pass] = spreadOf(times).median;
   if (cr.gpu_ms && allLookups && gpuTotal_ms > 0) cr.lookupsPerSecond = lookups / (gpuTotal_ms * 1e-3);
   if (isReference) reference.medianWall_ms = cr.wall_ms.median;
   return cr;

@@ -193,14 +193,24 @@ Result<void> GpuContext::submitAndWait(const vk::raii::CommandBuffer& commands, 
   const vk::CommandBuffer raw = *commands;
   queue_.submit(vk::SubmitInfo({}, {}, raw), *fence);
   const vk::Result waited = device_.waitForFences(*fence, VK_TRUE, kFenceTimeout_ns);
-  if (waited == vk::Result::eTimeout) return fail(ErrorCode::Timeout, "GPU frame did not finish within 60 s");
+  if (waited == vk::Result::eTimeout) {
+    // The work is still running and owns the command buffer and the
+    // resources it reads: the caller may free them once it has the error
+    // (a frame slower than 60 s freed them under lavapipe's running threads
+    // and crashed the bench). lavapipe finishes what it started.
+    device_.waitIdle();
+    return fail(ErrorCode::Timeout, "GPU frame did not finish within 60 s");
+  }
   if (waited != vk::Result::eSuccess) return fail(ErrorCode::Device, "waitForFences: " + vk::to_string(waited));
   return {};
 }
 
 Result<void> GpuContext::wait(const vk::raii::Fence& fence) const {
   const vk::Result waited = device_.waitForFences(*fence, VK_TRUE, kFenceTimeout_ns);
-  if (waited == vk::Result::eTimeout) return fail(ErrorCode::Timeout, "GPU work did not finish within 60 s");
+  if (waited == vk::Result::eTimeout) {
+    device_.waitIdle();  // as in submitAndWait
+    return fail(ErrorCode::Timeout, "GPU work did not finish within 60 s");
+  }
   if (waited != vk::Result::eSuccess) return fail(ErrorCode::Device, "waitForFences: " + vk::to_string(waited));
   return {};
 }

@@ -5,7 +5,9 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
+#include <string>
 
 #include "sky/render/cloud_renderer.hpp"
 
@@ -15,6 +17,8 @@ struct RendererCounters {
   // GPU time of the cloud passes of the last frame, ms (timestamps written
   // around the passes: lavapipe.md, "Timestamps").
   std::optional<double> gpuCloud_ms;
+  // The same per pass ("sun-map", "air-table", "clouds", "reproject", "upscale").
+  std::map<std::string, double> passes_ms;
   // Density lookups (3D noise texture fetches) of the last frame's cloud pass.
   std::optional<std::uint64_t> densityLookups;
 };

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -26,6 +27,7 @@ struct FrameTiming {
   double cpu_ms = 0;              // process CPU time during the frame
   double maxThread_ms = 0;        // the busiest thread's CPU time during the frame
   std::optional<std::uint64_t> lookups;  // density lookups of the frame, when the renderer counts them
+  std::map<std::string, double> passes_ms;  // GPU time per pass (renderer_probe.hpp), when it reports them
 };
 
 // Error of a configuration's frame(s) against reference at the same output size.
@@ -44,6 +46,7 @@ struct CaseResult {
   std::vector<FrameTiming> frames;                  // every timed frame (repeats x path frames)
   Spread wall_ms, cpu_ms, maxThread_ms;
   std::optional<Spread> gpu_ms;
+  std::map<std::string, double> passMedian_ms;  // each pass's median GPU time over the frames
   std::optional<double> lookupsPerSecond;  // lookups / GPU time, when both exist
   ErrorSummary error;  // a still: its image; a path: the mean over its frames
   ErrorSummary worst;  // a path: the worst frame (largest RMSE, lowest PSNR, lowest SSIM); a still: = error
