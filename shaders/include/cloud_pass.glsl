@@ -186,7 +186,8 @@ void loadFrameGlobals() {
   gMapScale = frame.weatherMap.x;
   gRings = frame.weatherRings;
   gSunMap = SunMap(kSunMethod, int(frame.sunMap.y), int(frame.sunMap.z), int(frame.sunMap.w), frame.sunMapU.w,
-                   frame.sunMapU.xyz, frame.sunMapV.xyz, frame.sunMapShells.x, frame.sunMapShells.y);
+                   frame.sunMapU.xyz, frame.sunMapV.xyz, frame.sunMapShells.x, frame.sunMapShells.y,
+                   frame.sunMapOrigin.xyz);
 }
 
 AirFrame frameAir() {

@@ -121,9 +121,11 @@ struct SkyFrame {
   uvec4 sunMap;         // the sun's shadow (sun_map.glsl, SunMap): x method (SunShadow; >= 2 a map and its
                         // pass), y texels per cascade edge, z cascades, w samples per layer along a texel's line
   vec4 sunMapU;         // xyz: the map's first axis, local frame; w: cascade 0's half extent (m)
-  vec4 sunMapV;         // xyz: its second axis; w: unused
+  vec4 sunMapV;         // xyz: its second axis; w: 1 when this frame builds the map, 0 when it reads the
+                        // map an earlier frame built (renderer/core/src/sun_map_plan.hpp)
   vec4 sunMapShells;    // x: the highest drawn layer's top, y: the lowest one's base, m above the ground
                         // sphere; zw: unused
+  vec4 sunMapOrigin;    // xyz: the map's centre, local frame (m; 0 when built this frame); w: unused
 };
 
 #ifdef __cplusplus
@@ -149,7 +151,7 @@ static_assert(offsetof(SkyFrame, raster) == 272 + 256 * kMaxLayers + 48);
 static_assert(offsetof(SkyFrame, frustum) == 272 + 256 * kMaxLayers + 80);
 static_assert(offsetof(SkyFrame, airTable) == 272 + 256 * kMaxLayers + 96);
 static_assert(offsetof(SkyFrame, sunMap) == 272 + 256 * kMaxLayers + 112);
-static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 176);
+static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 192);
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

@@ -12,7 +12,8 @@
 //
 // Geometry. The sun's rays are parallel, so every point p lies on one sun
 // line, p + s z (s towards the sun); the map is a grid over the plane
-// through the camera perpendicular to s, (u, v) = (p.U, p.V), cascade c
+// through the map's centre perpendicular to s, (u, v) = ((p - origin).U,
+// (p - origin).V), cascade c
 // covering |u|, |v| < extent 4^c with `size` texels a side. Along its line a
 // texel stores the clouds' extinction between where the line enters the
 // highest layer's top shell and where it leaves through the lowest layer's
@@ -67,6 +68,7 @@ struct SunMap {
   real3 axisV;     // unit, perpendicular to the sun and axisU
   real topHeight;  // m above the ground sphere: the highest drawn layer's top
   real baseHeight; // m: the lowest drawn layer's base
+  real3 origin;    // the map's centre, camera-local: the camera where it was built (sun_map_plan.hpp)
 };
 
 real4 sampleSunMap(int layer, real2 uv);
@@ -238,7 +240,7 @@ struct SunMapPlace {
 };
 
 SunMapPlace sunMapPlace(SunMap m, real3 p) {
-  real2 plane = real2(dot(p, m.axisU), dot(p, m.axisV));
+  real2 plane = real2(dot(p - m.origin, m.axisU), dot(p - m.origin, m.axisV));
   real reach = max(abs(plane.x), abs(plane.y));
   real extent = m.extent;
   int cascade = 0;
@@ -284,7 +286,7 @@ void storeSunMap(real4 part0, real4 part1);
 void buildSunMapTexel(AirFrame a, SunMap m, int layers, int cascade, int i, int j) {
   real extent = m.extent * pow(kSunCascadeRatio, real(cascade));
   real2 plane = ((real2(real(i), real(j)) + 0.5) / real(m.size) - 0.5) * (2.0 * extent);
-  real3 o = m.axisU * plane.x + m.axisV * plane.y;
+  real3 o = m.origin + m.axisU * plane.x + m.axisV * plane.y;
   real hO = heightAboveCameraSphere(o, a.r) + a.h;
   real muO = dot(upAt(o, a.r), a.sunDir);
   SunLine line = sunLineAt(hO, muO, a.r - a.h, m.topHeight, m.baseHeight);

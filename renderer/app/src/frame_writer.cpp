@@ -180,6 +180,8 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
     line["temporal"] = {{"drawn_whole", t.drawnWhole}, {"reason", t.reason},     {"drawn", t.drawn},
                         {"reused", t.reused},          {"offscreen", t.offscreen}, {"disoccluded", t.disoccluded}};
   }
+  if (render::sunMapParts(s.march.sunShadow.method) > 0)
+    line["sun_map"] = {{"rebuilt", r.sunMap.rebuilt}, {"reason", r.sunMap.reason}};
   if (outputs_.png) line["file"] = std::string(name) + ".png";
   if (outputs_.exr) line["exr"] = std::string(name) + ".exr";
   metadata_ << line.dump() << '\n';

@@ -27,6 +27,7 @@ Result<render::Image> timedRender(render::CloudRenderer& renderer, const render:
   record.cpu_ms = processCpu_ms() - cpu0;
   record.gpu = renderer.lastPassTimes();
   record.temporal = renderer.lastTemporal();
+  record.sunMap = renderer.lastSunMap();
   record.weatherMap = renderer.lastWeatherMap();
   record.stats = render::computeStats(*image);
   // The same choice as the renderer's frame setup: the ephemeris when the

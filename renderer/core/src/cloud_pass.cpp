@@ -217,9 +217,10 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
     tablePipeline = *built;
   }
   SKY_ASSERT(frame.sunMap.x == std::uint32_t(sunMapSize_.method));
-  // The map, where the frame has layers to shadow with it.
+  // The map, where the frame has layers to shadow with it and asks for it
+  // (or there is none to read yet).
   const ComputePipeline* sunPipeline = nullptr;
-  if (sunMapParts(sunMapSize_.method) > 0 && layersDrawn > 0) {
+  if (sunMapParts(sunMapSize_.method) > 0 && layersDrawn > 0 && (frame.sunMapV.w > 0.5f || !sunMapBuilt_)) {
     SKY_ASSERT(frame.sunMap.y == sunMapSize_.size && frame.sunMap.z == sunMapSize_.cascades);
     auto built = pipelineFor(ctx, Stage::SunMap, layersDrawn);
     if (!built) return tl::unexpected(built.error());
@@ -237,8 +238,13 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
                                   vk::ImageLayout::eUndefined, vk::ImageLayout::eGeneral, VK_QUEUE_FAMILY_IGNORED,
                                   VK_QUEUE_FAMILY_IGNORED, image, range);
   };
-  commands_.pipelineBarrier(vk::PipelineStageFlagBits::eTopOfPipe, vk::PipelineStageFlagBits::eComputeShader, {}, {},
-                            {}, {fresh(*airTable_.image, whole), fresh(*sunMap_.image, allLayers)});
+  // The sun map keeps its contents where a later frame reads them.
+  if (sunPipeline != nullptr || !sunMapBuilt_)
+    commands_.pipelineBarrier(vk::PipelineStageFlagBits::eTopOfPipe, vk::PipelineStageFlagBits::eComputeShader, {},
+                              {}, {}, {fresh(*airTable_.image, whole), fresh(*sunMap_.image, allLayers)});
+  else
+    commands_.pipelineBarrier(vk::PipelineStageFlagBits::eTopOfPipe, vk::PipelineStageFlagBits::eComputeShader, {},
+                              {}, {}, fresh(*airTable_.image, whole));
   if (sunPipeline != nullptr) {
     {
       const auto timed = timer_.section(commands_, "sun-map");
@@ -294,7 +300,11 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
                               toHost, {});
   }
   commands_.end();
-  if (auto ok = ctx.submitAndWait(commands_, fence_); !ok) return tl::unexpected(ok.error());
+  if (auto ok = ctx.submitAndWait(commands_, fence_); !ok) {
+    sunMapBuilt_ = false;
+    return tl::unexpected(ok.error());
+  }
+  sunMapBuilt_ = sunMapBuilt_ || sunPipeline != nullptr;
 
   if (next.upscale != nullptr) return next.upscale->readBack();
   if (next.reproject != nullptr) return next.reproject->readBack();

@@ -20,6 +20,7 @@
 #include "gpu_context.hpp"
 #include "noise_volume.hpp"
 #include "presenter.hpp"
+#include "sun_map_plan.hpp"
 #include "reproject_pass.hpp"
 #include "temporal_plan.hpp"
 #include "upscale_pass.hpp"
@@ -45,6 +46,8 @@ struct CloudRenderer::Impl {
   std::uint64_t coverageMipUploads = ~std::uint64_t(0);  // weather uploads the pass's coverage mip is of
   std::vector<float> coverageMip{};                       // its CPU copy (updated per tile as the map is)
   TemporalReport temporal{};  // what the reprojection did with the last frame
+  SunMapPlanner sunMaps{};
+  SunMapReport sunMap{};      // what became of the sun map in the last frame
 };
 
 namespace {
@@ -183,6 +186,14 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
     }
     FrameSetup setup = prepareFrame(impl_->settings, inputs, impl_->weather.field(), impl_->atmosphere);
     impl_->temporal = {};
+    impl_->sunMap = {};
+    const bool sunMap = sunMapParts(impl_->settings.march.sunShadow.method) > 0;
+    if (sunMap) {
+      const SunMapPlan plan = impl_->sunMaps.plan(setup, inputs.weatherClock_s, impl_->weather.uploads());
+      setup.sunMapReuse = plan.geometry;
+      setup.sunMapRebuild = plan.rebuild;
+      impl_->sunMap = {plan.rebuild, plan.reason};
+    }
     // With interleaving the planner chooses this frame's pixels and the
     // reprojection's block; with a divisor the upscale follows.
     CloudPass::Followers next;
@@ -207,6 +218,7 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
     auto image = impl_->pass.run(*impl_->ctx, frame, next);
     if (!image) {
       if (plan) impl_->planner.forget();
+      if (sunMap) impl_->sunMaps.forget();
       return image;
     }
     for (auto& t : impl_->pass.lastTimes()) impl_->passTimes.push_back(std::move(t));
@@ -236,6 +248,8 @@ Result<bool> CloudRenderer::present(const Image& image) {
 const std::string& CloudRenderer::noiseReport() const { return impl_->noiseReport; }
 
 const std::vector<PassTime>& CloudRenderer::lastPassTimes() const { return impl_->passTimes; }
+
+const SunMapReport& CloudRenderer::lastSunMap() const { return impl_->sunMap; }
 
 const TemporalReport& CloudRenderer::lastTemporal() const { return impl_->temporal; }
 

@@ -504,11 +504,12 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   const AirTableSettings& table = s.march.airTable;
   f.airTable = table.enabled ? gpu::uvec4(table.azimuths, table.zeniths, table.slices, 0u) : gpu::uvec4(0u);
   const SunMapSettings& sun = s.march.sunShadow;
-  const SunMapGeometry g = sunMapGeometry(s);
+  const SunMapGeometry g = s.sunMapReuse ? *s.sunMapReuse : sunMapGeometry(s);
   f.sunMap = gpu::uvec4(std::uint32_t(sun.method), sun.size, sun.cascades, sun.buildSteps);
   f.sunMapU = v4(g.axisU, sun.extent_m);
-  f.sunMapV = v4(g.axisV);
+  f.sunMapV = v4(g.axisV, s.sunMapRebuild ? 1.0 : 0.0);
   f.sunMapShells = gpu::vec4(float(g.top_m), float(g.base_m), 0.0f, 0.0f);
+  f.sunMapOrigin = v4(g.origin);
 
   for (std::size_t i = 0; i < s.layers.size(); ++i) {
     const LayerSetup& l = s.layers[i];

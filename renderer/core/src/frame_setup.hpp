@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <glm/mat3x3.hpp>
@@ -53,6 +54,18 @@ struct LayerSetup {
   bool absent = false;
 };
 
+// The sun-space map's frame (sun_map.glsl, SunMap): two unit axes across the
+// sun in the camera's local frame, and the heights above the ground sphere
+// of the highest drawn layer's top and the lowest one's base (0, 0 with no
+// layer drawn: the map's lines then miss every shell).
+struct SunMapGeometry {
+  glm::dvec3 axisU{1, 0, 0};
+  glm::dvec3 axisV{0, 1, 0};
+  double top_m = 0;
+  double base_m = 0;
+  glm::dvec3 origin{0};  // the map's centre, camera-local (0: built around the camera)
+};
+
 struct FrameSetup {
   // The image the cloud pass draws: the settings' size over the resolution
   // divisor, rounded up. Its pixel (i, j) is centred where the full image's
@@ -97,6 +110,11 @@ struct FrameSetup {
   // their pixels (R2 sequence, each in [0, 1)); applied when pixelJitter.
   glm::dvec2 pixelShift{0};
   bool pixelJitter = false;
+  // The sun map as this frame reads it, when it was built for an earlier
+  // frame (sun_map_plan.hpp); unset: built this frame around the camera
+  // (sunMapGeometry). sunMapRebuild: whether this frame builds it.
+  std::optional<SunMapGeometry> sunMapReuse;
+  bool sunMapRebuild = true;
 };
 
 // Haggstrom 2018's coverage ramp of the step length (sec. 4.2.2, eq. 34):
@@ -143,16 +161,7 @@ Result<void> validateInputs(const FrameInputs& inputs);
 FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& inputs, const WeatherField& field,
                         const AtmosphereTables& tables);
 
-// The sun-space map's frame (sun_map.glsl, SunMap): two unit axes across the
-// sun in the camera's local frame, and the heights above the ground sphere
-// of the highest drawn layer's top and the lowest one's base (0, 0 with no
-// layer drawn: the map's lines then miss every shell).
-struct SunMapGeometry {
-  glm::dvec3 axisU{1, 0, 0};
-  glm::dvec3 axisV{0, 1, 0};
-  double top_m = 0;
-  double base_m = 0;
-};
+// The sun map of frame `setup` built around its camera.
 SunMapGeometry sunMapGeometry(const FrameSetup& setup);
 
 // The uniform block, including the workgroup permutation for this image size.

@@ -36,7 +36,8 @@ struct Slab {
     c.layers[0] = shellLayer(f, kAlt, kBase, kThick, uniformType(kSigma));
     f.layerCount = 1;
     const Core::real3 u = normalize(cross(Core::real3(0, 0, 1), f.air.sunDir));
-    c.gSunMap = Core::SunMap{method, 64, 2, 32, 8000.0, u, cross(f.air.sunDir, u), kBase + kThick, kBase};
+    c.gSunMap = Core::SunMap{method, 64, 2, 32, 8000.0, u, cross(f.air.sunDir, u), kBase + kThick, kBase,
+                             Core::real3(0.0)};
     if (c.sunMapIsMap(method)) c.buildSunMap(f);
   }
   // The depth at p (camera-local) by the frame's method.

@@ -70,6 +70,7 @@ struct FrameRecord {
   double cpu_ms = 0;        // process CPU time during it (all threads: lavapipe's workers too)
   std::vector<render::PassTime> gpu;  // GPU time per pass (timestamps), in submission order
   render::TemporalReport temporal;    // what the reprojection did (interleaved presets)
+  render::SunMapReport sunMap;        // the sun map rebuilt or reused (map methods)
   render::WeatherMapReport weatherMap;  // what this frame changed in the weather map (per tile, or rebuilt and why)
   std::optional<bool> presented;      // windowed: whether the frame reached the window
   // With a frame budget (--frame-budget-ms): the level the frame was drawn

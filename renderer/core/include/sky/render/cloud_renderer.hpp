@@ -268,6 +268,14 @@ struct FrameInputs {
 // pixels were drawn, reused from the history, or upscaled from the drawn
 // ones because their point was outside the previous view or the history
 // there showed something else (disocclusion).
+// What became of the sun map in the last frame (sun_map_plan.hpp): rebuilt
+// (and why) or read as an earlier frame built it; no map: method "march" or
+// "column", rebuilt false.
+struct SunMapReport {
+  bool rebuilt = false;
+  std::string reason;  // "first frame", "weather changed", "sun turned", "clouds drifted", "camera moved", ...
+};
+
 struct TemporalReport {
   bool drawnWhole = false;
   std::string reason;  // why it was drawn whole ("first frame", "teleport 2.1 km", ...); empty otherwise
@@ -333,6 +341,8 @@ class CloudRenderer {
   // The passes the GPU ran for the last render() (and a present() after it),
   // in submission order; empty when the device's queue has no timestamps.
   const std::vector<PassTime>& lastPassTimes() const;
+  // The sun map of the last frame: rebuilt or reused.
+  const SunMapReport& lastSunMap() const;
   // What the reprojection did with the last render().
   const TemporalReport& lastTemporal() const;
   // What the weather map's update did for the last render().
