@@ -109,6 +109,16 @@ TEST(Presets, BadMarchSettingsAreRefused) {
   r = render::CloudRenderer::create(settings);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().detail.find("lightSteps"), std::string::npos) << r.error().detail;
+  // On lavapipe, a column march past its loop budget (256 x 1000 nested
+  // steps; 256 x 64 is within it).
+  settings.march.primarySteps = 256;
+  settings.march.lightSteps = 1000;
+  r = render::CloudRenderer::create(settings);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().detail.find("65535"), std::string::npos) << r.error().detail;
+  settings.march.lightSteps = 64;
+  EXPECT_TRUE(render::CloudRenderer::create(settings));
+  settings.march.primarySteps = 48;
   settings.march.sunShadow = {render::SunShadow::March};
   settings.march.lightSteps = 65;
   r = render::CloudRenderer::create(settings);

@@ -3,6 +3,7 @@
 // Result errors here and nowhere else.
 #include "sky/render/cloud_renderer.hpp"
 
+#include <algorithm>
 #include <exception>
 #include <map>
 #include <mutex>
@@ -106,6 +107,27 @@ NoiseVolume cachedNoise(const RenderSettings& settings, const char* kind, std::u
   return volume;
 }
 
+// llvmpipe's shader compiler (lavapipe's) gives an invocation 65535 loop
+// iterations in all, shared by every loop (gallivm's
+// LP_MAX_TGSI_LOOP_ITERATIONS); past them every loop exits and the pixel is
+// wrong (too bright, or black). The column march nests its steps in the
+// primary march's and in the air's: refused where the nesting alone could
+// pass half the budget (two layers crossed), with what to lower.
+Result<void> checkLoopBudget(const MarchSettings& m, const std::string& device) {
+  if (m.sunShadow.method != SunShadow::Column || device.find("llvmpipe") == std::string::npos) return {};
+  constexpr std::uint64_t kHalfBudget = 65535 / 2;
+  const std::uint64_t air = std::max<std::uint64_t>(m.airSteps == 0 ? 16 : m.airSteps,
+                                                    m.airTable.enabled ? m.airTable.slices : 0);
+  if (std::uint64_t(m.primarySteps) * m.lightSteps > kHalfBudget || air * m.sunShadow.buildSteps > kHalfBudget)
+    return fail(ErrorCode::InvalidArgument,
+                "render settings: the column march's primarySteps x lightSteps (" + std::to_string(m.primarySteps) +
+                    " x " + std::to_string(m.lightSteps) + ") or air steps x sunShadow.buildSteps (" +
+                    std::to_string(air) + " x " + std::to_string(m.sunShadow.buildSteps) + ") is over " +
+                    std::to_string(kHalfBudget) + ": " + device +
+                    " stops a shader's loops after 65535 iterations in all, and the pixels would be wrong");
+  return {};
+}
+
 }  // namespace
 
 CloudRenderer::CloudRenderer(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -118,6 +140,7 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
   return atVulkanEdge("CloudRenderer::create", [&]() -> Result<std::unique_ptr<CloudRenderer>> {
     auto ctx = GpuContext::create(gpu);
     if (!ctx) return tl::unexpected(ctx.error());
+    if (auto ok = checkLoopBudget(settings.march, (*ctx)->deviceName()); !ok) return tl::unexpected(ok.error());
     auto weather = WeatherTexture::create(**ctx);
     if (!weather) return tl::unexpected(weather.error());
     std::string noiseReport;
@@ -273,6 +296,7 @@ Result<void> CloudRenderer::setMarch(const MarchSettings& march) {
   if (was.enabled != now.enabled ||
       (now.enabled && (was.azimuths != now.azimuths || was.zeniths != now.zeniths || was.slices != now.slices)))
     return fail(ErrorCode::InvalidArgument, "CloudRenderer::setMarch: the air table is fixed when the renderer is built");
+  if (auto ok = checkLoopBudget(march, impl_->ctx->deviceName()); !ok) return ok;
   const SunMapSettings &sunWas = impl_->settings.march.sunShadow, &sunNow = march.sunShadow;
   if (sunWas.method != sunNow.method || sunWas.size != sunNow.size || sunWas.cascades != sunNow.cascades)
     return fail(ErrorCode::InvalidArgument,
