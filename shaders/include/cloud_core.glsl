@@ -362,6 +362,13 @@ CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
   return cs;
 }
 
+// The direct sun's mean transmittance over a broken field: a fraction c of
+// the rays meets a column of optical depth tau (at sun cosine mu), the rest
+// passes clear.
+real brokenFieldTransmittance(real c, real tau, real mu) {
+  return 1.0 - c * (1.0 - exp(-tau / mu));
+}
+
 // Transmission of sunlight and sky light down through the first `count`
 // layers to the point p (camera-relative, height hp above the ground
 // sphere): each layer above p (the part above p where p is inside it) by
@@ -399,7 +406,7 @@ real2 cloudShadow(AirFrame a, int count, int skip, real3 p, real hp, real muSun)
     CloudType t = L.blends ? mixCloudType(L.primary, L.secondary, weather.z) : L.primary;
     real tau = t.extinction_perm * weather.y * t.columnFill * (top - lo);
     real c = clamp(weather.x, 0.0, 1.0);
-    direct *= 1.0 - c * (1.0 - exp(-tau / mu));
+    direct *= brokenFieldTransmittance(c, tau, mu);
     diffuse *= 1.0 - c * (1.0 - 1.0 / (1.0 + 0.75 * (1.0 - kDiffuseAsymmetry) * tau));
   }
   return real2(direct, diffuse);
@@ -413,8 +420,7 @@ real2 cloudShadow(AirFrame a, int count, int skip, real3 p, real hp, real muSun)
 // marched with the map's buildSteps per layer (the ground truth's).
 real2 airSunShadow(AirFrame a, real3 p, real h, real muSun) {
   real2 shade = cloudShadow(a, a.shadowLayers, -1, p, h, muSun);
-  real tau = sunMapIsMap(gSunMap.method) ? sunMapDepth(a, gSunMap, p, muSun) : -1.0;
-  if (gSunMap.method == kSunColumn) tau = sunColumnDepth(a, gSunMap, p, muSun, gSunMap.buildSteps, a.shadowLayers);
+  real tau = sunDepthAbove(a, p, muSun, gSunMap.buildSteps, a.shadowLayers);
   shade.x = tau >= 0.0 ? exp(-tau) : shade.x;
   return shade;
 }
@@ -499,18 +505,17 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
     // The sun's optical depth: the layer's own light march, or (a map, the
     // column) every layer's; on the GPU the method is a pipeline constant,
     // so the ways not taken are compiled out.
-    int sunMethod = gSunMap.method;
+    bool march = gSunMap.method == kSunMarch;
     real tauSun = lightOpticalDepth(f.air.sunDir, muHere, L.thickness, L.lightDistance, L.sampling, ct, p, ph,
                                     cs.coverage, cs.peakNoise, cs.densityScale, f.march.lightSteps,
-                                    sunMethod == kSunMarch && cs.rho > 0.0 ? f.march.lightSteps : 0);
-    if (sunMethod == kSunColumn) tauSun = sunColumnDepth(f.air, gSunMap, p, muHere, f.march.lightSteps, f.layerCount);
+                                    march && cs.rho > 0.0 ? f.march.lightSteps : 0);
+    real above = sunDepthAbove(f.air, p, muHere, f.march.lightSteps, f.layerCount);
     // Past the map's last cascade, the layer's own shadow at the weather
     // map's scale (diffuseLight's column above p, as cloudShadow takes a
     // layer's), and the other layers' from cloudShadow.
-    real mapTau = sunMapIsMap(sunMethod) ? sunMapDepth(f.air, gSunMap, p, muHere) : 0.0;
     real ownAbove = ct.extinction_perm * cs.densityScale * ct.columnFill * (1.0 - ph) * L.thickness;
-    real ownFar = -log(max(1.0 - cs.coverage * (1.0 - exp(-ownAbove / max(muHere, kMinSunCosine))), 1e-6));
-    if (sunMapIsMap(sunMethod)) tauSun = mapTau >= 0.0 ? mapTau : ownFar;
+    real ownFar = -log(max(brokenFieldTransmittance(cs.coverage, ownAbove, max(muHere, kMinSunCosine)), 1e-6));
+    if (!march) tauSun = above >= 0.0 ? above : ownFar;
     // Sunlight at p through the clear air above it (reddened at low sun,
     // none in the Earth's shadow) and the other layers' clouds above it
     // (cirrus over cumulus, a deck over a layer), and the sky's light from
@@ -518,7 +523,7 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
     real3 sun = mix(mix(sunBaseStart, sunTopStart, ph), mix(sunBaseEnd, sunTopEnd, ph), u);
     real2 shade = cloudShadow(f.air, f.layerShadows, li, p, f.air.h + h, muHere);
     // The map and the column hold the other layers' shadow in tauSun.
-    shade.x = sunMethod == kSunMarch || mapTau < 0.0 ? shade.x : 1.0;
+    shade.x = above >= 0.0 ? 1.0 : shade.x;
     real3 scattered = sun * (shade.x * octaveSum(mix(phases1, phases2, cs.blend), tauSun)) +
                       diffuseLight(L, ct, ph, cs.coverage, cs.densityScale) * shade.y;
     // Hillaire 2016 energy-conserving step: integral over the step of
@@ -543,10 +548,8 @@ real3 groundRadiance(CoreFrame f, real3 dir, real t) {
   real muSun = dot(upAt(p, f.air.r), f.air.sunDir);
   real3 sun = f.air.sunIrradiance * sunTransmittance(0.0, muSun, f.air.r - f.air.h) * max(muSun, 0.0);
   real2 shadow = cloudShadow(f.air, f.layerCount, -1, p, 0.0, muSun);
-  int sunMethod = gSunMap.method;
-  if (sunMethod == kSunColumn) shadow.x = exp(-sunColumnDepth(f.air, gSunMap, p, muSun, gSunMap.buildSteps, f.layerCount));
-  real mapTau = sunMapIsMap(sunMethod) ? sunMapDepth(f.air, gSunMap, p, muSun) : -1.0;
-  shadow.x = mapTau >= 0.0 ? exp(-mapTau) : shadow.x;
+  real tau = sunDepthAbove(f.air, p, muSun, gSunMap.buildSteps, f.layerCount);
+  shadow.x = tau >= 0.0 ? exp(-tau) : shadow.x;
   real3 light = sun * (shadow.x + (1.0 - shadow.x) * shadow.y) + f.groundIrradiance * shadow.y;
   return light * (kGroundAlbedo / kPi);
 }

@@ -133,15 +133,24 @@ struct SunColumn {
 };
 
 // The column with one sample of optical depth dtau at x added, the sample
-// standing for x +- halfStep (no in/out parameters: the file is C++ too).
-SunColumn sunColumnAdd(SunColumn c, real x, real halfStep, real dtau) {
+// standing for x +- halfStep, and the sums `method` stores (no in/out
+// parameters: the file is C++ too; on the GPU the method is a pipeline
+// constant, so the others' sums are compiled out).
+SunColumn sunColumnAdd(SunColumn c, int method, real x, real halfStep, real dtau) {
   if (dtau <= 0.0) return c;
   c.tau += dtau;
   c.front = min(c.front, max(x - halfStep, 0.0));
   c.back = max(c.back, min(x + halfStep, 1.0));
-  real w = 2.0 * kPi * x;
-  c.part0 += 2.0 * dtau * real4(1.0, cos(w), cos(2.0 * w), cos(3.0 * w));
-  c.part1 += 2.0 * dtau * real4(sin(w), sin(2.0 * w), sin(3.0 * w), 0.0);
+  if (method == kSunFom) {
+    real w = 2.0 * kPi * x;
+    c.part0 += 2.0 * dtau * real4(1.0, cos(w), cos(2.0 * w), cos(3.0 * w));
+    c.part1 += 2.0 * dtau * real4(sin(w), sin(2.0 * w), sin(3.0 * w), 0.0);
+  }
+  if (method == kSunDeep) {
+    // The sample adds to every knot past it.
+    c.part0 += dtau * real4(x < 0.125 ? 1.0 : 0.0, x < 0.25 ? 1.0 : 0.0, x < 0.375 ? 1.0 : 0.0, x < 0.5 ? 1.0 : 0.0);
+    c.part1 += dtau * real4(x < 0.625 ? 1.0 : 0.0, x < 0.75 ? 1.0 : 0.0, x < 0.875 ? 1.0 : 0.0, 1.0);
+  }
   return c;
 }
 
@@ -150,10 +159,9 @@ SunColumn sunColumnAdd(SunColumn c, real x, real halfStep, real dtau) {
 // line), `steps` samples per layer crossed, each layer over its own part of
 // the line, times the part's length over the layer's thickness up to
 // `slantFactor` (1: `steps` at any sun); x of a sample is (entry - z) / D.
-// With `deep` the part sums are the deep map's knots instead of the Fourier
-// sums.
+// The part sums are those `method` stores (sunColumnAdd).
 SunColumn sunColumnMarch(AirFrame a, real3 o, real hO, real muO, SunLine line, real zLow, int steps, int layers,
-                         bool deep, int slantFactor) {
+                         int method, int slantFactor) {
   SunColumn c;
   c.tau = 0.0;
   c.front = 1.0;
@@ -184,15 +192,7 @@ SunColumn sunColumnMarch(AirFrame a, real3 o, real hO, real muO, SunLine line, r
       real ph = (heightAboveCameraSphere(q, a.r) + L.hBase) / L.thickness;
       CloudSample cs = cloudSample(L, q, ph, false);
       real dtau = cs.ct.extinction_perm * cs.rho * dz;
-      real x = (line.entry - z) * invLength;
-      if (deep) {
-        // The sample adds to every knot past it.
-        c.tau += dtau;
-        c.part0 += dtau * real4(x < 0.125 ? 1.0 : 0.0, x < 0.25 ? 1.0 : 0.0, x < 0.375 ? 1.0 : 0.0, x < 0.5 ? 1.0 : 0.0);
-        c.part1 += dtau * real4(x < 0.625 ? 1.0 : 0.0, x < 0.75 ? 1.0 : 0.0, x < 0.875 ? 1.0 : 0.0, 1.0);
-      } else {
-        c = sunColumnAdd(c, x, 0.5 * dz * invLength, dtau);
-      }
+      c = sunColumnAdd(c, method, (line.entry - z) * invLength, 0.5 * dz * invLength, dtau);
     }
   }
   return c;
@@ -283,7 +283,17 @@ real sunMapDepth(AirFrame a, SunMap m, real3 p, real muSun) {
 real sunColumnDepth(AirFrame a, SunMap m, real3 p, real muSun, int steps, int layers) {
   real hp = heightAboveCameraSphere(p, a.r) + a.h;
   SunLine line = sunLineAt(hp, muSun, a.r - a.h, m.topHeight, m.baseHeight);
-  return sunColumnMarch(a, p, hp, muSun, line, 0.0, steps, layers, false, 1).tau;
+  return sunColumnMarch(a, p, hp, muSun, line, 0.0, steps, layers, kSunColumn, 1).tau;
+}
+
+// The optical depth towards the sun at p by the frame's map or column
+// (`columnSteps` per layer, over the first `layers`); -1 where the method
+// has none (the march) or the map does not reach p: the caller's estimate
+// at the weather map's scale stands.
+real sunDepthAbove(AirFrame a, real3 p, real muSun, int columnSteps, int layers) {
+  real tau = sunMapIsMap(gSunMap.method) ? sunMapDepth(a, gSunMap, p, muSun) : -1.0;
+  if (gSunMap.method == kSunColumn) tau = sunColumnDepth(a, gSunMap, p, muSun, columnSteps, layers);
+  return tau;
 }
 
 #ifdef SKY_SUN_MAP_BUILDER
@@ -298,8 +308,8 @@ void buildSunMapTexel(AirFrame a, SunMap m, int layers, int cascade, int i, int 
   real hO = heightAboveCameraSphere(o, a.r) + a.h;
   real muO = dot(upAt(o, a.r), a.sunDir);
   SunLine line = sunLineAt(hO, muO, a.r - a.h, m.topHeight, m.baseHeight);
-  SunColumn c = sunColumnMarch(a, o, hO, muO, line, line.entry - line.span, m.buildSteps, layers,
-                               m.method == kSunDeep, kSunMapSlantFactor);
+  SunColumn c = sunColumnMarch(a, o, hO, muO, line, line.entry - line.span, m.buildSteps, layers, m.method,
+                               kSunMapSlantFactor);
   SunParts e = sunMapEncode(m.method, c);
   storeSunMap(e.part0, e.part1);
 }

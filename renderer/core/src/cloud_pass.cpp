@@ -239,12 +239,10 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
                                   VK_QUEUE_FAMILY_IGNORED, image, range);
   };
   // The sun map keeps its contents where a later frame reads them.
-  if (sunPipeline != nullptr || !sunMapBuilt_)
-    commands_.pipelineBarrier(vk::PipelineStageFlagBits::eTopOfPipe, vk::PipelineStageFlagBits::eComputeShader, {},
-                              {}, {}, {fresh(*airTable_.image, whole), fresh(*sunMap_.image, allLayers)});
-  else
-    commands_.pipelineBarrier(vk::PipelineStageFlagBits::eTopOfPipe, vk::PipelineStageFlagBits::eComputeShader, {},
-                              {}, {}, fresh(*airTable_.image, whole));
+  const std::array freshImages{fresh(*airTable_.image, whole), fresh(*sunMap_.image, allLayers)};
+  const bool sunMapFresh = sunPipeline != nullptr || !sunMapBuilt_;
+  commands_.pipelineBarrier(vk::PipelineStageFlagBits::eTopOfPipe, vk::PipelineStageFlagBits::eComputeShader, {}, {},
+                            {}, vk::ArrayProxy<const vk::ImageMemoryBarrier>(sunMapFresh ? 2u : 1u, freshImages.data()));
   if (sunPipeline != nullptr) {
     {
       const auto timed = timer_.section(commands_, "sun-map");

@@ -110,9 +110,11 @@ struct FrameSetup {
   // their pixels (R2 sequence, each in [0, 1)); applied when pixelJitter.
   glm::dvec2 pixelShift{0};
   bool pixelJitter = false;
-  // The sun map as this frame reads it, when it was built for an earlier
-  // frame (sun_map_plan.hpp); unset: built this frame around the camera
-  // (sunMapGeometry). sunMapRebuild: whether this frame builds it.
+  // The sun map as this frame reads it, around its anchor (the renderer's
+  // plan, sun_map_plan.hpp: this frame's camera when it rebuilds, an
+  // earlier one's when it reuses); unset: around this frame's camera
+  // (sunMapGeometry), as the CPU reference builds it. sunMapRebuild: whether
+  // this frame builds it.
   std::optional<SunMapGeometry> sunMapReuse;
   bool sunMapRebuild = true;
 };
