@@ -39,15 +39,45 @@ double timedFrame(render::CloudRenderer& r, const render::FrameInputs& in) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// `high` at 320x180: the time of levels 0-3 on the path's first frames,
-// measured round-robin so the machine's drift falls on all alike (again,
+// Round-robin medians of each level's frame time over `rounds` rounds (the
+// first round also builds what each level needs and is not counted), so the
+// machine's drift falls on all levels alike.
+std::vector<double> levelTimes(render::CloudRenderer& r, const std::vector<render::BudgetLevel>& ladder,
+                               const weather::WeatherSnapshot& snap, std::uint64_t rounds) {
+  std::vector<std::vector<double>> ms(ladder.size());
+  for (std::uint64_t round = 0; round < rounds; ++round)
+    for (std::size_t level = 0; level < ladder.size(); ++level) {
+      EXPECT_TRUE(r.setMarch(ladder[level].march));
+      const double t = timedFrame(r, pathFrame(snap, round));
+      if (round > 0) ms[level].push_back(t);
+    }
+  std::vector<double> out;
+  for (auto& m : ms) out.push_back(median(m));
+  return out;
+}
+
+// The most accurate level whose time fits the budget, else the cheapest.
+std::size_t bestFitting(const std::vector<double>& levelMs, double budgetMs) {
+  for (std::size_t level = 0; level < levelMs.size(); ++level)
+    if (levelMs[level] <= budgetMs) return level;
+  return levelMs.size() - 1;
+}
+
+// `high` at 320x180: every level's time on the path's first frames (again,
 // up to three times, until level 3 is faster than level 1, 20 % apart on
 // the bench); the budget halfway between levels 1 and 3; then 40 frames
-// under the budget. After 10 frames to settle, the median frame fits (5 %
-// over at most) and is within 20 % of the budget, and the level the frames
-// are drawn at most is the most accurate one measured to fit or a
-// neighbour: on a shared machine two neighbouring levels' times (5-10 %
-// apart) differ by less than the noise of their separate measurement.
+// under the budget. This machine is shared and its speed drifts by a third
+// within a minute (CI once measured level 4 at 85 ms where the calibration
+// had put level 3 at 66), so the test does not assume the calibration still
+// holds while the budget runs: after each budgeted frame it draws a probe
+// frame at a fixed level, and the probes' median over the calibrated time of
+// that level scales every level's time to the machine's speed during the run.
+// After 10 frames to settle, the level the frames are drawn at most is the
+// most accurate one that fits at that speed or a neighbour (two neighbouring
+// levels are 5-10 % apart, less than the noise of separate measurement), and
+// the median frame fits (5 % over at most) unless no cheaper level exists.
+// The calibration also checks the ladder's relative costs, which the bench
+// measured on its scenes, against this renderer on this path (20 %).
 TEST(FrameBudget, HoldsABudgetBetweenTwoLevelsOverAReplay) {
   SKY_RENDERER(shared, 64, 36);  // keeps the driver loaded (renderer_fixture.hpp)
   (void)shared;
@@ -61,58 +91,55 @@ TEST(FrameBudget, HoldsABudgetBetweenTwoLevelsOverAReplay) {
   ASSERT_TRUE(r) << describe(r.error());
   auto ladder = render::budgetLadder(*preset);
   ASSERT_TRUE(ladder);
+  ASSERT_GE(ladder->size(), 4u);
   weather::WeatherSnapshot snap;
   snap.layers.push_back(layer(1, 1500, 1000, 0.5, 1.0));
 
-  constexpr std::size_t kLevels = 4;
-  std::vector<double> levelMs(kLevels);
-  for (int attempt = 0; attempt < 3 && !(levelMs[3] > 0 && levelMs[3] < levelMs[1]); ++attempt) {
-    std::vector<std::vector<double>> ms(kLevels);
-    for (std::uint64_t round = 0; round < 5; ++round)
-      for (std::size_t level = 0; level < kLevels; ++level) {
-        ASSERT_TRUE((*r)->setMarch((*ladder)[level].march));
-        const double t = timedFrame(**r, pathFrame(snap, round));
-        if (round > 0) ms[level].push_back(t);  // the first round also builds what each level needs
-      }
-    for (std::size_t level = 0; level < kLevels; ++level) levelMs[level] = median(ms[level]);
-  }
+  std::vector<double> levelMs;
+  for (int attempt = 0; attempt < 3 && !(levelMs.size() > 3 && levelMs[3] < levelMs[1]); ++attempt)
+    levelMs = levelTimes(**r, *ladder, snap, 5);
+  const std::size_t cheapest = ladder->size() - 1;
   const double budgetMs = 0.5 * (levelMs[1] + levelMs[3]);
-  std::size_t best = kLevels - 1;
-  for (std::size_t level = 0; level < kLevels; ++level)
-    if (levelMs[level] <= budgetMs) {
-      best = level;
-      break;
-    }
-  std::printf("[ budget   ] levels 0-3 %.1f / %.1f / %.1f / %.1f ms; budget %.1f ms, level %zu fits\n", levelMs[0],
-              levelMs[1], levelMs[2], levelMs[3], budgetMs, best);
+  std::printf("[ budget   ] levels 0-%zu:", cheapest);
+  for (double ms : levelMs) std::printf(" %.1f", ms);
+  std::printf(" ms; budget %.1f ms, level %zu fits\n", budgetMs, bestFitting(levelMs, budgetMs));
   ASSERT_LT(levelMs[3], levelMs[1]) << "the ladder's levels must differ in time for the test to mean anything";
+  for (std::size_t level = 1; level < ladder->size(); ++level)
+    EXPECT_NEAR(levelMs[level] / levelMs[0], (*ladder)[level].relativeCost, 0.2 * (*ladder)[level].relativeCost)
+        << "level " << level << ": the bench's relative cost does not hold on this path";
 
+  constexpr std::size_t kProbe = 2;
   render::FrameBudget budget(budgetMs, *ladder);
-  std::size_t applied = 99;
-  std::vector<double> held;
+  std::vector<double> held, probes;
   std::map<std::size_t, int> levels;
   for (std::uint64_t i = 0; i < 40; ++i) {
-    if (budget.level() != applied) {
-      ASSERT_TRUE((*r)->setMarch(budget.current().march));
-      applied = budget.level();
-    }
+    ASSERT_TRUE((*r)->setMarch(budget.current().march));
     const std::size_t drawnAt = budget.level();
     const double ms = timedFrame(**r, pathFrame(snap, i));
     budget.update(ms);
+    ASSERT_TRUE((*r)->setMarch((*ladder)[kProbe].march));
+    const double probe = timedFrame(**r, pathFrame(snap, i));
     if (i >= 10) {
       held.push_back(ms);
+      probes.push_back(probe);
       ++levels[drawnAt];
     }
   }
+  const double speed = median(probes) / levelMs[kProbe];
+  std::vector<double> duringMs;
+  for (double ms : levelMs) duringMs.push_back(ms * speed);
+  const std::size_t best = bestFitting(duringMs, budgetMs);
   const double heldMs = median(held);
   const auto most = std::max_element(levels.begin(), levels.end(),
                                      [](const auto& a, const auto& b) { return a.second < b.second; });
-  std::printf("[ budget   ] held %.1f ms (budget %.1f); level %zu in %d of %zu frames\n", heldMs, budgetMs, most->first,
-              most->second, held.size());
-  EXPECT_NEAR(heldMs, budgetMs, 0.2 * budgetMs);
-  EXPECT_LE(heldMs, 1.05 * budgetMs);
+  std::printf("[ budget   ] held %.1f ms (budget %.1f); level %zu in %d of %zu frames; the machine ran at %.2fx the "
+              "calibration's times, where level %zu fits\n",
+              heldMs, budgetMs, most->first, most->second, held.size(), speed, best);
   EXPECT_GE(most->first + 1, best);
   EXPECT_LE(most->first, best + 1);
+  if (most->first < cheapest) {
+    EXPECT_LE(heldMs, 1.05 * budgetMs);
+  }
 }
 
 }  // namespace
