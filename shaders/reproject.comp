@@ -7,7 +7,10 @@
 // history is taken when its cloud depth there agrees with that point's
 // distance from the previous camera; otherwise (disocclusion, a point
 // outside the previous view) the pixel is upscaled from this frame's drawn
-// pixels. Layout: include/reproject_shared.h; the CPU side decides when the
+// pixels. In motion, the history a pixel takes (reused, or blended with a
+// redraw) is first clipped to the box the pixels drawn this frame around it
+// span (history_clip.glsl): what nothing drawn nearby shows any more does
+// not linger. Layout: include/reproject_shared.h; the CPU side decides when the
 // history is dropped altogether (temporal_plan.cpp).
 #version 450
 #extension GL_GOOGLE_include_directive : require
@@ -34,6 +37,7 @@ layout(std430, set = 0, binding = kReprojectBindingOutcomes) writeonly buffer Ou
 #define real4 vec4
 #define SKY_CORE_CONST const
 #include "core_common.glsl"
+#include "history_clip.glsl"
 
 // The block's numbers, read once at the start of main: storage loads are
 // gathers on lavapipe (clouds.comp says more), and the per-tap tests below
@@ -50,6 +54,8 @@ float gRadius;
 vec4 gFrustum, gPrevFrustum;  // this frame's and the previous frame's view frusta
 float gRelTolerance, gAbsTolerance, gBandMargin;
 float gAccumulation;  // the history's share of a redrawn pixel
+float gClipGamma;     // the history clip's gamma (0: off)
+bool gClip;           // clip the history this frame: gamma > 0 and the view not still
 uint gLayers;
 vec4 gBand[kReprojectMaxLayers];
 vec3 gMotion[kReprojectMaxLayers];
@@ -223,6 +229,22 @@ uint reuseHistory(ivec2 px, out vec4 colour, inout float depth) {
   return kStatDisoccluded;
 }
 
+// The box of the pixels drawn this frame around px (history_clip.glsl): the
+// drawn pixels of the 3 x 3 blocks centred on the one nearest px.
+HistoryBox drawnBox(ivec2 px) {
+  ivec2 c = ivec2(floor((vec2(px) - vec2(gPhase)) / float(gN) + 0.5));
+  HistoryBox box = historyBoxEmpty();
+  for (int k = 0; k < 9; ++k) {
+    ivec2 t;
+    if (drawnPixel(c + ivec2(k % 3 - 1, k / 3 - 1), t)) box = historyBoxAdd(box, historyClipSpace(freshAt(t)));
+  }
+  return box;
+}
+
+vec4 clippedHistory(ivec2 px, vec4 history) {
+  return gClip ? clipHistory(drawnBox(px), history, gClipGamma) : history;
+}
+
 uint resolvePixel(ivec2 px, out vec4 colour, out float depth) {
   ivec2 b = px >> gShift;
   ivec2 drawn;
@@ -234,7 +256,7 @@ uint resolvePixel(ivec2 px, out vec4 colour, out float depth) {
     if (gHasHistory && gAccumulation > 0.0) {
       vec4 before;
       float guess = depth;
-      if (reuseHistory(px, before, guess) == kStatReused) colour = mix(colour, before, gAccumulation);
+      if (reuseHistory(px, before, guess) == kStatReused) colour = mix(colour, clippedHistory(px, before), gAccumulation);
     }
     return kStatFresh;
   }
@@ -245,6 +267,7 @@ uint resolvePixel(ivec2 px, out vec4 colour, out float depth) {
   depth = nearestDrawnDepth(px);
   uint outcome = reuseHistory(px, colour, depth);
   if (outcome != kStatReused) upscale(px, colour, depth);
+  else colour = clippedHistory(px, colour);
   return outcome;
 }
 
@@ -270,12 +293,14 @@ void main() {
   gAbsTolerance = params.tolerance.y;
   gBandMargin = params.tolerance.z;
   gAccumulation = params.tolerance.w;
+  gClipGamma = params.raster.z;
   for (uint l = 0u; l < kReprojectMaxLayers; ++l) {
     gBand[l] = params.layerBand[l];
     gMotion[l] = params.layerMotion[l].xyz;
   }
   gStill = gPrevPosition == vec3(0.0) && gPrevFrustum == gFrustum && gPrevForward == gForward && gPrevRight == gRight && gPrevDown == gDown;
   for (uint l = 0u; l < kReprojectMaxLayers; ++l) gStill = gStill && (l >= gLayers || gMotion[l] == vec3(0.0));
+  gClip = gClipGamma > 0.0 && !gStill;
   ivec2 px = ivec2(gl_GlobalInvocationID.xy);
   if (px.x < int(gSize.x) && px.y < int(gSize.y)) {
     vec4 colour;

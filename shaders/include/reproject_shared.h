@@ -58,7 +58,8 @@ struct SkyReproject {
   vec4 tolerance;    // x: relative cloud-depth difference a reused pixel may have, y: the same in m
                      // (added), z: margin around a layer band its wind applies in (m), w: the history's
                      // share of a redrawn pixel (TemporalSettings::accumulation; 0: none)
-  vec4 raster;       // xy: the image's extent in its pixels for the camera rays (SkyFrame::raster); zw: unused
+  vec4 raster;       // xy: the image's extent in its pixels for the camera rays (SkyFrame::raster);
+                     // z: the history clip's gamma (TemporalSettings::historyClip; 0: off); w: unused
   vec4 frustum;      // this frame's view frustum (SkyFrame::frustum)
   vec4 prevFrustum;  // the previous frame's, which the history was drawn with
 };

@@ -140,6 +140,7 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
       {"interleave", s.temporal.interleave},
       {"accumulation", s.temporal.accumulation},
       {"pixel_jitter", s.temporal.pixelJitter && s.temporal.accumulation > 0},
+      {"history_clip", s.temporal.interleave > 1 ? s.temporal.historyClip : 0.0},
       {"resolution_divisor", s.resolution.divisor},
       {"resolution", {s.width, s.height}},
       {"vertical_fov_deg", s.verticalFov_deg},
@@ -177,7 +178,7 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
   if (r.presentDelay_ms) line["present_delay_ms"] = *r.presentDelay_ms;
   if (s.temporal.interleave > 1) {
     const render::TemporalReport& t = r.temporal;
-    line["temporal"] = {{"drawn_whole", t.drawnWhole}, {"reason", t.reason},     {"drawn", t.drawn},
+    line["temporal"] = {{"drawn_whole", t.drawnWhole}, {"reason", t.reason}, {"interleave", t.interleave},     {"drawn", t.drawn},
                         {"reused", t.reused},          {"offscreen", t.offscreen}, {"disoccluded", t.disoccluded}};
   }
   if (render::sunMapParts(s.march.sunShadow.method) > 0)

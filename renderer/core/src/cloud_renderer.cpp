@@ -249,6 +249,7 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
       impl_->temporal = impl_->reproject->counts();
       impl_->temporal.drawnWhole = plan->drawWhole;
       impl_->temporal.reason = plan->reason;
+      impl_->temporal.interleave = plan->interleave;
     }
     return image;
   });

@@ -48,16 +48,19 @@ glm::uvec2 interleavePhase(std::uint32_t n, std::uint32_t cycleIndex) {
   return {0, 0};
 }
 
+double TemporalPlanner::turn_deg(const Remembered& prev, const Remembered& now) {
+  // The rotation taking one camera's axes (in ECEF) to the other's.
+  const glm::dmat3 a = prev.localToEcef * glm::dmat3(prev.forward, prev.right, prev.down);
+  const glm::dmat3 b = now.localToEcef * glm::dmat3(now.forward, now.right, now.down);
+  const glm::dmat3 r = glm::transpose(b) * a;
+  return std::acos(std::clamp((r[0][0] + r[1][1] + r[2][2] - 1.0) / 2.0, -1.0, 1.0)) * kRadToDeg;
+}
+
 std::string TemporalPlanner::resetReason(const Remembered& prev, const Remembered& now) const {
   if (now.sceneKey != prev.sceneKey) return "weather changed";
   const double moved_m = glm::length(now.cameraEcef_m - prev.cameraEcef_m);
   if (moved_m > settings_.resetDistance_m) return "camera moved " + rounded(moved_m, 0) + " m";
-  // The turn between the two views: the rotation taking one camera's axes
-  // (in ECEF) to the other's.
-  const glm::dmat3 a = prev.localToEcef * glm::dmat3(prev.forward, prev.right, prev.down);
-  const glm::dmat3 b = now.localToEcef * glm::dmat3(now.forward, now.right, now.down);
-  const glm::dmat3 r = glm::transpose(b) * a;
-  const double turned_deg = std::acos(std::clamp((r[0][0] + r[1][1] + r[2][2] - 1.0) / 2.0, -1.0, 1.0)) * kRadToDeg;
+  const double turned_deg = turn_deg(prev, now);
   if (turned_deg > settings_.resetRotation_deg) return "view turned " + rounded(turned_deg, 1) + " deg";
   const double step_s = now.clock_s - prev.clock_s;
   if (std::abs(step_s) > settings_.resetClockStep_s) return "weather clock stepped " + rounded(step_s, 1) + " s";
@@ -96,8 +99,20 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   plan.drawWhole = !reason.empty();
   plan.reason = reason;
   plan.interleave = plan.drawWhole ? 1 : n;
+  // A fast turn: what comes into view would be upscaled from 1 pixel of 16
+  // and stay that coarse until each pixel's turn to be drawn comes, so the
+  // frame draws 1 of 4 instead (TemporalSettings::denseTurn_px).
+  if (!plan.drawWhole && n == 4 && settings_.denseTurn_px > 0) {
+    // One pixel's angle at the image's centre: the frustum's vertical angle
+    // over its rows.
+    const double pixel_deg = (std::atan(setup.frustum.z) - std::atan(setup.frustum.w)) * kRadToDeg /
+                             double(std::max<std::uint32_t>(setup.height, 1));
+    plan.turned_px = turn_deg(*previous_, now) / pixel_deg;
+    if (plan.turned_px > settings_.denseTurn_px) plan.interleave = 2;
+  }
+  const std::uint32_t drawnN = plan.interleave;
   const std::uint64_t index = inputs.patternIndex.value_or(frames_);
-  plan.phase = plan.drawWhole ? glm::uvec2(0) : interleavePhase(n, std::uint32_t(index % (n * n)));
+  plan.phase = plan.drawWhole ? glm::uvec2(0) : interleavePhase(drawnN, std::uint32_t(index % (drawnN * drawnN)));
   // With accumulation each cycle of n^2 frames shifts the step offsets by
   // the golden ratio: the additive recurrence spreads any number of
   // consecutive cycles' offsets evenly over [0, 1).
@@ -121,7 +136,7 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   p.frustum = gpu::vec4(setup.frustum);
   p.prevFrustum = p.frustum;
   p.image = gpu::uvec4(setup.width, setup.height, plan.interleave, plan.drawWhole ? 0u : 1u);
-  p.raster = gpu::vec4(float(setup.rasterWidth), float(setup.rasterHeight), 0.0f, 0.0f);
+  p.raster = gpu::vec4(float(setup.rasterWidth), float(setup.rasterHeight), float(settings_.historyClip), 0.0f);
   const std::uint32_t packedW = (setup.width + plan.interleave - 1) / plan.interleave;
   p.phase = gpu::uvec4(plan.phase.x, plan.phase.y, packedW, std::uint32_t(setup.layers.size()));
   p.tolerance = gpu::vec4(float(settings_.depthTolerance), float(kDepthToleranceSlack_m), float(kLayerWindMargin_m),

@@ -37,8 +37,9 @@ glm::uvec2 interleavePhase(std::uint32_t n, std::uint32_t cycleIndex);
 struct TemporalPlan {
   bool drawWhole = true;   // no history: the cloud pass draws every pixel
   std::string reason;      // why, when drawWhole
-  std::uint32_t interleave = 1;
+  std::uint32_t interleave = 1;  // of this frame: the settings', 2 in a fast turn, 1 drawn whole
   glm::uvec2 phase{0};
+  double turned_px = 0;  // how far the view turned since the previous frame, in pixels at the image's centre
   double jitterShift = 0;      // FrameSetup::jitterShift: the cycle's step-offset shift with accumulation
   glm::dvec2 pixelShift{0};    // FrameSetup::pixelShift: the cycle's ray-position shift with pixelJitter
   bool pixelJitter = false;
@@ -71,6 +72,9 @@ class TemporalPlanner {
     std::uint64_t sceneKey = 0;
     std::vector<int> layerSide;  // per layer: -1 under its base, 0 inside, 1 over its top
   };
+  // The angle the view turned from `prev` to `now` (the rotation between the
+  // two cameras' axes in ECEF, roll included), degrees.
+  static double turn_deg(const Remembered& prev, const Remembered& now);
   // Why the history cannot be used for a frame after `prev`; empty when it can.
   std::string resetReason(const Remembered& prev, const Remembered& now) const;
 

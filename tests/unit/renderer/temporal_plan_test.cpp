@@ -2,6 +2,7 @@
 // every pixel of a block exactly once, and the order is dispersed (a still
 // view fills in evenly, not in a sweep).
 #include <cstdlib>
+#include <cmath>
 #include <set>
 #include <utility>
 
@@ -105,6 +106,51 @@ TEST(TemporalPlanner, TheWeatherVersionDecidesWhenTheSceneIsCompared) {
   in.weatherVersion.reset();
   w.layers[0].base_m = 1400;
   EXPECT_EQ(planner.plan(setup, in).reason, "weather changed");
+}
+
+// A fast turn (TemporalSettings::denseTurn_px): a frame whose view turned
+// more than the threshold in pixels at the image's centre (yaw or roll
+// alike) is drawn at interleave 2 with a phase of the 2x2 cycle; slower, or
+// with the threshold 0, at the settings' 4; the turn is reported in pixels.
+TEST(TemporalPlanner, AFastTurnDrawsOnePixelOfFour) {
+  TemporalSettings t;
+  t.interleave = 4;
+  FrameSetup setup;
+  setup.width = 160;
+  setup.height = 90;
+  setup.frustum = {-std::tan(0.5236) * 16 / 9, std::tan(0.5236) * 16 / 9, std::tan(0.5236), -std::tan(0.5236)};
+  const double pixel_deg = 60.0 / 90.0;
+  auto look = [&](double yaw_deg, double roll_deg) {
+    const double y = yaw_deg * std::acos(-1.0) / 180, r = roll_deg * std::acos(-1.0) / 180;
+    setup.camForward = {std::sin(y), std::cos(y), 0};
+    const glm::dvec3 right0{std::cos(y), -std::sin(y), 0}, down0{0, 0, -1};
+    setup.camRight = std::cos(r) * right0 + std::sin(r) * down0;
+    setup.camDown = -std::sin(r) * right0 + std::cos(r) * down0;
+  };
+  FrameInputs in;
+  TemporalPlanner planner(t);
+  look(0, 0);
+  ASSERT_TRUE(planner.plan(setup, in).drawWhole);
+  look(1.5 * pixel_deg, 0);  // 1.5 px
+  TemporalPlan p = planner.plan(setup, in);
+  EXPECT_EQ(p.interleave, 4u);
+  EXPECT_NEAR(p.turned_px, 1.5, 1e-4);
+  look(1.5 * pixel_deg + 3 * pixel_deg, 0);  // 3 px of yaw
+  p = planner.plan(setup, in);
+  EXPECT_EQ(p.interleave, 2u);
+  EXPECT_LT(p.phase.x, 2u);
+  EXPECT_LT(p.phase.y, 2u);
+  EXPECT_EQ(p.params.image.z, 2u);  // the reprojection reads the packed image at n = 2
+  look(4.5 * pixel_deg, 2.5 * pixel_deg);  // 2.5 px of roll
+  p = planner.plan(setup, in);
+  EXPECT_EQ(p.interleave, 2u);
+  EXPECT_NEAR(p.turned_px, 2.5, 1e-4);
+  t.denseTurn_px = 0;
+  TemporalPlanner never(t);
+  look(0, 0);
+  never.plan(setup, in);
+  look(20 * pixel_deg, 0);
+  EXPECT_EQ(never.plan(setup, in).interleave, 4u);
 }
 
 }  // namespace

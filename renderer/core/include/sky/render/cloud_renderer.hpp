@@ -157,6 +157,24 @@ struct TemporalSettings {
   // R2 sequence, so the redraws average over the pixel's area (anti-aliased
   // edges) instead of sampling its centre. Ignored without accumulation.
   bool pixelJitter = false;
+  // Variance clipping of the history in motion (shaders/include/history_clip.glsl):
+  // a pixel taken from the history, and the history a redraw is blended
+  // with, are first clipped to the box of the pixels drawn this frame around
+  // it (the drawn pixels of its own and the eight neighbouring n x n
+  // blocks): their mean +- this many standard deviations, within their
+  // range, in a compressed YCoCg space with the transmittance. What the
+  // history holds that nothing drawn nearby now shows (a cloud that moved
+  // or changed, a stale horizon) is pulled back to what is drawn. Not
+  // applied to a still view (the camera and every layer's air unmoved),
+  // which keeps converging to the image drawn whole. 0: off. [0, 4].
+  double historyClip = 0;
+  // A fast turn with interleave 4: when the view turned since the previous
+  // frame by more than this many of the cloud pass's pixels (at the image's
+  // centre, roll included), the frame draws 1 pixel of 4 per block instead
+  // of 1 of 16, so what comes into view is drawn at half the spacing rather
+  // than upscaled from a quarter of it; the cloud pass costs ~4x that frame.
+  // 0: never. [0, 1000].
+  double denseTurn_px = 2;
 };
 
 // Frames of a still view after which an interleaved renderer's history is
@@ -279,6 +297,8 @@ struct SunMapReport {
 struct TemporalReport {
   bool drawnWhole = false;
   std::string reason;  // why it was drawn whole ("first frame", "teleport 2.1 km", ...); empty otherwise
+  // The frame's interleave: the settings', 2 in a fast turn (TemporalSettings::denseTurn_px), 1 drawn whole.
+  std::uint32_t interleave = 0;
   // Pixels of the image the cloud pass works on: with a resolution divisor d,
   // (width / d) x (height / d).
   std::uint64_t drawn = 0, reused = 0, offscreen = 0, disoccluded = 0;
