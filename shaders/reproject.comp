@@ -56,6 +56,7 @@ float gRelTolerance, gAbsTolerance, gBandMargin;
 float gAccumulation;  // the history's share of a redrawn pixel
 float gClipGamma;     // the history clip's gamma (0: off)
 bool gClip;           // clip the history this frame: gamma > 0 and the view not still
+float gAccumulationMotion;  // pixels of motion at which a redraw keeps none of its history (0: share constant)
 uint gLayers;
 vec4 gBand[kReprojectMaxLayers];
 vec3 gMotion[kReprojectMaxLayers];
@@ -206,17 +207,19 @@ float nearestDrawnDepth(ivec2 px) {
 // The pixel from the history: the point at `depth` (the nearest drawn
 // pixel's) seen from the previous camera; failing that, the point at the
 // depth the history holds there. `depth` becomes the reused pixel's depth
-// (reusedDepth).
-uint reuseHistory(ivec2 px, out vec4 colour, inout float depth) {
+// (reusedDepth). from: where in the previous image it was taken (pixels).
+uint reuseHistory(ivec2 px, out vec4 colour, inout float depth, out vec2 from) {
   vec3 dir = cameraRay(gForward, gRight, gDown, gFrustum, float(px.x), float(px.y), gRaster.x, gRaster.y);
   // First guess of the pixel's cloud depth: its own block's drawn pixel's
   // (upscale's nearest); then what the history holds where that leads.
   vec2 p;
   float expected, seen;
   colour = vec4(0.0);
+  from = vec2(px) + 0.5;
   if (!previousPixel(dir, depth, p, expected) || !insideImage(ivec2(floor(p)))) return kStatOffscreen;
   if (historyAt(p, expected, colour, seen)) {
     depth = reusedDepth(depth, expected, seen);
+    from = p;
     return kStatReused;
   }
   float guess = historyDepthNear(p);
@@ -224,6 +227,7 @@ uint reuseHistory(ivec2 px, out vec4 colour, inout float depth) {
   if (!previousPixel(dir, guess, p2, expected) || !insideImage(ivec2(floor(p2)))) return kStatOffscreen;
   if (historyAt(p2, expected, colour, seen)) {
     depth = reusedDepth(guess, expected, seen);
+    from = p2;
     return kStatReused;
   }
   return kStatDisoccluded;
@@ -256,7 +260,16 @@ uint resolvePixel(ivec2 px, out vec4 colour, out float depth) {
     if (gHasHistory && gAccumulation > 0.0) {
       vec4 before;
       float guess = depth;
-      if (reuseHistory(px, before, guess) == kStatReused) colour = mix(colour, clippedHistory(px, before), gAccumulation);
+      vec2 from;
+      if (reuseHistory(px, before, guess, from) == kStatReused) {
+        // In motion the history is resampled (blurred) and partly upscaled:
+        // its share falls with how far the pixel moved since the previous
+        // frame, to none at gAccumulationMotion pixels.
+        float moved = length(from - (vec2(px) + 0.5));
+        float share = gAccumulationMotion > 0.0 ? gAccumulation * clamp(1.0 - moved / gAccumulationMotion, 0.0, 1.0)
+                                                : gAccumulation;
+        colour = mix(colour, clippedHistory(px, before), share);
+      }
     }
     return kStatFresh;
   }
@@ -265,7 +278,8 @@ uint resolvePixel(ivec2 px, out vec4 colour, out float depth) {
     return kStatNoHistory;
   }
   depth = nearestDrawnDepth(px);
-  uint outcome = reuseHistory(px, colour, depth);
+  vec2 from;
+  uint outcome = reuseHistory(px, colour, depth, from);
   if (outcome != kStatReused) upscale(px, colour, depth);
   else colour = clippedHistory(px, colour);
   return outcome;
@@ -294,6 +308,7 @@ void main() {
   gBandMargin = params.tolerance.z;
   gAccumulation = params.tolerance.w;
   gClipGamma = params.raster.z;
+  gAccumulationMotion = params.raster.w;
   for (uint l = 0u; l < kReprojectMaxLayers; ++l) {
     gBand[l] = params.layerBand[l];
     gMotion[l] = params.layerMotion[l].xyz;

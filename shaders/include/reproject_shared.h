@@ -59,7 +59,9 @@ struct SkyReproject {
                      // (added), z: margin around a layer band its wind applies in (m), w: the history's
                      // share of a redrawn pixel (TemporalSettings::accumulation; 0: none)
   vec4 raster;       // xy: the image's extent in its pixels for the camera rays (SkyFrame::raster);
-                     // z: the history clip's gamma (TemporalSettings::historyClip; 0: off); w: unused
+                     // z: the history clip's gamma (TemporalSettings::historyClip; 0: off); w: the
+                     // motion in pixels at which a redraw keeps none of its history
+                     // (TemporalSettings::accumulationMotion_px; 0: the share does not fall)
   vec4 frustum;      // this frame's view frustum (SkyFrame::frustum)
   vec4 prevFrustum;  // the previous frame's, which the history was drawn with
 };

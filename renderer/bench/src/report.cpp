@@ -131,6 +131,7 @@ std::string reportJson(const BenchReport& report) {
                      {"lookups_per_s", number(c.lookupsPerSecond)},
                      {"error", errorJson(c.error)},
                      {"worst", errorJson(c.worst)},
+                     {"worst_frame", c.worstFrame},
                      {"temporal", temporal},
                      {"non_finite_pixels", c.nonFinitePixels},
                      {"repeatable", c.repeatable},
@@ -166,7 +167,7 @@ std::string reportMarkdown(const BenchReport& report) {
      << "* " << report.timingSource << "\n"
      << "* " << report.warmup << " warm-up frames per case, then " << report.repeats << " timed renders of each still, "
      << report.pathRepeats << " timed run(s) of each camera path; error against `reference` at the same resolution "
-     << "(paths: mean over frames; a path's contact sheet shows its last frame with that frame's SSIM and PSNR)\n\n";
+     << "(paths: mean over frames; a path's contact sheet shows each configuration's worst frame (lowest SSIM) with that frame's SSIM and PSNR)\n\n";
   std::set<std::pair<std::uint32_t, std::uint32_t>> sizes;
   for (const CaseResult& c : report.cases) sizes.insert({c.width, c.height});
   for (const auto& [w, h] : sizes) {

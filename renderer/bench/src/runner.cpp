@@ -147,6 +147,7 @@ Result<CaseResult> runCase(const LoadedScene& ls, const Configuration& config, c
       ssimSum += *s;
       cr.worst.rmseLinear = std::max(cr.worst.rmseLinear, *rmse);
       cr.worst.psnr_dB = std::min(cr.worst.psnr_dB, *p);
+      if (f == 0 || *s < cr.worst.ssim) cr.worstFrame = f;
       cr.worst.ssim = std::min(cr.worst.ssim, *s);
       kept.srgb.push_back(std::move(srgb));
     }
@@ -204,20 +205,25 @@ Result<CaseResult> runCase(const LoadedScene& ls, const Configuration& config, c
 
 // Writes each configuration's displayed frame and the scene's contact sheet:
 // one row per configuration (its frame, the reference, the error heat map).
+// A path's row shows the configuration's worst frame (lowest SSIM) beside
+// the reference's same frame: a path's errors come and go, and its last
+// frame may be one of its best.
 Result<std::string> writeSceneImages(const std::string& stem, const std::vector<CaseResult>& cases,
                                      const std::vector<KeptFrames>& kept, const RunOptions& options) {
   const std::filesystem::path dir = options.outDir / "contact";
   std::error_code ec;
   std::filesystem::create_directories(dir / "frames", ec);
   if (ec) return fail(ErrorCode::Io, (dir / "frames").string() + ": " + ec.message());
-  const Srgb8Image& ref = kept.front().srgb.back();
   std::vector<Srgb8Image> heat(cases.size());
   std::vector<std::vector<SheetCell>> rows;
   for (std::size_t i = 0; i < cases.size(); ++i) {
-    const Srgb8Image& img = kept[i].srgb.back();
+    const std::size_t shown = !cases[i].path ? 0 : i == 0 ? kept[i].srgb.size() - 1 : std::min(cases[i].worstFrame, kept[i].srgb.size() - 1);
+    const Srgb8Image& img = kept[i].srgb[shown];
+    const Srgb8Image& ref = kept.front().srgb[shown];
     if (auto ok = writePng(img, (dir / "frames" / (stem + "-" + cases[i].configuration + ".png")).string()); !ok)
       return tl::unexpected(ok.error());
-    const std::string timeLabel = cases[i].configuration + " " + fixed(cases[i].wall_ms.median, 1) + " MS";
+    const std::string timeLabel = cases[i].configuration + " " + fixed(cases[i].wall_ms.median, 1) + " MS" +
+                                  (cases[i].path && i > 0 ? " FRAME " + std::to_string(shown) : "");
     if (i == 0) {
       rows.push_back({{&img, timeLabel}});
       continue;
@@ -227,12 +233,12 @@ Result<std::string> writeSceneImages(const std::string& stem, const std::vector<
     auto shownPsnr = psnr(img, ref);
     if (!map || !shownSsim || !shownPsnr) return fail(ErrorCode::InvalidArgument, stem + ": cannot compare images");
     heat[i] = std::move(*map);
-    // The metrics of the frame shown (a path's last), not of the whole path.
+    // The metrics of the frame shown (a path's worst), not of the whole path.
     rows.push_back({{&img, timeLabel},
                     {&ref, "REFERENCE"},
                     {&heat[i], "SSIM " + fixed(*shownSsim, 3) + " PSNR " + fixed(*shownPsnr, 1)}});
   }
-  const std::string title = stem + (cases.front().path ? " (LAST FRAME)" : "") + " - ERROR 0 TO " +
+  const std::string title = stem + (cases.front().path ? " (EACH ROW AT ITS WORST FRAME)" : "") + " - ERROR 0 TO " +
                             fixed(kHeatMapFullScale, 0) + " LEVELS, BLACK TO WHITE";
   const std::string file = "contact/" + stem + ".png";
   if (auto ok = writePng(contactSheet(title, rows), (options.outDir / file).string()); !ok)

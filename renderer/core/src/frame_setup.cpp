@@ -181,7 +181,8 @@ Result<void> validateSettings(const RenderSettings& s) {
                   range("depthTolerance", t.depthTolerance, 0, 1, true),
                   range("accumulation", t.accumulation, 0, 0.95, false),
                   range("historyClip", t.historyClip, 0, 4, false),
-                  range("denseTurn_px", t.denseTurn_px, 0, 1000, false)})
+                  range("denseTurn_px", t.denseTurn_px, 0, 1000, false),
+                  range("accumulationMotion_px", t.accumulationMotion_px, 0, 1000, false)})
     if (!ok) return ok;
   if (t.accumulation > 0 && t.interleave == 1)
     return fail(ErrorCode::InvalidArgument,

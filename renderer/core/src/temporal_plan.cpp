@@ -136,7 +136,8 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   p.frustum = gpu::vec4(setup.frustum);
   p.prevFrustum = p.frustum;
   p.image = gpu::uvec4(setup.width, setup.height, plan.interleave, plan.drawWhole ? 0u : 1u);
-  p.raster = gpu::vec4(float(setup.rasterWidth), float(setup.rasterHeight), float(settings_.historyClip), 0.0f);
+  p.raster = gpu::vec4(float(setup.rasterWidth), float(setup.rasterHeight), float(settings_.historyClip),
+                       float(settings_.accumulationMotion_px));
   const std::uint32_t packedW = (setup.width + plan.interleave - 1) / plan.interleave;
   p.phase = gpu::uvec4(plan.phase.x, plan.phase.y, packedW, std::uint32_t(setup.layers.size()));
   p.tolerance = gpu::vec4(float(settings_.depthTolerance), float(kDepthToleranceSlack_m), float(kLayerWindMargin_m),

@@ -50,6 +50,7 @@ struct CaseResult {
   std::optional<double> lookupsPerSecond;  // lookups / GPU time, when both exist
   ErrorSummary error;  // a still: its image; a path: the mean over its frames
   ErrorSummary worst;  // a path: the worst frame (largest RMSE, lowest PSNR, lowest SSIM); a still: = error
+  std::size_t worstFrame = 0;  // a path: the frame of the lowest SSIM (the contact sheet shows it); a still: 0
   std::optional<TemporalError> temporal;  // paths only
   std::size_t nonFinitePixels = 0;        // over every kept frame
   bool repeatable = true;                 // every repeat of a still gave the same image, bit for bit

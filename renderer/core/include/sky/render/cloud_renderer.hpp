@@ -175,6 +175,13 @@ struct TemporalSettings {
   // than upscaled from a quarter of it; the cloud pass costs ~4x that frame.
   // 0: never. [0, 1000].
   double denseTurn_px = 2;
+  // Accumulation in motion: a redrawn pixel's history share falls linearly
+  // with how far its point moved in the image since the previous frame
+  // (camera, parallax and wind alike), from `accumulation` at rest to none
+  // at this many pixels: a history that was resampled, or upscaled where it
+  // came into view, would otherwise hold a fresh sample back for many
+  // frames (a lag that reads as ghosting). 0: the share does not fall. [0, 1000].
+  double accumulationMotion_px = 1;
 };
 
 // Frames of a still view after which an interleaved renderer's history is
