@@ -56,7 +56,7 @@ float gRelTolerance, gAbsTolerance, gBandMargin;
 float gAccumulation;  // the history's share of a redrawn pixel
 float gClipGamma;     // the history clip's gamma (0: off)
 bool gClip;           // clip the history this frame: gamma > 0 and the view not still
-float gAccumulationMotion;  // pixels of motion at which a redraw keeps none of its history (0: share constant)
+float gAccumulationMotion;  // pixels of motion at which a redraw keeps half its history's share (0: share constant)
 uint gLayers;
 vec4 gBand[kReprojectMaxLayers];
 vec3 gMotion[kReprojectMaxLayers];
@@ -264,9 +264,11 @@ uint resolvePixel(ivec2 px, out vec4 colour, out float depth) {
       if (reuseHistory(px, before, guess, from) == kStatReused) {
         // In motion the history is resampled (blurred) and partly upscaled:
         // its share falls with how far the pixel moved since the previous
-        // frame, to none at gAccumulationMotion pixels.
+        // frame, to half at gAccumulationMotion pixels. Not to none: inside
+        // a cloud the single march's noise, which the mean averages away,
+        // costs more than the lag (docs/motion.md).
         float moved = length(from - (vec2(px) + 0.5));
-        float share = gAccumulationMotion > 0.0 ? gAccumulation * clamp(1.0 - moved / gAccumulationMotion, 0.0, 1.0)
+        float share = gAccumulationMotion > 0.0 ? gAccumulation * clamp(1.0 - moved / gAccumulationMotion, 0.5, 1.0)
                                                 : gAccumulation;
         colour = mix(colour, clippedHistory(px, before), share);
       }

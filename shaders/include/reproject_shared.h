@@ -60,7 +60,7 @@ struct SkyReproject {
                      // share of a redrawn pixel (TemporalSettings::accumulation; 0: none)
   vec4 raster;       // xy: the image's extent in its pixels for the camera rays (SkyFrame::raster);
                      // z: the history clip's gamma (TemporalSettings::historyClip; 0: off); w: the
-                     // motion in pixels at which a redraw keeps none of its history
+                     // motion in pixels at which a redraw keeps half its history's share
                      // (TemporalSettings::accumulationMotion_px; 0: the share does not fall)
   vec4 frustum;      // this frame's view frustum (SkyFrame::frustum)
   vec4 prevFrustum;  // the previous frame's, which the history was drawn with

@@ -280,10 +280,10 @@ TEST(Temporal, FastRollDrawsDenser) {
 
 // Accumulation in a slow turn (yaw at 1.2 pixels a frame, under the dense
 // turn's 2, so 1 pixel of 16 is drawn): with the history's share falling to
-// none at 1 pixel of motion (TemporalSettings::accumulationMotion_px), a
-// redraw is taken as drawn and the mean error against the frames drawn
-// whole is lower, by at least a tenth, than with the share held at 0.75,
-// where a fresh sample is held back by the resampled history for frames.
+// half at 1 pixel of motion (TemporalSettings::accumulationMotion_px), a
+// redraw keeps 0.375 of its history and the mean error against the frames
+// drawn whole is lower than with the share held at 0.75, where a fresh
+// sample is held back by the resampled history for more frames.
 // A still view accumulates as before (share 0.75, moved 0 pixels): its
 // redraws converge on the image drawn whole.
 TEST(Temporal, AccumulationYieldsToMotion) {
@@ -316,7 +316,7 @@ TEST(Temporal, AccumulationYieldsToMotion) {
     hold += relativeError(renderOk(**holding, in), truth) / 24;
   }
   std::printf("[ measured ] slow turn: mean relative error %.4f yielding, %.4f holding 0.75\n", yield, hold);
-  EXPECT_LT(yield, 0.9 * hold);
+  EXPECT_LT(yield, 0.95 * hold);
 }
 
 // The same turn seen by a right-hand side channel (View Definition -5..55

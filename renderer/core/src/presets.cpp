@@ -82,18 +82,18 @@ const std::vector<Preset>& presets() {
       {"medium",
        "steps of 40 m in cloud, 80 m in clear air, +0.5 % of the distance; 4 light steps, exit at 0.2 %; "
        "1 pixel of 16 per frame (1 of 4 in a turn of over 2 pixels a frame), the rest reprojected, redraws accumulated "
-       "(history 0.75 at rest, none at 1 pixel of motion a frame)",
+       "(history 0.75 at rest, 0.375 from 1 pixel of motion a frame)",
        metres(256, 4, 0.002, 40, 80, 0.005, 12), interleaved(4, 0.75)},
       {"low",
        "steps of 40 m in cloud, 80 m in clear air, +1 % of the distance; 3 light steps, exit at 3 %; "
        "the air from a 48 x 48 x 24 table; 1 pixel of 16 per frame (1 of 4 in a turn of over 2 pixels a frame), the "
-       "rest reprojected, redraws accumulated (history 0.75 at rest, none at 1 pixel of motion a frame)",
+       "rest reprojected, redraws accumulated (history 0.75 at rest, 0.375 from 1 pixel of motion a frame)",
        withAirTable(metres(256, 3, 0.03, 40, 80, 0.01, 8), 48, 48, 24), interleaved(4, 0.75)},
       {"realtime",
        "steps of 40 m in cloud, 80 m in clear air, +2 % of the distance; 3 light steps, exit at 5 %; "
        "the air from a 32 x 32 x 16 table; the clouds drawn at 1/2 the width and height (depth-aware upscale); 1 "
        "pixel of 16 per frame (1 of 4 in a turn of over 2 pixels a frame), the rest reprojected, redraws accumulated "
-       "(history 0.75 at rest, none at 1 pixel of motion a frame)",
+       "(history 0.75 at rest, 0.375 from 1 pixel of motion a frame)",
        withAirTable(metres(256, 3, 0.05, 40, 80, 0.02, 8), 32, 32, 16), interleaved(4, 0.75), divided(2)},
   };
   return all;

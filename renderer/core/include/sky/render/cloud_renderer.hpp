@@ -177,10 +177,13 @@ struct TemporalSettings {
   double denseTurn_px = 2;
   // Accumulation in motion: a redrawn pixel's history share falls linearly
   // with how far its point moved in the image since the previous frame
-  // (camera, parallax and wind alike), from `accumulation` at rest to none
-  // at this many pixels: a history that was resampled, or upscaled where it
-  // came into view, would otherwise hold a fresh sample back for many
-  // frames (a lag that reads as ghosting). 0: the share does not fall. [0, 1000].
+  // (camera, parallax and wind alike), from `accumulation` at rest to half
+  // of it at this many pixels and beyond: a history that was resampled, or
+  // upscaled where it came into view, would otherwise hold a fresh sample
+  // back for many frames (a lag that reads as ghosting). Half, not none:
+  // inside a cloud the single march's noise that the mean averages away
+  // costs more than the lag (docs/motion.md). 0: the share does not fall.
+  // [0, 1000].
   double accumulationMotion_px = 1;
 };
 
