@@ -19,6 +19,10 @@
 
 layout(local_size_x = kReprojectLocalSizeX, local_size_y = kReprojectLocalSizeY) in;
 
+// TemporalSettings::historyClip > 0: the clip's code is compiled in (a
+// specialisation constant, as lavapipe runs every branch for every lane).
+layout(constant_id = 0) const bool kHistoryClip = false;
+
 layout(std430, set = 0, binding = kReprojectBindingParams) readonly buffer ParamsBlock { SkyReproject params; };
 // What it gathers from is in storage images (renderer/core/src/pixel_mirror.hpp:
 // llvmpipe loads a storage buffer at per-lane indices one lane and one
@@ -246,6 +250,7 @@ HistoryBox drawnBox(ivec2 px) {
 }
 
 vec4 clippedHistory(ivec2 px, vec4 history) {
+  if (!kHistoryClip) return history;
   return gClip ? clipHistory(drawnBox(px), history, gClipGamma) : history;
 }
 

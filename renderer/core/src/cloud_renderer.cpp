@@ -159,7 +159,8 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
     if (!pass) return tl::unexpected(pass.error());
     std::optional<ReprojectPass> reproject;
     if (settings.temporal.interleave > 1) {
-      auto created = ReprojectPass::create(**ctx, smallW, smallH, pass->output(), pass->depth());
+      auto created = ReprojectPass::create(**ctx, smallW, smallH, pass->output(), pass->depth(),
+                                           settings.temporal.historyClip > 0);
       if (!created) return tl::unexpected(created.error());
       reproject.emplace(std::move(*created));
     }
