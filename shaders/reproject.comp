@@ -7,10 +7,11 @@
 // history is taken when its cloud depth there agrees with that point's
 // distance from the previous camera; otherwise (disocclusion, a point
 // outside the previous view) the pixel is upscaled from this frame's drawn
-// pixels. In motion, the history a pixel takes (reused, or blended with a
-// redraw) is first clipped to the box the pixels drawn this frame around it
-// span (history_clip.glsl): what nothing drawn nearby shows any more does
-// not linger. Layout: include/reproject_shared.h; the CPU side decides when the
+// pixels. A redraw keeps less of its history the further its point moved
+// (TemporalSettings::accumulationMotion_px). With a history clip
+// (TemporalSettings::historyClip), in motion the history a pixel takes is
+// first clipped to the box the pixels drawn this frame around it span
+// (history_clip.glsl). Layout: include/reproject_shared.h; the CPU side decides when the
 // history is dropped altogether (temporal_plan.cpp).
 #version 450
 #extension GL_GOOGLE_include_directive : require
