@@ -80,49 +80,45 @@ TEST(Presets, UniformDeckCloseToReferenceForEveryPreset) {
   }
 }
 
+// Settings the renderer must refuse, with an InvalidArgument naming `what`.
+void expectRefusedNaming(const render::RenderSettings& settings, const std::string& what) {
+  auto r = render::CloudRenderer::create(settings);
+  ASSERT_FALSE(r) << what;
+  EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument) << what;
+  EXPECT_NE(r.error().detail.find(what), std::string::npos) << r.error().detail;
+}
+
 TEST(Presets, BadMarchSettingsAreRefused) {
   render::RenderSettings settings;
   settings.width = 16;
   settings.height = 16;
   settings.march.primarySteps = 0;
-  auto r = render::CloudRenderer::create(settings);
-  ASSERT_FALSE(r);
-  EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument);
-  EXPECT_NE(r.error().detail.find("primarySteps"), std::string::npos) << r.error().detail;
+  expectRefusedNaming(settings, "primarySteps");
   settings.march.primarySteps = 48;
   settings.march.minTransmittance = 1.0;
-  r = render::CloudRenderer::create(settings);
-  ASSERT_FALSE(r);
-  EXPECT_NE(r.error().detail.find("minTransmittance"), std::string::npos) << r.error().detail;
+  expectRefusedNaming(settings, "minTransmittance");
   settings.march.minTransmittance = 0.01;
   // The sun map: a size the map pass's 8x8 groups do not tile, too many
   // cascades, an unknown method, and the column's 1024-step limit.
   for (auto bad : {render::SunMapSettings{render::SunShadow::Deep, 100}, render::SunMapSettings{render::SunShadow::Bsm, 128, 5},
                    render::SunMapSettings{render::SunShadow(6)}}) {
     settings.march.sunShadow = bad;
-    r = render::CloudRenderer::create(settings);
-    ASSERT_FALSE(r);
-    EXPECT_NE(r.error().detail.find("sunShadow"), std::string::npos) << r.error().detail;
+    expectRefusedNaming(settings, "sunShadow");
   }
   settings.march.sunShadow = {render::SunShadow::Column};
   settings.march.lightSteps = 1025;
-  r = render::CloudRenderer::create(settings);
-  ASSERT_FALSE(r);
-  EXPECT_NE(r.error().detail.find("lightSteps"), std::string::npos) << r.error().detail;
+  expectRefusedNaming(settings, "lightSteps");
   // On lavapipe, a column march past its loop budget (256 x 1000 nested
   // steps; 256 x 64 is within it).
   settings.march.primarySteps = 256;
   settings.march.lightSteps = 1000;
-  r = render::CloudRenderer::create(settings);
-  ASSERT_FALSE(r);
-  EXPECT_NE(r.error().detail.find("65535"), std::string::npos) << r.error().detail;
+  expectRefusedNaming(settings, "65535");
   settings.march.lightSteps = 64;
   EXPECT_TRUE(render::CloudRenderer::create(settings));
   settings.march.primarySteps = 48;
   settings.march.sunShadow = {render::SunShadow::March};
   settings.march.lightSteps = 65;
-  r = render::CloudRenderer::create(settings);
-  ASSERT_FALSE(r) << "65 light steps: only the column march takes more than 64";
+  EXPECT_FALSE(render::CloudRenderer::create(settings)) << "65 light steps: only the column march takes more than 64";
 }
 
 // The renderer's sun map is sized when it is built: a budget level or a
