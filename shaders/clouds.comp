@@ -11,19 +11,33 @@
 layout(local_size_x = kLocalSize, local_size_y = kLocalSize) in;
 
 #include "cloud_pass.glsl"
+#include "fresh_edges.glsl"
 
 void main() {
   // Workgroup i draws tile (i * stride) mod n: lavapipe hands each thread a
   // contiguous range of workgroup ids, and the permutation spreads every range
   // over the whole image (lavapipe.md, "static split").
-  // With interleaving the tiles cover the packed image of this frame's
+  // With interleaving the first tiles cover the packed image of this frame's
   // pixels: packed pixel `sub` is pixel sub * n + phase of the full image.
+  // The tiles after them draw the fresh edges (fresh_edges.glsl), kLocalSize^2
+  // of their pixels each, written after the packed ones.
   uint tile = (gl_WorkGroupID.x * frame.dispatch.x) % frame.image.w;
-  uvec2 sub = uvec2(tile % frame.image.z, tile / frame.image.z) * kLocalSize + gl_LocalInvocationID.xy;
   uint n = frame.interleave.x;
   uvec2 packed = (frame.image.xy + uvec2(n - 1u)) / n;
-  if (sub.x >= packed.x || sub.y >= packed.y) return;
-  uvec2 px = sub * n + frame.interleave.yz;
+  uint packedTiles = frame.interleave.w;
+  uvec2 px;
+  uint slot;
+  if (tile < packedTiles) {
+    uvec2 sub = uvec2(tile % frame.image.z, tile / frame.image.z) * kLocalSize + gl_LocalInvocationID.xy;
+    if (sub.x >= packed.x || sub.y >= packed.y) return;
+    px = sub * n + frame.interleave.yz;
+    slot = sub.y * packed.x + sub.x;
+  } else {
+    uint k = (tile - packedTiles) * (kLocalSize * kLocalSize) + gl_LocalInvocationIndex;
+    if (k >= freshEdgeCount(frame.freshEdges, frame.image.xy)) return;
+    px = uvec2(freshEdgePixel(int(k), frame.freshEdges, frame.image.xy));
+    slot = packed.x * packed.y + k;
+  }
   if (px.x >= frame.image.x || px.y >= frame.image.y) return;
 
   loadFrameGlobals();
@@ -53,6 +67,6 @@ void main() {
   float jitter = frame.steps.w > 0.5 ? blueNoise[tileIndex] : pixelJitter(px.x, px.y);
   jitter = fract(jitter + frame.raster.z);
   PixelResult r = shadePixel(f, dir, jitter);
-  pixels[sub.y * packed.x + sub.x] = vec4(r.radiance, r.transmittance);
-  depths[sub.y * packed.x + sub.x] = r.depth;
+  pixels[slot] = vec4(r.radiance, r.transmittance);
+  depths[slot] = r.depth;
 }

@@ -43,6 +43,7 @@ layout(std430, set = 0, binding = kReprojectBindingOutcomes) writeonly buffer Ou
 #define SKY_CORE_CONST const
 #include "core_common.glsl"
 #include "history_clip.glsl"
+#include "fresh_edges.glsl"
 
 // The block's numbers, read once at the start of main: storage loads are
 // gathers on lavapipe (clouds.comp says more), and the per-tap tests below
@@ -66,6 +67,9 @@ uint gLayers;
 vec4 gBand[kReprojectMaxLayers];
 vec3 gMotion[kReprojectMaxLayers];
 bool gHasHistory;
+uvec4 gEdges;      // the fresh edges' widths (SkyReproject::freshEdges)
+uint gEdgeBase;    // where in the packed image their samples start (after the drawn pixels)
+float gPackedW;    // the packed image's width
 bool gStill;  // neither the camera nor any layer's air moved since the previous frame
 
 // The drawn pixel of block b, when it lies inside the image; texel: where
@@ -255,10 +259,23 @@ vec4 clippedHistory(ivec2 px, vec4 history) {
   return gClip ? clipHistory(drawnBox(px), history, gClipGamma) : history;
 }
 
-uint resolvePixel(ivec2 px, out vec4 colour, out float depth) {
+// Whether pixel px was drawn this frame, and where its sample is: its
+// block's drawn pixel, or a fresh edge's, after the packed pixels (the
+// packed image's row found in float: exact for the sizes there are, and
+// lavapipe's vector integer division is a loop over the lanes).
+bool drawnHere(ivec2 px, out ivec2 texel) {
   ivec2 b = px >> gShift;
+  if (px == (b << gShift) + ivec2(gPhase) && drawnPixel(b, texel)) return true;
+  int k = freshEdgeIndex(px, gEdges, gSize);
+  uint slot = gEdgeBase + uint(max(k, 0));
+  uint row = uint((float(slot) + 0.5) / gPackedW);
+  texel = ivec2(int(slot - row * uint(gPackedW)), int(row));
+  return k >= 0;
+}
+
+uint resolvePixel(ivec2 px, out vec4 colour, out float depth) {
   ivec2 drawn;
-  if (px == (b << gShift) + ivec2(gPhase) && drawnPixel(b, drawn)) {
+  if (drawnHere(px, drawn)) {
     colour = freshAt(drawn);
     depth = freshDepthAt(drawn);
     // Temporal accumulation: the redrawn pixel blended with its history,
@@ -299,6 +316,10 @@ void main() {
   gN = params.image.z;
   gShift = gN == 4u ? 2 : gN == 2u ? 1 : 0;
   gHasHistory = params.image.w != 0u;
+  gEdges = params.freshEdges;
+  uint packedW = params.phase.z;
+  gPackedW = float(packedW);
+  gEdgeBase = packedW * ((gSize.y + gN - 1u) >> uint(gShift));
   gPhase = params.phase.xy;
   gLayers = params.phase.w;
   gForward = params.camForward.xyz;

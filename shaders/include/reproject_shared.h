@@ -64,10 +64,12 @@ struct SkyReproject {
                      // (TemporalSettings::accumulationMotion_px; 0: the share does not fall)
   vec4 frustum;      // this frame's view frustum (SkyFrame::frustum)
   vec4 prevFrustum;  // the previous frame's, which the history was drawn with
+  uvec4 freshEdges;  // widths (px) of the bands at the left, right, top and bottom edges drawn at every
+                     // pixel this frame (fresh_edges.glsl), their samples after the packed pixels; 0 none
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(SkyReproject) == 16 * (9 + 2 * kReprojectMaxLayers + 4));
+static_assert(sizeof(SkyReproject) == 16 * (9 + 2 * kReprojectMaxLayers + 5));
 static_assert(offsetof(SkyReproject, image) == 112);
 static_assert(offsetof(SkyReproject, layerBand) == 144);
 }  // namespace sky::gpu

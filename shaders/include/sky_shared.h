@@ -107,8 +107,9 @@ struct SkyFrame {
                         // placement), y: step through clear air (m), z: step growth per metre, w: 1 when the
                         // step offsets come from the blue-noise tile, 0 from the pixel hash
   uvec4 interleave;     // x: n, the pass draws 1 pixel of each n x n block (1: every pixel); y, z: this
-                        // frame's pixel in the block (column, row); w: unused. The output holds the
-                        // drawn pixels packed, ceil(width / n) per row (reproject.comp reads them).
+                        // frame's pixel in the block (column, row); w: the tiles of those pixels (the
+                        // tiles after them draw the fresh edges). The output holds the drawn pixels
+                        // packed, ceil(width / n) per row, then the fresh edges' (reproject.comp reads them).
   vec4 raster;          // xy: the image's extent in its own pixels for the camera rays: the full size over the
                         // resolution divisor (image.xy rounds it up); z: added (mod 1) to every pixel's step
                         // offset (TemporalSettings::accumulation); w: unused
@@ -126,6 +127,8 @@ struct SkyFrame {
   vec4 sunMapShells;    // x: the highest drawn layer's top, y: the lowest one's base, m above the ground
                         // sphere; zw: unused
   vec4 sunMapOrigin;    // xyz: the map's centre, local frame (m; 0 when built this frame); w: unused
+  uvec4 freshEdges;     // with interleaving, the widths (px) of the bands at the left, right, top and bottom
+                        // edges drawn at every pixel as well (fresh_edges.glsl); 0 none
 };
 
 #ifdef __cplusplus
@@ -151,7 +154,7 @@ static_assert(offsetof(SkyFrame, raster) == 272 + 256 * kMaxLayers + 48);
 static_assert(offsetof(SkyFrame, frustum) == 272 + 256 * kMaxLayers + 80);
 static_assert(offsetof(SkyFrame, airTable) == 272 + 256 * kMaxLayers + 96);
 static_assert(offsetof(SkyFrame, sunMap) == 272 + 256 * kMaxLayers + 112);
-static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 192);
+static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 208);
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

@@ -141,6 +141,7 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
       {"accumulation", s.temporal.accumulation},
       {"pixel_jitter", s.temporal.pixelJitter && s.temporal.accumulation > 0},
       {"history_clip", s.temporal.interleave > 1 ? s.temporal.historyClip : 0.0},
+      {"fresh_edges", s.temporal.interleave > 1 && s.temporal.freshEdges},
       {"resolution_divisor", s.resolution.divisor},
       {"resolution", {s.width, s.height}},
       {"vertical_fov_deg", s.verticalFov_deg},
@@ -178,7 +179,8 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
   if (r.presentDelay_ms) line["present_delay_ms"] = *r.presentDelay_ms;
   if (s.temporal.interleave > 1) {
     const render::TemporalReport& t = r.temporal;
-    line["temporal"] = {{"drawn_whole", t.drawnWhole}, {"reason", t.reason}, {"interleave", t.interleave},     {"drawn", t.drawn},
+    line["temporal"] = {{"drawn_whole", t.drawnWhole}, {"reason", t.reason}, {"interleave", t.interleave},
+                        {"drawn", t.drawn},           {"fresh_edge_pixels", t.freshEdgePixels},
                         {"reused", t.reused},          {"offscreen", t.offscreen}, {"disoccluded", t.disoccluded}};
   }
   if (render::sunMapParts(s.march.sunShadow.method) > 0)

@@ -226,6 +226,7 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
       plan = impl_->planner.plan(setup, inputs);
       setup.interleave = plan->interleave;
       setup.phase = plan->phase;
+      setup.freshEdges = plan->freshEdges;
       setup.jitterShift = plan->jitterShift;
       setup.pixelShift = plan->pixelShift;
       setup.pixelJitter = plan->pixelJitter;
@@ -251,6 +252,8 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
       impl_->temporal.drawnWhole = plan->drawWhole;
       impl_->temporal.reason = plan->reason;
       impl_->temporal.interleave = plan->interleave;
+      impl_->temporal.freshEdges = {plan->freshEdges.x, plan->freshEdges.y, plan->freshEdges.z, plan->freshEdges.w};
+      impl_->temporal.freshEdgePixels = plan->freshEdgePixels;
     }
     return image;
   });

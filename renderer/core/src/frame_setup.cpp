@@ -10,6 +10,7 @@
 #include "sky/core/assert.hpp"
 #include "sky/render/ephemeris.hpp"
 #include "sky/render/haze.hpp"
+#include "fresh_edges.hpp"
 #include "sky/weather/advection.hpp"
 #include "sky_light_grid.hpp"
 
@@ -491,7 +492,13 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   const std::uint32_t packedW = (s.width + s.interleave - 1) / s.interleave;
   const std::uint32_t packedH = (s.height + s.interleave - 1) / s.interleave;
   const std::uint32_t tilesX = (packedW + gpu::kLocalSize - 1) / gpu::kLocalSize;
-  const std::uint32_t n = tileCount(packedW, packedH);
+  // The fresh edges' samples follow, kLocalSize^2 to a tile.
+  SKY_ASSERT(s.interleave > 1 || s.freshEdges == glm::uvec4(0));
+  const std::uint32_t packedTiles = tileCount(packedW, packedH);
+  const std::uint32_t edgePixels = FreshEdges{}.freshEdgeCount(s.freshEdges, glm::uvec2(s.width, s.height));
+  SKY_ASSERT(edgePixels <= packedW * (s.height - packedH) || edgePixels == 0);
+  const std::uint32_t tileArea = gpu::kLocalSize * gpu::kLocalSize;
+  const std::uint32_t n = packedTiles + (edgePixels + tileArea - 1) / tileArea;
   std::uint32_t stride = 1;
   if (n < kMaxPermutedTiles) {
     stride = std::max<std::uint32_t>(1, std::uint32_t(std::lround(kStrideFraction * n)));
@@ -501,7 +508,8 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   f.dispatch = gpu::uvec4(stride, s.march.primarySteps, s.march.lightSteps, s.march.airSteps);
   f.steps = gpu::vec4(float(s.march.cloudStep_m), float(s.march.emptyStep_m), float(s.march.stepGrowth),
                       s.march.blueNoise ? 1.0f : 0.0f);
-  f.interleave = gpu::uvec4(s.interleave, s.phase.x, s.phase.y, 0u);
+  f.interleave = gpu::uvec4(s.interleave, s.phase.x, s.phase.y, packedTiles);
+  f.freshEdges = gpu::uvec4(s.freshEdges);
   f.raster = gpu::vec4(float(s.rasterWidth), float(s.rasterHeight), float(s.jitterShift), 0.0f);
   f.pixelJitter = gpu::vec4(float(s.pixelShift.x), float(s.pixelShift.y), s.pixelJitter ? 1.0f : 0.0f, 0.0f);
   const AirTableSettings& table = s.march.airTable;

@@ -103,6 +103,9 @@ struct FrameSetup {
   // block, the one at `phase` in it (TemporalPlanner); 1, {0, 0}: all.
   std::uint32_t interleave = 1;
   glm::uvec2 phase{0};
+  // With interleaving, the bands at the image's edges drawn at every pixel
+  // as well (left, right, top, bottom widths; fresh_edges.glsl).
+  glm::uvec4 freshEdges{0};
   // Added (mod 1) to every pixel's step offset: TemporalSettings::accumulation's
   // per-cycle shift; 0 otherwise.
   double jitterShift = 0;

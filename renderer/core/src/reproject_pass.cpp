@@ -5,6 +5,7 @@
 #include <cstring>
 #include <vector>
 
+#include "fresh_edges.hpp"
 #include "sky/core/assert.hpp"
 
 namespace sky::render {
@@ -65,11 +66,17 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
 void ReprojectPass::record(const vk::raii::CommandBuffer& commands, GpuTimer& timer, const gpu::SkyReproject& params) {
   SKY_ASSERT(params.image.x == width_ && params.image.y == height_);
   std::memcpy(params_.mapped, &params, sizeof params);
-  // The pixels the cloud pass drew, packed n x n (n = params.image.z).
+  // The pixels the cloud pass drew, packed n x n (n = params.image.z), then
+  // the fresh edges' in the rows after them.
   const std::uint32_t n = std::max(params.image.z, 1u);
+  const std::uint32_t packedW = params.phase.z;
+  const std::uint32_t edgePixels =
+      FreshEdges{}.freshEdgeCount(glm::uvec4(params.freshEdges), glm::uvec2(width_, height_));
+  const std::uint32_t rows = (height_ + n - 1) / n + (edgePixels + packedW - 1) / packedW;
+  SKY_ASSERT(rows <= height_);
   {
     const auto timed = timer.section(commands, "reproject");
-    fresh_->record(commands, freshBuffers_.first, freshBuffers_.second, params.phase.z, (height_ + n - 1) / n);
+    fresh_->record(commands, freshBuffers_.first, freshBuffers_.second, packedW, rows);
     commands.bindPipeline(vk::PipelineBindPoint::eCompute, *pipeline_.pipeline);
     commands.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *pipeline_.layout, 0, *set_.set, {});
     const std::uint32_t gx = gpu::kReprojectLocalSizeX, gy = gpu::kReprojectLocalSizeY;

@@ -9,6 +9,8 @@
 
 #include "sky/core/assert.hpp"
 
+#include "fresh_edges.hpp"
+
 namespace sky::render {
 
 namespace {
@@ -35,6 +37,20 @@ std::string rounded(double v, int digits) {
 
 gpu::vec4 v4(const glm::dvec3& v, double w = 0) { return gpu::vec4(glm::dvec4(v, w)); }
 
+// The shaders' camera rays and projection (core_common.glsl), in double;
+// the GLSL calls GLM's built-ins unqualified.
+using namespace glm;
+struct Shared {
+  using real = double;
+  using real2 = glm::dvec2;
+  using real3 = glm::dvec3;
+  using real4 = glm::dvec4;
+  using uint = std::uint32_t;
+#define SKY_CORE_CONST static constexpr
+#include "core_common.glsl"
+#undef SKY_CORE_CONST
+};
+
 }  // namespace
 
 glm::uvec2 interleavePhase(std::uint32_t n, std::uint32_t cycleIndex) {
@@ -54,6 +70,67 @@ double TemporalPlanner::turn_deg(const Remembered& prev, const Remembered& now) 
   const glm::dmat3 b = now.localToEcef * glm::dmat3(now.forward, now.right, now.down);
   const glm::dmat3 r = glm::transpose(b) * a;
   return std::acos(std::clamp((r[0][0] + r[1][1] + r[2][2] - 1.0) / 2.0, -1.0, 1.0)) * kRadToDeg;
+}
+
+glm::uvec4 TemporalPlanner::freshEdges(const Remembered& prev, const FrameSetup& setup, std::uint32_t n) {
+  // The previous camera's axes in this frame's local frame. A point's
+  // direction stands for the point: the clouds lie far beyond one frame's
+  // camera motion (a near cloud the motion uncovers is the reprojection's
+  // disocclusion, upscaled as before).
+  const glm::dmat3 prevToLocal = glm::transpose(setup.localToEcef) * prev.localToEcef;
+  const glm::dvec3 pf = prevToLocal * prev.forward, pr = prevToLocal * prev.right, pd = prevToLocal * prev.down;
+  const double rw = setup.rasterWidth, rh = setup.rasterHeight;
+  const int w = int(setup.width), h = int(setup.height);
+  if (w < 2 || h < 2 || !(rw > 0) || !(rh > 0)) return glm::uvec4(0);
+  Shared shared;
+  // Where pixel (x, y)'s ray was in the previous image (continuous pixels;
+  // far outside when it was behind that camera). The history's bilinear
+  // lookup holds from 0 to the image's extent; past it on one side, the
+  // pixel came into view through that side's edge.
+  auto previous = [&](int x, int y) {
+    const glm::dvec3 dir = shared.cameraRay(setup.camForward, setup.camRight, setup.camDown, setup.frustum, double(x),
+                                            double(y), rw, rh);
+    const double z = glm::dot(dir, pf);
+    if (z <= 1e-9) return glm::dvec2(-1e30);
+    return shared.frustumPixel(prev.frustum, glm::dvec2(glm::dot(dir, pr), -glm::dot(dir, pd)) / z, rw, rh);
+  };
+  // Each edge walked inwards along every `step`-th row (column) and the
+  // last; a band one pixel wider covers the rows between.
+  const int rowStep = std::max(1, h / 64), columnStep = std::max(1, w / 64);
+  auto inward = [&](int along, int step, int limit, auto outsideAt) {
+    int width = 0;
+    for (int a = 0;; a = std::min(a + step, along - 1)) {
+      int d = 0;
+      while (d < limit && outsideAt(a, d)) ++d;
+      width = std::max(width, d);
+      if (a == along - 1) break;
+    }
+    return width > 0 && step > 1 ? std::min(width + 1, limit) : width;
+  };
+  // A ray from behind the previous camera counts as outside every side.
+  glm::uvec4 e(std::uint32_t(inward(h, rowStep, w / 2, [&](int y, int d) { return previous(d, y).x < 0; })),
+               std::uint32_t(inward(h, rowStep, w / 2, [&](int y, int d) {
+                 const glm::dvec2 p = previous(w - 1 - d, y);
+                 return p.x > rw || p.x < -1e29;
+               })),
+               std::uint32_t(inward(w, columnStep, h / 2, [&](int x, int d) { return previous(x, d).y < 0; })),
+               std::uint32_t(inward(w, columnStep, h / 2, [&](int x, int d) {
+                 const glm::dvec2 p = previous(x, h - 1 - d);
+                 return p.y > rh || p.y < -1e29;
+               })));
+  // The cloud pass writes the bands' samples after the packed pixels, in
+  // the rows of its output the packed image leaves free (reproject.comp
+  // reads them there): the widest band gives way until they fit.
+  const std::uint32_t packedW = (setup.width + n - 1) / n, packedH = (setup.height + n - 1) / n;
+  const std::uint32_t capacity = packedW * (setup.height - packedH);
+  const glm::uvec2 size(setup.width, setup.height);
+  while (FreshEdges{}.freshEdgeCount(e, size) > capacity) {
+    std::uint32_t* widest = &e.x;
+    for (std::uint32_t* c : {&e.y, &e.z, &e.w})
+      if (*c > *widest) widest = c;
+    --*widest;
+  }
+  return e;
 }
 
 std::string TemporalPlanner::resetReason(const Remembered& prev, const Remembered& now) const {
@@ -111,6 +188,10 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
     if (plan.turned_px > settings_.denseTurn_px) plan.interleave = 2;
   }
   const std::uint32_t drawnN = plan.interleave;
+  if (!plan.drawWhole && drawnN > 1 && settings_.freshEdges) {
+    plan.freshEdges = freshEdges(*previous_, setup, drawnN);
+    plan.freshEdgePixels = FreshEdges{}.freshEdgeCount(plan.freshEdges, glm::uvec2(setup.width, setup.height));
+  }
   const std::uint64_t index = inputs.patternIndex.value_or(frames_);
   plan.phase = plan.drawWhole ? glm::uvec2(0) : interleavePhase(drawnN, std::uint32_t(index % (drawnN * drawnN)));
   // With accumulation each cycle of n^2 frames shifts the step offsets by
@@ -140,6 +221,7 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
                        float(settings_.accumulationMotion_px));
   const std::uint32_t packedW = (setup.width + plan.interleave - 1) / plan.interleave;
   p.phase = gpu::uvec4(plan.phase.x, plan.phase.y, packedW, std::uint32_t(setup.layers.size()));
+  p.freshEdges = gpu::uvec4(plan.freshEdges);
   p.tolerance = gpu::vec4(float(settings_.depthTolerance), float(kDepthToleranceSlack_m), float(kLayerWindMargin_m),
                           float(settings_.accumulation));
   p.prevPosition = v4(glm::dvec3(0), setup.r_m);

@@ -39,6 +39,11 @@ struct TemporalPlan {
   std::string reason;      // why, when drawWhole
   std::uint32_t interleave = 1;  // of this frame: the settings', 2 in a fast turn, 1 drawn whole
   glm::uvec2 phase{0};
+  // Widths in pixels of the bands at the left, right, top and bottom edges
+  // the frame draws at every pixel (fresh_edges.glsl): what came into view
+  // since the previous frame. 0 without a history or with freshEdges off.
+  glm::uvec4 freshEdges{0};
+  std::uint32_t freshEdgePixels = 0;  // pixels in those bands
   double turned_px = 0;  // how far the view turned since the previous frame, in pixels at the image's centre
   double jitterShift = 0;      // FrameSetup::jitterShift: the cycle's step-offset shift with accumulation
   glm::dvec2 pixelShift{0};    // FrameSetup::pixelShift: the cycle's ray-position shift with pixelJitter
@@ -75,6 +80,9 @@ class TemporalPlanner {
   // The angle the view turned from `prev` to `now` (the rotation between the
   // two cameras' axes in ECEF, roll included), degrees.
   static double turn_deg(const Remembered& prev, const Remembered& now);
+  // The fresh edges' widths for a frame with this setup drawing 1 pixel of
+  // n x n after `prev`, within what the cloud pass's output can hold.
+  static glm::uvec4 freshEdges(const Remembered& prev, const FrameSetup& setup, std::uint32_t n);
   // Why the history cannot be used for a frame after `prev`; empty when it can.
   std::string resetReason(const Remembered& prev, const Remembered& now) const;
 

@@ -153,5 +153,74 @@ TEST(TemporalPlanner, AFastTurnDrawsOnePixelOfFour) {
   EXPECT_EQ(never.plan(setup, in).interleave, 4u);
 }
 
+// Fresh edges (TemporalSettings::freshEdges): after a turn the frame draws
+// at every pixel the band at the side the view turned towards, about as
+// wide as the view moved there (the turn at the centre, stretched by the
+// projection towards the edges); nothing when the view held
+// still or with the setting off; and never more than the rows the packed
+// image leaves free in the cloud pass's output (a 25 deg yaw bends the
+// corners' rows far out: the top and bottom bands share the room).
+TEST(TemporalPlanner, WhatCameIntoViewIsDrawnAtEveryPixel) {
+  TemporalSettings t;
+  t.interleave = 4;
+  t.denseTurn_px = 0;
+  t.freshEdges = true;
+  FrameSetup setup;
+  setup.width = 160;
+  setup.height = 90;
+  setup.rasterWidth = 160;
+  setup.rasterHeight = 90;
+  const double tanHalf = std::tan(30.0 * std::acos(-1.0) / 180);
+  setup.frustum = {-tanHalf * 16 / 9, tanHalf * 16 / 9, tanHalf, -tanHalf};
+  const double pixel_deg = 60.0 / 90.0, toRad = std::acos(-1.0) / 180;
+  auto look = [&](double yaw_deg, double pitch_deg) {
+    const double y = yaw_deg * toRad, p = pitch_deg * toRad;
+    setup.camForward = {std::sin(y) * std::cos(p), std::cos(y) * std::cos(p), std::sin(p)};
+    setup.camRight = {std::cos(y), -std::sin(y), 0};
+    setup.camDown = glm::cross(setup.camForward, setup.camRight);
+  };
+  FrameInputs in;
+  TemporalPlanner planner(t);
+  look(0, 0);
+  ASSERT_TRUE(planner.plan(setup, in).drawWhole);
+  TemporalPlan p = planner.plan(setup, in);
+  EXPECT_EQ(p.freshEdges, glm::uvec4(0)) << "a still view";
+  EXPECT_EQ(p.freshEdgePixels, 0u);
+
+  look(3 * pixel_deg, 0);  // 3 px to the right at the centre
+  p = planner.plan(setup, in);
+  ASSERT_FALSE(p.drawWhole);
+  EXPECT_EQ(p.freshEdges.x, 0u);
+  EXPECT_GE(p.freshEdges.y, 3u);
+  EXPECT_LE(p.freshEdges.y, 8u);  // the projection stretches the edge by ~2
+  EXPECT_LE(p.freshEdges.z + p.freshEdges.w, 6u);  // the corners' rows bend out a little
+  EXPECT_EQ(p.freshEdgePixels, p.freshEdges.y * 90 + (160 - p.freshEdges.y) * (p.freshEdges.z + p.freshEdges.w));
+  EXPECT_EQ(p.params.freshEdges, glm::uvec4(p.freshEdges));
+
+  look(3 * pixel_deg, 3 * pixel_deg);  // then 3 px up
+  p = planner.plan(setup, in);
+  EXPECT_GE(p.freshEdges.z, 3u);
+  EXPECT_LE(p.freshEdges.z, 6u);
+  EXPECT_EQ(p.freshEdges.w, 0u);
+  EXPECT_LE(p.freshEdges.x + p.freshEdges.y, 4u);
+
+  look(3 * pixel_deg + 60 * pixel_deg, 3 * pixel_deg);  // 40 deg: the history is dropped
+  EXPECT_TRUE(planner.plan(setup, in).drawWhole);
+  look(3 * pixel_deg + 100 * pixel_deg, 3 * pixel_deg);  // 40 px: more than the free rows hold
+  p = planner.plan(setup, in);
+  ASSERT_FALSE(p.drawWhole) << p.reason;
+  const std::uint32_t capacity = 40 * (90 - 23);  // the rows the packed image leaves free
+  EXPECT_LE(p.freshEdgePixels, capacity);
+  EXPECT_GT(p.freshEdgePixels, capacity - 160);  // what one band's pixel less frees
+  EXPECT_GT(p.freshEdges.y, 0u);
+
+  t.freshEdges = false;
+  TemporalPlanner off(t);
+  look(0, 0);
+  off.plan(setup, in);
+  look(3 * pixel_deg, 0);
+  EXPECT_EQ(off.plan(setup, in).freshEdges, glm::uvec4(0));
+}
+
 }  // namespace
 }  // namespace sky::render

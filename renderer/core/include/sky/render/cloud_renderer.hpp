@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -185,6 +186,13 @@ struct TemporalSettings {
   // costs more than the lag (docs/motion.md). 0: the share does not fall.
   // [0, 1000].
   double accumulationMotion_px = 1;
+  // Fresh edges: in a turn, the bands at the image's edges that came into
+  // view since the previous frame (their rays fell outside the previous
+  // image) are drawn at every pixel, not upscaled from 1 pixel of each
+  // block; the planner measures them each frame (shaders/include/fresh_edges.glsl).
+  // Off in every preset: on the bench's camera paths they cost up to half
+  // again the frame (fast turns) for at most +0.003 SSIM (docs/motion.md).
+  bool freshEdges = false;
 };
 
 // Frames of a still view after which an interleaved renderer's history is
@@ -309,6 +317,11 @@ struct TemporalReport {
   std::string reason;  // why it was drawn whole ("first frame", "teleport 2.1 km", ...); empty otherwise
   // The frame's interleave: the settings', 2 in a fast turn (TemporalSettings::denseTurn_px), 1 drawn whole.
   std::uint32_t interleave = 0;
+  // The fresh edges (TemporalSettings::freshEdges): the widths of the bands
+  // the frame drew at every pixel at the left, right, top and bottom edges,
+  // and their pixels (counted in `drawn` as well).
+  std::array<std::uint32_t, 4> freshEdges{};
+  std::uint64_t freshEdgePixels = 0;
   // Pixels of the image the cloud pass works on: with a resolution divisor d,
   // (width / d) x (height / d).
   std::uint64_t drawn = 0, reused = 0, offscreen = 0, disoccluded = 0;
