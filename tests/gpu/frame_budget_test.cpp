@@ -39,11 +39,14 @@ double timedFrame(render::CloudRenderer& r, const render::FrameInputs& in) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Round-robin medians of each level's frame time over `rounds` rounds (the
-// first round also builds what each level needs and is not counted), so the
-// machine's drift falls on all levels alike.
+// Each level's frame time over `rounds` rounds, round-robin (the first
+// round also builds what each level needs and is not counted), so the
+// machine's drift falls on all levels alike: the median per level, and in
+// `fastest` the fastest (the machine's other load only adds time, so the
+// fastest frames give the levels' own relative costs best).
 std::vector<double> levelTimes(render::CloudRenderer& r, const std::vector<render::BudgetLevel>& ladder,
-                               const weather::WeatherSnapshot& snap, std::uint64_t rounds) {
+                               const weather::WeatherSnapshot& snap, std::uint64_t rounds,
+                               std::vector<double>* fastest) {
   std::vector<std::vector<double>> ms(ladder.size());
   for (std::uint64_t round = 0; round < rounds; ++round)
     for (std::size_t level = 0; level < ladder.size(); ++level) {
@@ -52,7 +55,11 @@ std::vector<double> levelTimes(render::CloudRenderer& r, const std::vector<rende
       if (round > 0) ms[level].push_back(t);
     }
   std::vector<double> out;
-  for (auto& m : ms) out.push_back(median(m));
+  fastest->clear();
+  for (auto& m : ms) {
+    out.push_back(median(m));
+    fastest->push_back(*std::min_element(m.begin(), m.end()));
+  }
   return out;
 }
 
@@ -63,8 +70,8 @@ std::size_t bestFitting(const std::vector<double>& levelMs, double budgetMs) {
   return levelMs.size() - 1;
 }
 
-// `high` at 320x180: every level's time on the path's first frames (again,
-// up to three times, until level 3 is faster than level 1, 20 % apart on
+// `high` at 320x180: every level's time on the path's first frames (8 each,
+// again up to three times, until level 3 is faster than level 1, 20 % apart on
 // the bench); the budget halfway between levels 1 and 3; then 40 frames
 // under the budget. This machine is shared and its speed drifts by a third
 // within a minute (CI once measured level 4 at 85 ms where the calibration
@@ -77,7 +84,9 @@ std::size_t bestFitting(const std::vector<double>& levelMs, double budgetMs) {
 // levels are 5-10 % apart, less than the noise of separate measurement), and
 // the median frame fits (5 % over at most) unless no cheaper level exists.
 // The calibration also checks the ladder's relative costs, which the bench
-// measured on its scenes, against this renderer on this path (20 %).
+// measured on its scenes, against this renderer on this path (20 %), from
+// each level's fastest of 8 frames: a burst of the machine's other load
+// during one level's frames can move a median ratio past that.
 TEST(FrameBudget, HoldsABudgetBetweenTwoLevelsOverAReplay) {
   SKY_RENDERER(shared, 64, 36);  // keeps the driver loaded (renderer_fixture.hpp)
   (void)shared;
@@ -95,9 +104,9 @@ TEST(FrameBudget, HoldsABudgetBetweenTwoLevelsOverAReplay) {
   weather::WeatherSnapshot snap;
   snap.layers.push_back(layer(1, 1500, 1000, 0.5, 1.0));
 
-  std::vector<double> levelMs;
+  std::vector<double> levelMs, fastestMs;
   for (int attempt = 0; attempt < 3 && !(levelMs.size() > 3 && levelMs[3] < levelMs[1]); ++attempt)
-    levelMs = levelTimes(**r, *ladder, snap, 5);
+    levelMs = levelTimes(**r, *ladder, snap, 9, &fastestMs);
   const std::size_t cheapest = ladder->size() - 1;
   const double budgetMs = 0.5 * (levelMs[1] + levelMs[3]);
   std::printf("[ budget   ] levels 0-%zu:", cheapest);
@@ -105,7 +114,7 @@ TEST(FrameBudget, HoldsABudgetBetweenTwoLevelsOverAReplay) {
   std::printf(" ms; budget %.1f ms, level %zu fits\n", budgetMs, bestFitting(levelMs, budgetMs));
   ASSERT_LT(levelMs[3], levelMs[1]) << "the ladder's levels must differ in time for the test to mean anything";
   for (std::size_t level = 1; level < ladder->size(); ++level)
-    EXPECT_NEAR(levelMs[level] / levelMs[0], (*ladder)[level].relativeCost, 0.2 * (*ladder)[level].relativeCost)
+    EXPECT_NEAR(fastestMs[level] / fastestMs[0], (*ladder)[level].relativeCost, 0.2 * (*ladder)[level].relativeCost)
         << "level " << level << ": the bench's relative cost does not hold on this path";
 
   constexpr std::size_t kProbe = 2;
