@@ -6,7 +6,7 @@
 # from it, and every case must have been timed.
 # side-by-side: every stdout line must be exactly a CLOUDPASS line.
 # sweeps (with -DSWEEPS=deploy/bench/sweeps): the seeds' sweeps at 48x27 on
-# one scene write their eight tables.
+# one scene write their eight tables (--smoke: one timed repeat each).
 # Prints "SKIPPED: no Vulkan device" (ctest SKIP_REGULAR_EXPRESSION) when the
 # bench exits 77.
 cmake_minimum_required(VERSION 3.25)
@@ -50,7 +50,7 @@ if(MODE STREQUAL "sweeps")
   # deploy/bench/sweeps at 48x27 on one scene: eight tables, each with the
   # rows of its sweep (--scenes replaces the multmin and divmin sweeps' own).
   file(REMOVE_RECURSE "${OUT}")
-  execute_process(COMMAND bash ${SWEEPS} --bench ${BENCH} --resolution 48x27 --scenes cumulus-midday --out "${OUT}"
+  execute_process(COMMAND bash ${SWEEPS} --bench ${BENCH} --resolution 48x27 --scenes cumulus-midday --smoke --out "${OUT}"
                   RESULT_VARIABLE rc ERROR_VARIABLE err)
   string(REPLACE ";" "," err "${err}")
   if(NOT rc EQUAL 0 AND EXISTS "${OUT}/light.log")
