@@ -23,6 +23,9 @@ layout(local_size_x = kReprojectLocalSizeX, local_size_y = kReprojectLocalSizeY)
 // TemporalSettings::historyClip > 0: the clip's code is compiled in (a
 // specialisation constant, as lavapipe runs every branch for every lane).
 layout(constant_id = 0) const bool kHistoryClip = false;
+// TemporalSettings::sharpHistory: the history resampled with Catmull-Rom
+// weights over 4 x 4 pixels instead of bilinearly (compiled in only then).
+layout(constant_id = 1) const bool kSharpHistory = false;
 
 layout(std430, set = 0, binding = kReprojectBindingParams) readonly buffer ParamsBlock { SkyReproject params; };
 // What it gathers from is in storage images (renderer/core/src/pixel_mirror.hpp:
@@ -144,6 +147,49 @@ bool previousPixel(vec3 dir, float d, out vec2 p, out float expected) {
 
 bool insideImage(ivec2 q) { return q.x >= 0 && q.y >= 0 && q.x < int(gSize.x) && q.y < int(gSize.y); }
 
+// Catmull-Rom weights of the taps at -1, 0, 1 and 2 for a position t in
+// [0, 1) past tap 0: they sum to 1 and keep a linear ramp, and resampling
+// with them every frame blurs far less than bilinear weights do.
+vec4 catmullRom(float t) {
+  float t2 = t * t, t3 = t2 * t;
+  return vec4(-0.5 * t3 + t2 - 0.5 * t, 1.5 * t3 - 2.5 * t2 + 1.0, -1.5 * t3 + 2.0 * t2 + 0.5 * t, 0.5 * t3 - 0.5 * t2);
+}
+
+// historyAt's resampling with kSharpHistory: Catmull-Rom over the 4 x 4
+// taps round i0 + f whose depth agrees, renormalised over them, and held
+// within the range of the four nearest agreeing taps (the negative lobes
+// would otherwise ring at a cloud's edge). Accepted, and the depth blended,
+// as the bilinear lookup: over the four nearest taps.
+bool sharpHistoryAt(ivec2 i0, vec2 f, float expected, out vec4 colour, out float seenDepth) {
+  vec4 wx = catmullRom(f.x), wy = catmullRom(f.y);
+  colour = vec4(0.0);
+  seenDepth = 0.0;
+  vec4 lo = vec4(3.0e38), hi = vec4(-3.0e38);
+  float wsum = 0.0, inner = 0.0;
+  for (int k = 0; k < 16; ++k) {
+    ivec2 o = ivec2(k & 3, k >> 2) - 1;
+    ivec2 c = i0 + o;
+    if (!insideImage(c)) continue;
+    float hd = historyDepthAtPixel(c);
+    if (!agree(hd, expected)) continue;
+    vec4 v = historyAtPixel(c);
+    float w = wx[o.x + 1] * wy[o.y + 1];
+    colour += w * v;
+    wsum += w;
+    if (o.x >= 0 && o.x <= 1 && o.y >= 0 && o.y <= 1) {
+      float b = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
+      seenDepth += b * hd;
+      inner += b;
+      lo = min(lo, v);
+      hi = max(hi, v);
+    }
+  }
+  if (inner < 0.5 || wsum < 0.25) return false;
+  colour = clamp(colour / wsum, lo, hi);
+  seenDepth /= inner;
+  return true;
+}
+
 // The history at continuous position p, bilinear over the taps whose depth
 // agrees with `expected`; exactly the nearest pixel when p is (within 1e-3
 // px) a pixel centre, so a still view keeps its pixels bit for bit. False
@@ -167,6 +213,7 @@ bool historyAt(vec2 p, float expected, out vec4 colour, out float seenDepth) {
     seenDepth = hd;
     return true;
   }
+  if (kSharpHistory) return sharpHistoryAt(i0, f, expected, colour, seenDepth);
   float wsum = 0.0;
   for (int k = 0; k < 4; ++k) {
     ivec2 o = ivec2(k & 1, k >> 1);

@@ -7,8 +7,10 @@
 // (temporal_plan.cpp measures them). The bands' pixels are numbered left
 // band first, row by row, then right, top, bottom: the cloud pass writes
 // sample k after the packed pixels of the frame, the reprojection finds it
-// there. Written in the subset GLSL and C++ share (core_common.glsl); the
-// C++ unit test (tests/unit/renderer/fresh_edges_test.cpp) compiles it.
+// there. No preset turns it on: measured on the bench's camera paths it
+// costs more than it gains (docs/motion.md). Written in the subset GLSL and
+// C++ share (core_common.glsl); the C++ unit test
+// (tests/unit/renderer/fresh_edges_test.cpp) compiles it.
 
 // Pixels in the four bands of a width x height image.
 uint freshEdgeCount(uvec4 edges, uvec2 size) {

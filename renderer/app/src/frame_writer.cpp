@@ -142,6 +142,7 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
       {"pixel_jitter", s.temporal.pixelJitter && s.temporal.accumulation > 0},
       {"history_clip", s.temporal.interleave > 1 ? s.temporal.historyClip : 0.0},
       {"fresh_edges", s.temporal.interleave > 1 && s.temporal.freshEdges},
+      {"sharp_history", s.temporal.interleave > 1 && s.temporal.sharpHistory},
       {"resolution_divisor", s.resolution.divisor},
       {"resolution", {s.width, s.height}},
       {"vertical_fov_deg", s.verticalFov_deg},

@@ -10,8 +10,9 @@
 #include "sky/core/assert.hpp"
 #include "sky/render/ephemeris.hpp"
 #include "sky/render/haze.hpp"
-#include "fresh_edges.hpp"
 #include "sky/weather/advection.hpp"
+
+#include "fresh_edges.hpp"
 #include "sky_light_grid.hpp"
 
 namespace sky::render {

@@ -28,9 +28,11 @@ class ReprojectPass {
   // fresh and freshDepth: the cloud pass's output buffers (width * height
   // entries; they must outlive the pass). Errors: Io/Malformed for the
   // SPIR-V; other Vulkan failures throw. historyClip: compile the history
-  // clip in (TemporalSettings::historyClip > 0).
+  // clip in (TemporalSettings::historyClip > 0); sharpHistory: resample the
+  // history with Catmull-Rom weights (TemporalSettings::sharpHistory).
   static Result<ReprojectPass> create(const GpuContext& ctx, std::uint32_t width, std::uint32_t height,
-                                      const GpuBuffer& fresh, const GpuBuffer& freshDepth, bool historyClip);
+                                      const GpuBuffer& fresh, const GpuBuffer& freshDepth, bool historyClip,
+                                      bool sharpHistory);
 
   // Records the copy of the cloud pass's pixels, the pass, the copy of its
   // output into image() and the barrier that makes the output readable by

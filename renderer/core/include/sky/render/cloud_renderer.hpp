@@ -3,8 +3,8 @@
 // it returns, and PNG output. The Vulkan machinery stays behind a pimpl.
 #pragma once
 
-#include <cstddef>
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -193,6 +193,12 @@ struct TemporalSettings {
   // Off in every preset: on the bench's camera paths they cost up to half
   // again the frame (fast turns) for at most +0.003 SSIM (docs/motion.md).
   bool freshEdges = false;
+  // The history, where a pixel takes it from between the previous frame's
+  // pixels, resampled with Catmull-Rom weights over 4 x 4 of them (held
+  // within the four nearest) instead of bilinearly over 2 x 2: in a long
+  // turn each frame resamples what the last one resampled, and bilinear
+  // weights blur it a little more every time.
+  bool sharpHistory = false;
 };
 
 // Frames of a still view after which an interleaved renderer's history is
