@@ -26,6 +26,9 @@ layout(constant_id = 0) const bool kHistoryClip = false;
 // TemporalSettings::sharpHistory: the history resampled with Catmull-Rom
 // weights over 4 x 4 pixels instead of bilinearly (compiled in only then).
 layout(constant_id = 1) const bool kSharpHistory = false;
+// TemporalSettings::freshEdges: the fresh edges' lookup is compiled in only
+// then (no preset uses them, and every pixel would pay for it).
+layout(constant_id = 2) const bool kFreshEdges = false;
 
 layout(std430, set = 0, binding = kReprojectBindingParams) readonly buffer ParamsBlock { SkyReproject params; };
 // What it gathers from is in storage images (renderer/core/src/pixel_mirror.hpp:
@@ -313,6 +316,7 @@ vec4 clippedHistory(ivec2 px, vec4 history) {
 bool drawnHere(ivec2 px, out ivec2 texel) {
   ivec2 b = px >> gShift;
   if (px == (b << gShift) + ivec2(gPhase) && drawnPixel(b, texel)) return true;
+  if (!kFreshEdges) return false;
   int k = freshEdgeIndex(px, gEdges, gSize);
   uint slot = gEdgeBase + uint(max(k, 0));
   uint row = uint((float(slot) + 0.5) / gPackedW);

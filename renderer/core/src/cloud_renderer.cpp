@@ -160,7 +160,8 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
     std::optional<ReprojectPass> reproject;
     if (settings.temporal.interleave > 1) {
       auto created = ReprojectPass::create(**ctx, smallW, smallH, pass->output(), pass->depth(),
-                                           settings.temporal.historyClip > 0, settings.temporal.sharpHistory);
+                                           settings.temporal.historyClip > 0, settings.temporal.sharpHistory,
+                                           settings.temporal.freshEdges);
       if (!created) return tl::unexpected(created.error());
       reproject.emplace(std::move(*created));
     }

@@ -12,7 +12,7 @@ namespace sky::render {
 
 Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t width, std::uint32_t height,
                                             const GpuBuffer& fresh, const GpuBuffer& freshDepth, bool historyClip,
-                                            bool sharpHistory) {
+                                            bool sharpHistory, bool freshEdges) {
   ReprojectPass pass;
   pass.width_ = width;
   pass.height_ = height;
@@ -27,7 +27,7 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
   builder.shader("reproject.comp.spv");
   // The history clip's code only where it is used: lavapipe runs a branch
   // for every lane whatever the condition, so a uniform "off" still pays.
-  builder.constants({historyClip ? 1u : 0u, sharpHistory ? 1u : 0u});
+  builder.constants({historyClip ? 1u : 0u, sharpHistory ? 1u : 0u, freshEdges ? 1u : 0u});
   auto pipeline = builder.build(ctx);
   if (!pipeline) return tl::unexpected(pipeline.error());
   pass.pipeline_ = std::move(*pipeline);

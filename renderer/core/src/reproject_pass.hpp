@@ -29,10 +29,11 @@ class ReprojectPass {
   // entries; they must outlive the pass). Errors: Io/Malformed for the
   // SPIR-V; other Vulkan failures throw. historyClip: compile the history
   // clip in (TemporalSettings::historyClip > 0); sharpHistory: resample the
-  // history with Catmull-Rom weights (TemporalSettings::sharpHistory).
+  // history with Catmull-Rom weights (TemporalSettings::sharpHistory);
+  // freshEdges: read the fresh edges' samples (TemporalSettings::freshEdges).
   static Result<ReprojectPass> create(const GpuContext& ctx, std::uint32_t width, std::uint32_t height,
                                       const GpuBuffer& fresh, const GpuBuffer& freshDepth, bool historyClip,
-                                      bool sharpHistory);
+                                      bool sharpHistory, bool freshEdges);
 
   // Records the copy of the cloud pass's pixels, the pass, the copy of its
   // output into image() and the barrier that makes the output readable by
