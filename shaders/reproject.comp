@@ -12,7 +12,10 @@
 // (TemporalSettings::historyClip), in motion the history a pixel takes is
 // first clipped to the box the pixels drawn this frame around it span
 // (history_clip.glsl). Layout: include/reproject_shared.h; the CPU side decides when the
-// history is dropped altogether (temporal_plan.cpp).
+// history is dropped altogether (temporal_plan.cpp). Where a change of the
+// weather's tiles shows (history_drop.hpp), a redrawn pixel replaces its
+// history instead of accumulating into it, so what changed is current
+// after one cycle of n^2 frames.
 #version 450
 #extension GL_GOOGLE_include_directive : require
 
@@ -41,6 +44,7 @@ layout(set = 0, binding = kReprojectBindingHistoryDepth, r32f) uniform readonly 
 layout(std430, set = 0, binding = kReprojectBindingOut) writeonly buffer OutBlock { vec4 outPixels[]; };
 layout(std430, set = 0, binding = kReprojectBindingOutDepth) writeonly buffer OutDepthBlock { float outDepth[]; };
 layout(std430, set = 0, binding = kReprojectBindingOutcomes) writeonly buffer OutcomeBlock { uint outcomes[]; };
+layout(std430, set = 0, binding = kReprojectBindingDrop) readonly buffer DropBlock { uint dropCells[]; };
 
 #define real float
 #define real2 vec2
@@ -77,6 +81,9 @@ uvec4 gEdges;      // the fresh edges' widths (SkyReproject::freshEdges)
 uint gEdgeBase;    // where in the packed image their samples start (after the drawn pixels)
 float gPackedW;    // the packed image's width
 bool gStill;  // neither the camera nor any layer's air moved since the previous frame
+bool gDrop;   // the history-drop mask is set this frame (SkyReproject::drop)
+// Its cells across and down, log2 of a cell's edge in pixels.
+uvec4 gDropGrid;
 
 // The drawn pixel of block b, when it lies inside the image; texel: where
 // the packed image holds it.
@@ -324,14 +331,23 @@ bool drawnHere(ivec2 px, out ivec2 texel) {
   return k >= 0;
 }
 
+// Whether the weather's tiles changed where pixel px looks (the history-drop
+// mask's cell): its accumulated history shows the old weather.
+bool droppedHere(ivec2 px) {
+  if (!gDrop) return false;
+  uvec2 c = min(uvec2(px) >> gDropGrid.z, gDropGrid.xy - 1u);
+  return dropCells[c.y * gDropGrid.x + c.x] != 0u;
+}
+
 uint resolvePixel(ivec2 px, out vec4 colour, out float depth) {
   ivec2 drawn;
+  bool dropped = droppedHere(px);
   if (drawnHere(px, drawn)) {
     colour = freshAt(drawn);
     depth = freshDepthAt(drawn);
     // Temporal accumulation: the redrawn pixel blended with its history,
     // found through the motion at the depth just drawn (depth stays as drawn).
-    if (gHasHistory && gAccumulation > 0.0) {
+    if (gHasHistory && gAccumulation > 0.0 && !dropped) {
       vec4 before;
       float guess = depth;
       vec2 from;
@@ -396,6 +412,8 @@ void main() {
   gStill = gPrevPosition == vec3(0.0) && gPrevFrustum == gFrustum && gPrevForward == gForward && gPrevRight == gRight && gPrevDown == gDown;
   for (uint l = 0u; l < kReprojectMaxLayers; ++l) gStill = gStill && (l >= gLayers || gMotion[l] == vec3(0.0));
   gClip = gClipGamma > 0.0 && !gStill;
+  gDropGrid = params.drop;
+  gDrop = gDropGrid.w != 0u && gDropGrid.x > 0u && gDropGrid.y > 0u;
   ivec2 px = ivec2(gl_GlobalInvocationID.xy);
   if (px.x < int(gSize.x) && px.y < int(gSize.y)) {
     vec4 colour;

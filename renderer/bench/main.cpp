@@ -82,10 +82,14 @@ int main(int argc, char** argv) {
   app.add_option("--width", width, "output width (with --height: one resolution; side-by-side default 640)");
   app.add_option("--height", height, "output height (side-by-side default 360)");
   app.add_option("--warmup", warmup, "untimed frames before each case")->capture_default_str();
+  bool noHistoryWarmup = false;
+  app.add_flag("--no-history-warmup", noHistoryWarmup,
+               "do not fill a temporal configuration's history before timing (checks only: stills then show an "
+               "unconverged image)");
   app.add_option("--repeats", repeats, "timed renders of each still")->capture_default_str();
   app.add_option("--path-repeats", pathRepeats, "timed runs of each camera path")->capture_default_str();
   app.add_option("--out", outDir, "output folder (default bench-output/<UTC date-time>)");
-  app.add_flag("--quick", quick, "48x27, two scenes (a still and a path), 1 warm-up, 1 repeat: checks the bench works");
+  app.add_flag("--quick", quick, "48x27, two scenes (a still and a path), 1 warm-up (no history fill), 1 repeat: checks the bench works");
   app.add_flag("--no-plots", noPlots, "skip the gnuplot plots");
   app.add_flag("--list", list, "list the suite's scenes and the configurations, then exit");
   app.add_flag("--side-by-side", sideBySide, "time one view: one CLOUDPASS line per frame on stdout");
@@ -142,12 +146,14 @@ int main(int argc, char** argv) {
   options.warmup = warmup;
   options.repeats = repeats;
   options.pathRepeats = pathRepeats;
+  options.historyWarmup = !noHistoryWarmup;
   std::vector<std::string> sceneNames = splitList(scenes);
   if (quick) {
     options.resolutions = {{kQuickWidth, kQuickHeight}};
     options.warmup = 1;
     options.repeats = 1;
     options.pathRepeats = 1;
+    options.historyWarmup = false;
     if (sceneNames.empty()) sceneNames = kQuickScenes;
   }
   if (!resolutions.empty()) {

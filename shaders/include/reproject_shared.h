@@ -25,7 +25,9 @@ SKY_REPROJECT_CONST kReprojectBindingHistory = 3u;       // rgba32f storage imag
 SKY_REPROJECT_CONST kReprojectBindingHistoryDepth = 4u;  // r32f storage image, read: its cloud depth
 SKY_REPROJECT_CONST kReprojectBindingOut = 5u;           // vec4: this frame's full image (the next history)
 SKY_REPROJECT_CONST kReprojectBindingOutDepth = 6u;      // float: its cloud depth
-SKY_REPROJECT_CONST kReprojectBindingOutcomes = 7u;         // uint per pixel: what became of it (below)
+SKY_REPROJECT_CONST kReprojectBindingOutcomes = 7u;      // uint per pixel: what became of it (below)
+SKY_REPROJECT_CONST kReprojectBindingDrop = 8u;          // read-only uint per cell of the history-drop
+                                                          // mask (SkyReproject::drop): 1 = the weather changed there
 
 // What became of each pixel (the values of the outcome buffer).
 SKY_REPROJECT_CONST kStatFresh = 0u;       // drawn this frame
@@ -66,10 +68,12 @@ struct SkyReproject {
   vec4 prevFrustum;  // the previous frame's, which the history was drawn with
   uvec4 freshEdges;  // widths (px) of the bands at the left, right, top and bottom edges drawn at every
                      // pixel this frame (fresh_edges.glsl), their samples after the packed pixels; 0 none
+  uvec4 drop;        // the history-drop mask (history_drop.hpp): x, y: cells across and down, z: log2 of a
+                     // cell's edge in pixels, w: 1 when the mask is set this frame (else it is not read)
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(SkyReproject) == 16 * (9 + 2 * kReprojectMaxLayers + 5));
+static_assert(sizeof(SkyReproject) == 16 * (9 + 2 * kReprojectMaxLayers + 6));
 static_assert(offsetof(SkyReproject, image) == 112);
 static_assert(offsetof(SkyReproject, layerBand) == 144);
 }  // namespace sky::gpu

@@ -8,7 +8,9 @@
 //  * flying through a cumulus layer at 150 m/s, the error stays bounded;
 //  * the history is dropped, and the frame drawn whole (bit-identical to the
 //    whole image), on a teleport, a large turn, a clock jump, entering or
-//    leaving a layer and a weather change (of the fine or the coarse snapshot).
+//    leaving a layer and a weather change (of the fine or the coarse snapshot);
+//  * a change of tiles in part of the view keeps the history and is redrawn
+//    into it within one cycle, where accumulation alone would lag.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -22,6 +24,7 @@
 #include "scenes.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky/render/presets.hpp"
+#include "sky/geo/geodetic.hpp"
 #include "sky/weather/tiling.hpp"
 
 namespace sky::test {
@@ -513,6 +516,79 @@ TEST(Temporal, HistoryIsDroppedWhenItCannotHold) {
   in.camera.position.alt_m = 1150.0;
   renderOk(*interleaved, in);
   EXPECT_EQ(interleaved->lastTemporal().reason, "camera left cloud layer 0");
+}
+
+// A storm cell of 6 km, 25 km ahead on the left, steps from coverage 0.5 to
+// 0.95 (the layer tiled at level 12 round the camera). The interleaved
+// renderer (1 pixel of 16, accumulation 0.5) keeps its history: the frame
+// is not drawn whole, the change marks part of the view for one cycle of 16
+// frames, and after it the error against the whole image of the new weather,
+// above the renderer's own on a still view, is under kTileChangeGain of
+// what it was just after the change: a redraw there replaces its history.
+// Accumulating into it instead would leave half the change's error after
+// the cycle (a redraw keeps 0.5 of the old image).
+constexpr double kTileChangeGain = 0.3;
+
+TEST(Temporal, AChangeOfTilesIsRedrawnWithinACycle) {
+  std::string skip;
+  auto whole = makeRenderer(1, kMotionPreset, &skip);
+  if (!whole) {
+    if (!skip.empty()) GTEST_SKIP() << skip;
+    return;
+  }
+  render::RenderSettings s;
+  s.width = kW;
+  s.height = kH;
+  s.march = render::findPreset(kMotionPreset)->march;
+  s.temporal.interleave = 4;
+  s.temporal.accumulation = 0.5;
+  auto created = render::CloudRenderer::create(s);
+  ASSERT_TRUE(created) << describe(created.error());
+  render::CloudRenderer& interleaved = **created;
+  auto cell = [](float inside) {
+    weather::WeatherSnapshot w;
+    w.tileLevel = 12;
+    w.layers.push_back(layer(1, 1200.0, 1800.0, 0.5, 1.0));
+    for (std::uint64_t c : weather::coverCap({46.0, 13.0, 60000.0}, 12, 100000)) {
+      const weather::CellCentre at = weather::cellCentre(c);
+      const bool in = geo::geodesicDistance_m(at.lat_deg, at.lon_deg, 46.2, 12.85) <= 6000.0;
+      w.tiles.push_back({c, 1, in ? inside : 0.5f, 1.0f});
+    }
+    return w;
+  };
+  const weather::WeatherSnapshot before = cell(0.5f), after = cell(0.95f);
+  render::FrameInputs in;
+  in.camera = pose(46.0, 13.0, 800.0, 0.0, 8.0);
+  in.sunAzimuth_deg = 150.0;
+  in.sunElevation_deg = 45.0;
+  in.weather = &before;
+  const std::uint32_t warmup = render::historyWarmupFrames(s.temporal);
+  for (std::uint32_t i = 0; i < warmup; ++i) renderOk(interleaved, in);
+  in.weather = &after;
+  const render::Image truth = renderOk(*whole, in);
+  const render::Image first = renderOk(interleaved, in);
+  const render::TemporalReport t = interleaved.lastTemporal();
+  EXPECT_FALSE(t.drawnWhole) << t.reason;
+  EXPECT_GT(t.weatherChangedFraction, 0.0);
+  EXPECT_LT(t.weatherChangedFraction, 0.5);
+  render::Image last;
+  for (int f = 1; f < 16; ++f) {
+    last = renderOk(interleaved, in);
+    EXPECT_EQ(interleaved.lastTemporal().weatherChangedFraction, t.weatherChangedFraction) << "frame " << f;
+  }
+  render::Image converged = renderOk(interleaved, in);
+  EXPECT_FALSE(interleaved.lastTemporal().drawnWhole);
+  EXPECT_EQ(interleaved.lastTemporal().weatherChangedFraction, 0.0) << "a cycle after the change";
+  // The renderer's own error on the still view of the new weather once its
+  // accumulation has converged: what the change's error falls back to.
+  for (std::uint32_t i = 0; i < warmup; ++i) converged = renderOk(interleaved, in);
+  const double e0 = relativeError(converged, truth);
+  const double e1 = relativeError(first, truth), e16 = relativeError(last, truth);
+  std::printf("[ tiles    ] a cell stepping 0.5 -> 0.95 on %.1f %% of the view: error %.2f %% just after, "
+              "%.2f %% a cycle later, %.2f %% converged\n",
+              100 * t.weatherChangedFraction, 100 * e1, 100 * e16, 100 * e0);
+  EXPECT_GT(e1, 2 * e0) << "the change shows";
+  EXPECT_LT(e16 - e0, kTileChangeGain * (e1 - e0));
 }
 
 TEST(Temporal, SettingsOutOfRangeAreRefused) {

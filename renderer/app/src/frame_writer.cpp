@@ -182,7 +182,8 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
     const render::TemporalReport& t = r.temporal;
     line["temporal"] = {{"drawn_whole", t.drawnWhole}, {"reason", t.reason}, {"interleave", t.interleave},
                         {"drawn", t.drawn},           {"fresh_edge_pixels", t.freshEdgePixels},
-                        {"reused", t.reused},          {"offscreen", t.offscreen}, {"disoccluded", t.disoccluded}};
+                        {"reused", t.reused},          {"offscreen", t.offscreen}, {"disoccluded", t.disoccluded},
+                        {"weather_changed_fraction", t.weatherChangedFraction}};
   }
   if (render::sunMapParts(s.march.sunShadow.method) > 0)
     line["sun_map"] = {{"rebuilt", r.sunMap.rebuilt}, {"reason", r.sunMap.reason}};

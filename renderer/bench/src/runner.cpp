@@ -107,7 +107,8 @@ Result<CaseResult> runCase(const LoadedScene& ls, const Configuration& config, c
   // A configuration that reuses history starts with it full (the first view
   // held still, as a simulator sits before it moves), so a still scene shows
   // the converged image and its steady per-frame cost.
-  const std::uint32_t warmup = std::max(options.warmup, render::historyWarmupFrames(settings.temporal));
+  const std::uint32_t warmup =
+      options.historyWarmup ? std::max(options.warmup, render::historyWarmupFrames(settings.temporal)) : options.warmup;
   for (std::uint32_t i = 0; i < warmup; ++i)
     if (auto warm = (*renderer)->render(frameInputs(ls, 0)); !warm) return tl::unexpected(warm.error());
 

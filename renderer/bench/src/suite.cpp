@@ -70,7 +70,7 @@ Result<CameraKey> parseKey(const toml::table& t, bool onPath, const std::string&
 
 Result<Scene> parseScene(const toml::table& t, std::size_t index, const Where& where) {
   const std::string prefix = "scene[" + std::to_string(index) + "].";
-  if (auto r = onlyKeys(t, {"name", "description", "weather", "vfov_deg", "sun", "camera", "path", "frames"}, prefix,
+  if (auto r = onlyKeys(t, {"name", "description", "weather", "vfov_deg", "sun", "camera", "path", "frames", "change"}, prefix,
                         where);
       !r)
     return failWith(r);
@@ -119,6 +119,8 @@ Result<Scene> parseScene(const toml::table& t, std::size_t index, const Where& w
   if (camera) {
     if (t.get("frames"))
       return where.error(ErrorCode::Malformed, t.get("frames")->source(), prefix + "frames", "only a path has frames");
+    if (t.get("change"))
+      return where.error(ErrorCode::Malformed, t.get("change")->source(), prefix + "change", "only a path has a change");
     auto ct = subTable(*camera, prefix + "camera", where);
     if (!ct) return failWith(ct);
     auto key = parseKey(**ct, false, prefix + "camera.", where);
@@ -146,6 +148,38 @@ Result<Scene> parseScene(const toml::table& t, std::size_t index, const Where& w
     return where.error(ErrorCode::InvalidArgument, (*frames)->source(), prefix + "frames",
                        "must be an integer in [2, " + std::to_string(kMaxPathFrames) + "]");
   scene.frames = std::uint32_t(count->get());
+  if (const toml::node* changeNode = t.get("change")) {
+    auto ct = subTable(*changeNode, prefix + "change", where);
+    if (!ct) return failWith(ct);
+    const std::string cp = prefix + "change.";
+    if (auto r = onlyKeys(**ct, {"t_s", "ramp_s", "layer", "lat_deg", "lon_deg", "radius_km", "coverage"}, cp, where); !r)
+      return failWith(r);
+    WeatherChange c;
+    const struct {
+      const char* key;
+      double lo, hi;
+      double* out;
+    } fields[] = {{"t_s", 0, 1e6, &c.t_s},           {"lat_deg", -90, 90, &c.lat_deg},
+                  {"lon_deg", -180, 180, &c.lon_deg}, {"radius_km", 1e-3, 100, &c.radius_m},
+                  {"coverage", 0, 1, &c.coverage}};
+    for (const auto& f : fields) {
+      auto v = numberIn(**ct, f.key, f.lo, f.hi, cp, where);
+      if (!v) return failWith(v);
+      *f.out = *v;
+    }
+    if ((*ct)->get("ramp_s")) {
+      auto v = numberIn(**ct, "ramp_s", 0, 1e6, cp, where);
+      if (!v) return failWith(v);
+      c.ramp_s = *v;
+    }
+    c.radius_m *= 1000.0;
+    auto layer = numberIn(**ct, "layer", 0, 3, cp, where);
+    if (!layer) return failWith(layer);
+    if (*layer != std::floor(*layer))
+      return where.error(ErrorCode::InvalidArgument, (*ct)->get("layer")->source(), cp + "layer", "not a whole number");
+    c.layer = std::uint32_t(*layer);
+    scene.change = c;
+  }
   return scene;
 }
 

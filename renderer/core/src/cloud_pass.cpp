@@ -285,7 +285,7 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
     // through the permutation in frame.dispatch.
     commands_.dispatch(frame.image.w, 1, 1);
   }
-  if (next.reproject != nullptr) next.reproject->record(commands_, timer_, *next.reprojectParams);
+  if (next.reproject != nullptr) next.reproject->record(commands_, timer_, *next.reprojectParams, next.dropCells);
   if (next.upscale != nullptr)
     next.upscale->record(commands_, timer_, *next.upscaleParams);
   if (next.reproject == nullptr && next.upscale == nullptr) {

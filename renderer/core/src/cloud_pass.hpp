@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "atmosphere_tables.hpp"
@@ -49,6 +50,7 @@ class CloudPass {
   struct Followers {
     ReprojectPass* reproject = nullptr;
     const gpu::SkyReproject* reprojectParams = nullptr;
+    std::span<const std::uint32_t> dropCells;  // the history-drop mask, when reprojectParams->drop.w is set
     UpscalePass* upscale = nullptr;
     const gpu::SkyUpscale* upscaleParams = nullptr;
   };

@@ -195,7 +195,17 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
   if (auto ok = validateInputs(inputs); !ok) return tl::unexpected(ok.error());
   return atVulkanEdge("CloudRenderer::render", [&]() -> Result<Image> {
     impl_->passTimes.clear();
+    const std::uint64_t uploadsBefore = impl_->weather.uploads();
     if (auto ok = impl_->weather.update(*impl_->ctx, inputs); !ok) return tl::unexpected(ok.error());
+    // How the map changed since the previous frame, for the history: not
+    // at all, in these tiles' texels alone, or (unset) rebuilt.
+    WeatherEdit edit;
+    edit.field = &impl_->weather.field();
+    if (impl_->weather.uploads() == uploadsBefore)
+      edit.rects.emplace();
+    else if (impl_->weather.uploads() == uploadsBefore + 1 && !impl_->weather.lastUpdate().rebuilt)
+      edit.rects = impl_->weather.lastRects();
+    edit.largestStep = impl_->weather.lastUpdate().largestStep;
     impl_->passTimes = impl_->weather.lastUploadTimes();
     if (impl_->weather.uploads() != impl_->coverageMipUploads) {  // a new map: its max-coverage mip
       // After one upload of changed tiles only their cells of the mip; a
@@ -224,7 +234,7 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
     CloudPass::Followers next;
     std::optional<TemporalPlan> plan;
     if (impl_->reproject) {
-      plan = impl_->planner.plan(setup, inputs);
+      plan = impl_->planner.plan(setup, inputs, edit);
       setup.interleave = plan->interleave;
       setup.phase = plan->phase;
       setup.freshEdges = plan->freshEdges;
@@ -233,6 +243,7 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
       setup.pixelJitter = plan->pixelJitter;
       next.reproject = &*impl_->reproject;
       next.reprojectParams = &plan->params;
+      next.dropCells = plan->drop.cells;
     }
     const gpu::SkyFrame frame = packFrame(setup);
     gpu::SkyUpscale upscaleBlock{};
@@ -255,6 +266,7 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
       impl_->temporal.interleave = plan->interleave;
       impl_->temporal.freshEdges = {plan->freshEdges.x, plan->freshEdges.y, plan->freshEdges.z, plan->freshEdges.w};
       impl_->temporal.freshEdgePixels = plan->freshEdgePixels;
+      impl_->temporal.weatherChangedFraction = plan->drop.fraction();
     }
     return image;
   });

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fresh_edges.hpp"
+#include "history_drop.hpp"
 #include "sky/core/assert.hpp"
 
 namespace sky::render {
@@ -18,7 +19,7 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
   pass.height_ = height;
   ComputePipelineBuilder builder("sky.reproject");
   for (std::uint32_t b : {gpu::kReprojectBindingParams, gpu::kReprojectBindingOut, gpu::kReprojectBindingOutDepth,
-                          gpu::kReprojectBindingOutcomes})
+                          gpu::kReprojectBindingOutcomes, gpu::kReprojectBindingDrop})
     builder.binding(b, vk::DescriptorType::eStorageBuffer);
   // What it gathers from, as images (pixel_mirror.hpp).
   for (std::uint32_t b : {gpu::kReprojectBindingFresh, gpu::kReprojectBindingFreshDepth, gpu::kReprojectBindingHistory,
@@ -47,13 +48,18 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
   pass.colour_ = createHostBuffer(ctx, pixels * 4 * sizeof(float), usage, "sky.reproject.image");
   pass.depth_ = createHostBuffer(ctx, pixels * sizeof(float), usage, "sky.reproject.depth");
   pass.outcomes_ = createHostBuffer(ctx, pixels * sizeof(std::uint32_t), storage, "sky.reproject.outcomes");
+  const std::uint32_t cell = 1u << kHistoryDropCellShift;
+  const vk::DeviceSize cells = vk::DeviceSize((width + cell - 1) / cell) * ((height + cell - 1) / cell);
+  pass.drop_ = createHostBuffer(ctx, cells * sizeof(std::uint32_t), storage, "sky.reproject.drop");
+  std::memset(pass.drop_.mapped, 0, pass.drop_.size);
 
   auto info = [](const GpuBuffer& b) { return vk::DescriptorBufferInfo(*b.buffer, 0, b.size); };
   const std::vector<std::pair<std::uint32_t, vk::DescriptorBufferInfo>> buffers{
       std::pair{gpu::kReprojectBindingParams, info(pass.params_)},
       std::pair{gpu::kReprojectBindingOut, info(pass.colour_)},
       std::pair{gpu::kReprojectBindingOutDepth, info(pass.depth_)},
-      std::pair{gpu::kReprojectBindingOutcomes, info(pass.outcomes_)}};
+      std::pair{gpu::kReprojectBindingOutcomes, info(pass.outcomes_)},
+      std::pair{gpu::kReprojectBindingDrop, info(pass.drop_)}};
   // The history images hold zeros until the first record() (unused then: no history).
   const std::vector<std::pair<std::uint32_t, vk::DescriptorImageInfo>> images{
       std::pair{gpu::kReprojectBindingFresh, pass.fresh_->colourInfo()},
@@ -64,9 +70,16 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
   return pass;
 }
 
-void ReprojectPass::record(const vk::raii::CommandBuffer& commands, GpuTimer& timer, const gpu::SkyReproject& params) {
+void ReprojectPass::record(const vk::raii::CommandBuffer& commands, GpuTimer& timer, const gpu::SkyReproject& params,
+                           std::span<const std::uint32_t> dropCells) {
   SKY_ASSERT(params.image.x == width_ && params.image.y == height_);
   std::memcpy(params_.mapped, &params, sizeof params);
+  if (params.drop.w != 0) {
+    SKY_ASSERT(params.drop.z == kHistoryDropCellShift);
+    SKY_ASSERT(dropCells.size() == std::size_t(params.drop.x) * params.drop.y);
+    SKY_ASSERT(dropCells.size_bytes() <= drop_.size);
+    std::memcpy(drop_.mapped, dropCells.data(), dropCells.size_bytes());
+  }
   // The pixels the cloud pass drew, packed n x n (n = params.image.z), then
   // the fresh edges' in the rows after them.
   const std::uint32_t n = std::max(params.image.z, 1u);

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <utility>
 
 #include "compute_pipeline.hpp"
@@ -37,8 +38,10 @@ class ReprojectPass {
 
   // Records the copy of the cloud pass's pixels, the pass, the copy of its
   // output into image() and the barrier that makes the output readable by
-  // the host. The block is copied now.
-  void record(const vk::raii::CommandBuffer& commands, GpuTimer& timer, const gpu::SkyReproject& params);
+  // the host. The block and the history-drop mask (its cells, when
+  // params.drop.w is set: params.drop.x * params.drop.y of them) are copied now.
+  void record(const vk::raii::CommandBuffer& commands, GpuTimer& timer, const gpu::SkyReproject& params,
+              std::span<const std::uint32_t> dropCells = {});
   // After the submission completed: the image the last record() wrote, and
   // what became of its pixels.
   Image readBack() const;
@@ -58,6 +61,7 @@ class ReprojectPass {
   GpuBuffer colour_;                    // the image it writes (read back by the host)
   GpuBuffer depth_;
   GpuBuffer outcomes_;  // uint per pixel: what became of it (kStat*)
+  GpuBuffer drop_;      // uint per cell of the history-drop mask (history_drop.hpp)
   StorageSet set_;
   std::uint32_t width_ = 0, height_ = 0;
 };

@@ -134,7 +134,7 @@ glm::uvec4 TemporalPlanner::freshEdges(const Remembered& prev, const FrameSetup&
 }
 
 std::string TemporalPlanner::resetReason(const Remembered& prev, const Remembered& now) const {
-  if (now.sceneKey != prev.sceneKey) return "weather changed";
+  if (now.structureKey != prev.structureKey) return "weather changed";
   const double moved_m = glm::length(now.cameraEcef_m - prev.cameraEcef_m);
   if (moved_m > settings_.resetDistance_m) return "camera moved " + rounded(moved_m, 0) + " m";
   const double turned_deg = turn_deg(prev, now);
@@ -152,7 +152,7 @@ std::string TemporalPlanner::resetReason(const Remembered& prev, const Remembere
   return {};
 }
 
-TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& inputs) {
+TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& inputs, const WeatherEdit& edit) {
   Remembered now;
   now.cameraEcef_m = setup.cameraEcef_m;
   now.localToEcef = setup.localToEcef;
@@ -164,15 +164,46 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   now.moonLit = setup.moonLit;
   now.clock_s = inputs.weatherClock_s;
   if (!inputs.weatherVersion || inputs.weatherVersion != keyVersion_) {
-    versionKey_ = weatherSceneKey(inputs.weather, inputs.coarseWeather);
+    versionStructureKey_ = weatherStructureKey(inputs.weather, inputs.coarseWeather);
+    versionContentKey_ = weatherContentKey(inputs.weather, inputs.coarseWeather);
     keyVersion_ = inputs.weatherVersion;
   }
-  now.sceneKey = versionKey_;
+  now.structureKey = versionStructureKey_;
+  now.contentKey = versionContentKey_;
   for (const LayerSetup& l : setup.layers) now.layerSide.push_back(l.hTop_m > 0 ? 1 : l.hBase_m < 0 ? -1 : 0);
 
   TemporalPlan plan;
   const std::uint32_t n = settings_.interleave;
-  const std::string reason = previous_ ? resetReason(*previous_, now) : forgottenBecause_;
+  std::string reason = previous_ ? resetReason(*previous_, now) : forgottenBecause_;
+  // Only tiles changed: the history stays, redrawn without accumulation
+  // where they show; a step over most of the view (or a change the map
+  // does not know in tiles) redraws the frame whole.
+  const bool tilesChanged = reason.empty() && now.contentKey != previous_->contentKey;
+  if (tilesChanged) {
+    if (!settings_.regionDrop || !edit.rects || edit.field == nullptr) {
+      reason = "weather changed";
+    } else if (edit.largestStep > kMaxRampStep) {
+      const HistoryDrop d = historyDrop(setup, *edit.field, *edit.rects);
+      if (d.everywhere)
+        reason = "weather changed round the camera";
+      else if (d.fraction() > kMaxHistoryDropFraction)
+        reason = "weather changed over " + rounded(100.0 * d.fraction(), 0) + " % of the view";
+    }
+  }
+  // The changes of the last cycle of n^2 frames: each pixel is redrawn
+  // once a cycle, and until then its history shows the old weather, so a
+  // redraw replaces it wherever one of them shows in this frame's view. In
+  // the map's texels, so only while the map keeps its anchor.
+  if (!reason.empty() || (edit.field != nullptr && !sameAnchor(edit.field->anchor, recentAnchor_))) recent_.clear();
+  if (edit.field != nullptr) recentAnchor_ = edit.field->anchor;
+  if (reason.empty() && tilesChanged && !edit.rects->empty()) recent_.push_back({frames_, *edit.rects});
+  while (!recent_.empty() && frames_ - recent_.front().frame >= std::uint64_t(n) * n) recent_.pop_front();
+  if (!recent_.empty()) {
+    std::vector<TexelRect> rects;
+    for (const RecentEdit& e : recent_) rects.insert(rects.end(), e.rects.begin(), e.rects.end());
+    plan.drop = historyDrop(setup, *edit.field, rects);
+    if (plan.drop.marked == 0) plan.drop = {};
+  }
   plan.drawWhole = !reason.empty();
   plan.reason = reason;
   plan.interleave = plan.drawWhole ? 1 : n;
@@ -222,6 +253,8 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   const std::uint32_t packedW = (setup.width + plan.interleave - 1) / plan.interleave;
   p.phase = gpu::uvec4(plan.phase.x, plan.phase.y, packedW, std::uint32_t(setup.layers.size()));
   p.freshEdges = gpu::uvec4(plan.freshEdges);
+  if (!plan.drop.cells.empty())
+    p.drop = gpu::uvec4(plan.drop.cellsX, plan.drop.cellsY, kHistoryDropCellShift, 1u);
   p.tolerance = gpu::vec4(float(settings_.depthTolerance), float(kDepthToleranceSlack_m), float(kLayerWindMargin_m),
                           float(settings_.accumulation));
   p.prevPosition = v4(glm::dvec3(0), setup.r_m);

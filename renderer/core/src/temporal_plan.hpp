@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
@@ -16,6 +17,7 @@
 #include <glm/vec3.hpp>
 
 #include "frame_setup.hpp"
+#include "history_drop.hpp"
 #include "reproject_shared.h"
 #include "sky/render/cloud_renderer.hpp"
 
@@ -26,6 +28,14 @@ inline constexpr double kDepthToleranceSlack_m = 20;
 // Height margin around a layer inside which a point moves with its wind (m):
 // a cloud depth is a transmittance-weighted mean, which may lie just outside.
 inline constexpr double kLayerWindMargin_m = 300;
+// A change of tiles by more than this many of the map's 1/255 steps at a
+// texel is a step, not a ramp (a server's ramp moves coverage a few steps a
+// frame). A step that shows in more of the image than kMaxHistoryDropFraction
+// (in cells of the history-drop mask), or round the camera, redraws the
+// frame whole; a smaller one, or a ramp anywhere, keeps the history and is
+// redrawn into it over one interleave cycle.
+inline constexpr std::uint32_t kMaxRampStep = 16;
+inline constexpr double kMaxHistoryDropFraction = 0.5;
 // (sqrt(5) - 1) / 2: the step-offset shift per cycle with accumulation.
 inline constexpr double kGoldenRatioConjugate = 0.6180339887498949;
 
@@ -33,6 +43,16 @@ inline constexpr double kGoldenRatioConjugate = 0.6180339887498949;
 // cycle (0 .. n^2 - 1): ordered dispersed (Bayer), so consecutive frames
 // draw far-apart pixels and any n^2 consecutive frames draw every pixel once.
 glm::uvec2 interleavePhase(std::uint32_t n, std::uint32_t cycleIndex);
+
+// The weather map's change since the previous frame, as the renderer knows
+// it (WeatherTexture): the texel rectangles rewritten when only tiles
+// changed (none when the map did not change), unset when it was rebuilt or
+// is not known.
+struct WeatherEdit {
+  const WeatherField* field = nullptr;
+  std::optional<std::vector<TexelRect>> rects;
+  std::uint32_t largestStep = 0;  // WeatherMapReport::largestStep
+};
 
 struct TemporalPlan {
   bool drawWhole = true;   // no history: the cloud pass draws every pixel
@@ -44,6 +64,10 @@ struct TemporalPlan {
   // since the previous frame. 0 without a history or with freshEdges off.
   glm::uvec4 freshEdges{0};
   std::uint32_t freshEdgePixels = 0;  // pixels in those bands
+  // Where the changes of the weather's tiles of the last interleave cycle
+  // show (history_drop.hpp): there a redraw replaces its history. Empty
+  // cells when none.
+  HistoryDrop drop;
   double turned_px = 0;  // how far the view turned since the previous frame, in pixels at the image's centre
   double jitterShift = 0;      // FrameSetup::jitterShift: the cycle's step-offset shift with accumulation
   glm::dvec2 pixelShift{0};    // FrameSetup::pixelShift: the cycle's ray-position shift with pixelJitter
@@ -55,13 +79,16 @@ class TemporalPlanner {
  public:
   explicit TemporalPlanner(const TemporalSettings& settings) : settings_(settings) {}
 
-  // Plans the frame with this setup (inputs: its clock and weather) and
-  // remembers it as the previous frame for the next call.
-  TemporalPlan plan(const FrameSetup& setup, const FrameInputs& inputs);
+  // Plans the frame with this setup (inputs: its clock and weather; edit:
+  // how the weather map changed since the previous call) and remembers it
+  // as the previous frame for the next call. Without an edit a change of
+  // the weather's tiles redraws the frame whole.
+  TemporalPlan plan(const FrameSetup& setup, const FrameInputs& inputs, const WeatherEdit& edit = {});
   // Forgets the previous frame (after a frame that failed on the GPU, or on
   // a host's reset): the next frame is drawn whole, for `reason`.
   void forget(std::string reason = "first frame") {
     previous_.reset();
+    recent_.clear();
     forgottenBecause_ = std::move(reason);
   }
 
@@ -74,7 +101,8 @@ class TemporalPlanner {
     glm::dvec3 keyLightEcef{0};
     bool moonLit = false;
     double clock_s = 0;
-    std::uint64_t sceneKey = 0;
+    std::uint64_t structureKey = 0;  // weatherStructureKey
+    std::uint64_t contentKey = 0;    // weatherContentKey
     std::vector<int> layerSide;  // per layer: -1 under its base, 0 inside, 1 over its top
   };
   // The angle the view turned from `prev` to `now` (the rotation between the
@@ -88,11 +116,19 @@ class TemporalPlanner {
 
   TemporalSettings settings_;
   std::optional<Remembered> previous_;
-  // The scene key of the last weather version seen (FrameInputs::weatherVersion).
+  // The keys of the last weather version seen (FrameInputs::weatherVersion).
   std::optional<std::uint64_t> keyVersion_;
-  std::uint64_t versionKey_ = 0;
+  std::uint64_t versionStructureKey_ = 0, versionContentKey_ = 0;
   std::string forgottenBecause_ = "first frame";  // the reason of a frame without previous_
   std::uint64_t frames_ = 0;  // frames planned: the place in the interleave cycle (without patternIndex)
+  // The changes of tiles of the last interleave cycle (their frame, the
+  // map's texels they rewrote) and the map's anchor they refer to.
+  struct RecentEdit {
+    std::uint64_t frame = 0;
+    std::vector<TexelRect> rects;
+  };
+  std::deque<RecentEdit> recent_;
+  geo::Geodetic recentAnchor_;
 };
 
 }  // namespace sky::render

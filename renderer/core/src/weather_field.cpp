@@ -86,6 +86,14 @@ std::uint64_t tilesKey(const weather::WeatherSnapshot& snapshot) {
   return h;
 }
 
+// A layer as the map sees it: its id, type, and uniform coverage and density.
+void mixLayerContent(std::uint64_t& h, const weather::CloudLayer& layer) {
+  mix64(h, layer.id);
+  mix64(h, static_cast<std::uint64_t>(layer.type));
+  mix64(h, bitsOf(layer.coverage));
+  mix64(h, bitsOf(layer.density));
+}
+
 // Marks the start of the coarse snapshot's part of a key, so that tiles
 // moved from one snapshot to the other change it.
 constexpr std::uint64_t kCoarseKeyMarker = 0x636f6172736552ull;  // "coarseR"
@@ -98,12 +106,7 @@ WeatherKeys weatherKeys(const weather::WeatherSnapshot* snapshot, const weather:
   k.content = h;
   if (snapshot == nullptr) return k;
   mix64(h, snapshot->layers.size());
-  for (const auto& layer : snapshot->layers) {
-    mix64(h, layer.id);
-    mix64(h, static_cast<std::uint64_t>(layer.type));
-    mix64(h, bitsOf(layer.coverage));
-    mix64(h, bitsOf(layer.density));
-  }
+  for (const auto& layer : snapshot->layers) mixLayerContent(h, layer);
   k.fineTiles = tilesKey(*snapshot);
   mix64(h, k.fineTiles);
   // Only the coarse snapshot's tiles and level reach the map (its layers'
@@ -122,15 +125,29 @@ std::uint64_t weatherContentKey(const weather::WeatherSnapshot* snapshot, const 
   return weatherKeys(snapshot, coarse).content;
 }
 
-std::uint64_t weatherSceneKey(const weather::WeatherSnapshot* snapshot, const weather::WeatherSnapshot* coarse) {
-  std::uint64_t h = weatherContentKey(snapshot, coarse);
+std::uint64_t weatherStructureKey(const weather::WeatherSnapshot* snapshot, const weather::WeatherSnapshot* coarse) {
+  std::uint64_t h = 14695981039346656037ull;
   if (snapshot == nullptr) return h;
+  mix64(h, snapshot->layers.size());
   for (const auto& layer : snapshot->layers) {
+    mixLayerContent(h, layer);
     mix64(h, bitsOf(layer.base_m));
     mix64(h, bitsOf(layer.thickness_m));
     mix64(h, bitsOf(layer.wind.speed_mps));
     mix64(h, bitsOf(layer.wind.fromDirection_deg));
     mix64(h, bitsOf(layer.wind.vertical_mps));
+  }
+  // Whether each layer has tiles at all: a layer going from uniform to
+  // tiled (or back) changes it everywhere.
+  mix64(h, static_cast<std::uint64_t>(snapshot->tileLevel));
+  std::vector<std::uint32_t> tiled;
+  for (const auto& tile : snapshot->tiles)
+    if (std::find(tiled.begin(), tiled.end(), tile.layerId) == tiled.end()) tiled.push_back(tile.layerId);
+  std::sort(tiled.begin(), tiled.end());
+  for (std::uint32_t id : tiled) mix64(h, id);
+  if (coarse != nullptr) {
+    mix64(h, kCoarseKeyMarker);
+    mix64(h, static_cast<std::uint64_t>(coarse->tileLevel));
   }
   return h;
 }

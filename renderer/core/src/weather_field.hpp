@@ -168,11 +168,13 @@ struct WeatherKeys {
 };
 WeatherKeys weatherKeys(const weather::WeatherSnapshot* snapshot, const weather::WeatherSnapshot* coarse);
 
-// weatherContentKey and everything else about the weather that changes the
-// image, apart from the clock and the camera: each layer's base, thickness
-// and wind. A change of it drops an interleaved renderer's history.
-std::uint64_t weatherSceneKey(const weather::WeatherSnapshot* snapshot,
-                              const weather::WeatherSnapshot* coarse = nullptr);
+// What of the weather changes the image everywhere when it changes, apart
+// from the clock and the camera: the layers (ids, order, type, uniform
+// coverage and density, base, thickness, wind), the tile levels and which
+// layers have tiles; not the tiles' values, which change the image only
+// where they lie (temporal_plan.cpp drops the history there alone).
+std::uint64_t weatherStructureKey(const weather::WeatherSnapshot* snapshot,
+                                  const weather::WeatherSnapshot* coarse = nullptr);
 
 // Fills the map around anchor. A layer without tiles is uniform (its own
 // coverage and density); a layer with tiles is empty where a cell has none.

@@ -2,6 +2,8 @@
 #include "weather_field_update.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cstdlib>
 #include <numeric>
 
 #include "sky/core/assert.hpp"
@@ -160,8 +162,14 @@ WeatherFieldChange WeatherFieldUpdater::update(const weather::WeatherSnapshot* f
     for (std::uint32_t ring = t.ring; ring <= lastRing; ++ring) {
       indexCells(ring);
       Bounds& b = bounds[std::size_t(ring) * field_.sliceCount + t.slice];
+      const std::size_t sliceBase =
+          (std::size_t(ring) * field_.sliceCount + t.slice) * std::size_t(field_.size) * field_.size;
       for (const std::uint32_t texel : index_[ring].texelsOf(t.cell)) {
+        const std::uint8_t* at = &field_.texels[(sliceBase + texel) * kWeatherChannels];
+        const std::array<std::uint8_t, 3> before{at[0], at[1], at[2]};
         writeWeatherTexel(field_, ring, t.slice, texel, t.value);
+        for (std::size_t c = 0; c < before.size(); ++c)
+          change.largestStep = std::max<std::uint32_t>(change.largestStep, std::uint32_t(std::abs(int(at[c]) - int(before[c]))));
         const std::uint32_t x = texel % field_.size, y = texel / field_.size;
         b = {std::min(b.x0, x), std::min(b.y0, y), std::max(b.x1, x), std::max(b.y1, y)};
         ++change.texelsRewritten;

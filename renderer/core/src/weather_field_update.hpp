@@ -36,6 +36,10 @@ struct WeatherFieldChange {
   std::string reason;                 // why it was rebuilt ("anchor moved", "a tile removed", ...)
   std::uint64_t texelsRewritten = 0;  // texels written, counted per array layer (all of them when rebuilt)
   std::vector<TexelRect> dirty;       // Tiles: per array layer touched, the bounding rectangle of its rewrites
+  // Tiles: the largest change of a rewritten texel's coverage, density or
+  // blend, in the map's 1/255 steps (a ramp moves a few a frame, a step
+  // change many).
+  std::uint32_t largestStep = 0;
 };
 
 class WeatherFieldUpdater {

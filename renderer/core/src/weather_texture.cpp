@@ -41,6 +41,7 @@ Result<void> WeatherTexture::update(const GpuContext& ctx, const FrameInputs& in
       return uploadWhole(ctx);
     case WeatherFieldChange::Kind::Tiles:
       lastRects_ = change.dirty;
+      lastUpdate_.largestStep = change.largestStep;
       return uploadRects(ctx, change.dirty);
   }
   return {};

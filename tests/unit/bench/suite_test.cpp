@@ -48,9 +48,9 @@ TEST(Suite, ShippedSuiteLoadsEveryScene) {
   // The stills and the camera paths the issues asked for (issue 21 the last three).
   for (const char* n : {"cumulus-midday", "sunset-backlit", "overcast-below", "inside-cloud", "above-deck-10km",
                         "cumulonimbus", "cirrus-over-cumulus", "polar", "godrays", "fast-turn", "cumulus-fly-through",
-                        "glider-thermal", "airliner-climb", "roll-pitch-in-cloud"})
+                        "glider-thermal", "airliner-climb", "roll-pitch-in-cloud", "cell-grows", "cell-step"})
     EXPECT_TRUE(names.count(n)) << n;
-  EXPECT_EQ(paths, 5u);
+  EXPECT_EQ(paths, 7u);
   auto two = loadSuite(SKY_BENCH_SUITE_FILE, {"polar", "fast-turn"});
   ASSERT_TRUE(two);
   ASSERT_EQ(two->size(), 2u);
@@ -88,6 +88,16 @@ TEST(Suite, ErrorsNameLineAndField) {
       {pathScene(kKeyA, 4), "path"},                                                       // one key is no path
       {still + "frames = 3\n", "frames"},                                                  // a still with frames
       {"[[scene]\n", "TOML"},                                                              // syntax
+      {still + "change = { t_s = 0, layer = 0, lat_deg = 1, lon_deg = 2, radius_km = 3, coverage = 1 }\n",
+       "scene[0].change"},                                                                // a still with a change
+      {pathScene(kKeyA + kKeyB, 4) +
+           "change = { t_s = 0, layer = 0, lat_deg = 1, lon_deg = 2, radius_km = 300, coverage = 1 }\n",
+       "change.radius_km"},                                                               // out of range
+      {pathScene(kKeyA + kKeyB, 4) + "change = { t_s = 0, layer = 0.5, lat_deg = 1, lon_deg = 2, radius_km = 3, "
+                                     "coverage = 1 }\n",
+       "change.layer"},                                                                   // not whole
+      {pathScene(kKeyA + kKeyB, 4) + "change = { t_s = 0, layer = 0, lat_deg = 1, lon_deg = 2, radius_km = 3 }\n",
+       "change.coverage"},                                                                // missing
   };
   for (const Case& c : cases) {
     auto suite = parseSuite(c.text, "s.toml");
@@ -95,6 +105,47 @@ TEST(Suite, ErrorsNameLineAndField) {
     EXPECT_NE(suite.error().detail.find("s.toml:"), std::string::npos) << suite.error().detail;
     EXPECT_NE(suite.error().detail.find(c.fieldInError), std::string::npos) << suite.error().detail;
   }
+}
+
+// A path's change (Scene::change): parsed with its ramp, and the loaded
+// scene's weather tiles the layer round the first pose, the disc ramping
+// from the layer's coverage to the change's over ramp_s, the rest as it was.
+TEST(Suite, AChangeRampsTheDiscsTiles) {
+  auto suite = parseSuite(pathScene(kKeyA + kKeyB, 5) + "change = { t_s = 0.5, ramp_s = 1, layer = 0, lat_deg = 10.1, "
+                                                         "lon_deg = 179, radius_km = 5, coverage = 0.9 }\n",
+                          "p.toml");
+  ASSERT_TRUE(suite) << describe(suite.error());
+  const Scene& s = suite->scenes[0];
+  ASSERT_TRUE(s.change);
+  EXPECT_DOUBLE_EQ(s.change->radius_m, 5000);
+  EXPECT_DOUBLE_EQ(s.change->ramp_s, 1);
+  weather::WeatherSnapshot before;
+  before.layers.resize(1);
+  before.layers[0].id = 7;
+  before.layers[0].coverage = 0.5;
+  before.layers[0].density = 0.8;
+  const double done[] = {0, 0.5, 1};
+  auto three = changedSnapshots(before, *s.change, s.keys.front().pose, done);
+  ASSERT_TRUE(three) << describe(three.error());
+  ASSERT_EQ(three->size(), 3u);
+  const weather::WeatherSnapshot &start = (*three)[0], &half = (*three)[1], &end = (*three)[2];
+  ASSERT_GT(start.tiles.size(), 1000u);
+  ASSERT_EQ(start.tiles.size(), end.tiles.size());
+  std::size_t inDisc = 0;
+  for (std::size_t i = 0; i < end.tiles.size(); ++i) {
+    EXPECT_EQ(start.tiles[i].layerId, 7u);
+    EXPECT_FLOAT_EQ(start.tiles[i].coverage, 0.5f);
+    EXPECT_FLOAT_EQ(end.tiles[i].density, 0.8f);
+    if (end.tiles[i].coverage != 0.5f) {
+      ++inDisc;
+      EXPECT_FLOAT_EQ(end.tiles[i].coverage, 0.9f);
+      EXPECT_FLOAT_EQ(half.tiles[i].coverage, 0.7f);
+    }
+  }
+  EXPECT_GT(inDisc, 5u);
+  EXPECT_LT(inDisc, end.tiles.size() / 50);
+  before.layers.clear();
+  EXPECT_FALSE(changedSnapshots(before, *s.change, s.keys.front().pose, done)) << "no layer 0";
 }
 
 TEST(Suite, PathInterpolatesTheShortWayRound) {

@@ -303,15 +303,20 @@ TEST(WeatherRings, CoarseSnapshotFillsTheCoarseRing) {
     extra.coarse.tiles.push_back({cell, 99, 1.0f, 1.0f});
   EXPECT_EQ(buildWeatherField(&extra.fine, &extra.coarse, camera).texels, both.texels);
 
-  // The map's key (and the interleaved renderer's scene key) sees the
-  // coarse snapshot and its tiles.
+  // The map's key sees the coarse snapshot and its tiles; the structure key
+  // (whose change drops an interleaved renderer's history) sees the coarse
+  // snapshot but not its tiles' values (a change of tiles keeps the history).
   EXPECT_NE(weatherContentKey(&t.fine, &t.coarse), weatherContentKey(&t.fine));
   EXPECT_EQ(weatherContentKey(&t.fine, nullptr), weatherContentKey(&t.fine));
   TwoSnapshots changed = t;
   changed.coarse.tiles[3].coverage = 0.95f;
   EXPECT_NE(weatherContentKey(&changed.fine, &changed.coarse), weatherContentKey(&t.fine, &t.coarse));
-  EXPECT_NE(weatherSceneKey(&changed.fine, &changed.coarse), weatherSceneKey(&t.fine, &t.coarse));
-  EXPECT_NE(weatherSceneKey(&t.fine, &t.coarse), weatherSceneKey(&t.fine));
+  EXPECT_EQ(weatherStructureKey(&changed.fine, &changed.coarse), weatherStructureKey(&t.fine, &t.coarse));
+  EXPECT_NE(weatherStructureKey(&t.fine, &t.coarse), weatherStructureKey(&t.fine));
+  TwoSnapshots moved = t;
+  moved.fine.layers[0].base_m += 100;
+  EXPECT_NE(weatherStructureKey(&moved.fine, &moved.coarse), weatherStructureKey(&t.fine, &t.coarse));
+  EXPECT_EQ(weatherContentKey(&moved.fine, &moved.coarse), weatherContentKey(&t.fine, &t.coarse));
 }
 
 TEST(WeatherRings, BlendTypeCountsTheTilesOfBothRings) {

@@ -26,6 +26,10 @@ struct RunOptions {
   // Untimed frames before timing each case: a pipeline's first dispatch
   // compiles its shader variant (10-70 ms extra on lavapipe, lavapipe.md).
   std::uint32_t warmup = 2;
+  // A configuration that reuses history first fills it (historyWarmupFrames,
+  // hundreds of frames with accumulation); off only for checks that the
+  // bench runs, whose stills then show an unconverged image.
+  bool historyWarmup = true;
   std::uint32_t repeats = 5;      // timed renders of each still
   std::uint32_t pathRepeats = 1;  // timed runs of each whole camera path
   std::filesystem::path outDir;   // contact sheets go to outDir/contact/

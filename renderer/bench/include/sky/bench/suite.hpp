@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -28,6 +29,23 @@ struct CameraKey {
   geo::GeodeticPose pose;  // CIGI pose: lat/lon deg, alt m above the ellipsoid, yaw/pitch/roll deg
 };
 
+// A change of one layer's coverage within a disc during a path: the layer
+// is given tiles round the path's first pose (kChangeTiledRadius_m), all at
+// its own coverage and density until t_s, from when those whose centre lies
+// within the disc ramp linearly to `coverage` over ramp_s (a storm cell
+// growing in view, as the server's ramps change it).
+struct WeatherChange {
+  double t_s = 0;                  // path time it starts, [0, 1e6]
+  double ramp_s = 0;               // [0, 1e6]; 0: a step
+  std::uint32_t layer = 0;         // index into the weather file's layers
+  double lat_deg = 0, lon_deg = 0; // the disc's centre
+  double radius_m = 0;             // (0, 100 km]
+  double coverage = 0;             // [0, 1]
+};
+// How far round the first pose a changed layer has tiles, m: past the
+// renderer's fine weather ring (100 km); beyond it the layer is empty.
+inline constexpr double kChangeTiledRadius_m = 150000.0;
+
 struct Scene {
   std::string name;         // [A-Za-z0-9_-]+, unique in the suite; names output files
   std::string description;  // one line for the report
@@ -36,6 +54,7 @@ struct Scene {
   double sunAzimuth_deg = 0, sunElevation_deg = 0;  // local ENU at the camera: az clockwise from north [0, 360), el [-90, 90]
   std::vector<CameraKey> keys;  // one key: a still; two or more: a path
   std::uint32_t frames = 1;     // a path's frames, evenly spaced from the first key's time to the last's, [2, kMaxPathFrames]
+  std::optional<WeatherChange> change;  // a path's only
 
   bool isPath() const { return keys.size() > 1; }
 };

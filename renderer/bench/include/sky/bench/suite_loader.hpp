@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -27,7 +28,18 @@ Result<LoadedWeather> loadWeatherFile(const std::filesystem::path& path);
 struct LoadedScene {
   Scene scene;
   LoadedWeather weather;
+  // With Scene::change: each frame's weather (the changed layer tiled).
+  std::vector<weather::WeatherSnapshot> frameWeather;
 };
+
+// A scene's change (Scene::change) over `before`'s layers, one snapshot
+// per fraction of `done` ([0, 1] of the way): the layer tiled round
+// `centre` at its own coverage, the disc's tiles that fraction of the way
+// to the change's. Errors: InvalidArgument (no such layer).
+Result<std::vector<weather::WeatherSnapshot>> changedSnapshots(const weather::WeatherSnapshot& before,
+                                                                const WeatherChange& change,
+                                                                const geo::GeodeticPose& centre,
+                                                                std::span<const double> done);
 
 // Reads the suite and each chosen scene's weather (relative paths from the
 // suite's folder). `names` empty = every scene, in file order; otherwise these

@@ -199,6 +199,14 @@ struct TemporalSettings {
   // turn each frame resamples what the last one resampled, and bilinear
   // weights blur it a little more every time.
   bool sharpHistory = false;
+  // A change of only the weather's tiles (a region's or a station's
+  // coverage ramping) keeps the history; in the cells of the image the
+  // changed tiles' volume and shadow may show in (history_drop.hpp) a
+  // redrawn pixel replaces its history instead of accumulating into it, so
+  // the image follows the weather within one cycle of n^2 frames. A step
+  // (kMaxRampStep) over more than half the image redraws the frame whole,
+  // as does every change of tiles with this off.
+  bool regionDrop = true;
 };
 
 // Frames of a still view after which an interleaved renderer's history is
@@ -331,6 +339,10 @@ struct TemporalReport {
   // Pixels of the image the cloud pass works on: with a resolution divisor d,
   // (width / d) x (height / d).
   std::uint64_t drawn = 0, reused = 0, offscreen = 0, disoccluded = 0;
+  // The share of the image where the weather's tiles changed since the
+  // previous frame (history_drop.hpp; there a redraw replaces its history
+  // rather than accumulating into it), 0 without such a change.
+  double weatherChangedFraction = 0;
 };
 
 // What the weather map's update did for the last frame: nothing (same
@@ -342,6 +354,9 @@ struct WeatherMapReport {
   std::string reason;                 // why it was rebuilt ("anchor moved", ...); empty otherwise
   std::uint64_t texelsRewritten = 0;  // RGBA8 texels written, over all rings and slices
   std::uint64_t bytesUploaded = 0;    // bytes copied into the GPU's weather image
+  // With only tiles rewritten: the largest change of a texel's coverage,
+  // density or blend, in the map's 1/255 steps.
+  std::uint32_t largestStep = 0;
 };
 
 // Linear radiance, rgba per pixel (a = view-ray transmittance through the
