@@ -9,7 +9,7 @@
 //  * the history is dropped, and the frame drawn whole (bit-identical to the
 //    whole image), on a teleport, a large turn, a clock jump, entering or
 //    leaving a layer and a weather change (of the fine or the coarse snapshot);
-//  * a change of tiles in part of the view keeps the history and is redrawn
+//  * a ramp of tiles in part of the view keeps the history and is redrawn
 //    into it within one cycle, where accumulation alone would lag.
 #include <cmath>
 #include <cstdio>
@@ -518,18 +518,18 @@ TEST(Temporal, HistoryIsDroppedWhenItCannotHold) {
   EXPECT_EQ(interleaved->lastTemporal().reason, "camera left cloud layer 0");
 }
 
-// A storm cell of 6 km, 25 km ahead on the left, steps from coverage 0.5 to
-// 0.95 (the layer tiled at level 12 round the camera). The interleaved
-// renderer (1 pixel of 16, accumulation 0.5) keeps its history: the frame
-// is not drawn whole, the change marks part of the view for one cycle of 16
-// frames, and after it the error against the whole image of the new weather,
-// above the renderer's own on a still view, is under kTileChangeGain of
-// what it was just after the change: a redraw there replaces its history.
-// Accumulating into it instead would leave half the change's error after
-// the cycle (a redraw keeps 0.5 of the old image).
+// A storm cell of 6 km, 25 km ahead on the left, ramps from coverage 0.5 to
+// 0.95 in 9 frames (13 of the map's 1/255 steps a frame; the layer tiled at
+// level 12 round the camera). The interleaved renderer (1 pixel of 16,
+// accumulation 0.5) keeps its history through the ramp, marking part of
+// the view until a cycle of 16 frames after its last change. After that
+// cycle the error against the whole image of the new weather, above the
+// renderer's own once converged, is under kTileChangeGain of what it was at
+// the ramp's end: a redraw there replaces its history. Accumulating into it
+// instead leaves about a third (measured 0.35 of it; replacing, 0.10).
 constexpr double kTileChangeGain = 0.3;
 
-TEST(Temporal, AChangeOfTilesIsRedrawnWithinACycle) {
+TEST(Temporal, ARampOfTilesIsRedrawnWithinACycle) {
   std::string skip;
   auto whole = makeRenderer(1, kMotionPreset, &skip);
   if (!whole) {
@@ -556,38 +556,43 @@ TEST(Temporal, AChangeOfTilesIsRedrawnWithinACycle) {
     }
     return w;
   };
-  const weather::WeatherSnapshot before = cell(0.5f), after = cell(0.95f);
+  std::vector<weather::WeatherSnapshot> ramp;
+  for (int k = 0; k <= 9; ++k) ramp.push_back(cell(0.5f + 0.05f * float(k)));
   render::FrameInputs in;
   in.camera = pose(46.0, 13.0, 800.0, 0.0, 8.0);
   in.sunAzimuth_deg = 150.0;
   in.sunElevation_deg = 45.0;
-  in.weather = &before;
+  in.weather = &ramp[0];
   const std::uint32_t warmup = render::historyWarmupFrames(s.temporal);
   for (std::uint32_t i = 0; i < warmup; ++i) renderOk(interleaved, in);
-  in.weather = &after;
-  const render::Image truth = renderOk(*whole, in);
-  const render::Image first = renderOk(interleaved, in);
-  const render::TemporalReport t = interleaved.lastTemporal();
-  EXPECT_FALSE(t.drawnWhole) << t.reason;
-  EXPECT_GT(t.weatherChangedFraction, 0.0);
-  EXPECT_LT(t.weatherChangedFraction, 0.5);
-  render::Image last;
-  for (int f = 1; f < 16; ++f) {
-    last = renderOk(interleaved, in);
-    EXPECT_EQ(interleaved.lastTemporal().weatherChangedFraction, t.weatherChangedFraction) << "frame " << f;
+  render::Image atEnd;
+  double fraction = 0;
+  for (int k = 1; k <= 9; ++k) {
+    in.weather = &ramp[std::size_t(k)];
+    atEnd = renderOk(interleaved, in);
+    const render::TemporalReport& t = interleaved.lastTemporal();
+    EXPECT_FALSE(t.drawnWhole) << "ramp frame " << k << ": " << t.reason;
+    EXPECT_GT(t.weatherChangedFraction, 0.0) << k;
+    EXPECT_LT(t.weatherChangedFraction, 0.5) << k;
+    fraction = t.weatherChangedFraction;
   }
-  render::Image converged = renderOk(interleaved, in);
+  const render::Image truth = renderOk(*whole, in);
+  render::Image last;
+  for (int f = 1; f <= 16; ++f) {
+    last = renderOk(interleaved, in);
+    EXPECT_EQ(interleaved.lastTemporal().weatherChangedFraction > 0.0, f < 16) << "frame " << f << " after the ramp";
+  }
   EXPECT_FALSE(interleaved.lastTemporal().drawnWhole);
-  EXPECT_EQ(interleaved.lastTemporal().weatherChangedFraction, 0.0) << "a cycle after the change";
   // The renderer's own error on the still view of the new weather once its
   // accumulation has converged: what the change's error falls back to.
+  render::Image converged;
   for (std::uint32_t i = 0; i < warmup; ++i) converged = renderOk(interleaved, in);
   const double e0 = relativeError(converged, truth);
-  const double e1 = relativeError(first, truth), e16 = relativeError(last, truth);
-  std::printf("[ tiles    ] a cell stepping 0.5 -> 0.95 on %.1f %% of the view: error %.2f %% just after, "
+  const double e1 = relativeError(atEnd, truth), e16 = relativeError(last, truth);
+  std::printf("[ tiles    ] a cell ramping 0.5 -> 0.95 on %.1f %% of the view: error %.2f %% at the ramp's end, "
               "%.2f %% a cycle later, %.2f %% converged\n",
-              100 * t.weatherChangedFraction, 100 * e1, 100 * e16, 100 * e0);
-  EXPECT_GT(e1, 2 * e0) << "the change shows";
+              100 * fraction, 100 * e1, 100 * e16, 100 * e0);
+  EXPECT_GT(e1, 1.5 * e0) << "the change shows";
   EXPECT_LT(e16 - e0, kTileChangeGain * (e1 - e0));
 }
 

@@ -175,21 +175,14 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   TemporalPlan plan;
   const std::uint32_t n = settings_.interleave;
   std::string reason = previous_ ? resetReason(*previous_, now) : forgottenBecause_;
-  // Only tiles changed: the history stays, redrawn without accumulation
-  // where they show; a step over most of the view (or a change the map
-  // does not know in tiles) redraws the frame whole.
+  // Only tiles changed, a few of the map's steps at a time (a ramp): the
+  // history stays, redrawn without accumulation where they show. A step
+  // change, or one the map does not know in tiles, redraws the frame whole:
+  // kept, the history would dissolve into the new weather over a cycle.
   const bool tilesChanged = reason.empty() && now.contentKey != previous_->contentKey;
-  if (tilesChanged) {
-    if (!settings_.regionDrop || !edit.rects || edit.field == nullptr) {
-      reason = "weather changed";
-    } else if (edit.largestStep > kMaxRampStep) {
-      const HistoryDrop d = historyDrop(setup, *edit.field, *edit.rects);
-      if (d.everywhere)
-        reason = "weather changed round the camera";
-      else if (d.fraction() > kMaxHistoryDropFraction)
-        reason = "weather changed over " + rounded(100.0 * d.fraction(), 0) + " % of the view";
-    }
-  }
+  if (tilesChanged && (!settings_.regionDrop || !edit.rects || edit.field == nullptr ||
+                       edit.largestStep > kMaxRampStep))
+    reason = "weather changed";
   // The changes of the last cycle of n^2 frames: each pixel is redrawn
   // once a cycle, and until then its history shows the old weather, so a
   // redraw replaces it wherever one of them shows in this frame's view. In

@@ -29,13 +29,11 @@ inline constexpr double kDepthToleranceSlack_m = 20;
 // a cloud depth is a transmittance-weighted mean, which may lie just outside.
 inline constexpr double kLayerWindMargin_m = 300;
 // A change of tiles by more than this many of the map's 1/255 steps at a
-// texel is a step, not a ramp (a server's ramp moves coverage a few steps a
-// frame). A step that shows in more of the image than kMaxHistoryDropFraction
-// (in cells of the history-drop mask), or round the camera, redraws the
-// frame whole; a smaller one, or a ramp anywhere, keeps the history and is
-// redrawn into it over one interleave cycle.
+// texel is a step, which redraws the frame whole; up to it, a ramp (a
+// server's ramp moves coverage a few steps a frame at 30 frames/s: 0 to 1
+// in 10 s is under 1), which keeps the history and is redrawn into it over
+// one interleave cycle (docs/motion.md has both measured).
 inline constexpr std::uint32_t kMaxRampStep = 16;
-inline constexpr double kMaxHistoryDropFraction = 0.5;
 // (sqrt(5) - 1) / 2: the step-offset shift per cycle with accumulation.
 inline constexpr double kGoldenRatioConjugate = 0.6180339887498949;
 

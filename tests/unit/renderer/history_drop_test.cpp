@@ -7,8 +7,8 @@
 //  * a change behind the camera marks nothing; one round the camera marks
 //    every cell;
 //  * the planner keeps the history for a ramp of tiles and marks the
-//    cells for one interleave cycle, redraws whole for a step round the
-//    camera, for a change it cannot see in tiles, and with regionDrop off.
+//    cells for one interleave cycle, and redraws whole for a step, for a
+//    change it cannot see in tiles, and with regionDrop off.
 #include <cmath>
 #include <vector>
 
@@ -151,7 +151,7 @@ TEST(TemporalPlanner, AChangeOfTilesKeepsTheHistoryWhereItDoesNotShow) {
   const weather::WeatherSnapshot base = tiled(46.2, 12.85, 6000, 0.5f);
   const weather::WeatherSnapshot ramp = tiled(46.2, 12.85, 6000, 0.52f);  // 5 steps: a ramp
   const weather::WeatherSnapshot step = tiled(46.2, 12.85, 6000, 0.95f);
-  const weather::WeatherSnapshot round = tiled(kLat, kLon, 5000, 0.95f);
+  const weather::WeatherSnapshot round = tiled(kLat, kLon, 5000, 0.52f);
   auto planAfter = [&](const weather::WeatherSnapshot& to, TemporalSettings settings, bool withEdit) {
     Scene s;
     prepare(s, base, to);
@@ -170,13 +170,14 @@ TEST(TemporalPlanner, AChangeOfTilesKeepsTheHistoryWhereItDoesNotShow) {
   EXPECT_FALSE(a.drawWhole) << a.reason;
   EXPECT_GT(a.drop.marked, 0u);
   EXPECT_EQ(a.params.drop, gpu::uvec4(a.drop.cellsX, a.drop.cellsY, kHistoryDropCellShift, 1u));
-  const TemporalPlan b = planAfter(step, t, true);  // a step on a few cells of the view: kept too
-  EXPECT_FALSE(b.drawWhole) << b.reason;
-  const TemporalPlan c = planAfter(round, t, true);  // a step round the camera
-  EXPECT_TRUE(c.drawWhole);
-  EXPECT_EQ(c.reason, "weather changed round the camera");
-  EXPECT_TRUE(c.drop.cells.empty());
-  EXPECT_EQ(c.params.drop.w, 0u);
+  const TemporalPlan b = planAfter(step, t, true);  // a step, on a few cells of the view
+  EXPECT_TRUE(b.drawWhole);
+  EXPECT_EQ(b.reason, "weather changed");
+  EXPECT_TRUE(b.drop.cells.empty());
+  EXPECT_EQ(b.params.drop.w, 0u);
+  const TemporalPlan c = planAfter(round, t, true);  // a ramp round the camera: every cell
+  EXPECT_FALSE(c.drawWhole) << c.reason;
+  EXPECT_EQ(c.drop.marked, c.drop.cells.size());
   const TemporalPlan d = planAfter(ramp, t, false);  // the map's change is not known
   EXPECT_TRUE(d.drawWhole);
   EXPECT_EQ(d.reason, "weather changed");

@@ -204,7 +204,7 @@ struct TemporalSettings {
   // changed tiles' volume and shadow may show in (history_drop.hpp) a
   // redrawn pixel replaces its history instead of accumulating into it, so
   // the image follows the weather within one cycle of n^2 frames. A step
-  // (kMaxRampStep) over more than half the image redraws the frame whole,
+  // (over 16 of the map's 1/255 steps at a texel) redraws the frame whole,
   // as does every change of tiles with this off.
   bool regionDrop = true;
 };
