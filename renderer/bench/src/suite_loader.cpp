@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <fstream>
-#include <span>
 #include <sstream>
 
 #include "sky/geo/geodetic.hpp"
@@ -42,10 +41,12 @@ Result<LoadedWeather> loadWeatherFile(const std::filesystem::path& path) {
   return out;
 }
 
-Result<std::vector<weather::WeatherSnapshot>> changedSnapshots(const weather::WeatherSnapshot& before,
-                                                                const WeatherChange& change,
-                                                                const geo::GeodeticPose& centre,
-                                                                std::span<const double> done) {
+float ChangeTiles::coverageAt(double done) const {
+  return from + (to - from) * float(std::clamp(done, 0.0, 1.0));
+}
+
+Result<ChangeTiles> changeTiles(const weather::WeatherSnapshot& before, const WeatherChange& change,
+                                const geo::GeodeticPose& centre) {
   if (change.layer >= before.layers.size())
     return fail(ErrorCode::InvalidArgument, "change.layer " + std::to_string(change.layer) + ": the weather has " +
                                                 std::to_string(before.layers.size()) + " layers");
@@ -53,22 +54,18 @@ Result<std::vector<weather::WeatherSnapshot>> changedSnapshots(const weather::We
   // dozen in a disc of 8 km.
   constexpr int kLevel = 12;
   const weather::CloudLayer& layer = before.layers[change.layer];
-  weather::WeatherSnapshot base = before;
-  base.tileLevel = kLevel;
-  base.tiles.clear();
-  std::vector<std::size_t> inDisc;
+  ChangeTiles out;
+  out.tiled = before;
+  out.tiled.tileLevel = kLevel;
+  out.tiled.tiles.clear();
+  out.from = float(layer.coverage);
+  out.to = float(change.coverage);
   for (std::uint64_t cell :
        weather::coverCap({centre.position.lat_deg, centre.position.lon_deg, kChangeTiledRadius_m}, kLevel, 100000)) {
     const weather::CellCentre c = weather::cellCentre(cell);
     if (geo::geodesicDistance_m(c.lat_deg, c.lon_deg, change.lat_deg, change.lon_deg) <= change.radius_m)
-      inDisc.push_back(base.tiles.size());
-    base.tiles.push_back({cell, layer.id, float(layer.coverage), float(layer.density)});
-  }
-  std::vector<weather::WeatherSnapshot> out;
-  for (const double d : done) {
-    out.push_back(base);
-    const float coverage = float(layer.coverage + (change.coverage - layer.coverage) * std::clamp(d, 0.0, 1.0));
-    for (const std::size_t i : inDisc) out.back().tiles[i].coverage = coverage;
+      out.disc.push_back(out.tiled.tiles.size());
+    out.tiled.tiles.push_back({cell, layer.id, out.from, float(layer.density)});
   }
   return out;
 }
@@ -101,16 +98,12 @@ Result<std::vector<LoadedScene>> loadSuite(const std::filesystem::path& suiteFil
     if (weatherPath.is_relative()) weatherPath = suiteFile.parent_path() / weatherPath;
     auto weather = loadWeatherFile(weatherPath);
     if (!weather) return fail(weather.error().code, "scene '" + s->name + "': " + weather.error().detail);
-    LoadedScene loaded{*s, std::move(*weather), {}};
-    if (const auto& change = s->change) {
-      std::vector<double> done;
-      for (std::uint32_t f = 0; f < s->frames; ++f) {
-        const double t = frameTime_s(*s, f);
-        done.push_back(t < change->t_s ? 0.0 : change->ramp_s > 0 ? (t - change->t_s) / change->ramp_s : 1.0);
-      }
-      auto w = changedSnapshots(loaded.weather.snapshot, *change, s->keys.front().pose, done);
-      if (!w) return fail(w.error().code, "scene '" + s->name + "': " + w.error().detail);
-      loaded.frameWeather = std::move(*w);
+    LoadedScene loaded{*s, std::move(*weather), std::nullopt, {}};
+    if (s->change) {
+      auto tiles = changeTiles(loaded.weather.snapshot, *s->change, s->keys.front().pose);
+      if (!tiles) return fail(tiles.error().code, "scene '" + s->name + "': " + tiles.error().detail);
+      loaded.changing = tiles->tiled;
+      loaded.change = std::move(*tiles);
     }
     out.push_back(std::move(loaded));
   }
@@ -121,7 +114,14 @@ render::FrameInputs frameInputs(const LoadedScene& scene, std::uint32_t frame) {
   const double t = frameTime_s(scene.scene, frame);
   render::FrameInputs in;
   in.camera = poseAt(scene.scene, t);
-  in.weather = frame < scene.frameWeather.size() ? &scene.frameWeather[frame] : &scene.weather.snapshot;
+  in.weather = &scene.weather.snapshot;
+  if (scene.change) {
+    const WeatherChange& c = *scene.scene.change;
+    const double done = t < c.t_s ? 0.0 : c.ramp_s > 0 ? (t - c.t_s) / c.ramp_s : 1.0;
+    const float coverage = scene.change->coverageAt(done);
+    for (const std::size_t i : scene.change->disc) scene.changing.tiles[i].coverage = coverage;
+    in.weather = &scene.changing;
+  }
   in.weatherClock_s = scene.weather.clockStart_s + scene.weather.clockRate * t;
   in.sunAzimuth_deg = scene.scene.sunAzimuth_deg;
   in.sunElevation_deg = scene.scene.sunElevation_deg;

@@ -1,8 +1,9 @@
 // Where in the image a change of the weather's tiles shows: the cells of
 // the image whose rays may cross the changed tiles' volume (between the
 // layer's base and top) or its shadow on the ground, so an interleaved
-// renderer drops its history there alone and keeps it elsewhere (a storm
-// cell growing on one side of the view does not redraw the whole frame).
+// renderer keeps its history and lets a redraw replace it there alone (a
+// storm cell growing on one side of the view does not redraw the whole
+// frame; temporal_plan.cpp).
 // Conservative: the volume is sampled on a grid, projected into this frame's
 // camera, and the box of the projections, grown by a cell, is marked. Pure
 // (no GPU), unit-tested in tests/unit/renderer/history_drop_test.cpp.
@@ -25,7 +26,7 @@ inline constexpr std::uint32_t kHistoryDropCellShift = 3;
 
 struct HistoryDrop {
   std::uint32_t cellsX = 0, cellsY = 0;
-  std::vector<std::uint32_t> cells;  // cellsY rows of cellsX: 1 where the history is dropped
+  std::vector<std::uint32_t> cells;  // cellsY rows of cellsX: 1 where the change may show
   std::uint32_t marked = 0;          // cells set
   // The change reaches round the camera (part of its volume in front of it
   // and part behind): every cell is marked.

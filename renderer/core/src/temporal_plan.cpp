@@ -187,7 +187,7 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   // once a cycle, and until then its history shows the old weather, so a
   // redraw replaces it wherever one of them shows in this frame's view. In
   // the map's texels, so only while the map keeps its anchor.
-  if (!reason.empty() || (edit.field != nullptr && !sameAnchor(edit.field->anchor, recentAnchor_))) recent_.clear();
+  if (!reason.empty() || edit.field == nullptr || !sameAnchor(edit.field->anchor, recentAnchor_)) recent_.clear();
   if (edit.field != nullptr) recentAnchor_ = edit.field->anchor;
   if (reason.empty() && tilesChanged && !edit.rects->empty()) recent_.push_back({frames_, *edit.rects});
   while (!recent_.empty() && frames_ - recent_.front().frame >= std::uint64_t(n) * n) recent_.pop_front();

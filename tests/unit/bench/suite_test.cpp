@@ -7,6 +7,7 @@
 #include "sky/render/frame_budget.hpp"
 #include "sky/render/presets.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -124,28 +125,30 @@ TEST(Suite, AChangeRampsTheDiscsTiles) {
   before.layers[0].id = 7;
   before.layers[0].coverage = 0.5;
   before.layers[0].density = 0.8;
-  const double done[] = {0, 0.5, 1};
-  auto three = changedSnapshots(before, *s.change, s.keys.front().pose, done);
-  ASSERT_TRUE(three) << describe(three.error());
-  ASSERT_EQ(three->size(), 3u);
-  const weather::WeatherSnapshot &start = (*three)[0], &half = (*three)[1], &end = (*three)[2];
-  ASSERT_GT(start.tiles.size(), 1000u);
-  ASSERT_EQ(start.tiles.size(), end.tiles.size());
-  std::size_t inDisc = 0;
-  for (std::size_t i = 0; i < end.tiles.size(); ++i) {
-    EXPECT_EQ(start.tiles[i].layerId, 7u);
-    EXPECT_FLOAT_EQ(start.tiles[i].coverage, 0.5f);
-    EXPECT_FLOAT_EQ(end.tiles[i].density, 0.8f);
-    if (end.tiles[i].coverage != 0.5f) {
-      ++inDisc;
-      EXPECT_FLOAT_EQ(end.tiles[i].coverage, 0.9f);
-      EXPECT_FLOAT_EQ(half.tiles[i].coverage, 0.7f);
+  auto tiles = changeTiles(before, *s.change, s.keys.front().pose);
+  ASSERT_TRUE(tiles) << describe(tiles.error());
+  ASSERT_GT(tiles->tiled.tiles.size(), 1000u);
+  for (const weather::CoverageTile& tile : tiles->tiled.tiles) {
+    EXPECT_EQ(tile.layerId, 7u);
+    EXPECT_FLOAT_EQ(tile.coverage, 0.5f);
+    EXPECT_FLOAT_EQ(tile.density, 0.8f);
+  }
+  EXPECT_GT(tiles->disc.size(), 5u);
+  EXPECT_LT(tiles->disc.size(), tiles->tiled.tiles.size() / 50);
+  // Frames at 0, 0.5, 1, 1.5 and 2 s: the ramp from 0.5 s to 1.5 s.
+  LoadedScene scene{s, {before, 0, 1}, std::move(*tiles), {}};
+  scene.changing = scene.change->tiled;
+  const float expected[] = {0.5f, 0.5f, 0.7f, 0.9f, 0.9f};
+  for (std::uint32_t f = 0; f < 5; ++f) {
+    const render::FrameInputs in = frameInputs(scene, f);
+    ASSERT_EQ(in.weather, &scene.changing);
+    for (std::size_t i = 0; i < in.weather->tiles.size(); ++i) {
+      const bool inDisc = std::find(scene.change->disc.begin(), scene.change->disc.end(), i) != scene.change->disc.end();
+      ASSERT_FLOAT_EQ(in.weather->tiles[i].coverage, inDisc ? expected[f] : 0.5f) << "frame " << f << " tile " << i;
     }
   }
-  EXPECT_GT(inDisc, 5u);
-  EXPECT_LT(inDisc, end.tiles.size() / 50);
   before.layers.clear();
-  EXPECT_FALSE(changedSnapshots(before, *s.change, s.keys.front().pose, done)) << "no layer 0";
+  EXPECT_FALSE(changeTiles(before, *s.change, s.keys.front().pose)) << "no layer 0";
 }
 
 TEST(Suite, PathInterpolatesTheShortWayRound) {

@@ -3,7 +3,7 @@
 #pragma once
 
 #include <filesystem>
-#include <span>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,21 +25,31 @@ struct LoadedWeather {
 // InvalidArgument for more layers than the renderer draws (kMaxLayers).
 Result<LoadedWeather> loadWeatherFile(const std::filesystem::path& path);
 
+// A scene's change (Scene::change) as tiles: `before`'s layers with the
+// changed layer tiled round the path's first pose at its own coverage, and
+// the tiles that lie in the disc.
+struct ChangeTiles {
+  weather::WeatherSnapshot tiled;
+  std::vector<std::size_t> disc;  // indices into tiled.tiles
+  float from = 0, to = 0;         // the disc's coverage before and after the change
+  // The disc's coverage `done` ([0, 1]) of the way.
+  float coverageAt(double done) const;
+};
+
+// Errors: InvalidArgument (no such layer).
+Result<ChangeTiles> changeTiles(const weather::WeatherSnapshot& before, const WeatherChange& change,
+                                const geo::GeodeticPose& centre);
+
 struct LoadedScene {
   Scene scene;
   LoadedWeather weather;
-  // With Scene::change: each frame's weather (the changed layer tiled).
-  std::vector<weather::WeatherSnapshot> frameWeather;
+  std::optional<ChangeTiles> change;  // with Scene::change
+  // What frameInputs hands out for a scene with a change: change->tiled
+  // with the disc at that frame's coverage. One snapshot per scene,
+  // rewritten by each call, so the memory does not grow with the frames
+  // (a path may have 600 of ~15000 tiles each).
+  mutable weather::WeatherSnapshot changing;
 };
-
-// A scene's change (Scene::change) over `before`'s layers, one snapshot
-// per fraction of `done` ([0, 1] of the way): the layer tiled round
-// `centre` at its own coverage, the disc's tiles that fraction of the way
-// to the change's. Errors: InvalidArgument (no such layer).
-Result<std::vector<weather::WeatherSnapshot>> changedSnapshots(const weather::WeatherSnapshot& before,
-                                                                const WeatherChange& change,
-                                                                const geo::GeodeticPose& centre,
-                                                                std::span<const double> done);
 
 // Reads the suite and each chosen scene's weather (relative paths from the
 // suite's folder). `names` empty = every scene, in file order; otherwise these
@@ -49,7 +59,8 @@ Result<std::vector<LoadedScene>> loadSuite(const std::filesystem::path& suiteFil
 
 // The renderer's inputs for frame `frame` of a scene: the pose on its path,
 // the weather clock advanced by the path time at the file's rate, the sun.
-// The returned inputs point into `scene` (its weather snapshot).
+// The returned inputs point into `scene` (its weather snapshot; with a
+// change scene.changing, valid until the next call for that scene).
 render::FrameInputs frameInputs(const LoadedScene& scene, std::uint32_t frame);
 
 }  // namespace sky::bench
