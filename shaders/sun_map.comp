@@ -14,14 +14,23 @@ layout(local_size_x = kLocalSize, local_size_y = kLocalSize) in;
 #include "cloud_pass.glsl"
 
 void storeSunMap(vec4 part0, vec4 part1) {
-  ivec3 at = ivec3(gl_GlobalInvocationID.xy, int(gl_GlobalInvocationID.z) * sunMapParts(kSunMethod));
+  ivec3 at = ivec3(gl_GlobalInvocationID.x, int(gl_GlobalInvocationID.y) + int(frame.sunBuildShells.z),
+                   int(gl_GlobalInvocationID.z) * sunMapParts(kSunMethod) + int(frame.sunMapShells.w));
   imageStore(sunMapOut, at, part0);
   if (sunMapParts(kSunMethod) > 1) imageStore(sunMapOut, at + ivec3(0, 0, 1), part1);
 }
 
+// This frame builds rows [sunBuildShells.z, sunBuildShells.w) of every
+// cascade of the map being built (its geometry: sunBuild*), which frames
+// read once its last row is done (renderer/core/src/sun_map_plan.hpp).
 void main() {
-  ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
-  if (texel.x >= int(frame.sunMap.y) || texel.y >= int(frame.sunMap.y)) return;
+  ivec2 texel = ivec2(gl_GlobalInvocationID.x, int(gl_GlobalInvocationID.y) + int(frame.sunBuildShells.z));
+  if (texel.x >= int(frame.sunMap.y) || texel.y >= int(frame.sunBuildShells.w)) return;
   loadFrameGlobals();
+  gSunMap.axisU = frame.sunBuildU.xyz;
+  gSunMap.axisV = frame.sunBuildV.xyz;
+  gSunMap.topHeight = frame.sunBuildShells.x;
+  gSunMap.baseHeight = frame.sunBuildShells.y;
+  gSunMap.origin = frame.sunBuildOrigin.xyz;
   buildSunMapTexel(frameAir(), gSunMap, frameLayerCount(), int(gl_GlobalInvocationID.z), texel.x, texel.y);
 }

@@ -73,7 +73,7 @@ layout(set = 0, binding = kBindingSunMapOut, rgba32f) uniform writeonly image2DA
 layout(set = 0, binding = kBindingSunMap) uniform sampler2DArray sunMapTex;
 
 vec4 sampleSunMap(int layer, vec2 uv) {
-  return textureLod(sunMapTex, vec3(uv, float(layer)), 0.0);
+  return textureLod(sunMapTex, vec3(uv, float(layer) + frame.sunMapShells.z), 0.0);
 }
 
 #include "cloud_core.glsl"

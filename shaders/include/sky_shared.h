@@ -122,13 +122,20 @@ struct SkyFrame {
   uvec4 sunMap;         // the sun's shadow (sun_map.glsl, SunMap): x method (SunShadow; >= 2 a map and its
                         // pass), y texels per cascade edge, z cascades, w samples per layer along a texel's line
   vec4 sunMapU;         // xyz: the map's first axis, local frame; w: cascade 0's half extent (m)
-  vec4 sunMapV;         // xyz: its second axis; w: 1 when this frame builds the map, 0 when it reads the
-                        // map an earlier frame built (renderer/core/src/sun_map_plan.hpp)
+  vec4 sunMapV;         // xyz: its second axis; w: 1 when this frame builds rows of a map (sunBuild*), 0
+                        // when it only reads (renderer/core/src/sun_map_plan.hpp)
   vec4 sunMapShells;    // x: the highest drawn layer's top, y: the lowest one's base, m above the ground
-                        // sphere; zw: unused
+                        // sphere (as the map read was built); z: the image layer where the map read starts,
+                        // w: where the map built starts (the image holds two maps: one read while the
+                        // other is built over several frames)
   vec4 sunMapOrigin;    // xyz: the map's centre, local frame (m; 0 when built this frame); w: unused
   uvec4 freshEdges;     // with interleaving, the widths (px) of the bands at the left, right, top and bottom
                         // edges drawn at every pixel as well (fresh_edges.glsl); 0 none
+  vec4 sunBuildU;       // the map this frame builds rows of, as sunMapU: xyz its first axis; w unused
+  vec4 sunBuildV;       // xyz: its second axis; w unused
+  vec4 sunBuildShells;  // x, y: its top and base shells as sunMapShells; z: the first texel row built this
+                        // frame, w: one past the last (of every cascade)
+  vec4 sunBuildOrigin;  // xyz: its centre, local frame (m); w unused
 };
 
 #ifdef __cplusplus
@@ -154,7 +161,7 @@ static_assert(offsetof(SkyFrame, raster) == 272 + 256 * kMaxLayers + 48);
 static_assert(offsetof(SkyFrame, frustum) == 272 + 256 * kMaxLayers + 80);
 static_assert(offsetof(SkyFrame, airTable) == 272 + 256 * kMaxLayers + 96);
 static_assert(offsetof(SkyFrame, sunMap) == 272 + 256 * kMaxLayers + 112);
-static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 208);
+static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 272);
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

@@ -15,7 +15,9 @@
 
 #include "renderer_fixture.hpp"
 #include "scenes.hpp"
+#include "sky/geo/geodetic.hpp"
 #include "sky/render/cpu_reference.hpp"
+#include "sky/weather/tiling.hpp"
 #include "weather_field.hpp"
 
 namespace sky::test {
@@ -444,6 +446,105 @@ TEST(GpuVsCpu, SunMapIsReusedUntilWhatItHoldsMoves) {
   in.weather = &other;
   frame("new weather", true, "weather changed");
   frame("still again", false, "");
+}
+
+
+// A rebuild spread over frames (SunMapSettings::buildFrames, sun_map_plan.hpp):
+// with 4, the camera 1.5 km on starts a new map that is built a quarter of
+// the rows a frame while the frames read the old one (within the GPU-vs-CPU
+// bounds of the map built at once there: measured 2.7 % RMSE); the
+// fourth frame reads the new map, the same image as a renderer that built it
+// whole (to float rounding of the anchor's axes: measured 0.000 %). A new
+// weather map is built whole at once; with tiles changing every frame the
+// build is not restarted: it completes every 4 frames.
+TEST(GpuVsCpu, SunMapRebuildIsSpreadOverFrames) {
+  render::RenderSettings settings;
+  settings.width = 64;
+  settings.height = 36;
+  settings.march.primarySteps = 24;
+  settings.march.sunShadow = {render::SunShadow::Deep, 64, 2, 4000, 16, 1};
+  auto whole = render::CloudRenderer::create(settings);
+  ASSERT_TRUE(whole) << describe(whole.error());
+  settings.march.sunShadow.buildFrames = 4;
+  auto spread = render::CloudRenderer::create(settings);
+  ASSERT_TRUE(spread) << describe(spread.error());
+  const geo::GeodeticPose camera = pose(47, 8, 800, 135, 20);
+  weather::CloudLayer l = layer(1, 1500, 1000, 0.55, 1.0);
+  const weather::WeatherSnapshot snap = tiledSnapshot(camera.position, l, 0.55f, 1.0f);
+  render::FrameInputs in;
+  in.camera = camera;
+  in.weather = &snap;
+  in.sunElevation_deg = 30;
+  auto draw = [&](render::CloudRenderer& r) {
+    auto image = r.render(in);
+    EXPECT_TRUE(image) << describe(image.error());
+    return image ? std::move(*image) : render::Image{};
+  };
+  const render::Image firstWhole = draw(**whole), firstSpread = draw(**spread);
+  EXPECT_EQ((*spread)->lastSunMap().reason, "first frame");
+  EXPECT_TRUE((*spread)->lastSunMap().completed) << "the first map is built at once: there is nothing to read";
+  EXPECT_EQ(firstWhole.rgba, firstSpread.rgba);
+
+  // 1.5 km east, within the weather map's anchor cell (a new weather anchor
+  // would be a new weather map).
+  const geo::Geodetic start = in.camera.position;
+  for (const double east : {1.0, -1.0}) {
+    in.camera.position.lon_deg = start.lon_deg + east * 1500 / (111200.0 * std::cos(start.lat_deg * 3.14159265 / 180));
+    if (render::sameAnchor(render::weatherAnchorFor(in.camera.position), render::weatherAnchorFor(start))) break;
+  }
+  ASSERT_TRUE(render::sameAnchor(render::weatherAnchorFor(in.camera.position), render::weatherAnchorFor(start)));
+  const render::Image movedWhole = draw(**whole);
+  EXPECT_EQ((*whole)->lastSunMap().reason, "camera moved");
+  EXPECT_TRUE((*whole)->lastSunMap().completed);
+  for (std::uint32_t k = 0; k < 4; ++k) {
+    SCOPED_TRACE("spread frame " + std::to_string(k));
+    const render::Image image = draw(**spread);
+    const render::SunMapReport& m = (*spread)->lastSunMap();
+    EXPECT_TRUE(m.rebuilt);
+    EXPECT_EQ(m.reason, "camera moved");
+    EXPECT_EQ(m.rowBegin, 16 * k);
+    EXPECT_EQ(m.rowEnd, 16 * (k + 1));
+    EXPECT_EQ(m.completed, k == 3);
+    EXPECT_TRUE(hasPass(**spread, "sun-map"));
+    const Diff d = diff(image, movedWhole);
+    std::printf("[ sun map  ] spread over 4 frames, frame %u against the map built at once: rmse %.3f %%\n", k,
+                100 * d.displayedRmse / d.displayedMean);
+    if (k < 3)
+      EXPECT_LT(d.displayedRmse, kRelativeRmseTolerance * d.displayedMean) << "the old map, read through its anchor";
+    else
+      EXPECT_LT(d.displayedRmse, 1e-4 * d.displayedMean) << "the new map is the one built at once";
+  }
+  draw(**spread);
+  EXPECT_FALSE((*spread)->lastSunMap().rebuilt) << "still: nothing more to build";
+
+  // Tiles changing every frame (a cell ramping up 3 km from the camera):
+  // each completed build starts the next, none is restarted half-way.
+  auto cell = [&](float inside) {
+    weather::WeatherSnapshot w;
+    w.tileLevel = 12;
+    w.layers.push_back(l);
+    for (std::uint64_t c : weather::coverCap({47.0, 8.0, 30000.0}, 12, 100000)) {
+      const weather::CellCentre at = weather::cellCentre(c);
+      const bool in = geo::geodesicDistance_m(at.lat_deg, at.lon_deg, 47.02, 8.0) <= 2000.0;
+      w.tiles.push_back({c, 1, in ? inside : 0.55f, 1.0f});
+    }
+    return w;
+  };
+  std::vector<weather::WeatherSnapshot> ramp;
+  for (int k = 0; k <= 8; ++k) ramp.push_back(cell(0.55f + 0.04f * float(k)));
+  in.weather = &ramp[0];
+  draw(**spread);
+  EXPECT_EQ((*spread)->lastSunMap().reason, "weather changed") << "a new weather map: the whole map at once";
+  EXPECT_TRUE((*spread)->lastSunMap().completed);
+  std::vector<bool> completed;
+  for (std::size_t k = 1; k < ramp.size(); ++k) {
+    in.weather = &ramp[k];
+    draw(**spread);
+    EXPECT_TRUE((*spread)->lastSunMap().rebuilt);
+    EXPECT_EQ((*spread)->lastSunMap().reason, "tiles changed");
+    completed.push_back((*spread)->lastSunMap().completed);
+  }
+  EXPECT_EQ(completed, (std::vector<bool>{false, false, false, true, false, false, false, true}));
 }
 
 }  // namespace

@@ -28,9 +28,11 @@ Means means(const render::Image& im) {
 }
 
 // Bounds against reference, every preset. Measured (64x36, lavapipe): thin
-// deck T 0.4399 reference, realtime +0.005, luminance -1.1 %; thick deck T
+// deck T 0.4399 reference, realtime +0.005, luminance +0.2 %; thick deck T
 // 0.021 reference, each preset within its early-exit threshold (realtime
-// 0.044), luminance within 1.4 %.
+// 0.046), luminance within 2.8 % (realtime -2.8 %, high -0.7 %: the presets'
+// deep shadow map against reference's 64-step column; the thick deck follows
+// the thin one as a step of the weather, so every map is rebuilt at once).
 constexpr double kThinTransmittanceBound = 0.01;  // mean transmittance, thin deck
 constexpr double kLuminanceBound = 0.03;          // mean luminance, relative
 

@@ -34,6 +34,7 @@ nlohmann::json sunShadowJson(const render::SunMapSettings& s) {
     j["cascades"] = s.cascades;
     j["extent_m"] = s.extent_m;
     j["build_steps"] = s.buildSteps;
+    j["build_frames"] = s.buildFrames;
     j["bytes"] = render::sunMapBytes(s);
     j["used_bytes"] = render::sunMapUsedBytes(s);
   }
@@ -186,7 +187,10 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
                         {"weather_changed_fraction", t.weatherChangedFraction}};
   }
   if (render::sunMapParts(s.march.sunShadow.method) > 0)
-    line["sun_map"] = {{"rebuilt", r.sunMap.rebuilt}, {"reason", r.sunMap.reason}};
+    line["sun_map"] = {{"rebuilt", r.sunMap.rebuilt},
+                       {"reason", r.sunMap.reason},
+                       {"rows", {r.sunMap.rowBegin, r.sunMap.rowEnd}},
+                       {"completed", r.sunMap.completed}};
   if (outputs_.png) line["file"] = std::string(name) + ".png";
   if (outputs_.exr) line["exr"] = std::string(name) + ".exr";
   metadata_ << line.dump() << '\n';

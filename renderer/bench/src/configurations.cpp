@@ -137,6 +137,7 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     else if (key == "shadow-cascades") m.sunShadow.cascades = std::uint32_t(v);
     else if (key == "shadow-extent") m.sunShadow.extent_m = v;
     else if (key == "shadow-steps") m.sunShadow.buildSteps = std::uint32_t(v);
+    else if (key == "shadow-frames") m.sunShadow.buildFrames = std::uint32_t(v);
     else if (key == "accumulate" && v <= 0.95) c.settings.temporal.accumulation = v;
     else if (key == "pixel-jitter" && (v == 0 || v == 1)) c.settings.temporal.pixelJitter = v == 1;
     else if (key == "clip" && v >= 0 && v <= 4) c.settings.temporal.historyClip = v;
@@ -152,7 +153,7 @@ Result<Configuration> customConfiguration(const std::string& spec) {
                       "interleave 1|2|4, divisor 1|2|4, depth-aware 0|1, blue 0|1, cloud-shadows 0|1, air-table 0|1, "
                       "air-azimuths, air-zeniths, air-slices, budget 0..4 (after base), accumulate 0..0.95, "
                       "pixel-jitter 0|1, clip 0..4, dense-turn (px, 0 never), acc-motion (px, 0 off), edges 0|1, sharp 0|1, region-drop 0|1, shadow 0..5 (march, column, esm, bsm, fom, deep), shadow-size, "
-                      "shadow-cascades, shadow-extent (m), shadow-steps)");
+                      "shadow-cascades, shadow-extent (m), shadow-steps, shadow-frames)");
   }
   // Accumulation blends redraws with the history: without interleaving
   // there is none (a base preset's accumulation goes with its interleave).

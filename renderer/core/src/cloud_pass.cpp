@@ -63,8 +63,9 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
                                                     3 * pass.airTableSize_.slices),
                                        "sky.airTable");
   const std::uint32_t sunParts = sunMapParts(sunMap.method);
+  // Two maps: one read while the other is built (sun_map_plan.hpp).
   pass.sunMap_ = sunParts > 0 ? createStorageArray(ctx, vk::Format::eR32G32B32A32Sfloat, sunMap.size, sunMap.size,
-                                                   sunMap.cascades * sunParts, "sky.sunMap")
+                                                   2 * sunMap.cascades * sunParts, "sky.sunMap")
                               : createStorageArray(ctx, vk::Format::eR32G32B32A32Sfloat, 1, 1, 1, "sky.sunMap");
 
   auto noiseImage = [&](const NoiseVolume& n, const char* name) {
@@ -217,11 +218,13 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
     tablePipeline = *built;
   }
   SKY_ASSERT(frame.sunMap.x == std::uint32_t(sunMapSize_.method));
-  // The map, where the frame has layers to shadow with it and asks for it
-  // (or there is none to read yet).
+  // Rows of a map, where the frame has layers to shadow with it and asks
+  // for them.
   const ComputePipeline* sunPipeline = nullptr;
-  if (sunMapParts(sunMapSize_.method) > 0 && layersDrawn > 0 && (frame.sunMapV.w > 0.5f || !sunMapBuilt_)) {
+  const std::uint32_t sunRowBegin = std::uint32_t(frame.sunBuildShells.z), sunRowEnd = std::uint32_t(frame.sunBuildShells.w);
+  if (sunMapParts(sunMapSize_.method) > 0 && layersDrawn > 0 && frame.sunMapV.w > 0.5f) {
     SKY_ASSERT(frame.sunMap.y == sunMapSize_.size && frame.sunMap.z == sunMapSize_.cascades);
+    SKY_ASSERT(sunRowBegin < sunRowEnd && sunRowEnd <= sunMapSize_.size);
     auto built = pipelineFor(ctx, Stage::SunMap, layersDrawn);
     if (!built) return tl::unexpected(built.error());
     sunPipeline = *built;
@@ -238,18 +241,19 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
                                   vk::ImageLayout::eUndefined, vk::ImageLayout::eGeneral, VK_QUEUE_FAMILY_IGNORED,
                                   VK_QUEUE_FAMILY_IGNORED, image, range);
   };
-  // The sun map keeps its contents where a later frame reads them.
+  // The sun maps keep their contents for later frames (the one read, and the
+  // one being built band by band): only their first use starts from nothing.
   const std::array freshImages{fresh(*airTable_.image, whole), fresh(*sunMap_.image, allLayers)};
-  const bool sunMapFresh = sunPipeline != nullptr || !sunMapBuilt_;
   commands_.pipelineBarrier(vk::PipelineStageFlagBits::eTopOfPipe, vk::PipelineStageFlagBits::eComputeShader, {}, {},
-                            {}, vk::ArrayProxy<const vk::ImageMemoryBarrier>(sunMapFresh ? 2u : 1u, freshImages.data()));
+                            {}, vk::ArrayProxy<const vk::ImageMemoryBarrier>(sunMapBuilt_ ? 1u : 2u, freshImages.data()));
   if (sunPipeline != nullptr) {
     {
       const auto timed = timer_.section(commands_, "sun-map");
       commands_.bindPipeline(vk::PipelineBindPoint::eCompute, *sunPipeline->pipeline);
       commands_.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *sunPipeline->layout, 0, *descriptorSet_, {});
       const std::uint32_t groups = (sunMapSize_.size + gpu::kLocalSize - 1) / gpu::kLocalSize;
-      commands_.dispatch(groups, groups, sunMapSize_.cascades);
+      const std::uint32_t rowGroups = (sunRowEnd - sunRowBegin + gpu::kLocalSize - 1) / gpu::kLocalSize;
+      commands_.dispatch(groups, rowGroups, sunMapSize_.cascades);
     }
     commands_.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {},
                               {}, {},
@@ -302,7 +306,7 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
     sunMapBuilt_ = false;
     return tl::unexpected(ok.error());
   }
-  sunMapBuilt_ = sunMapBuilt_ || sunPipeline != nullptr;
+  sunMapBuilt_ = true;
 
   if (next.upscale != nullptr) return next.upscale->readBack();
   if (next.reproject != nullptr) return next.reproject->readBack();

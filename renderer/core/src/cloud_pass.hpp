@@ -98,7 +98,7 @@ class CloudPass {
   GpuImage airTable_;  // written by the table pass, sampled by the clouds (eGeneral)
   AirTableSettings airTableSize_;
   GpuImage sunMap_;  // written by the map pass, sampled by the table and the clouds (eGeneral)
-  bool sunMapBuilt_ = false;  // it holds a map (a frame may then read it without building it)
+  bool sunMapBuilt_ = false;  // it has been used (its contents are kept from then on; see sun_map_plan.hpp)
   SunMapSettings sunMapSize_;
   GpuBuffer uniforms_;  // the frame block (a storage buffer, see clouds.comp)
   GpuBuffer output_;

@@ -224,10 +224,13 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
     impl_->sunMap = {};
     const bool sunMap = sunMapParts(impl_->settings.march.sunShadow.method) > 0;
     if (sunMap) {
-      const SunMapPlan plan = impl_->sunMaps.plan(setup, inputs.weatherClock_s, impl_->weather.uploads());
-      setup.sunMapReuse = plan.geometry;
-      setup.sunMapRebuild = plan.rebuild;
-      impl_->sunMap = {plan.rebuild, plan.reason};
+      // A weather map rebuilt whole, or tiles that stepped rather than
+      // ramped (the history's rule, kMaxRampStep), make the old shadows wrong.
+      const auto& update = impl_->weather.lastUpdate();
+      const SunMapPlan plan = impl_->sunMaps.plan(setup, inputs.weatherClock_s, impl_->weather.uploads(),
+                                                  update.rebuilt || update.largestStep > kMaxRampStep);
+      setup.sunMapPlan = {plan.read, plan.build, plan.readSlot, plan.buildSlot, plan.rowBegin, plan.rowEnd};
+      impl_->sunMap = {plan.builds(), plan.reason, plan.rowBegin, plan.rowEnd, plan.completes};
     }
     // With interleaving the planner chooses this frame's pixels and the
     // reprojection's block; with a divisor the upscale follows.

@@ -143,13 +143,14 @@ Result<void> validateSettings(const RenderSettings& s) {
     return fail(ErrorCode::InvalidArgument, "render settings: march.lightSteps " + std::to_string(m.lightSteps) +
                                                 " outside [1, 1024] for the column march");
   if (sun.size < 16 || sun.size > 1024 || sun.size % 8 != 0 || sun.cascades < 1 || sun.cascades > 4 ||
-      !(sun.extent_m >= 500 && sun.extent_m <= 500000) || sun.buildSteps < 1 || sun.buildSteps > 256)
+      !(sun.extent_m >= 500 && sun.extent_m <= 500000) || sun.buildSteps < 1 || sun.buildSteps > 256 ||
+      sun.buildFrames < 1 || sun.buildFrames > 64)
     return fail(ErrorCode::InvalidArgument,
                 "render settings: march.sunShadow size " + std::to_string(sun.size) + ", cascades " +
                     std::to_string(sun.cascades) + ", extent_m " + num(sun.extent_m) + ", buildSteps " +
-                    std::to_string(sun.buildSteps) +
+                    std::to_string(sun.buildSteps) + ", buildFrames " + std::to_string(sun.buildFrames) +
                     " outside size [16, 1024] (a multiple of 8), cascades [1, 4], extent_m [500, 500000], "
-                    "buildSteps [1, 256]");
+                    "buildSteps [1, 256], buildFrames [1, 64]");
   if (!(m.stepGrowth >= 0 && m.stepGrowth <= 1))
     return fail(ErrorCode::InvalidArgument,
                 "render settings: march.stepGrowth " + num(m.stepGrowth) + " outside [0, 1]");
@@ -455,7 +456,7 @@ std::uint32_t sunMapParts(SunShadow method) {
 }
 
 std::uint64_t sunMapBytes(const SunMapSettings& map) {
-  return std::uint64_t(map.size) * map.size * map.cascades * sunMapParts(map.method) * 16;
+  return 2 * std::uint64_t(map.size) * map.size * map.cascades * sunMapParts(map.method) * 16;
 }
 
 std::uint64_t sunMapUsedBytes(const SunMapSettings& map) {
@@ -464,7 +465,7 @@ std::uint64_t sunMapUsedBytes(const SunMapSettings& map) {
                                  : map.method == SunShadow::Fom ? 28
                                  : map.method == SunShadow::Deep ? 32
                                                                  : 0;
-  return std::uint64_t(map.size) * map.size * map.cascades * perTexel;
+  return 2 * std::uint64_t(map.size) * map.size * map.cascades * perTexel;
 }
 
 gpu::SkyFrame packFrame(const FrameSetup& s) {
@@ -516,12 +517,25 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   const AirTableSettings& table = s.march.airTable;
   f.airTable = table.enabled ? gpu::uvec4(table.azimuths, table.zeniths, table.slices, 0u) : gpu::uvec4(0u);
   const SunMapSettings& sun = s.march.sunShadow;
-  const SunMapGeometry g = s.sunMapReuse ? *s.sunMapReuse : sunMapGeometry(s);
+  FrameSetup::SunMapFrame plan;
+  if (s.sunMapPlan) {
+    plan = *s.sunMapPlan;
+  } else {
+    plan.read = plan.build = sunMapGeometry(s);
+    plan.rowEnd = sun.size;
+  }
+  const SunMapGeometry& g = plan.read;
+  const auto slotLayer = [&](std::uint32_t slot) { return float(slot * sun.cascades * sunMapParts(sun.method)); };
   f.sunMap = gpu::uvec4(std::uint32_t(sun.method), sun.size, sun.cascades, sun.buildSteps);
   f.sunMapU = v4(g.axisU, sun.extent_m);
-  f.sunMapV = v4(g.axisV, s.sunMapRebuild ? 1.0 : 0.0);
-  f.sunMapShells = gpu::vec4(float(g.top_m), float(g.base_m), 0.0f, 0.0f);
+  f.sunMapV = v4(g.axisV, plan.rowEnd > plan.rowBegin ? 1.0 : 0.0);
+  f.sunMapShells = gpu::vec4(float(g.top_m), float(g.base_m), slotLayer(plan.readSlot), slotLayer(plan.buildSlot));
   f.sunMapOrigin = v4(g.origin);
+  const SunMapGeometry& b = plan.build;
+  f.sunBuildU = v4(b.axisU, 0.0);
+  f.sunBuildV = v4(b.axisV, 0.0);
+  f.sunBuildShells = gpu::vec4(float(b.top_m), float(b.base_m), float(plan.rowBegin), float(plan.rowEnd));
+  f.sunBuildOrigin = v4(b.origin);
 
   for (std::size_t i = 0; i < s.layers.size(); ++i) {
     const LayerSetup& l = s.layers[i];

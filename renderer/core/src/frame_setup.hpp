@@ -113,13 +113,17 @@ struct FrameSetup {
   // their pixels (R2 sequence, each in [0, 1)); applied when pixelJitter.
   glm::dvec2 pixelShift{0};
   bool pixelJitter = false;
-  // The sun map as this frame reads it, around its anchor (the renderer's
-  // plan, sun_map_plan.hpp: this frame's camera when it rebuilds, an
-  // earlier one's when it reuses); unset: around this frame's camera
-  // (sunMapGeometry), as the CPU reference builds it. sunMapRebuild: whether
-  // this frame builds it.
-  std::optional<SunMapGeometry> sunMapReuse;
-  bool sunMapRebuild = true;
+  // The sun map this frame reads and the rows of the one it builds, each
+  // around its anchor (the renderer's plan, sun_map_plan.hpp), and the slot
+  // of the image's two each lies in. Unset: the whole map built around this
+  // frame's camera (sunMapGeometry) into slot 0 and read, as the CPU
+  // reference builds it.
+  struct SunMapFrame {
+    SunMapGeometry read, build;
+    std::uint32_t readSlot = 0, buildSlot = 0;
+    std::uint32_t rowBegin = 0, rowEnd = 0;  // rows of every cascade built; none when equal
+  };
+  std::optional<SunMapFrame> sunMapPlan;
 };
 
 // Haggstrom 2018's coverage ramp of the step length (sec. 4.2.2, eq. 34):

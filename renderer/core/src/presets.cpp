@@ -37,6 +37,38 @@ MarchSettings marched(MarchSettings m) {
   return m;
 }
 
+// The sun's optical depth over the whole column above each cloud sample,
+// marched in 64 steps per layer crossed (and the air's and the ground's in 64
+// per layer): the ground truth the sun maps were measured against
+// (docs/light-transport.md). The presets' old secondary march stops at half a
+// layer's thickness, so it lit the far sides and bases of towering clouds
+// as if the sun shone through them: against this column it scores 6.6 dB on
+// the cumulonimbus at low sun. 256 primary x 64 column steps stays inside
+// lavapipe's loop budget (CloudRenderer refuses more).
+MarchSettings columnSun(MarchSettings m) {
+  m.sunShadow.method = SunShadow::Column;
+  m.lightSteps = 64;
+  m.sunShadow.buildSteps = 64;
+  return m;
+}
+
+// The sun's optical depth from a deep shadow map (the optical depth at 8
+// depths along each sun line; size x size texels x 4 cascades from 4 km to
+// 256 km either side), reused until what it holds has moved and then rebuilt
+// over buildFrames frames (sun_map_plan.hpp). On the bench's cloudy stills
+// it is 3-37 dB closer to the column than the secondary march at the same
+// cost, and within 1.5 dB of it inside and above a deck
+// (docs/light-transport.md, "The presets on the sun map"). The light march
+// is compiled out, so lightSteps is unused. The cheaper the preset, the
+// more frames a rebuild is spread over: a map of three layers at a sun 35
+// degrees up takes 115 ms to build whole at 128 texels (the airliner climb).
+MarchSettings deepMap(MarchSettings m, std::uint32_t size, std::uint32_t buildFrames) {
+  m.sunShadow.method = SunShadow::Deep;
+  m.sunShadow.size = size;
+  m.sunShadow.buildFrames = buildFrames;
+  return m;
+}
+
 // A smaller air table: it is built for every frame whatever the share of
 // pixels drawn, so at a few milliseconds a frame the cheap presets feel its
 // size (skyshell-bench 320x180: realtime 12.6 -> 5.2 ms on cumulus-midday
@@ -72,31 +104,35 @@ ResolutionSettings divided(std::uint32_t divisor) {
 const std::vector<Preset>& presets() {
   static const std::vector<Preset> all = {
       {"reference",
-       "ground truth: 256 primary steps, 8 light steps, no early exit, every sample, every pixel, the air marched "
-       "per pixel in 64 steps",
-       marched(march(256, 8, 0, 1)), {}},
+       "ground truth: 256 primary steps, no early exit, every sample, every pixel; the sun marched through the "
+       "whole column above each sample in 64 steps per layer; the air marched per pixel in 64 steps",
+       columnSun(marched(march(256, 64, 0, 1))), {}},
       {"high",
-       "the default: 48 primary steps, 4 light steps, exit at 1 %, every sample, every pixel; the air from the "
-       "per-frame table (as every preset but reference)",
-       MarchSettings{}, {}},
+       "the default: 48 primary steps, exit at 1 %, every sample, every pixel; the sun from a deep shadow map "
+       "(128 x 128 x 4 cascades, rebuilt over 4 frames); the air from the per-frame table (as every preset but "
+       "reference)",
+       deepMap(MarchSettings{}, 128, 4), {}},
       // Growth 0.005 and exit at 0.2 % (were 0.01 and 2 %): they take
       // medium past both seeds' settings on the two scenes it lost
       // (skyshell-bench 320x180, above-deck-10km: PSNR 50.7 -> 56.3 dB
       // against ford-2024's 52.3, 10.5 -> 13.4 ms; overcast-below: 56.4 ->
       // 65.1 dB against haggstrom-2018's 61.4, 8.3 -> 12.1 ms).
       {"medium",
-       "steps of 40 m in cloud, 80 m in clear air, +0.5 % of the distance; 4 light steps, exit at 0.2 %; "
+       "steps of 40 m in cloud, 80 m in clear air, +0.5 % of the distance; exit at 0.2 %; the sun from a deep shadow "
+       "map (128 x 128 x 4, rebuilt over 8 frames); "
        "1 pixel of 16 per frame (1 of 4 in a turn of over 2 pixels a frame), the rest reprojected, redraws accumulated "
        "(history 0.75 at rest, 0.375 from 1 pixel of motion a frame, resampled Catmull-Rom)",
-       metres(256, 4, 0.002, 40, 80, 0.005, 12), interleaved(4, 0.75)},
+       deepMap(metres(256, 4, 0.002, 40, 80, 0.005, 12), 128, 8), interleaved(4, 0.75)},
       {"low",
-       "steps of 40 m in cloud, 80 m in clear air, +1 % of the distance; 3 light steps, exit at 3 %; "
+       "steps of 40 m in cloud, 80 m in clear air, +1 % of the distance; exit at 3 %; the sun from a deep shadow map "
+       "(128 x 128 x 4, rebuilt over 16 frames); "
        "the air from a 48 x 48 x 24 table; 1 pixel of 16 per frame (1 of 4 in a turn of over 2 pixels a frame), the "
        "rest reprojected, redraws accumulated (history 0.75 at rest, 0.375 from 1 pixel of motion a frame, "
        "resampled Catmull-Rom)",
-       withAirTable(metres(256, 3, 0.03, 40, 80, 0.01, 8), 48, 48, 24), interleaved(4, 0.75)},
+       deepMap(withAirTable(metres(256, 3, 0.03, 40, 80, 0.01, 8), 48, 48, 24), 128, 16), interleaved(4, 0.75)},
       {"realtime",
-       "steps of 40 m in cloud, 80 m in clear air, +2 % of the distance; 3 light steps, exit at 5 %; "
+       "steps of 40 m in cloud, 80 m in clear air, +2 % of the distance; exit at 5 %; the sun from a deep shadow map "
+       "(64 x 64 x 4, rebuilt over 16 frames); "
        "the air from a 32 x 32 x 16 table; the clouds drawn at 1/2 the width and height (depth-aware upscale); 1 "
        "pixel of 16 per frame (1 of 4 in a turn of over 1 pixel of the half size a frame), the rest reprojected, "
        "redraws accumulated (history 0.75 at rest, 0.375 from 1 pixel of motion a frame, resampled Catmull-Rom)",
@@ -106,7 +142,8 @@ const std::vector<Preset>& presets() {
        // realtime reaches SSIM 0.973 on that path (worst frame 0.954) at 7.9
        // ms a frame at 320x180, where a threshold of 2 gives 0.965 (0.931)
        // at 6.7 ms (docs/motion.md).
-       withAirTable(metres(256, 3, 0.05, 40, 80, 0.02, 8), 32, 32, 16), interleaved(4, 0.75, 1), divided(2)},
+       deepMap(withAirTable(metres(256, 3, 0.05, 40, 80, 0.02, 8), 32, 32, 16), 64, 16), interleaved(4, 0.75, 1),
+       divided(2)},
   };
   return all;
 }

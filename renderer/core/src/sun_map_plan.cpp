@@ -10,46 +10,95 @@
 
 namespace sky::render {
 
-SunMapPlan SunMapPlanner::plan(const FrameSetup& s, double weatherClock_s, std::uint64_t weatherUploads) {
+namespace {
+
+bool sameMap(const SunMapSettings& a, const SunMapSettings& b) {
+  return a.method == b.method && a.size == b.size && a.cascades == b.cascades && a.extent_m == b.extent_m &&
+         a.buildSteps == b.buildSteps && a.buildFrames == b.buildFrames;
+}
+
+}  // namespace
+
+std::string SunMapPlanner::staleness(const Anchor& a, const FrameSetup& s, double weatherClock_s,
+                                     std::uint64_t weatherUploads) {
   const SunMapSettings& settings = s.march.sunShadow;
-  const SunMapGeometry fresh = sunMapGeometry(s);
-  const glm::dvec3 sunEcef = s.localToEcef * s.sunDir;
+  if (weatherUploads != a.weatherUploads) return "tiles changed";
+  if (std::acos(std::clamp(glm::dot(s.localToEcef * s.sunDir, a.sun), -1.0, 1.0)) >
+      kSunMapRebuildTurn_deg * std::numbers::pi / 180)
+    return "sun turned";
+  // The clouds drift with the fastest layer's wind; half a texel of the
+  // first cascade is what the map resolves.
+  double wind = 1.0;
+  for (const LayerSetup& l : s.layers)
+    if (!l.absent) wind = std::max(wind, glm::length(glm::dvec2(l.windEnu_mps.x, l.windEnu_mps.y)));
+  const double halfTexel = settings.extent_m / settings.size;
+  if (std::abs(weatherClock_s - a.weatherClock_s) * wind > halfTexel) return "clouds drifted";
+  if (glm::length(s.cameraEcef_m - a.ecef) > 0.25 * settings.extent_m) return "camera moved";
+  return {};
+}
+
+SunMapGeometry SunMapPlanner::inFrame(const Anchor& a, const FrameSetup& s) {
+  // The anchor's axes and place in this frame's local frame (its rotation is
+  // orthonormal: the inverse is the transpose).
+  const glm::dmat3 toLocal = glm::transpose(s.localToEcef);
+  SunMapGeometry g;
+  g.axisU = toLocal * a.axisU;
+  g.axisV = toLocal * a.axisV;
+  g.origin = toLocal * (a.ecef - s.cameraEcef_m);
+  g.top_m = a.top_m;
+  g.base_m = a.base_m;
+  return g;
+}
+
+SunMapPlan SunMapPlanner::plan(const FrameSetup& s, double weatherClock_s, std::uint64_t weatherUploads,
+                               bool weatherJumped) {
+  const SunMapSettings& settings = s.march.sunShadow;
   SunMapPlan p;
-  p.geometry = fresh;
-  if (!anchor_) {
-    p.reason = "first frame";
-  } else if (weatherUploads != anchor_->weatherUploads) {
-    p.reason = "weather changed";
-  } else if (settings.extent_m != anchor_->settings.extent_m || settings.buildSteps != anchor_->settings.buildSteps) {
-    p.reason = "settings changed";
-  } else if (std::acos(std::clamp(glm::dot(sunEcef, anchor_->sun), -1.0, 1.0)) >
-             kSunMapRebuildTurn_deg * std::numbers::pi / 180) {
-    p.reason = "sun turned";
-  } else {
-    // The clouds drift with the fastest layer's wind; half a texel of the
-    // first cascade is what the map resolves.
-    double wind = 1.0;
-    for (const LayerSetup& l : s.layers)
-      if (!l.absent) wind = std::max(wind, glm::length(glm::dvec2(l.windEnu_mps.x, l.windEnu_mps.y)));
-    const double halfTexel = settings.extent_m / settings.size;
-    const glm::dvec3 moved = s.cameraEcef_m - anchor_->ecef;
-    if (std::abs(weatherClock_s - anchor_->weatherClock_s) * wind > halfTexel)
-      p.reason = "clouds drifted";
-    else if (glm::length(moved) > 0.25 * settings.extent_m)
-      p.reason = "camera moved";
-  }
-  p.rebuild = !p.reason.empty();
-  if (p.rebuild) {
-    anchor_ = Anchor{s.cameraEcef_m, s.localToEcef * fresh.axisU, s.localToEcef * fresh.axisV, sunEcef,
-                     weatherClock_s, weatherUploads, settings};
+  const bool drawsLayers = std::any_of(s.layers.begin(), s.layers.end(), [](const LayerSetup& l) { return !l.absent; });
+  const auto anchorHere = [&] {
+    const SunMapGeometry fresh = sunMapGeometry(s);
+    return Anchor{s.cameraEcef_m, s.localToEcef * fresh.axisU, s.localToEcef * fresh.axisV, fresh.top_m,
+                  fresh.base_m,   s.localToEcef * s.sunDir,    weatherClock_s,              weatherUploads,
+                  settings};
+  };
+  if (!drawsLayers) {
+    p.read = front_ ? inFrame(*front_, s) : sunMapGeometry(s);
+    p.readSlot = frontSlot_;
     return p;
   }
-  // Reused: the anchor's axes and place in this frame's local frame (its
-  // rotation is orthonormal: the inverse is the transpose).
-  const glm::dmat3 toLocal = glm::transpose(s.localToEcef);
-  p.geometry.axisU = toLocal * anchor_->axisU;
-  p.geometry.axisV = toLocal * anchor_->axisV;
-  p.geometry.origin = toLocal * (anchor_->ecef - s.cameraEcef_m);
+  const bool newWeather = front_ && weatherJumped && weatherUploads != front_->weatherUploads;
+  if (!front_ || !sameMap(front_->settings, settings) || newWeather) {
+    // Nothing (of use) to read: the whole map now, read at once.
+    p.reason = !front_ ? "first frame" : newWeather ? "weather changed" : "settings changed";
+    pending_.reset();
+    front_ = anchorHere();
+    p.read = p.build = sunMapGeometry(s);
+    p.readSlot = p.buildSlot = frontSlot_;
+    p.rowEnd = settings.size;
+    p.completes = true;
+    return p;
+  }
+  if (!pending_) {
+    if (std::string why = staleness(*front_, s, weatherClock_s, weatherUploads); !why.empty())
+      pending_ = Pending{anchorHere(), 0, std::move(why)};
+  }
+  if (pending_) {
+    const std::uint32_t band = (settings.size + settings.buildFrames - 1) / settings.buildFrames;
+    p.reason = pending_->reason;
+    p.build = inFrame(pending_->anchor, s);
+    p.buildSlot = 1 - frontSlot_;
+    p.rowBegin = pending_->rowsDone;
+    p.rowEnd = std::min(settings.size, p.rowBegin + band);
+    pending_->rowsDone = p.rowEnd;
+    if (p.rowEnd == settings.size) {
+      front_ = pending_->anchor;
+      frontSlot_ = p.buildSlot;
+      pending_.reset();
+      p.completes = true;
+    }
+  }
+  p.read = inFrame(*front_, s);
+  p.readSlot = frontSlot_;
   return p;
 }
 

@@ -2,13 +2,28 @@
 // lies in the meantime. The map is Earth-fixed: built around the camera's
 // position at the time (its anchor), on axes across the sun fixed in ECEF,
 // and read by later frames through the anchor's offset and the axes in
-// their own local frame. It is rebuilt when what it holds has moved by
-// more than it resolves: the first frame; a new weather map (a new
-// snapshot, changed tiles); the key light turned by more than
-// kSunMapRebuildTurn_deg; the clouds drifted with the wind by more than half
-// a texel of the first cascade since the build; the camera moved more than
-// a quarter of the first cascade's half extent from the anchor (the
-// cascades stay centred on it); the map's settings changed.
+// their own local frame. A new map is started when what the map read holds
+// has moved by more than it resolves: changed tiles of the weather map; the
+// key light turned by more than kSunMapRebuildTurn_deg;
+// the clouds drifted with the wind by more than half a texel of the first
+// cascade since the build; the camera moved more than a quarter of the first
+// cascade's half extent from the anchor (the cascades stay centred on it).
+//
+// A new map is built over SunMapSettings::buildFrames frames, a band of rows
+// of every cascade per frame, into the second of the image's two maps,
+// while the frames read the first; the frame that builds the last band reads
+// the new map, and the two swap. So a rebuild costs a frame 1/buildFrames of
+// the map's build instead of all of it at once (a climbing airliner's map at
+// low sun takes 113 ms to build on this machine, against a 6 ms `realtime`
+// frame), and the map read lags what it should hold by at most buildFrames
+// frames. A build under way is not restarted by what moves on (the weather
+// changing every frame would never let it finish); when it completes the
+// planner looks again, from the new map. The first frame and a change of
+// the map's settings build the whole map at once: there is nothing to read.
+// So does a weather map rebuilt whole (a new snapshot, a new anchor) or
+// tiles that stepped (by more than kMaxRampStep at a texel): the old shadows
+// may belong to other clouds altogether, where tiles that ramp change them
+// a little.
 #pragma once
 
 #include <cstdint>
@@ -26,29 +41,55 @@ namespace sky::render {
 inline constexpr double kSunMapRebuildTurn_deg = 0.05;
 
 struct SunMapPlan {
-  bool rebuild = false;
-  std::string reason;  // why it is rebuilt ("first frame", "weather changed", ...); empty when reused
-  SunMapGeometry geometry;  // the map as this frame reads it (its axes and origin in this frame)
+  SunMapGeometry read;   // the map the frame reads, in this frame's local frame
+  std::uint32_t readSlot = 0;
+  // Rows [rowBegin, rowEnd) of every cascade of the map `build` are built
+  // this frame into slot buildSlot (none when rowEnd == rowBegin).
+  SunMapGeometry build;
+  std::uint32_t buildSlot = 0, rowBegin = 0, rowEnd = 0;
+  bool completes = false;  // this frame builds the new map's last rows (and reads it)
+  std::string reason;      // why a new map is being built ("first frame", ...); empty when none is
+  bool builds() const { return rowEnd > rowBegin; }
 };
 
 class SunMapPlanner {
  public:
   // The plan for frame s at weatherClock_s, whose weather map has had
-  // weatherUploads uploads so far (WeatherTexture::uploads).
-  SunMapPlan plan(const FrameSetup& s, double weatherClock_s, std::uint64_t weatherUploads);
-  // The map was not built after all (the frame failed): rebuild next time.
-  void forget() { anchor_.reset(); }
+  // weatherUploads uploads so far (WeatherTexture::uploads); weatherJumped:
+  // the last of them was a whole new map or a step (else a ramp). A frame that
+  // draws no layer builds nothing and moves nothing on (nothing reads the
+  // map, and the map pass does not run).
+  SunMapPlan plan(const FrameSetup& s, double weatherClock_s, std::uint64_t weatherUploads, bool weatherJumped);
+  // The frame planned last was not drawn (it failed): the maps' contents are
+  // unknown, so the next frame builds a whole map.
+  void forget() {
+    front_.reset();
+    pending_.reset();
+  }
 
  private:
   struct Anchor {
     glm::dvec3 ecef{0};              // the camera at the build
     glm::dvec3 axisU{0}, axisV{0};   // the map's axes, ECEF
+    double top_m = 0, base_m = 0;    // its shells
     glm::dvec3 sun{0};               // the key light's direction, ECEF
     double weatherClock_s = 0;
     std::uint64_t weatherUploads = 0;
     SunMapSettings settings;
   };
-  std::optional<Anchor> anchor_;
+  struct Pending {
+    Anchor anchor;
+    std::uint32_t rowsDone = 0;
+    std::string reason;
+  };
+  // Why the map `a` no longer holds frame s (empty: it does).
+  static std::string staleness(const Anchor& a, const FrameSetup& s, double weatherClock_s,
+                               std::uint64_t weatherUploads);
+  static SunMapGeometry inFrame(const Anchor& a, const FrameSetup& s);
+
+  std::optional<Anchor> front_;  // the map frames read, in slot frontSlot_
+  std::uint32_t frontSlot_ = 0;
+  std::optional<Pending> pending_;  // the map being built, in the other slot
 };
 
 }  // namespace sky::render

@@ -51,29 +51,34 @@ enum class SunShadow : std::uint32_t { March = 0, Column = 1, Esm = 2, Bsm = 3, 
 // The sun-space map of SunShadow's map methods: `cascades` square grids of
 // size x size texels, cascade 0 covering extent_m either side of the
 // camera and each next one 4x that; each texel marches its sun line with
-// buildSteps samples per layer crossed. Memory: size^2 x cascades x parts x
-// 16 bytes (RGBA32F; parts: 1 for ESM and BSM, 2 for FOM and deep), of
-// which ESM uses 4 bytes a texel, BSM 12, FOM 28, deep 32.
+// buildSteps samples per layer crossed. A map is rebuilt when what it holds
+// has moved, over buildFrames frames (a band of rows per frame) into a
+// second map while frames read the first (renderer/core/src/sun_map_plan.hpp).
+// Memory: 2 maps x size^2 x cascades x parts x 16 bytes (RGBA32F; parts: 1
+// for ESM and BSM, 2 for FOM and deep), of which ESM uses 4 bytes a texel,
+// BSM 12, FOM 28, deep 32.
 struct SunMapSettings {
   SunShadow method = SunShadow::March;
-  std::uint32_t size = 128;       // [16, 1024], a multiple of 8
-  std::uint32_t cascades = 4;     // [1, 4]
-  double extent_m = 4000;         // [500, 500000]
-  std::uint32_t buildSteps = 16;  // [1, 256]
+  std::uint32_t size = 128;        // [16, 1024], a multiple of 8
+  std::uint32_t cascades = 4;      // [1, 4]
+  double extent_m = 4000;          // [500, 500000]
+  std::uint32_t buildSteps = 16;   // [1, 256]
+  std::uint32_t buildFrames = 1;   // [1, 64]: the frames a rebuild is spread over
 };
 
 // The name of a sun shadow method ("march", "column", "esm", "bsm", "fom", "deep").
 const char* sunShadowName(SunShadow method);
 // RGBA32F parts a cascade of the method's map takes (0: no map).
 std::uint32_t sunMapParts(SunShadow method);
-// The bytes the map's image takes (0 without a map), and the bytes of it
-// the method's values fill (ESM 4, BSM 12, FOM 28, deep 32 a texel).
+// The bytes the image of the two maps takes (0 without a map), and the bytes
+// of it the method's values fill (ESM 4, BSM 12, FOM 28, deep 32 a texel).
 std::uint64_t sunMapBytes(const SunMapSettings& map);
 std::uint64_t sunMapUsedBytes(const SunMapSettings& map);
 
 // The cloud march's cost knobs (shaders/include/cloud_core.glsl), carried
 // in the frame block as run-time numbers. The defaults are the `high`
-// preset (presets.hpp), the march as it was before presets.
+// preset's march (presets.hpp) with the secondary sun march, which `high`
+// replaces with a deep shadow map.
 struct MarchSettings {
   std::uint32_t primarySteps = 48;  // samples per layer span, evenly spaced, [1, 4096]
   std::uint32_t lightSteps = 4;     // samples towards the sun per lit sample, [1, 64]; [1, 1024] for
@@ -322,8 +327,10 @@ struct FrameInputs {
 // (and why) or read as an earlier frame built it; no map: method "march" or
 // "column", rebuilt false.
 struct SunMapReport {
-  bool rebuilt = false;
-  std::string reason;  // "first frame", "weather changed", "sun turned", "clouds drifted", "camera moved", ...
+  bool rebuilt = false;  // this frame built rows of a new map
+  std::string reason;    // "first frame", "weather changed", "sun turned", "clouds drifted", "camera moved", ...
+  std::uint32_t rowBegin = 0, rowEnd = 0;  // the rows of every cascade it built
+  bool completed = false;  // it built the last rows, and read the new map
 };
 
 struct TemporalReport {
