@@ -17,12 +17,12 @@ render::Preset preset(const char* name) {
   return *p;
 }
 
-// Every preset but reference has a ladder (high and medium five levels, low
-// three, realtime two), its own march first, each cheaper than the one
+// Every preset but reference has a ladder (high five levels, medium, low and
+// realtime two), its own march first, each cheaper than the one
 // before (fewer samples or longer steps, never more light steps, an exit no
 // later) and measured to cost less.
 TEST(FrameBudget, LaddersGoFromThePresetDown) {
-  const std::pair<const char*, std::size_t> expected[] = {{"high", 5}, {"medium", 5}, {"low", 3}, {"realtime", 2}};
+  const std::pair<const char*, std::size_t> expected[] = {{"high", 5}, {"medium", 2}, {"low", 2}, {"realtime", 2}};
   for (const auto& [name, levels] : expected) {
     const render::Preset p = preset(name);
     auto ladder = render::budgetLadder(p);

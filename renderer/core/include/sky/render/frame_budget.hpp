@@ -28,8 +28,8 @@ struct BudgetLevel {
 // The ladder for preset p (not reference): its own march, then marches with
 // fewer samples (even placement: primarySteps over 1.5, 2, 3, 4; in metres:
 // the steps and their growth times those), fewer light steps and an earlier
-// exit, as far as each level saves time on the bench (high and medium 5
-// levels, low 3, realtime 2). Errors: InvalidArgument for reference (the
+// exit, as far as each level saves time on the bench (high 5
+// levels, medium, low and realtime 2). Errors: InvalidArgument for reference (the
 // ground truth has no cheaper level).
 Result<std::vector<BudgetLevel>> budgetLadder(const Preset& p);
 
