@@ -456,7 +456,8 @@ TEST(GpuVsCpu, SunMapIsReusedUntilWhatItHoldsMoves) {
 // fourth frame reads the new map, the same image as a renderer that built it
 // whole (to float rounding of the anchor's axes: measured 0.000 %). A new
 // weather map is built whole at once; with tiles changing every frame the
-// build is not restarted: it completes every 4 frames.
+// build is not restarted: it completes every 4 frames. A jump (the sun 2
+// degrees on) is built at once.
 TEST(GpuVsCpu, SunMapRebuildIsSpreadOverFrames) {
   render::RenderSettings settings;
   settings.width = 64;
@@ -545,6 +546,14 @@ TEST(GpuVsCpu, SunMapRebuildIsSpreadOverFrames) {
     completed.push_back((*spread)->lastSunMap().completed);
   }
   EXPECT_EQ(completed, (std::vector<bool>{false, false, false, true, false, false, false, true}));
+
+  // A jump (the host sets the sun 2 degrees on) is built at once, even with
+  // a build under way.
+  in.sunElevation_deg = 32;
+  draw(**spread);
+  EXPECT_EQ((*spread)->lastSunMap().reason, "sun turned");
+  EXPECT_EQ((*spread)->lastSunMap().rowEnd, 64u);
+  EXPECT_TRUE((*spread)->lastSunMap().completed);
 }
 
 }  // namespace

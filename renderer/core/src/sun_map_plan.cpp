@@ -19,21 +19,27 @@ bool sameMap(const SunMapSettings& a, const SunMapSettings& b) {
 
 }  // namespace
 
-std::string SunMapPlanner::staleness(const Anchor& a, const FrameSetup& s, double weatherClock_s,
-                                     std::uint64_t weatherUploads) {
+SunMapPlanner::Staleness SunMapPlanner::staleness(const Anchor& a, const FrameSetup& s, double weatherClock_s,
+                                                  std::uint64_t weatherUploads) {
   const SunMapSettings& settings = s.march.sunShadow;
-  if (weatherUploads != a.weatherUploads) return "tiles changed";
-  if (std::acos(std::clamp(glm::dot(s.localToEcef * s.sunDir, a.sun), -1.0, 1.0)) >
-      kSunMapRebuildTurn_deg * std::numbers::pi / 180)
-    return "sun turned";
+  const double turned_deg =
+      std::acos(std::clamp(glm::dot(s.localToEcef * s.sunDir, a.sun), -1.0, 1.0)) * 180 / std::numbers::pi;
   // The clouds drift with the fastest layer's wind; half a texel of the
   // first cascade is what the map resolves.
   double wind = 1.0;
   for (const LayerSetup& l : s.layers)
     if (!l.absent) wind = std::max(wind, glm::length(glm::dvec2(l.windEnu_mps.x, l.windEnu_mps.y)));
   const double halfTexel = settings.extent_m / settings.size;
-  if (std::abs(weatherClock_s - a.weatherClock_s) * wind > halfTexel) return "clouds drifted";
-  if (glm::length(s.cameraEcef_m - a.ecef) > 0.25 * settings.extent_m) return "camera moved";
+  const double drift = std::abs(weatherClock_s - a.weatherClock_s) * wind;
+  const double moved = glm::length(s.cameraEcef_m - a.ecef);
+  // A jump first: it decides how the new map is built.
+  if (turned_deg > kSunMapJumpTurn_deg) return {"sun turned", true};
+  if (drift > kSunMapJumpTexels * halfTexel) return {"clouds drifted", true};
+  if (moved > settings.extent_m) return {"camera moved", true};
+  if (weatherUploads != a.weatherUploads) return {"tiles changed", false};
+  if (turned_deg > kSunMapRebuildTurn_deg) return {"sun turned", false};
+  if (drift > halfTexel) return {"clouds drifted", false};
+  if (moved > 0.25 * settings.extent_m) return {"camera moved", false};
   return {};
 }
 
@@ -78,9 +84,19 @@ SunMapPlan SunMapPlanner::plan(const FrameSetup& s, double weatherClock_s, std::
     p.completes = true;
     return p;
   }
-  if (!pending_) {
-    if (std::string why = staleness(*front_, s, weatherClock_s, weatherUploads); !why.empty())
-      pending_ = Pending{anchorHere(), 0, std::move(why)};
+  // Moved on by a jump (a host setting the time of day, a teleport): the
+  // old map is of no use, whatever is being built.
+  if (Staleness stale = staleness(*front_, s, weatherClock_s, weatherUploads); stale.jumped) {
+    pending_.reset();
+    front_ = anchorHere();
+    p.reason = stale.reason;
+    p.read = p.build = sunMapGeometry(s);
+    p.readSlot = p.buildSlot = frontSlot_;
+    p.rowEnd = settings.size;
+    p.completes = true;
+    return p;
+  } else if (!pending_ && !stale.reason.empty()) {
+    pending_ = Pending{anchorHere(), 0, std::move(stale.reason)};
   }
   if (pending_) {
     const std::uint32_t band = (settings.size + settings.buildFrames - 1) / settings.buildFrames;

@@ -20,10 +20,11 @@
 // changing every frame would never let it finish); when it completes the
 // planner looks again, from the new map. The first frame and a change of
 // the map's settings build the whole map at once: there is nothing to read.
-// So does a weather map rebuilt whole (a new snapshot, a new anchor) or
-// tiles that stepped (by more than kMaxRampStep at a texel): the old shadows
-// may belong to other clouds altogether, where tiles that ramp change them
-// a little.
+// So do a weather map rebuilt whole (a new snapshot, a new anchor), tiles
+// that stepped (by more than kMaxRampStep at a texel) and a jump of the sun,
+// the clouds or the camera (kSunMapJumpTurn_deg and below): the old shadows
+// may belong to other clouds altogether, where what ramps or moves on
+// changes them a little.
 #pragma once
 
 #include <cstdint>
@@ -39,6 +40,13 @@ namespace sky::render {
 // 0.05 degrees: a shadow cast from 5 km above moves 4 m; the sun turns
 // that far in 12 s.
 inline constexpr double kSunMapRebuildTurn_deg = 0.05;
+// Past these the map has jumped rather than moved on (a host setting the
+// time of day or the weather clock, a teleport), and the new one is built
+// at once: the sun turned by over 1 degree (a shadow from 5 km up 87 m
+// away), the clouds drifted over 8 half texels of the first cascade, the
+// camera moved out of the first cascade's half extent.
+inline constexpr double kSunMapJumpTurn_deg = 1.0;
+inline constexpr double kSunMapJumpTexels = 8.0;
 
 struct SunMapPlan {
   SunMapGeometry read;   // the map the frame reads, in this frame's local frame
@@ -82,9 +90,14 @@ class SunMapPlanner {
     std::uint32_t rowsDone = 0;
     std::string reason;
   };
-  // Why the map `a` no longer holds frame s (empty: it does).
-  static std::string staleness(const Anchor& a, const FrameSetup& s, double weatherClock_s,
-                               std::uint64_t weatherUploads);
+  // Why the map `a` no longer holds frame s (empty: it does), and whether
+  // by a jump.
+  struct Staleness {
+    std::string reason;
+    bool jumped = false;
+  };
+  static Staleness staleness(const Anchor& a, const FrameSetup& s, double weatherClock_s,
+                             std::uint64_t weatherUploads);
   static SunMapGeometry inFrame(const Anchor& a, const FrameSetup& s);
 
   std::optional<Anchor> front_;  // the map frames read, in slot frontSlot_
