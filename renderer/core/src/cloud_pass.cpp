@@ -221,7 +221,8 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
   // Rows of a map, where the frame has layers to shadow with it and asks
   // for them.
   const ComputePipeline* sunPipeline = nullptr;
-  const std::uint32_t sunRowBegin = std::uint32_t(frame.sunBuildShells.z), sunRowEnd = std::uint32_t(frame.sunBuildShells.w);
+  const std::uint32_t sunRowBegin = std::uint32_t(frame.sunBuildShells.z);
+  const std::uint32_t sunRowEnd = std::uint32_t(frame.sunBuildShells.w);
   if (sunMapParts(sunMapSize_.method) > 0 && layersDrawn > 0 && frame.sunMapV.w > 0.5f) {
     SKY_ASSERT(frame.sunMap.y == sunMapSize_.size && frame.sunMap.z == sunMapSize_.cascades);
     SKY_ASSERT(sunRowBegin < sunRowEnd && sunRowEnd <= sunMapSize_.size);
@@ -244,8 +245,9 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
   // The sun maps keep their contents for later frames (the one read, and the
   // one being built band by band): only their first use starts from nothing.
   const std::array freshImages{fresh(*airTable_.image, whole), fresh(*sunMap_.image, allLayers)};
-  commands_.pipelineBarrier(vk::PipelineStageFlagBits::eTopOfPipe, vk::PipelineStageFlagBits::eComputeShader, {}, {},
-                            {}, vk::ArrayProxy<const vk::ImageMemoryBarrier>(sunMapBuilt_ ? 1u : 2u, freshImages.data()));
+  commands_.pipelineBarrier(
+      vk::PipelineStageFlagBits::eTopOfPipe, vk::PipelineStageFlagBits::eComputeShader, {}, {}, {},
+      vk::ArrayProxy<const vk::ImageMemoryBarrier>(sunMapBuilt_ ? 1u : 2u, freshImages.data()));
   if (sunPipeline != nullptr) {
     {
       const auto timed = timer_.section(commands_, "sun-map");

@@ -67,34 +67,30 @@ SunMapPlan SunMapPlanner::plan(const FrameSetup& s, double weatherClock_s, std::
                   fresh.base_m,   s.localToEcef * s.sunDir,    weatherClock_s,              weatherUploads,
                   settings};
   };
+  // Nothing (of use) to read: the whole map now, into the slot read, and
+  // read at once; whatever was being built is dropped.
+  const auto wholeNow = [&](std::string reason) {
+    pending_.reset();
+    front_ = anchorHere();
+    p.reason = std::move(reason);
+    p.read = p.build = sunMapGeometry(s);
+    p.readSlot = p.buildSlot = frontSlot_;
+    p.rowEnd = settings.size;
+    p.completes = true;
+    return p;
+  };
   if (!drawsLayers) {
     p.read = front_ ? inFrame(*front_, s) : sunMapGeometry(s);
     p.readSlot = frontSlot_;
     return p;
   }
-  const bool newWeather = front_ && weatherJumped && weatherUploads != front_->weatherUploads;
-  if (!front_ || !sameMap(front_->settings, settings) || newWeather) {
-    // Nothing (of use) to read: the whole map now, read at once.
-    p.reason = !front_ ? "first frame" : newWeather ? "weather changed" : "settings changed";
-    pending_.reset();
-    front_ = anchorHere();
-    p.read = p.build = sunMapGeometry(s);
-    p.readSlot = p.buildSlot = frontSlot_;
-    p.rowEnd = settings.size;
-    p.completes = true;
-    return p;
-  }
+  if (!front_) return wholeNow("first frame");
+  if (!sameMap(front_->settings, settings)) return wholeNow("settings changed");
+  if (weatherJumped && weatherUploads != front_->weatherUploads) return wholeNow("weather changed");
   // Moved on by a jump (a host setting the time of day, a teleport): the
-  // old map is of no use, whatever is being built.
+  // old map is of no use either.
   if (Staleness stale = staleness(*front_, s, weatherClock_s, weatherUploads); stale.jumped) {
-    pending_.reset();
-    front_ = anchorHere();
-    p.reason = stale.reason;
-    p.read = p.build = sunMapGeometry(s);
-    p.readSlot = p.buildSlot = frontSlot_;
-    p.rowEnd = settings.size;
-    p.completes = true;
-    return p;
+    return wholeNow(std::move(stale.reason));
   } else if (!pending_ && !stale.reason.empty()) {
     pending_ = Pending{anchorHere(), 0, std::move(stale.reason)};
   }
