@@ -122,8 +122,7 @@ struct SkyFrame {
   uvec4 sunMap;         // the sun's shadow (sun_map.glsl, SunMap): x method (SunShadow; >= 2 a map and its
                         // pass), y texels per cascade edge, z cascades, w samples per layer along a texel's line
   vec4 sunMapU;         // xyz: the map's first axis, local frame; w: cascade 0's half extent (m)
-  vec4 sunMapV;         // xyz: its second axis; w: 1 when this frame builds rows of a map (sunBuild*), 0
-                        // when it only reads (renderer/core/src/sun_map_plan.hpp)
+  vec4 sunMapV;         // xyz: its second axis; w: unused (the rows this frame builds: sunBuildShells)
   vec4 sunMapShells;    // x: the highest drawn layer's top, y: the lowest one's base, m above the ground
                         // sphere (as the map read was built); z: the image layer where the map read starts,
                         // w: where the map built starts (the image holds two maps: one read while the

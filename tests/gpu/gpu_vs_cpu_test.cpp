@@ -15,9 +15,7 @@
 
 #include "renderer_fixture.hpp"
 #include "scenes.hpp"
-#include "sky/geo/geodetic.hpp"
 #include "sky/render/cpu_reference.hpp"
-#include "sky/weather/tiling.hpp"
 #include "weather_field.hpp"
 
 namespace sky::test {
@@ -520,19 +518,9 @@ TEST(GpuVsCpu, SunMapRebuildIsSpreadOverFrames) {
 
   // Tiles changing every frame (a cell ramping up 3 km from the camera):
   // each completed build starts the next, none is restarted half-way.
-  auto cell = [&](float inside) {
-    weather::WeatherSnapshot w;
-    w.tileLevel = 12;
-    w.layers.push_back(l);
-    for (std::uint64_t c : weather::coverCap({47.0, 8.0, 30000.0}, 12, 100000)) {
-      const weather::CellCentre at = weather::cellCentre(c);
-      const bool in = geo::geodesicDistance_m(at.lat_deg, at.lon_deg, 47.02, 8.0) <= 2000.0;
-      w.tiles.push_back({c, 1, in ? inside : 0.55f, 1.0f});
-    }
-    return w;
-  };
   std::vector<weather::WeatherSnapshot> ramp;
-  for (int k = 0; k <= 8; ++k) ramp.push_back(cell(0.55f + 0.04f * float(k)));
+  for (int k = 0; k <= 8; ++k)
+    ramp.push_back(discSnapshot(l, {47.0, 8.0, 0.0}, 30000.0, 47.02, 8.0, 2000.0, 0.55f + 0.04f * float(k), 0.55f));
   in.weather = &ramp[0];
   draw(**spread);
   EXPECT_EQ((*spread)->lastSunMap().reason, "weather changed") << "a new weather map: the whole map at once";

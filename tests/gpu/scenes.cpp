@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "sky/geo/geodetic.hpp"
 #include "sky/weather/tiling.hpp"
 
 namespace sky::test {
@@ -38,6 +39,20 @@ weather::WeatherSnapshot tiledSnapshot(const geo::Geodetic& around, weather::Clo
   for (std::uint64_t cell : weather::coverCap({around.lat_deg, around.lon_deg, 200000.0}, kLevel, 4000))
     s.tiles.push_back({cell, l.id, coverage, density});
   return s;
+}
+
+weather::WeatherSnapshot discSnapshot(const weather::CloudLayer& layer, const geo::Geodetic& around, double radius_m,
+                                      double discLat_deg, double discLon_deg, double discRadius_m, float inside,
+                                      float outside) {
+  weather::WeatherSnapshot w;
+  w.tileLevel = 12;
+  w.layers.push_back(layer);
+  for (std::uint64_t c : weather::coverCap({around.lat_deg, around.lon_deg, radius_m}, 12, 100000)) {
+    const weather::CellCentre at = weather::cellCentre(c);
+    const bool in = geo::geodesicDistance_m(at.lat_deg, at.lon_deg, discLat_deg, discLon_deg) <= discRadius_m;
+    w.tiles.push_back({c, 1, in ? inside : outside, 1.0f});
+  }
+  return w;
 }
 
 weather::WeatherSnapshot stormCell(weather::CloudLayer l, double lat_deg, double lon_deg, double core_m,

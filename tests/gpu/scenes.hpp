@@ -27,6 +27,14 @@ weather::WeatherSnapshot tiledSnapshot(const geo::Geodetic& around, weather::Clo
 weather::WeatherSnapshot stormCell(weather::CloudLayer layer, double lat_deg, double lon_deg, double core_m,
                                    double radius_m, float coreCoverage, float edgeCoverage);
 
+// A layer given by level-12 tiles (~2 km) covering radius_m round `around`
+// at coverage `outside`, and `inside` on those within discRadius_m of
+// (discLat_deg, discLon_deg), density 1 (a cell growing in a tiled field);
+// the layer as given (its id on the tiles is 1).
+weather::WeatherSnapshot discSnapshot(const weather::CloudLayer& layer, const geo::Geodetic& around, double radius_m,
+                                      double discLat_deg, double discLon_deg, double discRadius_m, float inside,
+                                      float outside);
+
 // The six scenes of issue 5's correctness suite, with their weather and sun.
 struct Scene {
   std::string name;

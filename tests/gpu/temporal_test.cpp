@@ -24,7 +24,6 @@
 #include "scenes.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky/render/presets.hpp"
-#include "sky/geo/geodetic.hpp"
 #include "sky/weather/tiling.hpp"
 
 namespace sky::test {
@@ -546,15 +545,8 @@ TEST(Temporal, ARampOfTilesIsRedrawnWithinACycle) {
   ASSERT_TRUE(created) << describe(created.error());
   render::CloudRenderer& interleaved = **created;
   auto cell = [](float inside) {
-    weather::WeatherSnapshot w;
-    w.tileLevel = 12;
-    w.layers.push_back(layer(1, 1200.0, 1800.0, 0.5, 1.0));
-    for (std::uint64_t c : weather::coverCap({46.0, 13.0, 60000.0}, 12, 100000)) {
-      const weather::CellCentre at = weather::cellCentre(c);
-      const bool in = geo::geodesicDistance_m(at.lat_deg, at.lon_deg, 46.2, 12.85) <= 6000.0;
-      w.tiles.push_back({c, 1, in ? inside : 0.5f, 1.0f});
-    }
-    return w;
+    return discSnapshot(layer(1, 1200.0, 1800.0, 0.5, 1.0), {46.0, 13.0, 0.0}, 60000.0, 46.2, 12.85, 6000.0, inside,
+                        0.5f);
   };
   std::vector<weather::WeatherSnapshot> ramp;
   for (int k = 0; k <= 9; ++k) ramp.push_back(cell(0.5f + 0.05f * float(k)));

@@ -223,9 +223,9 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
   const ComputePipeline* sunPipeline = nullptr;
   const std::uint32_t sunRowBegin = std::uint32_t(frame.sunBuildShells.z);
   const std::uint32_t sunRowEnd = std::uint32_t(frame.sunBuildShells.w);
-  if (sunMapParts(sunMapSize_.method) > 0 && layersDrawn > 0 && frame.sunMapV.w > 0.5f) {
+  if (sunMapParts(sunMapSize_.method) > 0 && layersDrawn > 0 && sunRowEnd > sunRowBegin) {
     SKY_ASSERT(frame.sunMap.y == sunMapSize_.size && frame.sunMap.z == sunMapSize_.cascades);
-    SKY_ASSERT(sunRowBegin < sunRowEnd && sunRowEnd <= sunMapSize_.size);
+    SKY_ASSERT(sunRowEnd <= sunMapSize_.size);
     auto built = pipelineFor(ctx, Stage::SunMap, layersDrawn);
     if (!built) return tl::unexpected(built.error());
     sunPipeline = *built;

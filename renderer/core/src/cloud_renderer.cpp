@@ -229,8 +229,8 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
       const auto& update = impl_->weather.lastUpdate();
       const SunMapPlan plan = impl_->sunMaps.plan(setup, inputs.weatherClock_s, impl_->weather.uploads(),
                                                   update.rebuilt || update.largestStep > kMaxRampStep);
-      setup.sunMapPlan = {plan.read, plan.build, plan.readSlot, plan.buildSlot, plan.rowBegin, plan.rowEnd};
-      impl_->sunMap = {plan.builds(), plan.reason, plan.rowBegin, plan.rowEnd, plan.completes};
+      setup.sunMapPlan = plan.frame;
+      impl_->sunMap = {plan.builds(), plan.reason, plan.frame.rowBegin, plan.frame.rowEnd, plan.completes};
     }
     // With interleaving the planner chooses this frame's pixels and the
     // reprojection's block; with a divisor the upscale follows.

@@ -528,7 +528,7 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   const auto slotLayer = [&](std::uint32_t slot) { return float(slot * sun.cascades * sunMapParts(sun.method)); };
   f.sunMap = gpu::uvec4(std::uint32_t(sun.method), sun.size, sun.cascades, sun.buildSteps);
   f.sunMapU = v4(g.axisU, sun.extent_m);
-  f.sunMapV = v4(g.axisV, plan.rowEnd > plan.rowBegin ? 1.0 : 0.0);
+  f.sunMapV = v4(g.axisV, 0.0);
   f.sunMapShells = gpu::vec4(float(g.top_m), float(g.base_m), slotLayer(plan.readSlot), slotLayer(plan.buildSlot));
   f.sunMapOrigin = v4(g.origin);
   const SunMapGeometry& b = plan.build;

@@ -60,6 +60,7 @@ SunMapPlan SunMapPlanner::plan(const FrameSetup& s, double weatherClock_s, std::
                                bool weatherJumped) {
   const SunMapSettings& settings = s.march.sunShadow;
   SunMapPlan p;
+  FrameSetup::SunMapFrame& f = p.frame;
   const bool drawsLayers = std::any_of(s.layers.begin(), s.layers.end(), [](const LayerSetup& l) { return !l.absent; });
   const auto anchorHere = [&] {
     const SunMapGeometry fresh = sunMapGeometry(s);
@@ -73,15 +74,15 @@ SunMapPlan SunMapPlanner::plan(const FrameSetup& s, double weatherClock_s, std::
     pending_.reset();
     front_ = anchorHere();
     p.reason = std::move(reason);
-    p.read = p.build = sunMapGeometry(s);
-    p.readSlot = p.buildSlot = frontSlot_;
-    p.rowEnd = settings.size;
+    f.read = f.build = sunMapGeometry(s);
+    f.readSlot = f.buildSlot = frontSlot_;
+    f.rowEnd = settings.size;
     p.completes = true;
     return p;
   };
   if (!drawsLayers) {
-    p.read = front_ ? inFrame(*front_, s) : sunMapGeometry(s);
-    p.readSlot = frontSlot_;
+    f.read = front_ ? inFrame(*front_, s) : sunMapGeometry(s);
+    f.readSlot = frontSlot_;
     return p;
   }
   if (!front_) return wholeNow("first frame");
@@ -97,20 +98,20 @@ SunMapPlan SunMapPlanner::plan(const FrameSetup& s, double weatherClock_s, std::
   if (pending_) {
     const std::uint32_t band = (settings.size + settings.buildFrames - 1) / settings.buildFrames;
     p.reason = pending_->reason;
-    p.build = inFrame(pending_->anchor, s);
-    p.buildSlot = 1 - frontSlot_;
-    p.rowBegin = pending_->rowsDone;
-    p.rowEnd = std::min(settings.size, p.rowBegin + band);
-    pending_->rowsDone = p.rowEnd;
-    if (p.rowEnd == settings.size) {
+    f.build = inFrame(pending_->anchor, s);
+    f.buildSlot = 1 - frontSlot_;
+    f.rowBegin = pending_->rowsDone;
+    f.rowEnd = std::min(settings.size, f.rowBegin + band);
+    pending_->rowsDone = f.rowEnd;
+    if (f.rowEnd == settings.size) {
       front_ = pending_->anchor;
-      frontSlot_ = p.buildSlot;
+      frontSlot_ = f.buildSlot;
       pending_.reset();
       p.completes = true;
     }
   }
-  p.read = inFrame(*front_, s);
-  p.readSlot = frontSlot_;
+  f.read = inFrame(*front_, s);
+  f.readSlot = frontSlot_;
   return p;
 }
 

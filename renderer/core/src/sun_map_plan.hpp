@@ -14,7 +14,7 @@
 // while the frames read the first; the frame that builds the last band reads
 // the new map, and the two swap. So a rebuild costs a frame 1/buildFrames of
 // the map's build instead of all of it at once (a climbing airliner's map at
-// low sun takes 113 ms to build on this machine, against a 6 ms `realtime`
+// low sun takes 115 ms to build on this machine, against a 6 ms `realtime`
 // frame), and the map read lags what it should hold by at most buildFrames
 // frames. A build under way is not restarted by what moves on (the weather
 // changing every frame would never let it finish); when it completes the
@@ -49,15 +49,12 @@ inline constexpr double kSunMapJumpTurn_deg = 1.0;
 inline constexpr double kSunMapJumpTexels = 8.0;
 
 struct SunMapPlan {
-  SunMapGeometry read;   // the map the frame reads, in this frame's local frame
-  std::uint32_t readSlot = 0;
-  // Rows [rowBegin, rowEnd) of every cascade of the map `build` are built
-  // this frame into slot buildSlot (none when rowEnd == rowBegin).
-  SunMapGeometry build;
-  std::uint32_t buildSlot = 0, rowBegin = 0, rowEnd = 0;
+  // The map the frame reads and the rows of the one it builds, each in this
+  // frame's local frame, and their slots (FrameSetup::SunMapFrame).
+  FrameSetup::SunMapFrame frame;
   bool completes = false;  // this frame builds the new map's last rows (and reads it)
   std::string reason;      // why a new map is being built ("first frame", ...); empty when none is
-  bool builds() const { return rowEnd > rowBegin; }
+  bool builds() const { return frame.rowEnd > frame.rowBegin; }
 };
 
 class SunMapPlanner {
