@@ -60,6 +60,16 @@ find_package(SQLite3 REQUIRED)
 add_library(sky::sqlite INTERFACE IMPORTED)
 target_link_libraries(sky::sqlite INTERFACE SQLite::SQLite3)
 
+# GRIB2 forecasts (server/): Debian's libeccodes-dev. Its pkg-config file
+# names an include directory relative to itself that does not exist (the
+# header is under the multiarch include directory), so the library and the
+# header are found directly.
+find_library(ECCODES_LIBRARY NAMES eccodes REQUIRED)
+find_path(ECCODES_INCLUDE_DIR eccodes.h PATH_SUFFIXES ${CMAKE_LIBRARY_ARCHITECTURE} REQUIRED)
+add_library(sky::eccodes INTERFACE IMPORTED)
+target_link_libraries(sky::eccodes INTERFACE ${ECCODES_LIBRARY})
+target_include_directories(sky::eccodes SYSTEM INTERFACE ${ECCODES_INCLUDE_DIR})
+
 find_package(Vulkan REQUIRED)
 find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)
 find_package(glm CONFIG REQUIRED)
