@@ -7,7 +7,7 @@ import { $, el, showErrors } from "./dom.js";
 import { request, session } from "./api.js";
 import { checkTiming, fmt, ftFromM, keyOfServerError, num, OKTAS } from "./units.js";
 
-const MAX_REPORTS = 64;  // the server's limit per request
+const MAX_REPORTS = 1024;  // the server's limit per request (kMaxMetarReports)
 
 const METAR_KEYS = { reports: "reports", radius_m: "radius", ramp_s: "ramp", stations: "stations", at_s: "ramp" };
 
@@ -80,11 +80,11 @@ export class MetarPanel {
     const r = await request("POST", "/api/metar", { ...body, apply: false });
     if (!r.ok) return this.refused(r);
     this.show(r.body);
-    const good = r.body.reports.filter((x) => x.ok).length;
+    const good = r.body.reports.filter((x) => x.ok && x.sky === "read").length;
     note.textContent = `${good} of ${r.body.reports.length} reports map to weather` +
-      (good ? `: ${r.body.changes.length} station region(s) on apply` : "");
+      (good ? `: ${r.body.stations.set} station region(s) on apply` : "");
     note.className = `note ${good ? "ok" : "bad"}`;
-    if (good) this.previewed = body;
+    if (r.body.changes.length) this.previewed = body;
     this.updateButtons();
   }
 
@@ -118,11 +118,20 @@ export class MetarPanel {
     const list = $("#metar-result", this.root);
     list.replaceChildren(...reply.reports.map((rep) => {
       if (!rep.ok) return el("li", { class: "bad" }, `${rep.index}: ${rep.error}`);
-      const layers = rep.layers.length
-        ? rep.layers.map((l) => `${l.type} ${fmt(l.coverage * OKTAS, 1)}/8 (${fmt(l.coverage * 100)} %) ` +
-            `${fmt(ftFromM(l.base_m))}–${fmt(ftFromM(l.base_m + l.thickness_m))} ft MSL`).join("; ")
-        : "clear (no layers)";
-      return el("li", { class: "ok" }, el("b", {}, `${rep.index} ${rep.icao}`), `: ${layers}`);
+      const layers = rep.sky === "not_observed"
+        ? "sky not observed: the weather there stays as it is"
+        : rep.layers.length
+          ? rep.layers.map((l) => `${l.type} ${fmt(l.coverage * OKTAS, 1)}/8 (${fmt(l.coverage * 100)} %) ` +
+              `${fmt(ftFromM(l.base_m))}–${fmt(ftFromM(l.base_m + l.thickness_m))} ft MSL`).join("; ")
+          : "clear (no layers)";
+      // Groups the decoder skipped (not used) or read with the one before.
+      const notes = [];
+      for (const g of rep.skipped || []) notes.push(`skipped group ${g.group} '${g.text}': ${g.reason}`);
+      if ((rep.skipped_count || 0) > (rep.skipped || []).length)
+        notes.push(`and ${rep.skipped_count - rep.skipped.length} more skipped`);
+      for (const g of rep.joined || []) notes.push(`group ${g.group} '${g.text}': ${g.reason}`);
+      return el("li", { class: rep.sky === "not_observed" ? "warn" : "ok" }, el("b", {}, `${rep.index} ${rep.icao}`),
+        `: ${layers}`, ...(notes.length ? [el("div", { class: "notes" }, notes.join("; "))] : []));
     }));
   }
 }

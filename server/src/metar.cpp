@@ -1,7 +1,10 @@
 // METAR/SPECI decoder (see metar.hpp): groups are matched by hand-written
-// pattern checks, no regex, so any byte string is decoded in linear time.
+// pattern checks, no regex, so any byte string is decoded in linear time; a
+// group that fits no pattern is skipped and noted, never fatal past the
+// station.
 #include "sky/server/metar.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 
@@ -67,20 +70,41 @@ std::vector<std::string_view> splitGroups(std::string_view text) {
 
 class Groups {
  public:
-  explicit Groups(std::vector<std::string_view> groups) : groups_(std::move(groups)) {}
+  // `groups` are views of `capitals`, the report in capitals; notes quote the
+  // same bytes of `written`, the report as it came.
+  Groups(std::vector<std::string_view> groups, std::string_view capitals, std::string_view written)
+      : groups_(std::move(groups)), capitals_(capitals), written_(written) {}
   bool done() const { return next_ >= groups_.size(); }
   std::string_view peek(std::size_t ahead = 0) const {
     return next_ + ahead < groups_.size() ? groups_[next_ + ahead] : std::string_view{};
   }
   void advance(std::size_t n = 1) { next_ += n; }
+  std::size_t position() const { return next_ + 1; }  // of peek(), 1-based
   tl::unexpected<Error> error(ErrorCode code, const std::string& what) const {
     if (done()) return fail(code, "report ends early: " + what);
     return fail(code, "group " + std::to_string(next_ + 1) + " '" + std::string(peek()) +
                           "': " + what);
   }
+  // Notes the current group as skipped (not decoded) with the reason.
+  void skip(MetarReport& out, std::string reason) const {
+    ++out.skippedCount;
+    note(out.skipped, 0, std::move(reason));
+  }
+  // Notes the group `ahead` of the current one as read together with it.
+  void join(MetarReport& out, std::size_t ahead, std::string reason) const {
+    note(out.joined, ahead, std::move(reason));
+  }
 
  private:
+  void note(std::vector<MetarGroupNote>& notes, std::size_t ahead, std::string reason) const {
+    if (notes.size() >= kMaxNotedGroups) return;
+    const std::string_view g = peek(ahead);
+    const std::string_view written = written_.substr(static_cast<std::size_t>(g.data() - capitals_.data()), g.size());
+    notes.push_back({next_ + ahead + 1, std::string(written.substr(0, kMaxNotedGroupBytes)), std::move(reason)});
+  }
+
   std::vector<std::string_view> groups_;
+  std::string_view capitals_, written_;
   std::size_t next_ = 0;
 };
 
@@ -101,11 +125,11 @@ bool isStation(std::string_view g) {
 Result<MetarTime> parseTime(const Groups& in) {
   std::string_view g = in.peek();
   if (g.size() != 7 || g[6] != 'Z' || !allDigits(g.substr(0, 6)))
-    return in.error(ErrorCode::Malformed, "time is not DDHHMMZ");
+    return fail(ErrorCode::Malformed, "time is not DDHHMMZ");
   MetarTime t{toInt(g.substr(0, 2)), toInt(g.substr(2, 2)), toInt(g.substr(4, 2))};
-  if (t.day < 1 || t.day > 31) return in.error(ErrorCode::InvalidArgument, "day outside [1, 31]");
-  if (t.hour > 23) return in.error(ErrorCode::InvalidArgument, "hour outside [0, 23]");
-  if (t.minute > 59) return in.error(ErrorCode::InvalidArgument, "minute outside [0, 59]");
+  if (t.day < 1 || t.day > 31) return fail(ErrorCode::InvalidArgument, "day outside [1, 31]");
+  if (t.hour > 23) return fail(ErrorCode::InvalidArgument, "hour outside [0, 23]");
+  if (t.minute > 59) return fail(ErrorCode::InvalidArgument, "minute outside [0, 59]");
   return t;
 }
 
@@ -131,27 +155,27 @@ Result<std::optional<MetarWind>> parseWind(const Groups& in) {
     toKnots = kKnotsPerKmh;
   }
   if (allSlashes(body) && body.size() == 5) return std::optional<MetarWind>{};
-  if (body.size() < 5) return in.error(ErrorCode::Malformed, "wind is not dddff");
+  if (body.size() < 5) return fail(ErrorCode::Malformed, "wind is not dddff");
   std::string_view dir = body.substr(0, 3);
   if (dir == "VRB") {
     wind.variable = true;
   } else if (allDigits(dir)) {
     wind.direction_deg = toInt(dir);
     if (*wind.direction_deg > 360)
-      return in.error(ErrorCode::InvalidArgument, "wind direction above 360");
+      return fail(ErrorCode::InvalidArgument, "wind direction above 360");
   } else {
-    return in.error(ErrorCode::Malformed, "wind direction is not three digits or VRB");
+    return fail(ErrorCode::Malformed, "wind direction is not three digits or VRB");
   }
   std::string_view rest = body.substr(3);
   std::size_t gustAt = rest.find('G');
   std::string_view speed = rest.substr(0, gustAt);
   if (speed.size() < 2 || speed.size() > 3 || !allDigits(speed))
-    return in.error(ErrorCode::Malformed, "wind speed is not two or three digits");
+    return fail(ErrorCode::Malformed, "wind speed is not two or three digits");
   wind.speed_kt = toInt(speed) * toKnots;
   if (gustAt != std::string_view::npos) {
     std::string_view gust = rest.substr(gustAt + 1);
     if (gust.size() < 2 || gust.size() > 3 || !allDigits(gust))
-      return in.error(ErrorCode::Malformed, "gust is not two or three digits");
+      return fail(ErrorCode::Malformed, "gust is not two or three digits");
     wind.gust_kt = toInt(gust) * toKnots;
   }
   return std::optional<MetarWind>{wind};
@@ -209,7 +233,7 @@ bool isRunwayVisualRange(std::string_view g) {
 }
 
 // Present weather: (+|-|VC)? descriptor? phenomena*, at least one code; "//"
-// is weather not observed.
+// is weather not observed; RE.. is recent weather, NSW no significant weather.
 bool isWeather(std::string_view g) {
   if (g == "//") return true;
   static constexpr std::array<std::string_view, 8> kDescriptors{"MI", "PR", "BC", "DR",
@@ -217,9 +241,10 @@ bool isWeather(std::string_view g) {
   static constexpr std::array<std::string_view, 22> kPhenomena{
       "DZ", "RA", "SN", "SG", "IC", "PL", "GR", "GS", "UP", "BR", "FG",
       "FU", "VA", "DU", "SA", "HZ", "PY", "PO", "SQ", "FC", "SS", "DS"};
+  if (g == "NSW") return true;  // no significant weather
   std::string_view s = g;
   if (!s.empty() && (s[0] == '+' || s[0] == '-')) s.remove_prefix(1);
-  else if (s.substr(0, 2) == "VC") s.remove_prefix(2);
+  else if (s.substr(0, 2) == "VC" || s.substr(0, 2) == "RE") s.remove_prefix(2);
   bool any = false;
   if (s.size() >= 2) {
     for (std::string_view d : kDescriptors)
@@ -264,19 +289,19 @@ Result<MetarCloud> parseCloud(const Groups& in) {
   if (height.size() == 3 && allDigits(height)) {
     cloud.height_ft = toInt(height) * 100;
   } else if (height != "///") {
-    return in.error(ErrorCode::Malformed, "height is not three digits");
+    return fail(ErrorCode::Malformed, "height is not three digits");
   }
   std::string_view type = g.size() > 6 ? g.substr(6) : std::string_view{};
   if (type.empty()) cloud.convective = ConvectiveCloud::None;
   else if (type == "CB") cloud.convective = ConvectiveCloud::Cumulonimbus;
   else if (type == "TCU") cloud.convective = ConvectiveCloud::ToweringCumulus;
   else if (type == "///") cloud.convective = ConvectiveCloud::Unknown;
-  else return in.error(ErrorCode::Malformed, "cloud type is not CB, TCU or ///");
+  else return fail(ErrorCode::Malformed, "cloud type is not CB, TCU or ///");
   return cloud;
 }
 
 // M05/M07, 27/25, 15/, 15///, M01/// ; "//" for a missing value.
-bool parseTemperature(std::string_view g, MetarReport& out) {
+bool parseTemperature(std::string_view g, std::optional<int>& temperature, std::optional<int>& dewpoint) {
   std::size_t slash = g.find('/');
   if (slash == std::string_view::npos || slash == 0) return false;
   auto value = [](std::string_view s, std::optional<int>& v) {
@@ -290,8 +315,8 @@ bool parseTemperature(std::string_view g, MetarReport& out) {
   std::optional<int> t, d;
   std::string_view left = g.substr(0, slash);
   if (left.empty() || !value(left, t) || !value(g.substr(slash + 1), d)) return false;
-  out.temperature_degC = t;
-  out.dewpoint_degC = d;
+  temperature = t;
+  dewpoint = d;
   return true;
 }
 
@@ -306,7 +331,31 @@ void parsePressure(std::string_view g, MetarReport& out) {
   out.qnh_hPa = g[0] == 'Q' ? v : v / 100.0 * kHpaPerInHg;
 }
 
+// Reads a wind group at the current position into out.wind, and a variable
+// sector after it; a wind group that does not parse is skipped.
+void readWind(Groups& in, MetarReport& out) {
+  auto wind = parseWind(in);
+  if (!wind) {
+    in.skip(out, wind.error().detail);
+    in.advance();
+    return;
+  }
+  out.wind = *wind;
+  in.advance();
+  if (in.done() || !looksLikeVariableSector(in.peek())) return;
+  const int from = toInt(in.peek().substr(0, 3));
+  const int to = toInt(in.peek().substr(4, 3));
+  if (from > 360 || to > 360) {
+    in.skip(out, "variable sector direction above 360");
+  } else if (out.wind) {
+    out.wind->variableFrom_deg = from;
+    out.wind->variableTo_deg = to;
+  }
+  in.advance();
+}
+
 // Header: [METAR|SPECI] [COR] CCCC [DDHHMMZ] [NIL] [AUTO|COR]* [wind [dddVddd]].
+// Only the station is required; a bad time or wind is skipped.
 Result<void> parseHeader(Groups& in, MetarReport& out) {
   if (in.peek() == "METAR" || in.peek() == "SPECI") {
     out.speci = in.peek() == "SPECI";
@@ -321,54 +370,59 @@ Result<void> parseHeader(Groups& in, MetarReport& out) {
     return in.error(ErrorCode::Malformed, "station is not a four-character ICAO code");
   out.icao = std::string(in.peek());
   in.advance();
-  if (!in.done() && in.peek() != "NIL") {
+  const std::string_view t = in.peek();
+  if (!in.done() && t.size() >= 5 && t.back() == 'Z' && allDigits(t.substr(0, t.size() - 1))) {
     auto time = parseTime(in);
-    if (!time) return tl::unexpected(time.error());
-    out.time = *time;
+    if (time) out.time = *time;
+    else in.skip(out, time.error().detail);
     in.advance();
   }
   if (in.peek() == "NIL") {
     out.nil = true;
     in.advance();
-    if (!in.done()) return in.error(ErrorCode::Malformed, "group after NIL");
-    return {};
-  }
-  while (in.peek() == "AUTO" || in.peek() == "COR") {
-    (in.peek() == "AUTO" ? out.automatic : out.corrected) = true;
-    in.advance();
-  }
-  if (!in.done() && looksLikeWind(in.peek())) {
-    auto wind = parseWind(in);
-    if (!wind) return tl::unexpected(wind.error());
-    out.wind = *wind;
-    in.advance();
-    if (!in.done() && looksLikeVariableSector(in.peek())) {
-      int from = toInt(in.peek().substr(0, 3));
-      int to = toInt(in.peek().substr(4, 3));
-      if (from > 360 || to > 360)
-        return in.error(ErrorCode::InvalidArgument, "variable sector direction above 360");
-      if (out.wind) {
-        out.wind->variableFrom_deg = from;
-        out.wind->variableTo_deg = to;
-      }
+    // A missing report: whatever follows is not an observation.
+    while (!in.done()) {
+      in.skip(out, "group after NIL");
       in.advance();
     }
+    return {};
   }
+  while (in.peek() == "AUTO" || in.peek() == "COR" || in.peek() == "RTD") {
+    if (in.peek() == "AUTO") out.automatic = true;
+    if (in.peek() == "COR") out.corrected = true;
+    in.advance();
+  }
+  if (!in.done() && looksLikeWind(in.peek())) readWind(in, out);
   return {};
 }
 
-// Body: visibility, RVR, weather and sky groups in any order, then
-// temperature, then pressure.
-Result<void> parseBody(Groups& in, MetarReport& out) {
-  bool temperatureSeen = false;
+// A fraction or whole number of statute miles written apart from its unit:
+// "1/4 SM", "2 SM".
+bool isMilesBeforeUnit(std::string_view g, std::string_view next) {
+  if (next != "SM") return false;
+  std::string_view v = g;
+  if (!v.empty() && (v[0] == 'P' || v[0] == 'M')) v.remove_prefix(1);
+  const std::size_t slash = v.find('/');
+  if (slash == std::string_view::npos) return v.size() <= 2 && allDigits(v);
+  return allDigits(v.substr(0, slash)) && allDigits(v.substr(slash + 1));
+}
+
+bool sameCloud(const MetarCloud& a, const MetarCloud& b) {
+  return a.amount == b.amount && a.height_ft == b.height_ft && a.convective == b.convective;
+}
+
+// Body: visibility, RVR, weather, sky and temperature groups in any order, up
+// to the pressure, a trend or remarks. A group that fits nothing is skipped.
+void parseBody(Groups& in, MetarReport& out) {
+  // Position of the last cloud group read, for a cloud type written apart.
+  std::size_t lastCloudAt = 0;
   while (!in.done()) {
-    std::string_view g = in.peek();
-    if (isTrendOrRemarks(g)) return {};
+    const std::string_view g = in.peek();
+    if (isTrendOrRemarks(g)) return;
     if (isPressure(g)) {
       parsePressure(g, out);
-      return {};  // what follows the pressure is supplementary
+      return;  // what follows the pressure is supplementary
     }
-    if (temperatureSeen) return in.error(ErrorCode::Malformed, "expected QNH after temperature");
     if (g == "CAVOK") {
       out.cavok = true;
     } else if (g == "NSC" || g == "NCD" || g == "SKC" || g == "CLR") {
@@ -378,45 +432,88 @@ Result<void> parseBody(Groups& in, MetarReport& out) {
                                  : NoCloud::CLR;
     } else if (startsCloudGroup(g)) {
       auto cloud = parseCloud(in);
-      if (!cloud) return tl::unexpected(cloud.error());
-      out.clouds.push_back(*cloud);
+      if (!cloud) {
+        in.skip(out, cloud.error().detail);
+      } else if (std::any_of(out.clouds.begin(), out.clouds.end(),
+                             [&](const MetarCloud& c) { return sameCloud(c, *cloud); })) {
+        in.skip(out, "repeats an earlier cloud group");
+      } else {
+        out.clouds.push_back(*cloud);
+        lastCloudAt = in.position();
+      }
+    } else if ((g == "CB" || g == "TCU") && lastCloudAt + 1 == in.position() &&
+               out.clouds.back().convective == ConvectiveCloud::None && out.clouds.back().height_ft) {
+      // "FEW050 CB": the type written apart from its cloud group.
+      out.clouds.back().convective = g == "CB" ? ConvectiveCloud::Cumulonimbus : ConvectiveCloud::ToweringCumulus;
+      in.join(out, 0, "cloud type of the group before");
     } else if (g.substr(0, 2) == "VV") {
-      std::string_view h = g.substr(2);
+      const std::string_view h = g.substr(2);
       if (h == "///") {
+        out.verticalVisibility = true;
         out.verticalVisibility_ft.reset();
       } else if (h.size() == 3 && allDigits(h)) {
+        out.verticalVisibility = true;
         out.verticalVisibility_ft = toInt(h) * 100;
       } else {
-        return in.error(ErrorCode::Malformed, "vertical visibility is not three digits");
+        in.skip(out, "vertical visibility is not three digits");
       }
-      out.verticalVisibility = true;
     } else if (isWholeMilesBefore(g, in.peek(1))) {
       in.advance();  // "1" of "1 1/2SM"; the fraction is the next group
-    } else if (isVisibility(g) || isRunwayVisualRange(g) || isWeather(g)) {
-      // recognised, not used by the mapping
-    } else if (parseTemperature(g, out)) {
-      temperatureSeen = true;
+      continue;
+    } else if (allDigits(g) && g.size() <= 2 && isMilesBeforeUnit(in.peek(1), in.peek(2)) &&
+               in.peek(1).find('/') != std::string_view::npos) {
+      // "1 1/4 SM": whole miles, the fraction and the unit apart.
+      in.join(out, 1, "fraction of the visibility before");
+      in.join(out, 2, "unit of the visibility before");
+      in.advance(2);
+    } else if (isMilesBeforeUnit(g, in.peek(1))) {
+      in.join(out, 1, "unit of the visibility before");
+      in.advance();
+    } else if (isVisibility(g) || isRunwayVisualRange(g) || isWeather(g) || g == "$") {
+      // recognised, not used by the mapping ("$": the station needs maintenance)
+    } else if (g == "WS" && (in.peek(1).substr(0, 1) == "R" || in.peek(1) == "ALL")) {
+      // Wind shear on a runway ("WS R27", "WS ALL RWY"): supplementary.
+      in.join(out, 1, "runway of the wind shear before");
+      in.advance();
+      if (in.peek() == "ALL" && in.peek(1) == "RWY") {
+        in.join(out, 1, "runway of the wind shear before");
+        in.advance();
+      }
+    } else if (std::optional<int> t, d; parseTemperature(g, t, d)) {
+      if (out.temperature_degC || out.dewpoint_degC) {
+        in.skip(out, "second temperature group");
+      } else {
+        out.temperature_degC = t;
+        out.dewpoint_degC = d;
+      }
     } else if (looksLikeWind(g)) {
-      return in.error(ErrorCode::Malformed, "wind group out of place");
+      if (out.wind) {
+        in.skip(out, "second wind group");
+      } else {
+        readWind(in, out);  // a wind out of its place is still the wind
+        continue;
+      }
     } else if (g == "CB" || g == "TCU") {
-      return in.error(ErrorCode::Malformed, "cloud type without amount and height");
+      in.skip(out, "cloud type without amount and height");
     } else {
-      return in.error(ErrorCode::Malformed, "unrecognised group");
+      in.skip(out, "unrecognised group");
     }
     in.advance();
   }
-  return {};
 }
 
 }  // namespace
 
 Result<MetarReport> parseMetar(std::string_view report) {
-  Groups in(splitGroups(report));
+  // Capitals: a report typed or pasted in lower case is the same report.
+  std::string text(report);
+  for (char& c : text)
+    if (c >= 'a' && c <= 'z') c = static_cast<char>(c - 'a' + 'A');
+  Groups in(splitGroups(text), text, report);
   if (in.done()) return fail(ErrorCode::Malformed, "empty report");
   MetarReport out;
   if (auto header = parseHeader(in, out); !header) return tl::unexpected(header.error());
-  if (out.nil) return out;
-  if (auto body = parseBody(in, out); !body) return tl::unexpected(body.error());
+  if (!out.nil) parseBody(in, out);
   return out;
 }
 

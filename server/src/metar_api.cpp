@@ -1,7 +1,10 @@
 // POST /api/metar (see metar_api.hpp).
 #include "sky/server/metar_api.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
+#include <optional>
 
 #include "sky/core/utf8.hpp"
 #include "sky/server/api_json.hpp"
@@ -12,8 +15,7 @@ namespace {
 
 using nlohmann::json;
 
-constexpr std::size_t kMaxReports = 64;
-constexpr std::size_t kMaxStations = 4096;
+constexpr std::size_t kMaxStations = 8192;
 
 tl::unexpected<Error> bad(const std::string& path, const std::string& what) {
   return fail(ErrorCode::Malformed, path + ": " + what);
@@ -36,12 +38,18 @@ Result<MetarRequest> parseMetarRequest(std::string_view body) {
   for (auto it = doc.begin(); it != doc.end(); ++it) {
     const std::string& key = it.key();
     const json& v = it.value();
-    if (key == "reports") {
-      if (!v.is_array() || v.empty() || v.size() > kMaxReports)
-        return bad("reports", "expected an array of 1 to " + std::to_string(kMaxReports) + " strings");
+    if (key == "reports" || key == "remove") {
+      if (!v.is_array() || v.size() > kMaxMetarReports)
+        return bad(key, "expected an array of at most " + std::to_string(kMaxMetarReports) + " strings");
+      auto& out = key == "reports" ? r.reports : r.remove;
       for (std::size_t i = 0; i < v.size(); ++i) {
-        if (!v[i].is_string()) return bad("reports[" + std::to_string(i) + "]", "expected a string");
-        r.reports.push_back(v[i].get<std::string>().substr(0, 1024));
+        if (!v[i].is_string()) return bad(key + "[" + std::to_string(i) + "]", "expected a string");
+        const std::string text = v[i].get<std::string>();
+        if (key == "remove" && (text.size() != 4 || !std::all_of(text.begin(), text.end(), [](char c) {
+                                  return (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
+                                })))
+          return bad(key + "[" + std::to_string(i) + "]", "expected a four-character ICAO id");
+        out.push_back(text.substr(0, 1024));
       }
     } else if (key == "stations") {
       if (!v.is_array() || v.size() > kMaxStations)
@@ -94,51 +102,102 @@ Result<MetarRequest> parseMetarRequest(std::string_view body) {
       if (!v.is_string()) return bad(key, "expected a string");
       r.author = std::string(utf8::cut(v.get<std::string>(), kMaxAuthor_bytes));
     } else {
-      return bad(key, "unknown key (expected one of: reports, stations, radius_m, ramp_s, at_s, apply, author)");
+      return bad(key, "unknown key (expected one of: reports, remove, stations, radius_m, ramp_s, at_s, apply, author)");
     }
   }
-  if (r.reports.empty()) return bad("reports", "missing (required)");
+  if (r.reports.empty() && r.remove.empty()) return bad("reports", "missing (required: reports or remove)");
   return r;
 }
+
+namespace {
+
+json notesJson(const std::vector<MetarGroupNote>& notes) {
+  json out = json::array();
+  for (const MetarGroupNote& n : notes)
+    out.push_back({{"group", n.position}, {"text", utf8::sanitise(n.text)}, {"reason", n.reason}});
+  return out;
+}
+
+}  // namespace
 
 MetarReply handleMetar(const MetarRequest& request, std::span<const Station> serverStations,
                        WeatherService& weather) {
   const std::span<const Station> stations =
       request.stations ? std::span<const Station>(*request.stations) : serverStations;
-  const MetarPlan plan = planMetar(request.reports, stations, request.options);
+  const WeatherView now = weather.view();
+  const MetarPlan plan = planMetar(request.reports, stations, request.options, {now.layers, now.regions},
+                                   request.remove);
+  std::map<std::string, std::uint32_t> regionOf;
+  for (const MetarStationChange& s : plan.stations) regionOf[s.icao] = s.regionId;
   json reports = json::array();
-  std::size_t good = 0;
   for (std::size_t i = 0; i < plan.reports.size(); ++i) {
     const auto& r = plan.reports[i];
     if (r) {
-      ++good;
       json layers = json::array();
       for (const auto& l : r->layers) layers.push_back(toJson(l));
-      reports.push_back({{"index", i + 1}, {"icao", r->station.icao}, {"ok", true}, {"layers", layers}});
+      json one = {{"index", i + 1},
+                  {"icao", r->station.icao},
+                  {"ok", true},
+                  {"sky", r->skyObserved ? "read" : "not_observed"},
+                  {"layers", layers},
+                  {"skipped", notesJson(r->report.skipped)},
+                  {"skipped_count", r->report.skippedCount},
+                  {"joined", notesJson(r->report.joined)}};
+      if (const auto it = regionOf.find(r->station.icao); it != regionOf.end()) one["region_id"] = it->second;
+      reports.push_back(std::move(one));
     } else {
-      reports.push_back({{"index", i + 1}, {"ok", false}, {"error", r.error().detail}});
+      reports.push_back({{"index", i + 1}, {"ok", false}, {"error", utf8::sanitise(r.error().detail)}});
     }
   }
+  std::size_t replaced = 0;
+  for (const MetarStationChange& s : plan.stations) replaced += s.replaced ? 1 : 0;
   json changes = json::array();
-  for (const auto& c : plan.changes)
-    changes.push_back({{"op", "set_region"}, {"region", toJson(std::get<SetRegion>(c).region)}});
-  MetarReply reply{200, {{"reports", reports}, {"changes", changes}, {"applied", nullptr}}};
+  for (const auto& c : plan.changes) {
+    if (const auto* set = std::get_if<SetRegion>(&c))
+      changes.push_back({{"op", "set_region"}, {"region", toJson(set->region)}});
+    else
+      changes.push_back({{"op", "remove_region"}, {"id", std::get<RemoveRegion>(c).regionId}});
+  }
+  MetarReply reply{200,
+                   {{"reports", reports},
+                    {"stations",
+                     {{"set", plan.stations.size()},
+                      {"replaced", replaced},
+                      {"reshaped", plan.neighboursReshaped},
+                      {"removed", plan.removed.size()}}},
+                    {"remove_errors", plan.removeErrors},
+                    {"changes", changes},
+                    {"applied", nullptr}}};
   if (!request.apply) return reply;
   if (plan.changes.empty()) {
     reply.status = 400;
     reply.body["error"] = "reports: none of the " + std::to_string(plan.reports.size()) +
-                          " reports maps to weather; nothing applied";
+                          " reports sets a station's weather and nothing is removed; nothing applied";
     return reply;
   }
-  auto applied = weather.submit(
-      ChangeRequest{plan.changes, request.author.empty() ? "metar" : request.author, "metar"});
-  if (!applied) {
-    reply.status = 400;
-    reply.body["error"] = applied.error().detail;
-    return reply;
+  const std::string author = request.author.empty() ? "metar" : request.author;
+  const std::string what = std::to_string(plan.stations.size()) + " METAR station(s) set (" +
+                           std::to_string(replaced) + " replaced), " + std::to_string(plan.neighboursReshaped) +
+                           " reshaped, " + std::to_string(plan.removed.size()) + " removed";
+  std::optional<AppliedChange> first, last;
+  std::size_t submits = 0;
+  for (std::size_t at = 0; at < plan.changes.size(); at += kMaxChangesPerSubmit) {
+    const auto end = plan.changes.begin() + static_cast<std::ptrdiff_t>(std::min(plan.changes.size(), at + kMaxChangesPerSubmit));
+    auto applied = weather.submit(ChangeRequest{{plan.changes.begin() + static_cast<std::ptrdiff_t>(at), end}, author, "metar"});
+    if (!applied) {
+      reply.status = 400;
+      reply.body["error"] = "changes " + std::to_string(at + 1) + "..: " + applied.error().detail +
+                            (submits ? " (the " + std::to_string(at) + " changes before were applied)" : "");
+      break;
+    }
+    ++submits;
+    if (!first) first = *applied;
+    last = *applied;
   }
-  reply.body["applied"] = {{"sequence", applied->sequence}, {"clock_s", applied->clock_s},
-                           {"summary", applied->summary}};
+  if (last)
+    reply.body["applied"] = {{"sequence", last->sequence}, {"first_sequence", first->sequence},
+                             {"submits", submits},        {"clock_s", last->clock_s},
+                             {"summary", what}};
   return reply;
 }
 

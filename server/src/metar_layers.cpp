@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string_view>
+#include <unordered_map>
 
 #include "sky/geo/geodetic.hpp"
 
@@ -66,8 +68,7 @@ weather::LayerWind layerWind(const std::optional<MetarWind>& wind) {
 
 }  // namespace
 
-Result<std::vector<weather::CloudLayer>> layersFromMetar(const MetarReport& report,
-                                                         const Station& station) {
+Result<MetarSky> skyFromMetar(const MetarReport& report, const Station& station) {
   if (report.nil)
     return fail(ErrorCode::InvalidArgument, report.icao + ": NIL report (no observation)");
   if (report.icao != station.icao)
@@ -92,12 +93,15 @@ Result<std::vector<weather::CloudLayer>> layersFromMetar(const MetarReport& repo
     layers.push_back(layer);
   };
 
-  if (report.verticalVisibility_ft) {
-    const double top_m = *report.verticalVisibility_ft * kMetresPerFoot;
+  if (report.verticalVisibility) {
+    const double top_m =
+        report.verticalVisibility_ft.value_or(kUnknownVerticalVisibility_ft) * kMetresPerFoot;
     add(weather::CloudType::Stratus, station.elevation_m, std::max(top_m, kMinFogThickness_m), 1.0);
   }
   for (const MetarCloud& cloud : report.clouds) {
-    if (cloud.amount == CloudAmount::Unknown || !cloud.height_ft) continue;  // cannot place
+    if (!cloud.height_ft) continue;  // cannot place
+    // A base seen without an amount: cloud is there, FEW the least it can be.
+    const CloudAmount amount = cloud.amount == CloudAmount::Unknown ? CloudAmount::Few : cloud.amount;
     const double heightAgl_m = *cloud.height_ft * kMetresPerFoot;
     const double base_m = station.elevation_m + heightAgl_m;
     weather::CloudType type;
@@ -109,27 +113,27 @@ Result<std::vector<weather::CloudLayer>> layersFromMetar(const MetarReport& repo
       type = weather::CloudType::Cumulus;  // CIGI has no towering cumulus: a deep cumulus
       thickness_m = kToweringCumulusThickness_m;
     } else {
-      type = typeFromHeight(cloud.amount, heightAgl_m);
+      type = typeFromHeight(amount, heightAgl_m);
       thickness_m = thicknessOf(type);
     }
-    add(type, base_m, thickness_m, coverageOf(cloud.amount));
+    add(type, base_m, thickness_m, coverageOf(amount));
   }
 
-  const bool reportedClear = report.cavok || report.noCloud != NoCloud::None;
-  if (layers.empty() && !reportedClear)
-    return fail(ErrorCode::InvalidArgument,
-                report.icao + ": no usable sky condition (no cloud group with amount and "
-                              "height, no VV height, no CAVOK/NSC/NCD/SKC/CLR)");
   for (const weather::CloudLayer& layer : layers)
     if (auto ok = weather::validate(layer); !ok)
       return fail(ok.error().code, report.icao + ": " + ok.error().detail);
-  return layers;
+  const bool reportedClear = report.cavok || report.noCloud != NoCloud::None;
+  return MetarSky{!layers.empty() || reportedClear, std::move(layers)};
 }
 
 std::vector<Result<StationWeather>> layersFromMetarBatch(std::span<const std::string> reports,
                                                          std::span<const Station> stations) {
   std::vector<Result<StationWeather>> out;
   out.reserve(reports.size());
+  // A continent's table holds thousands of stations: found by ICAO in O(1).
+  std::unordered_map<std::string_view, const Station*> byIcao;
+  byIcao.reserve(stations.size());
+  for (const Station& s : stations) byIcao.emplace(s.icao, &s);
   for (std::size_t i = 0; i < reports.size(); ++i) {
     const std::string where = "report " + std::to_string(i + 1) + ": ";
     auto report = parseMetar(reports[i]);
@@ -137,19 +141,19 @@ std::vector<Result<StationWeather>> layersFromMetarBatch(std::span<const std::st
       out.push_back(fail(report.error().code, where + report.error().detail));
       continue;
     }
-    auto station = std::find_if(stations.begin(), stations.end(),
-                                [&](const Station& s) { return s.icao == report->icao; });
-    if (station == stations.end()) {
+    const auto found = byIcao.find(report->icao);
+    if (found == byIcao.end()) {
       out.push_back(fail(ErrorCode::InvalidArgument,
                          where + "station " + report->icao + " is not in the station table"));
       continue;
     }
-    auto layers = layersFromMetar(*report, *station);
-    if (!layers) {
-      out.push_back(fail(layers.error().code, where + layers.error().detail));
+    const Station* station = found->second;
+    auto sky = skyFromMetar(*report, *station);
+    if (!sky) {
+      out.push_back(fail(sky.error().code, where + sky.error().detail));
       continue;
     }
-    out.push_back(StationWeather{*station, std::move(*report), std::move(*layers)});
+    out.push_back(StationWeather{*station, std::move(*report), sky->observed, std::move(sky->layers)});
   }
   return out;
 }

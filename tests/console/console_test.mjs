@@ -141,14 +141,16 @@ const cases = {
     const a = await openConsole(browser, w, { token: TOKEN, name: "A" });
     const before = await w.state();
     // LJLJ (Ljubljana, 388 m in deploy/metar/stations.csv): broken at 3000 ft
-    // above the station; the second report's cloud group is malformed.
+    // above the station; the second report's only cloud group is malformed:
+    // skipped and named, its sky not observed.
     await a.page.fill('[name="reports"]',
       "METAR LJLJ 221150Z 24008KT 9999 BKN030 12/06 Q1018\nMETAR LIPQ 221150Z 24008KT 9999 BKN0x5 12/06 Q1018");
     await a.page.click("#metar-preview");
     await until("the preview", async () => (await a.page.$$("#metar-result li")).length === 2);
     const items = await a.page.$$eval("#metar-result li", (lis) => lis.map((li) => [li.className, li.textContent]));
     assert(items[0][0] === "ok" && /LJLJ/.test(items[0][1]) && /\/8/.test(items[0][1]), `report 1 previewed: ${items[0][1]}`);
-    assert(items[1][0] === "bad" && /BKN0x5/.test(items[1][1]), `report 2 refused naming its group: ${items[1][1]}`);
+    assert(items[1][0] === "warn" && /skipped group 6 'BKN0x5'/.test(items[1][1]) && /not observed/.test(items[1][1]),
+      `report 2's bad group skipped and named: ${items[1][1]}`);
     assert((await w.state()).sequence === before.sequence, "a preview changes nothing");
     await a.page.click("#metar-apply");
     await until("applied", async () => /applied #/.test(await a.page.textContent("#metar .note")));

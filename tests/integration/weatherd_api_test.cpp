@@ -276,8 +276,9 @@ namespace sky::test {
 namespace {
 
 // METAR through the API: a preview (no token) lists each report's layers and
-// the one that does not parse with its group, and changes nothing; applying
-// needs the token and puts a region at each station that mapped.
+// the groups skipped (a report whose only cloud group is malformed has its
+// sky not observed), and changes nothing; applying needs the token and puts a
+// region at each station whose sky was read.
 TEST(WeatherdApi, MetarPreviewThenApply) {
   Weatherd w("weatherd-metar");
   const std::string body = R"({"reports": ["METAR LIPQ 221150Z 09012KT 9999 BKN020 15/10 Q1015",
@@ -290,8 +291,9 @@ TEST(WeatherdApi, MetarPreviewThenApply) {
   ASSERT_EQ(p["reports"].size(), 2u);
   EXPECT_EQ(p["reports"][0]["ok"], true);
   EXPECT_EQ(p["reports"][0]["layers"][0]["type"], "stratocumulus");
-  EXPECT_EQ(p["reports"][1]["ok"], false);
-  EXPECT_NE(p["reports"][1]["error"].get<std::string>().find("'BKN0x5'"), std::string::npos) << preview.body;
+  EXPECT_EQ(p["reports"][1]["ok"], true);
+  EXPECT_EQ(p["reports"][1]["sky"], "not_observed");
+  EXPECT_EQ(p["reports"][1]["skipped"][0]["text"], "BKN0x5") << preview.body;
   ASSERT_EQ(p["changes"].size(), 1u);
   EXPECT_TRUE(p["applied"].is_null());
   EXPECT_TRUE(nlohmann::json::parse(w.request("GET", "/api/state").body)["regions"].empty());

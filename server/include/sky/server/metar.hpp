@@ -1,19 +1,25 @@
 // METAR/SPECI reports become weather layers.
 //
-// parseMetar is a pure decoder of one report (no I/O, no logging). It reads the
+// parseMetar is a pure, tolerant decoder of one report (no I/O, no logging),
+// written for reports as they really arrive from many countries. It reads the
 // header (METAR/SPECI, COR, station, DDHHMMZ, NIL, AUTO/COR, wind, variable
-// sector) in order, then the body groups in any order (visibility incl. statute
-// miles "1 1/2SM", RVR, present weather, CAVOK, clouds, VV, NSC/NCD/SKC/CLR),
-// then temperature/dewpoint and QNH. It stops at the first trend or remarks
-// keyword (NOSIG, BECMG, TEMPO, INTER, FMhhmm, PROBnn, RMK) and after the first
-// QNH group: what follows the pressure (recent weather RE.., wind shear WS,
-// runway state, sea state W../S.., colour states BLU/GRN/...) is supplementary
-// and not decoded. A group that fits no pattern rejects the report: the error
-// names the group by position and text ("group 5 'BKN0x5': height is not three
-// digits"). Group numbers count every whitespace-separated group from 1,
-// including a leading METAR/SPECI.
+// sector), then the body groups in any order (visibility incl. statute miles
+// "1 1/2SM", RVR, present and recent weather, CAVOK, clouds, VV,
+// NSC/NCD/SKC/CLR, temperature/dewpoint), up to the first trend or remarks
+// keyword (NOSIG, BECMG, TEMPO, INTER, FMhhmm, PROBnn, RMK) or the first QNH
+// group: what follows the pressure (recent weather RE.., wind shear WS, runway
+// state, sea state W../S.., colour states BLU/GRN/...) is supplementary and
+// not decoded. Letters are read as capitals ("metar ljlj ..." is a report).
 //
-// layersFromMetar maps a decoded report to CloudLayers (see the rules at the
+// A group that fits no pattern (`-VCTSRA`, a stray `M`, `BKN0x5`, a second
+// wind group) is skipped and listed in MetarReport::skipped with its position
+// and the reason; a group read together with its neighbour (`1/4 SM`, a lone
+// `CB` after `FEW050`) is listed in MetarReport::joined. Only a report whose
+// station cannot be read is refused, naming the group ("group 2 'K1': station
+// is not a four-character ICAO code"). Group numbers count every
+// whitespace-separated group from 1, including a leading METAR/SPECI.
+//
+// skyFromMetar maps a decoded report to CloudLayers (see the rules at the
 // function). layersFromMetarBatch does a set of reports against a station
 // table, each report on its own. coverageAt interpolates total cloud cover
 // between stations by inverse-distance weighting on geodesic distance.
@@ -62,6 +68,21 @@ struct MetarTime {
   int minute = 0;  // [0, 59]
 };
 
+// A group the decoder skipped (not used) or read together with the group
+// before it.
+struct MetarGroupNote {
+  std::size_t position = 0;  // 1-based group number in the report
+  std::string text;          // the group as written, capitals, at most kMaxNotedGroupBytes
+  std::string reason;        // "unrecognised group", "height is not three digits", ...
+};
+
+// Bounds of what a report's notes hold, whatever the input: the first
+// kMaxNotedGroups notes of each kind, each group cut to kMaxNotedGroupBytes
+// (a real group is at most ~20 characters: "R19R/1600V2000FT"); the rest are
+// counted in MetarReport::skippedCount.
+inline constexpr std::size_t kMaxNotedGroups = 32;
+inline constexpr std::size_t kMaxNotedGroupBytes = 32;
+
 struct MetarReport {
   std::string icao;
   bool speci = false;
@@ -78,10 +99,13 @@ struct MetarReport {
   std::optional<int> temperature_degC;
   std::optional<int> dewpoint_degC;
   std::optional<double> qnh_hPa;  // Q in hPa, or A (hundredths of inHg) converted
+  std::vector<MetarGroupNote> skipped;  // groups not decoded, in report order (at most kMaxNotedGroups)
+  std::size_t skippedCount = 0;         // every skipped group, noted or not
+  std::vector<MetarGroupNote> joined;   // groups read with the one before ("SM" of "1/4 SM", "CB" of "FEW050 CB")
 };
 
-// Errors: Malformed (a group that fits no pattern, or a report ending before
-// its station), InvalidArgument (a number out of range: day 32, direction 370).
+// Errors (Malformed): an empty report, no station, or a station group that is
+// not four letters or digits. Everything after the station is tolerated.
 Result<MetarReport> parseMetar(std::string_view report);
 
 struct Station {
@@ -124,6 +148,21 @@ inline constexpr double kScatteredCoverage = 3.5 / 8;
 inline constexpr double kBrokenCoverage = 6.0 / 8;
 inline constexpr double kOvercastCoverage = 1.0;
 
+// VV/// (sky obscured, vertical visibility not measured, as automatic
+// stations send in fog): the fog is taken as deep as VV001, the smallest
+// vertical visibility above "less than 100 ft" a report can give.
+inline constexpr int kUnknownVerticalVisibility_ft = 100;
+
+// What one report says about the sky at its station.
+struct MetarSky {
+  // false: the report carries no sky that can be read (an automatic station's
+  // "//////", or no sky group at all): it says nothing about cloud, and the
+  // weather around the station stays as it is. true: `layers` is the sky
+  // (empty: reported clear).
+  bool observed = false;
+  std::vector<weather::CloudLayer> layers;
+};
+
 // Maps one report at its station to layers, ids 1..n in report order (VV
 // first). Rules:
 // * cloud base MSL = station elevation + height above the station;
@@ -133,29 +172,33 @@ inline constexpr double kOvercastCoverage = 1.0;
 //   kStratusMaxBase_m else stratocumulus; middle FEW/SCT altocumulus, BKN/OVC
 //   altostratus; high cirrus;
 // * VV hhh -> stratus (fog) from the station elevation, coverage 1, top at the
-//   vertical visibility;
-// * a cloud group with unknown amount or height ("///") cannot be placed and
-//   gives no layer; an unknown type is chosen from the height;
+//   vertical visibility (VV/// at kUnknownVerticalVisibility_ft);
+// * a cloud group with a height and unknown amount ("///074///", a ceilometer
+//   that saw a base but no amount) is taken as FEW: cloud is there, and FEW is
+//   the least the report can mean; a group with no height ("FEW///",
+//   "//////") cannot be placed and gives no layer; an unknown type is chosen
+//   from the height;
 // * every layer gets the surface wind (VRB -> direction 0; calm or missing
 //   wind -> 0 m/s; gusts ignored);
-// * CAVOK/NSC/NCD/SKC/CLR with no cloud group -> no layers.
+// * CAVOK/NSC/NCD/SKC/CLR with no cloud group -> observed, no layers;
+// * nothing of the above -> not observed (MetarSky::observed false).
 // Errors (InvalidArgument): a NIL report, a station of another ICAO or with
-// non-finite position, a report with no usable sky information (no cloud
-// group that can be placed, no VV height and no clear-sky code: an empty sky
-// must be reported, never inferred), a layer weather::validate rejects.
-Result<std::vector<weather::CloudLayer>> layersFromMetar(const MetarReport& report,
-                                                         const Station& station);
+// non-finite position, a layer weather::validate rejects (BKN999: a base
+// above 20 km).
+Result<MetarSky> skyFromMetar(const MetarReport& report, const Station& station);
 
 struct StationWeather {
   Station station;
   MetarReport report;
-  std::vector<weather::CloudLayer> layers;
+  bool skyObserved = false;                 // MetarSky::observed
+  std::vector<weather::CloudLayer> layers;  // MetarSky::layers
 };
 
 // One result per input report, same order. A report that does not parse, whose
 // station is not in the table, or that does not map, is an error ("report 3:
-// group 5 'BKN0x5': height is not three digits") and the others still apply.
-// Several reports of one station give several results; the caller picks.
+// group 2 'K1': station is not a four-character ICAO code") and the others
+// still apply. Several reports of one station give several results; the
+// caller picks.
 std::vector<Result<StationWeather>> layersFromMetarBatch(std::span<const std::string> reports,
                                                          std::span<const Station> stations);
 
