@@ -19,7 +19,9 @@
 #include "sky/server/metar_api.hpp"
 #include "sky/server/metar_changes.hpp"
 #include "sky/server/snapshot_builder.hpp"
+#include "sky/server/weather_store.hpp"
 #include "sky/stream/messages.hpp"
+#include "store_files.hpp"
 #include "sky/weather/tiling.hpp"
 
 namespace sky::server {
@@ -335,11 +337,13 @@ std::vector<Row> realReports() {
 }
 
 // 5000 stations over North America (a jittered grid 25-55 N, 125-65 W, about
-// 40 km apart), each with a real report of the selection (its ICAO put in),
-// applied through POST /api/metar's handler in 20 requests of 250. Every
-// station whose sky is read keeps its region, and the first request's
-// stations survive the last. The apply time, a 300 km area's snapshot (size
-// on the wire and build time) are printed, not asserted.
+// 50-67 km apart, as the US network), each with a real report of the selection (its ICAO put in),
+// applied through POST /api/metar's handler in 20 requests of 250, every
+// change committed to a SQLite store as the server does. Every station whose
+// sky is read keeps its region, the first request's stations survive the
+// last, and after a restart from the store a newer report of a first-batch
+// station finds and replaces its region. The apply time, a 300 km area's
+// snapshot (size on the wire and build time) are printed, not asserted.
 TEST(MetarContinent, FiveThousandStationsAccumulate) {
   const std::vector<Row> rows = realReports();
   ASSERT_EQ(rows.size(), 157u);
@@ -364,9 +368,14 @@ TEST(MetarContinent, FiveThousandStationsAccumulate) {
     reports.push_back(text);
   }
   Live live(cumulus());
+  auto store = WeatherStore::open(test::freshDatabase("sky-metar-continent", "weather.db"));
+  ASSERT_TRUE(store) << store.error().detail;
+  live.weather.attachStore(&*store);
   std::size_t read = 0;
   double applyTotal_s = 0, applyMax_s = 0;
   std::set<std::uint32_t> firstBatch;
+  std::string firstIcao;  // the first station of the first request with a region, and its id
+  std::uint32_t firstId = 0;
   for (int b = 0; b < kStationCount / kBatch; ++b) {
     const std::vector<std::string> batch(reports.begin() + b * kBatch, reports.begin() + (b + 1) * kBatch);
     const auto started = std::chrono::steady_clock::now();
@@ -379,6 +388,10 @@ TEST(MetarContinent, FiveThousandStationsAccumulate) {
       if (r.contains("region_id")) {
         ++read;
         if (b == 0) firstBatch.insert(r["region_id"].get<std::uint32_t>());
+        if (firstIcao.empty()) {
+          firstIcao = r["icao"].get<std::string>();
+          firstId = r["region_id"].get<std::uint32_t>();
+        }
       }
   }
   const auto regions = metarRegions(live.weather);
@@ -388,8 +401,28 @@ TEST(MetarContinent, FiveThousandStationsAccumulate) {
   for (const auto& r : regions) ids.insert(r.id);
   EXPECT_EQ(ids.size(), regions.size());
   for (std::uint32_t id : firstBatch) EXPECT_TRUE(ids.count(id)) << "first batch's region " << id << " is gone";
-  std::printf("[ METAR    ] %d stations in %d requests: %zu regions; apply %.2f s in all, %.3f s a request at most\n",
-              kStationCount, kStationCount / kBatch, regions.size(), applyTotal_s, applyMax_s);
+  const auto& commits = live.weather.commitStats();
+  std::printf("[ METAR    ] %d stations in %d requests: %zu regions; apply %.2f s in all, %.3f s a request at most; "
+              "%llu commits to the store, %.2f s in all\n",
+              kStationCount, kStationCount / kBatch, regions.size(), applyTotal_s, applyMax_s,
+              static_cast<unsigned long long>(commits.count), commits.total_s);
+
+  // A restart: the weather from the store, then a newer report of the first
+  // station with a region.
+  {
+    Live restarted(cumulus());
+    auto saved = store->load();
+    ASSERT_TRUE(saved && *saved);
+    ASSERT_TRUE(restarted.weather.restore((*saved)->state, (*saved)->events));
+    EXPECT_EQ(metarRegions(restarted.weather).size(), regions.size());
+    ASSERT_FALSE(firstIcao.empty());
+    const MetarReply newer =
+        apply(restarted.weather, {"METAR " + firstIcao + " 231200Z 00000KT 9999 OVC010 10/05 Q1010"}, stations);
+    ASSERT_EQ(newer.status, 200) << newer.body.value("error", "");
+    EXPECT_EQ(newer.body["reports"][0]["region_id"], firstId);
+    EXPECT_EQ(newer.body["stations"]["replaced"], 1);
+    EXPECT_EQ(metarRegions(restarted.weather).size(), regions.size());
+  }
 
   // A renderer's 300 km area in the middle of the continent, with and
   // without the server's tile cache.
