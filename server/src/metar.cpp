@@ -331,6 +331,14 @@ void parsePressure(std::string_view g, MetarReport& out) {
   out.qnh_hPa = g[0] == 'Q' ? v : v / 100.0 * kHpaPerInHg;
 }
 
+// Groups that may stand before the station and be skipped.
+constexpr std::size_t kMaxGroupsBeforeStation = 3;
+
+// Digits and a Z: a time group, maybe a malformed one (1212Z).
+bool isTimeGroup(std::string_view t) {
+  return t.size() >= 5 && t.back() == 'Z' && allDigits(t.substr(0, t.size() - 1));
+}
+
 // Reads a wind group at the current position into out.wind, and a variable
 // sector after it; a wind group that does not parse is skipped.
 void readWind(Groups& in, MetarReport& out) {
@@ -366,12 +374,22 @@ Result<void> parseHeader(Groups& in, MetarReport& out) {
     in.advance();
   }
   if (in.done()) return in.error(ErrorCode::Malformed, "no station");
+  // Something before the station ("METAR:", a bulletin's date line "2018/09/14
+  // 12:35"): skipped when a station and its time follow within a few groups.
+  if (!isStation(in.peek()))
+    for (std::size_t ahead = 1; ahead <= kMaxGroupsBeforeStation; ++ahead)
+      if (isStation(in.peek(ahead)) && isTimeGroup(in.peek(ahead + 1))) {
+        for (std::size_t k = 0; k < ahead; ++k) {
+          in.skip(out, "not a station, before the station");
+          in.advance();
+        }
+        break;
+      }
   if (!isStation(in.peek()))
     return in.error(ErrorCode::Malformed, "station is not a four-character ICAO code");
   out.icao = std::string(in.peek());
   in.advance();
-  const std::string_view t = in.peek();
-  if (!in.done() && t.size() >= 5 && t.back() == 'Z' && allDigits(t.substr(0, t.size() - 1))) {
+  if (!in.done() && isTimeGroup(in.peek())) {
     auto time = parseTime(in);
     if (time) out.time = *time;
     else in.skip(out, time.error().detail);
