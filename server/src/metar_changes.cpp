@@ -64,6 +64,14 @@ std::vector<weather::CloudLayer> slotted(const StationWeather& s) {
   return v;
 }
 
+// Whether a region is a METAR station's: an id of theirs and their shape (a
+// circle that stays put), so that a region another input put in that range
+// (a CIGI host may use any 16-bit id) is neither reshaped nor taken over.
+bool isStationRegion(const weather::Region& r) {
+  return isMetarRegion(r.id) && !r.driftsWithWind && r.rotation_deg == 0 && r.sizeX_m == r.sizeY_m &&
+         r.cornerRadius_m == r.sizeX_m / 2;
+}
+
 // Longitude as LiveWeather stores a region's centre.
 double storedLon(double lon_deg) { return std::remainder(lon_deg, 360.0); }
 
@@ -186,7 +194,7 @@ MetarPlan planMetar(std::span<const std::string> reports, std::span<const Statio
   std::set<std::uint32_t> taken;
   for (std::size_t k = 0; k < now.regions.size(); ++k) {
     taken.insert(now.regions[k].id);
-    if (isMetarRegion(now.regions[k].id))
+    if (isStationRegion(now.regions[k]))
       existingAt.emplace(keyOf(now.regions[k].centerLat_deg, now.regions[k].centerLon_deg), k);
   }
   std::unordered_map<std::string_view, const Station*> table;
@@ -205,8 +213,7 @@ MetarPlan planMetar(std::span<const std::string> reports, std::span<const Statio
       plan.removeErrors.push_back("remove " + icao + ": the station has no weather to remove");
       continue;
     }
-    goes.insert(at->second);
-    plan.removed.push_back({icao, now.regions[at->second].id, true});
+    if (goes.insert(at->second).second) plan.removed.push_back({icao, now.regions[at->second].id, true});
   }
 
   // The layers every station region clears: the global ones.
@@ -244,7 +251,7 @@ MetarPlan planMetar(std::span<const std::string> reports, std::span<const Statio
     };
     for (const weather::CloudLayer& l : cleared) clear(l);
     for (const weather::Region& other : now.regions)
-      if (!isMetarRegion(other.id) && weather::regionWeight(other, st.lat_deg, st.lon_deg) > 0)
+      if (!isStationRegion(other) && weather::regionWeight(other, st.lat_deg, st.lon_deg) > 0)
         for (const weather::CloudLayer& l : other.layers) clear(l);
     if (r.layers.size() > weather::kMaxRegionLayers) {
       plan.reports[index] = fail(ErrorCode::InvalidArgument,

@@ -294,6 +294,37 @@ TEST(MetarChanges, StationsAccumulateAcrossRequests) {
   EXPECT_TRUE(std::none_of(regions.begin(), regions.end(), [&](const auto& r) { return r.id == khafId; }));
 }
 
+// A region another input put in the METAR id range (a CIGI host may use any
+// 16-bit id) is neither reshaped nor taken for a station; a station inside it
+// clears its layers like the global ones.
+TEST(MetarChanges, OtherRegionsInTheRangeAreLeftAlone) {
+  Live live(weather::Scenario{});
+  weather::Region square;
+  square.id = 50000;
+  square.centerLat_deg = kLjlj.lat_deg + 0.05;
+  square.centerLon_deg = kLjlj.lon_deg;
+  square.sizeX_m = square.sizeY_m = 40000;
+  square.transition_m = 5000;
+  weather::CloudLayer storm;
+  storm.id = 7;
+  storm.type = weather::CloudType::Cumulonimbus;
+  storm.base_m = 1000;
+  storm.thickness_m = 8000;
+  storm.coverage = 0.8;
+  square.layers = {storm};
+  ASSERT_TRUE(live.weather.submit({{SetRegion{square, {}}}, "cigi", "cigi"}));
+  const auto view = live.weather.view();
+  const MetarPlan plan = planMetar({{"METAR LJLJ 221150Z 24008KT 9999 FEW025 12/06 Q1018"}}, kStations, {},
+                                   {view.layers, view.regions});
+  ASSERT_EQ(plan.changes.size(), 1u) << "the square is not reshaped";
+  EXPECT_EQ(plan.neighboursReshaped, 0u);
+  const weather::Region& ljlj = regionOf(plan, 0);
+  EXPECT_NE(ljlj.id, square.id);
+  const weather::CloudLayer* cleared = slot(ljlj, 7);
+  ASSERT_NE(cleared, nullptr) << "the storm's layer, cleared at the station";
+  EXPECT_EQ(cleared->coverage, 0);
+}
+
 // The preview lists the groups skipped and joined, by position and text.
 TEST(MetarChanges, ThePreviewListsSkippedGroups) {
   Live live(cumulus());
