@@ -1,7 +1,8 @@
 // Reading GRIB2 messages with ecCodes (grib.hpp). The file is split into
-// messages here, by the lengths GRIB2's section 0 states, so a hostile length
-// is refused before ecCodes sees the bytes; ecCodes then decodes each message
-// from a copy. ecCodes reports through a logging callback (kept as the last
+// messages and fields here, by the lengths GRIB2's sections state, so a
+// hostile length is refused before ecCodes sees the bytes; ecCodes then
+// decodes each field as a message of its own (no state carried from one
+// message to the next, as its multi-field reader keeps). ecCodes reports through a logging callback (kept as the last
 // message for the error text, never printed) and, on an internal assertion,
 // through a callback that by default aborts the process: ours throws instead,
 // and the message is skipped.
@@ -50,7 +51,6 @@ codes_context* context() {
   std::call_once(once, [] {
     codes_context_set_logging_proc(codes_context_get_default(), onLog);
     codes_set_codes_assertion_failed_proc(onAssertion);
-    codes_grib_multi_support_on(codes_context_get_default());
   });
   return codes_context_get_default();
 }
@@ -217,6 +217,59 @@ std::uint64_t bigEndian(const std::byte* p, std::size_t n) {
 
 }  // namespace
 
+namespace {
+
+// Walks the sections of the GRIB2 message at [at, at + length) and appends
+// its fields; the reason when they do not add up.
+std::optional<std::string> splitFields(std::span<const std::byte> bytes, std::size_t at, std::size_t length,
+                                       std::size_t message, std::vector<GribFieldSpan>& out) {
+  const std::size_t end = at + length - 4;  // "7777"
+  std::size_t p = at + kSection0Bytes;
+  std::array<std::optional<GribSection>, 8> latest;  // by section number
+  std::optional<GribSection> bitmap;                 // the latest section 6 holding a bitmap
+  std::size_t fields = 0;
+  while (p < end) {
+    if (end - p < 5) return "a section header cut short at byte " + std::to_string(p - at);
+    const std::uint64_t len = bigEndian(bytes.data() + p, 4);
+    const auto number = static_cast<std::uint8_t>(bytes[p + 4]);
+    if (len < 5 || len > end - p)
+      return "section " + std::to_string(number) + " at byte " + std::to_string(p - at) + ": length " +
+             std::to_string(len) + " runs past the message";
+    if (number < 1 || number > 7) return "section number " + std::to_string(number) + " at byte " + std::to_string(p - at);
+    if (number == 1 && latest[1]) return "a second section 1";
+    if (number != 1 && !latest[1]) return "section " + std::to_string(number) + " before section 1";
+    const GribSection here{p, static_cast<std::size_t>(len)};
+    if (number == 6) {
+      if (len < 6) return "section 6 without its bitmap indicator";
+      const auto indicator = static_cast<std::uint8_t>(bytes[p + 5]);
+      if (indicator == 0) bitmap = here;
+      if (indicator == 254 && !bitmap) return "section 6 refers to a bitmap defined before, and there is none";
+      latest[6] = indicator == 254 ? *bitmap : here;
+    } else {
+      latest[number] = here;
+    }
+    // A section 3 or 4 starts what the next section 7 closes.
+    if (number == 3) latest[4] = latest[5] = latest[6] = std::nullopt;
+    if (number == 4) latest[5] = latest[6] = std::nullopt;
+    if (number == 7) {
+      for (int k : {3, 4, 5, 6})
+        if (!latest[k]) return "section 7 at byte " + std::to_string(p - at) + " without a section " + std::to_string(k);
+      GribFieldSpan f;
+      f.message = message;
+      for (int k = 1; k <= 7; ++k) f.sections[k - 1] = latest[k].value_or(GribSection{});
+      out.push_back(f);
+      ++fields;
+      latest[4] = latest[5] = latest[6] = latest[7] = std::nullopt;
+    }
+    p += len;
+  }
+  if (fields == 0) return "no field (no section 7)";
+  if (latest[4] || latest[5] || latest[6]) return "a field's sections after the last section 7";
+  return std::nullopt;
+}
+
+}  // namespace
+
 Result<GribSplit> splitGrib(std::span<const std::byte> bytes, std::string_view sourceName, const GribLimits& limits) {
   GribSplit split;
   std::size_t at = 0;
@@ -226,8 +279,8 @@ Result<GribSplit> splitGrib(std::span<const std::byte> bytes, std::string_view s
       ++at;
       continue;
     }
-    const std::size_t message = ++split.found;
-    if (split.found > limits.maxMessages)
+    const std::size_t message = ++split.messages;
+    if (split.messages > limits.maxMessages)
       return fail(ErrorCode::TooLarge,
                   std::string(sourceName) + ": more than " + std::to_string(limits.maxMessages) + " GRIB messages");
     const auto edition = static_cast<std::uint8_t>(p[7]);
@@ -251,90 +304,79 @@ Result<GribSplit> splitGrib(std::span<const std::byte> bytes, std::string_view s
       at += 4;
       continue;
     }
-    split.messages.push_back({message, at, static_cast<std::size_t>(length)});
+    const std::size_t before = split.fields.size();
+    if (auto bad = splitFields(bytes, at, static_cast<std::size_t>(length), message, split.fields)) {
+      split.fields.resize(before);
+      split.skipped.push_back({message, 0, *bad});
+    } else if (split.fields.size() > limits.maxMessages * 16) {
+      return fail(ErrorCode::TooLarge, std::string(sourceName) + ": more than " +
+                                           std::to_string(limits.maxMessages * 16) + " fields");
+    }
     at += length;
   }
-  if (split.found == 0)
+  for (std::size_t k = 0; k < split.fields.size(); ++k) split.fields[k].field = k + 1;
+  if (split.messages == 0)
     return fail(ErrorCode::Malformed,
                 std::string(sourceName) + ": no GRIB message in " + std::to_string(bytes.size()) + " bytes");
   return split;
 }
 
-Result<std::size_t> decodeGribMessage(std::span<const std::byte> bytes, std::size_t messageNumber,
-                                      std::size_t firstField, const GribWanted& wanted, const GribLimits& limits,
-                                      std::size_t& kept, const std::function<void(GribField&&)>& sink,
-                                      const std::function<void(GribSkip&&)>& skip) {
+std::vector<std::byte> fieldMessage(std::span<const std::byte> bytes, const GribFieldSpan& field) {
+  std::size_t total = kSection0Bytes + 4;
+  for (const GribSection& s : field.sections) total += s.length;
+  std::vector<std::byte> out;
+  out.reserve(total);
+  // Section 0 ("GRIB", reserved, discipline, edition) as in the file, where
+  // it stands right before the message's one section 1; then the new length.
+  const std::size_t s0 = field.sections[0].offset - kSection0Bytes;
+  out.insert(out.end(), bytes.begin() + static_cast<std::ptrdiff_t>(s0), bytes.begin() + static_cast<std::ptrdiff_t>(s0) + 8);
+  for (int k = 7; k >= 0; --k) out.push_back(static_cast<std::byte>((total >> (8 * k)) & 0xff));
+  for (const GribSection& s : field.sections)
+    out.insert(out.end(), bytes.begin() + static_cast<std::ptrdiff_t>(s.offset),
+               bytes.begin() + static_cast<std::ptrdiff_t>(s.offset + s.length));
+  for (char c : {'7', '7', '7', '7'}) out.push_back(static_cast<std::byte>(c));
+  return out;
+}
+
+Result<std::optional<GribField>> decodeGribField(std::span<const std::byte> bytes, const GribFieldSpan& span,
+                                                 const GribWanted& wanted, const GribLimits& limits,
+                                                 std::size_t& kept) {
   codes_context* ctx = context();
-  // ecCodes reads the fields of a multi-field message in place and advances
-  // `data` past the message after its last one; the handles point into this
-  // copy, so it outlives them.
-  std::vector<std::byte> copy(bytes.begin(), bytes.end());
-  void* data = copy.data();
-  std::size_t length = copy.size();
-  std::size_t fields = 0;
-  while (length > 0) {
-    lastEccodesMessage.clear();
-    const std::size_t field = firstField + fields;
-    try {
-      int err = 0;
-      Handle h(codes_grib_handle_new_from_multi_message(ctx, &data, &length, &err));
-      if (!h) {
-        if (fields == 0)
-          skip({messageNumber, 0, "ecCodes could not decode it: " + ecError(err)});
-        else if (err)
-          skip({messageNumber, field, "ecCodes stopped in the message: " + ecError(err)});
-        break;
-      }
-      ++fields;
-      auto meta = metaOf(h.get(), messageNumber);
-      if (!meta) {
-        skip({messageNumber, field, meta.error().detail});
-        continue;
-      }
-      meta->field = field;
-      if (!wanted(*meta)) continue;
-      const std::size_t points = static_cast<std::size_t>(meta->grid.ni) * meta->grid.nj;
-      const auto declared = getLong(h.get(), "numberOfDataPoints");
-      if (!declared || static_cast<std::size_t>(*declared) != points) {
-        skip({messageNumber, field, "numberOfDataPoints differs from the grid's " + std::to_string(points)});
-        continue;
-      }
-      if (points > limits.maxPointsPerMessage) {
-        skip({messageNumber, field,
-              std::to_string(points) + " points, more than " + std::to_string(limits.maxPointsPerMessage)});
-        continue;
-      }
-      if (kept + points > limits.maxValuesKept)
-        return fail(ErrorCode::TooLarge,
-                    "the wanted fields hold more than " + std::to_string(limits.maxValuesKept) + " values");
-      if (int e = codes_set_double(h.get(), "missingValue", kMissingSentinel); e) {
-        skip({messageNumber, field, "missingValue: " + ecError(e)});
-        continue;
-      }
-      std::size_t n = 0;
-      if (int e = codes_get_size(h.get(), "values", &n); e || n != points) {
-        skip({messageNumber, field,
-              e ? "values: " + ecError(e) : std::to_string(n) + " values for " + std::to_string(points) + " points"});
-        continue;
-      }
-      std::vector<double> raw(n);
-      if (int e = codes_get_double_array(h.get(), "values", raw.data(), &n); e || n != points) {
-        skip({messageNumber, field, "values: " + (e ? ecError(e) : std::string("short"))});
-        continue;
-      }
-      GribField out{std::move(*meta), std::vector<float>(n)};
-      for (std::size_t k = 0; k < n; ++k)
-        out.values[k] = raw[k] >= kMissingSentinel * 0.5 || !std::isfinite(raw[k])
-                            ? std::numeric_limits<float>::quiet_NaN()
-                            : static_cast<float>(raw[k]);
-      kept += n;
-      sink(std::move(out));
-    } catch (const EccodesAssertion& e) {
-      skip({messageNumber, field, e.what()});
-      break;
-    }
+  const std::vector<std::byte> message = fieldMessage(bytes, span);
+  lastEccodesMessage.clear();
+  auto skip = [](std::string why) { return fail(ErrorCode::Malformed, std::move(why)); };
+  try {
+    Handle h(codes_handle_new_from_message_copy(ctx, message.data(), message.size()));
+    if (!h) return skip("ecCodes could not decode it" + (lastEccodesMessage.empty() ? "" : ": " + lastEccodesMessage));
+    auto meta = metaOf(h.get(), span.message);
+    if (!meta) return skip(meta.error().detail);
+    meta->field = span.field;
+    if (!wanted(*meta)) return std::optional<GribField>{};
+    const std::size_t points = static_cast<std::size_t>(meta->grid.ni) * meta->grid.nj;
+    const auto declared = getLong(h.get(), "numberOfDataPoints");
+    if (!declared || static_cast<std::size_t>(*declared) != points)
+      return skip("numberOfDataPoints differs from the grid's " + std::to_string(points));
+    if (points > limits.maxPointsPerMessage)
+      return skip(std::to_string(points) + " points, more than " + std::to_string(limits.maxPointsPerMessage));
+    if (kept + points > limits.maxValuesKept)
+      return fail(ErrorCode::TooLarge,
+                  "the wanted fields hold more than " + std::to_string(limits.maxValuesKept) + " values");
+    if (int e = codes_set_double(h.get(), "missingValue", kMissingSentinel); e) return skip("missingValue: " + ecError(e));
+    std::size_t n = 0;
+    if (int e = codes_get_size(h.get(), "values", &n); e || n != points)
+      return skip(e ? "values: " + ecError(e) : std::to_string(n) + " values for " + std::to_string(points) + " points");
+    std::vector<double> raw(n);
+    if (int e = codes_get_double_array(h.get(), "values", raw.data(), &n); e || n != points)
+      return skip("values: " + (e ? ecError(e) : std::string("short")));
+    GribField out{std::move(*meta), std::vector<float>(n)};
+    for (std::size_t k = 0; k < n; ++k)
+      out.values[k] = raw[k] >= kMissingSentinel * 0.5 || !std::isfinite(raw[k]) ? std::numeric_limits<float>::quiet_NaN()
+                                                                                 : static_cast<float>(raw[k]);
+    kept += n;
+    return std::optional<GribField>(std::move(out));
+  } catch (const EccodesAssertion& e) {
+    return skip(e.what());
   }
-  return fields;
 }
 
 Result<GribFile> readGrib(std::span<const std::byte> bytes, std::string_view sourceName, const GribWanted& wanted,
@@ -342,16 +384,18 @@ Result<GribFile> readGrib(std::span<const std::byte> bytes, std::string_view sou
   auto split = splitGrib(bytes, sourceName, limits);
   if (!split) return tl::unexpected(split.error());
   GribFile file;
-  file.messages = split->found;
+  file.messages = split->messages;
+  file.fieldCount = split->fields.size();
   file.skipped = std::move(split->skipped);
   std::size_t kept = 0;
-  for (const GribMessageSpan& m : split->messages) {
-    auto n = decodeGribMessage(
-        bytes.subspan(m.offset, m.length), m.message, file.fieldCount + 1, wanted, limits, kept,
-        [&](GribField&& f) { file.fields.push_back(std::move(f)); },
-        [&](GribSkip&& s) { file.skipped.push_back(std::move(s)); });
-    if (!n) return fail(n.error().code, std::string(sourceName) + ": " + n.error().detail);
-    file.fieldCount += *n;
+  for (const GribFieldSpan& f : split->fields) {
+    auto r = decodeGribField(bytes, f, wanted, limits, kept);
+    if (!r && r.error().code == ErrorCode::TooLarge)
+      return fail(ErrorCode::TooLarge, std::string(sourceName) + ": " + r.error().detail);
+    if (!r)
+      file.skipped.push_back({f.message, f.field, r.error().detail});
+    else if (*r)
+      file.fields.push_back(std::move(**r));
   }
   std::sort(file.skipped.begin(), file.skipped.end(),
             [](const GribSkip& a, const GribSkip& b) { return std::tie(a.message, a.field) < std::tie(b.message, b.field); });

@@ -141,4 +141,11 @@ double isaPressure_hpa(double alt_m) {
   return 226.32 * std::exp(-(h - 11000.0) / 6341.62);
 }
 
+double isaAltitude_m(double pressure_hpa) {
+  // The inverse of isaPressure_hpa on its domain, -1 to 20 km.
+  const double p = std::clamp(pressure_hpa, isaPressure_hpa(20000.0), isaPressure_hpa(-1000.0));
+  if (p >= 226.32) return (1.0 - std::pow(p / 1013.25, 1.0 / 5.25588)) / 2.25577e-5;
+  return 11000.0 - 6341.62 * std::log(p / 226.32);
+}
+
 }  // namespace sky::weather

@@ -11,6 +11,7 @@
 // or the packing marks missing are NaN, never 0.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -114,39 +115,50 @@ struct GribFile {
   std::vector<GribField> fields;  // the wanted fields, in file order
   std::vector<GribSkip> skipped;  // not read (fields not wanted are not listed)
   std::size_t messages = 0;       // GRIB messages found
-  std::size_t fieldCount = 0;     // fields in the messages that decoded
+  std::size_t fieldCount = 0;     // fields in the messages that split
 };
 
 using GribWanted = std::function<bool(const GribMeta&)>;
 
-// The GRIB messages of a file, found by their section 0 ("GRIB", the
-// edition, the total length) and closing "7777"; bytes between messages are
-// ignored. A length that runs past the end, a message without its end
-// marker, or GRIB edition 1 is skipped with its reason. Pure: no ecCodes.
-struct GribMessageSpan {
-  std::size_t message = 0;  // 1-based
-  std::size_t offset = 0, length = 0;
+// The GRIB2 messages of a file and the fields in them, found without
+// ecCodes: each message by its section 0 ("GRIB", the edition, the total
+// length) and closing "7777", each field by walking the sections (length,
+// number) inside it. A GRIB2 message may repeat sections 2-7 for further
+// fields; each field is the latest section 1, 2 and 3 with its own 4 to 7
+// (a section 6 that says "the bitmap defined before" takes that one). A
+// message whose sections do not add up, GRIB edition 1, or a length past the
+// end of the file is skipped with its reason; bytes between messages are
+// ignored. Pure: no ecCodes.
+struct GribSection {
+  std::size_t offset = 0, length = 0;  // in the file; length 0: absent (section 2)
+};
+struct GribFieldSpan {
+  std::size_t message = 0, field = 0;  // 1-based; fields counted over the file as ecCodes' tools count
+  std::array<GribSection, 7> sections;  // sections 1 to 7
 };
 struct GribSplit {
-  std::vector<GribMessageSpan> messages;  // the GRIB2 ones, in file order
+  std::vector<GribFieldSpan> fields;  // in file order
   std::vector<GribSkip> skipped;
-  std::size_t found = 0;  // every "GRIB" header, read or skipped
+  std::size_t messages = 0;  // every "GRIB" header, read or skipped
 };
 Result<GribSplit> splitGrib(std::span<const std::byte> bytes, std::string_view sourceName,
                             const GribLimits& limits = {});
 
-// Decodes the fields of one GRIB2 message with ecCodes, numbering them from
-// firstField, and hands each wanted one to `sink` (skipped ones to `skip`).
-// Returns how many fields the message holds. ecCodes is not safe on hostile
-// bytes (a damaged packing section can make it read out of bounds): outside
-// tests, call this only in the decoder process (readGribIsolated). `kept`
-// counts the values kept so far against limits.maxValuesKept.
-Result<std::size_t> decodeGribMessage(std::span<const std::byte> message, std::size_t messageNumber,
-                                      std::size_t firstField, const GribWanted& wanted, const GribLimits& limits,
-                                      std::size_t& kept, const std::function<void(GribField&&)>& sink,
-                                      const std::function<void(GribSkip&&)>& skip);
+// One field as a GRIB2 message of its own (section 0 with its length, the
+// field's sections, "7777"): what ecCodes decodes, one field at a time.
+std::vector<std::byte> fieldMessage(std::span<const std::byte> bytes, const GribFieldSpan& field);
 
-// splitGrib and decodeGribMessage over a whole file in this process: for
+// Decodes one field with ecCodes: nullopt when `wanted` says no, a skip
+// (the error's detail) when it does not decode or is past the limits.
+// ecCodes is not safe on hostile bytes (a damaged packing section can make
+// it read out of bounds): outside tests, call this only in the decoder
+// process (readGribIsolated). `kept` counts the values kept so far against
+// limits.maxValuesKept (TooLarge past it).
+Result<std::optional<GribField>> decodeGribField(std::span<const std::byte> bytes, const GribFieldSpan& field,
+                                                 const GribWanted& wanted, const GribLimits& limits,
+                                                 std::size_t& kept);
+
+// splitGrib and decodeGribField over a whole file in this process: for
 // files this program trusts (its tests, ecCodes' own samples). A file with no
 // GRIB message, or past the limits, is an error naming `sourceName`.
 Result<GribFile> readGrib(std::span<const std::byte> bytes, std::string_view sourceName, const GribWanted& wanted,

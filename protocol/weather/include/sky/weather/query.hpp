@@ -46,5 +46,8 @@ CoverageLookup snapshotLookup(const WeatherSnapshot& snapshot, double clock_s);
 // weather model has no field for.
 double isaTemperature_c(double alt_m);
 double isaPressure_hpa(double alt_m);
+// The altitude (m) at which the standard atmosphere has this pressure: the
+// inverse of isaPressure_hpa, clamped to its -1 to 20 km.
+double isaAltitude_m(double pressure_hpa);
 
 }  // namespace sky::weather
