@@ -378,4 +378,30 @@ std::string Forecast::sourceAt(const ForecastLayer& layer, double lat_deg, doubl
   return name_ + ": " + s->cover->source + ", " + where;
 }
 
+ForecastField::ForecastField(std::shared_ptr<const Forecast> forecast, std::uint64_t serial, double valid_unix)
+    : forecast_(std::move(forecast)), valid_unix_(std::floor(valid_unix / kForecastTimeQuantum_s) * kForecastTimeQuantum_s) {
+  // serial and quantum index mixed (FNV-1a over the two words).
+  std::uint64_t h = 1469598103934665603ull;
+  for (std::uint64_t v : {serial, static_cast<std::uint64_t>(static_cast<std::int64_t>(valid_unix_ / kForecastTimeQuantum_s))}) {
+    h ^= v;
+    h *= 1099511628211ull;
+  }
+  key_ = h;
+}
+
+bool ForecastField::gives(std::uint32_t layerId) const {
+  return std::any_of(forecast_->layers().begin(), forecast_->layers().end(),
+                     [&](const ForecastLayer& l) { return l.layer.id == layerId; });
+}
+
+void ForecastField::sample(std::uint32_t layerId, std::span<const weather::CellCentre> at,
+                           std::span<weather::CoverageTile> out) const {
+  const ForecastLayer* layer = nullptr;
+  for (const ForecastLayer& l : forecast_->layers())
+    if (l.layer.id == layerId) layer = &l;
+  for (std::size_t k = 0; k < at.size() && k < out.size(); ++k)
+    out[k] = layer ? forecast_->tileAt(*layer, at[k].lat_deg, at[k].lon_deg, valid_unix_)
+                   : weather::CoverageTile{0, layerId, kNaN, 1};
+}
+
 }  // namespace sky::server

@@ -49,6 +49,23 @@ std::vector<weather::Region> LiveWeather::evaluateRegions(const State& s, double
   return v;
 }
 
+std::optional<weather::Region> LiveWeather::evaluateRegion(const State& s, std::uint32_t id, double c) {
+  std::optional<weather::Region> out;
+  if (auto it = s.regions.find(id); it != s.regions.end()) out = weather::regionAt(it->second, c);
+  for (const RegionRamp& r : s.regionRamps) {
+    if (r.regionId != id || c < r.start_s) continue;
+    const double f = r.end_s > r.start_s ? std::clamp((c - r.start_s) / (r.end_s - r.start_s), 0.0, 1.0) : 1.0;
+    if (f >= 1.0 && r.removeAtEnd) {
+      out.reset();
+      continue;
+    }
+    const weather::Region to = weather::regionAt(r.to, c);
+    const weather::Region from = r.fromAbsent ? shrunk(to) : weather::regionAt(r.from, c);
+    out = lerpRegion(from, to, f);
+  }
+  return out;
+}
+
 std::vector<weather::Region> LiveWeather::regionsAt(double clock_s) const {
   return evaluateRegions(state(), clock_s);
 }
@@ -63,27 +80,40 @@ Result<std::string> LiveWeather::applyRegion(State& s, const WeatherChange& chan
     to.placedAtClock_s = start_s;  // the centre given is where it is when the change starts
     if (auto ok = weather::validate(to); !ok)
       return fail(ErrorCode::InvalidArgument, at + ".region: " + ok.error().detail);
-    auto regions = evaluateRegions(s, start_s);
-    const auto it = std::find_if(regions.begin(), regions.end(),
-                                 [&](const weather::Region& r) { return r.id == to.id; });
+    // This region alone, not all of them: a continent's METAR stations are
+    // thousands of regions, changed hundreds at a time.
+    const std::optional<weather::Region> now = evaluateRegion(s, to.id, start_s);
     RegionRamp r;
     r.sequence = sequence;
     r.regionId = to.id;
     r.start_s = start_s;
     r.end_s = start_s + set->timing.ramp_s;
-    r.fromAbsent = it == regions.end();
-    if (!r.fromAbsent) {
-      r.from = *it;
-      *it = to;
-    } else {
-      regions.push_back(to);
-    }
+    r.fromAbsent = !now;
+    if (now) r.from = *now;
     r.to = to;
-    const std::size_t ids = distinctLayerIds(evaluate(s, start_s), regions);
-    if (ids > kMaxScenarioLayers)
-      return fail(ErrorCode::InvalidArgument, at + ".region.layers: " + std::to_string(ids) +
-                                                  " distinct layer ids with the global layers, at most " +
-                                                  std::to_string(kMaxScenarioLayers));
+    // Only a layer id no layer or region has yet can pass the bound: look
+    // for each of `to`'s ids, stopping when all are found.
+    std::set<std::uint32_t> unseen;
+    for (const auto& l : to.layers) unseen.insert(l.id);
+    for (const auto& l : evaluate(s, start_s)) unseen.erase(l.id);
+    if (now)
+      for (const auto& l : now->layers) unseen.erase(l.id);
+    auto seen = [&](const weather::Region& region) {
+      for (const auto& l : region.layers) unseen.erase(l.id);
+      return unseen.empty();
+    };
+    for (auto it = s.regions.begin(); !unseen.empty() && it != s.regions.end(); ++it) seen(it->second);
+    for (auto it = s.regionRamps.begin(); !unseen.empty() && it != s.regionRamps.end(); ++it) seen(it->to) || seen(it->from);
+    if (!unseen.empty()) {
+      auto regions = evaluateRegions(s, start_s);
+      std::erase_if(regions, [&](const weather::Region& x) { return x.id == to.id; });
+      regions.push_back(to);
+      const std::size_t ids = distinctLayerIds(evaluate(s, start_s), regions);
+      if (ids > kMaxScenarioLayers)
+        return fail(ErrorCode::InvalidArgument, at + ".region.layers: " + std::to_string(ids) +
+                                                    " distinct layer ids with the global layers, at most " +
+                                                    std::to_string(kMaxScenarioLayers));
+    }
     r.summary = "region " + std::to_string(to.id) + (r.fromAbsent ? " added: " : " changed: ") + describe(to) +
                 (set->timing.ramp_s > 0 ? " over " + fmt("%.0f", set->timing.ramp_s) + " s" : "") +
                 (set->timing.at_s ? " from clock " + fmt("%.0f", start_s) : "");
@@ -93,11 +123,8 @@ Result<std::string> LiveWeather::applyRegion(State& s, const WeatherChange& chan
   const auto& remove = std::get<RemoveRegion>(change);
   if (auto ok = checkTiming(remove.timing, at, now_s); !ok) return tl::unexpected(ok.error());
   const double start_s = remove.timing.at_s.value_or(now_s);
-  const auto regions = evaluateRegions(s, start_s);
-  const auto it = std::find_if(regions.begin(), regions.end(),
-                               [&](const weather::Region& r) { return r.id == remove.regionId; });
-  if (it == regions.end())
-    return fail(ErrorCode::InvalidArgument, at + ".id: no region " + std::to_string(remove.regionId));
+  const std::optional<weather::Region> it = evaluateRegion(s, remove.regionId, start_s);
+  if (!it) return fail(ErrorCode::InvalidArgument, at + ".id: no region " + std::to_string(remove.regionId));
   RegionRamp r;
   r.sequence = sequence;
   r.regionId = remove.regionId;

@@ -65,6 +65,13 @@ bool LiveWeather::changing(double clock_s) const {
     if (clock_s < r.end_s || (r.end_s == r.start_s && clock_s < r.start_s)) return true;
   for (const RegionRamp& r : regionRamps_)
     if (clock_s < r.end_s || (r.end_s == r.start_s && clock_s < r.start_s)) return true;
+  // A forecast between two of its steps evolves with the clock.
+  if (forecast_ && clock_.rate() > 0 && forecast_->forecast->stepCount() > 1) {
+    const double valid = forecast_->placement.validAt(clock_s);
+    if (valid < static_cast<double>(forecast_->forecast->lastValid_unix()) &&
+        valid > static_cast<double>(forecast_->forecast->firstValid_unix()) - kForecastTimeQuantum_s)
+      return true;
+  }
   return false;
 }
 
@@ -241,6 +248,7 @@ Result<AppliedChange> LiveWeather::commit(State next, std::vector<TimelineItem> 
   regions_ = std::move(next.regions);
   regionRamps_ = std::move(next.regionRamps);
   clock_ = next.clock;
+  forecast_ = std::move(next.forecast);
   timeline_ = std::move(timeline);
   ++sequence_;
   ++version_;
@@ -332,6 +340,7 @@ nlohmann::json LiveWeather::stateJson(const State& s, const std::vector<Timeline
           {"regions", regions},
           {"region_ramps", regionRamps},
           {"timeline", timelineJson(timeline)},
+          {"forecast", forecastJson(s.forecast.get())},
           {"sequence", sequence},
           {"version", version},
           {"clock", {{"clock_s", s.clock.at(wallNow_())}, {"rate", s.clock.rate()}, {"unix_ms", unixNowMs_()}}}};
@@ -339,7 +348,8 @@ nlohmann::json LiveWeather::stateJson(const State& s, const std::vector<Timeline
 
 nlohmann::json LiveWeather::toJson() const { return stateJson(state(), timeline_, sequence_, version_); }
 
-Result<void> LiveWeather::restore(const nlohmann::json& j, std::vector<ChangeEvent> events) {
+Result<void> LiveWeather::restore(const nlohmann::json& j, std::vector<ChangeEvent> events,
+                                  const ForecastLoader& loader) {
   auto bad = [](const std::string& what) { return fail(ErrorCode::Malformed, "saved state: " + what); };
   try {
     std::map<std::uint32_t, weather::CloudLayer> layers;
@@ -399,6 +409,15 @@ Result<void> LiveWeather::restore(const nlohmann::json& j, std::vector<ChangeEve
       if (!t) return tl::unexpected(t.error());
       timeline = std::move(*t);
     }
+    // The forecast came with format 4 of the saved state.
+    std::shared_ptr<const LoadedForecast> forecast;
+    if (j.contains("forecast") && !j.at("forecast").is_null()) {
+      if (!loader) return bad("a forecast, and no way to decode it");
+      auto f = loader(j.at("forecast"));
+      if (!f) return fail(f.error().code, "saved state: forecast: " + f.error().detail);
+      f->serial = ++forecastSerial_;
+      forecast = std::make_shared<const LoadedForecast>(std::move(*f));
+    }
     const auto& c = j.at("clock");
     const double rate = c.at("rate").get<double>();
     const double downtime_s = double(unixNowMs_() - c.at("unix_ms").get<std::int64_t>()) / 1000.0;
@@ -408,6 +427,7 @@ Result<void> LiveWeather::restore(const nlohmann::json& j, std::vector<ChangeEve
     regions_ = std::move(regions);
     regionRamps_ = std::move(regionRamps);
     timeline_ = std::move(timeline);
+    forecast_ = std::move(forecast);
     sequence_ = j.at("sequence").get<std::uint64_t>();
     version_ = j.at("version").get<std::uint64_t>() + 1;
     clock_ = WeatherClock(clockNow_s, rate, wallNow_());

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numbers>
 
@@ -150,9 +151,10 @@ void keepWeight(TileCache::Weights& out, std::size_t cell, double w) {
 // comes out the same everywhere. Only the cells a region reaches are
 // blended (a storm cell reaches a few hundred of an area's thousands).
 LayerTiles layerTiles(std::span<const std::uint64_t> cells, const weather::CloudLayer& layer,
-                      std::span<const Contribution> contributions) {
+                      std::span<const Contribution> contributions,
+                      std::span<const weather::CoverageTile> field = {}) {
   LayerTiles out;
-  if (contributions.empty()) return out;
+  if (contributions.empty() && field.empty()) return out;
   // Per reached cell, the sums over the contributions in their order.
   struct Sum {
     std::uint32_t cell;
@@ -185,28 +187,45 @@ LayerTiles layerTiles(std::span<const std::uint64_t> cells, const weather::Cloud
     }
   }
   const auto coverage = static_cast<float>(layer.coverage), density = static_cast<float>(layer.density);
+  // The value a cell has before regions blend in: the field's where it has
+  // one, else the layer's own.
+  auto baseAt = [&](std::size_t ci) {
+    weather::CoverageTile t{cells[ci], layer.id, coverage, density};
+    if (!field.empty() && !std::isnan(field[ci].coverage)) {
+      t = field[ci];
+      t.cellId = cells[ci];
+      t.layerId = layer.id;
+    }
+    return t;
+  };
   std::vector<std::pair<std::uint32_t, weather::CoverageTile>> blended;
   bool varies = false;
   for (const Sum& s : sums) {
     if (!(s.w > 0)) continue;
-    weather::CoverageTile t{cells[s.cell], layer.id, coverage, density};
+    weather::CoverageTile t = baseAt(s.cell);
     const double w = std::min(s.w, 1.0);
-    t.coverage = static_cast<float>(layer.coverage + w * (s.cov / s.w - layer.coverage));
-    t.density = static_cast<float>(layer.density + w * (s.den / s.w - layer.density));
-    if (s.heaviestType != layer.type) {
+    t.coverage = static_cast<float>(t.coverage + w * (s.cov / s.w - t.coverage));
+    t.density = static_cast<float>(t.density + w * (s.den / s.w - t.density));
+    if (s.heaviestType != layer.type && w >= t.blend) {
       t.blendType = s.heaviestType;
       t.blend = static_cast<float>(w);
     }
     varies = varies || t.coverage != coverage || t.density != density || t.blendType != weather::CloudType::None;
     blended.emplace_back(s.cell, t);
   }
+  out.tiles.reserve(cells.size());
+  for (std::size_t ci = 0; ci < cells.size(); ++ci) {
+    out.tiles.push_back(baseAt(ci));
+    const auto& t = out.tiles.back();
+    varies = varies || t.coverage != coverage || t.density != density || t.blendType != weather::CloudType::None;
+  }
   // A layer the same everywhere in the area needs no tiles: a renderer takes
   // a layer without tiles as uniform (its own coverage and density).
-  if (!varies) return out;
-  out.coverage = coverage;
+  if (!varies) return LayerTiles{};
+  // With a field every tile may differ from the layer's own value, and a
+  // diff compares them all (NaN never equals the next snapshot's).
+  out.coverage = field.empty() ? coverage : std::numeric_limits<float>::quiet_NaN();
   out.density = density;
-  out.tiles.reserve(cells.size());
-  for (std::uint64_t cell : cells) out.tiles.push_back({cell, layer.id, coverage, density});
   out.reached.reserve(blended.size());
   for (const auto& [ci, t] : blended) {
     out.tiles[ci] = t;
@@ -228,14 +247,21 @@ const weather::CloudLayer* layerOf(const weather::Region& r, std::uint32_t id) {
 std::vector<weather::CoverageTile> tilesFromWeights(std::span<const std::uint64_t> cells,
                                                     std::span<const weather::CloudLayer> layers,
                                                     std::span<const weather::Region> regions,
-                                                    std::span<const TileCache::Weights* const> weights) {
+                                                    std::span<const TileCache::Weights* const> weights,
+                                                    const LayerField* field, std::span<const weather::CellCentre> centres) {
   std::vector<weather::CoverageTile> tiles;
   std::vector<Contribution> contributions;
+  std::vector<weather::CoverageTile> base;
   for (const weather::CloudLayer& layer : layers) {
     contributions.clear();
     for (std::size_t k = 0; k < regions.size(); ++k)
       if (const auto* rl = layerOf(regions[k], layer.id); rl && weights[k]) contributions.push_back({weights[k], rl});
-    const auto t = layerTiles(cells, layer, contributions).tiles;
+    base.clear();
+    if (field && field->gives(layer.id)) {
+      base.resize(cells.size());
+      field->sample(layer.id, centres, base);
+    }
+    const auto t = layerTiles(cells, layer, contributions, base).tiles;
     tiles.insert(tiles.end(), t.begin(), t.end());
   }
   return tiles;
@@ -306,10 +332,15 @@ const TileCache::Weights& TileCache::weights(Entry& entry, const weather::Region
 
 std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> cells,
                                                std::span<const weather::CloudLayer> layers,
-                                               std::span<const weather::Region> regions) {
+                                               std::span<const weather::Region> regions, const LayerField* field) {
   std::vector<TileCache::Weights> weights(regions.size());
   std::vector<const TileCache::Weights*> byRegion(regions.size(), nullptr);
   std::vector<UnitVector> units;
+  std::vector<weather::CellCentre> centres;
+  if (field) {
+    centres.reserve(cells.size());
+    for (std::uint64_t c : cells) centres.push_back(weather::cellCentre(c));
+  }
   if (!regions.empty()) {
     units.reserve(cells.size());
     for (std::uint64_t c : cells) {
@@ -326,12 +357,12 @@ std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> ce
     }
     if (!weights[k].cells.empty()) byRegion[k] = &weights[k];
   }
-  return tilesFromWeights(cells, layers, regions, byRegion);
+  return tilesFromWeights(cells, layers, regions, byRegion, field, centres);
 }
 
 std::vector<LayerRun> deriveRuns(TileCache& cache, TileCache::Entry& entry,
                                  std::span<const weather::CloudLayer> layers,
-                                 std::span<const weather::Region> regions) {
+                                 std::span<const weather::Region> regions, const LayerField* field) {
   // Room for every region's weights first: the pointers below must stay valid.
   if (entry.shapeWeights.size() + regions.size() > kMaxShapesPerCovering) entry.shapeWeights.clear();
   // The regions that can reach a cell of this covering (its cells reach past
@@ -353,6 +384,8 @@ std::vector<LayerRun> deriveRuns(TileCache& cache, TileCache::Entry& entry,
     // shape and layer values: equal inputs give equal tiles (their bit
     // patterns compared exactly, not hashed).
     inputs = {static_cast<std::uint64_t>(layer.type), bitsOf(layer.coverage), bitsOf(layer.density)};
+    const bool fromField = field && field->gives(layer.id);
+    if (fromField) inputs.insert(inputs.end(), {~0ull, field->key()});
     for (std::size_t k = 0; k < regions.size(); ++k) {
       const auto* rl = reaches[k] ? layerOf(regions[k], layer.id) : nullptr;
       if (!rl) continue;
@@ -369,7 +402,12 @@ std::vector<LayerRun> deriveRuns(TileCache& cache, TileCache::Entry& entry,
       for (std::size_t k = 0; k < regions.size(); ++k)
         if (const auto* rl = reaches[k] ? layerOf(regions[k], layer.id) : nullptr)
           contributions.push_back({&cache.weights(entry, regions[k]), rl});
-      auto tiles = layerTiles(entry.covering.cells, layer, contributions);
+      std::vector<weather::CoverageTile> base;
+      if (fromField) {
+        base.resize(entry.covering.cells.size());
+        field->sample(layer.id, entry.centres, base);
+      }
+      auto tiles = layerTiles(entry.covering.cells, layer, contributions, base);
       tiles.covering = entry.serial;
       // New tiles, not the old ones overwritten: snapshots sent before still
       // hold the old.
@@ -406,7 +444,7 @@ std::size_t tileCount(const BuiltSnapshot& built) {
 BuiltSnapshot buildSnapshotWithGenerations(const stream::Subscribe& request,
                                            std::span<const weather::CloudLayer> layers, double clock_s,
                                            std::size_t maxCells, std::span<const weather::Region> regions,
-                                           TileCache* cache) {
+                                           TileCache* cache, const LayerField* field) {
   const std::vector<weather::CloudLayer> table = snapshotLayers(layers, regions);
   const std::size_t budget = cellBudget(maxCells, table.size());
   BuiltSnapshot built;
@@ -417,10 +455,13 @@ BuiltSnapshot buildSnapshotWithGenerations(const stream::Subscribe& request,
   // No region reaches the area: the weather there is uniform and needs no
   // tiles, so no covering either (the level is the one the budget allows).
   const auto& cap = request.area;
-  const bool regional = std::any_of(regions.begin(), regions.end(), [&](const weather::Region& r) {
-    return sphereDistance_m(cap.centerLat_deg, cap.centerLon_deg, r.centerLat_deg, r.centerLon_deg) <=
-           cap.radius_m + reachOf(r);
-  });
+  const bool regional =
+      std::any_of(regions.begin(), regions.end(),
+                  [&](const weather::Region& r) {
+                    return sphereDistance_m(cap.centerLat_deg, cap.centerLon_deg, r.centerLat_deg, r.centerLon_deg) <=
+                           cap.radius_m + reachOf(r);
+                  }) ||
+      (field && std::any_of(table.begin(), table.end(), [&](const auto& l) { return field->gives(l.id); }));
   if (!regional) {
     int level = request.tileLevel;
     while (level > 0 && estimatedCells(cap, level) > static_cast<double>(budget)) --level;
@@ -431,20 +472,21 @@ BuiltSnapshot buildSnapshotWithGenerations(const stream::Subscribe& request,
   if (cache) {
     TileCache::Entry& e = cache->covering(cap, request.tileLevel, budget);
     snapshot.tileLevel = e.covering.level;
-    built.runs = deriveRuns(*cache, e, table, regions);
+    built.runs = deriveRuns(*cache, e, table, regions, field);
     return built;
   }
   const Covering covering = coverArea(cap, request.tileLevel, budget);
   snapshot.tileLevel = covering.level;
-  snapshot.tiles = deriveTiles(covering.cells, table, regions);
+  snapshot.tiles = deriveTiles(covering.cells, table, regions, field);
   return built;  // runs not known
 }
 
 weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,
                                        std::span<const weather::CloudLayer> layers,
                                        double clock_s, std::size_t maxCells,
-                                       std::span<const weather::Region> regions, TileCache* cache) {
-  return wholeSnapshot(buildSnapshotWithGenerations(request, layers, clock_s, maxCells, regions, cache));
+                                       std::span<const weather::Region> regions, TileCache* cache,
+                                       const LayerField* field) {
+  return wholeSnapshot(buildSnapshotWithGenerations(request, layers, clock_s, maxCells, regions, cache, field));
 }
 
 }  // namespace sky::server

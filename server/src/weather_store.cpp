@@ -75,7 +75,8 @@ Result<WeatherStore> WeatherStore::open(const std::filesystem::path& path, std::
   if (auto r = store.exec("PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL;"); !r) return explain(r.error());
   if (auto r = store.exec("CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);"
                           "CREATE TABLE IF NOT EXISTS events (sequence INTEGER PRIMARY KEY, clock_s REAL NOT NULL,"
-                          " wall_ms INTEGER NOT NULL, author TEXT NOT NULL, source TEXT NOT NULL, summary TEXT NOT NULL);");
+                          " wall_ms INTEGER NOT NULL, author TEXT NOT NULL, source TEXT NOT NULL, summary TEXT NOT NULL);"
+                          "CREATE TABLE IF NOT EXISTS files (key TEXT PRIMARY KEY, name TEXT NOT NULL, bytes BLOB NOT NULL);");
       !r)
     return explain(r.error());
   // The first change must not be the first to find out the file cannot be
@@ -171,6 +172,44 @@ Result<std::size_t> WeatherStore::storedEvents() const {
   if (!st.ok() || sqlite3_step(st.get()) != SQLITE_ROW)
     return fail(ErrorCode::Io, path_.string() + ": " + sqlite3_errmsg(db_.get()));
   return static_cast<std::size_t>(sqlite3_column_int64(st.get(), 0));
+}
+
+Result<void> WeatherStore::putFile(const std::string& key, const std::string& name, std::span<const std::byte> bytes) {
+  Statement st(db_.get(), "INSERT INTO files (key, name, bytes) VALUES (?1, ?2, ?3) "
+                          "ON CONFLICT(key) DO UPDATE SET name = excluded.name");
+  if (!st.ok() || sqlite3_bind_text(st.get(), 1, key.c_str(), -1, SQLITE_TRANSIENT) != SQLITE_OK ||
+      sqlite3_bind_text(st.get(), 2, name.c_str(), -1, SQLITE_TRANSIENT) != SQLITE_OK ||
+      sqlite3_bind_blob64(st.get(), 3, bytes.data(), bytes.size(), SQLITE_STATIC) != SQLITE_OK ||
+      sqlite3_step(st.get()) != SQLITE_DONE)
+    return fail(ErrorCode::Io, path_.string() + ": saving file " + name + ": " + sqlite3_errmsg(db_.get()));
+  return {};
+}
+
+Result<std::vector<std::byte>> WeatherStore::getFile(const std::string& key) const {
+  Statement st(db_.get(), "SELECT bytes FROM files WHERE key = ?1");
+  if (!st.ok() || sqlite3_bind_text(st.get(), 1, key.c_str(), -1, SQLITE_TRANSIENT) != SQLITE_OK)
+    return fail(ErrorCode::Io, path_.string() + ": " + sqlite3_errmsg(db_.get()));
+  if (sqlite3_step(st.get()) != SQLITE_ROW) return fail(ErrorCode::Malformed, path_.string() + ": no file " + key);
+  const auto* p = static_cast<const std::byte*>(sqlite3_column_blob(st.get(), 0));
+  const auto n = static_cast<std::size_t>(sqlite3_column_bytes(st.get(), 0));
+  return std::vector<std::byte>(p, p + n);
+}
+
+Result<void> WeatherStore::keepFiles(const std::set<std::string>& keys) {
+  std::vector<std::string> gone;
+  {
+    Statement st(db_.get(), "SELECT key FROM files");
+    if (!st.ok()) return fail(ErrorCode::Io, path_.string() + ": " + sqlite3_errmsg(db_.get()));
+    while (sqlite3_step(st.get()) == SQLITE_ROW)
+      if (!keys.count(text(st.get(), 0))) gone.push_back(text(st.get(), 0));
+  }
+  for (const std::string& key : gone) {
+    Statement del(db_.get(), "DELETE FROM files WHERE key = ?1");
+    if (!del.ok() || sqlite3_bind_text(del.get(), 1, key.c_str(), -1, SQLITE_TRANSIENT) != SQLITE_OK ||
+        sqlite3_step(del.get()) != SQLITE_DONE)
+      return fail(ErrorCode::Io, path_.string() + ": removing file " + key + ": " + sqlite3_errmsg(db_.get()));
+  }
+  return {};
 }
 
 }  // namespace sky::server

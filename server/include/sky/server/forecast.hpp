@@ -36,6 +36,7 @@
 
 #include "sky/core/result.hpp"
 #include "sky/server/grib.hpp"
+#include "sky/server/snapshot_builder.hpp"
 #include "sky/weather/model.hpp"
 
 namespace sky::server {
@@ -109,6 +110,31 @@ struct ForecastPlacement {
   double anchorClock_s = 0;
   std::int64_t anchorValid_unix = 0;
   double validAt(double clock_s) const { return static_cast<double>(anchorValid_unix) + (clock_s - anchorClock_s); }
+};
+
+// Forecast time in whole steps of this (s): the tiles of a forecast change
+// once a minute of forecast time, not at every heartbeat, so a snapshot
+// between two quanta is the cached one. Cloud cover moves by well under
+// 1/255 (the wire's step) in a minute between six-hourly steps.
+inline constexpr double kForecastTimeQuantum_s = 60;
+
+// A forecast at one valid time, as the snapshot builder samples it.
+class ForecastField final : public LayerField {
+ public:
+  // valid_unix is rounded down to kForecastTimeQuantum_s; `serial` names the
+  // forecast (a new load, a new serial).
+  ForecastField(std::shared_ptr<const Forecast> forecast, std::uint64_t serial, double valid_unix);
+  bool gives(std::uint32_t layerId) const override;
+  void sample(std::uint32_t layerId, std::span<const weather::CellCentre> at,
+              std::span<weather::CoverageTile> out) const override;
+  std::uint64_t key() const override { return key_; }
+  double valid_unix() const { return valid_unix_; }
+  const Forecast& forecast() const { return *forecast_; }
+
+ private:
+  std::shared_ptr<const Forecast> forecast_;
+  double valid_unix_ = 0;
+  std::uint64_t key_ = 0;
 };
 
 }  // namespace sky::server

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "sky/server/change.hpp"
+#include "sky/server/forecast.hpp"
 #include "sky/server/scenario.hpp"
 #include "sky/server/weather_clock.hpp"
 
@@ -29,6 +30,27 @@ inline constexpr std::size_t kMaxPendingRamps = 1024;
 // Batched (CIGI) changes that may wait for their commit before a batched
 // submit commits at once: bounds memory when commits keep failing.
 inline constexpr std::size_t kMaxUnsavedEvents = 256;
+
+// A forecast as the live weather holds it (live_forecast.cpp): the decoded
+// layers, where they sit on the weather clock, and the GRIB files they came
+// from (kept in the store by key, so a restart decodes them again).
+struct LoadedForecast {
+  std::shared_ptr<const Forecast> forecast;
+  ForecastPlacement placement;
+  struct File {
+    std::string key;   // the store's key of the file's bytes (weather_store.hpp)
+    std::string name;  // as the operator named it: a file name, never a path
+  };
+  std::vector<File> files;
+  std::uint64_t serial = 0;  // set by loadForecast: a new load, a new number
+};
+
+// A loaded forecast as the saved state and GET /api/state show it: null, or
+// its name, files (key, name), placement, steps and notes. What restore
+// needs back is forecastFilesFromJson's and forecastPlacementFromJson's.
+nlohmann::json forecastJson(const LoadedForecast* forecast);
+Result<std::vector<LoadedForecast::File>> forecastFilesFromJson(const nlohmann::json& saved);
+Result<ForecastPlacement> forecastPlacementFromJson(const nlohmann::json& saved);
 
 class LiveWeather final : public WeatherService {
  public:
@@ -81,6 +103,21 @@ class LiveWeather final : public WeatherService {
   // now (the weather moved on since it was checked) is dropped: its outcome
   // says why.
   std::vector<TimelineOutcome> runTimeline();
+
+  // Forecasts (live_forecast.cpp). Loading one is one accepted change: the
+  // forecast's layers (slots 30-34, forecast.hpp) become global layers,
+  // replacing the layers of those ids (and the forecast loaded before); its
+  // valid time is placement.anchorValid_unix at placement.anchorClock_s.
+  // Removing it removes its layers. With a store, the files' bytes must be
+  // in it (WeatherStore::putFile) before; files no state names are pruned
+  // after the commit.
+  Result<AppliedChange> loadForecast(LoadedForecast forecast, const std::string& author, const std::string& source);
+  Result<AppliedChange> removeForecast(const std::string& author, const std::string& source);
+  // The forecast loaded, if any, and the field its tiles come from at clock c.
+  std::shared_ptr<const LoadedForecast> forecast() const { return forecast_; }
+  std::shared_ptr<const ForecastField> fieldAt(double clock_s) const;
+  // Decodes a saved state's forecast (its "forecast" JSON) for restore.
+  using ForecastLoader = std::function<Result<LoadedForecast>(const nlohmann::json& saved)>;
   const std::vector<TimelineItem>& timeline() const { return timeline_; }
   std::vector<ChangeEvent> events(std::size_t limit) const override;
 
@@ -126,7 +163,10 @@ class LiveWeather final : public WeatherService {
   // Replaces the state with a saved one; the weather clock goes on from the
   // saved value at its rate for the time the server was down (the weather
   // outside did not stop). Malformed when the JSON is not a saved state.
-  Result<void> restore(const nlohmann::json& state, std::vector<ChangeEvent> events);
+  // A saved forecast is decoded again by `loader` (none: the state must
+  // have no forecast).
+  Result<void> restore(const nlohmann::json& state, std::vector<ChangeEvent> events,
+                       const ForecastLoader& loader = {});
   // FNV-1a of the canonical state without the clock's position (layers,
   // ramps, sequence, clock rate): equal before a shutdown and after restore.
   std::uint64_t stateHash() const;
@@ -158,10 +198,12 @@ class LiveWeather final : public WeatherService {
     std::map<std::uint32_t, weather::Region> regions;     // settled
     std::vector<RegionRamp> regionRamps;                  // in submission order
     WeatherClock clock;
+    std::shared_ptr<const LoadedForecast> forecast;
   };
-  State state() const { return State{layers_, ramps_, regions_, regionRamps_, clock_}; }
+  State state() const { return State{layers_, ramps_, regions_, regionRamps_, clock_, forecast_}; }
   static std::vector<weather::CloudLayer> evaluate(const State& s, double clock_s);
   static std::vector<weather::Region> evaluateRegions(const State& s, double clock_s);
+  static std::optional<weather::Region> evaluateRegion(const State& s, std::uint32_t id, double clock_s);
   Result<std::string> applyRegion(State& s, const WeatherChange& change, const std::string& at, double now_s,
                                   std::uint64_t sequence) const;
   // `at` names the change in errors ("changes[2]").
@@ -191,6 +233,8 @@ class LiveWeather final : public WeatherService {
   std::map<std::uint32_t, weather::Region> regions_;
   std::vector<RegionRamp> regionRamps_;
   WeatherClock clock_;
+  std::shared_ptr<const LoadedForecast> forecast_;
+  std::uint64_t forecastSerial_ = 0;
   std::vector<TimelineItem> timeline_;  // by at_s
   std::vector<ChangeEvent> events_;
   std::vector<ChangeEvent> unsaved_;  // applied by submitBatched, not yet on disk (oldest first)

@@ -137,6 +137,23 @@ class TileCache {
   std::uint64_t coveringSerials_ = 0;
 };
 
+// Cover that varies over the Earth from outside the layers and regions (a
+// loaded forecast, forecast.hpp): the tile of some layers at any point. A
+// region's weight then blends from this tile instead of the layer's own
+// values.
+class LayerField {
+ public:
+  virtual ~LayerField() = default;
+  // Whether this field gives layer `id`'s cover.
+  virtual bool gives(std::uint32_t layerId) const = 0;
+  // The tile (coverage, density, type blend) of the layer at each point;
+  // coverage NaN where the field has none (the layer's own values hold there).
+  virtual void sample(std::uint32_t layerId, std::span<const weather::CellCentre> at,
+                      std::span<weather::CoverageTile> out) const = 0;
+  // Equal keys, equal tiles everywhere: what the tile cache compares.
+  virtual std::uint64_t key() const = 0;
+};
+
 // One tile per (cell, table layer) for each layer that varies over the
 // cells; a layer that is the same everywhere there gets none (a renderer then
 // takes the layer's own values: the snapshot of uniform weather is just its
@@ -149,7 +166,8 @@ class TileCache {
 // (weather::regionAt), and `layers` the table from snapshotLayers.
 std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> cells,
                                                std::span<const weather::CloudLayer> layers,
-                                               std::span<const weather::Region> regions = {});
+                                               std::span<const weather::Region> regions = {},
+                                               const LayerField* field = nullptr);
 // One layer's tiles in a snapshot, as the TileCache that derived them holds
 // them, and their generation there: two runs from one cache with the same
 // non-zero generation are the very same tiles (0: not known).
@@ -164,7 +182,7 @@ struct LayerRun {
 // without copying a tile the cache already holds.
 std::vector<LayerRun> deriveRuns(TileCache& cache, TileCache::Entry& entry,
                                  std::span<const weather::CloudLayer> layers,
-                                 std::span<const weather::Region> regions);
+                                 std::span<const weather::Region> regions, const LayerField* field = nullptr);
 
 // A snapshot as the server keeps it for a subscriber. With a cache its tiles
 // stay in `runs` (one per layer of snapshot.layers, shared with the cache:
@@ -193,11 +211,11 @@ weather::WeatherSnapshot buildSnapshot(const stream::Subscribe& request,
                                        std::span<const weather::CloudLayer> layers,
                                        double clock_s, std::size_t maxCells,
                                        std::span<const weather::Region> regions = {},
-                                       TileCache* cache = nullptr);
+                                       TileCache* cache = nullptr, const LayerField* field = nullptr);
 // The same, as the server keeps it (see BuiltSnapshot).
 BuiltSnapshot buildSnapshotWithGenerations(const stream::Subscribe& request,
                                            std::span<const weather::CloudLayer> layers, double clock_s,
                                            std::size_t maxCells, std::span<const weather::Region> regions,
-                                           TileCache* cache);
+                                           TileCache* cache, const LayerField* field = nullptr);
 
 }  // namespace sky::server

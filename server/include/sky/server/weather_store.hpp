@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <set>
 #include <span>
 #include <string>
 #include <vector>
@@ -54,6 +55,14 @@ class WeatherStore {
   // Commits the state and its events (oldest first) atomically, pruning the
   // log to the newest kMaxStoredEvents in the same transaction.
   Result<void> save(const nlohmann::json& state, std::span<const ChangeEvent> events);
+  // Files the state refers to by key (a loaded forecast's GRIB files), kept
+  // beside it so that a restart decodes them again. putFile stores (or
+  // keeps) a file, getFile reads it back, keepFiles removes every file not
+  // named (called after the commit of a state that names only those).
+  Result<void> putFile(const std::string& key, const std::string& name, std::span<const std::byte> bytes);
+  Result<std::vector<std::byte>> getFile(const std::string& key) const;
+  Result<void> keepFiles(const std::set<std::string>& keys);
+
   // Events in the file (for tests of the retention bound).
   Result<std::size_t> storedEvents() const;
 
