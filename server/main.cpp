@@ -18,6 +18,7 @@
 
 #include "sky/server/cigi_weather_input.hpp"
 #include "sky/server/console_files.hpp"
+#include "sky/server/forecast_files.hpp"
 #include "sky/server/http_api.hpp"
 #include "sky/server/metar_changes.hpp"
 #include "sky/server/scenario.hpp"
@@ -121,6 +122,14 @@ int main(int argc, char** argv) {
                  "(0 picks a free one; default: no CIGI input)")
       ->check(CLI::Range(0, 65535));
   app.add_option("--cigi-port-file", cigiPortFile, "Write the CIGI UDP port here once listening");
+  std::string gribPath, gribDir, gribDecoder;
+  app.add_option("--grib", gribPath,
+                 "GRIB2 forecast to load at start: a file, or a directory of files (one per forecast step); "
+                 "its layers take slots 30-34 and its first valid time starts at the weather clock's now");
+  app.add_option("--grib-dir", gribDir,
+                 "Directory POST /api/grib may load files from by path (default: none, only uploaded files)");
+  app.add_option("--grib-decoder", gribDecoder,
+                 "The GRIB decoder executable (default: skyshell-grib-decode beside this executable)");
   app.add_option("--log-level", logLevel, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
@@ -180,6 +189,8 @@ int main(int argc, char** argv) {
     log->info("event=timeline_scheduled scenario={:?} entries={} first_at_s={:.0f}", scenarioPath, scenario->timeline.size(),
               scenario->timeline.front().at_s);
 
+  sky::server::GribDecoder decoder;
+  decoder.executable = gribDecoder.empty() ? sky::server::defaultGribDecoder() : std::filesystem::path(gribDecoder);
   std::optional<sky::server::WeatherStore> store;
   if (!dbPath.empty()) {
     auto storageFailed = [&](const sky::Error& e) {
@@ -195,7 +206,10 @@ int main(int argc, char** argv) {
     if (!saved) return storageFailed(saved.error());
     auto& weather = (*server)->weather();
     if (*saved) {
-      if (auto r = weather.restore((*saved)->state, std::move((*saved)->events)); !r) return storageFailed(r.error());
+      if (auto r = weather.restore((*saved)->state, std::move((*saved)->events),
+                                   sky::server::storeForecastLoader(*store, decoder));
+          !r)
+        return storageFailed(r.error());
       log->info("event=restored db={:?} sequence={} layers={} state_hash={:016x}", dbPath,
                 weather.view().lastSequence, weather.view().layers.size(), weather.stateHash());
     } else if (auto r = store->save(weather.toJson(), nullptr); !r) {
@@ -204,6 +218,24 @@ int main(int argc, char** argv) {
       log->info("event=new_db db={:?}", dbPath);
     }
     weather.attachStore(&*store);
+  }
+
+  if (!gribPath.empty()) {
+    auto& weather = (*server)->weather();
+    auto inputs = sky::server::gribInputs(gribPath);
+    auto decoded = inputs ? sky::server::decodeForecast(*inputs, std::filesystem::path(gribPath).filename().string(),
+                                                        weather.clockNow(), decoder)
+                          : sky::Result<sky::server::DecodedForecast>(tl::unexpected(inputs.error()));
+    for (const std::string& skip : decoded ? decoded->skipped : std::vector<std::string>{})
+      log->warn("event=grib_skipped detail={:?}", skip);
+    auto applied = decoded ? sky::server::applyForecast(weather, std::move(*decoded), "cli", "grib")
+                           : sky::Result<sky::server::AppliedChange>(tl::unexpected(decoded.error()));
+    if (!applied) {
+      log->error("event=bad_grib file={:?} detail={:?}", gribPath, sky::describe(applied.error()));
+      return kExitBadInput;
+    }
+    log->info("event=change_applied source=grib sequence={} summary={:?}", applied->sequence, applied->summary);
+    for (const std::string& note : weather.forecast()->forecast->notes()) log->info("event=grib_layer detail={:?}", note);
   }
 
   sky::server::Server& s = **server;
@@ -282,6 +314,8 @@ int main(int argc, char** argv) {
     hooks.extraMetrics = moreMetrics;
     hooks.renderers = [&s] { return sky::server::renderersJson(s.renderers()); };
     hooks.rejections = &s.rejections();
+    http.gribDecoder = decoder;
+    http.gribDir = gribDir;
     auto created = sky::server::HttpApi::create(s.io(), http, s.weather(), std::move(hooks));
     if (!created) {
       log->error("{}", sky::describe(created.error()));

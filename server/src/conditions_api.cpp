@@ -16,7 +16,8 @@ nlohmann::json conditionsJson(const LiveWeather& weather, const ConditionsQuery&
   stream::Subscribe area;
   area.area = {q.lat_deg, q.lon_deg, 1.0};
   area.tileLevel = q.level;
-  weather::WeatherSnapshot snapshot = buildSnapshot(area, layers, clock_s, kDefaultMaxCells, regions);
+  const auto field = weather.fieldAt(clock_s);
+  weather::WeatherSnapshot snapshot = buildSnapshot(area, layers, clock_s, kDefaultMaxCells, regions, nullptr, field.get());
   // As a subscriber holds them: the stream carries a tile's fractions in 8
   // bits (stream/messages.cpp).
   for (weather::CoverageTile& t : snapshot.tiles) {
@@ -26,6 +27,13 @@ nlohmann::json conditionsJson(const LiveWeather& weather, const ConditionsQuery&
   }
   const weather::PointWeather pw =
       weather::weatherAt(snapshot.layers, weather::snapshotLookup(snapshot, clock_s), q.lat_deg, q.lon_deg, q.alt_m);
+  // Where each forecast layer's cover at the point comes from.
+  nlohmann::json sources = nlohmann::json::object();
+  if (field)
+    for (const ForecastLayer& l : field->forecast().layers()) {
+      const std::string src = field->forecast().sourceAt(l, q.lat_deg, q.lon_deg, field->valid_unix());
+      if (!src.empty()) sources[std::to_string(l.layer.id)] = src;
+    }
   return {{"lat_deg", q.lat_deg},
           {"lon_deg", q.lon_deg},
           {"alt_m", q.alt_m},
@@ -38,7 +46,8 @@ nlohmann::json conditionsJson(const LiveWeather& weather, const ConditionsQuery&
           {"cloud_density", pw.cloudDensity},
           {"layer_id", pw.layerId ? nlohmann::json(*pw.layerId) : nlohmann::json(nullptr)},
           {"air_temperature_c", weather::isaTemperature_c(q.alt_m)},
-          {"pressure_hpa", weather::isaPressure_hpa(q.alt_m)}};
+          {"pressure_hpa", weather::isaPressure_hpa(q.alt_m)},
+          {"forecast_sources", sources}};
 }
 
 }  // namespace sky::server

@@ -8,6 +8,7 @@
 #include "sky/server/api_json.hpp"
 #include "sky/server/conditions_api.hpp"
 #include "sky/server/console_files.hpp"
+#include "sky/server/forecast_files.hpp"
 #include "sky/server/http_api.hpp"
 #include "sky/server/metar_api.hpp"
 #include "sky/server/scenario_api.hpp"
@@ -27,7 +28,11 @@ HttpReply HttpApi::serve(Endpoint endpoint, const ApiRequest& r) {
   switch (endpoint) {
     case Endpoint::Healthz: return {200, "text/plain", "ok\n"};
     case Endpoint::Metrics: return metrics();
-    case Endpoint::State: return json(toJson(weather_.view()));
+    case Endpoint::State: {
+      nlohmann::json state = toJson(weather_.view());
+      state["forecast"] = forecastJson(weather_.forecast().get());
+      return json(state);
+    }
     case Endpoint::Renderers:
       return json({{"renderers", hooks_.renderers ? hooks_.renderers() : nlohmann::json::array()}});
     case Endpoint::Conditions: {
@@ -39,6 +44,7 @@ HttpReply HttpApi::serve(Endpoint endpoint, const ApiRequest& r) {
     case Endpoint::Changes: return changes(r);
     case Endpoint::Scenario: return scenario(r);
     case Endpoint::Metar: return metar(r);
+    case Endpoint::Grib: return grib(r);
     case Endpoint::Feed: break;  // an upgrade: HttpExchange hands it to the feed
   }
   return error(426, "upgrade: GET /api/ws is a WebSocket (send Upgrade: websocket)");
@@ -179,6 +185,77 @@ HttpReply HttpApi::refuseFeed() {
   refused(RejectReason::WsRefused, "console feed full");
   return error(503, "ws: " + std::to_string(feed_.clients()) + " console clients connected, at most " +
                         std::to_string(options_.feed.maxClients));
+}
+
+namespace {
+
+// A name the operator gave an uploaded file (?name=...): letters, digits,
+// '.', '-', '_', at most 100 of them; anything else is the default.
+std::string uploadName(std::string_view query) {
+  constexpr std::string_view key = "name=";
+  std::string name;
+  for (std::size_t at = 0; at <= query.size();) {
+    const std::size_t amp = std::min(query.find('&', at), query.size());
+    const std::string_view pair = query.substr(at, amp - at);
+    if (pair.substr(0, key.size()) == key) name = std::string(pair.substr(key.size()));
+    at = amp + 1;
+  }
+  const bool ok = !name.empty() && name.size() <= 100 && name.find_first_not_of(
+      "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789._-") == std::string::npos;
+  return ok ? name : "upload.grib2";
+}
+
+}  // namespace
+
+HttpReply HttpApi::grib(const ApiRequest& r) {
+  auto refuse = [&](int status, const std::string& detail) {
+    ++counters_.rejected;
+    refused(RejectReason::HttpInvalid, detail);
+    if (options_.log) options_.log->info("event=grib_refused detail={:?}", detail);
+    return error(status, utf8::sanitiseAndCut(detail, 1024));
+  };
+  std::vector<GribInput> inputs;
+  std::string name;
+  Result<DecodedForecast> decoded = tl::unexpected(Error{ErrorCode::InvalidArgument, ""});
+  if (r.body.size() >= 4 && r.body.substr(0, 4) == "GRIB") {
+    name = uploadName(r.query);
+    decoded = decodeUploadedForecast(std::as_bytes(std::span(r.body.data(), r.body.size())), name,
+                                     weather_.clockNow(), options_.gribDecoder);
+  } else {
+    const nlohmann::json body = nlohmann::json::parse(r.body, nullptr, false);
+    if (body.is_discarded() || !body.is_object())
+      return refuse(400, "body: a GRIB2 file (starting 'GRIB') or a JSON object {\"path\": ...} or {\"remove\": true}");
+    if (body.value("remove", false) == true) {
+      auto removed = weather_.removeForecast("api", "grib");
+      if (!removed) return refuse(400, removed.error().detail);
+      ++counters_.applied;
+      return json({{"sequence", removed->sequence}, {"summary", removed->summary}});
+    }
+    if (!body.contains("path") || !body["path"].is_string()) return refuse(400, "path: missing (a file or directory inside --grib-dir)");
+    if (options_.gribDir.empty()) return refuse(403, "path: this server takes no GRIB paths (start it with --grib-dir)");
+    auto where = pathInside(options_.gribDir, body["path"].get<std::string>());
+    if (!where) return refuse(400, where.error().detail);
+    auto found = gribInputs(*where);
+    if (!found) return refuse(404, "path: " + body["path"].get<std::string>() + ": no GRIB file there");
+    inputs = std::move(*found);
+    name = where->filename().string();
+    decoded = decodeForecast(inputs, name, weather_.clockNow(), options_.gribDecoder);
+  }
+  if (!decoded) return refuse(decoded.error().code == ErrorCode::TooLarge ? 413 : 400, decoded.error().detail);
+  const std::vector<std::string> skipped = decoded->skipped;
+  auto applied = applyForecast(weather_, std::move(*decoded), "api", "grib");
+  if (!applied) return refuse(applied.error().code == ErrorCode::Io ? 500 : 400, applied.error().detail);
+  ++counters_.applied;
+  if (options_.log)
+    options_.log->info("event=change_applied source=grib sequence={} summary={:?}", applied->sequence, applied->summary);
+  nlohmann::json skips = nlohmann::json::array();
+  for (std::size_t k = 0; k < skipped.size() && k < 100; ++k) skips.push_back(utf8::sanitiseAndCut(skipped[k], 300));
+  return json({{"sequence", applied->sequence},
+               {"clock_s", applied->clock_s},
+               {"summary", applied->summary},
+               {"forecast", forecastJson(weather_.forecast().get())},
+               {"skipped", skips},
+               {"skipped_total", skipped.size()}});
 }
 
 }  // namespace sky::server

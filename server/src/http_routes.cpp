@@ -13,6 +13,9 @@ namespace {
 constexpr std::size_t kMaxBody_bytes = 64 * 1024;
 // A scenario may carry up to 1024 timeline entries of a few hundred bytes.
 constexpr std::size_t kMaxScenarioBody_bytes = 1024 * 1024;
+// An uploaded GRIB2 file: a regional forecast's cloud and wind fields at a
+// few steps are a few MB; larger files go by path (--grib-dir).
+constexpr std::size_t kMaxGribBody_bytes = 32 * 1024 * 1024;
 
 constexpr std::array kRoutes = {
     Route{"/healthz", Endpoint::Healthz, kGet, 0, TokenRule::None},
@@ -24,6 +27,7 @@ constexpr std::array kRoutes = {
     Route{"/api/changes", Endpoint::Changes, kPost, kMaxBody_bytes, TokenRule::Always},
     Route{"/api/scenario", Endpoint::Scenario, kPost, kMaxScenarioBody_bytes, TokenRule::Always},
     Route{"/api/metar", Endpoint::Metar, kPost, kMaxBody_bytes, TokenRule::WhenApplying},
+    Route{"/api/grib", Endpoint::Grib, kPost, kMaxGribBody_bytes, TokenRule::Always},
     Route{"/api/ws", Endpoint::Feed, kGet, 0, TokenRule::None},
 };
 

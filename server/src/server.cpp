@@ -268,9 +268,11 @@ void Server::weatherChanged() {
 }
 
 BuiltSnapshot Server::snapshotFor(const stream::Subscribe& request) {
+  const double clock_s = clockNow();
+  const auto field = weather_.fieldAt(clock_s);
   BuiltSnapshot built =
-      buildSnapshotWithGenerations(request, weather_.layersAt(clockNow()), clockNow(), options_.maxCellsPerSnapshot,
-                                   weather_.regionsAt(clockNow()), &tileCache_);
+      buildSnapshotWithGenerations(request, weather_.layersAt(clock_s), clock_s, options_.maxCellsPerSnapshot,
+                                   weather_.regionsAt(clock_s), &tileCache_, field.get());
   log_->debug("event=snapshot level={} asked={} tiles={}", built.snapshot.tileLevel, request.tileLevel,
               tileCount(built));
   return built;

@@ -36,6 +36,7 @@
 
 #include "sky/core/result.hpp"
 #include "sky/server/console_feed.hpp"
+#include "sky/server/grib_isolated.hpp"
 #include "sky/server/http_guard.hpp"
 #include "sky/server/http_routes.hpp"
 #include "sky/server/live_weather.hpp"
@@ -69,6 +70,10 @@ struct HttpApiOptions {
   // send them: "http://ops-console:8080"). See http_guard.hpp.
   std::vector<std::string> allowedHosts;
   std::vector<std::string> allowedOrigins;
+  // POST /api/grib: the decoder, and the directory files may be named in
+  // (empty: uploads only).
+  GribDecoder gribDecoder;
+  std::string gribDir;
   std::shared_ptr<spdlog::logger> log;
 };
 
@@ -119,6 +124,7 @@ class HttpApi {
   HttpReply changes(const ApiRequest& request);
   HttpReply scenario(const ApiRequest& request);
   HttpReply metar(const ApiRequest& request);
+  HttpReply grib(const ApiRequest& request);
   HttpReply unauthorized(const char* what);
   HttpReply consoleFile(std::string_view method, std::string_view path) const;
   // The answer to a WebSocket upgrade while the feed is full (503).

@@ -23,6 +23,7 @@ enum class Endpoint {
   Changes,
   Scenario,
   Metar,
+  Grib,
   Feed,  // GET /api/ws: the console's WebSocket (an upgrade, never a plain answer)
 };
 

@@ -157,6 +157,7 @@ class LiveWeather final : public WeatherService {
   // it (state and event, one transaction) before submit returns; a failed
   // commit refuses the change (Io) and leaves the state as it was.
   void attachStore(class WeatherStore* store) { store_ = store; }
+  class WeatherStore* store() const { return store_; }
   // The whole state as JSON: layers, ramps in progress, sequence, version,
   // and the clock as (clock_s, rate) at unix_ms.
   nlohmann::json toJson() const;
