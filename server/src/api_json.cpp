@@ -105,10 +105,12 @@ Result<weather::Region> parseRegion(const json& o, const std::string& path, bool
   if (!o.is_object()) return bad(path, "expected an object");
   if (auto r = withPlacement
                    ? onlyKeys(o, {"id", "center_lat_deg", "center_lon_deg", "size_x_m", "size_y_m", "corner_radius_m",
-                                  "rotation_deg", "transition_m", "drifts_with_wind", "layers", "placed_at_clock_s"},
+                                  "rotation_deg", "transition_m", "drifts_with_wind", "layers", "placed_at_clock_s",
+                                  "replaces_all_layers"},
                               path)
                    : onlyKeys(o, {"id", "center_lat_deg", "center_lon_deg", "size_x_m", "size_y_m", "corner_radius_m",
-                                  "rotation_deg", "transition_m", "drifts_with_wind", "layers"},
+                                  "rotation_deg", "transition_m", "drifts_with_wind", "layers",
+                                  "replaces_all_layers"},
                               path);
       !r)
     return tl::unexpected(r.error());
@@ -134,6 +136,10 @@ Result<weather::Region> parseRegion(const json& o, const std::string& path, bool
   if (o.contains("drifts_with_wind")) {
     if (!o.at("drifts_with_wind").is_boolean()) return bad(path + ".drifts_with_wind", "expected true or false");
     g.driftsWithWind = o.at("drifts_with_wind").get<bool>();
+  }
+  if (o.contains("replaces_all_layers")) {
+    if (!o.at("replaces_all_layers").is_boolean()) return bad(path + ".replaces_all_layers", "expected true or false");
+    g.replacesAllLayers = o.at("replaces_all_layers").get<bool>();
   }
   if (!o.contains("layers") || !o.at("layers").is_array()) return bad(path + ".layers", "expected an array of layers");
   const json& layers = o.at("layers");
@@ -283,6 +289,7 @@ nlohmann::json toJson(const weather::Region& r) {
           {"rotation_deg", r.rotation_deg},
           {"transition_m", r.transition_m},
           {"drifts_with_wind", r.driftsWithWind},
+          {"replaces_all_layers", r.replacesAllLayers},
           {"placed_at_clock_s", r.placedAtClock_s},
           {"layers", layers}};
 }

@@ -7,6 +7,7 @@
 #include "sky/core/utf8.hpp"
 #include "sky/server/api_json.hpp"
 #include "sky/server/conditions_api.hpp"
+#include "sky/server/conformance.hpp"
 #include "sky/server/console_files.hpp"
 #include "sky/server/forecast_files.hpp"
 #include "sky/server/http_api.hpp"
@@ -39,6 +40,11 @@ HttpReply HttpApi::serve(Endpoint endpoint, const ApiRequest& r) {
       auto q = parseConditionsQuery(r.query);
       if (!q) return error(400, q.error().detail);
       return json(conditionsJson(weather_, *q));
+    }
+    case Endpoint::Conformance: {
+      auto q = parseConformanceQuery(r.query);
+      if (!q) return error(400, q.error().detail);
+      return json(conformanceJson(weather_, options_.stations, *q));
     }
     case Endpoint::Events: return events(r.query);
     case Endpoint::Changes: return changes(r);

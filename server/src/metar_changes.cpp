@@ -240,6 +240,9 @@ MetarPlan planMetar(std::span<const std::string> reports, std::span<const Statio
     r.centerLat_deg = st.lat_deg;
     r.centerLon_deg = storedLon(st.lon_deg);
     r.layers = slotted(sw);
+    // The report is the whole sky at the station: layers that come later (a
+    // forecast loaded after it) are cleared there too.
+    r.replacesAllLayers = true;
     // Every global layer, and every layer of other regions reaching the
     // station, at coverage 0 (its own slot of the same id wins).
     auto clear = [&](const weather::CloudLayer& l) {

@@ -242,6 +242,21 @@ const weather::CloudLayer* layerOf(const weather::Region& r, std::uint32_t id) {
   return nullptr;
 }
 
+// The layer at cover 0: what a region that replaces every layer has of a
+// layer it does not carry.
+weather::CloudLayer clearedOf(const weather::CloudLayer& layer) {
+  weather::CloudLayer l = layer;
+  l.coverage = 0;
+  return l;
+}
+
+// What region r contributes to layer `id`: its own layer of that id, or
+// `cleared` when it replaces every layer, or nothing.
+const weather::CloudLayer* regionLayer(const weather::Region& r, std::uint32_t id, const weather::CloudLayer& cleared) {
+  if (const auto* own = layerOf(r, id)) return own;
+  return r.replacesAllLayers ? &cleared : nullptr;
+}
+
 // Every layer's tiles from every region's weight per cell (weights[k] for
 // region k; null where it reaches no cell).
 std::vector<weather::CoverageTile> tilesFromWeights(std::span<const std::uint64_t> cells,
@@ -254,8 +269,10 @@ std::vector<weather::CoverageTile> tilesFromWeights(std::span<const std::uint64_
   std::vector<weather::CoverageTile> base;
   for (const weather::CloudLayer& layer : layers) {
     contributions.clear();
+    const weather::CloudLayer cleared = clearedOf(layer);
     for (std::size_t k = 0; k < regions.size(); ++k)
-      if (const auto* rl = layerOf(regions[k], layer.id); rl && weights[k]) contributions.push_back({weights[k], rl});
+      if (const auto* rl = regionLayer(regions[k], layer.id, cleared); rl && weights[k])
+        contributions.push_back({weights[k], rl});
     base.clear();
     if (field && field->gives(layer.id)) {
       base.resize(cells.size());
@@ -386,8 +403,9 @@ std::vector<LayerRun> deriveRuns(TileCache& cache, TileCache::Entry& entry,
     inputs = {static_cast<std::uint64_t>(layer.type), bitsOf(layer.coverage), bitsOf(layer.density)};
     const bool fromField = field && field->gives(layer.id);
     if (fromField) inputs.insert(inputs.end(), {~0ull, field->key()});
+    const weather::CloudLayer cleared = clearedOf(layer);
     for (std::size_t k = 0; k < regions.size(); ++k) {
-      const auto* rl = reaches[k] ? layerOf(regions[k], layer.id) : nullptr;
+      const auto* rl = reaches[k] ? regionLayer(regions[k], layer.id, cleared) : nullptr;
       if (!rl) continue;
       const TileCache::ShapeKey shape = shapeKey(regions[k]);
       inputs.push_back(k);
@@ -400,7 +418,7 @@ std::vector<LayerRun> deriveRuns(TileCache& cache, TileCache::Entry& entry,
     if (!hit) {
       contributions.clear();
       for (std::size_t k = 0; k < regions.size(); ++k)
-        if (const auto* rl = reaches[k] ? layerOf(regions[k], layer.id) : nullptr)
+        if (const auto* rl = reaches[k] ? regionLayer(regions[k], layer.id, cleared) : nullptr)
           contributions.push_back({&cache.weights(entry, regions[k]), rl});
       std::vector<weather::CoverageTile> base;
       if (fromField) {

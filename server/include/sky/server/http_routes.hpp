@@ -19,6 +19,7 @@ enum class Endpoint {
   State,
   Renderers,
   Conditions,
+  Conformance,
   Events,
   Changes,
   Scenario,

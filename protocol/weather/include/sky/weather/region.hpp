@@ -26,6 +26,10 @@ struct Region {
   // drifting) on the weather clock, from where it was at placedAtClock_s.
   bool driftsWithWind = false;
   double placedAtClock_s = 0;
+  // Whether the region's weather is the whole sky there (a METAR station:
+  // the report says every layer): a layer it does not carry has cover 0 in
+  // it, blending back across the perimeter, instead of standing unchanged.
+  bool replacesAllLayers = false;
   std::vector<CloudLayer> layers;  // at most kMaxRegionLayers, distinct ids, each valid
 };
 

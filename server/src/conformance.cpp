@@ -1,0 +1,254 @@
+// GET /api/conformance (see conformance.hpp).
+#include "sky/server/conformance.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "sky/server/live_weather.hpp"
+#include "sky/server/metar_changes.hpp"
+#include "sky/server/snapshot_builder.hpp"
+#include "sky/weather/query.hpp"
+#include "sky/weather/region.hpp"
+#include "sky/weather/tiling.hpp"
+
+namespace sky::server {
+
+namespace {
+
+constexpr double kMeanEarthRadius_m = 6371008.8;
+
+double distance_m(double lat1, double lon1, double lat2, double lon2) {
+  constexpr double k = 3.14159265358979323846 / 180;
+  const double s1 = std::sin((lat2 - lat1) * k / 2), s2 = std::sin((lon2 - lon1) * k / 2);
+  const double h = s1 * s1 + std::cos(lat1 * k) * std::cos(lat2 * k) * s2 * s2;
+  return 2 * kMeanEarthRadius_m * std::asin(std::min(1.0, std::sqrt(h)));
+}
+
+Result<double> number(std::string_view key, std::string_view v, double lo, double hi) {
+  double x = 0;
+  const auto [end, err] = std::from_chars(v.data(), v.data() + v.size(), x);
+  if (v.empty() || err != std::errc() || end != v.data() + v.size() || !std::isfinite(x))
+    return fail(ErrorCode::Malformed, std::string(key) + ": '" + std::string(v) + "' is not a number");
+  if (x < lo || x > hi)
+    return fail(ErrorCode::InvalidArgument, std::string(key) + ": " + std::string(v) + " is not in [" +
+                                                std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  return x;
+}
+
+struct Layer {
+  std::uint32_t id = 0;
+  int oktas = 0;
+  double base_m = 0;
+};
+
+std::optional<double> ceilingOf(const std::vector<Layer>& layers) {
+  std::optional<double> c;
+  for (const Layer& l : layers)
+    if (l.oktas >= 5 && (!c || l.base_m < *c)) c = l.base_m;
+  return c;
+}
+
+nlohmann::json layersJson(const std::vector<Layer>& layers) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const Layer& l : layers) a.push_back({{"id", l.id}, {"oktas", l.oktas}, {"base_m", l.base_m}});
+  return a;
+}
+
+nlohmann::json optional(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
+
+}  // namespace
+
+int oktas(double cover) {
+  if (!(cover > 0)) return 0;
+  if (cover >= 1) return 8;
+  return std::clamp(static_cast<int>(std::lround(cover * 8)), 1, 7);
+}
+
+Result<ConformanceQuery> parseConformanceQuery(std::string_view query) {
+  ConformanceQuery q;
+  if (query.size() > 512) return fail(ErrorCode::InvalidArgument, "query: longer than 512 bytes");
+  std::set<std::string_view> seen;
+  while (!query.empty()) {
+    const std::size_t amp = query.find('&');
+    const std::string_view pair = query.substr(0, amp);
+    query = amp == std::string_view::npos ? std::string_view{} : query.substr(amp + 1);
+    const std::size_t eq = pair.find('=');
+    if (eq == std::string_view::npos) return fail(ErrorCode::Malformed, "query: '" + std::string(pair) + "' is not key=value");
+    const std::string_view key = pair.substr(0, eq), value = pair.substr(eq + 1);
+    if (!seen.insert(key).second) return fail(ErrorCode::InvalidArgument, std::string(key) + ": given twice");
+    Result<double> v = 0.0;
+    if (key == "stations") {
+      if (!(v = number(key, value, 0, 10000))) return tl::unexpected(v.error());
+      q.maxStations = static_cast<std::size_t>(*v);
+    } else if (key == "grid_points") {
+      if (!(v = number(key, value, 0, 2000))) return tl::unexpected(v.error());
+      q.gridPoints = static_cast<std::size_t>(*v);
+    } else if (key == "lat_deg") {
+      if (!(v = number(key, value, -90, 90))) return tl::unexpected(v.error());
+      q.lat_deg = *v;
+    } else if (key == "lon_deg") {
+      if (!(v = number(key, value, -180, 180))) return tl::unexpected(v.error());
+      q.lon_deg = *v;
+    } else if (key == "radius_m") {
+      if (!(v = number(key, value, 1, 2e7))) return tl::unexpected(v.error());
+      q.radius_m = *v;
+    } else {
+      return fail(ErrorCode::InvalidArgument, "query: unknown key '" + std::string(key) + "'");
+    }
+  }
+  if (q.lat_deg.has_value() != q.lon_deg.has_value() || q.lat_deg.has_value() != (q.radius_m > 0))
+    return fail(ErrorCode::InvalidArgument, "lat_deg, lon_deg, radius_m: give all three or none");
+  return q;
+}
+
+nlohmann::json conformanceJson(const LiveWeather& weather, std::span<const Station> stations,
+                               const ConformanceQuery& q) {
+  const double clock_s = weather.clockNow();
+  const std::vector<weather::CloudLayer> globals = weather.layersAt(clock_s);
+  const std::vector<weather::Region> regions = weather.regionsAt(clock_s);
+  const std::vector<weather::CloudLayer> table = snapshotLayers(globals, regions);
+  const auto field = weather.fieldAt(clock_s);
+  auto inArea = [&](double lat, double lon) {
+    return !q.lat_deg || distance_m(*q.lat_deg, *q.lon_deg, lat, lon) <= q.radius_m;
+  };
+
+  // The points: station regions, then forecast grid points.
+  struct StationPoint {
+    const weather::Region* region;
+    std::string icao;
+  };
+  std::vector<StationPoint> stationPoints;
+  std::size_t stationsInArea = 0;
+  for (const auto& r : regions) {
+    if (r.id < kMetarRegionFirst || r.id > kMetarRegionLast || !inArea(r.centerLat_deg, r.centerLon_deg)) continue;
+    ++stationsInArea;
+    if (stationPoints.size() >= q.maxStations) continue;
+    std::string icao;
+    // The region's centre is the station's (its longitude normalised).
+    for (const Station& s : stations)
+      if (std::abs(s.lat_deg - r.centerLat_deg) < 1e-9 && std::abs(std::remainder(s.lon_deg - r.centerLon_deg, 360.0)) < 1e-9)
+        icao = s.icao;
+    stationPoints.push_back({&r, icao});
+  }
+  struct GridPoint {
+    double lat, lon;
+    int i, j;
+  };
+  std::vector<GridPoint> gridPoints;
+  const ForecastLayer* gridOf = nullptr;
+  if (field && q.gridPoints > 0) {
+    gridOf = &field->forecast().layers().front();
+    const GribGrid& g = gridOf->steps.front().cover->grid;
+    std::vector<GridPoint> all;
+    for (int j = 0; j < g.nj; ++j)
+      for (int i = 0; i < g.ni; ++i) {
+        const LatLon at = gridLatLon(g, i, j);
+        if (inArea(at.lat_deg, at.lon_deg)) all.push_back({at.lat_deg, at.lon_deg, i, j});
+      }
+    const std::size_t stride = std::max<std::size_t>(1, (all.size() + q.gridPoints - 1) / q.gridPoints);
+    for (std::size_t k = 0; k < all.size() && gridPoints.size() < q.gridPoints; k += stride) gridPoints.push_back(all[k]);
+  }
+
+  // The tiles of every point's cell, as a renderer's snapshot has them.
+  std::set<std::uint64_t> cellSet;
+  for (const auto& s : stationPoints)
+    cellSet.insert(weather::cellAt(s.region->centerLat_deg, s.region->centerLon_deg, kConformanceLevel));
+  for (const auto& g : gridPoints) cellSet.insert(weather::cellAt(g.lat, g.lon, kConformanceLevel));
+  const std::vector<std::uint64_t> cells(cellSet.begin(), cellSet.end());
+  weather::WeatherSnapshot snapshot;
+  snapshot.weatherClock_s = clock_s;
+  snapshot.layers = table;
+  snapshot.tileLevel = kConformanceLevel;
+  snapshot.tiles = deriveTiles(cells, table, regions, field.get());
+  for (weather::CoverageTile& t : snapshot.tiles) {
+    t.coverage = weather::dequantizeUnit(weather::quantizeUnit(t.coverage));
+    t.density = weather::dequantizeUnit(weather::quantizeUnit(t.density));
+  }
+  const weather::CoverageLookup lookup = weather::snapshotLookup(snapshot, clock_s);
+  auto drawnAt = [&](double lat, double lon) {
+    std::vector<Layer> out;
+    for (const auto& l : table) {
+      const auto tile = lookup(l, lat, lon);
+      const double cover = tile ? tile->coverage : l.coverage;
+      if (const int o = oktas(cover); o > 0) out.push_back({l.id, o, l.base_m});
+    }
+    return out;
+  };
+
+  nlohmann::json stationRows = nlohmann::json::array();
+  std::size_t stationsOk = 0;
+  for (const auto& s : stationPoints) {
+    const weather::Region& r = *s.region;
+    std::vector<Layer> reported;
+    for (const auto& l : r.layers)
+      if (l.id >= kMetarFogSlot && l.id <= kMetarLastSlot && oktas(l.coverage) > 0)
+        reported.push_back({l.id, oktas(l.coverage), l.base_m});
+    const std::vector<Layer> drawn = drawnAt(r.centerLat_deg, r.centerLon_deg);
+    // Per layer id in either: the okta difference.
+    std::map<std::uint32_t, std::pair<int, int>> byId;
+    for (const Layer& l : reported) byId[l.id].first = l.oktas;
+    for (const Layer& l : drawn) byId[l.id].second = l.oktas;
+    int worst = 0;
+    for (const auto& [id, p] : byId) worst = std::max(worst, std::abs(p.second - p.first));
+    const auto cr = ceilingOf(reported), cd = ceilingOf(drawn);
+    const bool ceilingOk = (!cr && !cd) || (cr && cd && std::abs(*cr - *cd) <= kCeilingTolerance_m);
+    const bool ok = worst <= kOktaTolerance && ceilingOk;
+    stationsOk += ok;
+    stationRows.push_back({{"region_id", r.id},
+                           {"icao", s.icao.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.icao)},
+                           {"lat_deg", r.centerLat_deg},
+                           {"lon_deg", r.centerLon_deg},
+                           {"reported", {{"layers", layersJson(reported)}, {"ceiling_m", optional(cr)}, {"visibility_m", nullptr}}},
+                           {"drawn", {{"layers", layersJson(drawn)}, {"ceiling_m", optional(cd)}, {"visibility_m", nullptr}}},
+                           {"oktas_off", worst},
+                           {"ceiling_off_m", cr && cd ? nlohmann::json(*cd - *cr) : nlohmann::json(nullptr)},
+                           {"ok", ok}});
+  }
+
+  nlohmann::json gridRows = nlohmann::json::array();
+  std::size_t gridOk = 0;
+  if (field)
+    for (const GridPoint& g : gridPoints) {
+      nlohmann::json layers = nlohmann::json::array();
+      int worst = 0;
+      bool any = false;
+      for (const ForecastLayer& fl : field->forecast().layers()) {
+        const float cover = field->forecast().coverage(fl, g.lat, g.lon, field->valid_unix());
+        if (std::isnan(cover)) continue;
+        any = true;
+        const auto tile = lookup(fl.layer, g.lat, g.lon);
+        const int want = oktas(cover), got = oktas(tile ? tile->coverage : 0);
+        worst = std::max(worst, std::abs(got - want));
+        layers.push_back({{"id", fl.layer.id}, {"forecast_oktas", want}, {"drawn_oktas", got}});
+      }
+      if (!any) continue;
+      // Within a station's reach its report overrides the forecast: the
+      // difference is the report's, and the station's row checks it.
+      double station = 0;
+      for (const auto& r : regions)
+        if (r.replacesAllLayers) station = std::max(station, weather::regionWeight(r, g.lat, g.lon));
+      const bool ok = worst <= kOktaTolerance || station > 0;
+      gridOk += ok;
+      gridRows.push_back({{"lat_deg", g.lat}, {"lon_deg", g.lon}, {"i", g.i}, {"j", g.j}, {"layers", layers},
+                          {"oktas_off", worst}, {"station_weight", station}, {"ok", ok}});
+    }
+
+  return {{"clock_s", clock_s},
+          {"tile_level", kConformanceLevel},
+          {"tolerances", {{"oktas", kOktaTolerance}, {"ceiling_m", kCeilingTolerance_m}}},
+          {"visibility", "not in the weather model yet"},
+          {"forecast", field ? nlohmann::json(field->forecast().name()) : nlohmann::json(nullptr)},
+          {"stations", stationRows},
+          {"grid", gridRows},
+          {"summary",
+           {{"stations", stationRows.size()},
+            {"stations_in_area", stationsInArea},
+            {"stations_ok", stationsOk},
+            {"grid_points", gridRows.size()},
+            {"grid_ok", gridOk}}}};
+}
+
+}  // namespace sky::server

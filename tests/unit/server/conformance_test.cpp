@@ -1,0 +1,140 @@
+// GET /api/conformance's check (conformance.hpp) on a live weather with METAR
+// stations and a GFS forecast: what the tiles draw at each station is its
+// report, whichever came first; a station region that does not replace
+// every layer (as a hand-made one) is caught; grid points match the grid.
+#include <gtest/gtest.h>
+
+#include "grib_tools.hpp"
+#include "sky/server/conformance.hpp"
+#include "sky/server/forecast.hpp"
+#include "sky/server/live_weather.hpp"
+#include "sky/server/metar_changes.hpp"
+
+namespace sky::server {
+namespace {
+
+const WallClock::time_point kT0{std::chrono::seconds(1000)};
+const std::vector<Station> kStations = {{"LJLJ", 46.2237, 14.4576, 388}, {"LIPQ", 45.8275, 13.4722, 12},
+                                         {"LOWK", 46.6425, 14.3377, 450}};
+
+struct Fixture {
+  WallClock::time_point now = kT0;
+  LiveWeather weather{Scenario{}, kT0, [this] { return now; }, [] { return std::int64_t{1700000000000}; }};
+
+  void metar(const std::vector<std::string>& reports) {
+    const auto layers = weather.layersAt(weather.clockNow());
+    const auto regions = weather.regionsAt(weather.clockNow());
+    MetarContext ctx{layers, regions};
+    MetarPlan plan = planMetar(reports, kStations, MetarOptions{}, ctx);
+    for (const auto& r : plan.reports) ASSERT_TRUE(r) << r.error().detail;
+    ASSERT_TRUE(weather.submit({plan.changes, "test", "metar"}));
+  }
+  void gfs() {
+    auto file = readGrib(readBytes(kGfs), "gfs", forecastWants);
+    ASSERT_TRUE(file);
+    auto fc = Forecast::fromGrib({&*file}, "gfs.grib2");
+    ASSERT_TRUE(fc);
+    LoadedForecast loaded;
+    loaded.placement = {weather.clockNow(), fc->firstValid_unix()};
+    loaded.forecast = std::make_shared<const Forecast>(std::move(*fc));
+    loaded.files = {{"key", "gfs.grib2"}};
+    ASSERT_TRUE(weather.loadForecast(std::move(loaded), "test", "grib"));
+  }
+  nlohmann::json check(std::size_t gridPoints = 200) {
+    ConformanceQuery q;
+    q.gridPoints = gridPoints;
+    return conformanceJson(weather, kStations, q);
+  }
+};
+
+const std::vector<std::string> kReports = {"METAR LJLJ 221150Z 24008KT 9999 FEW025 SCT045 BKN080 12/06 Q1018",
+                                           "METAR LIPQ 221150Z 24008KT CAVOK 12/06 Q1018",
+                                           "METAR LOWK 221150Z 24008KT 9999 OVC012 12/06 Q1018"};
+
+void expectStationsAsReported(const nlohmann::json& j) {
+  ASSERT_EQ(j["stations"].size(), 3u) << j.dump();
+  for (const auto& s : j["stations"]) {
+    EXPECT_TRUE(s["ok"]) << s.dump();
+    EXPECT_EQ(s["oktas_off"], 0) << s.dump();
+    EXPECT_EQ(s["drawn"]["layers"], s["reported"]["layers"]) << s.dump();
+  }
+  const auto row = [&](const std::string& icao) {
+    for (const auto& s : j["stations"])
+      if (s["icao"] == icao) return s;
+    ADD_FAILURE() << "no row for " << icao;
+    return nlohmann::json{};
+  };
+  EXPECT_EQ(row("LJLJ")["reported"]["layers"].size(), 3u);
+  EXPECT_TRUE(row("LIPQ")["drawn"]["layers"].empty());  // CAVOK: the forecast's clouds cleared there
+  // OVC012 at 450 m elevation: the ceiling at 450 + 1200 ft.
+  EXPECT_NEAR(row("LOWK")["drawn"]["ceiling_m"].get<double>(), 450 + 1200 * 0.3048, 1);
+}
+
+TEST(Conformance, StationsDrawTheirReportsWhenTheForecastCameFirst) {
+  Fixture f;
+  f.gfs();
+  f.metar(kReports);
+  expectStationsAsReported(f.check());
+}
+
+TEST(Conformance, StationsDrawTheirReportsWhenTheForecastCameAfter) {
+  Fixture f;
+  f.metar(kReports);
+  f.gfs();
+  const auto j = f.check();
+  expectStationsAsReported(j);
+  // Grid points: every one checked matches the grid, or lies in a station's reach.
+  ASSERT_GT(j["grid"].size(), 150u);
+  std::size_t nearStation = 0;
+  for (const auto& g : j["grid"]) {
+    EXPECT_TRUE(g["ok"]) << g.dump();
+    if (g["oktas_off"] > 1) {
+      EXPECT_GT(g["station_weight"].get<double>(), 0) << g.dump();
+    }
+    nearStation += g["station_weight"].get<double>() > 0;
+  }
+  EXPECT_EQ(j["summary"]["grid_ok"], j["grid"].size());
+  std::printf("[ conformance ] %zu grid points, %zu within a station's reach\n", j["grid"].size(), nearStation);
+}
+
+TEST(Conformance, AStationRegionThatLeavesOtherLayersStandingIsCaught) {
+  Fixture f;
+  f.metar(kReports);
+  // LIPQ's region as a hand-made one would be: its layers, not the whole sky.
+  auto regions = f.weather.regionsAt(f.weather.clockNow());
+  for (auto& r : regions)
+    if (std::abs(r.centerLat_deg - 45.8275) < 1e-9) {
+      r.replacesAllLayers = false;
+      r.layers.clear();
+      ASSERT_TRUE(f.weather.submit({{SetRegion{r, {}}}, "test", "api"}));
+    }
+  f.gfs();
+  const auto j = f.check(0);
+  bool caught = false;
+  for (const auto& s : j["stations"])
+    if (s["icao"] == "LIPQ") {
+      EXPECT_FALSE(s["ok"]) << s.dump();
+      EXPECT_GT(s["oktas_off"], 1);
+      caught = true;
+    }
+  EXPECT_TRUE(caught);
+  EXPECT_EQ(j["summary"]["stations_ok"], 2);
+}
+
+TEST(Conformance, QueryKeysAreChecked) {
+  EXPECT_TRUE(parseConformanceQuery(""));
+  EXPECT_TRUE(parseConformanceQuery("stations=10&grid_points=5&lat_deg=46&lon_deg=14&radius_m=100000"));
+  EXPECT_FALSE(parseConformanceQuery("lat_deg=46"));
+  EXPECT_FALSE(parseConformanceQuery("stations=-1"));
+  EXPECT_FALSE(parseConformanceQuery("grid_points=1e9"));
+  EXPECT_FALSE(parseConformanceQuery("bogus=1"));
+  EXPECT_FALSE(parseConformanceQuery("stations=1&stations=2"));
+  EXPECT_EQ(oktas(0), 0);
+  EXPECT_EQ(oktas(0.01), 1);
+  EXPECT_EQ(oktas(0.5), 4);
+  EXPECT_EQ(oktas(0.99), 7);
+  EXPECT_EQ(oktas(1), 8);
+}
+
+}  // namespace
+}  // namespace sky::server
