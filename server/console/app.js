@@ -10,6 +10,7 @@ import { LayerPanel } from "./layers.js";
 import { EventLog, renderHealth, renderRenderers } from "./log.js";
 import { MapView } from "./map.js";
 import { MetarPanel } from "./metar.js";
+import { ConformancePanel } from "./conformance.js";
 import { RegionPanel } from "./regions.js";
 import { fmt, keyOfServerError, num } from "./units.js";
 
@@ -102,6 +103,7 @@ const map = new MapView($("#map"), {
 const layers = new LayerPanel($("#layers"), app);
 const regions = new RegionPanel($("#region"), app);
 const metar = new MetarPanel($("#metar"), app);
+new ConformancePanel($("#conformance"));
 new ClockPanel($("#clock"), app);
 const log = new EventLog($("#events"));
 

@@ -162,6 +162,13 @@ const cases = {
     assert(layer.coverage >= 5 / 8 && layer.coverage <= 7 / 8, `BKN coverage ${layer.coverage}`);
     near(layer.base_m, 3000 * 0.3048 + 388, 15, "BKN030 base in metres MSL");
     await until("the METAR event", async () => /metar/.test(await a.page.textContent("#events")));
+    // The conformance check: LJLJ's report is what the renderers draw there.
+    await a.page.click("#conformance-check");
+    await until("the conformance table", async () => (await a.page.$$("#conformance-result tbody tr")).length === 1);
+    const row = await a.page.textContent("#conformance-result tbody tr");
+    assert(/LJLJ/.test(row) && /at 427\d ft/.test(row) && /0\/8$/.test(row.trim()), `LJLJ's conformance row: ${row}`);
+    assert(await a.page.getAttribute("#conformance-result tbody tr", "class") === "ok", "LJLJ within tolerance");
+    assert(/1 of 1 stations/.test(await a.page.textContent("#conformance .note")), "the summary");
     noProblems(a.problems);
   },
 
