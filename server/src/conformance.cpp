@@ -186,7 +186,14 @@ nlohmann::json conformanceJson(const LiveWeather& weather, std::span<const Stati
     for (const auto& l : r.layers)
       if (l.id >= kMetarFogSlot && l.id <= kMetarLastSlot && oktas(l.coverage) > 0)
         reported.push_back({l.id, oktas(l.coverage), l.base_m});
-    const std::vector<Layer> drawn = drawnAt(r.centerLat_deg, r.centerLon_deg);
+    // A renderer at the station gets the table made round it (its own
+    // report's bases for the slots only stations have): the bases drawn.
+    const weather::CellCentre here{r.centerLat_deg, r.centerLon_deg};
+    const std::vector<weather::CloudLayer> local = snapshotLayers(globals, regions, &here);
+    std::vector<Layer> drawn = drawnAt(r.centerLat_deg, r.centerLon_deg);
+    for (Layer& l : drawn)
+      for (const auto& t : local)
+        if (t.id == l.id) l.base_m = t.base_m;
     // Per layer id in either: the okta difference.
     std::map<std::uint32_t, std::pair<int, int>> byId;
     for (const Layer& l : reported) byId[l.id].first = l.oktas;

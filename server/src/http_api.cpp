@@ -154,7 +154,7 @@ HttpApi::HttpApi(asio::io_context& io, HttpApiOptions options, LiveWeather& weat
       weather_(weather),
       hooks_(std::move(hooks)),
       feed_(io, options_.feed,
-            ConsoleFeedSource{options_.serverId, [this] { return toJson(weather_.view()); },
+            ConsoleFeedSource{options_.serverId, [this] { return apiStateJson(weather_); },
                               [this] { return hooks_.renderers ? hooks_.renderers() : nlohmann::json::array(); },
                               [this] { return healthJson(); },
                               [this] {

@@ -29,11 +29,7 @@ HttpReply HttpApi::serve(Endpoint endpoint, const ApiRequest& r) {
   switch (endpoint) {
     case Endpoint::Healthz: return {200, "text/plain", "ok\n"};
     case Endpoint::Metrics: return metrics();
-    case Endpoint::State: {
-      nlohmann::json state = toJson(weather_.view());
-      state["forecast"] = forecastJson(weather_.forecast().get());
-      return json(state);
-    }
+    case Endpoint::State: return json(apiStateJson(weather_));
     case Endpoint::Renderers:
       return json({{"renderers", hooks_.renderers ? hooks_.renderers() : nlohmann::json::array()}});
     case Endpoint::Conditions: {

@@ -3,6 +3,7 @@
 #include <set>
 
 #include "ramp_math.hpp"
+#include "sky/server/api_json.hpp"
 #include "sky/server/live_weather.hpp"
 #include "sky/server/weather_store.hpp"
 
@@ -70,6 +71,12 @@ Result<ForecastPlacement> forecastPlacementFromJson(const nlohmann::json& j) {
   } catch (const nlohmann::json::exception& e) {
     return fail(ErrorCode::Malformed, std::string("forecast: ") + e.what());
   }
+}
+
+nlohmann::json apiStateJson(const LiveWeather& weather) {
+  nlohmann::json state = toJson(weather.view());
+  state["forecast"] = forecastJson(weather.forecast().get());
+  return state;
 }
 
 std::shared_ptr<const ForecastField> LiveWeather::fieldAt(double clock_s) const {

@@ -64,12 +64,14 @@ std::vector<weather::CloudLayer> slotted(const StationWeather& s) {
   return v;
 }
 
-// Whether a region is a METAR station's: an id of theirs and their shape (a
-// circle that stays put), so that a region another input put in that range
-// (a CIGI host may use any 16-bit id) is neither reshaped nor taken over.
+// Whether a region is a METAR station's: an id of theirs, the mark only
+// stations carry (their weather replaces every layer: CIGI and the console
+// never set it) and their shape (a circle that stays put), so that a region
+// another input put in that range (a CIGI host may use any 16-bit id) is
+// neither reshaped nor taken over.
 bool isStationRegion(const weather::Region& r) {
-  return isMetarRegion(r.id) && !r.driftsWithWind && r.rotation_deg == 0 && r.sizeX_m == r.sizeY_m &&
-         r.cornerRadius_m == r.sizeX_m / 2;
+  return isMetarRegion(r.id) && r.replacesAllLayers && !r.driftsWithWind && r.rotation_deg == 0 &&
+         r.sizeX_m == r.sizeY_m && r.cornerRadius_m == r.sizeX_m / 2;
 }
 
 // Longitude as LiveWeather stores a region's centre.

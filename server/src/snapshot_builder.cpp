@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
 #include <numbers>
 
 #include "sky/core/assert.hpp"
@@ -42,6 +43,12 @@ double estimatedCells(const weather::SphericalCap& cap, int level) {
 
 }  // namespace
 
+namespace {
+// Defined below with the other region bounds.
+double sphereDistance_m(double lat1, double lon1, double lat2, double lon2);
+double reachOf(const weather::Region& r);
+}  // namespace
+
 std::size_t cellBudget(std::size_t maxCells, std::size_t layerCount) {
   const std::size_t tilesPerFrame =
       (stream::kMaxFrameBytes - kFrameHeadroomBytes) / kTileWireBytes;
@@ -61,7 +68,7 @@ Covering coverArea(const weather::SphericalCap& cap, int wantedLevel, std::size_
 }
 
 std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLayer> layers,
-                                                std::span<const weather::Region> regions) {
+                                                std::span<const weather::Region> regions, const weather::CellCentre* at) {
   std::vector<weather::CloudLayer> table(layers.begin(), layers.end());
   std::map<std::uint32_t, weather::CloudLayer> regionOnly;
   std::vector<const weather::Region*> byId;
@@ -76,6 +83,21 @@ std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLa
         regionOnly[l.id] = absent;
       }
     }
+  if (at && !regionOnly.empty()) {
+    // The regions round `at` (cheap distance bound first), heaviest first.
+    std::vector<std::pair<double, const weather::Region*>> near;
+    for (const weather::Region* r : byId)
+      if (sphereDistance_m(at->lat_deg, at->lon_deg, r->centerLat_deg, r->centerLon_deg) <= reachOf(*r))
+        if (const double w = weather::regionWeight(*r, at->lat_deg, at->lon_deg); w > 0) near.emplace_back(w, r);
+    std::stable_sort(near.begin(), near.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::set<std::uint32_t> done;
+    for (const auto& [w, r] : near)
+      for (const weather::CloudLayer& l : r->layers)
+        if (auto it = regionOnly.find(l.id); it != regionOnly.end() && done.insert(l.id).second) {
+          it->second = l;
+          it->second.coverage = 0;
+        }
+  }
   for (const auto& [id, l] : regionOnly) table.push_back(l);
   return table;
 }
@@ -463,7 +485,8 @@ BuiltSnapshot buildSnapshotWithGenerations(const stream::Subscribe& request,
                                            std::span<const weather::CloudLayer> layers, double clock_s,
                                            std::size_t maxCells, std::span<const weather::Region> regions,
                                            TileCache* cache, const LayerField* field) {
-  const std::vector<weather::CloudLayer> table = snapshotLayers(layers, regions);
+  const weather::CellCentre centre{request.area.centerLat_deg, request.area.centerLon_deg};
+  const std::vector<weather::CloudLayer> table = snapshotLayers(layers, regions, &centre);
   const std::size_t budget = cellBudget(maxCells, table.size());
   BuiltSnapshot built;
   weather::WeatherSnapshot& snapshot = built.snapshot;

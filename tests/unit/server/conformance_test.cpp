@@ -9,13 +9,15 @@
 #include "sky/server/forecast.hpp"
 #include "sky/server/live_weather.hpp"
 #include "sky/server/metar_changes.hpp"
+#include "sky/server/snapshot_builder.hpp"
 
 namespace sky::server {
 namespace {
 
 const WallClock::time_point kT0{std::chrono::seconds(1000)};
 const std::vector<Station> kStations = {{"LJLJ", 46.2237, 14.4576, 388}, {"LIPQ", 45.8275, 13.4722, 12},
-                                         {"LOWK", 46.6425, 14.3377, 450}};
+                                         {"LOWK", 46.6425, 14.3377, 450},   {"LIPA", 46.0319, 12.5965, 125},
+                                         {"LIPH", 45.6484, 12.1944, 18}};
 
 struct Fixture {
   WallClock::time_point now = kT0;
@@ -119,6 +121,32 @@ TEST(Conformance, AStationRegionThatLeavesOtherLayersStandingIsCaught) {
     }
   EXPECT_TRUE(caught);
   EXPECT_EQ(j["summary"]["stations_ok"], 2);
+}
+
+// Two stations 53 km apart whose broken layers fall in one base band (one
+// layer id): each is drawn at its own base where a renderer round it looks
+// (the table made round its centre), not at the other's.
+TEST(Conformance, StationsSharingASlotKeepTheirOwnBases) {
+  Fixture f;
+  f.metar({"METAR LIPA 221150Z 24008KT 9999 BKN020 12/06 Q1018", "METAR LIPH 221150Z 24008KT 9999 BKN022 12/06 Q1018"});
+  const auto j = f.check(0);
+  ASSERT_EQ(j["stations"].size(), 2u);
+  for (const auto& s : j["stations"]) EXPECT_TRUE(s["ok"]) << s.dump();
+  // The same through a snapshot a subscriber round each station gets.
+  const auto layers = f.weather.layersAt(f.weather.clockNow());
+  const auto regions = f.weather.regionsAt(f.weather.clockNow());
+  for (const auto& [lat, lon, base] : {std::tuple{46.0319, 12.5965, 125 + 2000 * 0.3048},
+                                       std::tuple{45.6484, 12.1944, 18 + 2200 * 0.3048}}) {
+    stream::Subscribe s;
+    s.area = {lat, lon, 20000};
+    s.tileLevel = 11;
+    const auto snap = buildSnapshot(s, layers, f.weather.clockNow(), kDefaultMaxCells, regions);
+    // Both bases lie in the band from 600 to 800 m MSL: slot 43 + 4.
+    const auto it = std::find_if(snap.layers.begin(), snap.layers.end(),
+                                 [](const auto& l) { return l.id == kMetarFirstBandSlot + 4; });
+    ASSERT_NE(it, snap.layers.end());
+    EXPECT_NEAR(it->base_m, base, 1) << "round " << lat << ", " << lon;
+  }
 }
 
 TEST(Conformance, QueryKeysAreChecked) {

@@ -196,6 +196,42 @@ TEST(Forecast, NamCoverIsDerivedFromHumidityOnItsPressureLevels) {
   EXPECT_TRUE(std::isnan(fc->coverage(*low, 48, 11, fc->firstValid_unix())));
 }
 
+TEST(Forecast, EcmwfLowMediumHighCoverAreLayersToo) {
+  // GFS's low, middle and high cover re-coded as ECMWF codes them (lcc, mcc,
+  // hcc: discipline 0, category 6, numbers 3, 4, 5, on the surface) with
+  // ecCodes' grib_set.
+  const auto dir = std::filesystem::temp_directory_path() / ("sky_ecmwf_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::string cat;
+  for (int k = 0; k < 3; ++k) {
+    const auto part = dir / ("part" + std::to_string(k) + ".grib2");
+    // grib_set keeps the messages -w does not pick: grib_copy picks first.
+    const auto one = dir / ("one" + std::to_string(k) + ".grib2");
+    const std::string cmd = std::string(SKY_GRIB_COPY) + " -w count=" + std::to_string(k + 1) + " '" + kGfs + "' '" +
+                            one.string() + "' && " + SKY_GRIB_SET + " -s centre=98,typeOfFirstFixedSurface=1,paramId=" +
+                            std::to_string(3073 + k) + " '" + one.string() + "' '" + part.string() + "'";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    std::ifstream in(part, std::ios::binary);
+    cat += std::string(std::istreambuf_iterator<char>(in), {});
+  }
+  std::ofstream(dir / "ecmwf.grib2", std::ios::binary) << cat;
+  const GribFile file = isolated((dir / "ecmwf.grib2").string(), GribSelection::Forecast);
+  std::filesystem::remove_all(dir);
+  ASSERT_EQ(file.fields.size(), 3u);
+  EXPECT_EQ(file.fields[0].meta.shortName, "lcc");
+  auto fc = Forecast::fromGrib({&file}, "ecmwf.grib2");
+  ASSERT_TRUE(fc) << fc.error().detail;
+  ASSERT_EQ(fc->layers().size(), 3u);
+  const std::uint32_t slots[] = {kForecastLowSlot, kForecastMiddleSlot, kForecastHighSlot};
+  for (int k = 0; k < 3; ++k) {
+    const ForecastLayer* l = layerOf(*fc, slots[k]);
+    ASSERT_NE(l, nullptr);
+    const auto truth = gribGetData(kGfs, k + 1);
+    for (std::size_t p = 0; p < truth.size(); p += 97)
+      EXPECT_NEAR(fc->coverage(*l, truth[p].lat, truth[p].lon, fc->firstValid_unix()), truth[p].value / 100, 1e-5);
+  }
+}
+
 TEST(Forecast, StepsAreInterpolatedInTime) {
   // Two steps of the GFS file: the second its values halved, 6 h later.
   GribFile a = isolated(kGfs, GribSelection::Forecast);

@@ -52,6 +52,11 @@ nlohmann::json forecastJson(const LoadedForecast* forecast);
 Result<std::vector<LoadedForecast::File>> forecastFilesFromJson(const nlohmann::json& saved);
 Result<ForecastPlacement> forecastPlacementFromJson(const nlohmann::json& saved);
 
+class LiveWeather;
+// GET /api/state's body, and the console feed's state: the view (api_json's
+// toJson) with the forecast.
+nlohmann::json apiStateJson(const LiveWeather& weather);
+
 class LiveWeather final : public WeatherService {
  public:
   using WallNow = std::function<WallClock::time_point()>;

@@ -45,10 +45,14 @@ struct Covering {
 Covering coverArea(const weather::SphericalCap& cap, int wantedLevel, std::size_t maxCells);
 
 // The layer table of a snapshot: the global layers, then each layer id only
-// regions have (taken from the lowest region id that has it) with coverage 0,
-// since outside its regions there is none of it.
+// regions have, with coverage 0, since outside its regions there is none of
+// it. Such a layer's other values (base, thickness, type) are those of the
+// region that weighs most at `at` (a subscriber's centre: near a METAR
+// station, its own report's base), or with none there, or no `at`, of the
+// lowest region id that has it.
 std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLayer> layers,
-                                                std::span<const weather::Region> regions);
+                                                std::span<const weather::Region> regions,
+                                                const weather::CellCentre* at = nullptr);
 
 // One layer's tiles over a covering (every cell, in the covering's order),
 // with what lets two of them be compared without reading them all: the value
