@@ -297,5 +297,74 @@ TEST(CigiConditions, TheServerRefusesABadQueryNamingTheField) {
   EXPECT_EQ(w.process->stop(), 0) << w.process->log();
 }
 
+// A GRIB2 forecast (GFS over north-east Italy) reaches the renderer through
+// the stream: its CIGI answers carry the forecast's layers, as the server's
+// point query does, inside each of them and between them.
+TEST(CigiConditions, TheRendererAnswersTheForecastsClouds) {
+  const fs::path dir = fs::path(SKY_TEST_OUTPUT_DIR) / "conditions-grib";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  Weatherd w("conditions-grib-weatherd", SKY_SCENARIO_CLEAR, false,
+             {"--grib", std::string(SKY_TEST_DATA_DIR) + "/grib/gfs-2p5deg-2011011012-f120-cloud-layers-10m-wind.grib2"});
+  ASSERT_GT(w.httpPort, 0u) << w.process->log();
+  ChildProcess render({SKY_RENDER, "--headless", "--server", "127.0.0.1:" + std::to_string(w.streamPort),
+                       "--cigi-port", "0", "--port-file", (dir / "render.port").string(), "--out",
+                       (dir / "frames").string(), "--width", "32", "--height", "18", "--no-exr",
+                       "--weather-timeout", "120"},
+                      (dir / "render.log").string(), {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
+  const unsigned cigiPort = waitForPortFile((dir / "render.port").string(), 120s);
+  ASSERT_GT(cigiPort, 0u) << render.log();
+  // Wait for the detailed area's snapshot with the forecast's tiles.
+  CigiHost host;
+  bool tiles = false;
+  for (auto until = std::chrono::steady_clock::now() + 180s; !tiles && std::chrono::steady_clock::now() < until;) {
+    host.send(cigiPort, {ownship()});
+    while (host.receive(100ms)) {
+    }
+    const std::string log = render.log();
+    const std::string snapshot = "weather snapshot of area 0: ";
+    for (std::size_t at = log.find(snapshot); at != std::string::npos; at = log.find(snapshot, at + 1)) {
+      int layers = 0, count = 0;
+      if (std::sscanf(log.c_str() + at + snapshot.size(), "%d layers, %d", &layers, &count) == 2)
+        tiles = tiles || (layers >= 5 && count > 0);  // the scenario's and the five forecast layers
+    }
+    if (!tiles) std::this_thread::sleep_for(200ms);
+  }
+  ASSERT_TRUE(tiles) << "no snapshot with the forecast's tiles:\n" << render.log();
+  const Point points[] = {
+      {"in the boundary-layer cloud", kLat, kLon, 800},   {"in the low layer", kLat, kLon, 1700},
+      {"between low and middle", kLat, kLon, 3000},       {"in the middle layer", kLat, kLon, 4500},
+      {"in the high layer", kLat, kLon, 8500},            {"above every layer", kLat, kLon, 12000},
+  };
+  int cloudy = 0;
+  for (std::size_t i = 0; i < std::size(points); ++i) {
+    const Point& p = points[i];
+    const IgAnswer ig = ask(host, cigiPort, static_cast<std::uint8_t>(40 + i), p);
+    char target[160];
+    std::snprintf(target, sizeof target, "/api/conditions?lat_deg=%.9f&lon_deg=%.9f&alt_m=%.3f", p.lat_deg, p.lon_deg,
+                  p.alt_m);
+    const auto s = nlohmann::json::parse(w.request("GET", target, "", "").body);
+    ASSERT_TRUE(ig.weather) << p.what;
+    SCOPED_TRACE(std::string(p.what) + ": server " + s.dump());
+    const double density = s["cloud_density"].get<double>();
+    cloudy += density > 0;
+    EXPECT_EQ(ig.weather->humidity_pct, density > 0 ? 100 : 50);
+    const double visibility = density > 0 ? std::min(kClearVisibility_m, 3.912 / (kExtinctionPerDensity * density))
+                                          : kClearVisibility_m;
+    EXPECT_NEAR(ig.weather->visibility_m, visibility, 1e-4 * visibility);
+    if (!s["layer_id"].is_null()) {
+      const auto layer = s["layer_id"].get<std::uint32_t>();
+      EXPECT_GE(layer, 30u);
+      EXPECT_LE(layer, 34u);
+      EXPECT_FALSE(s["forecast_sources"][std::to_string(layer)].is_null());
+    }
+    std::printf("[conditions] %-28s IG humidity %3d visibility %8.1f m | server density %.4f layer %s\n", p.what,
+                ig.weather->humidity_pct, ig.weather->visibility_m, density, s["layer_id"].dump().c_str());
+  }
+  EXPECT_GE(cloudy, 3) << "GFS has boundary-layer, low, middle and high cloud over 46.2 N 12.8 E on 2011-01-15 12Z";
+  EXPECT_EQ(render.stop(), 0) << render.log();
+  EXPECT_EQ(w.process->stop(), 0) << w.process->log();
+}
+
 }  // namespace
 }  // namespace sky::test
