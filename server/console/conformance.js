@@ -2,6 +2,8 @@
 // what its report says against what the renderers draw there (oktas per
 // layer, ceiling), and how many points of a loaded forecast's grid match
 // their grid values; rows out of tolerance first, in the warning colour.
+// And at a point: the weather there (GET /api/conditions) and where each
+// forecast layer's cover comes from (file, field, grid point).
 import { $, el, note } from "./dom.js";
 import { request } from "./api.js";
 import { fmt, ftFromM } from "./units.js";
@@ -14,6 +16,27 @@ export class ConformancePanel {
   constructor(root) {
     this.root = root;
     $("#conformance-check", root).addEventListener("click", () => this.check());
+    $("#source-form", root).addEventListener("submit", (e) => { e.preventDefault(); this.source(); });
+  }
+
+  async source() {
+    const f = (name) => Number($(`#source-form [name="${name}"]`, this.root).value);
+    const out = $("#source-result", this.root);
+    const lat = f("lat"), lon = f("lon"), alt = f("alt");
+    if (![lat, lon, alt].every(Number.isFinite) || Math.abs(lat) > 90 || Math.abs(lon) > 180) {
+      out.replaceChildren(el("li", { class: "bad" }, "latitude, longitude (degrees) and altitude (m MSL)"));
+      return;
+    }
+    const r = await request("GET", `/api/conditions?lat_deg=${lat}&lon_deg=${lon}&alt_m=${alt}`);
+    if (!r.ok) {
+      out.replaceChildren(el("li", { class: "bad" }, (r.body && r.body.error) || `HTTP ${r.status}`));
+      return;
+    }
+    const c = r.body, sources = Object.entries(c.forecast_sources || {});
+    out.replaceChildren(
+      el("li", {}, c.layer_id === null ? "clear air here" : `layer ${c.layer_id}, cloud density ${fmt(c.cloud_density, 2)}`),
+      ...(sources.length ? sources.map(([id, src]) => el("li", {}, `layer ${id}: ${src}`))
+        : [el("li", {}, "no forecast cover here (hand-made layers, regions and stations only)")]));
   }
 
   async check() {

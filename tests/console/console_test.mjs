@@ -169,6 +169,14 @@ const cases = {
     assert(/LJLJ/.test(row) && /at 427\d ft/.test(row) && /0\/8$/.test(row.trim()), `LJLJ's conformance row: ${row}`);
     assert(await a.page.getAttribute("#conformance-result tbody tr", "class") === "ok", "LJLJ within tolerance");
     assert(/1 of 1 stations/.test(await a.page.textContent("#conformance .note")), "the summary");
+    // At a point: the weather there; no forecast is loaded, so no source.
+    await a.page.fill('#source-form [name="lat"]', "46.2237");
+    await a.page.fill('#source-form [name="lon"]', "14.4576");
+    await a.page.fill('#source-form [name="alt"]', "1400");
+    await a.page.click("#source-ask");
+    await until("the point's answer", async () => (await a.page.$$("#source-result li")).length === 2);
+    const answer = await a.page.textContent("#source-result");
+    assert(/layer \d+, cloud density/.test(answer) && /no forecast cover here/.test(answer), `the point's answer: ${answer}`);
     noProblems(a.problems);
   },
 
