@@ -4,24 +4,11 @@
 #include <cmath>
 #include <string>
 
+#include "query_number.hpp"
 #include "sky/server/conditions_api.hpp"
 
 namespace sky::server {
 
-namespace {
-
-Result<double> number(std::string_view key, std::string_view v, double lo, double hi) {
-  double x = 0;
-  const auto [end, err] = std::from_chars(v.data(), v.data() + v.size(), x);
-  if (v.empty() || err != std::errc() || end != v.data() + v.size() || !std::isfinite(x))
-    return fail(ErrorCode::Malformed, std::string(key) + ": '" + std::string(v) + "' is not a number");
-  if (x < lo || x > hi)
-    return fail(ErrorCode::InvalidArgument, std::string(key) + ": " + std::string(v) + " is not in [" +
-                                                std::to_string(lo) + ", " + std::to_string(hi) + "]");
-  return x;
-}
-
-}  // namespace
 
 Result<ConditionsQuery> parseConditionsQuery(std::string_view query) {
   ConditionsQuery q;
@@ -44,19 +31,19 @@ Result<ConditionsQuery> parseConditionsQuery(std::string_view query) {
     Result<double> v = 0.0;
     if (key == "lat_deg") {
       if (auto r = once(lat); !r) return tl::unexpected(r.error());
-      if (!(v = number(key, value, -90, 90))) return tl::unexpected(v.error());
+      if (!(v = queryNumber(key, value, -90, 90))) return tl::unexpected(v.error());
       q.lat_deg = *v;
     } else if (key == "lon_deg") {
       if (auto r = once(lon); !r) return tl::unexpected(r.error());
-      if (!(v = number(key, value, -180, 180))) return tl::unexpected(v.error());
+      if (!(v = queryNumber(key, value, -180, 180))) return tl::unexpected(v.error());
       q.lon_deg = *v;
     } else if (key == "alt_m") {
       if (auto r = once(alt); !r) return tl::unexpected(r.error());
-      if (!(v = number(key, value, -1000, 100000))) return tl::unexpected(v.error());
+      if (!(v = queryNumber(key, value, -1000, 100000))) return tl::unexpected(v.error());
       q.alt_m = *v;
     } else if (key == "level") {
       if (auto r = once(level); !r) return tl::unexpected(r.error());
-      if (!(v = number(key, value, 0, kMaxConditionsLevel))) return tl::unexpected(v.error());
+      if (!(v = queryNumber(key, value, 0, kMaxConditionsLevel))) return tl::unexpected(v.error());
       if (*v != std::floor(*v)) return fail(ErrorCode::InvalidArgument, "level: '" + std::string(value) + "' is not an integer");
       q.level = static_cast<int>(*v);
     } else {

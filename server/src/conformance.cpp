@@ -1,8 +1,10 @@
 // GET /api/conformance (see conformance.hpp).
 #include "sky/server/conformance.hpp"
 
+#include "query_number.hpp"
+#include "sky/geo/geodetic.hpp"
+
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <map>
 #include <set>
@@ -17,26 +19,6 @@
 namespace sky::server {
 
 namespace {
-
-constexpr double kMeanEarthRadius_m = 6371008.8;
-
-double distance_m(double lat1, double lon1, double lat2, double lon2) {
-  constexpr double k = 3.14159265358979323846 / 180;
-  const double s1 = std::sin((lat2 - lat1) * k / 2), s2 = std::sin((lon2 - lon1) * k / 2);
-  const double h = s1 * s1 + std::cos(lat1 * k) * std::cos(lat2 * k) * s2 * s2;
-  return 2 * kMeanEarthRadius_m * std::asin(std::min(1.0, std::sqrt(h)));
-}
-
-Result<double> number(std::string_view key, std::string_view v, double lo, double hi) {
-  double x = 0;
-  const auto [end, err] = std::from_chars(v.data(), v.data() + v.size(), x);
-  if (v.empty() || err != std::errc() || end != v.data() + v.size() || !std::isfinite(x))
-    return fail(ErrorCode::Malformed, std::string(key) + ": '" + std::string(v) + "' is not a number");
-  if (x < lo || x > hi)
-    return fail(ErrorCode::InvalidArgument, std::string(key) + ": " + std::string(v) + " is not in [" +
-                                                std::to_string(lo) + ", " + std::to_string(hi) + "]");
-  return x;
-}
 
 struct Layer {
   std::uint32_t id = 0;
@@ -81,19 +63,19 @@ Result<ConformanceQuery> parseConformanceQuery(std::string_view query) {
     if (!seen.insert(key).second) return fail(ErrorCode::InvalidArgument, std::string(key) + ": given twice");
     Result<double> v = 0.0;
     if (key == "stations") {
-      if (!(v = number(key, value, 0, 10000))) return tl::unexpected(v.error());
+      if (!(v = queryNumber(key, value, 0, 10000))) return tl::unexpected(v.error());
       q.maxStations = static_cast<std::size_t>(*v);
     } else if (key == "grid_points") {
-      if (!(v = number(key, value, 0, 2000))) return tl::unexpected(v.error());
+      if (!(v = queryNumber(key, value, 0, 2000))) return tl::unexpected(v.error());
       q.gridPoints = static_cast<std::size_t>(*v);
     } else if (key == "lat_deg") {
-      if (!(v = number(key, value, -90, 90))) return tl::unexpected(v.error());
+      if (!(v = queryNumber(key, value, -90, 90))) return tl::unexpected(v.error());
       q.lat_deg = *v;
     } else if (key == "lon_deg") {
-      if (!(v = number(key, value, -180, 180))) return tl::unexpected(v.error());
+      if (!(v = queryNumber(key, value, -180, 180))) return tl::unexpected(v.error());
       q.lon_deg = *v;
     } else if (key == "radius_m") {
-      if (!(v = number(key, value, 1, 2e7))) return tl::unexpected(v.error());
+      if (!(v = queryNumber(key, value, 1, 2e7))) return tl::unexpected(v.error());
       q.radius_m = *v;
     } else {
       return fail(ErrorCode::InvalidArgument, "query: unknown key '" + std::string(key) + "'");
@@ -112,7 +94,7 @@ nlohmann::json conformanceJson(const LiveWeather& weather, std::span<const Stati
   const std::vector<weather::CloudLayer> table = snapshotLayers(globals, regions);
   const auto field = weather.fieldAt(clock_s);
   auto inArea = [&](double lat, double lon) {
-    return !q.lat_deg || distance_m(*q.lat_deg, *q.lon_deg, lat, lon) <= q.radius_m;
+    return !q.lat_deg || geo::geodesicDistance_m(*q.lat_deg, *q.lon_deg, lat, lon) <= q.radius_m;
   };
 
   // The points: station regions, then forecast grid points.

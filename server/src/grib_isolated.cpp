@@ -29,8 +29,10 @@ namespace sky::server {
 
 namespace {
 
-// Bytes of one record's JSON: a field's metadata is a few hundred.
-constexpr std::uint32_t kMaxRecordJson = 64 * 1024;
+// Bytes of one record's JSON: a field's metadata is a few hundred (names
+// are read into 256-byte buffers), a skip's reason is cut to kMaxReason.
+constexpr std::uint32_t kMaxRecordJson = 4 * 1024;
+constexpr std::size_t kMaxReason = 300;
 // What a decoder may spend on one file: CPU seconds (its own limit, so a
 // decoder looping in ecCodes ends even if the parent is gone).
 constexpr rlim_t kDecoderCpu_s = 300;
@@ -127,7 +129,7 @@ class Writer {
     return true;
   }
   bool tagged(char tag, const json& j) {
-    const std::string s = j.dump();
+    const std::string s = j.dump(-1, ' ', false, json::error_handler_t::replace);  // a cut reason stays valid
     const auto n = static_cast<std::uint32_t>(s.size());
     return put(&tag, 1) && put(&n, 4) && put(s.data(), s.size());
   }
@@ -297,7 +299,7 @@ Result<DecoderOutput> parseDecoderOutput(std::span<const std::byte> bytes, const
       auto j = r.getJson();
       if (!j || !j->contains("reason") || !(*j)["reason"].is_string()) return bad("a skip record");
       into.skipped.push_back({j->value("message", std::size_t{0}), j->value("field", std::size_t{0}),
-                              (*j)["reason"].get<std::string>().substr(0, 1000)});
+                              (*j)["reason"].get<std::string>().substr(0, kMaxReason)});
     } else if (tag == 'N') {
       std::uint64_t field = 0;
       if (!r.get(field)) return bad("a field's end");
@@ -381,10 +383,11 @@ int runGribDecoder(const std::filesystem::path& file, std::size_t firstFieldInde
     bool ok = true;
     if (!r && r.error().code == ErrorCode::TooLarge) return fatal(r.error());
     if (!r) {
-      ok = w.tagged('S', {{"message", span.message}, {"field", span.field}, {"reason", r.error().detail}});
+      ok = w.tagged('S', {{"message", span.message}, {"field", span.field},
+                          {"reason", r.error().detail.substr(0, kMaxReason)}});
     } else if (*r) {
       const GribField& f = **r;
-      const std::string s = metaJson(f.meta).dump();
+      const std::string s = metaJson(f.meta).dump(-1, ' ', false, json::error_handler_t::replace);
       const auto len = static_cast<std::uint32_t>(s.size());
       const std::uint64_t count = f.values.size();
       ok = w.put("F", 1) && w.put(&len, 4) && w.put(s.data(), s.size()) && w.put(&count, 8) &&

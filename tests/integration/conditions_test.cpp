@@ -149,6 +149,36 @@ IgAnswer ask(CigiHost& host, unsigned port, std::uint8_t id, const Point& p) {
   return {};
 }
 
+// skyshell-render headless on the weather server, taking CIGI on a port of
+// its own (its log in dir/render.log).
+ChildProcess startRenderer(const fs::path& dir, unsigned streamPort) {
+  return ChildProcess({SKY_RENDER, "--headless", "--server", "127.0.0.1:" + std::to_string(streamPort), "--cigi-port",
+                       "0", "--port-file", (dir / "render.port").string(), "--out", (dir / "frames").string(),
+                       "--width", "32", "--height", "18", "--no-exr", "--weather-timeout", "120"},
+                      (dir / "render.log").string(), {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
+}
+
+// Flies the ownship until the renderer logs a snapshot of its detailed area
+// (area 0) that `wanted(layers, tiles)` accepts; false after 180 s.
+template <class Wanted>
+bool waitForSnapshot(ChildProcess& render, CigiHost& host, unsigned cigiPort, Wanted wanted) {
+  const std::string snapshot = "weather snapshot of area 0: ";
+  for (auto until = std::chrono::steady_clock::now() + 180s; std::chrono::steady_clock::now() < until;) {
+    host.send(cigiPort, {ownship()});
+    while (host.receive(100ms)) {
+    }
+    const std::string log = render.log();
+    for (std::size_t at = log.find(snapshot); at != std::string::npos; at = log.find(snapshot, at + 1)) {
+      int layers = 0, tiles = 0;
+      if (std::sscanf(log.c_str() + at + snapshot.size(), "%d layers, %d", &layers, &tiles) == 2 &&
+          wanted(layers, tiles))
+        return true;
+    }
+    std::this_thread::sleep_for(200ms);
+  }
+  return false;
+}
+
 double angleBetween_deg(double a, double b) {
   const double d = std::fmod(std::abs(a - b), 360.0);
   return std::min(d, 360.0 - d);
@@ -172,29 +202,14 @@ TEST(CigiConditions, TheRendererAnswersWhatTheServerSaysAtThePoint) {
                   "wind": {"speed_mps": 10, "from_deg": 270, "vertical_mps": 0.5}}]}}]})");
   ASSERT_EQ(posted.status, 200) << posted.body;
 
-  ChildProcess render({SKY_RENDER, "--headless", "--server", "127.0.0.1:" + std::to_string(w.streamPort),
-                       "--cigi-port", "0", "--port-file", (dir / "render.port").string(), "--out",
-                       (dir / "frames").string(), "--width", "32", "--height", "18", "--no-exr",
-                       "--weather-timeout", "120"},
-                      (dir / "render.log").string(), {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
+  ChildProcess render = startRenderer(dir, w.streamPort);
   const unsigned cigiPort = waitForPortFile((dir / "render.port").string(), 120s);
   ASSERT_GT(cigiPort, 0u) << render.log();
 
   // The ownship's pose makes the renderer subscribe around it: wait for the
   // snapshot with the region's tiles before asking.
   CigiHost host;
-  bool tiles = false;
-  for (auto until = std::chrono::steady_clock::now() + 180s; !tiles && std::chrono::steady_clock::now() < until;) {
-    host.send(cigiPort, {ownship()});
-    while (host.receive(100ms)) {
-    }
-    const std::string log = render.log();
-    // The detailed area's snapshot (area 0): the one the conditions come from.
-    const std::string snapshot = "weather snapshot of area 0: ", none = snapshot + "2 layers, 0 ";
-    for (std::size_t at = log.find(snapshot); at != std::string::npos; at = log.find(snapshot, at + 1))
-      tiles = tiles || log.compare(at, none.size(), none) != 0;
-    if (!tiles) std::this_thread::sleep_for(200ms);
-  }
+  const bool tiles = waitForSnapshot(render, host, cigiPort, [](int, int count) { return count > 0; });
   ASSERT_TRUE(tiles) << "no snapshot with tiles:\n" << render.log();
 
   const double kmLat = 1.0 / 111.2, kmLon = 1.0 / (111.2 * std::cos(kLat * M_PI / 180));
@@ -307,29 +322,14 @@ TEST(CigiConditions, TheRendererAnswersTheForecastsClouds) {
   Weatherd w("conditions-grib-weatherd", SKY_SCENARIO_CLEAR, false,
              {"--grib", std::string(SKY_TEST_DATA_DIR) + "/grib/gfs-2p5deg-2011011012-f120-cloud-layers-10m-wind.grib2"});
   ASSERT_GT(w.httpPort, 0u) << w.process->log();
-  ChildProcess render({SKY_RENDER, "--headless", "--server", "127.0.0.1:" + std::to_string(w.streamPort),
-                       "--cigi-port", "0", "--port-file", (dir / "render.port").string(), "--out",
-                       (dir / "frames").string(), "--width", "32", "--height", "18", "--no-exr",
-                       "--weather-timeout", "120"},
-                      (dir / "render.log").string(), {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
+  ChildProcess render = startRenderer(dir, w.streamPort);
   const unsigned cigiPort = waitForPortFile((dir / "render.port").string(), 120s);
   ASSERT_GT(cigiPort, 0u) << render.log();
-  // Wait for the detailed area's snapshot with the forecast's tiles.
+  // Wait for the detailed area's snapshot with the forecast's tiles (the
+  // scenario's layer and the five forecast layers).
   CigiHost host;
-  bool tiles = false;
-  for (auto until = std::chrono::steady_clock::now() + 180s; !tiles && std::chrono::steady_clock::now() < until;) {
-    host.send(cigiPort, {ownship()});
-    while (host.receive(100ms)) {
-    }
-    const std::string log = render.log();
-    const std::string snapshot = "weather snapshot of area 0: ";
-    for (std::size_t at = log.find(snapshot); at != std::string::npos; at = log.find(snapshot, at + 1)) {
-      int layers = 0, count = 0;
-      if (std::sscanf(log.c_str() + at + snapshot.size(), "%d layers, %d", &layers, &count) == 2)
-        tiles = tiles || (layers >= 5 && count > 0);  // the scenario's and the five forecast layers
-    }
-    if (!tiles) std::this_thread::sleep_for(200ms);
-  }
+  const bool tiles =
+      waitForSnapshot(render, host, cigiPort, [](int layers, int count) { return layers >= 5 && count > 0; });
   ASSERT_TRUE(tiles) << "no snapshot with the forecast's tiles:\n" << render.log();
   const Point points[] = {
       {"in the boundary-layer cloud", kLat, kLon, 800},   {"in the low layer", kLat, kLon, 1700},
