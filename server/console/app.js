@@ -2,7 +2,7 @@
 // the panels, keeps the token for the tab's session, and turns the page
 // read-only without it. Served by skyshell-weatherd at / (README, "The
 // operator console").
-import { LiveLink, postChanges, session } from "./api.js";
+import { LiveLink, postChanges, request, session } from "./api.js";
 import { ClockPanel } from "./clock.js";
 import { layerIds } from "./coverage.js";
 import { $, $$, note, showErrors } from "./dom.js";
@@ -16,8 +16,11 @@ import { fmt, keyOfServerError, num } from "./units.js";
 
 const VIEW_KEY = "skyshell.view";
 // Where the map looks before anything says better: the bundled demo's area
-// (north-east Italy), 250 m per pixel.
-const DEFAULT_VIEW = { lat_deg: 46.0, lon_deg: 13.0, scale_mpp: 250 };
+// (north-east Italy), Leaflet zoom 8.75 (about 250 m per pixel there).
+const DEFAULT_VIEW = { lat_deg: 46.0, lon_deg: 13.0, zoom: 8.75 };
+// Web Mercator's metres per pixel at the equator at zoom 0 (2 pi 6378137 m /
+// 256 px): turns an old "scale" (m per px at the focus) into a zoom.
+const MERCATOR_MPP_AT_ZOOM0 = 156543.03392804097;
 
 const app = {
   stateValue: null,
@@ -37,12 +40,13 @@ const app = {
   canEdit() { return session.token() !== ""; },
   allLayerIds() { return layerIds(this.state()); },
   redraw() { map.redraw(); },
+  stationsChanged() { refreshStations(); },
   onSelect(id) { setOverlay(id); },
   tokenRefused() {
     session.setToken("");
     updateEditable();
   },
-  changed() { link.refreshState(); },
+  changed() { link.refreshState(); refreshStations(); },
 
   // Sends one batch. The server applies all of it or none; a refusal lands
   // next to the field it names (keys: API key -> the form's field).
@@ -89,14 +93,22 @@ const map = new MapView($("#map"), {
   reshape: (shape) => regions.reshape(shape),
   pick: (id) => regions.edit(id),
   cursor: (text) => { $("#map-cursor").textContent = text; },
-  view: (focus, scale) => {
+  view: (focus, zoom) => {
     $('[name="focus_lat"]').value = fmt(focus.lat_deg, 4);
     $('[name="focus_lon"]').value = fmt(focus.lon_deg, 4);
     $("#map").dataset.focus = `${focus.lat_deg},${focus.lon_deg}`;
-    $("#map").dataset.scale = String(scale);
+    $("#map").dataset.zoom = String(zoom);
+    // The view in this browser and in the address (a link shows the same place).
     clearTimeout(app.saveView);
-    app.saveView = setTimeout(() => localStorage.setItem(VIEW_KEY,
-      JSON.stringify({ lat_deg: focus.lat_deg, lon_deg: focus.lon_deg, scale_mpp: scale })), 500);
+    app.saveView = setTimeout(() => {
+      localStorage.setItem(VIEW_KEY, JSON.stringify({ lat_deg: focus.lat_deg, lon_deg: focus.lon_deg, zoom }));
+      history.replaceState(null, "", `#focus=${fmt(focus.lat_deg, 5)},${fmt(focus.lon_deg, 5)}&zoom=${zoom}`);
+    }, 500);
+  },
+  // The Natural Earth ground loaded (null) or not (why).
+  basemap: (error) => {
+    $("#map").dataset.basemap = error ? "failed" : "loaded";
+    if (error) $("#map-hint").textContent = `coastlines not loaded: ${error}`;
   },
 });
 
@@ -178,6 +190,10 @@ const link = new LiveLink({
     document.body.dataset.sequence = String(s.sequence);
     updateOverlayChoices(s);
     layers.render(s);
+    if (stationRegionsOf(s) !== stationRegions) {
+      stationRegions = stationRegionsOf(s);
+      refreshStations();
+    }
     autoFocus();
     map.redraw();
   },
@@ -223,30 +239,54 @@ $("#focus-form").addEventListener("submit", (e) => {
   app.viewChosen = true;
   map.setView(lat, lon);
 });
-$("#zoom-in").addEventListener("click", () => map.setView(map.focus.lat_deg, map.focus.lon_deg, map.scale_mpp / 1.6));
-$("#zoom-out").addEventListener("click", () => map.setView(map.focus.lat_deg, map.focus.lon_deg, map.scale_mpp * 1.6));
+$("#zoom-in").addEventListener("click", () => map.zoomBy(1));
+$("#zoom-out").addEventListener("click", () => map.zoomBy(-1));
+$("#show-land").addEventListener("change", (e) => map.base.show("land", e.target.checked));
+$("#show-borders").addEventListener("change", (e) => map.base.show("borders", e.target.checked));
+$("#show-stations").addEventListener("change", (e) => map.stations.show(e.target.checked));
 
-// The view: from the URL (#focus=46.1,13.2&scale=200), else the last one
-// this browser used, else the default until a region or renderer appears.
+// The METAR stations and their latest reports: asked again after an apply
+// and whenever the set of station regions (ids 40000-65535) changes.
+let stationRegions = null;
+async function refreshStations() {
+  const r = await request("GET", "/api/metar/stations");
+  if (r.ok) map.stations.update(r.body.stations);
+}
+function stationRegionsOf(state) {
+  return state.regions.filter((x) => x.id >= 40000).map((x) => x.id).join(",");
+}
+
+// A zoom from a view that names one, or from an older console's scale (m
+// per CSS px at the focus); NaN when it names neither.
+function zoomOf(v, lat_deg) {
+  if (Number.isFinite(v.zoom)) return v.zoom;
+  if (v.scale_mpp > 0) return Math.log2((MERCATOR_MPP_AT_ZOOM0 * Math.cos((lat_deg * Math.PI) / 180)) / v.scale_mpp);
+  return NaN;
+}
+
+// The view: from the URL (#focus=46.1,13.2&zoom=9), else the last one this
+// browser used, else the default until a region or renderer appears.
 function initialView() {
   const hash = new URLSearchParams(location.hash.slice(1));
   const focus = (hash.get("focus") || "").split(",").map(Number);
   if (focus.length === 2 && focus.every(Number.isFinite)) {
     app.viewChosen = true;
-    return { lat_deg: focus[0], lon_deg: focus[1], scale_mpp: Number(hash.get("scale")) || DEFAULT_VIEW.scale_mpp };
+    const zoom = zoomOf({ zoom: hash.has("zoom") ? Number(hash.get("zoom")) : NaN,
+      scale_mpp: Number(hash.get("scale")) }, focus[0]);
+    return { lat_deg: focus[0], lon_deg: focus[1], zoom: Number.isFinite(zoom) ? zoom : DEFAULT_VIEW.zoom };
   }
   try {
     const saved = JSON.parse(localStorage.getItem(VIEW_KEY) || "null");
-    if (saved && Number.isFinite(saved.lat_deg)) {
+    if (saved && Number.isFinite(saved.lat_deg) && Number.isFinite(zoomOf(saved, saved.lat_deg))) {
       app.viewChosen = true;
-      return saved;
+      return { ...saved, zoom: zoomOf(saved, saved.lat_deg) };
     }
   } catch { /* a damaged saved view: use the default */ }
   return DEFAULT_VIEW;
 }
 
 const view = initialView();
-map.setView(view.lat_deg, view.lon_deg, view.scale_mpp);
+map.setView(view.lat_deg, view.lon_deg, view.zoom);
 setMode("pan");
 updateEditable();
 renderRenderers($("#renderers"), []);

@@ -1,351 +1,331 @@
-// The console's map: a canvas drawn here, no tiles. An azimuthal equidistant
-// view about a focus point (north up at the focus) with a graticule, the
-// selected layer's coverage as a translucent overlay, its wind as arrows,
-// every region's edge and transition perimeter, the region tool's draft with
-// its handles, and each connected renderer as an aircraft at its camera
-// position and heading. Drag pans, the wheel zooms; in a placing mode a click
-// (or a drag, for its size) puts a storm cell or a clearing there.
+// The console's map, on Leaflet (leaflet.js, loaded by index.html as
+// window.L): Web Mercator with north up, Natural Earth land, coastlines and
+// borders (basemap.js), a graticule, the selected layer's coverage and wind
+// on a canvas overlay, every region's edge and transition perimeter, the
+// region tool's draft with its size and perimeter handles, the METAR
+// stations coloured by flight category (stations.js), and each connected
+// renderer as an aircraft at its camera position and heading. Leaflet pans
+// and zooms; in a placing mode a click (or a press and drag, for its size)
+// puts a storm cell or a clearing there.
+//
+// Longitudes: Leaflet draws a longitude where it is numerically, so every
+// shape is given longitudes continuous along it and within 180 degrees of
+// the view's centre (a region across the antimeridian is one shape, on the
+// side the operator looks at). Latitudes beyond Web Mercator's 85.05 degrees
+// are drawn at that edge (Leaflet clamps them), and said so.
+import { BaseMap } from "./basemap.js";
 import { coverageAt, regionEdgeDistance_m, regionOutline, regionPoint, regionWeight } from "./coverage.js";
-import { direct, Projection } from "./geo.js";
+import { direct, inverse, normalizeLon } from "./geo.js";
+import { StationLayer } from "./stations.js";
 import { fmt, ftFromM } from "./units.js";
+
+const L = window.L;
 
 // Coverage is sampled on a grid this coarse (CSS px) and smoothed up: the
 // field varies over kilometres, and 6 px keeps a redraw near 10 ms.
 const COVERAGE_CELL_PX = 6;
 // Spacing of the wind arrows (CSS px).
 const ARROW_SPACING_PX = 90;
-// Zoom limits (metres per CSS pixel): 5 m/px shows a few km, 20 km/px a hemisphere.
-const MIN_SCALE_MPP = 5, MAX_SCALE_MPP = 20000;
+// Zoom limits: at 2 the world is 1024 px wide; at 15 a pixel is about 3 m at 46 N.
+export const MIN_ZOOM = 2, MAX_ZOOM = 15;
+// The view holds quarter levels; the wheel and the +/- buttons move by half.
+const ZOOM_SNAP = 0.25, ZOOM_DELTA = 0.5;
 // A press that moves less than this is a click, not a drag (CSS px).
 const CLICK_SLOP_PX = 4;
-// Handles are grabbed within this distance (CSS px).
-const HANDLE_GRAB_PX = 9;
 // A renderer whose last report is older than this is drawn as stale.
 const STALE_AFTER_S = 5;
 // Least distance between two longitude labels (CSS px): "12.45°" is ~40 px wide.
 const LABEL_GAP_PX = 56;
 // Graticule spacings to choose from (degrees).
 const GRID_STEPS_DEG = [0.01, 0.02, 0.05, 0.1, 0.2, 0.25, 0.5, 1, 2, 5, 10, 15, 30];
+// Web Mercator's latitude limit (Leaflet's SphericalMercator.MAX_LATITUDE).
+const MERCATOR_MAX_LAT_DEG = 85.0511287798;
+// Panes above Leaflet's tile pane (200) and below its marker pane (600): the
+// ground, then coverage, wind and graticule, then the regions' outlines.
+const PANES = [["basemap", 250], ["coverage", 350], ["regions", 420]];
+// The region ids the server gives METAR stations (server/API.md, POST /api/metar).
+const METAR_REGION_IDS = [40000, 65535];
+// How far inside the map's edge a symbol beyond it is drawn (CSS px): half
+// the aircraft symbol.
+const EDGE_INSET_PX = 12;
+// One nautical mile (m), for the scale bar's second line.
+const NAUTICAL_MILE_M = 1852;
+
+// A longitude moved by whole turns to within 180 degrees of `ref_deg`.
+const near = (lon_deg, ref_deg) => ref_deg + normalizeLon(lon_deg - ref_deg);
+
+// Points (lat, lon) as Leaflet LatLngs with continuous longitudes, the first
+// within 180 degrees of ref_deg.
+function continuous(points, ref_deg) {
+  let prev = ref_deg;
+  return points.map((p) => {
+    prev = near(p.lon_deg, prev);
+    return L.latLng(p.lat_deg, prev);
+  });
+}
+
+// The scale bar in kilometres and nautical miles (Leaflet's control, with
+// its imperial line reading NM instead of miles).
+const NauticalScale = L.Control.Scale.extend({
+  _updateImperial(maxMeters) {
+    const nm = maxMeters / NAUTICAL_MILE_M;
+    const round = this._getRoundNum(nm);
+    this._updateScale(this._iScale, `${round} NM`, round / nm);
+  },
+});
+
+// A canvas over the whole view, redrawn by `draw(ctx, width, height)` after
+// each move or zoom (hidden while a zoom animates).
+const CanvasOverlay = L.Layer.extend({
+  initialize(draw, pane) {
+    this.draw = draw;
+    this.options.pane = pane;
+  },
+  onAdd(map) {
+    this.canvas = L.DomUtil.create("canvas", "sky-overlay leaflet-zoom-hide");
+    this.getPane().appendChild(this.canvas);
+    map.on("moveend zoomend resize viewreset", this.redraw, this);
+    this.redraw();
+  },
+  onRemove(map) {
+    L.DomUtil.remove(this.canvas);
+    map.off("moveend zoomend resize viewreset", this.redraw, this);
+  },
+  redraw() {
+    if (!this._map) return;
+    const size = this._map.getSize();
+    const dpr = window.devicePixelRatio || 1;
+    L.DomUtil.setPosition(this.canvas, this._map.containerPointToLayerPoint([0, 0]));
+    if (this.canvas.width !== Math.round(size.x * dpr) || this.canvas.height !== Math.round(size.y * dpr)) {
+      this.canvas.width = Math.round(size.x * dpr);
+      this.canvas.height = Math.round(size.y * dpr);
+      this.canvas.style.width = `${size.x}px`;
+      this.canvas.style.height = `${size.y}px`;
+    }
+    const g = this.canvas.getContext("2d");
+    g.setTransform(dpr, 0, 0, dpr, 0, 0);
+    g.clearRect(0, 0, size.x, size.y);
+    this.draw(g, size.x, size.y);
+  },
+});
+
+// The aircraft symbol, nose up (24 x 24 px): fuselage, wings, tail.
+const AIRCRAFT_PATH = "M12 1 L14 8 L23 13 L23 15 L14 13 L13.5 19 L17 22 L17 23.5 L12 22 L7 23.5 L7 22 L10.5 19 " +
+  "L10 13 L1 15 L1 13 L10 8 Z";
+
+function aircraftElement() {
+  const root = document.createElement("div");
+  root.className = "aircraft";
+  const svg = document.createElementNS("http://www.w3.org/2000/svg", "svg");
+  svg.setAttribute("viewBox", "0 0 24 24");
+  svg.setAttribute("width", "24");
+  svg.setAttribute("height", "24");
+  const path = document.createElementNS("http://www.w3.org/2000/svg", "path");
+  path.setAttribute("d", AIRCRAFT_PATH);
+  svg.append(path);
+  const label = document.createElement("span");
+  label.className = "aircraft-label";
+  root.append(svg, label);
+  return root;
+}
 
 export class MapView {
-  // data: {state(), renderers(), draft(), selectedLayer(), selectedRegion(), canEdit()}
-  // on: {place(kind, lat, lon, half_m), placed(), reshape(shape), pick(regionId), cursor(text),
-  //      view(focus, scale)}
-  constructor(canvas, data, on) {
-    Object.assign(this, { canvas, data, on });
-    this.ctx = canvas.getContext("2d");
-    this.focus = { lat_deg: 46.0, lon_deg: 13.0 };
-    this.scale_mpp = 250;
-    this.mode = "pan";  // "pan", "storm", "clearing"
-    this.proj = new Projection(this.focus.lat_deg, this.focus.lon_deg);
-    this.coverageKey = null;
-    this.coverageCanvas = document.createElement("canvas");
-    this.dirty = true;
-    this.drag = null;
-    new ResizeObserver(() => this.resize()).observe(canvas);
-    canvas.addEventListener("pointerdown", (e) => this.pointerDown(e));
-    canvas.addEventListener("pointermove", (e) => this.pointerMove(e));
-    canvas.addEventListener("pointerup", (e) => this.pointerUp(e));
-    canvas.addEventListener("pointercancel", () => { this.drag = null; });
-    canvas.addEventListener("pointerleave", () => this.on.cursor(""));
-    canvas.addEventListener("wheel", (e) => this.wheel(e), { passive: false });
-    this.resize();
-    const frame = () => {
-      if (this.dirty) this.draw();
-      requestAnimationFrame(frame);
-    };
-    requestAnimationFrame(frame);
+  // container: the map's element. data: {state(), renderers(), draft(),
+  // selectedLayer(), selectedRegion(), canEdit()}. on: {place, placed,
+  // reshape, pick, cursor, view, basemap}.
+  constructor(container, data, on) {
+    this.container = container;
+    this.data = data;
+    this.on = on;
+    this.mode = "pan";
+    this.focus = { lat_deg: 0, lon_deg: 0 };
+    this.zoom = MIN_ZOOM;
+    const map = L.map(container, {
+      zoomControl: false, worldCopyJump: true, minZoom: MIN_ZOOM, maxZoom: MAX_ZOOM, zoomSnap: ZOOM_SNAP,
+      zoomDelta: ZOOM_DELTA, wheelPxPerZoomLevel: 120, boxZoom: false,
+      // Nothing outside the world's latitudes: Web Mercator ends at 85.05 degrees.
+      maxBounds: [[-90, -1e6], [90, 1e6]], maxBoundsViscosity: 1,
+    });
+    this.map = map;
+    map.attributionControl.setPrefix("Leaflet");
+    map.attributionControl.addAttribution("Natural Earth");
+    new NauticalScale({ metric: true, imperial: true, position: "bottomleft", maxWidth: 140 }).addTo(map);
+    for (const [name, z] of PANES) map.createPane(name).style.zIndex = String(z);
+    this.regionRenderer = L.svg({ pane: "regions", padding: 0.5 });
+    this.base = new BaseMap(map, "basemap");
+    this.base.load().then(() => this.on.basemap(null), (e) => this.on.basemap(String(e.message || e)));
+    this.overlay = new CanvasOverlay((g, w, h) => this.drawOverlay(g, w, h), "coverage").addTo(map);
+    this.regionGroup = L.layerGroup().addTo(map);
+    this.draftGroup = L.layerGroup().addTo(map);
+    this.rendererGroup = L.layerGroup().addTo(map);
+    this.stations = new StationLayer(map);
+    this.aircraft = new Map();  // renderer id -> {marker, ring}
+    this.handleMarkers = {};    // kind -> L.Marker
+    this.regionKey = "";
+    this.place = null;
+    this.swallowClick = false;
+    this.handleDrag = null;
+    // The container's size follows the page's layout (panels filling in, a
+    // narrower window): Leaflet must know, or its centre is not the middle.
+    new ResizeObserver(() => map.invalidateSize({ animate: false })).observe(container);
+    map.on("moveend", () => this.moved());
+    map.on("zoomend", () => container.classList.toggle("zoomed-out", map.getZoom() < 6));
+    map.on("mousedown", (e) => this.pressed(e));
+    map.on("mousemove", (e) => this.pointerMoved(e));
+    map.on("mouseup", (e) => this.released(e));
+    map.on("click", (e) => this.clicked(e));
   }
 
-  redraw() { this.dirty = true; }
+  // Centre (degrees) and zoom; zoom kept when not given.
+  setView(lat_deg, lon_deg, zoom = this.map.getZoom()) {
+    const lat = Math.max(-MERCATOR_MAX_LAT_DEG, Math.min(MERCATOR_MAX_LAT_DEG, lat_deg));
+    this.map.setView([lat, normalizeLon(lon_deg)], Math.max(MIN_ZOOM, Math.min(MAX_ZOOM, zoom)), { animate: false });
+    this.moved();
+  }
 
-  setView(lat_deg, lon_deg, scale_mpp = this.scale_mpp) {
-    this.focus = { lat_deg: Math.max(-89.9, Math.min(89.9, lat_deg)), lon_deg };
-    this.scale_mpp = Math.max(MIN_SCALE_MPP, Math.min(MAX_SCALE_MPP, scale_mpp));
-    this.proj = new Projection(this.focus.lat_deg, this.focus.lon_deg);
-    this.on.view(this.focus, this.scale_mpp);
-    this.redraw();
+  zoomBy(delta) {
+    this.map.setZoom(this.map.getZoom() + delta);
   }
 
   setMode(mode) {
     this.mode = mode;
-    this.canvas.dataset.mode = mode;
-    this.redraw();
+    this.container.dataset.mode = mode;
+    const placing = mode !== "pan";
+    for (const h of [this.map.dragging, this.map.doubleClickZoom]) placing ? h.disable() : h.enable();
   }
 
-  resize() {
-    const r = this.canvas.getBoundingClientRect();
-    this.w = Math.max(1, r.width);
-    this.h = Math.max(1, r.height);
-    const dpr = window.devicePixelRatio || 1;
-    this.canvas.width = Math.round(this.w * dpr);
-    this.canvas.height = Math.round(this.h * dpr);
-    this.ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
-    this.coverageKey = null;
-    this.redraw();
-  }
-
-  // Screen (CSS px from the canvas's top left) <-> surface.
-  toScreen(lat_deg, lon_deg) {
-    const { x_m, y_m } = this.proj.forward(lat_deg, lon_deg);
-    return { x: this.w / 2 + x_m / this.scale_mpp, y: this.h / 2 - y_m / this.scale_mpp };
-  }
-  toSurface(x, y) {
-    return this.proj.inverse((x - this.w / 2) * this.scale_mpp, (this.h / 2 - y) * this.scale_mpp);
-  }
-  eventPoint(e) {
-    const r = this.canvas.getBoundingClientRect();
-    return { x: e.clientX - r.left, y: e.clientY - r.top };
-  }
-
-  // ---- interaction ----
-
-  handles() {
-    const d = this.data.draft();
-    if (!d || !(d.size_x_m > 0) || !this.data.canEdit()) return [];
-    const edge = regionPoint(d, d.size_x_m / 2, 0);
-    const outer = regionPoint(d, d.size_x_m / 2 + Math.max(0, d.transition_m || 0), 0);
-    return [
-      { kind: "size", ...this.toScreen(edge.lat_deg, edge.lon_deg) },
-      { kind: "transition", ...this.toScreen(outer.lat_deg, outer.lon_deg) },
-    ];
-  }
-
-  pointerDown(e) {
-    const p = this.eventPoint(e);
-    this.canvas.setPointerCapture(e.pointerId);
-    const handle = this.handles().find((h) => Math.hypot(h.x - p.x, h.y - p.y) <= HANDLE_GRAB_PX);
-    if (handle) {
-      this.drag = { kind: handle.kind, start: p, region: this.data.draft() };
-    } else if ((this.mode === "storm" || this.mode === "clearing") && this.data.canEdit()) {
-      this.drag = { kind: "place", start: p, centre: this.toSurface(p.x, p.y) };
-    } else {
-      this.drag = { kind: "pan", start: p, focus: { ...this.focus }, moved: false };
-    }
-  }
-
-  pointerMove(e) {
-    const p = this.eventPoint(e);
-    const s = this.toSurface(p.x, p.y);
-    this.on.cursor(`${fmt(s.lat_deg, 4)}°, ${fmt(s.lon_deg, 4)}°`);
-    this.canvas.style.cursor = this.handles().some((h) => Math.hypot(h.x - p.x, h.y - p.y) <= HANDLE_GRAB_PX) ? "grab" : "";
-    const d = this.drag;
-    if (!d) return;
-    const moved = Math.hypot(p.x - d.start.x, p.y - d.start.y) > CLICK_SLOP_PX;
-    if (d.kind === "pan") {
-      if (!moved && !d.moved) return;
-      d.moved = true;
-      // Keep the surface point under the press under the pointer.
-      const start = new Projection(d.focus.lat_deg, d.focus.lon_deg);
-      const c = start.inverse((d.start.x - p.x) * this.scale_mpp, (p.y - d.start.y) * this.scale_mpp);
-      this.setView(c.lat_deg, c.lon_deg);
-    } else if (d.kind === "place") {
-      if (!moved) return;
-      d.dragged = true;
-      const half_m = Math.hypot(p.x - d.start.x, p.y - d.start.y) * this.scale_mpp;
-      this.on.place(this.mode, d.centre.lat_deg, d.centre.lon_deg, half_m);
-    } else {
-      // A handle: its distance from the region's centre, along the region's x axis.
-      const r = d.region;
-      const c = this.toScreen(r.center_lat_deg, r.center_lon_deg);
-      const dist_m = Math.hypot(p.x - c.x, p.y - c.y) * this.scale_mpp;
-      if (d.kind === "size") {
-        const half = Math.max(50, dist_m);
-        const k = half / (r.size_x_m / 2);
-        this.on.reshape({ size_x_m: r.size_x_m * k, size_y_m: r.size_y_m * k, corner_radius_m: (r.corner_radius_m || 0) * k });
-      } else {
-        this.on.reshape({ transition_m: Math.max(0, dist_m - r.size_x_m / 2) });
-      }
-    }
-  }
-
-  pointerUp(e) {
-    const d = this.drag;
-    this.drag = null;
-    if (!d) return;
-    const p = this.eventPoint(e);
-    if (d.kind === "place") {
-      if (!d.dragged) this.on.place(this.mode, d.centre.lat_deg, d.centre.lon_deg, null);
-      this.on.placed();
-    } else if (d.kind === "pan" && !d.moved) {
-      // A click: pick the region under it (innermost first).
-      const s = this.toSurface(p.x, p.y);
-      const hit = this.data.state().regions
-        .map((r) => ({ r, d: regionEdgeDistance_m(r, s.lat_deg, s.lon_deg) }))
-        .filter((x) => x.d <= 0).sort((a, b) => a.d - b.d)[0];
-      if (hit) this.on.pick(hit.r.id);
-    }
-  }
-
-  wheel(e) {
-    e.preventDefault();
-    const p = this.eventPoint(e);
-    const before = this.toSurface(p.x, p.y);
-    const k = Math.exp(Math.max(-1, Math.min(1, e.deltaY / 300)));
-    this.scale_mpp = Math.max(MIN_SCALE_MPP, Math.min(MAX_SCALE_MPP, this.scale_mpp * k));
-    // Keep the point under the pointer where it was.
-    const proj = new Projection(before.lat_deg, before.lon_deg);
-    const c = proj.inverse(-(p.x - this.w / 2) * this.scale_mpp, (p.y - this.h / 2) * this.scale_mpp);
-    this.setView(c.lat_deg, c.lon_deg);
-  }
-
-  // ---- drawing ----
-
-  draw() {
-    this.dirty = false;
-    const g = this.ctx;
-    g.clearRect(0, 0, this.w, this.h);
-    g.fillStyle = "#1b2a3a";
-    g.fillRect(0, 0, this.w, this.h);
-    const state = this.data.state();
-    const layerId = this.data.selectedLayer();
-    if (state && layerId !== null) this.drawCoverage(state, layerId);
-    this.drawGraticule();
-    if (state) {
-      this.drawRegions(state);
-      if (layerId !== null) this.drawWind(state, layerId);
-    }
+  redraw() {
+    this.overlay.redraw();
+    this.drawRegions();
     this.drawDraft();
     this.drawRenderers(this.data.renderers() || []);
-    this.drawFocusAndScale();
   }
 
-  drawCoverage(state, layerId) {
-    const cols = Math.ceil(this.w / COVERAGE_CELL_PX), rows = Math.ceil(this.h / COVERAGE_CELL_PX);
-    const key = JSON.stringify([state.layers, state.regions, layerId, this.focus, this.scale_mpp, cols, rows]);
-    if (key !== this.coverageKey) {
-      this.coverageKey = key;
-      const c = this.coverageCanvas;
-      c.width = cols;
-      c.height = rows;
-      const cg = c.getContext("2d");
-      const img = cg.createImageData(cols, rows);
-      for (let j = 0; j < rows; ++j) {
-        for (let i = 0; i < cols; ++i) {
-          const s = this.toSurface((i + 0.5) * COVERAGE_CELL_PX, (j + 0.5) * COVERAGE_CELL_PX);
-          const v = coverageAt(state, layerId, s.lat_deg, s.lon_deg);
-          const o = 4 * (j * cols + i);
-          // White cloud over the dark ground, opacity with coverage.
-          img.data[o] = 236; img.data[o + 1] = 242; img.data[o + 2] = 250;
-          img.data[o + 3] = Math.round(200 * Math.max(0, Math.min(1, v)));
-        }
-      }
-      cg.putImageData(img, 0, 0);
+  moved() {
+    const c = this.map.getCenter();
+    this.focus = { lat_deg: c.lat, lon_deg: normalizeLon(c.lng) };
+    this.zoom = this.map.getZoom();
+    this.on.view(this.focus, this.zoom);
+    // Shapes follow the view round the world (see `near`).
+    this.drawRegions();
+    this.drawDraft();
+    this.drawRenderers(this.data.renderers() || []);
+    this.stations.follow(c.lng);
+  }
+
+  // The view's centre longitude, unwrapped as Leaflet holds it.
+  ref() {
+    return this.map.getCenter().lng;
+  }
+
+  // ---- the pointer ----
+
+  pressed(e) {
+    this.swallowClick = false;
+    if (this.mode === "pan" || !this.data.canEdit() || this.handleDrag) return;
+    this.place = { start: e.containerPoint, centre: e.latlng.wrap(), dragged: false };
+  }
+
+  pointerMoved(e) {
+    const p = e.latlng.wrap();
+    this.on.cursor(`${fmt(p.lat, 4)}°, ${fmt(p.lng, 4)}°`);
+    const d = this.place;
+    if (!d) return;
+    if (!d.dragged && e.containerPoint.distanceTo(d.start) <= CLICK_SLOP_PX) return;
+    d.dragged = true;
+    const half_m = inverse(d.centre.lat, d.centre.lng, p.lat, p.lng).distance_m;
+    this.on.place(this.mode, d.centre.lat, d.centre.lng, half_m);
+  }
+
+  released() {
+    const d = this.place;
+    this.place = null;
+    if (!d) return;
+    if (!d.dragged) this.on.place(this.mode, d.centre.lat, d.centre.lng, null);
+    // The click the browser may fire after this release placed; it picks nothing.
+    this.swallowClick = true;
+    this.on.placed();
+  }
+
+  // A click in pan mode picks the region under it (innermost first).
+  clicked(e) {
+    if (this.swallowClick) {
+      this.swallowClick = false;
+      return;
     }
-    const g = this.ctx;
+    if (this.mode !== "pan") return;
+    const s = e.latlng.wrap();
+    const state = this.data.state();
+    if (!state) return;
+    const hit = state.regions
+      .map((r) => ({ r, d: regionEdgeDistance_m(r, s.lat, s.lng) }))
+      .filter((x) => x.d <= 0).sort((a, b) => a.d - b.d)[0];
+    if (hit) this.on.pick(hit.r.id);
+  }
+
+  // ---- the canvas overlay: coverage, graticule, wind ----
+
+  drawOverlay(g, w, h) {
+    const state = this.data.state();
+    const layerId = this.data.selectedLayer();
+    if (state && layerId !== null) this.drawCoverage(g, w, h, state, layerId);
+    this.drawGraticule(g, w, h);
+    if (state && layerId !== null) this.drawWind(g, w, h, state, layerId);
+  }
+
+  surfaceAt(x, y) {
+    const p = this.map.containerPointToLatLng([x, y]);
+    return { lat_deg: p.lat, lon_deg: normalizeLon(p.lng) };
+  }
+
+  drawCoverage(g, w, h, state, layerId) {
+    const cols = Math.ceil(w / COVERAGE_CELL_PX), rows = Math.ceil(h / COVERAGE_CELL_PX);
+    const cells = this.coverageCanvas || (this.coverageCanvas = document.createElement("canvas"));
+    cells.width = cols;
+    cells.height = rows;
+    const cg = cells.getContext("2d");
+    const img = cg.createImageData(cols, rows);
+    for (let j = 0; j < rows; ++j) {
+      for (let i = 0; i < cols; ++i) {
+        const s = this.surfaceAt((i + 0.5) * COVERAGE_CELL_PX, (j + 0.5) * COVERAGE_CELL_PX);
+        const v = coverageAt(state, layerId, s.lat_deg, s.lon_deg);
+        const o = 4 * (j * cols + i);
+        // White cloud over the dark ground, opacity with coverage.
+        img.data[o] = 236; img.data[o + 1] = 242; img.data[o + 2] = 250;
+        img.data[o + 3] = Math.round(170 * Math.max(0, Math.min(1, v)));
+      }
+    }
+    cg.putImageData(img, 0, 0);
     g.imageSmoothingEnabled = true;
-    g.drawImage(this.coverageCanvas, 0, 0, cols * COVERAGE_CELL_PX, rows * COVERAGE_CELL_PX);
+    g.drawImage(cells, 0, 0, cols * COVERAGE_CELL_PX, rows * COVERAGE_CELL_PX);
   }
 
-  // The visible extent in degrees, from the corners and edge midpoints.
-  extent() {
-    const pts = [];
-    for (const fx of [0, 0.5, 1]) for (const fy of [0, 0.5, 1]) pts.push(this.toSurface(fx * this.w, fy * this.h));
-    const lats = pts.map((p) => p.lat_deg);
-    // Longitudes relative to the focus, so the antimeridian does not wrap.
-    const dl = pts.map((p) => ((p.lon_deg - this.focus.lon_deg + 540) % 360) - 180);
-    return { latMin: Math.min(...lats), latMax: Math.max(...lats), dlMin: Math.min(...dl), dlMax: Math.max(...dl) };
-  }
-
-  drawGraticule() {
-    const g = this.ctx;
-    const e = this.extent();
-    const span = Math.max(e.latMax - e.latMin, 0.001);
+  drawGraticule(g, w, h) {
+    const b = this.map.getBounds();
+    const south = Math.max(-MERCATOR_MAX_LAT_DEG, b.getSouth()), north = Math.min(MERCATOR_MAX_LAT_DEG, b.getNorth());
+    const span = Math.max(north - south, 0.001);
     const step = GRID_STEPS_DEG.find((s) => span / s <= 8) || 30;
-    const latStart = Math.ceil(Math.max(-90, e.latMin - step) / step) * step;
-    const lonMin = this.focus.lon_deg + e.dlMin, lonMax = this.focus.lon_deg + e.dlMax;
-    const lonStep = step;
     g.save();
-    g.strokeStyle = "rgba(150, 180, 210, 0.35)";
-    g.fillStyle = "rgba(190, 210, 230, 0.8)";
+    g.strokeStyle = "rgba(150, 180, 210, 0.3)";
+    g.fillStyle = "rgba(190, 210, 230, 0.85)";
     g.lineWidth = 1;
     g.font = "11px system-ui, sans-serif";
-    const n = 48;
-    for (let lat = latStart; lat <= Math.min(90, e.latMax + step); lat += step) {
-      g.beginPath();
-      for (let k = 0; k <= n; ++k) {
-        const p = this.toScreen(lat, lonMin - lonStep + ((lonMax - lonMin + 2 * lonStep) * k) / n);
-        k ? g.lineTo(p.x, p.y) : g.moveTo(p.x, p.y);
-      }
-      g.stroke();
-      const l = this.toScreen(lat, this.toSurface(4, this.h / 2).lon_deg);
-      if (l.y > 12 && l.y < this.h - 4) g.fillText(`${fmt(lat, 2)}°`, 4, l.y - 3);
+    // Web Mercator: parallels are horizontal lines, meridians vertical.
+    for (let lat = Math.ceil(south / step) * step; lat <= north; lat += step) {
+      const y = Math.round(this.map.latLngToContainerPoint([lat, b.getWest()]).y) + 0.5;
+      g.beginPath(); g.moveTo(0, y); g.lineTo(w, y); g.stroke();
+      // Labels keep clear of the scale bar (bottom left) and the attribution (bottom right).
+      if (y > 12 && y < h - 60) g.fillText(`${fmt(lat, 2)}°`, 4, y - 3);
     }
-    const lonStart = Math.ceil((lonMin - lonStep) / lonStep) * lonStep;
     let lastLabel_px = -Infinity;  // labels closer than LABEL_GAP_PX are left out
-    for (let lon = lonStart; lon <= lonMax + lonStep; lon += lonStep) {
-      g.beginPath();
-      for (let k = 0; k <= n; ++k) {
-        const p = this.toScreen(e.latMin - step + ((e.latMax - e.latMin + 2 * step) * k) / n, lon);
-        k ? g.lineTo(p.x, p.y) : g.moveTo(p.x, p.y);
+    for (let lon = Math.ceil(b.getWest() / step) * step; lon <= b.getEast(); lon += step) {
+      const x = Math.round(this.map.latLngToContainerPoint([b.getSouth(), lon]).x) + 0.5;
+      g.beginPath(); g.moveTo(x, 0); g.lineTo(x, h); g.stroke();
+      if (x > 170 && x < w - 130 && x - lastLabel_px >= LABEL_GAP_PX) {
+        const shown = normalizeLon(lon);
+        g.fillText(`${fmt(shown === -180 ? 180 : shown, 2)}°`, x + 3, h - 6);
+        lastLabel_px = x;
       }
-      g.stroke();
-      const b = this.toScreen(this.toSurface(this.w / 2, this.h - 4).lat_deg, lon);
-      const shown = ((lon + 540) % 360) - 180;
-      if (b.x > 30 && b.x < this.w - 30 && b.x - lastLabel_px >= LABEL_GAP_PX) {
-        g.fillText(`${fmt(shown, 2)}°`, b.x + 3, this.h - 6);
-        lastLabel_px = b.x;
-      }
-    }
-    g.restore();
-  }
-
-  path(points) {
-    const g = this.ctx;
-    g.beginPath();
-    points.forEach((pt, k) => {
-      const p = this.toScreen(pt.lat_deg, pt.lon_deg);
-      k ? g.lineTo(p.x, p.y) : g.moveTo(p.x, p.y);
-    });
-    g.closePath();
-  }
-
-  drawRegionShape(r, colour, selected) {
-    const g = this.ctx;
-    g.save();
-    g.strokeStyle = colour;
-    g.lineWidth = selected ? 2.5 : 1.5;
-    this.path(regionOutline(r, 0));
-    g.stroke();
-    if (r.transition_m > 0) {
-      g.setLineDash([6, 5]);
-      g.lineWidth = 1;
-      this.path(regionOutline(r, r.transition_m));
-      g.stroke();
-    }
-    g.restore();
-  }
-
-  drawRegions(state) {
-    const g = this.ctx;
-    const selected = this.data.selectedRegion();
-    for (const r of state.regions) {
-      const clearing = r.layers.length > 0 && r.layers.every((l) => l.coverage === 0);
-      const colour = clearing ? "#7fd1ff" : "#ffb347";
-      this.drawRegionShape(r, colour, r.id === selected);
-      const c = this.toScreen(r.center_lat_deg, r.center_lon_deg);
-      g.fillStyle = colour;
-      g.font = "12px system-ui, sans-serif";
-      g.fillText(`R${r.id}${r.drifts_with_wind ? " ↝" : ""}`, c.x + 4, c.y - 4);
-    }
-  }
-
-  drawDraft() {
-    const d = this.data.draft();
-    if (!d || !(d.size_x_m > 0) || !(d.size_y_m > 0) || !Number.isFinite(d.center_lat_deg)) return;
-    const g = this.ctx;
-    g.save();
-    g.fillStyle = "rgba(255, 120, 60, 0.12)";
-    this.path(regionOutline(d, 0));
-    g.fill();
-    this.drawRegionShape(d, "#ff7a3c", true);
-    for (const h of this.handles()) {
-      g.beginPath();
-      g.arc(h.x, h.y, 6, 0, 2 * Math.PI);
-      g.fillStyle = h.kind === "size" ? "#ff7a3c" : "#ffd27f";
-      g.fill();
-      g.strokeStyle = "#1b2a3a";
-      g.stroke();
     }
     g.restore();
   }
@@ -361,25 +341,25 @@ export class MapView {
       if (w >= bestW) { best = l; bestW = w; }
     }
     if (best) return best.coverage > 0 ? best.wind : null;
-    const g = state.layers.find((x) => x.id === layerId);
-    return g ? g.wind : null;
+    const gl = state.layers.find((x) => x.id === layerId);
+    return gl ? gl.wind : null;
   }
 
-  drawWind(state, layerId) {
-    const g = this.ctx;
+  drawWind(g, w, h, state, layerId) {
     g.save();
     g.strokeStyle = "rgba(120, 230, 160, 0.85)";
     g.fillStyle = g.strokeStyle;
     g.lineWidth = 1.5;
-    for (let y = ARROW_SPACING_PX / 2; y < this.h; y += ARROW_SPACING_PX) {
-      for (let x = ARROW_SPACING_PX / 2; x < this.w; x += ARROW_SPACING_PX) {
-        const s = this.toSurface(x, y);
-        const w = this.windAt(state, layerId, s.lat_deg, s.lon_deg);
-        if (!w || w.speed_mps <= 0) continue;
-        // Arrows point downwind (the wind blows from from_deg); length grows
-        // with speed, 2 px per m/s from 10 px, at most 40.
-        const len = Math.min(40, 10 + 2 * w.speed_mps);
-        const a = ((w.from_deg + 180) * Math.PI) / 180;
+    for (let y = ARROW_SPACING_PX / 2; y < h; y += ARROW_SPACING_PX) {
+      for (let x = ARROW_SPACING_PX / 2; x < w; x += ARROW_SPACING_PX) {
+        const s = this.surfaceAt(x, y);
+        const wind = this.windAt(state, layerId, s.lat_deg, s.lon_deg);
+        if (!wind || wind.speed_mps <= 0) continue;
+        // Arrows point downwind (the wind blows from from_deg); Mercator
+        // keeps north up everywhere. Length grows with speed, 2 px per m/s
+        // from 10 px, at most 40.
+        const len = Math.min(40, 10 + 2 * wind.speed_mps);
+        const a = ((wind.from_deg + 180) * Math.PI) / 180;
         const dx = Math.sin(a) * len, dy = -Math.cos(a) * len;
         g.beginPath();
         g.moveTo(x - dx / 2, y - dy / 2);
@@ -397,78 +377,169 @@ export class MapView {
     g.restore();
   }
 
-  drawRenderers(renderers) {
-    const g = this.ctx;
-    // Each renderer's area of interest (the spherical cap it subscribed).
-    g.save();
-    g.strokeStyle = "rgba(255, 225, 77, 0.35)";
-    g.setLineDash([2, 4]);
-    for (const r of renderers) {
-      const a = r.area;
-      if (!a || !(a.radius_m > 0) || !Number.isFinite(a.center_lat_deg)) continue;
-      const ring = [];
-      for (let k = 0; k < 72; ++k) ring.push(direct(a.center_lat_deg, a.center_lon_deg, k * 5, a.radius_m));
-      this.path(ring);
-      g.stroke();
+  // ---- regions and the draft ----
+
+  // The edge and, when it has one, the dashed transition perimeter of a
+  // region, each one polygon (SVG path) with continuous longitudes.
+  // kind: "region" (the state's) or "draft" (the region tool's), in the paths' classes.
+  // faint: a METAR station's region (thin, half transparent).
+  regionShapes(r, colour, selected, kind = "region", extra = {}, faint = false) {
+    const c = near(r.center_lon_deg, this.ref());
+    const opts = { renderer: this.regionRenderer, interactive: false, color: colour, fill: false, opacity: faint ? 0.45 : 1 };
+    const shapes = [L.polygon(continuous(regionOutline(r, 0), c), { ...opts, weight: selected ? 2.5 : faint ? 1 : 1.5,
+      className: `${kind}-edge ${kind}-${r.id}`, ...extra })];
+    if (r.transition_m > 0) {
+      shapes.push(L.polygon(continuous(regionOutline(r, r.transition_m), c), { ...opts, weight: 1, dashArray: "6 5",
+        className: `${kind}-perimeter ${kind}-${r.id}` }));
     }
-    g.restore();
-    for (const r of renderers) {
-      if (r.lat_deg === null || r.lon_deg === null || r.lat_deg === undefined) continue;
-      const p = this.toScreen(r.lat_deg, r.lon_deg);
-      if (p.x < -20 || p.y < -20 || p.x > this.w + 20 || p.y > this.h + 20) continue;
-      const stale = r.last_report_age_s !== null && r.last_report_age_s > STALE_AFTER_S;
-      g.save();
-      g.translate(p.x, p.y);
-      // Heading is true, clockwise from north; the map's north is up at the
-      // focus (close enough for a symbol anywhere in view).
-      g.rotate(((r.heading_deg || 0) * Math.PI) / 180);
-      g.fillStyle = stale ? "#8a94a0" : "#ffe14d";
-      g.strokeStyle = "#1b2a3a";
-      g.lineWidth = 1;
-      g.beginPath();
-      // A small aircraft, nose up: fuselage, wings, tail.
-      g.moveTo(0, -11); g.lineTo(2, -4); g.lineTo(11, 1); g.lineTo(11, 3); g.lineTo(2, 1); g.lineTo(1.5, 7);
-      g.lineTo(5, 10); g.lineTo(5, 11.5); g.lineTo(0, 10); g.lineTo(-5, 11.5); g.lineTo(-5, 10); g.lineTo(-1.5, 7);
-      g.lineTo(-2, 1); g.lineTo(-11, 3); g.lineTo(-11, 1); g.lineTo(-2, -4); g.closePath();
-      g.fill();
-      g.stroke();
-      g.restore();
-      g.fillStyle = stale ? "#8a94a0" : "#ffe14d";
-      g.font = "11px system-ui, sans-serif";
-      const alt = r.alt_m === null || r.alt_m === undefined ? "" : ` ${fmt(ftFromM(r.alt_m))} ft`;
-      g.fillText(`${r.channel || r.id}${alt}${stale ? " (stale)" : ""}`, p.x + 13, p.y + 4);
+    return shapes;
+  }
+
+  drawRegions() {
+    const state = this.data.state();
+    const regions = state ? state.regions : [];
+    const selected = this.data.selectedRegion();
+    const key = JSON.stringify([regions, selected, Math.round(this.ref())]);
+    if (key === this.regionKey) return;
+    this.regionKey = key;
+    this.regionGroup.clearLayers();
+    for (const r of regions) {
+      // A METAR station's region is drawn faint and unlabelled: its marker names it.
+      const station = r.id >= METAR_REGION_IDS[0] && r.id <= METAR_REGION_IDS[1];
+      const clearing = r.layers.length > 0 && r.layers.every((l) => l.coverage === 0);
+      const colour = station ? "#c9a37a" : clearing ? "#7fd1ff" : "#ffb347";
+      const shapes = this.regionShapes(r, colour, r.id === selected, "region", {}, station);
+      for (const s of shapes) this.regionGroup.addLayer(s);
+      if (station) continue;
+      const label = document.createElement("span");
+      label.textContent = `R${r.id}${r.drifts_with_wind ? " ↝" : ""}`;
+      label.className = clearing ? "region-label clearing" : "region-label";
+      this.regionGroup.addLayer(L.marker([r.center_lat_deg, near(r.center_lon_deg, this.ref())], {
+        interactive: false, keyboard: false,
+        icon: L.divIcon({ className: "region-label-icon", html: label, iconSize: null, iconAnchor: [-4, 16] }),
+      }));
     }
   }
 
-  drawFocusAndScale() {
-    const g = this.ctx;
-    g.save();
-    // Focus cross.
-    g.strokeStyle = "rgba(255,255,255,0.5)";
-    g.beginPath();
-    g.moveTo(this.w / 2 - 6, this.h / 2); g.lineTo(this.w / 2 + 6, this.h / 2);
-    g.moveTo(this.w / 2, this.h / 2 - 6); g.lineTo(this.w / 2, this.h / 2 + 6);
-    g.stroke();
-    // Scale bar: the round length nearest 120 px.
-    const target_m = 120 * this.scale_mpp;
-    const pow = 10 ** Math.floor(Math.log10(target_m));
-    const len_m = [1, 2, 5, 10].map((k) => k * pow).reduce((a, b) => (Math.abs(b - target_m) < Math.abs(a - target_m) ? b : a));
-    const px = len_m / this.scale_mpp;
-    const x0 = 12, y0 = this.h - 26;
-    g.strokeStyle = "#e8eef5";
-    g.lineWidth = 2;
-    g.beginPath();
-    g.moveTo(x0, y0 - 4); g.lineTo(x0, y0); g.lineTo(x0 + px, y0); g.lineTo(x0 + px, y0 - 4);
-    g.stroke();
-    g.fillStyle = "#e8eef5";
-    g.font = "11px system-ui, sans-serif";
-    g.fillText(len_m >= 1000 ? `${fmt(len_m / 1000)} km (${fmt(len_m / 1852, 1)} NM)` : `${fmt(len_m)} m`, x0 + px + 6, y0);
-    // North arrow.
-    g.beginPath();
-    g.moveTo(this.w - 20, 14); g.lineTo(this.w - 26, 30); g.lineTo(this.w - 20, 26); g.lineTo(this.w - 14, 30);
-    g.closePath();
-    g.fill();
-    g.fillText("N", this.w - 24, 44);
-    g.restore();
+  drawDraft() {
+    this.draftGroup.clearLayers();
+    const d = this.data.draft();
+    const valid = d && d.size_x_m > 0 && d.size_y_m > 0 && Number.isFinite(d.center_lat_deg) &&
+      Number.isFinite(d.center_lon_deg);
+    if (valid) {
+      for (const s of this.regionShapes(d, "#ff7a3c", true, "draft", { fill: true, fillColor: "#ff783c", fillOpacity: 0.12 }))
+        this.draftGroup.addLayer(s);
+    }
+    this.drawHandles(valid && this.data.canEdit() ? d : null);
+  }
+
+  // The draft's handles on its x axis (east at rotation 0): the edge (size)
+  // and the perimeter's outer edge (transition). Kept while one is dragged.
+  drawHandles(d) {
+    for (const kind of ["size", "transition"]) {
+      let m = this.handleMarkers[kind];
+      if (!d) {
+        if (m && !this.handleDrag) { this.map.removeLayer(m); delete this.handleMarkers[kind]; }
+        continue;
+      }
+      const p = kind === "size" ? regionPoint(d, d.size_x_m / 2, 0)
+        : regionPoint(d, d.size_x_m / 2 + Math.max(0, d.transition_m || 0), 0);
+      const at = L.latLng(p.lat_deg, near(p.lon_deg, near(d.center_lon_deg, this.ref())));
+      if (!m) {
+        m = L.marker(at, { draggable: true, keyboard: false, zIndexOffset: 2000, title: kind === "size"
+          ? "drag to resize" : "drag to set the transition perimeter",
+        icon: L.divIcon({ className: `handle handle-${kind}`, iconSize: [12, 12] }) });
+        m.on("dragstart", () => { this.handleDrag = { kind, region: this.data.draft() }; });
+        m.on("drag", (e) => this.handleDragged(e.target.getLatLng()));
+        m.on("dragend", () => { this.handleDrag = null; this.drawDraft(); });
+        m.addTo(this.map);
+        this.handleMarkers[kind] = m;
+      } else if (!this.handleDrag) {
+        m.setLatLng(at);
+      }
+    }
+  }
+
+  // A handle's distance from the region's centre sets its size or perimeter.
+  handleDragged(latlng) {
+    const { kind, region: r } = this.handleDrag;
+    const dist_m = inverse(r.center_lat_deg, r.center_lon_deg, latlng.lat, normalizeLon(latlng.lng)).distance_m;
+    if (kind === "size") {
+      const half = Math.max(50, dist_m);
+      const k = half / (r.size_x_m / 2);
+      this.on.reshape({ size_x_m: r.size_x_m * k, size_y_m: r.size_y_m * k, corner_radius_m: (r.corner_radius_m || 0) * k });
+    } else {
+      this.on.reshape({ transition_m: Math.max(0, dist_m - r.size_x_m / 2) });
+    }
+  }
+
+  // ---- renderers ----
+
+  drawRenderers(renderers) {
+    const seen = new Set();
+    const ref = this.ref();
+    for (const r of renderers) {
+      const key = String(r.id);
+      seen.add(key);
+      let a = this.aircraft.get(key);
+      if (!a) {
+        const el = aircraftElement();
+        a = { el, marker: L.marker([0, 0], { interactive: false, keyboard: false, zIndexOffset: 1000,
+          icon: L.divIcon({ className: "aircraft-icon", html: el, iconSize: [24, 24], iconAnchor: [12, 12] }) }),
+        ring: null, ringKey: "" };
+        this.aircraft.set(key, a);
+      }
+      this.drawArea(a, r.area, ref);
+      const placed = r.lat_deg !== null && r.lat_deg !== undefined && r.lon_deg !== null && r.lon_deg !== undefined;
+      if (!placed) {
+        if (this.rendererGroup.hasLayer(a.marker)) this.rendererGroup.removeLayer(a.marker);
+        continue;
+      }
+      const stale = r.last_report_age_s !== null && r.last_report_age_s !== undefined && r.last_report_age_s > STALE_AFTER_S;
+      a.marker.setLatLng([this.drawnLat(r.lat_deg), near(r.lon_deg, ref)]);
+      if (!this.rendererGroup.hasLayer(a.marker)) this.rendererGroup.addLayer(a.marker);
+      // Heading is true, clockwise from north; Mercator keeps north up.
+      a.el.querySelector("svg").style.transform = `rotate(${r.heading_deg || 0}deg)`;
+      a.el.classList.toggle("stale", stale);
+      a.el.dataset.id = key;
+      a.el.dataset.lat = String(r.lat_deg);
+      a.el.dataset.lon = String(r.lon_deg);
+      const beyond = Math.abs(r.lat_deg) > MERCATOR_MAX_LAT_DEG;
+      const alt = r.alt_m === null || r.alt_m === undefined ? "" : ` ${fmt(ftFromM(r.alt_m))} ft`;
+      a.el.querySelector(".aircraft-label").textContent = `${r.channel || r.id}${alt}${stale ? " (stale)" : ""}` +
+        (beyond ? ` at ${fmt(Math.abs(r.lat_deg), 2)}°${r.lat_deg > 0 ? "N" : "S"}, beyond the map's edge` : "");
+      a.el.classList.toggle("beyond-edge", beyond);
+    }
+    for (const [key, a] of this.aircraft) {
+      if (seen.has(key)) continue;
+      this.rendererGroup.removeLayer(a.marker);
+      if (a.ring) this.rendererGroup.removeLayer(a.ring);
+      this.aircraft.delete(key);
+    }
+  }
+
+  // The latitude a symbol is drawn at: its own, or for one beyond Web
+  // Mercator's edge (over a pole), just inside the edge, so it stays whole.
+  drawnLat(lat_deg) {
+    if (Math.abs(lat_deg) <= MERCATOR_MAX_LAT_DEG) return lat_deg;
+    const zoom = this.map.getZoom(), sign = Math.sign(lat_deg);
+    const edge = this.map.project([sign * MERCATOR_MAX_LAT_DEG, 0], zoom);
+    return this.map.unproject(edge.add([0, sign * EDGE_INSET_PX]), zoom).lat;
+  }
+
+  // A renderer's area of interest (the spherical cap it subscribed), dashed.
+  drawArea(a, area, ref) {
+    const ok = area && area.radius_m > 0 && Number.isFinite(area.center_lat_deg) && Number.isFinite(area.center_lon_deg);
+    const key = ok ? JSON.stringify([area, Math.round(ref)]) : "";
+    if (key === a.ringKey) return;
+    a.ringKey = key;
+    if (a.ring) this.rendererGroup.removeLayer(a.ring);
+    a.ring = null;
+    if (!ok) return;
+    const ring = [];
+    for (let k = 0; k <= 72; ++k) ring.push(direct(area.center_lat_deg, area.center_lon_deg, k * 5, area.radius_m));
+    a.ring = L.polyline(continuous(ring, near(area.center_lon_deg, ref)), { renderer: this.regionRenderer,
+      interactive: false, color: "#ffe14d", opacity: 0.4, weight: 1, dashArray: "2 4", className: "renderer-area" });
+    this.rendererGroup.addLayer(a.ring);
   }
 }

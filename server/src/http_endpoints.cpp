@@ -46,6 +46,7 @@ HttpReply HttpApi::serve(Endpoint endpoint, const ApiRequest& r) {
     case Endpoint::Changes: return changes(r);
     case Endpoint::Scenario: return scenario(r);
     case Endpoint::Metar: return metar(r);
+    case Endpoint::MetarStations: return json(metarStations_.list(options_.stations, weather_.view()));
     case Endpoint::Grib: return grib(r);
     case Endpoint::Feed: break;  // an upgrade: HttpExchange hands it to the feed
   }
@@ -165,6 +166,7 @@ HttpReply HttpApi::metar(const ApiRequest& r) {
   if (request->apply) {
     if (reply.status == 200) {
       ++counters_.applied;
+      metarStations_.remember(*request, reply.body, options_.stations);
       if (options_.log)
         options_.log->info("event=change_applied source=metar sequence={} summary={:?}",
                            reply.body["applied"]["sequence"].get<std::uint64_t>(),

@@ -28,6 +28,7 @@ constexpr std::array kRoutes = {
     Route{"/api/changes", Endpoint::Changes, kPost, kMaxBody_bytes, TokenRule::Always},
     Route{"/api/scenario", Endpoint::Scenario, kPost, kMaxScenarioBody_bytes, TokenRule::Always},
     Route{"/api/metar", Endpoint::Metar, kPost, kMaxBody_bytes, TokenRule::WhenApplying},
+    Route{"/api/metar/stations", Endpoint::MetarStations, kGet, 0, TokenRule::None},
     Route{"/api/grib", Endpoint::Grib, kPost, kMaxGribBody_bytes, TokenRule::Always},
     Route{"/api/ws", Endpoint::Feed, kGet, 0, TokenRule::None},
 };

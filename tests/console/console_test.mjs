@@ -14,6 +14,62 @@ import {
 const R = 6371008.8;  // the console's sphere (mean Earth radius)
 const D2R = Math.PI / 180;
 
+// Web Mercator as the tests compute it, independently of the page and of
+// Leaflet: the world is 256 * 2^zoom CSS px round the equator, north up.
+const worldPx = (zoom) => 256 * 2 ** zoom;
+const mercatorY = (lat) => Math.log(Math.tan(Math.PI / 4 + (lat * D2R) / 2));
+// Pixel offset (x east, y south) of (lat, lon) from the view's centre.
+function offsetPx(lat0, lon0, zoom, lat, lon) {
+  const dLon = ((((lon - lon0 + 180) % 360) + 360) % 360) - 180;  // the short way round
+  return { x: (dLon / 360) * worldPx(zoom), y: ((mercatorY(lat0) - mercatorY(lat)) / (2 * Math.PI)) * worldPx(zoom) };
+}
+// The surface point at a pixel offset from the view's centre.
+function pointAt(lat0, lon0, zoom, dx, dy) {
+  const y = mercatorY(lat0) - (dy * 2 * Math.PI) / worldPx(zoom);
+  return { lat: (2 * Math.atan(Math.exp(y)) - Math.PI / 2) / D2R, lon: lon0 + (dx * 360) / worldPx(zoom) };
+}
+// Metres per CSS px along a parallel at `lat` on the console's sphere.
+const metresPerPx = (lat, zoom) => (2 * Math.PI * R * Math.cos(lat * D2R)) / worldPx(zoom);
+
+// Presses at (x0, y0), moves to (x1, y1) in steps, releases.
+async function drag(page, x0, y0, x1, y1) {
+  await page.mouse.move(x0, y0);
+  await page.mouse.down();
+  await page.mouse.move((x0 + x1) / 2, (y0 + y1) / 2, { steps: 4 });
+  await page.mouse.move(x1, y1, { steps: 4 });
+  await page.mouse.up();
+}
+
+// The map's centre on the page (CSS px).
+async function mapCentre(page) {
+  const box = await page.locator("#map").boundingBox();
+  return { box, cx: box.x + box.width / 2, cy: box.y + box.height / 2 };
+}
+
+// Where (lat, lon) is on the page now (CSS px), from the map's box and the
+// view the page reports (#map data-focus, data-zoom): the layout round the
+// map moves as panels fill in, so each press is placed afresh.
+async function screenOf(page, lat, lon) {
+  const { cx, cy } = await mapCentre(page);
+  const [lat0, lon0] = (await page.getAttribute("#map", "data-focus")).split(",").map(Number);
+  const zoom = Number(await page.getAttribute("#map", "data-zoom"));
+  const o = offsetPx(lat0, lon0, zoom, lat, lon);
+  return { x: cx + o.x, y: cy + o.y };
+}
+
+// The point `east_m` metres east of (lat, lon) along its parallel (near enough
+// for a few tens of km: the tests drag handles along the region's x axis).
+function east(lat, lon, east_m) {
+  return { lat, lon: lon + east_m / (R * D2R * Math.cos(lat * D2R)) };
+}
+
+// Drags from the point (lat, lon) + e0 metres east to + e1 metres east.
+async function dragEast(page, lat, lon, e0, e1) {
+  const a = east(lat, lon, e0), b = east(lat, lon, e1);
+  const p0 = await screenOf(page, a.lat, a.lon), p1 = await screenOf(page, b.lat, b.lon);
+  await drag(page, p0.x, p0.y, p1.x, p1.y);
+}
+
 // Text of the layer table's row for a layer id.
 const rowText = (page, id) => page.textContent(`#layer-table tbody tr[data-id="${id}"]`).catch(() => "");
 
@@ -184,58 +240,58 @@ const cases = {
   // appears in the API where it was clicked.
   async region_click(cleanup) {
     const { w, browser } = await setup("region_click", cleanup);
-    const lat0 = 46, lon0 = 13, scale = 100;  // m per CSS px
+    const lat0 = 46, lon0 = 13, zoom = 10;  // about 106 m per CSS px here
     const a = await openConsole(browser, w, { token: TOKEN, name: "A",
-      hash: `#focus=${lat0},${lon0}&scale=${scale}` });
-    const box = await a.page.locator("#map").boundingBox();
-    const cx = box.x + box.width / 2, cy = box.y + box.height / 2;
+      hash: `#focus=${lat0},${lon0}&zoom=${zoom}` });
+    const { cx, cy } = await mapCentre(a.page);
     const dx = 120, dy = -80;  // px: east and north of the focus
     await a.page.click("#mode-storm");
     await a.page.mouse.click(cx + dx, cy + dy);
     await until("the region form", async () => a.page.isVisible("#region-form"));
-    // The size handle sits on the east edge: 5 km (50 px) east of the centre
-    // for the default 10 km cell; dragging it to 80 px makes the cell 16 km.
-    await a.page.mouse.move(cx + dx + 50, cy + dy);
-    await a.page.mouse.down();
-    await a.page.mouse.move(cx + dx + 65, cy + dy, { steps: 4 });
-    await a.page.mouse.move(cx + dx + 80, cy + dy, { steps: 4 });
-    await a.page.mouse.up();
+    const centre = pointAt(lat0, lon0, zoom, dx, dy);
+    // The size handle sits on the east edge, 5 km from the centre of the
+    // default 10 km cell; dragged to 8 km it makes the cell 16 km.
+    await dragEast(a.page, centre.lat, centre.lon, 5000, 8000);
     await a.page.click("#region-apply");
     await until("applied", async () => /applied #/.test(await a.page.textContent("#region .note")));
     const s = await w.state();
     assert(s.regions.length === 1, `one region: ${JSON.stringify(s.regions)}`);
     const r = s.regions[0];
-    // Independent of the page's projection code: a flat local frame, good
-    // to well under a pixel 15 km from the focus.
-    near(r.center_lat_deg, lat0 + (-dy * scale) / R / D2R, 0.001, "centre latitude");
-    near(r.center_lon_deg, lon0 + (dx * scale) / (R * Math.cos(lat0 * D2R)) / D2R, 0.0015, "centre longitude");
+    // Within 1.5 px: Leaflet puts the view's origin on a whole pixel.
+    const tolerance_m = 1.5 * metresPerPx(centre.lat, zoom);
+    near(r.center_lat_deg, centre.lat, tolerance_m / (R * D2R), "centre latitude");
+    near(r.center_lon_deg, centre.lon, tolerance_m / (R * D2R * Math.cos(centre.lat * D2R)), "centre longitude");
     near(r.size_x_m, 16000, 300, "width after dragging the handle");
     assert(r.layers.length === 1 && r.layers[0].type === "cumulonimbus", "a storm cell's layer");
-    // The transition handle: the default 4 km perimeter ends 40 px beyond the
-    // 80 px edge; dragged out to 150 px it becomes 7 km.
-    await a.page.mouse.move(cx + dx + 120, cy + dy);
-    await a.page.mouse.down();
-    await a.page.mouse.move(cx + dx + 135, cy + dy, { steps: 4 });
-    await a.page.mouse.move(cx + dx + 150, cy + dy, { steps: 4 });
-    await a.page.mouse.up();
+    // The transition handle: the default 4 km perimeter ends 12 km from the
+    // centre; dragged out to 15 km it becomes 7 km.
+    await dragEast(a.page, r.center_lat_deg, r.center_lon_deg, 12000, 15000);
     await a.page.click("#region-apply");
     await until("the perimeter applied", async () => {
       const g = (await w.state()).regions[0];
       return g && Math.abs(g.transition_m - 7000) < 300;
     });
-    // A clearing placed by press and drag: 60 px from its centre is a 12 km
+    // The region and its perimeter on the map: one SVG path each.
+    assert(await a.page.locator(`path.region-edge.region-${r.id}`).count() === 1, "the region's edge drawn");
+    assert(await a.page.locator(`path.region-perimeter.region-${r.id}`).count() === 1, "its perimeter drawn");
+    // A clearing placed by press and drag: 6 km from its centre is a 12 km
     // hole, every global layer at coverage 0 inside.
     await a.page.click("#mode-clearing");
-    await a.page.mouse.move(cx - 150, cy + 100);
-    await a.page.mouse.down();
-    await a.page.mouse.move(cx - 120, cy + 100, { steps: 4 });
-    await a.page.mouse.move(cx - 90, cy + 100, { steps: 4 });
-    await a.page.mouse.up();
+    const clearingAt = pointAt(lat0, lon0, zoom, -150, 100);
+    await dragEast(a.page, clearingAt.lat, clearingAt.lon, 0, 6000);
     await a.page.click("#region-apply");
     const clearing = await until("the clearing in the API", async () => (await w.state()).regions.find((g) => g.id !== r.id));
     near(clearing.size_x_m, 12000, 300, "clearing size from the drag");
     assert(clearing.layers.length === 1 && clearing.layers[0].id === 1 && clearing.layers[0].coverage === 0,
       `a clearing of layer 1: ${JSON.stringify(clearing.layers)}`);
+    // A click on the storm cell (in pan mode) opens it in the region tool.
+    await a.page.click("#region-cancel");
+    const cell = await screenOf(a.page, r.center_lat_deg, r.center_lon_deg);
+    await a.page.mouse.click(cell.x, cell.y);
+    await until("the storm cell picked", async () => (await a.page.isVisible("#region-form")) &&
+      (await a.page.textContent("#region-title")) === `Region ${r.id}`).catch(async (e) => {
+      throw new Error(`${e.message}: the region tool says "${await a.page.textContent("#region-title")}" ${JSON.stringify(await a.page.evaluate(([x, y]) => document.elementsFromPoint(x, y).map((q) => q.tagName + "." + q.className.baseVal + q.className), [cell.x, cell.y]))}`);
+    });
     noProblems(a.problems);
   },
 
@@ -420,13 +476,33 @@ const cases = {
       { ...layer(1, "cumulus", 1500, 1800, 0.8, 12, 280), at_s: now + 600, ramp_s: 900 },
       { op: "remove_layer", id: 2, at_s: now + 1800, ramp_s: 600 }] });
     assert(later.status === 200, later.text);
-    const a = await openConsole(browser, w, { token: TOKEN, name: "A",
-      hash: "#focus=46.0,13.0&scale=90" });
+    // METAR at the stations round the cell, one of each flight category.
+    const metar = await w.api("POST", "/api/metar", { apply: true, author: "instructor", radius_m: 30000, reports: [
+      "METAR LJLJ 221150Z 24008KT 9999 FEW025 SCT045 BKN090 12/06 Q1018",
+      "METAR LIPZ 221150Z 18006KT 4000 BR BKN012 14/12 Q1016",
+      "METAR LIPH 221150Z 17005KT 2500 BR OVC007 13/12 Q1016",
+      "METAR LIPQ 221150Z 22004KT 0800 FG VV002 11/11 Q1017",
+      "METAR LOWK 221150Z 31005KT 9999 SCT050 09/02 Q1020"] });
+    assert(metar.status === 200, metar.text);
+    const a = await openConsole(browser, w, { token: TOKEN, name: "A", viewport: { width: 1600, height: 1100 },
+      hash: "#focus=46.0,13.2&zoom=8.25" });
+    await until("the coastline", async () => (await a.page.getAttribute("#map", "data-basemap")) === "loaded");
+    await until("the stations", async () => (await a.page.$$('.station[data-category="LIFR"]')).length === 1);
     await a.page.fill('[name="reports"]', "METAR LJLJ 221150Z 24008KT 9999 FEW025 SCT045 BKN090 12/06 Q1018");
     await a.page.click("#metar-preview");
     await until("the preview", async () => (await a.page.$$("#metar-result li")).length === 1);
     await a.page.click('#layer-table tbody tr[data-id="1"]');
     await until("the timeline", async () => /scheduled|ramping|at /.test(await a.page.textContent("#timeline-list")));
+    // The storm cell in the region tool, and one station's report open.
+    await a.page.click("#region-cancel").catch(() => {});
+    const { cx, cy } = await mapCentre(a.page);
+    const cell = offsetPx(46.0, 13.2, 8.25, 46.05, 13.25);
+    await a.page.mouse.click(cx + cell.x, cy + cell.y);
+    await until("the storm cell picked", async () => (await a.page.textContent("#region-title")) === "Region 1");
+    // The overlay shows the storm cell's own layer (cumulonimbus, id 6).
+    await a.page.selectOption("#overlay-layer", "6");
+    await a.page.click('.station[data-icao="LIPZ"] .station-dot');
+    await until("LIPZ's popup", async () => /LIPZ/.test(await a.page.textContent(".leaflet-popup-content")));
     await a.page.waitForTimeout(500);
     fs.mkdirSync(config.out, { recursive: true });
     const shot = path.join(config.out, "console.png");
@@ -439,6 +515,179 @@ const cases = {
     assert(fs.statSync(shot).size > 50000, "a screenshot with something in it");
     noProblems(a.problems);
   },
+};
+
+// The Natural Earth ground is drawn where it belongs: along the parallel
+// through Trieste (45.65 N) the Gulf of Trieste is sea and the first land
+// east of it is the city's waterfront, Piazza Unita d'Italia at 13.767 E
+// (1:50m data is generalised by a km or two: 0.03 deg, 2.3 km, allowed).
+// The basemap's canvas is read at points projected here, not by the page.
+cases.coastline = async (cleanup) => {
+  const { w, browser } = await setup("coastline", cleanup);
+  // No cloud overlay over the ground: the one global layer removed.
+  const r = await w.api("POST", "/api/changes", { changes: [{ op: "remove_layer", id: 1 }] });
+  assert(r.status === 200, r.text);
+  const lat0 = 45.65, lon0 = 13.7, zoom = 11;
+  const a = await openConsole(browser, w, { name: "A", hash: `#focus=${lat0},${lon0}&zoom=${zoom}` });
+  await until("the coastline", async () => (await a.page.getAttribute("#map", "data-basemap")) === "loaded");
+  await a.page.waitForTimeout(300);  // the canvas renderer draws on the next frame
+  const { box } = await mapCentre(a.page);
+  // Points along the parallel, 0.005 deg apart, from 13.60 E to 13.85 E, as
+  // offsets from the map's centre in CSS px.
+  const lons = [];
+  for (let lon = 13.6; lon <= 13.85 + 1e-9; lon += 0.005) lons.push(lon);
+  const points = lons.map((lon) => offsetPx(lat0, lon0, zoom, lat0, lon));
+  const pixels = await a.page.evaluate(([pts, mapW, mapH]) => {
+    const c = document.querySelector(".leaflet-basemap-pane canvas");
+    const rect = c.getBoundingClientRect(), map = document.querySelector("#map").getBoundingClientRect();
+    const k = c.width / rect.width, g = c.getContext("2d");
+    return pts.map((p) => {
+      const x = (map.left + mapW / 2 + p.x - rect.left) * k, y = (map.top + mapH / 2 + p.y - rect.top) * k;
+      return [...g.getImageData(Math.round(x), Math.round(y), 1, 1).data];
+    });
+  }, [points, box.width, box.height]);
+  // Land is filled (#27362b), the sea is the container showing through (alpha 0).
+  const isLand = (px) => px[3] > 200 && px[0] < 80 && px[1] > 40 && px[1] < 80;
+  const isSea = (px) => px[3] === 0;
+  const firstLand = pixels.findIndex(isLand);
+  console.log(`  along 45.65 N: ${pixels.map((p) => (isLand(p) ? "#" : isSea(p) ? "." : "+")).join("")}`);
+  assert(firstLand > 0, "sea west of Trieste, land east of it");
+  assert(pixels.slice(0, firstLand - 2).every(isSea), "the Gulf of Trieste is sea");
+  assert(pixels.slice(firstLand + 2).every(isLand), "the Karst east of the city is land");
+  near(lons[firstLand], 13.767, 0.03, "the coast at Trieste (deg E)");
+  // The coastline itself is stroked there (light blue, #8fb3cf).
+  const coastPx = offsetPx(lat0, lon0, zoom, lat0, lons[firstLand]);
+  const stroke = await a.page.evaluate(([p, mapW, mapH]) => {
+    const c = document.querySelector(".leaflet-basemap-pane canvas");
+    const rect = c.getBoundingClientRect(), map = document.querySelector("#map").getBoundingClientRect();
+    const k = c.width / rect.width, g = c.getContext("2d");
+    const x = (map.left + mapW / 2 + p.x - rect.left) * k, y = (map.top + mapH / 2 + p.y - rect.top) * k;
+    const d = g.getImageData(Math.round(x - 8 * k), Math.round(y - 2 * k), Math.round(16 * k), Math.round(4 * k)).data;
+    let blue = 0;
+    for (let i = 0; i < d.length; i += 4) if (d[i + 2] > 150 && d[i + 1] > 120 && d[i] > 90 && d[i] < 200) ++blue;
+    return blue;
+  }, [coastPx, box.width, box.height]);
+  assert(stroke > 0, "the coastline's stroke at the coast");
+  noProblems(a.problems);
+};
+
+// METAR stations on the map: every station of the server's table is a
+// marker, coloured by the flight category of its latest applied report;
+// a newer report changes the colour live, and a click shows the report and
+// the layers it became.
+cases.stations = async (cleanup) => {
+  const { w, browser } = await setup("stations", cleanup);
+  const table = fs.readFileSync(config.stations, "utf8").split("\n").filter((l) => /^[A-Z0-9]{4},/.test(l))
+    .map((l) => l.split(",")[0]);
+  const a = await openConsole(browser, w, { name: "A", hash: "#focus=46.0,13.2&zoom=8" });
+  await until("a marker per station", async () => (await a.page.$$(".station")).length === new Set(table).size);
+  const category = (icao) => a.page.getAttribute(`.station[data-icao="${icao}"]`, "data-category");
+  const colour = (icao) => a.page.$eval(`.station[data-icao="${icao}"] .station-dot`, (e) => getComputedStyle(e).backgroundColor);
+  assert((await category("LJLJ")) === "", "no report yet: no category");
+  // The colours pilots know (aviationweather.gov): VFR green, MVFR blue, IFR red, LIFR magenta.
+  const expected = { VFR: "rgb(46, 204, 64)", MVFR: "rgb(58, 123, 255)", IFR: "rgb(255, 59, 48)", LIFR: "rgb(224, 64, 251)" };
+  // [report, its category by ceiling and visibility (FAA AIM 7-1-7)]
+  const reports = {
+    LJLJ: ["METAR LJLJ 221150Z 24008KT 9999 FEW025 SCT045 BKN090 12/06 Q1018", "VFR"],  // ceiling 9000 ft, 10 km
+    LOWK: ["METAR LOWK 221150Z 31005KT 6000 BKN025 09/02 Q1020", "MVFR"],               // 2500 ft, 3.7 SM
+    LIPZ: ["METAR LIPZ 221150Z 18006KT 4000 BR BKN012 14/12 Q1016", "IFR"],             // 1200 ft but 2.5 SM
+    LIPH: ["METAR LIPH 221150Z 17005KT 9999 OVC007 13/12 Q1016", "IFR"],                // ceiling 700 ft
+    LIPQ: ["METAR LIPQ 221150Z 22004KT 0800 FG VV002 11/11 Q1017", "LIFR"],             // 200 ft, 0.5 SM
+  };
+  const applied = await w.api("POST", "/api/metar", { apply: true, author: "test", reports: Object.values(reports).map((x) => x[0]) });
+  assert(applied.status === 200, applied.text);
+  const listed = (await w.api("GET", "/api/metar/stations")).json.stations;
+  for (const icao of Object.keys(reports))
+    assert(listed.find((x) => x.icao === icao).report.text === reports[icao][0], `${icao}'s report in GET /api/metar/stations`);
+  for (const [icao, [, cat]] of Object.entries(reports)) {
+    await until(`${icao} ${cat}`, async () => (await category(icao)) === cat);
+    assert((await colour(icao)) === expected[cat], `${icao}'s colour for ${cat}: ${await colour(icao)}`);
+  }
+  // A newer report: LJLJ goes down to LIFR, and its marker follows.
+  const worse = "METAR LJLJ 221220Z 24004KT 0600 FG OVC002 10/10 Q1018";
+  assert((await w.api("POST", "/api/metar", { apply: true, reports: [worse] })).status === 200, "the newer report");
+  await until("LJLJ turns LIFR", async () => (await category("LJLJ")) === "LIFR");
+  assert((await colour("LJLJ")) === expected.LIFR, "LJLJ magenta");
+  // The report and its layers on click.
+  await a.page.click('.station[data-icao="LJLJ"] .station-dot');
+  const popup = await until("LJLJ's popup", async () => {
+    const t = await a.page.textContent(".leaflet-popup-content").catch(() => "");
+    return /LJLJ/.test(t) && t;
+  });
+  assert(popup.includes(worse), `the report in the popup: ${popup}`);
+  assert(/LIFR/.test(popup) && /layer \d+: stratus 8\/8/.test(popup), `the category and the layer it became: ${popup}`);
+  noProblems(a.problems);
+};
+
+// Across the antimeridian and over the pole: a storm cell placed at 180
+// degrees with the region tool is one shape (one SVG path the size of the
+// cell, not a band round the world), seen from either side; a renderer over
+// the North Pole (fed into the page's WebSocket) is drawn at the map's top
+// edge and says so.
+cases.antimeridian = async (cleanup) => {
+  const { w, browser } = await setup("antimeridian", cleanup);
+  const lat0 = -17, zoom = 9;
+  const context = await browser.newContext({ viewport: { width: 1600, height: 1000 } });
+  cleanup(() => context.close());
+  // The live feed through the test: every renderers message gains one over the pole.
+  const pole = { id: 99, channel: "pole", peer: "test", lat_deg: 89.9, lon_deg: 30, alt_m: 3000, heading_deg: 180,
+    last_report_age_s: 0, area: { center_lat_deg: 89.9, center_lon_deg: 30, radius_m: 50000 } };
+  await context.routeWebSocket(/\/api\/ws$/, (ws) => {
+    const server = ws.connectToServer();
+    ws.onMessage((m) => server.send(m));
+    server.onMessage((m) => {
+      const msg = JSON.parse(m);
+      if (msg.type === "renderers") msg.renderers = [...(msg.renderers || []), pole];
+      ws.send(JSON.stringify(msg));
+    });
+  });
+  const page = await context.newPage();
+  const { watch } = await import("./harness.mjs");
+  const problems = watch(page, "A");
+  await page.goto(`${w.base}/#focus=${lat0},180&zoom=${zoom}`);
+  await until("live", async () => (await page.getAttribute("body", "data-link")) === "live");
+  await page.fill('[name="token"]', TOKEN);
+  await page.click("#token-use");
+  const { cx, cy, box } = await mapCentre(page);
+  await page.click("#mode-storm");
+  await page.mouse.click(cx, cy);
+  await until("the region form", async () => page.isVisible("#region-form"));
+  await page.click("#region-apply");
+  const region = await until("the cell in the API", async () => (await w.state()).regions[0]);
+  near(Math.abs(region.center_lon_deg), 180, 0.01, "the cell's centre at the antimeridian");
+  const cellPx = 10000 / metresPerPx(lat0, zoom);
+  for (const lon0 of [180, 179.8, -179.8]) {
+    await page.fill('[name="focus_lat"]', String(lat0));
+    await page.fill('[name="focus_lon"]', String(lon0));
+    await page.click('#focus-form button[type="submit"]');
+    const edge = page.locator(`path.region-edge.region-${region.id}`);
+    await until("the edge redrawn", async () => (await edge.count()) === 1);
+    const d = await edge.getAttribute("d");
+    const b = await edge.boundingBox();
+    const want = offsetPx(lat0, lon0, zoom, lat0, 180);
+    assert((d.match(/M/g) || []).length === 1, `one shape seen from ${lon0}: ${d.slice(0, 80)}`);
+    near(b.width, cellPx, 4, `the cell's width in px seen from ${lon0}`);
+    near(b.x + b.width / 2 - cx, want.x, 3, `the cell where 180 degrees is, seen from ${lon0}`);
+  }
+  // Over the pole: the view as far north as it goes shows Web Mercator's
+  // top edge (85.05 N) at the map's top; the aircraft is drawn whole just
+  // inside it (its centre 12 px down), and labelled.
+  await page.fill('[name="focus_lat"]', "89.9");
+  await page.fill('[name="focus_lon"]', "30");
+  await page.click('#focus-form button[type="submit"]');
+  const plane = page.locator('.aircraft[data-id="99"]');
+  await until("the aircraft over the pole", async () => (await plane.count()) === 1);
+  const mb = (await mapCentre(page)).box;
+  // The map pans back inside the world after the jump (animated): wait for it.
+  await until("the map's top at the world's edge", async () => {
+    const [focusLat] = (await page.getAttribute("#map", "data-focus")).split(",").map(Number);
+    return Math.abs(offsetPx(focusLat, 30, zoom, 85.0511287798, 30).y + mb.height / 2) < 2;
+  }, 5000);
+  const pb = await plane.locator("svg").boundingBox();
+  assert(pb.x > mb.x && pb.x + pb.width < mb.x + mb.width, "the aircraft within the map's width");
+  near(pb.y - mb.y, 0, 2, "the whole aircraft at the map's top");
+  assert(/89\.9\d*°N, beyond the map's edge/.test(await plane.textContent()), `labelled: ${await plane.textContent()}`);
+  noProblems(problems);
 };
 
 // A real renderer channel (skyshell-render, headless) flown by
@@ -469,27 +718,26 @@ cases.renderers = async (cleanup) => {
   }, 90000, 500);
   near(listed.lon_deg, 12.8, 0.02, "renderer longitude");
   near(listed.heading_deg, 90, 2, "renderer heading");
-  const lat0 = 46.2, lon0 = 12.8, scale = 20;
+  const lat0 = 46.2, lon0 = 12.8, zoom = 12.5;  // about 20 m per CSS px
   const a = await openConsole(browser, w, { name: "A",
-    hash: `#focus=${lat0},${lon0}&scale=${scale}` });
+    hash: `#focus=${lat0},${lon0}&zoom=${zoom}` });
   await until("the renderer row", async () => /46\.2/.test(await a.page.textContent("#renderers tbody")), 30000);
-  // The aircraft symbol is yellow (#ffe14d): look for it where the flight is
-  // on a flat local frame (the replay moves ~55 m/s east: up to 20 px here).
-  const found = await until("a yellow aircraft on the map", async () => {
+  // The aircraft is drawn where the flight is (Web Mercator computed here),
+  // nose to its heading (east); the replay moves ~55 m/s east, so the pose
+  // is read just before the symbol and allowed 20 px.
+  const { cx, cy } = await mapCentre(a.page);
+  const found = await until("the aircraft on the map where the flight is", async () => {
     const r = (await w.api("GET", "/api/renderers")).json;
     const pose = (Array.isArray(r) ? r : r.renderers).find((x) => x.lat_deg !== null);
-    const x = ((pose.lon_deg - lon0) * D2R * R * Math.cos(lat0 * D2R)) / scale;
-    const y = (-(pose.lat_deg - lat0) * D2R * R) / scale;
-    return a.page.evaluate(([dx, dy]) => {
-      const c = document.querySelector("#map");
-      const g = c.getContext("2d");
-      const k = c.width / c.getBoundingClientRect().width;
-      const cx = (c.width / 2 + dx * k) | 0, cy = (c.height / 2 + dy * k) | 0, half = (30 * k) | 0;
-      const img = g.getImageData(cx - half, cy - half, 2 * half, 2 * half).data;
-      let yellow = 0;
-      for (let i = 0; i < img.length; i += 4) if (img[i] > 230 && img[i + 1] > 200 && img[i + 2] < 120) ++yellow;
-      return yellow > 10;
-    }, [x, y]);
+    const want = offsetPx(lat0, lon0, zoom, pose.lat_deg, pose.lon_deg);
+    const plane = a.page.locator(".aircraft").first();
+    const box = await plane.locator("svg").boundingBox();
+    if (!box) return false;
+    const x = box.x + box.width / 2 - cx, y = box.y + box.height / 2 - cy;
+    const transform = await plane.locator("svg").evaluate((e) => e.style.transform);
+    console.log(`  aircraft at (${x.toFixed(1)}, ${y.toFixed(1)}) px, flight at (${want.x.toFixed(1)}, ${want.y.toFixed(1)}), ${transform}`);
+    const angle = Number((/rotate\(([-\d.]+)deg\)/.exec(transform) || [])[1]);
+    return Math.hypot(x - want.x, y - want.y) < 20 && Math.abs(angle - 90) < 3;
   }, 30000, 500);
   assert(found, "the aircraft is drawn");
   noProblems(a.problems);
@@ -550,6 +798,17 @@ cases.installed = async (cleanup) => {
   assert(js.status === 200 && /text\/javascript/.test(js.headers.get("content-type")), "app.js as JavaScript");
   const logged = w.log();
   assert(logged.includes(path.join(prefix, "share", "skyshell", "console")), `served from the prefix: ${logged}`);
+  // The map library and the Natural Earth data are installed and served
+  // with the page, each with its licence.
+  for (const [file, type] of [["leaflet.js", /text\/javascript/], ["leaflet.css", /text\/css/],
+    ["topojson-client.min.js", /text\/javascript/], ["countries-50m.json", /application\/json/],
+    ["leaflet-LICENSE.txt", /text\/plain/], ["topojson-client-LICENSE.txt", /text\/plain/],
+    ["world-atlas-LICENSE.txt", /text\/plain/]]) {
+    const r = await fetch(`${w.base}/console/${file}`);
+    assert(r.status === 200 && type.test(r.headers.get("content-type")), `${file}: ${r.status} ${r.headers.get("content-type")}`);
+  }
+  const topo = await (await fetch(`${w.base}/console/countries-50m.json`)).json();
+  assert(topo.type === "Topology" && topo.objects.land && topo.objects.countries, "Natural Earth's land and countries");
 };
 
 const name = process.argv[2];

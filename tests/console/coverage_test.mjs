@@ -80,4 +80,24 @@ run("coverage", async () => {
   const wa = regionWeight(a, mid.lat_deg, mid.lon_deg), wb = regionWeight(b, mid.lat_deg, mid.lon_deg);
   assert(wa === 1 && wb === 1, "the midpoint is inside both");
   near(coverageAt(both, 1, mid.lat_deg, mid.lon_deg), 0.6, 1e-12, "two full weights: the mean of 0.2 and 1.0");
+
+  // Flight categories (FAA AIM 7-1-7; the station markers' colours) at and
+  // across each bound of ceiling and visibility, in metres and statute miles.
+  const { flightCategory, readReport } = await import("../../server/console/flight_category.js");
+  const cat = (groups) => flightCategory(`METAR LJLJ 221150Z 24008KT ${groups} 12/06 Q1018`);
+  for (const [groups, want] of [
+    ["9999 FEW025 SCT045 BKN090", "VFR"], ["CAVOK", "VFR"], ["9999 NSC", "VFR"], ["10SM SKC", "VFR"],
+    ["9999 BKN031", "VFR"], ["9999 BKN030", "MVFR"], ["9999 OVC010", "MVFR"], ["9999 OVC009", "IFR"],
+    ["9999 BKN005", "IFR"], ["9999 BKN004", "LIFR"], ["0800 FG VV002", "LIFR"], ["9999 VV///", "LIFR"],
+    ["P6SM SCT010", "VFR"], ["5SM BKN040", "MVFR"], ["6SM BKN040", "VFR"], ["3SM SCT040", "MVFR"],
+    ["2 1/2SM BR", "IFR"], ["1SM BR", "IFR"], ["M1SM FG", "LIFR"], ["1/2SM FG OVC002", "LIFR"],
+    ["9000 SCT020", "VFR"], ["8000 SCT020", "MVFR"], ["6000 FEW020", "MVFR"], ["4000 BR", "IFR"], ["1700 BR", "IFR"], ["1500 BR", "LIFR"],
+    // A ceiling of few/scattered clouds is none; the trend after NOSIG/TEMPO is not the observation.
+    ["9999 SCT003", "VFR"], ["9999 FEW030 TEMPO 0500 FG", "VFR"], ["9999 BKN040 RMK OVC002", "VFR"],
+    ["4000NE BKN050", "IFR"], ["9999NDV OVC035", "VFR"],
+  ]) assert(cat(groups) === want, `'${groups}' is ${cat(groups)}, expected ${want}`);
+  assert(flightCategory("METAR LJLJ 221150Z 24008KT ////// 12/06 Q1018") === null, "no sky, no visibility: no category");
+  const read = readReport("METAR KJFK 221151Z 18012KT 1 3/4SM BR BKN008 OVC015 12/11 A2992");
+  near(read.visibility_sm, 1.75, 1e-12, "1 3/4SM");
+  assert(read.ceiling_ft === 800, `the lowest broken layer: ${read.ceiling_ft}`);
 });

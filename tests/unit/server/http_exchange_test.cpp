@@ -176,6 +176,50 @@ TEST_F(HttpExchangeTest, MetarNeedsTheTokenOnlyWhenApplying) {
   EXPECT_EQ(api_->counters().unauthorized, 1u);
 }
 
+// GET /api/metar/stations (issue 23: the console's station markers): an
+// applied report is listed with its station, its text and the layers it
+// became; a preview is not; a station whose region is gone has no report;
+// "remove" forgets it.
+TEST_F(HttpExchangeTest, MetarStationsListTheLatestAppliedReport) {
+  const auto stations = [&] {
+    const Answer a = request("GET", "/api/metar/stations");
+    EXPECT_EQ(a.status, 200) << a.body;
+    return nlohmann::json::parse(a.body)["stations"];
+  };
+  EXPECT_TRUE(stations().empty()) << "no --metar-stations table in this fixture, nothing applied";
+  const std::string body = R"({"reports": ["METAR LIPQ 201150Z 24008KT 1500 BR OVC004 15/08 Q1015"],
+    "stations": [{"icao": "LIPQ", "lat_deg": 45.8, "lon_deg": 13.5, "elevation_m": 12}]})";
+  ASSERT_EQ(request("POST", "/api/metar", body).status, 200);
+  EXPECT_TRUE(stations().empty()) << "a preview is not applied";
+  std::string apply = body;
+  apply.insert(1, R"("apply": true, )");
+  const Answer applied = request("POST", "/api/metar", apply, bearer());
+  ASSERT_EQ(applied.status, 200) << applied.body;
+  const auto list = stations();
+  ASSERT_EQ(list.size(), 1u) << list;
+  EXPECT_EQ(list[0]["icao"], "LIPQ");
+  EXPECT_DOUBLE_EQ(list[0]["lat_deg"].get<double>(), 45.8);
+  const auto& report = list[0]["report"];
+  ASSERT_TRUE(report.is_object()) << list;
+  EXPECT_EQ(report["text"], "METAR LIPQ 201150Z 24008KT 1500 BR OVC004 15/08 Q1015");
+  EXPECT_EQ(report["sequence"], nlohmann::json::parse(applied.body)["applied"]["sequence"]);
+  EXPECT_EQ(report["sky"], "read");
+  ASSERT_FALSE(report["layers"].empty());
+  const auto regionId = report["region_id"].get<std::uint32_t>();
+  // The region removed by another change: the station stays, its report goes.
+  const std::string removeRegion = R"({"changes": [{"op": "remove_region", "id": )" + std::to_string(regionId) + "}]}";
+  ASSERT_EQ(request("POST", "/api/changes", removeRegion, bearer()).status, 200);
+  EXPECT_TRUE(stations()[0]["report"].is_null()) << stations();
+  // "remove" forgets a station a request brought.
+  ASSERT_EQ(request("POST", "/api/metar", apply, bearer()).status, 200);
+  EXPECT_TRUE(stations()[0]["report"].is_object());
+  const Answer removed = request("POST", "/api/metar", R"({"apply": true, "remove": ["LIPQ"],
+    "stations": [{"icao": "LIPQ", "lat_deg": 45.8, "lon_deg": 13.5, "elevation_m": 12}]})", bearer());
+  ASSERT_EQ(removed.status, 200) << removed.body;
+  EXPECT_TRUE(stations().empty()) << stations();
+  EXPECT_EQ(findRoute("/api/metar/stations")->token, TokenRule::None);
+}
+
 TEST_F(HttpExchangeTest, ForeignHostOrOriginIsForbidden) {
   EXPECT_EQ(send("GET /api/state HTTP/1.1\r\nHost: evil.example:" + std::to_string(api_->port()) + "\r\n\r\n").status,
             403);

@@ -7,6 +7,8 @@
 //   POST /api/scenario   a scenario file; needs the token
 //   POST /api/metar      METAR reports previewed, or applied with the token
 //                        (metar_api.hpp)
+//   GET  /api/metar/stations  the station table with each station's latest
+//                        applied report (metar_stations.hpp)
 //   GET  /, /console/*   the operator console's files, when options.console is set
 //                        (console_files.hpp)
 //   GET  /api/renderers  the weather-stream subscribers and their cameras
@@ -41,6 +43,7 @@
 #include "sky/server/http_routes.hpp"
 #include "sky/server/live_weather.hpp"
 #include "sky/server/metar.hpp"
+#include "sky/server/metar_stations.hpp"
 #include "sky/server/rejections.hpp"
 
 namespace spdlog {
@@ -143,6 +146,7 @@ class HttpApi {
   std::shared_ptr<Registry> registry_;
   std::uint16_t port_ = 0;
   Counters counters_;
+  MetarStationBoard metarStations_;  // the reports POST /api/metar applied
   std::array<bool, kRejectReasons> logged_{};
   bool acceptErrorLogged_ = false;
   bool closed_ = false;

@@ -24,6 +24,7 @@ enum class Endpoint {
   Changes,
   Scenario,
   Metar,
+  MetarStations,  // GET /api/metar/stations (metar_stations.hpp)
   Grib,
   Feed,  // GET /api/ws: the console's WebSocket (an upgrade, never a plain answer)
 };

@@ -1,0 +1,48 @@
+// GET /api/metar/stations: the METAR stations the console marks on its map,
+// each with the latest report applied to it through POST /api/metar (the raw
+// text and the layers it became) while its region is still in the weather.
+// Kept in memory by the HTTP API: after a restart the stations' regions are
+// still there (the store keeps them), their report texts are not.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <span>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "sky/server/change.hpp"
+#include "sky/server/metar.hpp"
+#include "sky/server/metar_api.hpp"
+
+namespace sky::server {
+
+class MetarStationBoard {
+ public:
+  // Remembers the reports of an applied POST /api/metar: `reply` is
+  // handleMetar's body for `request` (status 200, "applied" set). A report
+  // that set a station's region replaces that station's entry; a removed
+  // station is forgotten.
+  void remember(const MetarRequest& request, const nlohmann::json& reply, std::span<const Station> serverStations);
+
+  // {"stations": [{"icao", "lat_deg", "lon_deg", "elevation_m", "report": null or
+  //   {"text", "region_id", "sequence", "clock_s", "sky", "layers": [LAYER...]}}]}:
+  // the server's table in its order, then stations only requests brought
+  // (by ICAO). A report is shown only while its region is in `now`.
+  nlohmann::json list(std::span<const Station> serverStations, const WeatherView& now) const;
+
+ private:
+  struct Entry {
+    Station station;
+    std::string text;
+    std::uint32_t regionId = 0;
+    std::uint64_t sequence = 0;
+    double clock_s = 0;
+    nlohmann::json sky;
+    nlohmann::json layers;
+  };
+  std::map<std::string, Entry> latest_;  // by ICAO
+};
+
+}  // namespace sky::server
