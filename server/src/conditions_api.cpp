@@ -26,7 +26,8 @@ nlohmann::json conditionsJson(const LiveWeather& weather, const ConditionsQuery&
     t.blend = weather::dequantizeUnit(weather::quantizeUnit(t.blend));
   }
   const weather::PointWeather pw =
-      weather::weatherAt(snapshot.layers, weather::snapshotLookup(snapshot, clock_s), q.lat_deg, q.lon_deg, q.alt_m);
+      weather::weatherAt(snapshot.layers, weather::snapshotLookup(snapshot, clock_s), q.lat_deg, q.lon_deg, q.alt_m,
+                         weather::snapshotWindLookup(snapshot));
   // Where each forecast layer's cover at the point comes from.
   nlohmann::json sources = nlohmann::json::object();
   if (field)

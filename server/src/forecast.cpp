@@ -328,6 +328,7 @@ Result<Forecast> Forecast::fromGrib(const std::vector<const GribFile*>& files, s
                         " m, " + std::to_string(static_cast<int>(l.layer.thickness_m)) + " m thick: " + l.heightFrom);
     fc.layers_.push_back(std::move(l));
   }
+  fc.wind_ = ForecastWind::fromGrib(files, fc.notes_);
   fc.reference_unix_ = reference.value_or(0);
   fc.firstValid_unix_ = *valids.begin();
   fc.lastValid_unix_ = *valids.rbegin();
@@ -387,6 +388,27 @@ ForecastField::ForecastField(std::shared_ptr<const Forecast> forecast, std::uint
     h *= 1099511628211ull;
   }
   key_ = h;
+}
+
+std::optional<weather::WindVector> Forecast::windAt(const ForecastLayer& layer, double lat_deg, double lon_deg,
+                                                   double valid_unix) const {
+  return wind_.at(lat_deg, lon_deg, layer.layer.base_m + layer.layer.thickness_m / 2, valid_unix);
+}
+
+bool ForecastField::givesWind(std::uint32_t layerId) const {
+  return !forecast_->wind().empty() && gives(layerId);
+}
+
+void ForecastField::sampleWind(std::uint32_t layerId, std::span<const weather::CellCentre> at,
+                               std::span<weather::WindVector> out) const {
+  const ForecastLayer* layer = nullptr;
+  for (const ForecastLayer& l : forecast_->layers())
+    if (l.layer.id == layerId) layer = &l;
+  constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t k = 0; k < at.size() && k < out.size(); ++k) {
+    const auto w = layer ? forecast_->windAt(*layer, at[k].lat_deg, at[k].lon_deg, valid_unix_) : std::nullopt;
+    out[k] = w.value_or(weather::WindVector{kNone, kNone, kNone});
+  }
 }
 
 bool ForecastField::gives(std::uint32_t layerId) const {

@@ -132,6 +132,7 @@ Result<GribGrid> gridOf(codes_handle* h) {
   g.iNegative = flag("iScansNegatively");
   g.jPositive = flag("jScansPositively");
   g.jConsecutive = flag("jPointsAreConsecutive");
+  g.uvRelativeToGrid = flag("uvRelativeToGrid");
   auto dbl = [&](const char* key, double& out) -> Result<void> {
     const auto v = getDouble(h, key);
     if (!v) return tl::unexpected(v.error());

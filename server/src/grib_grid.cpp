@@ -198,4 +198,13 @@ float sampleField(const GribGrid& g, std::span<const float> values, double lat_d
   return static_cast<float>(sum / weight);
 }
 
+std::pair<double, double> eastNorthWind(const GribGrid& grid, double lat_deg, double lon_deg, double u, double v) {
+  (void)lat_deg;  // a conic projection's convergence depends on longitude alone
+  if (!grid.uvRelativeToGrid || grid.projection != GribGrid::Projection::Lambert) return {u, v};
+  const double theta = coneOf(grid).n * geo::normalizeLon_deg(lon_deg - grid.lov_deg) * kDeg;
+  // The grid's +y is north turned clockwise by theta (east of LoV, where the
+  // meridians lean towards the apex), its +x east turned the same way.
+  return {u * std::cos(theta) + v * std::sin(theta), -u * std::sin(theta) + v * std::cos(theta)};
+}
+
 }  // namespace sky::server

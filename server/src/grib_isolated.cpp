@@ -70,7 +70,8 @@ json metaJson(const GribMeta& m) {
             {"latin2", g.latin2_deg},
             {"dx", g.dx_m},
             {"dy", g.dy_m},
-            {"radius", g.radius_m}}}};
+            {"radius", g.radius_m},
+            {"uvRelativeToGrid", g.uvRelativeToGrid}}}};
 }
 
 Result<GribMeta> metaFromJson(const json& j) {
@@ -107,6 +108,7 @@ Result<GribMeta> metaFromJson(const json& j) {
     grid.dx_m = g.at("dx").get<double>();
     grid.dy_m = g.at("dy").get<double>();
     grid.radius_m = g.at("radius").get<double>();
+    grid.uvRelativeToGrid = g.value("uvRelativeToGrid", false);
     if (auto v = validate(grid); !v) return tl::unexpected(v.error());
     return m;
   } catch (const json::exception& e) {

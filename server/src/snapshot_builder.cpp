@@ -1,5 +1,6 @@
 // Snapshot building (see snapshot_builder.hpp).
 #include "sky/server/snapshot_builder.hpp"
+#include "sky/server/wind_tiles.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -26,6 +27,8 @@ constexpr double kMeanEarthRadius_m = 6371008.8;
 // Cube faces: no covering of anything has fewer cells per level than this
 // bound allows for, so it is the smallest budget that can always be met.
 constexpr std::size_t kMinCells = 6;
+// The most of a frame wind tiles take from cover tiles (a quarter of it).
+constexpr std::size_t kMaxWindFrameTiles = kMaxWindLayers * kMaxWindCells;
 
 // Upper estimate of the cells covering `cap` at `level`: its area in cells plus
 // a ring of boundary cells. Only used to avoid asking S2 for a covering that
@@ -43,15 +46,23 @@ double estimatedCells(const weather::SphericalCap& cap, int level) {
 
 }  // namespace
 
-namespace {
-// Defined below with the other region bounds.
-double sphereDistance_m(double lat1, double lon1, double lat2, double lon2);
-double reachOf(const weather::Region& r);
-}  // namespace
+double sphereDistance_m(double lat1, double lon1, double lat2, double lon2) {
+  constexpr double kDegToRad = std::numbers::pi / 180.0;
+  const double s1 = std::sin((lat2 - lat1) * kDegToRad / 2), s2 = std::sin((lon2 - lon1) * kDegToRad / 2);
+  const double h = s1 * s1 + std::cos(lat1 * kDegToRad) * std::cos(lat2 * kDegToRad) * s2 * s2;
+  return 2 * kMeanEarthRadius_m * std::asin(std::min(1.0, std::sqrt(h)));
+}
 
-std::size_t cellBudget(std::size_t maxCells, std::size_t layerCount) {
+// Half diagonal plus perimeter, with 1 % and 1 km for the ellipsoid and the
+// sphere bound's own error.
+double reachOf(const weather::Region& r) {
+  return 1.01 * (std::hypot(r.sizeX_m, r.sizeY_m) / 2 + r.transition_m) + 1000.0;
+}
+
+std::size_t cellBudget(std::size_t maxCells, std::size_t layerCount, std::size_t windTiles) {
+  static_assert(stream::kWindTileWireBytes == kTileWireBytes, "a wind tile takes a cover tile's room");
   const std::size_t tilesPerFrame =
-      (stream::kMaxFrameBytes - kFrameHeadroomBytes) / kTileWireBytes;
+      (stream::kMaxFrameBytes - kFrameHeadroomBytes) / kTileWireBytes - std::min(windTiles, kMaxWindFrameTiles);
   const std::size_t byFrame = tilesPerFrame / std::max<std::size_t>(layerCount, 1);
   return std::max(kMinCells, std::min(maxCells, byFrame));
 }
@@ -105,21 +116,6 @@ std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLa
 namespace {
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
-
-// Great-circle distance on the mean sphere, m: a cheap bound to skip regions
-// far from an area before the exact geodesic measure.
-double sphereDistance_m(double lat1, double lon1, double lat2, double lon2) {
-  const double s1 = std::sin((lat2 - lat1) * kDegToRad / 2), s2 = std::sin((lon2 - lon1) * kDegToRad / 2);
-  const double h = s1 * s1 + std::cos(lat1 * kDegToRad) * std::cos(lat2 * kDegToRad) * s2 * s2;
-  return 2 * kMeanEarthRadius_m * std::asin(std::min(1.0, std::sqrt(h)));
-}
-
-// Half diagonal plus perimeter, with 1 % and 1 km for the ellipsoid and the
-// sphere bound's own error: beyond this (sphere distance from the centre) a
-// region's weight is 0.
-double reachOf(const weather::Region& r) {
-  return 1.01 * (std::hypot(r.sizeX_m, r.sizeY_m) / 2 + r.transition_m) + 1000.0;
-}
 
 // A region's reach as a bound on the dot product of unit vectors: a cell
 // whose centre has dot(centre, region centre) below it is out of reach.
@@ -357,6 +353,10 @@ double TileCache::cellWeight(const ShapeKey& shape, const weather::Region& regio
   return w;
 }
 
+void TileCache::makeRoomForShapes(Entry& entry, std::size_t regions) {
+  if (entry.shapeWeights.size() + regions > kMaxShapesPerCovering) entry.shapeWeights.clear();
+}
+
 const TileCache::Weights& TileCache::weights(Entry& entry, const weather::Region& region) {
   // (Never erases: the caller bounds entry.shapeWeights before asking.)
   const ShapeKey shape = shapeKey(region);
@@ -403,7 +403,7 @@ std::vector<LayerRun> deriveRuns(TileCache& cache, TileCache::Entry& entry,
                                  std::span<const weather::CloudLayer> layers,
                                  std::span<const weather::Region> regions, const LayerField* field) {
   // Room for every region's weights first: the pointers below must stay valid.
-  if (entry.shapeWeights.size() + regions.size() > kMaxShapesPerCovering) entry.shapeWeights.clear();
+  TileCache::makeRoomForShapes(entry, regions.size());
   // The regions that can reach a cell of this covering (its cells reach past
   // the cap by up to a cell: S2 cells are at most about twice the average
   // edge across); the others change nothing here.
@@ -487,12 +487,15 @@ BuiltSnapshot buildSnapshotWithGenerations(const stream::Subscribe& request,
                                            TileCache* cache, const LayerField* field) {
   const weather::CellCentre centre{request.area.centerLat_deg, request.area.centerLon_deg};
   const std::vector<weather::CloudLayer> table = snapshotLayers(layers, regions, &centre);
-  const std::size_t budget = cellBudget(maxCells, table.size());
   BuiltSnapshot built;
   weather::WeatherSnapshot& snapshot = built.snapshot;
   snapshot.weatherClock_s = clock_s;
   snapshot.layers = table;
   snapshot.areaIndex = request.areaIndex;
+  WindTiles wind = deriveWindTiles(request.area, table, regions, field, cache);
+  snapshot.windTileLevel = wind.level;
+  snapshot.windTiles = std::move(wind.tiles);
+  const std::size_t budget = cellBudget(maxCells, table.size(), snapshot.windTiles.size());
   // No region reaches the area: the weather there is uniform and needs no
   // tiles, so no covering either (the level is the one the budget allows).
   const auto& cap = request.area;

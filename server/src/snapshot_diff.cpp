@@ -15,7 +15,12 @@ bool byLayer(const BuiltSnapshot& s) {
 
 // The snapshot's layer table alone, at `tileLevel`.
 weather::WeatherSnapshot tableOf(const BuiltSnapshot& s, int tileLevel) {
-  return {s.snapshot.weatherClock_s, s.snapshot.layers, tileLevel, {}, s.snapshot.areaIndex};
+  weather::WeatherSnapshot t;
+  t.weatherClock_s = s.snapshot.weatherClock_s;
+  t.layers = s.snapshot.layers;
+  t.tileLevel = tileLevel;
+  t.areaIndex = s.snapshot.areaIndex;
+  return t;
 }
 
 const LayerRun* runOf(const BuiltSnapshot& s, std::uint32_t layerId) {
@@ -73,6 +78,19 @@ std::optional<weather::WeatherDelta> diffBuilt(const BuiltSnapshot& before, cons
   // when layers were reordered), from the tables alone.
   auto delta = weather::diffSnapshots(tableOf(before, afterLevel), tableOf(after, afterLevel));
   if (!delta) return std::nullopt;
+  // Wind tiles (a few thousand at most) by the general diff, on the tables.
+  if (!before.snapshot.windTiles.empty() || !after.snapshot.windTiles.empty() ||
+      before.snapshot.windTileLevel != after.snapshot.windTileLevel) {
+    weather::WeatherSnapshot windBefore = tableOf(before, afterLevel), windAfter = tableOf(after, afterLevel);
+    windBefore.windTileLevel = before.snapshot.windTileLevel;
+    windBefore.windTiles = before.snapshot.windTiles;
+    windAfter.windTileLevel = after.snapshot.windTileLevel;
+    windAfter.windTiles = after.snapshot.windTiles;
+    const auto wind = weather::diffSnapshots(windBefore, windAfter);
+    if (!wind) return std::nullopt;
+    delta->windTileLevel = wind->windTileLevel;
+    delta->windTiles = wind->windTiles;
+  }
   // Tiles, in the order of `after`'s: per layer, the tiles that differ from
   // the same layer's before. Any layer whose cells are not the ones it had
   // (a layer gaining or losing tiles, a covering that moved) goes through

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <tuple>
 
 #include "sky/core/overloaded.hpp"
 #include "sky/stream/framing.hpp"
@@ -164,6 +165,32 @@ Result<std::vector<weather::CoverageTile>> decodeTiles(const char* message, int 
   return out;
 }
 
+Result<std::vector<weather::WindTile>> decodeWindTiles(const char* message, int level,
+                                                       const flatbuffers::Vector<const fbs::WindTile*>* tiles) {
+  std::vector<weather::WindTile> out;
+  if (!tiles) return out;
+  if (auto r = checkCount(message, "wind_tiles", tiles->size(), kMaxMessageTiles); !r) return tl::unexpected(r.error());
+  // As for coverage tiles: the verifier does not check the 8-byte alignment.
+  if (tiles->size() > 0 && reinterpret_cast<std::uintptr_t>(tiles->Data()) % alignof(fbs::WindTile) != 0)
+    return fail(ErrorCode::Malformed, std::string(message) + ".wind_tiles: vector of structs is misaligned");
+  out.reserve(tiles->size());
+  for (flatbuffers::uoffset_t i = 0; i < tiles->size(); ++i) {
+    const fbs::WindTile* t = tiles->Get(i);
+    const std::string at = std::string(message) + ".wind_tiles[" + std::to_string(i) + "]";
+    if (!weather::isCellAtLevel(t->cell_id(), level))
+      return fail(ErrorCode::InvalidArgument, at + ".cell_id " + std::to_string(t->cell_id()) +
+                                                  " is not an S2 cell of level " + std::to_string(level));
+    for (auto [name, v, limit] : {std::tuple{"east_cmps", t->east_cmps(), 15000}, {"north_cmps", t->north_cmps(), 15000},
+                                  {"up_cmps", t->up_cmps(), 5000}})
+      if (v < -limit || v > limit)
+        return fail(ErrorCode::InvalidArgument, at + "." + name + " " + std::to_string(v) + " outside [-" +
+                                                    std::to_string(limit) + ", " + std::to_string(limit) + "]");
+    out.push_back({t->cell_id(), t->layer_id(), weather::dequantizeWind(t->east_cmps()),
+                   weather::dequantizeWind(t->north_cmps()), weather::dequantizeWind(t->up_cmps())});
+  }
+  return out;
+}
+
 Result<Message> decodeSnapshot(const fbs::Snapshot& s) {
   weather::WeatherSnapshot out;
   out.weatherClock_s = s.weather_clock_s();
@@ -181,6 +208,12 @@ Result<Message> decodeSnapshot(const fbs::Snapshot& s) {
   auto tiles = decodeTiles("Snapshot", out.tileLevel, s.tiles());
   if (!tiles) return tl::unexpected(tiles.error());
   out.tiles = std::move(*tiles);
+  out.windTileLevel = s.wind_tile_level();
+  if (auto r = checkRange("Snapshot", "wind_tile_level", out.windTileLevel, 0, 30); !r)
+    return tl::unexpected(r.error());
+  auto windTiles = decodeWindTiles("Snapshot", out.windTileLevel, s.wind_tiles());
+  if (!windTiles) return tl::unexpected(windTiles.error());
+  out.windTiles = std::move(*windTiles);
   // Every tile's layer by binary search in the sorted ids: O(tiles log layers).
   const auto ids = sortedUniqueIds("Snapshot", out.layers);
   if (!ids) return tl::unexpected(ids.error());
@@ -188,6 +221,10 @@ Result<Message> decodeSnapshot(const fbs::Snapshot& s) {
     if (!std::binary_search(ids->begin(), ids->end(), t.layerId))
       return fail(ErrorCode::InvalidArgument,
                   "Snapshot.tiles: a tile of layer " + std::to_string(t.layerId) + ", which the Snapshot does not have");
+  for (const auto& t : out.windTiles)
+    if (!std::binary_search(ids->begin(), ids->end(), t.layerId))
+      return fail(ErrorCode::InvalidArgument, "Snapshot.wind_tiles: a tile of layer " + std::to_string(t.layerId) +
+                                                  ", which the Snapshot does not have");
   return Message(std::move(out));
 }
 
@@ -211,6 +248,11 @@ Result<Message> decodeDelta(const fbs::Delta& d) {
   auto tiles = decodeTiles("Delta", out.tileLevel, d.tiles());
   if (!tiles) return tl::unexpected(tiles.error());
   out.tiles = std::move(*tiles);
+  out.windTileLevel = d.wind_tile_level();
+  if (auto r = checkRange("Delta", "wind_tile_level", out.windTileLevel, 0, 30); !r) return tl::unexpected(r.error());
+  auto windTiles = decodeWindTiles("Delta", out.windTileLevel, d.wind_tiles());
+  if (!windTiles) return tl::unexpected(windTiles.error());
+  out.windTiles = std::move(*windTiles);
   return Message(std::move(out));
 }
 
@@ -284,6 +326,16 @@ std::vector<fbs::Tile> encodeTiles(const std::vector<weather::CoverageTile>& til
   return out;
 }
 
+std::vector<fbs::WindTile> encodeWindTiles(const std::vector<weather::WindTile>& tiles) {
+  std::vector<fbs::WindTile> out;
+  out.reserve(tiles.size());
+  for (const auto& t : tiles)
+    out.emplace_back(t.cellId, static_cast<std::uint16_t>(t.layerId), weather::quantizeWind(t.east_mps, 150),
+                     weather::quantizeWind(t.north_mps, 150), weather::quantizeWind(t.up_mps, 50));
+  return out;
+}
+
+static_assert(sizeof(fbs::WindTile) == kWindTileWireBytes, "kWindTileWireBytes must match the schema's WindTile");
 static_assert(sizeof(fbs::Tile) == kTileWireBytes, "kTileWireBytes must match the schema's Tile");
 static_assert(kMaxMessageTiles * kTileWireBytes == kMaxFrameBytes, "kMaxMessageTiles: the tiles of one full frame");
 
@@ -310,10 +362,12 @@ std::vector<std::uint8_t> encodeMessage(const Message& message) {
             std::vector<flatbuffers::Offset<fbs::Layer>> layers;
             for (const auto& l : s.layers) layers.push_back(encodeLayer(b, l));
             const std::vector<fbs::Tile> tiles = encodeTiles(s.tiles);
+            const std::vector<fbs::WindTile> windTiles = encodeWindTiles(s.windTiles);
             return std::pair{fbs::Body::Snapshot,
                              fbs::CreateSnapshotDirect(b, s.weatherClock_s, &layers,
                                                        static_cast<std::uint8_t>(s.tileLevel), &tiles,
-                                                       s.areaIndex)
+                                                       s.areaIndex, static_cast<std::uint8_t>(s.windTileLevel),
+                                                       s.windTiles.empty() ? nullptr : &windTiles)
                                  .Union()};
           },
           [&](const Heartbeat& h) {
@@ -327,9 +381,12 @@ std::vector<std::uint8_t> encodeMessage(const Message& message) {
             std::vector<flatbuffers::Offset<fbs::Layer>> layers;
             for (const auto& l : d.layers) layers.push_back(encodeLayer(b, l));
             const std::vector<fbs::Tile> tiles = encodeTiles(d.tiles);
+            const std::vector<fbs::WindTile> windTiles = encodeWindTiles(d.windTiles);
             return std::pair{fbs::Body::Delta,
                              fbs::CreateDeltaDirect(b, d.weatherClock_s, &layers, &d.removedLayerIds,
-                                                    static_cast<std::uint8_t>(d.tileLevel), &tiles, d.areaIndex)
+                                                    static_cast<std::uint8_t>(d.tileLevel), &tiles, d.areaIndex,
+                                                    static_cast<std::uint8_t>(d.windTileLevel),
+                                                    d.windTiles.empty() ? nullptr : &windTiles)
                                  .Union()};
           },
           [&](const CameraReport& r) {

@@ -4,6 +4,7 @@
 #include <GeographicLib/Geodesic.hpp>
 
 #include "sky/geo/geodetic.hpp"
+#include "sky/weather/wind_field.hpp"
 
 namespace sky::weather {
 
@@ -16,6 +17,10 @@ SurfacePoint advect(const SurfacePoint& p, const LayerWind& wind, double dt_s) {
                                           out.lat_deg, out.lon_deg);
   out.lon_deg = geo::normalizeLon_deg(out.lon_deg);
   return out;
+}
+
+SurfacePoint upwindOf(const SurfacePoint& p, const WindVector& windAtP, double age_s) {
+  return advect(p, fromVector(windAtP), -age_s);
 }
 
 }  // namespace sky::weather

@@ -55,6 +55,85 @@ Result<void> validate(const CloudLayer& layer) {
   return {};
 }
 
+namespace {
+
+// Upserts `add` into `tiles` by (cell, layer); tiles of one kind share a level.
+template <class Tile>
+Result<void> upsertTiles(std::vector<Tile>& tiles, int& level, const std::vector<Tile>& add, int addLevel,
+                         const std::vector<CloudLayer>& layers, const char* what) {
+  if (add.empty()) return {};
+  if (!tiles.empty() && addLevel != level)
+    return fail(ErrorCode::InvalidArgument, std::string("delta ") + what + "s at S2 level " + std::to_string(addLevel) +
+                                                ", the snapshot's are at " + std::to_string(level));
+  level = addLevel;
+  std::map<std::pair<std::uint64_t, std::uint32_t>, std::size_t> index;  // (cell, layer) -> position
+  for (std::size_t i = 0; i < tiles.size(); ++i) index.emplace(std::pair{tiles[i].cellId, tiles[i].layerId}, i);
+  for (const Tile& t : add) {
+    if (std::none_of(layers.begin(), layers.end(), [&](const CloudLayer& l) { return l.id == t.layerId; }))
+      return fail(ErrorCode::InvalidArgument,
+                  std::string("delta ") + what + " of layer " + std::to_string(t.layerId) + ", which does not exist");
+    auto it = index.find({t.cellId, t.layerId});
+    if (it != index.end()) {
+      tiles[it->second] = t;
+    } else {
+      index.emplace(std::pair{t.cellId, t.layerId}, tiles.size());
+      tiles.push_back(t);
+    }
+  }
+  return {};
+}
+
+// The tiles of `after` that a delta must carry (into `out`); false when a
+// delta cannot say it: a (cell, layer) of `before` whose layer stays is gone,
+// or the level moves with no tile to carry it.
+template <class Tile>
+bool diffTiles(const std::vector<Tile>& before, const std::vector<Tile>& after, int beforeLevel, int afterLevel,
+               const std::vector<std::uint32_t>& removedLayerIds, std::vector<Tile>& out) {
+  // Fast path: the same tiles in the same order (one area, one covering).
+  const bool sameOrder = before.size() == after.size() && removedLayerIds.empty() &&
+                         std::equal(before.begin(), before.end(), after.begin(), [](const Tile& a, const Tile& b) {
+                           return a.cellId == b.cellId && a.layerId == b.layerId;
+                         });
+  if (sameOrder) {
+    for (std::size_t i = 0; i < after.size(); ++i)
+      if (!(before[i] == after[i])) out.push_back(after[i]);
+    return !(out.empty() && beforeLevel != afterLevel);
+  }
+  std::map<std::pair<std::uint64_t, std::uint32_t>, const Tile*> was;
+  for (const Tile& t : before) was[{t.cellId, t.layerId}] = &t;
+  std::size_t matched = 0;
+  for (const Tile& t : after) {
+    const auto it = was.find({t.cellId, t.layerId});
+    if (it == was.end()) {
+      out.push_back(t);
+      continue;
+    }
+    ++matched;
+    if (!(*it->second == t)) out.push_back(t);
+  }
+  std::size_t kept = 0;  // tiles of `before` whose layer is not removed
+  for (const Tile& t : before)
+    if (std::find(removedLayerIds.begin(), removedLayerIds.end(), t.layerId) == removedLayerIds.end()) ++kept;
+  if (matched != kept) return false;  // a tile (or a layer's tiles) went away
+  // With no tiles the delta cannot move the snapshot's level.
+  return !(out.empty() && beforeLevel != afterLevel);
+}
+
+}  // namespace
+
+std::int16_t quantizeWind(double mps, double limit_mps) {
+  if (!std::isfinite(mps)) return 0;
+  return static_cast<std::int16_t>(std::lround(std::clamp(mps, -limit_mps, limit_mps) * 100.0));
+}
+
+WindTile quantized(const WindTile& tile) {
+  WindTile t = tile;
+  t.east_mps = dequantizeWind(quantizeWind(tile.east_mps, 150));
+  t.north_mps = dequantizeWind(quantizeWind(tile.north_mps, 150));
+  t.up_mps = dequantizeWind(quantizeWind(tile.up_mps, 50));
+  return t;
+}
+
 std::uint8_t quantizeUnit(double v) {
   if (!(v > 0)) return 0;
   if (v >= 1) return 255;
@@ -82,27 +161,13 @@ Result<void> applyDelta(WeatherSnapshot& snapshot, const WeatherDelta& delta) {
       return fail(ErrorCode::InvalidArgument, "delta removes layer " + std::to_string(id) + ", which does not exist");
     next.layers.erase(it);
     std::erase_if(next.tiles, [&](const CoverageTile& t) { return t.layerId == id; });
+    std::erase_if(next.windTiles, [&](const WindTile& t) { return t.layerId == id; });
   }
-  if (!delta.tiles.empty()) {
-    if (!next.tiles.empty() && delta.tileLevel != next.tileLevel)
-      return fail(ErrorCode::InvalidArgument, "delta tiles at S2 level " + std::to_string(delta.tileLevel) +
-                                                  ", the snapshot's are at " + std::to_string(next.tileLevel));
-    next.tileLevel = delta.tileLevel;
-    std::map<std::pair<std::uint64_t, std::uint32_t>, std::size_t> index;  // (cell, layer) -> position
-    auto key = [](std::uint64_t cell, std::uint32_t layer) { return std::pair{cell, layer}; };
-    for (std::size_t i = 0; i < next.tiles.size(); ++i) index.emplace(key(next.tiles[i].cellId, next.tiles[i].layerId), i);
-    for (const CoverageTile& t : delta.tiles) {
-      if (std::none_of(next.layers.begin(), next.layers.end(), [&](const CloudLayer& l) { return l.id == t.layerId; }))
-        return fail(ErrorCode::InvalidArgument, "delta tile of layer " + std::to_string(t.layerId) + ", which does not exist");
-      auto it = index.find(key(t.cellId, t.layerId));
-      if (it != index.end()) {
-        next.tiles[it->second] = t;
-      } else {
-        index.emplace(key(t.cellId, t.layerId), next.tiles.size());
-        next.tiles.push_back(t);
-      }
-    }
-  }
+  if (auto r = upsertTiles(next.tiles, next.tileLevel, delta.tiles, delta.tileLevel, next.layers, "tile"); !r) return r;
+  if (auto r = upsertTiles(next.windTiles, next.windTileLevel, delta.windTiles, delta.windTileLevel, next.layers,
+                           "wind tile");
+      !r)
+    return r;
   snapshot = std::move(next);
   return {};
 }
@@ -114,6 +179,9 @@ std::optional<WeatherDelta> diffSnapshots(const WeatherSnapshot& before, const W
   d.areaIndex = after.areaIndex;
   if (before.areaIndex != after.areaIndex) return std::nullopt;
   if (!before.tiles.empty() && !after.tiles.empty() && before.tileLevel != after.tileLevel) return std::nullopt;
+  if (!before.windTiles.empty() && !after.windTiles.empty() && before.windTileLevel != after.windTileLevel)
+    return std::nullopt;
+  d.windTileLevel = after.windTileLevel;
   // Layers: the ones kept must stay in their order, new ones come last.
   std::vector<std::uint32_t> kept;
   for (const CloudLayer& b : before.layers) {
@@ -140,38 +208,11 @@ std::optional<WeatherDelta> diffSnapshots(const WeatherSnapshot& before, const W
       d.layers.push_back(a);
     }
   }
-  // Tiles: every kept (cell, layer) must still be there; changed and new ones
-  // go. Fast path: the same tiles in the same order (one area, one covering).
-  const bool sameOrder = before.tiles.size() == after.tiles.size() && d.removedLayerIds.empty() &&
-                         std::equal(before.tiles.begin(), before.tiles.end(), after.tiles.begin(),
-                                    [](const CoverageTile& a, const CoverageTile& b) {
-                                      return a.cellId == b.cellId && a.layerId == b.layerId;
-                                    });
-  if (sameOrder) {
-    for (std::size_t i = 0; i < after.tiles.size(); ++i)
-      if (!(before.tiles[i] == after.tiles[i])) d.tiles.push_back(after.tiles[i]);
-    if (d.tiles.empty() && before.tileLevel != after.tileLevel) return std::nullopt;
-    return d;
-  }
-  std::map<std::pair<std::uint64_t, std::uint32_t>, const CoverageTile*> was;
-  for (const CoverageTile& t : before.tiles) was[{t.cellId, t.layerId}] = &t;
-  std::size_t matched = 0;
-  for (const CoverageTile& t : after.tiles) {
-    const auto it = was.find({t.cellId, t.layerId});
-    if (it == was.end()) {
-      d.tiles.push_back(t);
-      continue;
-    }
-    ++matched;
-    if (!(*it->second == t)) d.tiles.push_back(t);
-  }
-  std::size_t keptTiles = 0;  // tiles of `before` whose layer is not removed
-  for (const CoverageTile& t : before.tiles)
-    if (std::find(d.removedLayerIds.begin(), d.removedLayerIds.end(), t.layerId) == d.removedLayerIds.end())
-      ++keptTiles;
-  if (matched != keptTiles) return std::nullopt;  // a tile (or a layer's tiles) went away
-  // With no tiles the delta cannot move the snapshot's level.
-  if (d.tiles.empty() && before.tileLevel != after.tileLevel) return std::nullopt;
+  if (!diffTiles(before.tiles, after.tiles, before.tileLevel, after.tileLevel, d.removedLayerIds, d.tiles))
+    return std::nullopt;
+  if (!diffTiles(before.windTiles, after.windTiles, before.windTileLevel, after.windTileLevel, d.removedLayerIds,
+                 d.windTiles))
+    return std::nullopt;
   return d;
 }
 

@@ -10,6 +10,7 @@
 
 #include "sky/weather/advection.hpp"
 #include "sky/weather/tiling.hpp"
+#include "sky/weather/wind_field.hpp"
 
 namespace sky::weather {
 
@@ -26,33 +27,18 @@ double presence(const CloudLayer& l, double alt_m) {
   return std::max(0.0, 1.0 - outside / l.transitionBand_m);
 }
 
-// Wind as (east, north) components of the air's motion, m/s.
-struct Components {
-  double east, north;
-};
-Components components(const LayerWind& w) {
-  const double to = (w.fromDirection_deg + 180.0) * kDeg;
-  return {w.speed_mps * std::sin(to), w.speed_mps * std::cos(to)};
-}
-LayerWind fromComponents(const Components& c, double vertical_mps) {
-  LayerWind w;
-  w.speed_mps = std::hypot(c.east, c.north);
-  // The direction the air comes FROM: opposite to where it goes.
-  double from = std::atan2(-c.east, -c.north) / kDeg;
-  if (from < 0) from += 360.0;
-  w.fromDirection_deg = w.speed_mps > 0 ? std::fmod(from, 360.0) : 0.0;
-  w.vertical_mps = vertical_mps;
-  return w;
-}
-
 }  // namespace
 
 PointWeather weatherAt(std::span<const CloudLayer> layers, const CoverageLookup& lookup, double lat_deg,
-                       double lon_deg, double alt_m) {
+                       double lon_deg, double alt_m, const WindLookup& windLookup) {
   PointWeather out;
   if (layers.empty()) return out;
+  // Each layer with its wind at this point.
+  std::vector<CloudLayer> local(layers.begin(), layers.end());
+  if (windLookup)
+    for (CloudLayer& l : local) l.wind = windLookup(l, lat_deg, lon_deg);
   std::vector<const CloudLayer*> byBase;
-  for (const auto& l : layers) byBase.push_back(&l);
+  for (const auto& l : local) byBase.push_back(&l);
   std::sort(byBase.begin(), byBase.end(), [](const CloudLayer* a, const CloudLayer* b) { return a->base_m < b->base_m; });
 
   // Wind.
@@ -79,9 +65,9 @@ PointWeather weatherAt(std::span<const CloudLayer> layers, const CoverageLookup&
     } else {
       const double z0 = below->base_m + below->thickness_m, z1 = above->base_m;
       const double f = z1 > z0 ? std::clamp((alt_m - z0) / (z1 - z0), 0.0, 1.0) : 0.0;
-      const Components a = components(below->wind), b = components(above->wind);
-      out.wind = fromComponents({a.east + f * (b.east - a.east), a.north + f * (b.north - a.north)},
-                                below->wind.vertical_mps + f * (above->wind.vertical_mps - below->wind.vertical_mps));
+      const WindVector a = toVector(below->wind), b = toVector(above->wind);
+      out.wind = fromVector({a.east_mps + f * (b.east_mps - a.east_mps), a.north_mps + f * (b.north_mps - a.north_mps),
+                             a.up_mps + f * (b.up_mps - a.up_mps)});
     }
   }
 
@@ -115,10 +101,11 @@ CoverageLookup snapshotLookup(const WeatherSnapshot& snapshot, double clock_s) {
   }
   const double since_s = clock_s - snapshot.weatherClock_s;
   const int level = snapshot.tileLevel;
-  return [index, tiled, since_s, level](const CloudLayer& layer, double lat_deg,
-                                        double lon_deg) -> std::optional<CoverageTile> {
+  auto wind = std::make_shared<const WindField>(snapshot);
+  return [index, tiled, since_s, level, wind](const CloudLayer& layer, double lat_deg,
+                                              double lon_deg) -> std::optional<CoverageTile> {
     if (!tiled->count(layer.id)) return std::nullopt;
-    const SurfacePoint upwind = advect({lat_deg, lon_deg}, layer.wind, -since_s);
+    const SurfacePoint upwind = upwindOf({lat_deg, lon_deg}, wind->at(layer, lat_deg, lon_deg), since_s);
     const auto it = index->find({layer.id, cellAt(upwind.lat_deg, upwind.lon_deg, level)});
     if (it == index->end()) {
       CoverageTile empty;
@@ -127,6 +114,13 @@ CoverageLookup snapshotLookup(const WeatherSnapshot& snapshot, double clock_s) {
       return empty;
     }
     return it->second;
+  };
+}
+
+WindLookup snapshotWindLookup(const WeatherSnapshot& snapshot) {
+  auto wind = std::make_shared<const WindField>(snapshot);
+  return [wind](const CloudLayer& layer, double lat_deg, double lon_deg) {
+    return wind->windAt(layer, lat_deg, lon_deg);
   };
 }
 

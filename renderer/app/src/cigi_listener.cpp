@@ -261,14 +261,16 @@ std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRe
                                           std::chrono::steady_clock::time_point now,
                                           const std::optional<geo::Geodetic>& camera, const HostAtmosphere& air) {
   std::vector<cigi::Packet> out;
-  // The layers (and their winds) are the same in both areas' snapshots; the
+  // The layers are the same in both areas' snapshots; the tiles and the wind
   // tiles come from the area that reaches the point.
   const auto& layers = view.snapshot.layers;
   const bool far = view.coarse && camera &&
                    geo::geodesicDistance_m(camera->lat_deg, camera->lon_deg, r.lat_deg, r.lon_deg) > kDetailedReach_m;
-  const auto lookup = weather::snapshotLookup(far ? *view.coarse : view.snapshot, view.clockNow(now));
+  const weather::WeatherSnapshot& reaching = far ? *view.coarse : view.snapshot;
+  const auto lookup = weather::snapshotLookup(reaching, view.clockNow(now));
   if (r.requestType & cigi::kRequestWeather) {
-    const weather::PointWeather pw = weather::weatherAt(layers, lookup, r.lat_deg, r.lon_deg, r.alt_m);
+    const weather::PointWeather pw = weather::weatherAt(layers, lookup, r.lat_deg, r.lon_deg, r.alt_m,
+                                                        weather::snapshotWindLookup(reaching));
     cigi::WeatherConditionsResponse wcr;
     wcr.requestId = r.requestId;
     wcr.humidity_pct = static_cast<std::uint8_t>(pw.cloudDensity > 0 ? 100 : air.humidity_pct);

@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "sky/core/result.hpp"
+#include "sky/server/forecast_wind.hpp"
 #include "sky/server/grib.hpp"
 #include "sky/server/snapshot_builder.hpp"
 #include "sky/weather/model.hpp"
@@ -83,6 +84,12 @@ class Forecast {
   std::size_t stepCount() const { return stepCount_; }  // distinct valid times
   // What was read, derived or left out, one line each, for the log and the console.
   const std::vector<std::string>& notes() const { return notes_; }
+  // The winds of the files (empty when they have none).
+  const ForecastWind& wind() const { return wind_; }
+  // A layer's wind at a point: the forecast's at the middle of the layer's
+  // height; nullopt where the forecast has no wind there.
+  std::optional<weather::WindVector> windAt(const ForecastLayer& layer, double lat_deg, double lon_deg,
+                                            double valid_unix) const;
 
   // Cover of a layer at a point at a valid time: linear in time between the
   // steps around it (the first or last step outside them), bilinear in
@@ -102,6 +109,7 @@ class Forecast {
   std::int64_t reference_unix_ = 0, firstValid_unix_ = 0, lastValid_unix_ = 0;
   std::size_t stepCount_ = 0;
   std::vector<std::string> notes_;
+  ForecastWind wind_;
 };
 
 // Where a forecast sits on the weather clock: at clock c the weather is the
@@ -128,6 +136,10 @@ class ForecastField final : public LayerField {
   void sample(std::uint32_t layerId, std::span<const weather::CellCentre> at,
               std::span<weather::CoverageTile> out) const override;
   std::uint64_t key() const override { return key_; }
+  // The forecast's winds for its own layers, at each layer's middle height.
+  bool givesWind(std::uint32_t layerId) const override;
+  void sampleWind(std::uint32_t layerId, std::span<const weather::CellCentre> at,
+                  std::span<weather::WindVector> out) const override;
   double valid_unix() const { return valid_unix_; }
   const Forecast& forecast() const { return *forecast_; }
 

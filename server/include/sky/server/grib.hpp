@@ -39,8 +39,18 @@ struct GribGrid {
   double lov_deg = 0, lad_deg = 0, latin1_deg = 0, latin2_deg = 0;
   double dx_m = 0, dy_m = 0;
   double radius_m = 6371229;
+  // Winds (u, v) along the projection's x and y axes instead of east and
+  // north (flag table 3.3, bit 5: ecCodes' uvRelativeToGrid). NAM's are.
+  bool uvRelativeToGrid = false;
   bool operator==(const GribGrid&) const = default;
 };
+
+// A wind given by u and v of a message on this grid, as east and north
+// components at a point: a Lambert grid's axes turn from east and north by
+// n (lon - LoV) away from the central meridian (the cone's convergence), so
+// grid-relative winds are rotated by that angle; earth-relative ones are
+// returned as they are.
+std::pair<double, double> eastNorthWind(const GribGrid& grid, double lat_deg, double lon_deg, double u, double v);
 
 // Checks a grid's numbers (sizes, spacings, latitudes, a Lambert cone that
 // exists); the error names the key ("Lambert: Latin1 -91").

@@ -18,6 +18,7 @@
 #include "sky/weather/model.hpp"
 #include "sky/weather/region.hpp"
 #include "sky/weather/tiling.hpp"
+#include "sky/weather/wind_field.hpp"
 
 namespace sky::server {
 
@@ -30,9 +31,16 @@ inline constexpr std::size_t kDefaultMaxCells = 20000;
 // sky::stream::kMaxFrameBytes (the schema's size, pinned in protocol/).
 inline constexpr std::size_t kTileWireBytes = stream::kTileWireBytes;
 
+// Great-circle distance on the mean sphere, m: a cheap bound to skip regions
+// far from an area before the exact geodesic measure.
+double sphereDistance_m(double lat1, double lon1, double lat2, double lon2);
+// Beyond this (sphere distance from its centre, m) a region weighs 0.
+double reachOf(const weather::Region& r);
+
 // Cells allowed for `layerCount` layers: maxCells, lowered so that cells ×
-// layers tiles still fit one stream frame (with room for the layer table).
-std::size_t cellBudget(std::size_t maxCells, std::size_t layerCount);
+// layers tiles still fit one stream frame (with room for the layer table and
+// `windTiles` wind tiles).
+std::size_t cellBudget(std::size_t maxCells, std::size_t layerCount, std::size_t windTiles = 0);
 
 struct Covering {
   int level = 0;                     // S2 level actually used, <= the wanted one
@@ -127,6 +135,10 @@ class TileCache {
   void countTiles(bool hit) { ++(hit ? tileHits_ : tileMisses_); }
   // A number no tiles derived before had: equal generations, equal tiles.
   std::uint64_t nextGeneration() { return ++generations_; }
+  // Makes room in entry.shapeWeights for `regions` more shapes (forgetting
+  // the ones it holds when they would not fit), so that references weights()
+  // returns for them stay valid together.
+  static void makeRoomForShapes(Entry& entry, std::size_t regions);
 
  private:
   double cellWeight(const ShapeKey& shape, const weather::Region& region, std::uint64_t cell,
@@ -156,6 +168,18 @@ class LayerField {
                       std::span<weather::CoverageTile> out) const = 0;
   // Equal keys, equal tiles everywhere: what the tile cache compares.
   virtual std::uint64_t key() const = 0;
+  // Whether this field gives layer `id`'s wind, and that wind at each point
+  // (components NaN where the field has none: the layer's own wind there).
+  virtual bool givesWind(std::uint32_t layerId) const {
+    (void)layerId;
+    return false;
+  }
+  virtual void sampleWind(std::uint32_t layerId, std::span<const weather::CellCentre> at,
+                          std::span<weather::WindVector> out) const {
+    (void)layerId;
+    (void)at;
+    (void)out;
+  }
 };
 
 // One tile per (cell, table layer) for each layer that varies over the

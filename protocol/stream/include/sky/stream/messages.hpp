@@ -23,6 +23,8 @@ inline constexpr std::uint16_t kProtocolVersion = 2;
 // Bytes one coverage tile takes on the wire (FlatBuffers struct Tile),
 // for budgeting tiles against kMaxFrameBytes.
 inline constexpr std::size_t kTileWireBytes = 16;
+// The same for a WindTile.
+inline constexpr std::size_t kWindTileWireBytes = 16;
 
 // Caps on one Snapshot or Delta, checked before anything is decoded, so a
 // crafted frame costs O(n log n) in its counts and no more. Layers: a server

@@ -18,4 +18,14 @@ struct SurfacePoint {
 // the antimeridian; at a pole the azimuth is taken as GeographicLib defines it.
 SurfacePoint advect(const SurfacePoint& p, const LayerWind& wind, double dt_s);
 
+// Where the air at p came from age_s seconds ago, semi-Lagrangian in one
+// step: carried back along the geodesic by the wind at p itself (the
+// departure point of a trajectory ending at p, with the arrival point's
+// wind). Every reader of coverage tiles places them this way (the point
+// query, the renderers' weather map, whose shader does the same in the map's
+// plane), so a wind that varies over the area moves each part of a layer by
+// its own wind and every channel agrees.
+struct WindVector;
+SurfacePoint upwindOf(const SurfacePoint& p, const WindVector& windAtP, double age_s);
+
 }  // namespace sky::weather

@@ -64,6 +64,28 @@ struct CoverageTile {
   bool operator==(const CoverageTile&) const = default;
 };
 
+// The wind of one layer on one S2 cell, where it differs over the area (a
+// forecast's field, a region's own wind): components of the air's motion,
+// east and north parallel to the ellipsoid and up. A layer without wind
+// tiles has its own wind (CloudLayer::wind) everywhere; between the tiles of
+// a layer that has them, see sky/weather/wind_field.hpp. On the wire each
+// component is quantised to 1 cm/s (quantizeWind).
+struct WindTile {
+  std::uint64_t cellId = 0;  // S2CellId, at the snapshot's wind tile level
+  std::uint32_t layerId = 0; // [0, 65535] on the wire
+  float east_mps = 0;        // [-150, 150]
+  float north_mps = 0;       // [-150, 150]
+  float up_mps = 0;          // [-50, 50]
+  bool operator==(const WindTile&) const = default;
+};
+
+// Wind components on the wire: metres per second to whole cm/s, clamped to
+// the model's ranges (+-150 horizontal, +-50 vertical); NaN -> 0.
+std::int16_t quantizeWind(double mps, double limit_mps);
+inline float dequantizeWind(std::int16_t cmps) { return static_cast<float>(cmps) / 100.0f; }
+// A tile as it arrives: every component rounded as on the wire.
+WindTile quantized(const WindTile& tile);
+
 struct WeatherSnapshot {
   double weatherClock_s = 0;  // seconds on the weather clock
   std::vector<CloudLayer> layers;
@@ -72,10 +94,14 @@ struct WeatherSnapshot {
   // Which of a subscriber's areas (sky::stream::Subscribe::areaIndex) this
   // answers: each area has its own snapshot, kept up to date by its own deltas.
   std::uint8_t areaIndex = 0;
+  // Wind tiles are coarser than coverage tiles (wind varies over tens of
+  // kilometres): their own S2 level.
+  int windTileLevel = 0;
+  std::vector<WindTile> windTiles;
 };
 
 // A change to a snapshot: layers upserted by id, layers removed (with their
-// tiles), tiles upserted by (cell, layer).
+// tiles and wind tiles), tiles and wind tiles upserted by (cell, layer).
 struct WeatherDelta {
   double weatherClock_s = 0;
   std::vector<CloudLayer> layers;
@@ -83,19 +109,22 @@ struct WeatherDelta {
   int tileLevel = 0;  // must equal the snapshot's when tiles are present
   std::vector<CoverageTile> tiles;
   std::uint8_t areaIndex = 0;  // must equal the snapshot's
+  int windTileLevel = 0;  // must equal the snapshot's when wind tiles are present
+  std::vector<WindTile> windTiles;
 };
 
-// Applies a delta; on error (another area's delta, a tile level that differs from the snapshot's,
-// a tile of a layer that does not exist afterwards, removal of an unknown
-// layer) the snapshot is left exactly as it was.
+// Applies a delta; on error (another area's delta, a tile or wind tile level
+// that differs from the snapshot's, a tile or wind tile of a layer that does
+// not exist afterwards, removal of an unknown layer) the snapshot is left
+// exactly as it was.
 Result<void> applyDelta(WeatherSnapshot& snapshot, const WeatherDelta& delta);
 
 // The delta that takes `before` to `after` (applyDelta(before, delta) gives
 // after exactly: same layers in the same order, same tiles by (cell, layer)):
-// changed and new layers, removed layers, and the tiles that differ. None when
-// a delta cannot say it: another area, a different tile level, a layer losing tiles it had
-// (a delta only upserts tiles), a tile gone, or layers reordered; the caller
-// then sends a snapshot.
+// changed and new layers, removed layers, and the tiles and wind tiles that
+// differ. None when a delta cannot say it: another area, a different tile or
+// wind tile level, a layer losing tiles or wind tiles it had (a delta only
+// upserts them), or layers reordered; the caller then sends a snapshot.
 std::optional<WeatherDelta> diffSnapshots(const WeatherSnapshot& before, const WeatherSnapshot& after);
 
 // Fractions on the wire: [0, 1] -> 0..255, rounding to nearest; NaN -> 0.

@@ -24,21 +24,28 @@ struct PointWeather {
 // varies regionally; nullopt: the layer's own uniform values apply.
 using CoverageLookup = std::function<std::optional<CoverageTile>(const CloudLayer& layer, double lat_deg, double lon_deg)>;
 
-// Wind: inside a layer (base to top) that layer's; between two layers linear
+// A layer's wind at a surface point, when it varies over the area (see
+// wind_field.hpp); none: each layer's own wind applies everywhere.
+using WindLookup = std::function<LayerWind(const CloudLayer& layer, double lat_deg, double lon_deg)>;
+
+// Wind: each layer's at the point (windLookup), then: inside a layer (base to top) that layer's; between two layers linear
 // in altitude (by components) from the top of the one below to the base of
 // the one above; below the lowest or above the highest, the nearest layer's;
 // no layers: calm. Cloud: each layer is fully present from base to top and
 // fades linearly to nothing over its transition band above and below; the
 // densest layer at the point wins.
 PointWeather weatherAt(std::span<const CloudLayer> layers, const CoverageLookup& lookup, double lat_deg,
-                       double lon_deg, double alt_m);
+                       double lon_deg, double alt_m, const WindLookup& windLookup = {});
 
 // A lookup over a snapshot's tiles at weather clock clock_s: the tile of the
 // point's S2 cell at the snapshot's level, the point first carried back by
-// the layer's wind from clock_s to the snapshot's clock (advect). A layer
-// with tiles is empty where it has none; a layer without tiles is uniform.
-// The lookup keeps a reference to the snapshot.
+// the layer's wind at the point (its wind field's, upwindOf) from clock_s to
+// the snapshot's clock. A layer with tiles is empty where it has none; a
+// layer without tiles is uniform. The lookup keeps no reference to the
+// snapshot.
 CoverageLookup snapshotLookup(const WeatherSnapshot& snapshot, double clock_s);
+// Each layer's wind at a point from the snapshot's wind tiles (WindField).
+WindLookup snapshotWindLookup(const WeatherSnapshot& snapshot);
 
 // ICAO standard atmosphere below 20 km (altitude MSL, m): 15 C and 1013.25 hPa
 // at sea level, -6.5 K/km to the tropopause at 11 km (-56.5 C, 226.32 hPa),
