@@ -43,6 +43,9 @@ const MERCATOR_MAX_LAT_DEG = 85.0511287798;
 // Panes above Leaflet's tile pane (200) and below its marker pane (600): the
 // ground, then coverage, wind and graticule, then the regions' outlines.
 const PANES = [["basemap", 250], ["coverage", 350], ["regions", 420]];
+// Names of stations and aircraft are shown from this zoom in (about 2.4 km
+// per CSS px at 46 N below it: a hundred stations' names would overlap).
+const LABELS_FROM_ZOOM = 6;
 // The region ids the server gives METAR stations (server/API.md, POST /api/metar).
 const METAR_REGION_IDS = [40000, 65535];
 // How far inside the map's edge a symbol beyond it is drawn (CSS px): half
@@ -169,7 +172,6 @@ export class MapView {
     // narrower window): Leaflet must know, or its centre is not the middle.
     new ResizeObserver(() => map.invalidateSize({ animate: false })).observe(container);
     map.on("moveend", () => this.moved());
-    map.on("zoomend", () => container.classList.toggle("zoomed-out", map.getZoom() < 6));
     map.on("mousedown", (e) => this.pressed(e));
     map.on("mousemove", (e) => this.pointerMoved(e));
     map.on("mouseup", (e) => this.released(e));
@@ -205,6 +207,8 @@ export class MapView {
     const c = this.map.getCenter();
     this.focus = { lat_deg: c.lat, lon_deg: normalizeLon(c.lng) };
     this.zoom = this.map.getZoom();
+    // Zoomed out, the stations' and aircraft's names would cover the map.
+    this.container.classList.toggle("zoomed-out", this.zoom < LABELS_FROM_ZOOM);
     this.on.view(this.focus, this.zoom);
     // Shapes follow the view round the world (see `near`).
     this.drawRegions();
@@ -281,6 +285,19 @@ export class MapView {
   drawCoverage(g, w, h, state, layerId) {
     const cols = Math.ceil(w / COVERAGE_CELL_PX), rows = Math.ceil(h / COVERAGE_CELL_PX);
     const cells = this.coverageCanvas || (this.coverageCanvas = document.createElement("canvas"));
+    // Sampled again only when the weather, the layer or the view changed
+    // (a redraw for the region tool's draft or a renderer keeps it).
+    const c = this.map.getCenter();
+    const key = JSON.stringify([state.layers, state.regions, layerId, c.lat, c.lng, this.map.getZoom(), cols, rows]);
+    if (key !== this.coverageKey) {
+      this.coverageKey = key;
+      this.sampleCoverage(cells, cols, rows, state, layerId);
+    }
+    g.imageSmoothingEnabled = true;
+    g.drawImage(cells, 0, 0, cols * COVERAGE_CELL_PX, rows * COVERAGE_CELL_PX);
+  }
+
+  sampleCoverage(cells, cols, rows, state, layerId) {
     cells.width = cols;
     cells.height = rows;
     const cg = cells.getContext("2d");
@@ -296,8 +313,6 @@ export class MapView {
       }
     }
     cg.putImageData(img, 0, 0);
-    g.imageSmoothingEnabled = true;
-    g.drawImage(cells, 0, 0, cols * COVERAGE_CELL_PX, rows * COVERAGE_CELL_PX);
   }
 
   drawGraticule(g, w, h) {
