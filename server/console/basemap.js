@@ -3,14 +3,61 @@
 // page, decoded with topojson-client) drawn by Leaflet on one canvas, under
 // everything else. The world repeats east and west: the copies a view
 // across the antimeridian needs are added as it moves.
-const L = window.L;
-const topojson = window.topojson;
+// window.L and window.topojson (globalThis: Node.js tests the pure functions
+// below without them).
+const L = globalThis.L;
+const topojson = globalThis.topojson;
 
 export const BASEMAP_URL = "/console/countries-50m.json";
 // Colours of the dark instructor map: sea is the map container's background.
 export const LAND_COLOUR = "#27362b";
 export const COAST_COLOUR = "#8fb3cf";
 const BORDER_COLOUR = "#9c8bb0";
+
+// Natural Earth cuts rings and lines at the antimeridian, and TopoJSON's
+// quantisation joins the cut's two sides again: a ring of Chukotka or Fiji
+// steps from 179.9 to -180 and back, which Leaflet would draw as a band round
+// the whole world. A step of more than 180 degrees is such a cut.
+const isCut = (a, b) => Math.abs(b[0] - a[0]) > 180;
+
+// A ring made continuous across the cut (longitudes past +-180), unless it
+// goes round a pole (Antarctica), which is right as it is within +-180.
+export function unwrapRing(ring) {
+  let winding = 0;
+  for (let i = 1; i < ring.length; ++i) {
+    const d = ring[i][0] - ring[i - 1][0];
+    winding += d - 360 * Math.round(d / 360);
+  }
+  if (Math.abs(winding) > 180) return ring;
+  let shift = 0;
+  return ring.map((p, i) => {
+    if (i > 0 && isCut(ring[i - 1], p)) shift -= 360 * Math.sign(p[0] - ring[i - 1][0]);
+    return shift ? [p[0] + shift, p[1]] : p;
+  });
+}
+
+// A line split where it steps across the cut (each piece stays on its side).
+export function splitLine(line) {
+  const pieces = [[line[0]]];
+  for (let i = 1; i < line.length; ++i) {
+    if (isCut(line[i - 1], line[i])) pieces.push([]);
+    pieces[pieces.length - 1].push(line[i]);
+  }
+  return pieces.filter((p) => p.length > 1);
+}
+
+function unwrapPolygons(collection) {
+  for (const f of collection.features) {
+    const g = f.geometry;
+    if (g.type === "Polygon") g.coordinates = g.coordinates.map(unwrapRing);
+    if (g.type === "MultiPolygon") g.coordinates = g.coordinates.map((p) => p.map(unwrapRing));
+  }
+  return collection;
+}
+
+function splitLines(multiLine) {
+  return { type: "MultiLineString", coordinates: multiLine.coordinates.flatMap(splitLine) };
+}
 
 export class BaseMap {
   // map: the Leaflet map; pane: the pane to draw in.
@@ -30,10 +77,10 @@ export class BaseMap {
     const r = await fetch(BASEMAP_URL);
     if (!r.ok) throw new Error(`${BASEMAP_URL}: HTTP ${r.status}`);
     const topo = await r.json();
-    const land = topojson.feature(topo, topo.objects.land);
+    const land = unwrapPolygons(topojson.feature(topo, topo.objects.land));
     // The land's outline is the coastline; arcs shared by two countries are borders.
-    const coast = topojson.mesh(topo, topo.objects.land);
-    const borders = topojson.mesh(topo, topo.objects.countries, (a, b) => a !== b);
+    const coast = splitLines(topojson.mesh(topo, topo.objects.land));
+    const borders = splitLines(topojson.mesh(topo, topo.objects.countries, (a, b) => a !== b));
     this.layers = { land, coast, borders };
     this.updateCopies();
   }

@@ -3,6 +3,8 @@
 // the map draws (server/console/geo.js, coverage.js), which must agree with
 // the server's (sky/weather/region.hpp: smoothstep across the perimeter;
 // snapshot_builder.cpp: the weighted blend into the global layer).
+import fs from "node:fs";
+import { createRequire } from "node:module";
 import { assert, near, run, skip } from "./harness.mjs";
 
 
@@ -100,4 +102,35 @@ run("coverage", async () => {
   const read = readReport("METAR KJFK 221151Z 18012KT 1 3/4SM BR BKN008 OVC015 12/11 A2992");
   near(read.visibility_sm, 1.75, 1e-12, "1 3/4SM");
   assert(read.ceiling_ft === 800, `the lowest broken layer: ${read.ceiling_ft}`);
+
+  // The Natural Earth ground across the antimeridian (basemap.js), on the
+  // data the console serves: after unwrapping, no ring steps across the
+  // cut but those round the South Pole, and no coast or border line does.
+  const { splitLine, unwrapRing } = await import("../../server/console/basemap.js");
+  near(unwrapRing([[179, -16], [-179, -16], [-179, -17], [179, -17], [179, -16]])[1][0], 181, 1e-12, "a ring across 180 goes on east");
+  assert(splitLine([[170, 65], [179.9, 66], [-180, 66], [-175, 65]]).length === 2, "a line across 180 is split");
+  const vendor = new URL("../../server/console/vendor/node_modules/", import.meta.url);
+  if (!fs.existsSync(vendor)) skip("the console's map packages are not installed (deploy/setup)");
+  const require = createRequire(vendor);
+  const topojson = require("topojson-client");
+  const topo = JSON.parse(fs.readFileSync(new URL("world-atlas/countries-50m.json", vendor), "utf8"));
+  const steps = (points) => points.some((p, i) => i > 0 && Math.abs(p[0] - points[i - 1][0]) > 180);
+  let rings = 0, acrossBefore = 0, acrossAfter = 0, polar = 0;
+  for (const f of topojson.feature(topo, topo.objects.land).features) {
+    const polys = f.geometry.type === "Polygon" ? [f.geometry.coordinates] : f.geometry.coordinates;
+    for (const ring of polys.flat()) {
+      ++rings;
+      if (!steps(ring)) continue;
+      ++acrossBefore;
+      const u = unwrapRing(ring);
+      if (!steps(u)) continue;
+      ++acrossAfter;
+      if (ring.every((p) => p[1] < -60)) ++polar;
+    }
+  }
+  console.log(`  land: ${rings} rings, ${acrossBefore} across 180, ${acrossAfter} still after unwrapping (${polar} round the pole)`);
+  assert(acrossBefore >= 3, "Chukotka, Wrangel Island and Fiji cross 180 in the data");
+  assert(acrossAfter === polar, "only rings round the South Pole keep their step");
+  const coast = topojson.mesh(topo, topo.objects.land).coordinates.flatMap(splitLine);
+  assert(!coast.some(steps), "no coastline steps across 180 after splitting");
 });
