@@ -6,6 +6,9 @@
 
 // Mean Earth radius (IUGG R1), the sphere the server's own bounds use.
 export const EARTH_RADIUS_M = 6371008.8;
+// Web Mercator's latitude limit, where the map ends (the latitude whose
+// Mercator y is pi: Leaflet's SphericalMercator.MAX_LATITUDE).
+export const MERCATOR_MAX_LAT_DEG = 85.0511287798;
 const D2R = Math.PI / 180;
 
 // Longitude into [-180, 180).
