@@ -8,11 +8,14 @@
 const L = globalThis.L;
 const topojson = globalThis.topojson;
 
-export const BASEMAP_URL = "/console/countries-50m.json";
+const BASEMAP_URL = "/console/countries-50m.json";
 // Colours of the dark instructor map: sea is the map container's background.
-export const LAND_COLOUR = "#27362b";
-export const COAST_COLOUR = "#8fb3cf";
+const LAND_COLOUR = "#27362b";
+const COAST_COLOUR = "#8fb3cf";
 const BORDER_COLOUR = "#9c8bb0";
+// How far beyond the view the ground is drawn (a fraction of the view each
+// side, Leaflet's default is 0.1): a short pan shows drawn land at once.
+const DRAWN_MARGIN = 0.2;
 
 // Natural Earth cuts rings and lines at the antimeridian, and TopoJSON's
 // quantisation joins the cut's two sides again: a ring of Chukotka or Fiji
@@ -63,7 +66,7 @@ export class BaseMap {
   // map: the Leaflet map; pane: the pane to draw in.
   constructor(map, pane) {
     this.map = map;
-    this.renderer = L.canvas({ pane, padding: 0.2 });
+    this.renderer = L.canvas({ pane, padding: DRAWN_MARGIN });
     this.copies = new Map();  // longitude offset (deg) -> L.LayerGroup, built once each
     this.onMap = new Set();   // the offsets on the map now
     this.layers = null;       // {land, coast, borders} GeoJSON, once loaded

@@ -23,7 +23,7 @@ import { WeatherOverlay } from "./weather_overlay.js";
 const L = window.L;
 
 // Zoom limits: at 2 the world is 1024 px wide; at 15 a pixel is about 3 m at 46 N.
-export const MIN_ZOOM = 2, MAX_ZOOM = 15;
+const MIN_ZOOM = 2, MAX_ZOOM = 15;
 // The view holds quarter levels; the wheel and the +/- buttons move by half.
 const ZOOM_SNAP = 0.25, ZOOM_DELTA = 0.5;
 // A press that moves less than this is a click, not a drag (CSS px).
@@ -41,6 +41,9 @@ const METAR_REGION_IDS = [40000, 65535];
 // How far inside the map's edge a symbol beyond it is drawn (CSS px): half
 // the aircraft symbol.
 const EDGE_INSET_PX = 12;
+// How far beyond the view regions and areas are drawn (a fraction of the
+// view each side): a pan of half the view shows them at once.
+const SHAPES_MARGIN = 0.5;
 // One nautical mile (m), for the scale bar's second line.
 const NAUTICAL_MILE_M = 1852;
 
@@ -109,7 +112,7 @@ export class MapView {
     map.attributionControl.addAttribution("Natural Earth");
     new NauticalScale({ metric: true, imperial: true, position: "bottomleft", maxWidth: 140 }).addTo(map);
     for (const [name, z] of PANES) map.createPane(name).style.zIndex = String(z);
-    this.regionRenderer = L.svg({ pane: "regions", padding: 0.5 });
+    this.regionRenderer = L.svg({ pane: "regions", padding: SHAPES_MARGIN });
     this.base = new BaseMap(map, "basemap");
     this.base.load().then(() => this.on.basemap(null), (e) => this.on.basemap(String(e.message || e)));
     this.overlay = new WeatherOverlay(data, "coverage").addTo(map);

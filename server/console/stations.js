@@ -10,7 +10,7 @@ import { fmt, ftFromM, OKTAS } from "./units.js";
 const L = window.L;
 
 // What a category means, for the popup and the legend.
-export const CATEGORY_TEXT = {
+const CATEGORY_TEXT = {
   VFR: "VFR: ceiling above 3000 ft and visibility above 5 SM",
   MVFR: "MVFR: ceiling 1000-3000 ft or visibility 3-5 SM",
   IFR: "IFR: ceiling 500-999 ft or visibility 1-3 SM",

@@ -2,9 +2,9 @@
 #include "sky/server/metar_stations.hpp"
 
 #include <algorithm>
-#include <set>
 
 #include "sky/core/utf8.hpp"
+#include "sky/server/api_json.hpp"
 
 namespace sky::server {
 
@@ -43,22 +43,25 @@ void MetarStationBoard::remember(const MetarRequest& request, const json& reply,
                      r["region_id"].get<std::uint32_t>(),
                      applied.value("sequence", std::uint64_t{0}),
                      applied.value("clock_s", 0.0),
-                     r.value("sky", json("read")),
-                     r.value("layers", json::array())};
+                     r.value("sky", json("read"))};
   }
 }
 
 json MetarStationBoard::list(std::span<const Station> serverStations, const WeatherView& now) const {
-  std::set<std::uint32_t> regions;
-  for (const auto& r : now.regions) regions.insert(r.id);
+  std::map<std::uint32_t, const weather::Region*> regions;
+  for (const auto& r : now.regions) regions[r.id] = &r;
   json out = json::array();
   auto withReport = [&](json station, const std::string& icao) {
     const auto it = latest_.find(icao);
-    if (it != latest_.end() && regions.count(it->second.regionId)) {
-      const Entry& e = it->second;
-      station["report"] = {{"text", e.text}, {"region_id", e.regionId}, {"sequence", e.sequence},
-                           {"clock_s", e.clock_s}, {"sky", e.sky}, {"layers", e.layers}};
-    }
+    if (it == latest_.end()) return station;
+    const Entry& e = it->second;
+    const auto region = regions.find(e.regionId);
+    if (region == regions.end()) return station;
+    // The layers the report became: its region's, as they are now.
+    json layers = json::array();
+    for (const auto& l : region->second->layers) layers.push_back(toJson(l));
+    station["report"] = {{"text", e.text}, {"region_id", e.regionId}, {"sequence", e.sequence},
+                         {"clock_s", e.clock_s}, {"sky", e.sky}, {"layers", layers}};
     return station;
   };
   for (const Station& s : serverStations) out.push_back(withReport(stationJson(s), s.icao));

@@ -204,8 +204,20 @@ TEST_F(HttpExchangeTest, MetarStationsListTheLatestAppliedReport) {
   EXPECT_EQ(report["text"], "METAR LIPQ 201150Z 24008KT 1500 BR OVC004 15/08 Q1015");
   EXPECT_EQ(report["sequence"], nlohmann::json::parse(applied.body)["applied"]["sequence"]);
   EXPECT_EQ(report["sky"], "read");
-  ASSERT_FALSE(report["layers"].empty());
+  // The layers it became: its region's, the overcast at 400 ft in its slot
+  // (40 and up, metar_changes.hpp) at 8/8.
   const auto regionId = report["region_id"].get<std::uint32_t>();
+  const auto state = nlohmann::json::parse(request("GET", "/api/state").body);
+  for (const auto& r : state["regions"]) {
+    if (r["id"] == regionId) {
+      EXPECT_EQ(report["layers"], r["layers"]);
+    }
+  }
+  ASSERT_FALSE(report["layers"].empty());
+  bool overcast = false;
+  for (const auto& l : report["layers"])
+    overcast = overcast || (l["id"].get<int>() >= 40 && l["coverage"].get<double>() == 1.0);
+  EXPECT_TRUE(overcast) << report["layers"];
   // The region removed by another change: the station stays, its report goes.
   const std::string removeRegion = R"({"changes": [{"op": "remove_region", "id": )" + std::to_string(regionId) + "}]}";
   ASSERT_EQ(request("POST", "/api/changes", removeRegion, bearer()).status, 200);

@@ -29,7 +29,8 @@ class MetarStationBoard {
   // {"stations": [{"icao", "lat_deg", "lon_deg", "elevation_m", "report": null or
   //   {"text", "region_id", "sequence", "clock_s", "sky", "layers": [LAYER...]}}]}:
   // the server's table in its order, then stations only requests brought
-  // (by ICAO). A report is shown only while its region is in `now`.
+  // (by ICAO). A report is shown only while its region is in `now`, with
+  // that region's layers as they are in `now` (the layers it became).
   nlohmann::json list(std::span<const Station> serverStations, const WeatherView& now) const;
 
  private:
@@ -40,7 +41,6 @@ class MetarStationBoard {
     std::uint64_t sequence = 0;
     double clock_s = 0;
     nlohmann::json sky;
-    nlohmann::json layers;
   };
   std::map<std::string, Entry> latest_;  // by ICAO
 };
