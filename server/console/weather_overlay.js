@@ -16,6 +16,12 @@ const COVERAGE_CELL_PX = 6;
 const ARROW_SPACING_PX = 90;
 // Least distance between two longitude labels (CSS px): "12.45°" is ~40 px wide.
 const LABEL_GAP_PX = 56;
+// Graticule labels keep clear of Leaflet's controls (CSS px): the scale bar
+// in the bottom left corner (140 px wide, two lines of ~20 px, a 10 px
+// margin) and the attribution in the bottom right (~150 px) with a label's
+// width (~40 px) before it.
+const CLEAR_LEFT_PX = 170, CLEAR_BOTTOM_PX = 60, CLEAR_RIGHT_PX = 190;
+const LABEL_FONT_PX = 11;
 // Graticule spacings to choose from (degrees).
 const GRID_STEPS_DEG = [0.01, 0.02, 0.05, 0.1, 0.2, 0.25, 0.5, 1, 2, 5, 10, 15, 30];
 
@@ -107,19 +113,18 @@ export const WeatherOverlay = L.Layer.extend({
     g.strokeStyle = "rgba(150, 180, 210, 0.3)";
     g.fillStyle = "rgba(190, 210, 230, 0.85)";
     g.lineWidth = 1;
-    g.font = "11px system-ui, sans-serif";
+    g.font = `${LABEL_FONT_PX}px system-ui, sans-serif`;
     // Web Mercator: parallels are horizontal lines, meridians vertical.
     for (let lat = Math.ceil(south / step) * step; lat <= north; lat += step) {
       const y = Math.round(this._map.latLngToContainerPoint([lat, b.getWest()]).y) + 0.5;
       g.beginPath(); g.moveTo(0, y); g.lineTo(w, y); g.stroke();
-      // Labels keep clear of the scale bar (bottom left) and the attribution (bottom right).
-      if (y > 12 && y < h - 60) g.fillText(`${fmt(lat, 2)}°`, 4, y - 3);
+      if (y > LABEL_FONT_PX && y < h - CLEAR_BOTTOM_PX) g.fillText(`${fmt(lat, 2)}°`, 4, y - 3);
     }
     let lastLabel_px = -Infinity;  // labels closer than LABEL_GAP_PX are left out
     for (let lon = Math.ceil(b.getWest() / step) * step; lon <= b.getEast(); lon += step) {
       const x = Math.round(this._map.latLngToContainerPoint([b.getSouth(), lon]).x) + 0.5;
       g.beginPath(); g.moveTo(x, 0); g.lineTo(x, h); g.stroke();
-      if (x > 170 && x < w - 130 && x - lastLabel_px >= LABEL_GAP_PX) {
+      if (x > CLEAR_LEFT_PX && x < w - CLEAR_RIGHT_PX && x - lastLabel_px >= LABEL_GAP_PX) {
         const shown = normalizeLon(lon);
         g.fillText(`${fmt(shown === -180 ? 180 : shown, 2)}°`, x + 3, h - 6);
         lastLabel_px = x;
