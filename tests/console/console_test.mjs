@@ -57,6 +57,15 @@ async function screenOf(page, lat, lon) {
   return { x: cx + o.x, y: cy + o.y };
 }
 
+// Waits until the page shows the server's latest state: the panels round
+// the map (the overlay list, the event log) change with it and can move the
+// map on the page, so a press is placed only after.
+async function settled(page, w) {
+  const sequence = String((await w.state()).sequence);
+  await until("the page at the server's state", async () => (await page.getAttribute("body", "data-sequence")) === sequence);
+  await page.waitForTimeout(100);  // Leaflet's resize handling runs on the next frame
+}
+
 // The point `east_m` metres east of (lat, lon) along its parallel (near enough
 // for a few tens of km: the tests drag handles along the region's x axis).
 function east(lat, lon, east_m) {
@@ -263,6 +272,7 @@ const cases = {
     near(r.center_lon_deg, centre.lon, tolerance_m / (R * D2R * Math.cos(centre.lat * D2R)), "centre longitude");
     near(r.size_x_m, 16000, 300, "width after dragging the handle");
     assert(r.layers.length === 1 && r.layers[0].type === "cumulonimbus", "a storm cell's layer");
+    await settled(a.page, w);
     // The transition handle: the default 4 km perimeter ends 12 km from the
     // centre; dragged out to 15 km it becomes 7 km.
     await dragEast(a.page, r.center_lat_deg, r.center_lon_deg, 12000, 15000);
@@ -271,6 +281,7 @@ const cases = {
       const g = (await w.state()).regions[0];
       return g && Math.abs(g.transition_m - 7000) < 300;
     });
+    await settled(a.page, w);
     // The region and its perimeter on the map: one SVG path each.
     assert(await a.page.locator(`path.region-edge.region-${r.id}`).count() === 1, "the region's edge drawn");
     assert(await a.page.locator(`path.region-perimeter.region-${r.id}`).count() === 1, "its perimeter drawn");
@@ -286,6 +297,7 @@ const cases = {
       `a clearing of layer 1: ${JSON.stringify(clearing.layers)}`);
     // A click on the storm cell (in pan mode) opens it in the region tool.
     await a.page.click("#region-cancel");
+    await settled(a.page, w);
     const cell = await screenOf(a.page, r.center_lat_deg, r.center_lon_deg);
     await a.page.mouse.click(cell.x, cell.y);
     await until("the storm cell picked", async () => (await a.page.isVisible("#region-form")) &&
