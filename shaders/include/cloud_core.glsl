@@ -15,6 +15,11 @@
 //   real  sampleDetail(LayerSampling s, real3 pLocal)    // Worley detail noise in [0, 1]
 //   real  sampleMaxCoverage(LayerSampling s, real3 pLocal) // the weather map's max-coverage mip cell:
 //                                                          // >= any coverage sampleWeather gives in it
+//   real3 sampleWindLocal(LayerSampling s, real3 pLocal) // the layer's wind at p, camera-local (m/s,
+//                                                          // horizontal), for a layer whose wind varies
+// The three noise hooks read their noise at pLocal - s.flowShift, the
+// weather hooks their tiles where the air at pLocal was at the snapshot's
+// clock (for a layer whose wind varies: its wind at pLocal times the age).
 //   real2 airCloudShadow(AirFrame a, real3 p, real h, real muSun) // airSunShadow(a, p, h, muSun)
 //   real4 sampleAirTable(int part, real3 uvw)           // the frame's air table (air_table.glsl)
 //   real4 sampleSunMap(int layer, real2 uv)             // the frame's sun map (sun_map.glsl)
@@ -96,6 +101,10 @@ struct LayerSampling {
   real4 cloudMapOrigin;  // the same for the cloud map
   real3 coverageShift;   // xy: coverage drift east/north (m); z: weather-map slice
   real shapeStretchZ;    // the shape noise's ECEF z scale: < 1 draws streaks along the Earth's axis
+  real4 flow;            // x, y: the two flow phases' ages (s); z: phase A's weight; w: 1 when the wind varies
+  real4 windRef;         // xyz: the layer's own wind (camera-local, m/s); w: the map tiles' age (s)
+  real3 flowShift;       // where this sample's noise is read from: pLocal - flowShift (m; flow phase A's)
+  real3 flowShiftB;      // the same for flow phase B (the core reads it through the hooks as flowShift)
 };
 
 struct CoreLayer {
@@ -127,6 +136,60 @@ real2 sampleCloudMap(LayerSampling s, real3 pLocal);
 real2 sampleShape(LayerSampling s, real3 pLocal);
 real sampleDetail(LayerSampling s, real3 pLocal);
 real sampleMaxCoverage(LayerSampling s, real3 pLocal);
+real3 sampleWindLocal(LayerSampling s, real3 pLocal);
+
+// The wind map's texel (both components' high and low bytes, filtered) as
+// the wind, m/s: the weather texture's encoding (sky_shared.h).
+real2 windFromTexel(real4 t) {
+  real2 q = real2(t.x * 255.0 * 256.0 + t.y * 255.0, t.z * 255.0 * 256.0 + t.w * 255.0);
+  return (q / 65535.0 * 2.0 - 1.0) * real(kWindMapScale_mps);
+}
+
+// The noise of a layer whose wind varies, carried by the local wind in two
+// phases of the flow (the flow-map scheme of texture advection): each phase
+// reads the noise where the air was when the phase began, up to a period
+// ago (frame_setup.cpp, kWindFlowPeriod_s); as one grows old the other takes
+// over across a short crossfade (flow.z: phase A's weight). During it both
+// are read and mixed so that the mix keeps the noise's contrast (the
+// variance-preserving blend of Heitz and Neyret 2018, about the noise's mid
+// value): a plain mix of two unrelated patterns is flatter, and the clouds
+// would pulse in brightness at every crossfade. A shear thus stretches the
+// shapes by at most its rate times the period and never tears them.
+LayerSampling flowPhaseB(LayerSampling s) {
+  s.flowShift = s.flowShiftB;
+  return s;
+}
+
+real flowMix(real a, real b, real wA) {
+  real wB = 1.0 - wA;
+  return clamp(0.5 + (wA * (a - 0.5) + wB * (b - 0.5)) / sqrt(wA * wA + wB * wB), 0.0, 1.0);
+}
+
+real2 flowShape(LayerSampling s, real3 p) {
+  real wA = s.flow.z;
+  if (s.flow.w < 0.5 || wA >= 1.0) return sampleShape(s, p);
+  real2 b = sampleShape(flowPhaseB(s), p);
+  if (wA <= 0.0) return b;
+  real2 a = sampleShape(s, p);
+  return real2(flowMix(a.x, b.x, wA), flowMix(a.y, b.y, wA));
+}
+
+real2 flowCloudMap(LayerSampling s, real3 p) {
+  real wA = s.flow.z;
+  if (s.flow.w < 0.5 || wA >= 1.0) return sampleCloudMap(s, p);
+  real2 b = sampleCloudMap(flowPhaseB(s), p);
+  if (wA <= 0.0) return b;
+  real2 a = sampleCloudMap(s, p);
+  return real2(flowMix(a.x, b.x, wA), flowMix(a.y, b.y, wA));
+}
+
+real flowDetail(LayerSampling s, real3 p) {
+  real wA = s.flow.z;
+  if (s.flow.w < 0.5 || wA >= 1.0) return sampleDetail(s, p);
+  real b = sampleDetail(flowPhaseB(s), p);
+  if (wA <= 0.0) return b;
+  return flowMix(sampleDetail(s, p), b, wA);
+}
 
 // The march's cost knobs (defaults above; RenderSettings::march). Two ways
 // to place the samples of a layer span: evenly (cloudStep 0: primarySteps
@@ -298,7 +361,7 @@ real lightOpticalDepth(real3 sunDir, real muSun, real thickness, real lightDista
     real3 q = p + sunDir * ((real(j) + 0.5) * lightDt);
     real qh = ph + (real(j) + 0.5) * dph;
     real sa = shapeProfile(t, qh, c, peakNoise);
-    tau += cloudShape(t, sampleShape(ls, q), c, sa) * densityProfile(t, qh);
+    tau += cloudShape(t, flowShape(ls, q), c, sa) * densityProfile(t, qh);
   }
   return tau * t.extinction_perm * densityScale * lightDt;
 }
@@ -326,9 +389,11 @@ struct CloudSample {
   real peakNoise;     // the cloud map's peak value
   real densityScale;  // the weather map's density
   real blend;
+  real3 flowShift;    // where its noise was read from (flow phases A and B), for the light march
+  real3 flowShiftB;
 };
 
-CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
+CloudSample cloudSampleAt(CoreLayer L, real3 p, real ph, bool cheap) {
   CloudSample cs;
   cs.rho = 0.0;
   cs.ct = L.primary;
@@ -336,6 +401,8 @@ CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
   cs.peakNoise = 0.0;
   cs.densityScale = 0.0;
   cs.blend = 0.0;
+  cs.flowShift = L.sampling.flowShift;
+  cs.flowShiftB = L.sampling.flowShiftB;
   if (ph <= 0.0 || ph >= 1.0) return cs;
   // Empty-space skipping: a long step in a mip cell without coverage is
   // clear, known from one read.
@@ -344,13 +411,13 @@ CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
   if (weather.x <= 0.0) return cs;
   cs.blend = L.blends ? weather.z : 0.0;
   cs.ct = cs.blend > 0.0 ? mixCloudType(L.primary, L.secondary, cs.blend) : L.primary;
-  real2 map = sampleCloudMap(L.sampling, p);
+  real2 map = flowCloudMap(L.sampling, p);
   cs.peakNoise = map.y;
   cs.densityScale = weather.y;
   cs.coverage = anvilCoverage(cs.ct, ph, weather.x < 1.0 ? mappedCoverage(weather.x, map.x) : 1.0);
   real sa = shapeProfile(cs.ct, ph, cs.coverage, map.y);
   if (sa <= 0.0) return cs;
-  real shape = cloudShape(cs.ct, sampleShape(L.sampling, p), cs.coverage, sa);
+  real shape = cloudShape(cs.ct, flowShape(L.sampling, p), cs.coverage, sa);
   if (shape <= 0.0) return cs;
   real da = densityProfile(cs.ct, ph) * weather.y;
   if (da <= 0.0 || cheap) {
@@ -358,8 +425,21 @@ CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
     return cs;
   }
   // Erosion leaves a full shape (1) full: the detail fetch only at the edges.
-  cs.rho = (shape < 1.0 ? erodeShape(cs.ct, shape, sampleDetail(L.sampling, p), cs.coverage, ph) : 1.0) * da;
+  cs.rho = (shape < 1.0 ? erodeShape(cs.ct, shape, flowDetail(L.sampling, p), cs.coverage, ph) : 1.0) * da;
   return cs;
+}
+
+// The density at p; for a layer whose wind varies over the map, its noise
+// carried by the local wind's difference from the layer's own (with which
+// the noise origins drift already), in the two phases of the flow.
+CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
+  if (L.sampling.flow.w > 0.5 && ph > 0.0 && ph < 1.0) {
+    real3 rel = sampleWindLocal(L.sampling, p) - real3(L.sampling.windRef);
+    rel.z = 0.0;
+    L.sampling.flowShift = rel * L.sampling.flow.x;
+    L.sampling.flowShiftB = rel * L.sampling.flow.y;
+  }
+  return cloudSampleAt(L, p, ph, cheap);
 }
 
 // The direct sun's mean transmittance over a broken field: a fraction c of
@@ -506,7 +586,10 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
     // column) every layer's; on the GPU the method is a pipeline constant,
     // so the ways not taken are compiled out.
     bool march = gSunMap.method == kSunMarch;
-    real tauSun = lightOpticalDepth(f.air.sunDir, muHere, L.thickness, L.lightDistance, L.sampling, ct, p, ph,
+    LayerSampling lightSampling = L.sampling;
+    lightSampling.flowShift = cs.flowShift;
+    lightSampling.flowShiftB = cs.flowShiftB;
+    real tauSun = lightOpticalDepth(f.air.sunDir, muHere, L.thickness, L.lightDistance, lightSampling, ct, p, ph,
                                     cs.coverage, cs.peakNoise, cs.densityScale, f.march.lightSteps,
                                     march && cs.rho > 0.0 ? f.march.lightSteps : 0);
     real above = sunDepthAbove(f.air, p, muHere, f.march.lightSteps, f.layerCount);

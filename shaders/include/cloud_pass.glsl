@@ -85,18 +85,47 @@ vec2 airCloudShadow(AirFrame a, vec3 p, float h, float muSun) {
 // Weather map lookup: camera-local point -> weather anchor frame -> gnomonic
 // plane of the anchor sphere (x = R q.x / q.z) -> texture coordinates of the
 // rings: the fine ring inside its blend band, the coarse ring beyond, linear
-// in the max norm between (WeatherField::sample, ringBlendWeight).
-vec3 sampleWeather(LayerSampling s, vec3 p) {
+// in the max norm between (WeatherField::sample, ringBlendWeight). `base`:
+// the texture layer of the fine ring (a cover slice, or a wind slice).
+bool weatherPlane(vec3 p, out vec2 plane) {
   vec3 q = gCamToAnchor * p + gCamInAnchor.xyz;
-  if (q.z <= 0.0) return vec3(0.0);
-  vec2 plane = q.xy * (gCamInAnchor.w / q.z) - s.coverageShift.xy;
+  plane = q.xy * (gCamInAnchor.w / q.z);
+  return q.z > 0.0;
+}
+
+vec4 sampleMapLayer(vec2 plane, float base) {
   float e = 2.0 * max(abs(plane.x), abs(plane.y)) * gMapScale;
   float w = clamp((e - gRings.y) / (gRings.z - gRings.y), 0.0, 1.0);
-  vec3 v = vec3(0.0);
-  if (w < 1.0) v = textureLod(weatherTex, vec3(plane * gMapScale + 0.5, s.coverageShift.z), 0.0).xyz;
-  if (w > 0.0)
-    v = mix(v, textureLod(weatherTex, vec3(plane * gRings.x + 0.5, s.coverageShift.z + float(kMaxLayers)), 0.0).xyz, w);
+  vec4 v = vec4(0.0);
+  if (w < 1.0) v = textureLod(weatherTex, vec3(plane * gMapScale + 0.5, base), 0.0);
+  if (w > 0.0) v = mix(v, textureLod(weatherTex, vec3(plane * gRings.x + 0.5, base + float(kMaxLayers)), 0.0), w);
   return v;
+}
+
+// The layer's wind at a plane point, in the anchor's east/north (m/s).
+vec2 windInPlane(LayerSampling s, vec2 plane) {
+  return windFromTexel(sampleMapLayer(plane, float(kWindMapLayers) + s.coverageShift.z));
+}
+
+// Where the layer's tiles are read for plane point `plane`: carried back by
+// the uniform drift, or (a wind that varies) by the wind there times the
+// tiles' age (weather::upwindOf, in the map's plane).
+vec2 tilePlane(LayerSampling s, vec2 plane) {
+  if (s.flow.w > 0.5) return plane - windInPlane(s, plane) * s.windRef.w;
+  return plane - s.coverageShift.xy;
+}
+
+vec3 sampleWeather(LayerSampling s, vec3 p) {
+  vec2 plane;
+  if (!weatherPlane(p, plane)) return vec3(0.0);
+  return sampleMapLayer(tilePlane(s, plane), s.coverageShift.z).xyz;
+}
+
+vec3 sampleWindLocal(LayerSampling s, vec3 p) {
+  vec2 plane;
+  if (!weatherPlane(p, plane)) return s.windRef.xyz;
+  // Anchor east/north back to the camera's frame (the rotation's transpose).
+  return vec3(windInPlane(s, plane), 0.0) * gCamToAnchor;
 }
 
 // The max-coverage mip of a camera-local point: the weather lookup's plane
@@ -110,9 +139,9 @@ float mipCell(uint ring, uint slice, vec2 uv) {
 }
 
 float sampleMaxCoverage(LayerSampling s, vec3 p) {
-  vec3 q = gCamToAnchor * p + gCamInAnchor.xyz;
-  if (q.z <= 0.0) return 0.0;
-  vec2 plane = q.xy * (gCamInAnchor.w / q.z) - s.coverageShift.xy;
+  vec2 plane;
+  if (!weatherPlane(p, plane)) return 0.0;
+  plane = tilePlane(s, plane);
   float e = 2.0 * max(abs(plane.x), abs(plane.y)) * gMapScale;
   float w = clamp((e - gRings.y) / (gRings.z - gRings.y), 0.0, 1.0);
   uint slice = uint(s.coverageShift.z);
@@ -132,19 +161,19 @@ vec3 noiseCoord(vec4 origin, vec3 p) {
 // The shape noise, stretched along ECEF z for streaky types (the origin is
 // stretched the same way on the CPU, so the pattern stays Earth-fixed).
 vec2 sampleShape(LayerSampling s, vec3 p) {
-  vec3 e = gLocalToEcef * p;
+  vec3 e = gLocalToEcef * (p - s.flowShift);
   e.z *= s.shapeStretchZ;
   return textureLod(shapeTex, s.shapeOrigin.xyz + e * s.shapeOrigin.w, 0.0).rg;
 }
 
 float sampleDetail(LayerSampling s, vec3 p) {
-  return textureLod(detailTex, noiseCoord(s.detailOrigin, p), 0.0).r;
+  return textureLod(detailTex, noiseCoord(s.detailOrigin, p - s.flowShift), 0.0).r;
 }
 
 // Large-scale cloud map: the shape texture's smooth and Worley channels at a
 // larger, incommensurate period.
 vec2 sampleCloudMap(LayerSampling s, vec3 p) {
-  return textureLod(shapeTex, noiseCoord(s.cloudMapOrigin, p), 0.0).ba;
+  return textureLod(shapeTex, noiseCoord(s.cloudMapOrigin, p - s.flowShift), 0.0).ba;
 }
 
 CloudType unpackType(SkyCloudType t) {
@@ -171,7 +200,8 @@ CloudType unpackType(SkyCloudType t) {
 CoreLayer layerAt(int li) {
   SkyLayer l = frame.layers[li];
   LayerSampling s = LayerSampling(l.shapeOrigin, l.detailOrigin, l.cloudMapOrigin,
-                                  vec3(l.coverageShift.xy, l.shape.y), l.coverageShift.w);
+                                  vec3(l.coverageShift.xy, l.shape.y), l.coverageShift.w, l.flow, l.windRef,
+                                  vec3(0.0), vec3(0.0));
   return CoreLayer(l.heights.x, l.heights.y, l.heights.z, l.heights.w, l.shape.x, l.shape.z, l.shape.w > 0.5,
                    unpackType(l.primary), unpackType(l.secondary), l.ambient.rgb, l.sunDiffuse.rgb,
                    l.sunDiffuse.w, s, l.ambient.w > 0.5, l.coverageShift.z);

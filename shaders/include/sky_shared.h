@@ -22,7 +22,9 @@ SKY_SHARED_CONST kBindingFrame = 0u;          // read-only storage buffer holdin
 SKY_SHARED_CONST kBindingShape = 1u;          // sampler3D, tileable shape noise (RGBA8, repeat):
                                               // billowy Perlin-Worley, fibrous, smooth fBm, Worley
 SKY_SHARED_CONST kBindingWeather = 2u;        // sampler2DArray, RGBA8 = coverage, density, type blend;
-                                              // one slice per layer and ring: layer ring * kMaxLayers + slice
+                                              // one slice per layer and ring: layer ring * kMaxLayers + slice;
+                                              // then the wind map, layer kWindMapLayers + ring * kMaxLayers +
+                                              // slice: RGBA8 = east high, east low, north high, north low byte
 SKY_SHARED_CONST kBindingOutput = 3u;         // storage buffer of vec4 radiance (rgb) + transmittance (a)
 SKY_SHARED_CONST kBindingDetail = 4u;         // sampler3D, tileable Worley detail noise (R8, repeat)
 SKY_SHARED_CONST kBindingTransmittance = 5u;  // sampler2D, atmosphere transmittance table (RGBA16F, clamp)
@@ -49,6 +51,12 @@ SKY_SHARED_CONST kCoverageMipSize = 32u;
 SKY_SHARED_CONST kLocalSize = 8u;
 // Cloud layers the pass draws; also the slice count of the weather texture.
 SKY_SHARED_CONST kMaxLayers = 4u;
+// The weather texture's first wind layer (after the two rings' cover), and
+// the wind it encodes: each component (m/s, +-kWindMapScale_mps) in 16 bits
+// as a high and a low byte, q = (v / scale + 1) / 2 * 65535, so the texture
+// filter (linear in each byte) filters the wind itself.
+SKY_SHARED_CONST kWindMapLayers = 2u * kMaxLayers;
+SKY_SHARED_CONST kWindMapScale_mps = 150u;
 
 // A cloud type's 15 numbers (cloud_density.glsl's CloudType, in its order,
 // four per vec4; the last one unused).
@@ -78,6 +86,10 @@ struct SkyLayer {
   vec4 sunDiffuse;     // rgb: sunlight at the layer top as diffuse radiance, E T mu / pi; w: mu of the sun
   SkyCloudType primary;    // the layer's own type
   SkyCloudType secondary;  // the type its tiles blend towards
+  vec4 flow;           // the layer's wind field (wind map): x, y: the two flow phases' ages (s), z: phase A's
+                       // weight, w: 1 when the layer's wind varies over the map (its wind slice is read), else 0
+  vec4 windRef;        // xyz: the layer's own wind, camera-local (m/s), which the noise origins drift with;
+                       // w: the age of the map's tiles, weather clock minus the snapshot's (s)
 };
 
 struct SkyFrame {
@@ -140,7 +152,7 @@ struct SkyFrame {
 #ifdef __cplusplus
 static_assert(sizeof(vec4) == 16 && sizeof(uvec4) == 16);
 static_assert(sizeof(SkyCloudType) == 64);
-static_assert(sizeof(SkyLayer) == 256);
+static_assert(sizeof(SkyLayer) == 288);
 static_assert(offsetof(SkyLayer, shapeOrigin) == 32);
 static_assert(offsetof(SkyLayer, ambient) == 96);
 static_assert(offsetof(SkyLayer, sunDiffuse) == 112);
@@ -153,14 +165,15 @@ static_assert(offsetof(SkyFrame, image) == 240);
 static_assert(offsetof(SkyFrame, dispatch) == 256);
 static_assert(offsetof(SkyFrame, layers) == 272);
 static_assert(offsetof(SkyLayer, cloudMapOrigin) == 64);
-static_assert(offsetof(SkyFrame, weatherRings) == 272 + 256 * kMaxLayers);
-static_assert(offsetof(SkyFrame, steps) == 272 + 256 * kMaxLayers + 16);
-static_assert(offsetof(SkyFrame, interleave) == 272 + 256 * kMaxLayers + 32);
-static_assert(offsetof(SkyFrame, raster) == 272 + 256 * kMaxLayers + 48);
-static_assert(offsetof(SkyFrame, frustum) == 272 + 256 * kMaxLayers + 80);
-static_assert(offsetof(SkyFrame, airTable) == 272 + 256 * kMaxLayers + 96);
-static_assert(offsetof(SkyFrame, sunMap) == 272 + 256 * kMaxLayers + 112);
-static_assert(sizeof(SkyFrame) == 272 + 256 * kMaxLayers + 272);
+static_assert(offsetof(SkyLayer, flow) == 256);
+static_assert(offsetof(SkyFrame, weatherRings) == 272 + 288 * kMaxLayers);
+static_assert(offsetof(SkyFrame, steps) == 272 + 288 * kMaxLayers + 16);
+static_assert(offsetof(SkyFrame, interleave) == 272 + 288 * kMaxLayers + 32);
+static_assert(offsetof(SkyFrame, raster) == 272 + 288 * kMaxLayers + 48);
+static_assert(offsetof(SkyFrame, frustum) == 272 + 288 * kMaxLayers + 80);
+static_assert(offsetof(SkyFrame, airTable) == 272 + 288 * kMaxLayers + 96);
+static_assert(offsetof(SkyFrame, sunMap) == 272 + 288 * kMaxLayers + 112);
+static_assert(sizeof(SkyFrame) == 272 + 288 * kMaxLayers + 272);
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

@@ -54,7 +54,7 @@ void updateCoverageMip(std::vector<float>& mip, const WeatherField& field, std::
   const int block = int(field.size) / cells;
   for (const TexelRect& r : changed) {
     const std::uint32_t ring = r.layer / field.sliceCount, slice = r.layer % field.sliceCount;
-    if (slice >= gpu::kMaxLayers) continue;
+    if (slice >= gpu::kMaxLayers || ring >= kWeatherRings) continue;  // (the wind layers have no mip)
     // Cell c reads texels [c block - 1, (c + 1) block]: the cells whose
     // reach meets the rectangle (the first bound errs low, which only
     // recomputes a cell more).

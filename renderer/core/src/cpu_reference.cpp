@@ -34,6 +34,8 @@ namespace {
 // exp, pow, smoothstep) unqualified; GLM provides them with GLSL semantics.
 using namespace glm;
 using gpu::kMaxLayers;
+using gpu::kWindMapLayers;
+using gpu::kWindMapScale_mps;
 
 class CpuCore {
  public:
@@ -99,11 +101,14 @@ class CpuCore {
                       coreType(l.primary), coreType(l.secondary), l.skyTop, l.sunDiffuseTop, l.sunCosine,
                       LayerSampling{real4(l.shapeOrigin, 1.0 / l.shapePeriod_m), real4(l.detailOrigin, 1.0 / l.detailPeriod_m),
                                     real4(l.cloudMapOrigin, 1.0 / l.cloudMapPeriod_m),
-                                    real3(l.coverageShift_m, double(i)), l.shapeStretchZ},
+                                    real3(l.coverageShift_m, double(i)), l.shapeStretchZ, l.flow, l.windRef,
+                                    real3(0.0), real3(0.0)},
                       l.absent, l.stepFactor};
       } else {
         c = CoreLayer{0.0, 0.0, 0.0, 0.0, 1.0, 1.0, false, cumulus, cumulus, real3(0.0), real3(0.0), 0.0,
-                      LayerSampling{real4(0.0), real4(0.0), real4(0.0), real3(0.0, 0.0, double(i)), 1.0}, true, 1.0};
+                      LayerSampling{real4(0.0), real4(0.0), real4(0.0), real3(0.0, 0.0, double(i)), 1.0, real4(0.0),
+                                    real4(0.0), real3(0.0), real3(0.0)},
+                      true, 1.0};
       }
     }
     return f;
@@ -139,6 +144,13 @@ class CpuCore {
   }
 
  private:
+  // The weather map's plane point of a camera-local point (false behind the
+  // anchor sphere's horizon), the layer's wind there (anchor east/north),
+  // and where its tiles are read for it (as cloud_pass.glsl's).
+  bool weatherPlane(real3 p, real2& plane) const;
+  real2 windInPlane(LayerSampling s, real2 plane);
+  real2 tilePlane(LayerSampling s, real2 plane);
+
   CoreLayer layers_[kMaxLayers]{};
   AirTableTexels airTable_;
   SunMapTexels sunMap_;
@@ -166,25 +178,47 @@ void CpuCore::storeAirTable(int slice, real4 part0, real4 part1, real4 part2) {
 CpuCore::real4 CpuCore::sampleAirTable(int part, real3 uvw) { return airTable_.sample(part, uvw); }
 
 // The hooks mirror those of shaders/clouds.comp.
+bool CpuCore::weatherPlane(real3 p, real2& plane) const {
+  const real3 q = setup_.camToAnchor * p + setup_.camInAnchor_m;
+  plane = real2(q.x, q.y) * (setup_.anchorRadius_m / q.z);
+  return q.z > 0.0;
+}
+
+CpuCore::real2 CpuCore::windInPlane(LayerSampling s, real2 plane) {
+  ++lookups_;
+  return windFromTexel(weather_.sampleLayer(kWindMapLayers + std::uint32_t(s.coverageShift.z), plane.x, plane.y));
+}
+
+CpuCore::real2 CpuCore::tilePlane(LayerSampling s, real2 plane) {
+  if (s.flow.w > 0.5) return plane - windInPlane(s, plane) * s.windRef.w;
+  return plane - real2(s.coverageShift.x, s.coverageShift.y);
+}
+
 CpuCore::real3 CpuCore::sampleWeather(LayerSampling s, real3 p) {
   ++lookups_;
-  const real3 q = setup_.camToAnchor * p + setup_.camInAnchor_m;
-  if (q.z <= 0.0) return real3(0.0);
-  const real2 plane = real2(q.x, q.y) * (setup_.anchorRadius_m / q.z) - real2(s.coverageShift.x, s.coverageShift.y);
+  real2 plane;
+  if (!weatherPlane(p, plane)) return real3(0.0);
+  plane = tilePlane(s, plane);
   return weather_.sample(std::uint32_t(s.coverageShift.z), plane.x, plane.y);
+}
+
+CpuCore::real3 CpuCore::sampleWindLocal(LayerSampling s, real3 p) {
+  real2 plane;
+  if (!weatherPlane(p, plane)) return real3(s.windRef);
+  return real3(windInPlane(s, plane), 0.0) * setup_.camToAnchor;
 }
 
 CpuCore::real CpuCore::sampleMaxCoverage(LayerSampling s, real3 p) {
   ++lookups_;
-  const real3 q = setup_.camToAnchor * p + setup_.camInAnchor_m;
-  if (q.z <= 0.0) return 0.0;
-  const real2 plane = real2(q.x, q.y) * (setup_.anchorRadius_m / q.z) - real2(s.coverageShift.x, s.coverageShift.y);
+  real2 plane;
+  if (!weatherPlane(p, plane)) return 0.0;
+  plane = tilePlane(s, plane);
   return sampleCoverageMip(coverageMip_, weather_, std::uint32_t(s.coverageShift.z), plane.x, plane.y);
 }
 
 CpuCore::real2 CpuCore::sampleShape(LayerSampling s, real3 p) {
   ++lookups_;
-  real3 e = setup_.localToEcef * p;
+  real3 e = setup_.localToEcef * (p - s.flowShift);
   e.z *= s.shapeStretchZ;
   const real4 v = shape_.sample(real3(s.shapeOrigin) + e * s.shapeOrigin.w);
   return real2(v.x, v.y);
@@ -192,13 +226,13 @@ CpuCore::real2 CpuCore::sampleShape(LayerSampling s, real3 p) {
 
 CpuCore::real CpuCore::sampleDetail(LayerSampling s, real3 p) {
   ++lookups_;
-  return detail_.sample(real3(s.detailOrigin) + (setup_.localToEcef * p) * s.detailOrigin.w).x;
+  return detail_.sample(real3(s.detailOrigin) + (setup_.localToEcef * (p - s.flowShift)) * s.detailOrigin.w).x;
 }
 
 // The cloud map: the shape texture's smooth and Worley channels at its own period.
 CpuCore::real2 CpuCore::sampleCloudMap(LayerSampling s, real3 p) {
   ++lookups_;
-  const real4 v = shape_.sample(real3(s.cloudMapOrigin) + (setup_.localToEcef * p) * s.cloudMapOrigin.w);
+  const real4 v = shape_.sample(real3(s.cloudMapOrigin) + (setup_.localToEcef * (p - s.flowShift)) * s.cloudMapOrigin.w);
   return real2(v.z, v.w);
 }
 

@@ -11,6 +11,7 @@
 #include "sky/render/ephemeris.hpp"
 #include "sky/render/haze.hpp"
 #include "sky/weather/advection.hpp"
+#include "sky/weather/wind_field.hpp"
 
 #include "fresh_edges.hpp"
 #include "sky_light_grid.hpp"
@@ -266,6 +267,21 @@ Result<void> validateInputs(const FrameInputs& in) {
   return {};
 }
 
+glm::dvec3 windFlowPhases(double weatherClock_s) {
+  const double period = kWindFlowPeriod_s;
+  auto age = [&](double t) {
+    const double m = std::fmod(t, period);
+    return m < 0 ? m + period : m;
+  };
+  const double a = age(weatherClock_s), b = age(weatherClock_s + period / 2);
+  // Phase A's weight: 0 at its reset (age 0), 1 from a quarter period on
+  // until the crossfade before its next reset; B's is the rest, and B resets
+  // at A's half period, where B weighs nothing.
+  const double u = std::min(a, period - a) / period;  // [0, 0.5]
+  const double x = std::clamp((u - (0.25 - kWindFlowCrossfade)) / (2 * kWindFlowCrossfade), 0.0, 1.0);
+  return {a, b, x * x * (3 - 2 * x)};
+}
+
 FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, const WeatherField& field,
                         const AtmosphereTables& tables) {
   FrameSetup s;
@@ -347,6 +363,8 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
 
   if (in.weather == nullptr) return s;
   const double sinceSnapshot_s = in.weatherClock_s - in.weather->weatherClock_s;
+  const glm::dvec3 flow = windFlowPhases(in.weatherClock_s);
+  const weather::WindField wind(*in.weather);
   for (std::size_t slice = 0; slice < in.weather->layers.size(); ++slice) {
     const weather::CloudLayer& layer = in.weather->layers[slice];
     LayerSetup l;
@@ -379,15 +397,22 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
     l.hTop_m = alt_m - (layer.base_m + layer.thickness_m);
     l.cBase_m2 = l.hBase_m * (2 * s.r_m - l.hBase_m);
     l.cTop_m2 = l.hTop_m * (2 * s.r_m - l.hTop_m);
-    // Wind blows from fromDirection: the air moves towards fromDirection + 180.
-    const double downwind = (layer.wind.fromDirection_deg + 180.0) * kDegToRad;
-    const glm::dvec3 windEnu_mps(layer.wind.speed_mps * std::sin(downwind),
-                                 layer.wind.speed_mps * std::cos(downwind), layer.wind.vertical_mps);
-    // Earth-fixed noise that drifts with the wind: sample (x - wind t). The
-    // drift uses the wind's direction at the camera, so it turns slowly
-    // (~1 degree per 100 km) as the camera travels; per-point advection comes
-    // with the full model.
+    const weather::WindVector own = weather::toVector(layer.wind);
+    const glm::dvec3 windEnu_mps(own.east_mps, own.north_mps, own.up_mps);
+    // Earth-fixed noise that drifts with the layer's own wind: sample
+    // (x - wind t). The drift uses the wind's direction at the camera, so it
+    // turns slowly (~1 degree per 100 km) as the camera travels. A wind that
+    // varies over the map moves the noise further by its difference from this
+    // (cloudSample's flow) and the tiles by its own (sampleWeather).
     l.windEnu_mps = windEnu_mps;
+    l.windAtCamera_mps = windEnu_mps;
+    l.windRef = glm::dvec4(windEnu_mps, sinceSnapshot_s);
+    if (field.windVaries[slice]) {
+      l.flow = glm::dvec4(flow.x, flow.y, flow.z, 1.0);
+      const weather::WindVector here =
+          wind.at(layer, in.camera.position.lat_deg, in.camera.position.lon_deg);
+      l.windAtCamera_mps = glm::dvec3(here.east_mps, here.north_mps, here.up_mps);
+    }
     const glm::dvec3 origin = toGlm(enu.originEcef_m) - s.localToEcef * windEnu_mps * in.weatherClock_s;
     auto inPeriods = [&](double period_m, double stretchZ) {
       glm::dvec3 out;
@@ -407,10 +432,13 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
     l.cloudMapOrigin = inPeriods(l.cloudMapPeriod_m, 1.0);
     // The coverage tiles are the server's field at the snapshot's clock; the
     // air over the camera now was, then, where the shared advection formula
-    // (weather::advect, the one the server moves its regions with) says: the
-    // map is sampled that far upwind. East/north of the camera's frame.
-    const weather::SurfacePoint upwind = weather::advect(
-        {in.camera.position.lat_deg, in.camera.position.lon_deg}, layer.wind, -sinceSnapshot_s);
+    // (weather::upwindOf, with the wind over the camera) says: the map is
+    // sampled that far upwind. East/north of the camera's frame. A layer
+    // whose wind varies reads each point's own (sampleWeather), and this
+    // shift only places its changed tiles for the history (history_drop).
+    const weather::SurfacePoint upwind = weather::upwindOf(
+        {in.camera.position.lat_deg, in.camera.position.lon_deg},
+        {l.windAtCamera_mps.x, l.windAtCamera_mps.y, l.windAtCamera_mps.z}, sinceSnapshot_s);
     const geo::Vec3d upwindEcef = geo::toEcef({upwind.lat_deg, upwind.lon_deg, alt_m});
     const glm::dvec3 drift = inFrame(enu, enu.originEcef_m - upwindEcef);
     // A uniform layer is the same everywhere: it does not drift off the map
@@ -551,6 +579,8 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
     g.sunDiffuse = v4(l.sunDiffuseTop, l.sunCosine);
     g.primary = packCloudType(l.primary);
     g.secondary = packCloudType(l.secondary);
+    g.flow = gpu::vec4(l.flow);
+    g.windRef = gpu::vec4(l.windRef);
   }
   // Unused slots keep a positive thickness and valid types so the shader's
   // per-layer setup never divides by 0.

@@ -42,7 +42,16 @@ struct LayerSetup {
   glm::dvec3 detailOrigin{0};      // the same for the detail period
   glm::dvec3 cloudMapOrigin{0};    // the same for the cloud-map period
   glm::dvec2 coverageShift_m{0};   // wind drift of the coverage since the snapshot, east/north
-  glm::dvec3 windEnu_mps{0};       // the layer's air velocity (where it blows to), local frame
+  glm::dvec3 windEnu_mps{0};       // the layer's own air velocity (where it blows to), local frame
+  // The layer's wind field (cloud_core.glsl's LayerSampling::flow, windRef):
+  // x, y the two flow phases' ages (s), z phase A's weight, w 1 when the wind
+  // varies over the map (WeatherField::windVaries); and the own wind with the
+  // map tiles' age (s) in w.
+  glm::dvec4 flow{0};
+  glm::dvec4 windRef{0};
+  // The air's velocity over the camera (the wind field's there, or the own
+  // wind): what moves the layer's clouds near the camera, local frame.
+  glm::dvec3 windAtCamera_mps{0};
   glm::dvec3 skyTop{0};            // mean sky radiance at the layer top, linear units
   glm::dvec3 sunDiffuseTop{0};     // sunlight at the layer top as diffuse radiance, E T mu / pi
   double sunCosine = 0;            // mu of the sun at the layer top over the camera, >= 0
@@ -58,6 +67,17 @@ struct LayerSetup {
 // sun in the camera's local frame, and the heights above the ground sphere
 // of the highest drawn layer's top and the lowest one's base (0, 0 with no
 // layer drawn: the map's lines then miss every shell).
+// The noise's flow with a wind that varies (cloud_core.glsl, cloudSample):
+// each phase carries the noise for up to this long, then the other takes
+// over. A shear of 1e-3 /s (10 m/s across 10 km) stretches a cloud by 60 %
+// at most before its phase fades; a forecast's shear (1e-5 /s) by 1 %.
+inline constexpr double kWindFlowPeriod_s = 600;
+// Half the crossfade, in fractions of the period: both phases are read for
+// 2 x 2 x 0.05 = 20 % of the time (a minute of each ten).
+inline constexpr double kWindFlowCrossfade = 0.05;
+// At weather clock t: the ages (s) of flow phases A and B and A's weight.
+glm::dvec3 windFlowPhases(double weatherClock_s);
+
 struct SunMapGeometry {
   glm::dvec3 axisU{1, 0, 0};
   glm::dvec3 axisV{0, 1, 0};

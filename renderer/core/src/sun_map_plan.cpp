@@ -28,7 +28,9 @@ SunMapPlanner::Staleness SunMapPlanner::staleness(const Anchor& a, const FrameSe
   // first cascade is what the map resolves.
   double wind = 1.0;
   for (const LayerSetup& l : s.layers)
-    if (!l.absent) wind = std::max(wind, glm::length(glm::dvec2(l.windEnu_mps.x, l.windEnu_mps.y)));
+    if (!l.absent)
+      wind = std::max({wind, glm::length(glm::dvec2(l.windEnu_mps.x, l.windEnu_mps.y)),
+                       glm::length(glm::dvec2(l.windAtCamera_mps.x, l.windAtCamera_mps.y))});
   const double halfTexel = settings.extent_m / settings.size;
   const double drift = std::abs(weatherClock_s - a.weatherClock_s) * wind;
   const double moved = glm::length(s.cameraEcef_m - a.ecef);

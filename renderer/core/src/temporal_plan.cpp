@@ -267,7 +267,9 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
     for (std::size_t i = 0; i < setup.layers.size(); ++i) {
       const LayerSetup& l = setup.layers[i];
       p.layerBand[i] = gpu::vec4(float(-l.hBase_m), float(-l.hTop_m), 0.0f, 0.0f);
-      p.layerMotion[i] = v4(l.windEnu_mps * step_s);
+      // The air over the camera (a wind field's there): the reprojection
+      // moves the layer's history by one wind across the view.
+      p.layerMotion[i] = v4(l.windAtCamera_mps * step_s);
     }
   }
   previous_ = now;

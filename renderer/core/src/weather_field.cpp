@@ -6,8 +6,11 @@
 #include <cstring>
 #include <unordered_map>
 
+#include <glm/glm.hpp>
+
 #include "sky/core/assert.hpp"
 #include "sky/weather/tiling.hpp"
+#include "sky/weather/wind_field.hpp"
 #include "sky_shared.h"
 
 namespace sky::render {
@@ -40,31 +43,40 @@ double ringBlendWeight(double x_m, double y_m) {
 }
 
 glm::dvec3 WeatherField::sample(std::uint32_t slice, double x_m, double y_m) const {
-  const double w = ringBlendWeight(x_m, y_m);
-  glm::dvec3 v(0);
-  if (w < 1) v = sampleRing(0, slice, x_m, y_m);
-  if (w > 0) v += w * (sampleRing(1, slice, x_m, y_m) - v);
-  return v;
+  SKY_ASSERT(slice < sliceCount);
+  return glm::dvec3(sampleLayer(slice, x_m, y_m));
 }
 
 glm::dvec3 WeatherField::sampleRing(std::uint32_t ring, std::uint32_t slice, double x_m, double y_m) const {
   SKY_ASSERT(slice < sliceCount && ring < kWeatherRings);
+  return glm::dvec3(sampleTexels(std::size_t(ring) * sliceCount + slice, halfExtent_m[ring], x_m, y_m));
+}
+
+glm::dvec4 WeatherField::sampleLayer(std::uint32_t fineLayer, double x_m, double y_m) const {
+  const double w = ringBlendWeight(x_m, y_m);
+  glm::dvec4 v(0);
+  if (w < 1) v = sampleTexels(fineLayer, halfExtent_m[0], x_m, y_m);
+  if (w > 0) v += w * (sampleTexels(fineLayer + sliceCount, halfExtent_m[1], x_m, y_m) - v);
+  return v;
+}
+
+glm::dvec4 WeatherField::sampleTexels(std::size_t layer, double halfExtent, double x_m, double y_m) const {
   const int n = static_cast<int>(size);
-  const double tx = (x_m / (2 * halfExtent_m[ring]) + 0.5) * size - 0.5;
-  const double ty = (y_m / (2 * halfExtent_m[ring]) + 0.5) * size - 0.5;
-  if (!(std::abs(tx) < 2.0 * size && std::abs(ty) < 2.0 * size)) return {0, 0, 0};  // far outside, or NaN
+  const double tx = (x_m / (2 * halfExtent) + 0.5) * size - 0.5;
+  const double ty = (y_m / (2 * halfExtent) + 0.5) * size - 0.5;
+  if (!(std::abs(tx) < 2.0 * size && std::abs(ty) < 2.0 * size)) return {0, 0, 0, 0};  // far outside, or NaN
+  if (layer * size * size * kChannels >= texels.size()) return {0, 0, 0, 0};
   const double fx = std::floor(tx), fy = std::floor(ty);
   const int i0 = static_cast<int>(fx), j0 = static_cast<int>(fy);
   const double ax = tx - fx, ay = ty - fy;
-  const std::size_t layer = std::size_t(ring) * sliceCount + slice;
-  glm::dvec3 sum(0);
+  glm::dvec4 sum(0);
   for (int dj = 0; dj <= 1; ++dj)
     for (int di = 0; di <= 1; ++di) {
       const int i = i0 + di, j = j0 + dj;
       if (i < 0 || j < 0 || i >= n || j >= n) continue;
       const std::size_t idx = ((layer * size + std::size_t(j)) * size + std::size_t(i)) * kChannels;
       const double w = (di ? ax : 1 - ax) * (dj ? ay : 1 - ay);
-      sum += w * glm::dvec3(texels[idx], texels[idx + 1], texels[idx + 2]) / 255.0;
+      sum += w * glm::dvec4(texels[idx], texels[idx + 1], texels[idx + 2], texels[idx + 3]) / 255.0;
     }
   return sum;
 }
@@ -148,6 +160,17 @@ std::uint64_t weatherStructureKey(const weather::WeatherSnapshot* snapshot, cons
   if (coarse != nullptr) {
     mix64(h, kCoarseKeyMarker);
     mix64(h, static_cast<std::uint64_t>(coarse->tileLevel));
+  }
+  // Which layers have a wind field (their noise flows, their tiles move
+  // point by point): not the winds' values, which move clouds smoothly.
+  for (const weather::WeatherSnapshot* s : {snapshot, coarse}) {
+    if (s == nullptr) continue;
+    std::vector<std::uint32_t> windy;
+    for (const auto& t : s->windTiles)
+      if (std::find(windy.begin(), windy.end(), t.layerId) == windy.end()) windy.push_back(t.layerId);
+    std::sort(windy.begin(), windy.end());
+    mix64(h, windy.size());
+    for (std::uint32_t id : windy) mix64(h, id);
   }
   return h;
 }
@@ -248,7 +271,8 @@ WeatherField buildWeatherField(const WeatherTiles& tiles, const weather::Weather
   field.sliceCount = gpu::kMaxLayers;
   field.contentKey = weatherContentKey(snapshot, coarse);
   const std::size_t sliceTexels = std::size_t(field.size) * field.size;
-  field.texels.assign(sliceTexels * field.sliceCount * kWeatherRings * kChannels, 0);
+  // Cover, then wind: two layers of texture per ring and slice.
+  field.texels.assign(2 * sliceTexels * field.sliceCount * kWeatherRings * kChannels, 0);
   field.blendType = tiles.blendType;
   field.tiled = tiles.tiled;
   if (snapshot == nullptr) return field;
@@ -298,7 +322,91 @@ WeatherField buildWeatherField(const WeatherTiles& tiles, const weather::Weather
         }
       }
   }
+  writeWindTexels(field, snapshot, coarse);
   return field;
+}
+
+std::array<std::uint8_t, 2> encodeWindComponent(double mps) {
+  const double scale = gpu::kWindMapScale_mps;
+  const double f = std::clamp(std::isfinite(mps) ? mps / scale : 0.0, -1.0, 1.0);
+  const auto q = static_cast<std::uint32_t>(std::lround((f + 1) / 2 * 65535));
+  return {static_cast<std::uint8_t>(q >> 8), static_cast<std::uint8_t>(q & 0xff)};
+}
+
+std::uint64_t weatherWindKey(const weather::WeatherSnapshot* fine, const weather::WeatherSnapshot* coarse) {
+  std::uint64_t h = 14695981039346656037ull;
+  for (const weather::WeatherSnapshot* s : {fine, coarse}) {
+    mix64(h, s == nullptr ? 0 : 1);
+    if (s == nullptr) continue;
+    mix64(h, static_cast<std::uint64_t>(s->windTileLevel));
+    mix64(h, s->windTiles.size());
+    for (const auto& t : s->windTiles) {
+      mix64(h, t.cellId);
+      mix64(h, t.layerId);
+      std::uint32_t bits[3];
+      std::memcpy(&bits[0], &t.east_mps, 4);
+      std::memcpy(&bits[1], &t.north_mps, 4);
+      std::memcpy(&bits[2], &t.up_mps, 4);
+      mix64(h, (std::uint64_t(bits[0]) << 32) | bits[1]);
+      mix64(h, bits[2]);
+    }
+  }
+  return h;
+}
+
+void writeWindTexels(WeatherField& field, const weather::WeatherSnapshot* fine, const weather::WeatherSnapshot* coarse) {
+  field.windVaries.fill(false);
+  field.windKey = weatherWindKey(fine, coarse);
+  const std::size_t sliceTexels = std::size_t(field.size) * field.size;
+  const std::size_t windBase = std::size_t(gpu::kWindMapLayers) * sliceTexels * kChannels;
+  std::fill(field.texels.begin() + std::ptrdiff_t(windBase), field.texels.end(), std::uint8_t(0));
+  if (fine == nullptr) return;
+  const weather::WindField fineWind(*fine);
+  const weather::WindField coarseWind = coarse != nullptr ? weather::WindField(*coarse) : weather::WindField();
+  const std::uint32_t n = field.size;
+  const std::uint32_t nodes = (n + kWindLattice - 1) / kWindLattice + 1;  // every kWindLattice-th texel and the last
+  const double groundRadius_m = field.radius_m - field.anchorAlt_m;
+  std::vector<glm::dvec2> node(std::size_t(nodes) * nodes);
+  for (std::size_t s = 0; s < fine->layers.size() && s < field.sliceCount; ++s) {
+    const weather::CloudLayer& layer = fine->layers[s];
+    const bool fineVaries = fineWind.varies(layer.id), coarseVaries = coarse != nullptr && coarseWind.varies(layer.id);
+    if (!fineVaries && !coarseVaries) continue;
+    field.windVaries[s] = true;
+    for (std::uint32_t ring = 0; ring < kWeatherRings; ++ring) {
+      const weather::WindField& wind = ring == 1 && coarse != nullptr ? coarseWind : fineWind;
+      // The wind at the lattice's texel centres, in the anchor's east/north
+      // (the map plane's axes; the gnomonic plane's scale is within 1 % of
+      // the ground's over the rings).
+      auto texelOf = [&](std::uint32_t k) { return std::min(k * kWindLattice, n - 1); };
+      for (std::uint32_t b = 0; b < nodes; ++b)
+        for (std::uint32_t a = 0; a < nodes; ++a) {
+          const double x_m = ((texelOf(a) + 0.5) / n - 0.5) * 2 * field.halfExtent_m[ring];
+          const double y_m = ((texelOf(b) + 0.5) / n - 0.5) * 2 * field.halfExtent_m[ring];
+          const geo::Vec3d dir =
+              geo::normalize(field.frame.east * x_m + field.frame.north * y_m + field.frame.up * field.radius_m);
+          const geo::Geodetic g = geo::fromEcef(field.centreEcef_m + dir * groundRadius_m);
+          const weather::WindVector v = wind.at(layer, g.lat_deg, g.lon_deg);
+          const geo::EnuFrame there = geo::enuFrameAt(g);
+          const geo::Vec3d ecef = there.east * v.east_mps + there.north * v.north_mps;
+          node[std::size_t(b) * nodes + a] = {geo::dot(ecef, field.frame.east), geo::dot(ecef, field.frame.north)};
+        }
+      const std::size_t layerBase = (std::size_t(gpu::kWindMapLayers) + std::size_t(ring) * field.sliceCount + s) * sliceTexels;
+      for (std::uint32_t j = 0; j < n; ++j)
+        for (std::uint32_t i = 0; i < n; ++i) {
+          const std::uint32_t a = std::min(i / kWindLattice, nodes - 2), b = std::min(j / kWindLattice, nodes - 2);
+          const double fx = double(i - texelOf(a)) / double(texelOf(a + 1) - texelOf(a));
+          const double fy = double(j - texelOf(b)) / double(texelOf(b + 1) - texelOf(b));
+          const glm::dvec2 v = glm::mix(glm::mix(node[std::size_t(b) * nodes + a], node[std::size_t(b) * nodes + a + 1], fx),
+                                        glm::mix(node[std::size_t(b + 1) * nodes + a], node[std::size_t(b + 1) * nodes + a + 1], fx), fy);
+          const auto east = encodeWindComponent(v.x), north = encodeWindComponent(v.y);
+          std::uint8_t* t = &field.texels[(layerBase + std::size_t(j) * n + i) * kChannels];
+          t[0] = east[0];
+          t[1] = east[1];
+          t[2] = north[0];
+          t[3] = north[1];
+        }
+    }
+  }
 }
 
 geo::Geodetic weatherAnchorFor(const geo::Geodetic& camera) {

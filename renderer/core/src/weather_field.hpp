@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include "sky/core/result.hpp"
 #include "sky/geo/geodetic.hpp"
@@ -61,7 +62,8 @@ struct WeatherField {
   std::uint32_t sliceCount = 0;        // slices per ring in texels (always gpu::kMaxLayers)
   std::vector<std::uint8_t> texels;    // unorm8 (the stream's 1/255 steps): ring, slice, row (north),
                                        // column (east), (coverage, density, blend, 0); the GPU's
-                                       // array layer ring * sliceCount + slice
+                                       // array layer ring * sliceCount + slice; then the wind map's
+                                       // layers (gpu::kWindMapLayers + ring * sliceCount + slice)
   // Per slice, the one type its tiles blend towards (None: no blend). A tile
   // may name another type than the slice's; the slice takes the type with the
   // largest summed blend in its tiles (of both rings) and such tiles draw unblended.
@@ -69,7 +71,13 @@ struct WeatherField {
   // Per slice, whether the layer came with tiles in either ring (else the
   // slice is uniform over the map and drifting it changes nothing).
   std::array<bool, gpu::kMaxLayers> tiled{};
+  // Per slice, whether the layer's wind varies over the map (its snapshot
+  // has wind tiles for it): its wind slices then hold the wind, in the
+  // anchor's east/north, from weather::WindField at each texel (bilinear
+  // between every kWindLattice-th texel).
+  std::array<bool, gpu::kMaxLayers> windVaries{};
   std::uint64_t contentKey = 0;        // weatherContentKey() of the source snapshots
+  std::uint64_t windKey = 0;           // weatherWindKey() of the source snapshots
   geo::Geodetic anchor;                // where the map was built
   // Per ring, the S2 level of its cells (its source snapshot's tile level)
   // and per texel (row, column) the cell of that level at the texel's
@@ -83,7 +91,28 @@ struct WeatherField {
   glm::dvec3 sample(std::uint32_t slice, double x_m, double y_m) const;
   // One ring alone: bilinear, zero outside it, as the GPU's clamp-to-border.
   glm::dvec3 sampleRing(std::uint32_t ring, std::uint32_t slice, double x_m, double y_m) const;
+  // Any texture layer of ring 0 (a cover slice, or gpu::kWindMapLayers + a
+  // slice) with its ring 1 layer (+ sliceCount), blended as sample: the four
+  // channels as the GPU's filter gives them, in [0, 1].
+  glm::dvec4 sampleLayer(std::uint32_t fineLayer, double x_m, double y_m) const;
+  // One texture layer of a ring of this half extent, bilinear, 0 outside.
+  glm::dvec4 sampleTexels(std::size_t layer, double halfExtent_m, double x_m, double y_m) const;
 };
+
+// Every kWindLattice-th texel's wind comes from the field; the texels
+// between are bilinear (the wind varies over kilometres, a texel is 780 m).
+inline constexpr std::uint32_t kWindLattice = 8;
+
+// The wind map's encoding of one component (sky_shared.h): 16 bits as a
+// high and a low byte.
+std::array<std::uint8_t, 2> encodeWindComponent(double mps);
+
+// Fills the wind slices of a field built at its anchor from the snapshots'
+// wind tiles (ring 1 from `coarse` when given), and windVaries, windKey.
+void writeWindTexels(WeatherField& field, const weather::WeatherSnapshot* fine, const weather::WeatherSnapshot* coarse);
+
+// Hash of the snapshots' wind tiles and levels (what the wind slices hold).
+std::uint64_t weatherWindKey(const weather::WeatherSnapshot* fine, const weather::WeatherSnapshot* coarse);
 
 // Channels per texel of the map: coverage, density, blend, unused.
 inline constexpr std::size_t kWeatherChannels = 4;

@@ -111,7 +111,11 @@ WeatherFieldChange WeatherFieldUpdater::update(const weather::WeatherSnapshot* f
   if (built_ && version && version == version_ && sameAnchor(field_.anchor, anchor)) return change;
   version_ = version;
   const WeatherKeys keys = weatherKeys(fine, coarse);
-  if (built_ && keys.content == field_.contentKey && sameAnchor(field_.anchor, anchor)) return change;
+  const std::uint64_t windKey = weatherWindKey(fine, coarse);
+  if (built_ && keys.content == field_.contentKey && sameAnchor(field_.anchor, anchor)) {
+    if (windKey != field_.windKey) rewriteWind(fine, coarse, change);
+    return change;
+  }
 
   change.reason = snapshotReason(fine, coarse, anchor);
   // A snapshot whose tiles are the ones the map was filled from keeps its
@@ -181,7 +185,19 @@ WeatherFieldChange WeatherFieldUpdater::update(const weather::WeatherSnapshot* f
       change.dirty.push_back({layer, b.x0, b.y0, b.x1 - b.x0 + 1, b.y1 - b.y0 + 1});
   field_.contentKey = keys.content;
   tiles_ = std::move(next);
+  if (windKey != field_.windKey) rewriteWind(fine, coarse, change);
   return change;
+}
+
+void WeatherFieldUpdater::rewriteWind(const weather::WeatherSnapshot* fine, const weather::WeatherSnapshot* coarse,
+                                      WeatherFieldChange& change) {
+  writeWindTexels(field_, fine, coarse);
+  change.kind = WeatherFieldChange::Kind::Tiles;
+  for (std::uint32_t ring = 0; ring < kWeatherRings; ++ring)
+    for (std::uint32_t s = 0; s < field_.sliceCount; ++s) {
+      change.windDirty.push_back({gpu::kWindMapLayers + ring * field_.sliceCount + s, 0, 0, field_.size, field_.size});
+      change.texelsRewritten += std::uint64_t(field_.size) * field_.size;
+    }
 }
 
 }  // namespace sky::render

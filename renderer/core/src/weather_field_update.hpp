@@ -40,6 +40,11 @@ struct WeatherFieldChange {
   // blend, in the map's 1/255 steps (a ramp moves a few a frame, a step
   // change many).
   std::uint32_t largestStep = 0;
+  // Tiles: the wind slices rewritten whole (their wind tiles changed: a
+  // forecast's wind moving on, a region's own wind). Not in `dirty`: a wind
+  // that changes by centimetres a second leaves the picture, and so the
+  // renderer's history, as it is.
+  std::vector<TexelRect> windDirty;
 };
 
 class WeatherFieldUpdater {
@@ -59,6 +64,10 @@ class WeatherFieldUpdater {
   const WeatherField& field() const { return field_; }
 
  private:
+  // Rewrites the wind slices (the wind tiles changed, nothing else) and
+  // says so in `change`.
+  void rewriteWind(const weather::WeatherSnapshot* fine, const weather::WeatherSnapshot* coarse,
+                   WeatherFieldChange& change);
   // One ring's texels grouped by cell (CSR): the texels (row * size +
   // column) of cells[k] are texels[start[k] .. start[k + 1]). A function of
   // the anchor and the level alone, so it stays valid across rebuilds at

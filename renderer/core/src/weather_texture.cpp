@@ -10,8 +10,9 @@ namespace sky::render {
 
 Result<WeatherTexture> WeatherTexture::create(const GpuContext& ctx) {
   WeatherTexture t;
+  // Cover and wind: two layers per ring and slice.
   t.image_ = createSampledImage(ctx, vk::ImageType::e2D, vk::Format::eR8G8B8A8Unorm,
-                                vk::Extent3D(kWeatherMapSize, kWeatherMapSize, 1), gpu::kMaxLayers * kWeatherRings,
+                                vk::Extent3D(kWeatherMapSize, kWeatherMapSize, 1), 2 * gpu::kMaxLayers * kWeatherRings,
                                 "sky.weatherMap");
   t.timer_ = GpuTimer(ctx, 1, "sky.weatherMap.timer");
   if (auto ok = t.uploadWhole(ctx); !ok) return tl::unexpected(ok.error());
@@ -39,10 +40,13 @@ Result<void> WeatherTexture::update(const GpuContext& ctx, const FrameInputs& in
       lastUpdate_.rebuilt = true;
       lastUpdate_.reason = change.reason;
       return uploadWhole(ctx);
-    case WeatherFieldChange::Kind::Tiles:
+    case WeatherFieldChange::Kind::Tiles: {
       lastRects_ = change.dirty;
       lastUpdate_.largestStep = change.largestStep;
-      return uploadRects(ctx, change.dirty);
+      std::vector<TexelRect> rects = change.dirty;
+      rects.insert(rects.end(), change.windDirty.begin(), change.windDirty.end());
+      return uploadRects(ctx, rects);
+    }
   }
   return {};
 }

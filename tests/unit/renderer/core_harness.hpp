@@ -17,6 +17,7 @@ namespace sky::test {
 
 using namespace glm;
 using gpu::kMaxLayers;
+using gpu::kWindMapScale_mps;
 
 class Core {
  public:
@@ -95,6 +96,8 @@ inline Core::real Core::sampleDetail(LayerSampling, real3) {
   ++lookups;
   return detail;
 }
+// A uniform field: the layer's own wind everywhere.
+inline Core::real3 Core::sampleWindLocal(LayerSampling s, real3) { return real3(s.windRef); }
 inline Core::real2 Core::airCloudShadow(AirFrame a, real3 p, real h, real muSun) {
   return airSunShadow(a, p, h, muSun);
 }
@@ -169,7 +172,8 @@ inline Core::CoreLayer shellLayer(const Core::CoreFrame& f, double alt, double b
   const double hBase = alt - base, hTop = alt - (base + thickness);
   return Core::CoreLayer{hBase, hTop, hBase * (2 * f.air.r - hBase), hTop * (2 * f.air.r - hTop), thickness,
                          0.5 * thickness, false, t, t, Core::real3(0), Core::real3(0), 1.0,
-                         Core::LayerSampling{Core::real4(0.0), Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), 1.0},
+                         Core::LayerSampling{Core::real4(0.0), Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), 1.0,
+                                             Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), Core::real3(0.0)},
                          false, 1.0};
 }
 

@@ -1,0 +1,136 @@
+// A wind that varies over the map (wind tiles): a shear moves the clouds on
+// each side by their own wind, on the GPU, and the GPU agrees with the CPU
+// reference while the noise's two flow phases crossfade.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <gtest/gtest.h>
+
+#include "renderer_fixture.hpp"
+#include "scenes.hpp"
+#include "sky/render/cpu_reference.hpp"
+#include "sky/weather/tiling.hpp"
+#include "sky/weather/wind_field.hpp"
+
+namespace sky::test {
+namespace {
+
+constexpr double kLat = 46, kLon = 14;
+constexpr float kWind_mps = 15;
+
+// One layer of uniform cover 0.5 whose wind tiles (level 12, ~2 km) blow
+// northwards west of kLon and southwards east of it (shear), or northwards
+// everywhere (control); the layer's own wind is calm.
+weather::WeatherSnapshot windSnapshot(bool shear) {
+  weather::WeatherSnapshot s;
+  weather::CloudLayer l = layer(1, 1500, 1000, 0.5, 1.0);
+  s.layers.push_back(l);
+  s.windTileLevel = 12;
+  for (std::uint64_t cell : weather::coverCap({kLat, kLon, 60000}, 12, 100000)) {
+    const weather::CellCentre c = weather::cellCentre(cell);
+    const float north = !shear || c.lon_deg < kLon ? kWind_mps : -kWind_mps;
+    s.windTiles.push_back({cell, 1, 0.0f, north, 0.0f});
+  }
+  return s;
+}
+
+std::vector<double> luminance(const render::Image& im) {
+  std::vector<double> out(std::size_t(im.width) * im.height);
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out[i] = 0.2126 * im.rgba[4 * i] + 0.7152 * im.rgba[4 * i + 1] + 0.0722 * im.rgba[4 * i + 2];
+  return out;
+}
+
+// The row shift k (features moved k rows up, i.e. north) that best matches
+// `later` to `before` over columns [c0, c1).
+int bestRowShift(const render::Image& before, const render::Image& later, std::uint32_t c0, std::uint32_t c1) {
+  const auto a = luminance(before), b = luminance(later);
+  const int w = int(before.width), h = int(before.height);
+  int best = 0;
+  double bestErr = 1e300;
+  for (int k = -35; k <= 35; ++k) {
+    double err = 0;
+    int n = 0;
+    for (int r = 0; r < h; ++r) {
+      const int r0 = r + k;
+      if (r0 < 0 || r0 >= h) continue;
+      for (int c = int(c0); c < int(c1); ++c) {
+        const double d = b[std::size_t(r) * w + c] - a[std::size_t(r0) * w + c];
+        err += d * d;
+        ++n;
+      }
+    }
+    if (n > 0 && err / n < bestErr) {
+      bestErr = err / n;
+      best = k;
+    }
+  }
+  return best;
+}
+
+// Looking straight down from 12 km on a deck 10 km below (~12 km of it
+// across the image): 60 s of 15 m/s is 900 m, ~12 rows.
+TEST(WindField, AShearMovesEachSideByItsOwnWind) {
+  SKY_RENDERER(r, 160, 90);
+  const geo::GeodeticPose camera = pose(kLat, kLon, 12000, 0, -90);
+  // Both frames in phase A's plateau (ages 200 and 260 s of its 600): the
+  // noise moves with the wind alone, no crossfade.
+  auto frame = [&](const weather::WeatherSnapshot& s, double clock_s) {
+    render::FrameInputs in;
+    in.camera = camera;
+    in.weather = &s;
+    in.weatherClock_s = clock_s;
+    in.sunElevation_deg = 60;
+    auto im = r.render(in);
+    EXPECT_TRUE(im) << (im ? "" : describe(im.error()));
+    return im ? *im : render::Image{};
+  };
+  const weather::WeatherSnapshot control = windSnapshot(false), shear = windSnapshot(true);
+  const render::Image c0 = frame(control, 200), c1 = frame(control, 260);
+  const render::Image s0 = frame(shear, 200), s1 = frame(shear, 260);
+  ASSERT_EQ(c0.width, 160u);
+  savePng(s0, "wind_shear_t200");
+  savePng(s1, "wind_shear_t260");
+  // West and east thirds, clear of the ~2 km the field blends across.
+  const int controlWest = bestRowShift(c0, c1, 0, 53), controlEast = bestRowShift(c0, c1, 107, 160);
+  const int shearWest = bestRowShift(s0, s1, 0, 53), shearEast = bestRowShift(s0, s1, 107, 160);
+  std::printf("rows moved in 60 s: uniform wind west %d east %d; shear west %d east %d\n", controlWest, controlEast,
+              shearWest, shearEast);
+  EXPECT_GE(controlWest, 6);  // north is up in the image
+  EXPECT_NEAR(controlEast, controlWest, 1);
+  EXPECT_NEAR(shearWest, controlWest, 1);   // west of the line: northwards, as the uniform wind
+  EXPECT_NEAR(shearEast, -controlWest, 1);  // east of it: as far southwards
+}
+
+// The CPU reference at the middle of a crossfade (both flow phases read,
+// weighted half and half) and on a plateau: the same model on both.
+TEST(WindField, GpuMatchesTheCpuReferenceAcrossTheFlowCrossfade) {
+  SKY_RENDERER(r, 64, 36);
+  auto reference = render::CpuReference::create(r.settings());
+  ASSERT_TRUE(reference) << describe(reference.error());
+  const weather::WeatherSnapshot shear = windSnapshot(true);
+  for (double clock_s : {150.0, 230.0}) {
+    SCOPED_TRACE(clock_s);
+    render::FrameInputs in;
+    in.camera = pose(kLat, kLon - 0.02, 800, 80, 25);
+    in.weather = &shear;
+    in.weatherClock_s = clock_s;
+    in.sunElevation_deg = 40;
+    auto gpu = r.render(in);
+    ASSERT_TRUE(gpu) << describe(gpu.error());
+    auto cpu = reference->render(in);
+    ASSERT_TRUE(cpu) << describe(cpu.error());
+    const Diff d = diff(*gpu, *cpu);
+    const double mean = render::computeStats(*cpu).meanLuminance;
+    const double meanError = std::abs(render::computeStats(*gpu).meanLuminance - mean) / mean;
+    std::printf("[ gpu/cpu  ] wind shear at %.0f s: mean %.4f (gpu %+.3f %%) displayed rmse %.2f %%\n", clock_s, mean,
+                100 * meanError, 100 * d.displayedRmse / d.displayedMean);
+    // The tolerances of gpu_vs_cpu_test.cpp.
+    EXPECT_LT(meanError, 0.005);
+    EXPECT_LT(d.displayedRmse, 0.05 * d.displayedMean);
+  }
+}
+
+}  // namespace
+}  // namespace sky::test
