@@ -24,8 +24,11 @@ const L = window.L;
 
 // Zoom limits: at 2 the world is 1024 px wide; at 15 a pixel is about 3 m at 46 N.
 const MIN_ZOOM = 2, MAX_ZOOM = 15;
-// The view holds quarter levels; the wheel and the +/- buttons move by half.
+// The view holds quarter levels; the keyboard's +/- move by half.
 const ZOOM_SNAP = 0.25, ZOOM_DELTA = 0.5;
+// Wheel travel per zoom level in Leaflet's formula (its default is 60): a
+// wheel notch (100 px in Chromium) zooms by 0.75 levels (measured), not 1.25.
+const WHEEL_PX_PER_ZOOM = 120;
 // A press that moves less than this is a click, not a drag (CSS px).
 const CLICK_SLOP_PX = 4;
 // A renderer whose last report is older than this is drawn as stale.
@@ -103,7 +106,7 @@ export class MapView {
     this.zoom = MIN_ZOOM;
     const map = L.map(container, {
       zoomControl: false, worldCopyJump: true, minZoom: MIN_ZOOM, maxZoom: MAX_ZOOM, zoomSnap: ZOOM_SNAP,
-      zoomDelta: ZOOM_DELTA, wheelPxPerZoomLevel: 120, boxZoom: false,
+      zoomDelta: ZOOM_DELTA, wheelPxPerZoomLevel: WHEEL_PX_PER_ZOOM, boxZoom: false,
       // Nothing outside the world's latitudes: Web Mercator ends at 85.05 degrees.
       maxBounds: [[-90, -1e6], [90, 1e6]], maxBoundsViscosity: 1,
     });
