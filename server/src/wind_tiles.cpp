@@ -56,19 +56,33 @@ WindTiles deriveWindTiles(const weather::SphericalCap& cap, std::span<const weat
   std::sort(byBase.begin(), byBase.end());
   for (std::size_t n = kMaxWindLayers; n < byBase.size(); ++n) varies[byBase[n].second] = false;
 
-  // The covering, and each near region's weight at its cells.
+  // The covering, and each near region's weight at its cells. It reaches
+  // two cell edges past the area, so that the wind anywhere in the area has
+  // every cell the field's kernel weighs (a point query's area of one metre
+  // would otherwise be one cell, its neighbours taken as the layer's own
+  // wind); at the level the budget allows, found from the wanted one down.
   Covering local;
   std::vector<weather::CellCentre> localCentres;
   TileCache::Entry* entry = nullptr;
   WindCells at;
+  for (int level = kWindTileLevel;;) {
+    const weather::SphericalCap wider{cap.centerLat_deg, cap.centerLon_deg,
+                                      cap.radius_m + 2 * weather::averageCellEdge_m(level)};
+    if (cache) {
+      entry = &cache->covering(wider, level, kMaxWindCells);
+      at = {entry->covering.cells, entry->centres, entry->covering.level};
+    } else {
+      local = coverArea(wider, level, kMaxWindCells);
+      at = {local.cells, {}, local.level};
+    }
+    if (at.level == level || at.level == 0) break;
+    level = at.level;  // coarser cells: a wider margin at that level
+  }
   if (cache) {
-    entry = &cache->covering(cap, kWindTileLevel, kMaxWindCells);
     TileCache::makeRoomForShapes(*entry, near.size());
-    at = {entry->covering.cells, entry->centres, entry->covering.level};
   } else {
-    local = coverArea(cap, kWindTileLevel, kMaxWindCells);
     for (std::uint64_t c : local.cells) localCentres.push_back(weather::cellCentre(c));
-    at = {local.cells, localCentres, local.level};
+    at.centres = localCentres;
   }
   std::vector<std::vector<double>> weightOf(near.size());
   auto weights = [&](std::size_t k) -> const std::vector<double>& {

@@ -337,6 +337,7 @@ TEST(CigiConditions, TheRendererAnswersTheForecastsClouds) {
       {"in the high layer", kLat, kLon, 8500},            {"above every layer", kLat, kLon, 12000},
   };
   int cloudy = 0;
+  double boundaryWind = 0;
   for (std::size_t i = 0; i < std::size(points); ++i) {
     const Point& p = points[i];
     const IgAnswer ig = ask(host, cigiPort, static_cast<std::uint8_t>(40 + i), p);
@@ -358,10 +359,25 @@ TEST(CigiConditions, TheRendererAnswersTheForecastsClouds) {
       EXPECT_LE(layer, 34u);
       EXPECT_FALSE(s["forecast_sources"][std::to_string(layer)].is_null());
     }
-    std::printf("[conditions] %-28s IG humidity %3d visibility %8.1f m | server density %.4f layer %s\n", p.what,
-                ig.weather->humidity_pct, ig.weather->visibility_m, density, s["layer_id"].dump().c_str());
+    // The wind: the forecast's 10 m wind moves the boundary-layer cloud
+    // (wind tiles); the renderer's area and the server's point query cover
+    // the point with wind tiles of different levels, each smoothed by the
+    // same kernel, hence the tolerance (GFS's 2.5-degree field is smooth).
+    const double speed = s["wind"]["speed_mps"].get<double>();
+    EXPECT_NEAR(ig.weather->horizontalWind_mps, speed, 0.3);
+    if (speed > 1) {
+      EXPECT_LT(angleBetween_deg(ig.weather->windDirection_deg, s["wind"]["from_deg"].get<double>()), 3);
+    }
+    if (i == 0) boundaryWind = speed;
+    std::printf("[conditions] %-28s IG humidity %3d visibility %8.1f m wind %5.2f m/s from %5.1f | server density "
+                "%.4f layer %s wind %5.2f from %5.1f\n",
+                p.what, ig.weather->humidity_pct, ig.weather->visibility_m, ig.weather->horizontalWind_mps,
+                ig.weather->windDirection_deg, density, s["layer_id"].dump().c_str(), speed,
+                s["wind"]["from_deg"].get<double>());
   }
   EXPECT_GE(cloudy, 3) << "GFS has boundary-layer, low, middle and high cloud over 46.2 N 12.8 E on 2011-01-15 12Z";
+  // The forecast's layers have no wind of their own: the boundary layer's is GFS's 10 m wind.
+  EXPECT_GT(boundaryWind, 0.5);
   EXPECT_EQ(render.stop(), 0) << render.log();
   EXPECT_EQ(w.process->stop(), 0) << w.process->log();
 }
