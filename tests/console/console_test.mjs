@@ -285,6 +285,25 @@ const cases = {
     // The region and its perimeter on the map: one SVG path each.
     assert(await a.page.locator(`path.region-edge.region-${r.id}`).count() === 1, "the region's edge drawn");
     assert(await a.page.locator(`path.region-perimeter.region-${r.id}`).count() === 1, "its perimeter drawn");
+    // Its layer as the overlay: the coverage field is white at the cell's
+    // centre (0.95 of the overlay's full alpha) and empty 30 km away. The
+    // least alpha of 3 x 3 pixels: a graticule line or an arrow on the same
+    // canvas only adds to it.
+    await a.page.selectOption("#overlay-layer", String(r.layers[0].id));
+    const alphaAt = async (lat, lon) => {
+      const p = await screenOf(a.page, lat, lon);
+      return a.page.evaluate(([x, y]) => {
+        const c = document.querySelector("canvas.sky-overlay"), rect = c.getBoundingClientRect();
+        const k = c.width / rect.width;
+        const d = c.getContext("2d").getImageData(Math.round((x - rect.left) * k) - 1, Math.round((y - rect.top) * k) - 1, 3, 3).data;
+        let least = 255;
+        for (let i = 3; i < d.length; i += 4) least = Math.min(least, d[i]);
+        return least;
+      }, [p.x, p.y]);
+    };
+    await until("the cell's coverage on the overlay", async () => (await alphaAt(r.center_lat_deg, r.center_lon_deg)) > 140);
+    const far = east(r.center_lat_deg, r.center_lon_deg, -30000);
+    assert((await alphaAt(far.lat, far.lon)) === 0, "no coverage of the cell's layer outside it");
     // A clearing placed by press and drag: 6 km from its centre is a 12 km
     // hole, every global layer at coverage 0 inside.
     await a.page.click("#mode-clearing");
