@@ -13,6 +13,7 @@
 #include "sky/server/http_api.hpp"
 #include "sky/server/metar_api.hpp"
 #include "sky/server/scenario_api.hpp"
+#include "sky/server/wind_api.hpp"
 
 namespace sky::server {
 
@@ -41,6 +42,11 @@ HttpReply HttpApi::serve(Endpoint endpoint, const ApiRequest& r) {
       auto q = parseConformanceQuery(r.query);
       if (!q) return error(400, q.error().detail);
       return json(conformanceJson(weather_, options_.stations, *q));
+    }
+    case Endpoint::Wind: {
+      auto q = parseWindQuery(r.query);
+      if (!q) return error(400, q.error().detail);
+      return json(windJson(weather_, *q));
     }
     case Endpoint::Events: return events(r.query);
     case Endpoint::Changes: return changes(r);

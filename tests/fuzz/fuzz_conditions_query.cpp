@@ -1,6 +1,6 @@
 // libFuzzer target: query strings of the weather server's GET
-// /api/conditions. The parser may refuse (naming the key), never crash, hang
-// or read out of bounds; what it accepts is in range.
+// /api/conditions and GET /api/wind. The parsers may refuse (naming the key),
+// never crash, hang or read out of bounds; what they accept is in range.
 // Seeds: tests/fuzz/corpus/conditions_query/.
 #include <cmath>
 #include <cstddef>
@@ -9,9 +9,17 @@
 #include <string_view>
 
 #include "sky/server/conditions_api.hpp"
+#include "sky/server/wind_api.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view query(reinterpret_cast<const char*>(data), size);
+  if (const auto w = sky::server::parseWindQuery(query)) {
+    if (!(std::abs(w->lat_deg) <= 90) || !(std::abs(w->lon_deg) <= 180) || !(w->alt_m >= -1000 && w->alt_m <= 20000) ||
+        !(w->radius_m >= 1000 && w->radius_m <= 2e6))
+      std::abort();
+  } else if (w.error().detail.empty()) {
+    std::abort();
+  }
   const auto q = sky::server::parseConditionsQuery(query);
   if (!q) {
     if (q.error().detail.empty()) std::abort();

@@ -13,6 +13,7 @@
 //                        (console_files.hpp)
 //   GET  /api/renderers  the weather-stream subscribers and their cameras
 //   GET  /api/conditions the weather at points (conditions_api.hpp)
+//   GET  /api/wind       the wind field over an area at a height (wind_api.hpp)
 //   GET  /api/ws         WebSocket upgrade: the console's live feed (console_feed.hpp)
 // Routes, their methods, body limits and token rules are one table
 // (http_routes.hpp); each request goes through HttpExchange

@@ -20,6 +20,7 @@ enum class Endpoint {
   Renderers,
   Conditions,
   Conformance,
+  Wind,  // GET /api/wind (wind_api.hpp)
   Events,
   Changes,
   Scenario,
