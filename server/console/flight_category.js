@@ -64,14 +64,33 @@ export function readReport(text) {
   return { ceiling_ft, visibility_sm };
 }
 
-// "VFR", "MVFR", "IFR", "LIFR", or null when the report gives neither a
-// ceiling nor a visibility (nor says the sky is clear).
-export function flightCategory(text) {
-  const { ceiling_ft, visibility_sm } = readReport(text);
+// The category of a ceiling (ft above the station) and a visibility (SM),
+// either null when unknown; null when both are.
+export function categoryOf(ceiling_ft, visibility_sm) {
   if (ceiling_ft === null && visibility_sm === null) return null;
   for (const l of LIMITS) {
     if ((ceiling_ft !== null && ceiling_ft < l.ceiling_ft) || (visibility_sm !== null && visibility_sm < l.visibility_sm))
       return l.category;
   }
   return "VFR";
+}
+
+// "VFR", "MVFR", "IFR", "LIFR", or null when the report gives neither a
+// ceiling nor a visibility (nor says the sky is clear).
+export function flightCategory(text) {
+  const { ceiling_ft, visibility_sm } = readReport(text);
+  return categoryOf(ceiling_ft, visibility_sm);
+}
+
+// Broken: 5 oktas, the least cover that makes a ceiling.
+const CEILING_COVERAGE = 5 / 8;
+const FT_PER_M = 1 / 0.3048;
+
+// The category from a station region's layers alone (the server restarted
+// and no longer has the report's text): the ceiling is the lowest base with
+// 5 oktas or more above the station; visibility is not in the weather model,
+// so a clear sky counts as VFR by its ceiling only.
+export function categoryFromLayers(layers, elevation_m) {
+  const bases = layers.filter((l) => l.coverage >= CEILING_COVERAGE).map((l) => (l.base_m - elevation_m) * FT_PER_M);
+  return categoryOf(bases.length ? Math.max(0, Math.min(...bases)) : Infinity, null);
 }

@@ -3,7 +3,7 @@
 // category of its latest applied report (flight_category.js), grey without
 // one; a click opens the report and the layers it became.
 import { el } from "./dom.js";
-import { flightCategory } from "./flight_category.js";
+import { categoryFromLayers, flightCategory } from "./flight_category.js";
 import { normalizeLon } from "./geo.js";
 import { fmt, ftFromM, OKTAS } from "./units.js";
 
@@ -33,8 +33,9 @@ function popupContent(s, category) {
   const cleared = r.layers.length - cloudy.length;
   return el("div", { class: "station-popup" }, head,
     el("div", { class: `station-category cat-${category || "none"}` }, category ? CATEGORY_TEXT[category] : "category unknown"),
-    el("code", { class: "station-report" }, r.text),
-    el("div", { class: "muted" }, `applied #${r.sequence} as region ${r.region_id}`),
+    r.text !== null ? el("code", { class: "station-report" }, r.text)
+      : el("div", { class: "muted" }, "the report's text is gone (the server restarted since); category from its layers' ceiling"),
+    el("div", { class: "muted" }, r.sequence !== null ? `applied #${r.sequence} as region ${r.region_id}` : `region ${r.region_id}`),
     r.sky === "not_observed" ? el("div", {}, "sky not observed: the weather there stays as it was")
       : el("ul", { class: "station-layers" }, ...(cloudy.length ? cloudy.map((l) => el("li", {}, `layer ${l.id}: ${layerText(l)}`))
         : [el("li", {}, "clear sky")]),
@@ -61,7 +62,10 @@ export class StationLayer {
     const seen = new Set();
     for (const s of list) {
       seen.add(s.icao);
-      const category = s.report ? flightCategory(s.report.text) : null;
+      // From the report, or from its region's layers when the server no
+      // longer has the text (it restarted since).
+      const category = !s.report ? null
+        : s.report.text !== null ? flightCategory(s.report.text) : categoryFromLayers(s.report.layers, s.elevation_m);
       const key = JSON.stringify([s, category]);
       let m = this.markers.get(s.icao);
       if (!m) {

@@ -2,9 +2,11 @@
 #include "sky/server/metar_stations.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "sky/core/utf8.hpp"
 #include "sky/server/api_json.hpp"
+#include "sky/server/metar_changes.hpp"
 
 namespace sky::server {
 
@@ -50,23 +52,39 @@ void MetarStationBoard::remember(const MetarRequest& request, const json& reply,
 json MetarStationBoard::list(std::span<const Station> serverStations, const WeatherView& now) const {
   std::map<std::uint32_t, const weather::Region*> regions;
   for (const auto& r : now.regions) regions[r.id] = &r;
-  json out = json::array();
-  auto withReport = [&](json station, const std::string& icao) {
-    const auto it = latest_.find(icao);
-    if (it == latest_.end()) return station;
-    const Entry& e = it->second;
-    const auto region = regions.find(e.regionId);
-    if (region == regions.end()) return station;
-    // The layers the report became: its region's, as they are now.
+  auto layersOf = [](const weather::Region& r) {
     json layers = json::array();
-    for (const auto& l : region->second->layers) layers.push_back(toJson(l));
-    station["report"] = {{"text", e.text}, {"region_id", e.regionId}, {"sequence", e.sequence},
-                         {"clock_s", e.clock_s}, {"sky", e.sky}, {"layers", layers}};
+    for (const auto& l : r.layers) layers.push_back(toJson(l));
+    return layers;
+  };
+  auto withReport = [&](const Station& s) {
+    json station = stationJson(s);
+    if (const auto it = latest_.find(s.icao); it != latest_.end()) {
+      const Entry& e = it->second;
+      if (const auto region = regions.find(e.regionId); region != regions.end()) {
+        // The layers the report became: its region's, as they are now.
+        station["report"] = {{"text", e.text},         {"region_id", e.regionId}, {"sequence", e.sequence},
+                             {"clock_s", e.clock_s},   {"sky", e.sky},            {"layers", layersOf(*region->second)}};
+        return station;
+      }
+    }
+    // Not remembered (the server restarted since): the station's region is
+    // found by its centre, the station's own position, as the conformance
+    // check finds it; its layers without the report's text.
+    for (const auto& r : now.regions) {
+      if (isMetarRegion(r.id) && std::abs(s.lat_deg - r.centerLat_deg) < 1e-9 &&
+          std::abs(std::remainder(s.lon_deg - r.centerLon_deg, 360.0)) < 1e-9) {
+        station["report"] = {{"text", nullptr}, {"region_id", r.id},   {"sequence", nullptr},
+                             {"clock_s", nullptr}, {"sky", "read"}, {"layers", layersOf(r)}};
+        break;
+      }
+    }
     return station;
   };
-  for (const Station& s : serverStations) out.push_back(withReport(stationJson(s), s.icao));
+  json out = json::array();
+  for (const Station& s : serverStations) out.push_back(withReport(s));
   for (const auto& [icao, e] : latest_)
-    if (!findStation(serverStations, icao)) out.push_back(withReport(stationJson(e.station), icao));
+    if (!findStation(serverStations, icao)) out.push_back(withReport(e.station));
   return {{"stations", out}};
 }
 

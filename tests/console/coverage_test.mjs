@@ -99,6 +99,14 @@ run("coverage", async () => {
     ["4000NE BKN050", "IFR"], ["9999NDV OVC035", "VFR"],
   ]) assert(cat(groups) === want, `'${groups}' is ${cat(groups)}, expected ${want}`);
   assert(flightCategory("METAR LJLJ 221150Z 24008KT ////// 12/06 Q1018") === null, "no sky, no visibility: no category");
+  // From a station region's layers alone (after a server restart): the
+  // lowest base of 5 oktas or more above the station, visibility unknown.
+  const { categoryFromLayers } = await import("../../server/console/flight_category.js");
+  const layer = (coverage, base_m) => ({ coverage, base_m });
+  assert(categoryFromLayers([layer(1, 388 + 60)], 388) === "LIFR", "fog 200 ft above the station");
+  assert(categoryFromLayers([layer(0.75, 388 + 300), layer(0.19, 388 + 100)], 388) === "IFR", "BKN at 984 ft; FEW below it no ceiling");
+  assert(categoryFromLayers([layer(0, 300), layer(0.44, 1000)], 388) === "VFR", "no ceiling: VFR by ceiling");
+  assert(categoryFromLayers([layer(1, 388 + 914.4)], 388) === "MVFR", "OVC at 3000 ft");
   const read = readReport("METAR KJFK 221151Z 18012KT 1 3/4SM BR BKN008 OVC015 12/11 A2992");
   near(read.visibility_sm, 1.75, 1e-12, "1 3/4SM");
   assert(read.ceiling_ft === 800, `the lowest broken layer: ${read.ceiling_ft}`);

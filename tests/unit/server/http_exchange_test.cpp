@@ -232,6 +232,39 @@ TEST_F(HttpExchangeTest, MetarStationsListTheLatestAppliedReport) {
   EXPECT_EQ(findRoute("/api/metar/stations")->token, TokenRule::None);
 }
 
+// After a restart the reports' texts are gone (kept in memory) but the
+// stations' regions are back: a table station's region, found by its centre,
+// is listed with its layers and no text; a region elsewhere or outside the
+// METAR ids is not taken for it.
+TEST(MetarStationBoard, AStationsRegionIsFoundWithoutItsReport) {
+  const std::vector<Station> table = {{"LJLJ", 46.2237, 14.4576, 388}, {"LIPQ", 45.8275, 13.4722, 12}};
+  WeatherView now;
+  weather::Region ljlj;
+  ljlj.id = 44773;
+  ljlj.centerLat_deg = 46.2237;
+  ljlj.centerLon_deg = 14.4576;
+  weather::CloudLayer fog;
+  fog.id = 40;
+  fog.coverage = 1;
+  fog.base_m = 388;
+  fog.thickness_m = 60;
+  ljlj.layers = {fog};
+  weather::Region notMetar = ljlj;  // at LIPQ, but an operator's region id
+  notMetar.id = 7;
+  notMetar.centerLat_deg = 45.8275;
+  notMetar.centerLon_deg = 13.4722;
+  now.regions = {ljlj, notMetar};
+  const auto list = MetarStationBoard().list(table, now)["stations"];
+  ASSERT_EQ(list.size(), 2u) << list;
+  EXPECT_EQ(list[0]["icao"], "LJLJ");
+  ASSERT_TRUE(list[0]["report"].is_object()) << list;
+  EXPECT_TRUE(list[0]["report"]["text"].is_null());
+  EXPECT_EQ(list[0]["report"]["region_id"], 44773);
+  ASSERT_EQ(list[0]["report"]["layers"].size(), 1u);
+  EXPECT_EQ(list[0]["report"]["layers"][0]["id"], 40);
+  EXPECT_TRUE(list[1]["report"].is_null()) << list;
+}
+
 TEST_F(HttpExchangeTest, ForeignHostOrOriginIsForbidden) {
   EXPECT_EQ(send("GET /api/state HTTP/1.1\r\nHost: evil.example:" + std::to_string(api_->port()) + "\r\n\r\n").status,
             403);

@@ -1,8 +1,9 @@
 // GET /api/metar/stations: the METAR stations the console marks on its map,
 // each with the latest report applied to it through POST /api/metar (the raw
 // text and the layers it became) while its region is still in the weather.
-// Kept in memory by the HTTP API: after a restart the stations' regions are
-// still there (the store keeps them), their report texts are not.
+// The texts are kept in memory by the HTTP API: after a restart the stations'
+// regions are back (the store keeps them) and listed with their layers, the
+// texts are not.
 #pragma once
 
 #include <cstdint>
@@ -30,7 +31,10 @@ class MetarStationBoard {
   //   {"text", "region_id", "sequence", "clock_s", "sky", "layers": [LAYER...]}}]}:
   // the server's table in its order, then stations only requests brought
   // (by ICAO). A report is shown only while its region is in `now`, with
-  // that region's layers as they are in `now` (the layers it became).
+  // that region's layers as they are in `now` (the layers it became). A
+  // station with no remembered report whose region is in `now` (found by its
+  // centre) gets {"text": null, "region_id", "sequence": null, "clock_s":
+  // null, "sky": "read", "layers"}.
   nlohmann::json list(std::span<const Station> serverStations, const WeatherView& now) const;
 
  private:
