@@ -20,6 +20,7 @@
 #extension GL_GOOGLE_include_directive : require
 
 #include "reproject_shared.h"
+#include "sky_shared.h"
 
 layout(local_size_x = kReprojectLocalSizeX, local_size_y = kReprojectLocalSizeY) in;
 
@@ -53,6 +54,15 @@ layout(std430, set = 0, binding = kReprojectBindingDrop) readonly buffer DropBlo
 #define SKY_CORE_CONST const
 #include "core_common.glsl"
 #include "history_clip.glsl"
+#include "wind_map.glsl"
+
+layout(set = 0, binding = kReprojectBindingWeather) uniform sampler2DArray weatherTex;
+mat3 gCamToAnchor;
+vec4 gCamInAnchor;
+float gMapScale;
+vec4 gRings;
+vec4 gLayerWind[kReprojectMaxLayers];
+#include "weather_map.glsl"
 #include "fresh_edges.glsl"
 
 // The block's numbers, read once at the start of main: storage loads are
@@ -137,14 +147,19 @@ bool previousPixel(vec3 dir, float d, out vec2 p, out float expected) {
     vec3 x = dir * d;
     float h = heightAboveCameraSphere(x, gRadius);
     vec3 motion = vec3(0.0);
+    vec4 wind = vec4(0.0);
     // A constant trip count, so the loop unrolls and the arrays stay in
     // registers; the first band that holds the point wins.
     bool found = false;
     for (uint l = 0u; l < kReprojectMaxLayers; ++l) {
       bool inside = l < gLayers && h >= gBand[l].x - gBandMargin && h <= gBand[l].y + gBandMargin;
       motion = (inside && !found) ? gMotion[l] : motion;
+      wind = (inside && !found) ? gLayerWind[l] : wind;
       found = found || inside;
     }
+    // A layer whose wind varies: the air at x moved with the wind there.
+    if (wind.y > 0.5)
+      motion = mapWindLocal(wind.x, x, vec3(motion.xy / max(wind.z, 1e-6), 0.0)) * wind.z + vec3(0.0, 0.0, motion.z);
     v = x - motion - gPrevPosition;
     expected = length(v);
   }
@@ -408,7 +423,12 @@ void main() {
   for (uint l = 0u; l < kReprojectMaxLayers; ++l) {
     gBand[l] = params.layerBand[l];
     gMotion[l] = params.layerMotion[l].xyz;
+    gLayerWind[l] = params.layerWind[l];
   }
+  gCamToAnchor = transpose(mat3(params.camToAnchor[0].xyz, params.camToAnchor[1].xyz, params.camToAnchor[2].xyz));
+  gCamInAnchor = params.camInAnchor;
+  gMapScale = params.weatherMap.x;
+  gRings = vec4(params.weatherMap.w, params.weatherMap.y, params.weatherMap.z, 0.0);
   gStill = gPrevPosition == vec3(0.0) && gPrevFrustum == gFrustum && gPrevForward == gForward && gPrevRight == gRight && gPrevDown == gDown;
   for (uint l = 0u; l < kReprojectMaxLayers; ++l) gStill = gStill && (l >= gLayers || gMotion[l] == vec3(0.0));
   gClip = gClipGamma > 0.0 && !gStill;

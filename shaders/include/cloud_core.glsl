@@ -33,6 +33,7 @@
 #include "atmosphere_core.glsl"
 #include "air_table.glsl"
 #include "cloud_density.glsl"
+#include "wind_map.glsl"
 
 // Single-scattering albedo of cloud droplets and ice in the visible
 // (formulas.md: 0.999+).
@@ -138,12 +139,6 @@ real sampleDetail(LayerSampling s, real3 pLocal);
 real sampleMaxCoverage(LayerSampling s, real3 pLocal);
 real3 sampleWindLocal(LayerSampling s, real3 pLocal);
 
-// The wind map's texel (both components' high and low bytes, filtered) as
-// the wind, m/s: the weather texture's encoding (sky_shared.h).
-real2 windFromTexel(real4 t) {
-  real2 q = real2(t.x * 255.0 * 256.0 + t.y * 255.0, t.z * 255.0 * 256.0 + t.w * 255.0);
-  return (q / 65535.0 * 2.0 - 1.0) * real(kWindMapScale_mps);
-}
 
 // The noise of a layer whose wind varies, carried by the local wind in two
 // phases of the flow (the flow-map scheme of texture advection): each phase

@@ -82,36 +82,13 @@ vec2 airCloudShadow(AirFrame a, vec3 p, float h, float muSun) {
   return airSunShadow(a, p, h, muSun);
 }
 
-// Weather map lookup: camera-local point -> weather anchor frame -> gnomonic
-// plane of the anchor sphere (x = R q.x / q.z) -> texture coordinates of the
-// rings: the fine ring inside its blend band, the coarse ring beyond, linear
-// in the max norm between (WeatherField::sample, ringBlendWeight). `base`:
-// the texture layer of the fine ring (a cover slice, or a wind slice).
-bool weatherPlane(vec3 p, out vec2 plane) {
-  vec3 q = gCamToAnchor * p + gCamInAnchor.xyz;
-  plane = q.xy * (gCamInAnchor.w / q.z);
-  return q.z > 0.0;
-}
-
-vec4 sampleMapLayer(vec2 plane, float base) {
-  float e = 2.0 * max(abs(plane.x), abs(plane.y)) * gMapScale;
-  float w = clamp((e - gRings.y) / (gRings.z - gRings.y), 0.0, 1.0);
-  vec4 v = vec4(0.0);
-  if (w < 1.0) v = textureLod(weatherTex, vec3(plane * gMapScale + 0.5, base), 0.0);
-  if (w > 0.0) v = mix(v, textureLod(weatherTex, vec3(plane * gRings.x + 0.5, base + float(kMaxLayers)), 0.0), w);
-  return v;
-}
-
-// The layer's wind at a plane point, in the anchor's east/north (m/s).
-vec2 windInPlane(LayerSampling s, vec2 plane) {
-  return windFromTexel(sampleMapLayer(plane, float(kWindMapLayers) + s.coverageShift.z));
-}
+#include "weather_map.glsl"
 
 // Where the layer's tiles are read for plane point `plane`: carried back by
 // the uniform drift, or (a wind that varies) by the wind there times the
 // tiles' age (weather::upwindOf, in the map's plane).
 vec2 tilePlane(LayerSampling s, vec2 plane) {
-  if (s.flow.w > 0.5) return plane - windInPlane(s, plane) * s.windRef.w;
+  if (s.flow.w > 0.5) return plane - mapWind(s.coverageShift.z, plane) * s.windRef.w;
   return plane - s.coverageShift.xy;
 }
 
@@ -122,10 +99,7 @@ vec3 sampleWeather(LayerSampling s, vec3 p) {
 }
 
 vec3 sampleWindLocal(LayerSampling s, vec3 p) {
-  vec2 plane;
-  if (!weatherPlane(p, plane)) return s.windRef.xyz;
-  // Anchor east/north back to the camera's frame (the rotation's transpose).
-  return vec3(windInPlane(s, plane), 0.0) * gCamToAnchor;
+  return mapWindLocal(s.coverageShift.z, p, s.windRef.xyz);
 }
 
 // The max-coverage mip of a camera-local point: the weather lookup's plane

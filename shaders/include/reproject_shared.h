@@ -28,6 +28,8 @@ SKY_REPROJECT_CONST kReprojectBindingOutDepth = 6u;      // float: its cloud dep
 SKY_REPROJECT_CONST kReprojectBindingOutcomes = 7u;      // uint per pixel: what became of it (below)
 SKY_REPROJECT_CONST kReprojectBindingDrop = 8u;          // read-only uint per cell of the history-drop
                                                           // mask (SkyReproject::drop): 1 = the weather changed there
+SKY_REPROJECT_CONST kReprojectBindingWeather = 9u;       // sampler2DArray: the cloud pass's weather texture
+                                                          // (sky_shared.h), for the wind of layers whose wind varies
 
 // What became of each pixel (the values of the outcome buffer).
 SKY_REPROJECT_CONST kStatFresh = 0u;       // drawn this frame
@@ -70,10 +72,19 @@ struct SkyReproject {
                      // pixel this frame (fresh_edges.glsl), their samples after the packed pixels; 0 none
   uvec4 drop;        // the history-drop mask (history_drop.hpp): x, y: cells across and down, z: log2 of a
                      // cell's edge in pixels, w: 1 when the mask is set this frame (else it is not read)
+  // The weather map, as the cloud pass reads it (SkyFrame's fields of the
+  // same names): for a layer whose wind varies, each pixel's point moves by
+  // the wind there.
+  vec4 camToAnchor[3];  // rows of the rotation camera-local -> weather-anchor-local
+  vec4 camInAnchor;     // xyz: camera relative to the anchor sphere centre, anchor frame (m); w: its radius
+  vec4 weatherMap;      // x: 1 / the fine ring's edge (1/m); y, z: the rings' blend band; w: 1 / the coarse ring's edge
+  vec4 layerWind[kReprojectMaxLayers];  // x: the layer's weather-map slice, y: 1 when its wind varies (the wind
+                                        // map then moves it, layerMotion.z its vertical), z: seconds since the
+                                        // previous frame; w: unused
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(SkyReproject) == 16 * (9 + 2 * kReprojectMaxLayers + 6));
+static_assert(sizeof(SkyReproject) == 16 * (9 + 2 * kReprojectMaxLayers + 6 + 5 + kReprojectMaxLayers));
 static_assert(offsetof(SkyReproject, image) == 112);
 static_assert(offsetof(SkyReproject, layerBand) == 144);
 }  // namespace sky::gpu

@@ -126,8 +126,8 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
                                           vk::ImageLayout::eShaderReadOnlyOptimal);
   const vk::DescriptorImageInfo msInfo(*pass.tableSampler_, *pass.multipleScattering_.view,
                                        vk::ImageLayout::eShaderReadOnlyOptimal);
-  const vk::DescriptorImageInfo weatherInfo(*pass.weatherSampler_, *weather.image().view,
-                                            vk::ImageLayout::eShaderReadOnlyOptimal);
+  pass.weatherView_ = *weather.image().view;
+  const vk::DescriptorImageInfo weatherInfo = pass.weatherDescriptor();
   const vk::DescriptorImageInfo airOutInfo({}, *pass.airTable_.view, vk::ImageLayout::eGeneral);
   const vk::DescriptorImageInfo airInfo(*pass.airTableSampler_, *pass.airTable_.view, vk::ImageLayout::eGeneral);
   const vk::DescriptorImageInfo sunOutInfo({}, *pass.sunMap_.view, vk::ImageLayout::eGeneral);

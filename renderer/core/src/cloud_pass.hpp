@@ -61,6 +61,11 @@ class CloudPass {
   // What the clouds write: radiance + transmittance and cloud depth of the
   // pixels drawn, packed (sky_shared.h, SkyFrame::interleave).
   const GpuBuffer& output() const { return output_; }
+  // The weather texture as this pass samples it (its sampler), for the
+  // reprojection's reads of the wind map.
+  vk::DescriptorImageInfo weatherDescriptor() const {
+    return {*weatherSampler_, weatherView_, vk::ImageLayout::eShaderReadOnlyOptimal};
+  }
   const GpuBuffer& depth() const { return depth_; }
   // Replaces the max-coverage mip the march reads (coverage_mip.hpp; size
   // kMaxLayers x kCoverageMipSize^2). Call between runs.
@@ -90,6 +95,7 @@ class CloudPass {
   vk::raii::Sampler noiseSampler_{nullptr};
   vk::raii::Sampler airTableSampler_{nullptr};
   vk::raii::Sampler weatherSampler_{nullptr};
+  vk::ImageView weatherView_;  // the WeatherTexture's (which outlives this pass)
   vk::raii::Sampler tableSampler_{nullptr};
   GpuImage shape_;
   GpuImage detail_;

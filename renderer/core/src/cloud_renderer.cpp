@@ -161,7 +161,7 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
     if (settings.temporal.interleave > 1) {
       auto created = ReprojectPass::create(**ctx, smallW, smallH, pass->output(), pass->depth(),
                                            settings.temporal.historyClip > 0, settings.temporal.sharpHistory,
-                                           settings.temporal.freshEdges);
+                                           settings.temporal.freshEdges, pass->weatherDescriptor());
       if (!created) return tl::unexpected(created.error());
       reproject.emplace(std::move(*created));
     }

@@ -48,11 +48,14 @@ Result<ComputePipeline> ComputePipelineBuilder::build(const GpuContext& ctx) con
 
 StorageSet createStorageSet(const GpuContext& ctx, const ComputePipeline& pipeline, const std::string& name,
                             const std::vector<std::pair<std::uint32_t, vk::DescriptorBufferInfo>>& buffers,
-                            const std::vector<std::pair<std::uint32_t, vk::DescriptorImageInfo>>& images) {
+                            const std::vector<std::pair<std::uint32_t, vk::DescriptorImageInfo>>& images,
+                            const std::vector<std::pair<std::uint32_t, vk::DescriptorImageInfo>>& sampled) {
   const auto& device = ctx.device();
   std::vector<vk::DescriptorPoolSize> sizes;
   if (!buffers.empty()) sizes.emplace_back(vk::DescriptorType::eStorageBuffer, std::uint32_t(buffers.size()));
   if (!images.empty()) sizes.emplace_back(vk::DescriptorType::eStorageImage, std::uint32_t(images.size()));
+  if (!sampled.empty())
+    sizes.emplace_back(vk::DescriptorType::eCombinedImageSampler, std::uint32_t(sampled.size()));
   StorageSet s;
   s.pool = vk::raii::DescriptorPool(
       device, vk::DescriptorPoolCreateInfo(vk::DescriptorPoolCreateFlagBits::eFreeDescriptorSet, 1, sizes));
@@ -65,6 +68,8 @@ StorageSet createStorageSet(const GpuContext& ctx, const ComputePipeline& pipeli
     writes.emplace_back(*s.set, binding, 0, vk::DescriptorType::eStorageBuffer, nullptr, info);
   for (const auto& [binding, info] : images)
     writes.emplace_back(*s.set, binding, 0, vk::DescriptorType::eStorageImage, info);
+  for (const auto& [binding, info] : sampled)
+    writes.emplace_back(*s.set, binding, 0, vk::DescriptorType::eCombinedImageSampler, info);
   device.updateDescriptorSets(writes, {});
   return s;
 }

@@ -55,6 +55,7 @@ struct StorageSet {
 // (the reprojection, the upscale), written with these bindings.
 StorageSet createStorageSet(const GpuContext& ctx, const ComputePipeline& pipeline, const std::string& name,
                             const std::vector<std::pair<std::uint32_t, vk::DescriptorBufferInfo>>& buffers,
-                            const std::vector<std::pair<std::uint32_t, vk::DescriptorImageInfo>>& images);
+                            const std::vector<std::pair<std::uint32_t, vk::DescriptorImageInfo>>& images,
+                            const std::vector<std::pair<std::uint32_t, vk::DescriptorImageInfo>>& sampled = {});
 
 }  // namespace sky::render

@@ -13,7 +13,8 @@ namespace sky::render {
 
 Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t width, std::uint32_t height,
                                             const GpuBuffer& fresh, const GpuBuffer& freshDepth, bool historyClip,
-                                            bool sharpHistory, bool freshEdges) {
+                                            bool sharpHistory, bool freshEdges,
+                                            const vk::DescriptorImageInfo& weather) {
   ReprojectPass pass;
   pass.width_ = width;
   pass.height_ = height;
@@ -25,6 +26,7 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
   for (std::uint32_t b : {gpu::kReprojectBindingFresh, gpu::kReprojectBindingFreshDepth, gpu::kReprojectBindingHistory,
                           gpu::kReprojectBindingHistoryDepth})
     builder.binding(b, vk::DescriptorType::eStorageImage);
+  builder.binding(gpu::kReprojectBindingWeather, vk::DescriptorType::eCombinedImageSampler);
   builder.shader("reproject.comp.spv");
   // The history clip's code only where it is used: lavapipe runs a branch
   // for every lane whatever the condition, so a uniform "off" still pays.
@@ -66,7 +68,8 @@ Result<ReprojectPass> ReprojectPass::create(const GpuContext& ctx, std::uint32_t
       std::pair{gpu::kReprojectBindingFreshDepth, pass.fresh_->depthInfo()},
       std::pair{gpu::kReprojectBindingHistory, pass.history_->colourInfo()},
       std::pair{gpu::kReprojectBindingHistoryDepth, pass.history_->depthInfo()}};
-  pass.set_ = createStorageSet(ctx, pass.pipeline_, "sky.reproject", buffers, images);
+  pass.set_ = createStorageSet(ctx, pass.pipeline_, "sky.reproject", buffers, images,
+                               {std::pair{gpu::kReprojectBindingWeather, weather}});
   return pass;
 }
 

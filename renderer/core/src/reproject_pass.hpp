@@ -32,9 +32,10 @@ class ReprojectPass {
   // clip in (TemporalSettings::historyClip > 0); sharpHistory: resample the
   // history with Catmull-Rom weights (TemporalSettings::sharpHistory);
   // freshEdges: read the fresh edges' samples (TemporalSettings::freshEdges).
+  // `weather`: the cloud pass's weather texture (CloudPass::weatherDescriptor).
   static Result<ReprojectPass> create(const GpuContext& ctx, std::uint32_t width, std::uint32_t height,
                                       const GpuBuffer& fresh, const GpuBuffer& freshDepth, bool historyClip,
-                                      bool sharpHistory, bool freshEdges);
+                                      bool sharpHistory, bool freshEdges, const vk::DescriptorImageInfo& weather);
 
   // Records the copy of the cloud pass's pixels, the pass, the copy of its
   // output into image() and the barrier that makes the output readable by

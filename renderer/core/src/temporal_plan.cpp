@@ -10,6 +10,7 @@
 #include "sky/core/assert.hpp"
 
 #include "fresh_edges.hpp"
+#include "weather_field.hpp"
 
 namespace sky::render {
 
@@ -267,11 +268,19 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
     for (std::size_t i = 0; i < setup.layers.size(); ++i) {
       const LayerSetup& l = setup.layers[i];
       p.layerBand[i] = gpu::vec4(float(-l.hBase_m), float(-l.hTop_m), 0.0f, 0.0f);
-      // The air over the camera (a wind field's there): the reprojection
-      // moves the layer's history by one wind across the view.
+      // The air over the camera; a layer whose wind varies moves each
+      // pixel's point by the wind there instead (reproject.comp, the same
+      // weather map as the cloud pass), and by this one's vertical part.
       p.layerMotion[i] = v4(l.windAtCamera_mps * step_s);
+      p.layerWind[i] = gpu::vec4(float(i), l.flow.w > 0.5 ? 1.0f : 0.0f, float(step_s), 0.0f);
     }
   }
+  for (int row = 0; row < 3; ++row)
+    p.camToAnchor[row] =
+        v4(glm::dvec3(setup.camToAnchor[0][row], setup.camToAnchor[1][row], setup.camToAnchor[2][row]));
+  p.camInAnchor = v4(setup.camInAnchor_m, setup.anchorRadius_m);
+  p.weatherMap = gpu::vec4(float(1.0 / (2 * setup.mapHalfExtent_m)), float(kRingBlendStart), float(kRingBlendEnd),
+                           float(1.0 / (2 * setup.coarseHalfExtent_m)));
   previous_ = now;
   return plan;
 }
