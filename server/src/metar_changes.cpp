@@ -77,17 +77,24 @@ bool isStationRegion(const weather::Region& r) {
 // Longitude as LiveWeather stores a region's centre.
 double storedLon(double lon_deg) { return std::remainder(lon_deg, 360.0); }
 
+// A position to 1e-7 degree (about a centimetre): a station's region is
+// found at its station's position whatever the arithmetic its centre went
+// through since it was placed (the weather's regions come back with their
+// longitude normalised by GeographicLib, 14.4576 as 14.457600000000014,
+// and through the store's JSON).
 struct PositionKey {
-  std::uint64_t lat, lon;
+  std::int64_t lat, lon;
   bool operator==(const PositionKey&) const = default;
 };
 struct PositionHash {
   std::size_t operator()(const PositionKey& k) const {
-    return static_cast<std::size_t>((k.lat * 1099511628211ull) ^ k.lon);
+    return static_cast<std::size_t>((std::uint64_t(k.lat) * 1099511628211ull) ^ std::uint64_t(k.lon));
   }
 };
 PositionKey keyOf(double lat_deg, double lon_deg) {
-  return {std::bit_cast<std::uint64_t>(lat_deg), std::bit_cast<std::uint64_t>(storedLon(lon_deg))};
+  double lon = storedLon(lon_deg);
+  if (lon >= 180 - 0.5e-7) lon -= 360;  // 180 and -180 are one meridian
+  return {std::llround(lat_deg * 1e7), std::llround(lon * 1e7)};
 }
 
 std::uint32_t icaoHash(std::string_view icao) {

@@ -294,6 +294,23 @@ TEST(MetarChanges, StationsAccumulateAcrossRequests) {
   EXPECT_TRUE(std::none_of(regions.begin(), regions.end(), [&](const auto& r) { return r.id == khafId; }));
 }
 
+// LJLJ's longitude 14.4576 comes back from the weather as 14.457600000000014
+// (normalised by GeographicLib): its newer report still replaces its region
+// instead of adding a second one at the station.
+TEST(MetarChanges, ANewerReportReplacesItsStationWhateverItsLongitudeBecame) {
+  Live live(cumulus());
+  auto first = apply(live.weather, {"METAR LJLJ 221150Z 24008KT 9999 FEW025 12/06 Q1018"}, kStations);
+  ASSERT_EQ(first.status, 200) << first.body.dump();
+  const auto regions = metarRegions(live.weather);
+  ASSERT_EQ(regions.size(), 1u);
+  std::printf("LJLJ's region centre as the weather holds it: %.17g\n", regions[0].centerLon_deg);
+  auto second = apply(live.weather, {"METAR LJLJ 221220Z 24010KT 9999 BKN030 12/06 Q1018"}, kStations);
+  ASSERT_EQ(second.status, 200) << second.body.dump();
+  EXPECT_EQ(second.body["stations"]["replaced"].get<int>(), 1);
+  EXPECT_EQ(metarRegions(live.weather).size(), 1u);
+  EXPECT_EQ(second.body["reports"][0]["region_id"], first.body["reports"][0]["region_id"]);
+}
+
 // A region another input put in the METAR id range (a CIGI host may use any
 // 16-bit id) is neither reshaped nor taken for a station; a station inside it
 // clears its layers like the global ones.
