@@ -2,6 +2,8 @@
 // each side by their own wind, on the GPU, and the GPU agrees with the CPU
 // reference while the noise's two flow phases crossfade.
 #include <algorithm>
+#include <chrono>
+#include <vector>
 #include <cmath>
 #include <cstdio>
 
@@ -130,6 +132,46 @@ TEST(WindField, GpuMatchesTheCpuReferenceAcrossTheFlowCrossfade) {
     EXPECT_LT(meanError, 0.005);
     EXPECT_LT(d.displayedRmse, 0.05 * d.displayedMean);
   }
+}
+
+}  // namespace
+}  // namespace sky::test
+
+namespace sky::test {
+namespace {
+
+// What a wind field costs a frame (printed, not asserted: timings belong to
+// benchmarks; this machine is shared): the same view of a 0.5-cover deck
+// with the layer's own wind, with a wind field on a plateau of the flow, and
+// in its crossfade (both phases' noise read), medians of 5 frames each.
+TEST(WindField, CostOfTheFieldIsPrinted) {
+  SKY_RENDERER(r, 160, 90);
+  const weather::WeatherSnapshot field = windSnapshot(true);
+  weather::WeatherSnapshot own = field;
+  own.windTiles.clear();
+  own.windTileLevel = 0;
+  own.layers[0].wind = {kWind_mps, 180, 0};
+  auto medianMs = [&](const weather::WeatherSnapshot& s, double clock_s) {
+    std::vector<double> ms;
+    for (int k = 0; k < 6; ++k) {
+      render::FrameInputs in;
+      in.camera = pose(kLat, kLon - 0.02, 800, 80, 25);
+      in.weather = &s;
+      in.weatherClock_s = clock_s;
+      in.sunElevation_deg = 40;
+      const auto t0 = std::chrono::steady_clock::now();
+      auto im = r.render(in);
+      const auto t1 = std::chrono::steady_clock::now();
+      EXPECT_TRUE(im);
+      if (k > 0) ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    }
+    std::sort(ms.begin(), ms.end());
+    return ms[ms.size() / 2];
+  };
+  const double base = medianMs(own, 230), plateau = medianMs(field, 230), crossfade = medianMs(field, 150);
+  std::printf("[ wind cost ] 160x90: own wind %.1f ms, wind field on a plateau %.1f ms (%.2fx), in the crossfade "
+              "%.1f ms (%.2fx)\n",
+              base, plateau, plateau / base, crossfade, crossfade / base);
 }
 
 }  // namespace
