@@ -12,9 +12,15 @@ import { MapView } from "./map.js";
 import { MetarPanel } from "./metar.js";
 import { ConformancePanel } from "./conformance.js";
 import { RegionPanel } from "./regions.js";
-import { fmt, keyOfServerError, num } from "./units.js";
+import { fmt, ftFromM, keyOfServerError, mFromFt, num } from "./units.js";
+import { WIND_ALT_LIMITS_M } from "./weather_overlay.js";
 
 const VIEW_KEY = "skyshell.view";
+// The wind field's units ("m": m and m/s, "ft": ft and kt), kept per browser.
+const UNITS_KEY = "skyshell.units";
+// The wind field's height until the operator (or the URL) says otherwise:
+// 1500 m MSL, near the bundled scenario's cumulus base.
+const DEFAULT_WIND_ALT_M = 1500;
 // Where the map looks before anything says better: the bundled demo's area
 // (north-east Italy), Leaflet zoom 8.75 (about 250 m per pixel there).
 const DEFAULT_VIEW = { lat_deg: 46.0, lon_deg: 13.0, zoom: 8.75 };
@@ -98,12 +104,7 @@ const map = new MapView($("#map"), {
     $('[name="focus_lon"]').value = fmt(focus.lon_deg, 4);
     $("#map").dataset.focus = `${focus.lat_deg},${focus.lon_deg}`;
     $("#map").dataset.zoom = String(zoom);
-    // The view in this browser and in the address (a link shows the same place).
-    clearTimeout(app.saveView);
-    app.saveView = setTimeout(() => {
-      localStorage.setItem(VIEW_KEY, JSON.stringify({ lat_deg: focus.lat_deg, lon_deg: focus.lon_deg, zoom }));
-      history.replaceState(null, "", `#focus=${fmt(focus.lat_deg, 5)},${fmt(focus.lon_deg, 5)}&zoom=${zoom}`);
-    }, 500);
+    saveView();
   },
   // The Natural Earth ground loaded (null) or not (why).
   basemap: (error) => {
@@ -118,6 +119,40 @@ const metar = new MetarPanel($("#metar"), app);
 new ConformancePanel($("#conformance"));
 new ClockPanel($("#clock"), app);
 const log = new EventLog($("#events"));
+
+// The view in this browser and in the address (a link shows the same place,
+// and the wind field when it is shown: #focus=38,-97&zoom=6&wind_alt_m=6000).
+function saveView() {
+  clearTimeout(app.saveView);
+  app.saveView = setTimeout(() => {
+    const { focus, zoom } = map, wind = map.windField;
+    localStorage.setItem(VIEW_KEY, JSON.stringify({ lat_deg: focus.lat_deg, lon_deg: focus.lon_deg, zoom,
+      wind_alt_m: wind.alt_m, wind_shown: wind.shown }));
+    history.replaceState(null, "", `#focus=${fmt(focus.lat_deg, 5)},${fmt(focus.lon_deg, 5)}&zoom=${zoom}` +
+      (wind.shown ? `&wind_alt_m=${fmt(wind.alt_m, 1)}` : ""));
+  }, 500);
+}
+
+// The wind field's controls: the height in the chosen units, checked
+// against the server's range next to the field; the field follows a valid one.
+function windHeightShown(alt_m, units) {
+  $("#wind-height").value = fmt(units === "ft" ? ftFromM(alt_m) : alt_m, units === "ft" ? 0 : 1);
+}
+function windHeightChanged() {
+  const input = $("#wind-height"), units = $("#wind-units").value;
+  const v = num(input.value), alt_m = units === "ft" ? mFromFt(v) : v;
+  const [lo, hi] = WIND_ALT_LIMITS_M;
+  const bad = !Number.isFinite(alt_m) ? "enter a height" : alt_m < lo || alt_m > hi
+    ? `the wind field is from ${units === "ft" ? `${fmt(ftFromM(lo))} to ${fmt(ftFromM(hi))} ft` : `${lo} to ${hi} m`} MSL` : "";
+  input.title = bad;
+  if (bad) {
+    input.setAttribute("aria-invalid", "true");
+    return;
+  }
+  input.removeAttribute("aria-invalid");
+  map.setWindField({ alt_m });
+  saveView();
+}
 
 function setOverlay(id) {
   app.overlayLayer = id;
@@ -196,6 +231,7 @@ const link = new LiveLink({
     }
     autoFocus();
     map.redraw();
+    map.windField.weatherChanged();
   },
   event: (e) => log.add(e),
   events: (list) => log.setAll(list),
@@ -244,6 +280,18 @@ $("#zoom-out").addEventListener("click", () => map.zoomBy(-1));
 $("#show-land").addEventListener("change", (e) => map.base.show("land", e.target.checked));
 $("#show-borders").addEventListener("change", (e) => map.base.show("borders", e.target.checked));
 $("#show-stations").addEventListener("change", (e) => map.stations.show(e.target.checked));
+$("#show-wind-field").addEventListener("change", (e) => {
+  map.setWindField({ shown: e.target.checked });
+  saveView();
+});
+$("#wind-form").addEventListener("submit", (e) => { e.preventDefault(); windHeightChanged(); });
+$("#wind-height").addEventListener("change", windHeightChanged);
+$("#wind-units").addEventListener("change", (e) => {
+  localStorage.setItem(UNITS_KEY, e.target.value);
+  map.setWindField({ units: e.target.value });
+  windHeightShown(map.windField.alt_m, e.target.value);
+  $("#wind-height").removeAttribute("aria-invalid");
+});
 
 // The METAR stations and their latest reports: asked again after an apply
 // and whenever the set of station regions (ids 40000-65535) changes.
@@ -264,8 +312,17 @@ function zoomOf(v, lat_deg) {
   return NaN;
 }
 
-// The view: from the URL (#focus=46.1,13.2&zoom=9), else the last one this
-// browser used, else the default until a region or renderer appears.
+// A wind field height from a URL or a saved view: metres within the
+// server's range, else null.
+function windAltOf(v) {
+  const alt_m = Number(v);
+  return v !== null && v !== undefined && v !== "" && alt_m >= WIND_ALT_LIMITS_M[0] && alt_m <= WIND_ALT_LIMITS_M[1]
+    ? alt_m : null;
+}
+
+// The view: from the URL (#focus=46.1,13.2&zoom=9, with &wind_alt_m=6000
+// when the wind field is shown), else the last one this browser used, else
+// the default until a region or renderer appears.
 function initialView() {
   const hash = new URLSearchParams(location.hash.slice(1));
   const focus = (hash.get("focus") || "").split(",").map(Number);
@@ -273,20 +330,28 @@ function initialView() {
     app.viewChosen = true;
     const zoom = zoomOf({ zoom: hash.has("zoom") ? Number(hash.get("zoom")) : NaN,
       scale_mpp: Number(hash.get("scale")) }, focus[0]);
-    return { lat_deg: focus[0], lon_deg: focus[1], zoom: Number.isFinite(zoom) ? zoom : DEFAULT_VIEW.zoom };
+    const wind_alt_m = windAltOf(hash.get("wind_alt_m"));
+    return { lat_deg: focus[0], lon_deg: focus[1], zoom: Number.isFinite(zoom) ? zoom : DEFAULT_VIEW.zoom,
+      wind_alt_m: wind_alt_m ?? DEFAULT_WIND_ALT_M, wind_shown: wind_alt_m !== null };
   }
   try {
     const saved = JSON.parse(localStorage.getItem(VIEW_KEY) || "null");
     if (saved && Number.isFinite(saved.lat_deg) && Number.isFinite(zoomOf(saved, saved.lat_deg))) {
       app.viewChosen = true;
-      return { ...saved, zoom: zoomOf(saved, saved.lat_deg) };
+      return { ...saved, zoom: zoomOf(saved, saved.lat_deg), wind_alt_m: windAltOf(saved.wind_alt_m) ?? DEFAULT_WIND_ALT_M,
+        wind_shown: saved.wind_shown === true };
     }
   } catch { /* a damaged saved view: use the default */ }
-  return DEFAULT_VIEW;
+  return { ...DEFAULT_VIEW, wind_alt_m: DEFAULT_WIND_ALT_M, wind_shown: false };
 }
 
 const view = initialView();
 map.setView(view.lat_deg, view.lon_deg, view.zoom);
+const units = localStorage.getItem(UNITS_KEY) === "ft" ? "ft" : "m";
+$("#wind-units").value = units;
+$("#show-wind-field").checked = view.wind_shown;
+windHeightShown(view.wind_alt_m, units);
+map.setWindField({ shown: view.wind_shown, alt_m: view.wind_alt_m, units });
 setMode("pan");
 updateEditable();
 renderRenderers($("#renderers"), []);

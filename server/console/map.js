@@ -1,7 +1,8 @@
 // The console's map, on Leaflet (leaflet.js, loaded by index.html as
 // window.L): Web Mercator with north up, Natural Earth land, coastlines and
 // borders (basemap.js), a graticule and the selected layer's coverage and
-// wind on a canvas overlay (weather_overlay.js), every region's edge and transition perimeter, the
+// wind on a canvas overlay, the wind field at a height when shown (both
+// weather_overlay.js), every region's edge and transition perimeter, the
 // region tool's draft with its size and perimeter handles, the METAR
 // stations coloured by flight category (stations.js), and each connected
 // renderer as an aircraft at its camera position and heading. Leaflet pans
@@ -18,7 +19,7 @@ import { regionEdgeDistance_m, regionOutline, regionPoint } from "./coverage.js"
 import { direct, inverse, MERCATOR_MAX_LAT_DEG, normalizeLon } from "./geo.js";
 import { StationLayer } from "./stations.js";
 import { fmt, ftFromM } from "./units.js";
-import { WeatherOverlay } from "./weather_overlay.js";
+import { WeatherOverlay, WindFieldLayer } from "./weather_overlay.js";
 
 const L = window.L;
 
@@ -118,7 +119,10 @@ export class MapView {
     this.regionRenderer = L.svg({ pane: "regions", padding: SHAPES_MARGIN });
     this.base = new BaseMap(map, "basemap");
     this.base.load().then(() => this.on.basemap(null), (e) => this.on.basemap(String(e.message || e)));
-    this.overlay = new WeatherOverlay(data, "coverage").addTo(map);
+    // The layer's own arrows give way to the wind field while it is shown:
+    // one set of arrows on the map at a time.
+    this.overlay = new WeatherOverlay({ ...data, layerWind: () => !this.windField.shown }, "coverage").addTo(map);
+    this.windField = new WindFieldLayer("coverage").addTo(map);
     this.regionGroup = L.layerGroup().addTo(map);
     this.draftGroup = L.layerGroup().addTo(map);
     this.rendererGroup = L.layerGroup().addTo(map);
@@ -157,6 +161,13 @@ export class MapView {
     for (const h of [this.map.dragging, this.map.doubleClickZoom]) placing ? h.disable() : h.enable();
   }
 
+  // The wind field: {shown, alt_m, units} (WindFieldLayer.set).
+  setWindField(options) {
+    this.windField.set(options);
+    this.container.classList.toggle("wind-field-shown", this.windField.shown);
+    this.overlay.redraw();
+  }
+
   redraw() {
     this.overlay.redraw();
     this.drawRegions();
@@ -193,7 +204,8 @@ export class MapView {
 
   pointerMoved(e) {
     const p = e.latlng.wrap();
-    this.on.cursor(`${fmt(p.lat, 4)}°, ${fmt(p.lng, 4)}°`);
+    const arrow = this.windField.pick(e.containerPoint);
+    this.on.cursor(`${fmt(p.lat, 4)}°, ${fmt(p.lng, 4)}°` + (arrow ? ` · wind ${this.windField.describe(arrow)}` : ""));
     const d = this.place;
     if (!d) return;
     if (!d.dragged && e.containerPoint.distanceTo(d.start) <= CLICK_SLOP_PX) return;
@@ -212,13 +224,19 @@ export class MapView {
     this.on.placed();
   }
 
-  // A click in pan mode picks the region under it (innermost first).
+  // A click in pan mode on a wind field's arrow shows its wind; elsewhere it
+  // picks the region under it (innermost first).
   clicked(e) {
     if (this.swallowClick) {
       this.swallowClick = false;
       return;
     }
     if (this.mode !== "pan") return;
+    const arrow = this.windField.pick(e.containerPoint);
+    if (arrow) {
+      this.windField.popup(arrow);
+      return;
+    }
     const s = e.latlng.wrap();
     const state = this.data.state();
     if (!state) return;

@@ -32,6 +32,7 @@ export const config = {
   flight: env("SKY_TEST_FLIGHT"),
   scenario: env("SKY_SCENARIO"),
   stations: env("SKY_METAR_STATIONS"),
+  namGrib: env("SKY_NAM_GRIB"),
   out: env("SKY_CONSOLE_OUTPUT_DIR", path.resolve("console-output")),
   chromium: env("SKY_CHROMIUM", "/usr/bin/chromium"),
 };
@@ -78,15 +79,17 @@ export async function until(what, fn, timeout_ms = 20000, every_ms = 100) {
   }
 }
 
-// One skyshell-weatherd: start(), stop(), restart() on the same ports and file.
+// One skyshell-weatherd: start(), stop(), restart() on the same ports and
+// file. args: more command-line arguments (a forecast: ["--grib", FILE]).
 export class Weatherd {
-  constructor(name, { db = false } = {}) {
+  constructor(name, { db = false, args = [] } = {}) {
     if (!config.weatherd || !config.scenario) throw new Error("SKY_WEATHERD and SKY_SCENARIO must be set");
     this.dir = path.join(config.out, name);
     fs.rmSync(this.dir, { recursive: true, force: true });
     fs.mkdirSync(this.dir, { recursive: true });
     fs.writeFileSync(path.join(this.dir, "token"), `${TOKEN}\n`);
     this.db = db ? path.join(this.dir, "weather.sqlite") : null;
+    this.extraArgs = args;
     this.httpPort = 0;
     this.starts = 0;
   }
@@ -100,6 +103,7 @@ export class Weatherd {
       "--http-port-file", portFile, "--token-file", path.join(this.dir, "token"), "--heartbeat-ms", "200"];
     if (config.stations) args.push("--metar-stations", config.stations);
     if (this.db) args.push("--db", this.db);
+    args.push(...this.extraArgs);
     // The CIGI weather input too (UDP, loopback): a host's Weather Control
     // reaches the consoles like an API change.
     const cigiPortFile = path.join(this.dir, "cigi.port");
