@@ -226,8 +226,9 @@ const WIND_PICK_PX = 8;
 // linear between stops, the last colour beyond.
 const WIND_COLOUR_STOPS = [[0, [95, 168, 255]], [10, [111, 224, 160]], [20, [242, 225, 78]], [35, [255, 154, 60]],
   [50, [255, 79, 109]], [75, [224, 64, 251]]];
-// The legend's bar spans the stops; its ticks in each unit system.
-const LEGEND_TICKS = { m: [0, 25, 50, 75], ft: [0, 50, 100, 150] };
+// The legend's bar spans the stops (0-75 m/s, 0-146 kt); its ticks in each
+// unit system, within the bar.
+const LEGEND_TICKS = { m: [0, 25, 50, 75], ft: [0, 50, 100, 140] };
 const LEGEND_W_PX = 160, LEGEND_H_PX = 26, LEGEND_BAR_H_PX = 8;
 
 // The colour of a wind speed (m/s) as a CSS rgb().
@@ -275,7 +276,8 @@ const WindLegend = L.Control.extend({
       g.fillRect(Math.round(x), LEGEND_BAR_H_PX, 1, 3);
       g.fillText(String(t), x, LEGEND_H_PX - 3);
     }
-    this.getContainer().setAttribute("aria-label", `${text}; colour scale 0 to ${LEGEND_TICKS[units].at(-1)} ${units === "ft" ? "kt" : "m/s"}`);
+    this.getContainer().setAttribute("aria-label",
+      `${text}; colour scale 0 to ${fmt(top_mps * perMps)} ${units === "ft" ? "kt" : "m/s"}`);
   },
 });
 
