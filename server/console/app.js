@@ -233,8 +233,14 @@ const link = new LiveLink({
     map.redraw();
     map.windField.weatherChanged();
   },
-  event: (e) => log.add(e),
-  events: (list) => log.setAll(list),
+  event: (e) => {
+    log.add(e);
+    metarApplied([e]);
+  },
+  events: (list) => {
+    log.setAll(list);
+    metarApplied(list);
+  },
   renderers: (list) => {
     app.renderersValue = list;
     renderRenderers($("#renderers"), list);
@@ -302,6 +308,18 @@ async function refreshStations() {
 }
 function stationRegionsOf(state) {
   return state.regions.filter((x) => x.id >= 40000).map((x) => x.id).join(",");
+}
+// A newer report replaces its station's region in place (same id), so the
+// set of station regions need not change: the stations are asked again after
+// every METAR change too, whoever applied it (events of source "metar").
+let lastMetarSequence = null;
+function metarApplied(events) {
+  const sequences = events.filter((e) => e.source === "metar").map((e) => e.sequence);
+  if (sequences.length === 0) return;
+  const newest = Math.max(...sequences);
+  if (newest === lastMetarSequence) return;
+  lastMetarSequence = newest;
+  refreshStations();
 }
 
 // A zoom from a view that names one, or from an older console's scale (m

@@ -636,7 +636,10 @@ cases.stations = async (cleanup) => {
     await until(`${icao} ${cat}`, async () => (await category(icao)) === cat);
     assert((await colour(icao)) === expected[cat], `${icao}'s colour for ${cat}: ${await colour(icao)}`);
   }
-  // A newer report: LJLJ goes down to LIFR, and its marker follows.
+  // A newer report: LJLJ goes down to LIFR, and its marker follows. (Bug:
+  // the console asked for the stations again only when the set of station
+  // regions changed; since a newer report replaces its station's region in
+  // place, the marker kept its old category. It now asks after every METAR event.)
   const worse = "METAR LJLJ 221220Z 24004KT 0600 FG OVC002 10/10 Q1018";
   assert((await w.api("POST", "/api/metar", { apply: true, reports: [worse] })).status === 200, "the newer report");
   await until("LJLJ turns LIFR", async () => (await category("LJLJ")) === "LIFR");
@@ -651,11 +654,8 @@ cases.stations = async (cleanup) => {
   assert(/LIFR/.test(popup) && /layer \d+: stratus 8\/8/.test(popup), `the category and the layer it became: ${popup}`);
   // A restart keeps the stations' regions (the store) but not the reports'
   // texts: the markers keep their category, from the regions' ceilings
-  // (LIPZ's IFR came from its visibility, which the weather does not keep).
-  // LJLJ is left out: its newer report added a second region at the station
-  // instead of replacing the first (the server stores a centre of 14.4576 E
-  // as 14.457600000000014, and METAR finds a station's region by its exact
-  // position, metar_changes.cpp), and which of the two is found is not defined.
+  // (LIPZ's IFR came from its visibility, which the weather does not keep;
+  // LJLJ's newer report replaced its region, OVC002 a LIFR ceiling).
   await w.stop();
   await until("offline", async () => (await a.page.getAttribute("body", "data-link")) === "offline", 30000);
   await w.start();
@@ -664,7 +664,8 @@ cases.stations = async (cleanup) => {
   assert(after.report && after.report.text === null && after.report.layers.length > 0, `LIPQ after the restart: ${JSON.stringify(after)}`);
   await a.page.reload();
   await until("LIPQ still LIFR", async () => (await category("LIPQ")) === "LIFR");
-  for (const icao of ["LOWK", "LIPH"]) assert((await category(icao)) === reports[icao][1], `${icao} by its ceiling alone`);
+  for (const [icao, cat] of [["LOWK", "MVFR"], ["LIPH", "IFR"], ["LJLJ", "LIFR"]])
+    assert((await category(icao)) === cat, `${icao} by its ceiling alone: ${await category(icao)}`);
   noProblems(a.problems);
 };
 
