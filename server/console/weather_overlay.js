@@ -303,12 +303,20 @@ export const WindFieldLayer = L.Layer.extend({
     this.getPane().appendChild(this.svg);
     this.legend = new WindLegend();
     map.on("moveend zoomend resize viewreset", this.moved, this);
+    // A tab in the background skips its refreshes and asks once it is back.
+    this.visible = () => {
+      if (document.hidden || !this.refreshSkipped) return;
+      this.refreshSkipped = false;
+      this.ask();
+    };
+    document.addEventListener("visibilitychange", this.visible);
     this.redraw();
   },
   onRemove(map) {
     L.DomUtil.remove(this.svg);
     if (this.shown) this.legend.remove();
     map.off("moveend zoomend resize viewreset", this.moved, this);
+    document.removeEventListener("visibilitychange", this.visible);
     clearTimeout(this.settleTimer);
     clearTimeout(this.refreshTimer);
   },
@@ -363,7 +371,7 @@ export const WindFieldLayer = L.Layer.extend({
     this.inFlight = true;
     const q = this.query();
     const r = await request("GET", `/api/wind?lat_deg=${q.lat_deg.toFixed(5)}&lon_deg=${q.lon_deg.toFixed(5)}` +
-      `&alt_m=${q.alt_m}&radius_m=${q.radius_m}`);
+      `&alt_m=${fmt(q.alt_m, 2)}&radius_m=${q.radius_m}`);
     this.inFlight = false;
     if (!this.shown) return;
     if (r.ok && r.body && Array.isArray(r.body.arrows)) {
@@ -378,7 +386,10 @@ export const WindFieldLayer = L.Layer.extend({
       this.again = false;
       this.ask();
     } else {
-      this.refreshTimer = setTimeout(() => this.ask(), WIND_REFRESH_MS);
+      this.refreshTimer = setTimeout(() => {
+        if (document.hidden) this.refreshSkipped = true;
+        else this.ask();
+      }, WIND_REFRESH_MS);
     }
   },
 
