@@ -16,8 +16,6 @@ namespace sky::weather {
 
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-
 // Vertical presence of a layer at an altitude, [0, 1].
 double presence(const CloudLayer& l, double alt_m) {
   const double top = l.base_m + l.thickness_m;
