@@ -5,6 +5,7 @@
 // the weather clock, and a restart that decodes the stored files again.
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -131,6 +132,21 @@ TEST(WeatherdGrib, ApiLoadsFilesAndRefusesWhatItMust) {
     return t.layerId == server::kForecastLowSlot && t.coverage > 0;
   });
   EXPECT_GT(lowTiles, 10);
+  // And NAM's winds as wind tiles of its three layers, varying over Kansas
+  // (the forecast's layers have no wind of their own).
+  std::map<std::uint32_t, std::pair<double, double>> eastRange;  // layer -> (min, max) east wind
+  for (const auto& t : kansas.windTiles) {
+    auto [it, added] = eastRange.try_emplace(t.layerId, t.east_mps, t.east_mps);
+    it->second = {std::min<double>(it->second.first, t.east_mps), std::max<double>(it->second.second, t.east_mps)};
+  }
+  EXPECT_EQ(eastRange.size(), 3u) << kansas.windTiles.size() << " wind tiles";
+  for (const auto& [layer, range] : eastRange) {
+    std::printf("[ grib ] NAM layer %u: %zu wind tiles at level %d, east wind %.1f to %.1f m/s\n", layer,
+                std::size_t(std::count_if(kansas.windTiles.begin(), kansas.windTiles.end(),
+                                          [&](const auto& t) { return t.layerId == layer; })),
+                kansas.windTileLevel, range.first, range.second);
+    EXPECT_GT(range.second - range.first, 2.0) << "layer " << layer;
+  }
   const auto europe = snapshotOf(w.streamPort, 48, 11, 100000, 8);
   EXPECT_EQ(std::count_if(europe.tiles.begin(), europe.tiles.end(),
                           [](const auto& t) { return t.layerId == server::kForecastLowSlot && t.coverage > 0; }),
