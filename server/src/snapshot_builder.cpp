@@ -353,6 +353,8 @@ double TileCache::cellWeight(const ShapeKey& shape, const weather::Region& regio
   return w;
 }
 
+TileCache::ShapeKey TileCache::shapeOf(const weather::Region& region) { return shapeKey(region); }
+
 void TileCache::makeRoomForShapes(Entry& entry, std::size_t regions) {
   if (entry.shapeWeights.size() + regions > kMaxShapesPerCovering) entry.shapeWeights.clear();
 }

@@ -2,6 +2,7 @@
 #include "sky/server/wind_tiles.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <optional>
 
@@ -105,12 +106,33 @@ WindTiles deriveWindTiles(const weather::SphericalCap& cap, std::span<const weat
   out.level = at.level;
   std::vector<weather::WindVector> base, sum;
   std::vector<double> total;
+  std::vector<std::uint64_t> inputs;
+  auto bits = [](double v) { return std::bit_cast<std::uint64_t>(v); };
   for (std::size_t i = 0; i < table.size(); ++i) {
     if (!varies[i]) continue;
     const weather::CloudLayer& layer = table[i];
     const weather::WindVector own = weather::toVector(layer.wind);
+    const bool fromField = field && field->givesWind(layer.id);
+    // What this layer's tiles come from, exactly (as the cover's memo).
+    inputs = {bits(own.east_mps), bits(own.north_mps), bits(own.up_mps)};
+    if (fromField) inputs.insert(inputs.end(), {~0ull, field->key(), bits(layer.base_m), bits(layer.thickness_m)});
+    for (std::size_t k = 0; k < near.size(); ++k)
+      if (const auto* rl = ownLayer(*near[k], layer.id)) {
+        const TileCache::ShapeKey shape = TileCache::shapeOf(*near[k]);
+        const weather::WindVector v = weather::toVector(rl->wind);
+        inputs.push_back(k);
+        inputs.insert(inputs.end(), shape.begin(), shape.end());
+        inputs.insert(inputs.end(), {bits(v.east_mps), bits(v.north_mps), bits(v.up_mps)});
+      }
+    if (entry) {
+      const auto memo = entry->windLayers.find(layer.id);
+      if (memo != entry->windLayers.end() && memo->second.inputs == inputs) {
+        out.tiles.insert(out.tiles.end(), memo->second.tiles.begin(), memo->second.tiles.end());
+        continue;
+      }
+    }
     base.assign(at.cells.size(), own);
-    if (field && field->givesWind(layer.id)) {
+    if (fromField) {
       std::vector<weather::WindVector> sampled(at.cells.size());
       field->sampleWind(layer.id, at.centres, sampled);
       for (std::size_t c = 0; c < sampled.size(); ++c)
@@ -150,8 +172,16 @@ WindTiles deriveWindTiles(const weather::SphericalCap& cap, std::span<const weat
       differs = differs || !sameOnTheWire(v, own);
       tiles.push_back(weather::quantized({at.cells[c], layer.id, float(v.east_mps), float(v.north_mps), float(v.up_mps)}));
     }
-    if (differs) out.tiles.insert(out.tiles.end(), tiles.begin(), tiles.end());
+    if (!differs) tiles.clear();
+    out.tiles.insert(out.tiles.end(), tiles.begin(), tiles.end());
+    if (entry) entry->windLayers[layer.id] = {inputs, std::move(tiles)};
   }
+  // Layers gone from the table take their memo with them.
+  if (entry)
+    for (auto it = entry->windLayers.begin(); it != entry->windLayers.end();)
+      it = std::any_of(table.begin(), table.end(), [&](const auto& l) { return l.id == it->first; })
+               ? std::next(it)
+               : entry->windLayers.erase(it);
   if (out.tiles.empty()) out.level = 0;
   return out;
 }

@@ -364,7 +364,9 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
   if (in.weather == nullptr) return s;
   const double sinceSnapshot_s = in.weatherClock_s - in.weather->weatherClock_s;
   const glm::dvec3 flow = windFlowPhases(in.weatherClock_s);
-  const weather::WindField wind(*in.weather);
+  // Indexed only when a layer's wind varies (thousands of tiles, each frame).
+  const bool anyField = std::any_of(field.windVaries.begin(), field.windVaries.end(), [](bool v) { return v; });
+  const weather::WindField wind = anyField ? weather::WindField(*in.weather) : weather::WindField();
   for (std::size_t slice = 0; slice < in.weather->layers.size(); ++slice) {
     const weather::CloudLayer& layer = in.weather->layers[slice];
     LayerSetup l;

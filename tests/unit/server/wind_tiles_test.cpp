@@ -132,6 +132,15 @@ TEST(WindTilesOnTheServer, ANamSnapshotCarriesItsWindFieldWithinTheBudget) {
     EXPECT_NEAR(t.east_mps, w->east_mps, 0.006);
     EXPECT_NEAR(t.north_mps, w->north_mps, 0.006);
   }
+  // Through the tile cache (a layer's wind tiles kept with what they came
+  // from): the same tiles, first derived and then reused; a later forecast
+  // time (another field key) derives them again.
+  TileCache cache;
+  EXPECT_EQ(buildSnapshot(request, table, 0, kDefaultMaxCells, {}, &cache, &field).windTiles, s.windTiles);
+  EXPECT_EQ(buildSnapshot(request, table, 0, kDefaultMaxCells, {}, &cache, &field).windTiles, s.windTiles);
+  const ForecastField later(fc, 1, valid + 3 * 3600);
+  EXPECT_EQ(buildSnapshot(request, table, 0, kDefaultMaxCells, {}, &cache, &later).windTiles,
+            buildSnapshot(request, table, 0, kDefaultMaxCells, {}, nullptr, &later).windTiles);
   // The wind varies: the high layer's tiles span more than 5 m/s here.
   double lo = 1e9, hi = -1e9;
   for (const auto& t : s.windTiles)

@@ -122,6 +122,15 @@ class TileCache {
     std::vector<UnitVector> units;             // of centres
     std::unordered_map<ShapeKey, Weights, ShapeKeyHash> shapeWeights;
     std::map<std::uint32_t, LayerMemo> layers;  // by layer id
+    // Per layer id, its wind tiles over this covering (wind_tiles.cpp) and
+    // the bit patterns of what they came from: a region edit elsewhere, or
+    // another subscriber of the same area, does not sample a forecast's
+    // winds again.
+    struct WindMemo {
+      std::vector<std::uint64_t> inputs;
+      std::vector<weather::WindTile> tiles;  // empty: the layer's own wind everywhere
+    };
+    std::map<std::uint32_t, WindMemo> windLayers;
   };
   Entry& covering(const weather::SphericalCap& cap, int wantedLevel, std::size_t maxCells);
   // regionWeight(region, cell centre) of the cells of `entry` where it is
@@ -139,6 +148,8 @@ class TileCache {
   // the ones it holds when they would not fit), so that references weights()
   // returns for them stay valid together.
   static void makeRoomForShapes(Entry& entry, std::size_t regions);
+  // A region's shape as the cache keys it.
+  static ShapeKey shapeOf(const weather::Region& region);
 
  private:
   double cellWeight(const ShapeKey& shape, const weather::Region& region, std::uint64_t cell,
