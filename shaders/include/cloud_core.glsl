@@ -388,7 +388,16 @@ struct CloudSample {
   real3 flowShiftB;
 };
 
-CloudSample cloudSampleAt(CoreLayer L, real3 p, real ph, bool cheap) {
+// For a layer whose wind varies over the map, its noise is carried by the
+// local wind's difference from the layer's own (with which the noise origins
+// drift already), in the two phases of the flow (flowShape and the others).
+CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
+  if (L.sampling.flow.w > 0.5 && ph > 0.0 && ph < 1.0) {
+    real3 rel = sampleWindLocal(L.sampling, p) - real3(L.sampling.windRef);
+    rel.z = 0.0;
+    L.sampling.flowShift = rel * L.sampling.flow.x;
+    L.sampling.flowShiftB = rel * L.sampling.flow.y;
+  }
   CloudSample cs;
   cs.rho = 0.0;
   cs.ct = L.primary;
@@ -422,19 +431,6 @@ CloudSample cloudSampleAt(CoreLayer L, real3 p, real ph, bool cheap) {
   // Erosion leaves a full shape (1) full: the detail fetch only at the edges.
   cs.rho = (shape < 1.0 ? erodeShape(cs.ct, shape, flowDetail(L.sampling, p), cs.coverage, ph) : 1.0) * da;
   return cs;
-}
-
-// The density at p; for a layer whose wind varies over the map, its noise
-// carried by the local wind's difference from the layer's own (with which
-// the noise origins drift already), in the two phases of the flow.
-CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
-  if (L.sampling.flow.w > 0.5 && ph > 0.0 && ph < 1.0) {
-    real3 rel = sampleWindLocal(L.sampling, p) - real3(L.sampling.windRef);
-    rel.z = 0.0;
-    L.sampling.flowShift = rel * L.sampling.flow.x;
-    L.sampling.flowShiftB = rel * L.sampling.flow.y;
-  }
-  return cloudSampleAt(L, p, ph, cheap);
 }
 
 // The direct sun's mean transmittance over a broken field: a fraction c of

@@ -72,11 +72,14 @@ class ChildProcess {
     return std::nullopt;
   }
 
-  // SIGTERM, then SIGKILL if it is still there after a grace period.
+  // SIGTERM, then SIGKILL if it is still there after a grace period: 20 s,
+  // since a renderer ends its frame first, and under ASan beside the suite's
+  // other tests a first frame (the shaders' JIT compile and both weather
+  // maps) has taken 5 s.
   int stop() {
     if (exitCode_) return *exitCode_;
     kill(pid_, SIGTERM);
-    if (auto c = wait(std::chrono::seconds(5))) return *c;
+    if (auto c = wait(std::chrono::seconds(20))) return *c;
     kill(pid_, SIGKILL);
     return wait(std::chrono::seconds(5)).value_or(-1);
   }
