@@ -160,30 +160,37 @@ real flowMix(real a, real b, real wA) {
   return clamp(0.5 + (wA * (a - 0.5) + wB * (b - 0.5)) / sqrt(wA * wA + wB * wB), 0.0, 1.0);
 }
 
+// The flow's second read: 1 while a flowing layer's phases crossfade, else
+// 0. As a loop's trip count (lavapipe runs both sides of a branch for every
+// lane, but leaves a loop no lane is in), so the layers that do not flow,
+// and a flowing one outside its crossfades, read their noise once. Outside
+// a crossfade flowShift holds the one phase that shows (cloudSample).
+int flowReads(LayerSampling s) {
+  return s.flow.w > 0.5 && s.flow.z > 0.0 && s.flow.z < 1.0 ? 1 : 0;
+}
+
 real2 flowShape(LayerSampling s, real3 p) {
-  real wA = s.flow.z;
-  if (s.flow.w < 0.5 || wA >= 1.0) return sampleShape(s, p);
-  real2 b = sampleShape(flowPhaseB(s), p);
-  if (wA <= 0.0) return b;
-  real2 a = sampleShape(s, p);
-  return real2(flowMix(a.x, b.x, wA), flowMix(a.y, b.y, wA));
+  real2 v = sampleShape(s, p);
+  for (int i = 0; i < flowReads(s); ++i) {
+    real2 b = sampleShape(flowPhaseB(s), p);
+    v = real2(flowMix(v.x, b.x, s.flow.z), flowMix(v.y, b.y, s.flow.z));
+  }
+  return v;
 }
 
 real2 flowCloudMap(LayerSampling s, real3 p) {
-  real wA = s.flow.z;
-  if (s.flow.w < 0.5 || wA >= 1.0) return sampleCloudMap(s, p);
-  real2 b = sampleCloudMap(flowPhaseB(s), p);
-  if (wA <= 0.0) return b;
-  real2 a = sampleCloudMap(s, p);
-  return real2(flowMix(a.x, b.x, wA), flowMix(a.y, b.y, wA));
+  real2 v = sampleCloudMap(s, p);
+  for (int i = 0; i < flowReads(s); ++i) {
+    real2 b = sampleCloudMap(flowPhaseB(s), p);
+    v = real2(flowMix(v.x, b.x, s.flow.z), flowMix(v.y, b.y, s.flow.z));
+  }
+  return v;
 }
 
 real flowDetail(LayerSampling s, real3 p) {
-  real wA = s.flow.z;
-  if (s.flow.w < 0.5 || wA >= 1.0) return sampleDetail(s, p);
-  real b = sampleDetail(flowPhaseB(s), p);
-  if (wA <= 0.0) return b;
-  return flowMix(sampleDetail(s, p), b, wA);
+  real v = sampleDetail(s, p);
+  for (int i = 0; i < flowReads(s); ++i) v = flowMix(v, sampleDetail(flowPhaseB(s), p), s.flow.z);
+  return v;
 }
 
 // The march's cost knobs (defaults above; RenderSettings::march). Two ways
@@ -392,10 +399,12 @@ struct CloudSample {
 // local wind's difference from the layer's own (with which the noise origins
 // drift already), in the two phases of the flow (flowShape and the others).
 CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
-  if (L.sampling.flow.w > 0.5 && ph > 0.0 && ph < 1.0) {
+  // A loop of one trip for a flowing layer, none for the others (flowReads).
+  for (int i = 0; i < int(L.sampling.flow.w); ++i) {
     real3 rel = sampleWindLocal(L.sampling, p) - real3(L.sampling.windRef);
     rel.z = 0.0;
-    L.sampling.flowShift = rel * L.sampling.flow.x;
+    // Phase A's shift first, or B's alone where only B shows.
+    L.sampling.flowShift = rel * (L.sampling.flow.z > 0.0 ? L.sampling.flow.x : L.sampling.flow.y);
     L.sampling.flowShiftB = rel * L.sampling.flow.y;
   }
   CloudSample cs;

@@ -88,8 +88,11 @@ vec2 airCloudShadow(AirFrame a, vec3 p, float h, float muSun) {
 // the uniform drift, or (a wind that varies) by the wind there times the
 // tiles' age (weather::upwindOf, in the map's plane).
 vec2 tilePlane(LayerSampling s, vec2 plane) {
-  if (s.flow.w > 0.5) return plane - mapWind(s.coverageShift.z, plane) * s.windRef.w;
-  return plane - s.coverageShift.xy;
+  // A loop, not a branch: lavapipe would read the wind map for every layer
+  // (cloud_core.glsl's flowReads).
+  vec2 shift = s.coverageShift.xy;
+  for (int i = 0; i < int(s.flow.w); ++i) shift = mapWind(s.coverageShift.z, plane) * s.windRef.w;
+  return plane - shift;
 }
 
 vec3 sampleWeather(LayerSampling s, vec3 p) {

@@ -190,7 +190,7 @@ CpuCore::real2 CpuCore::windInPlane(LayerSampling s, real2 plane) {
 }
 
 CpuCore::real2 CpuCore::tilePlane(LayerSampling s, real2 plane) {
-  if (s.flow.w > 0.5) return plane - windInPlane(s, plane) * s.windRef.w;
+  if (s.flow.w > 0.5) return plane - windInPlane(s, plane) * s.windRef.w;  // (as cloud_pass.glsl's loop)
   return plane - real2(s.coverageShift.x, s.coverageShift.y);
 }
 
