@@ -37,12 +37,15 @@ struct Measured {
   std::array<double, kStepFactors.size()> psnr_db;
 };
 constexpr std::array<Measured, 4> kMeasured = {{
-    // high's costs measured again after the wind field's shader changes
-    // (flow phases, the wind map's reads) on three of the scenes
-    // (cumulus-midday, sunset-backlit, cumulonimbus; the run's time limit
-    // ended it there): the cheap levels now save more (were 0.879, 0.834,
-    // 0.781, 0.757). Its PSNR row is the five scenes' from before.
-    {"high", 5, {1.0, 0.942, 0.728, 0.633, 0.622}, {39.8, 37.7, 35.7, 32.7, 30.3}},
+    // high's costs after the wind field's shader changes (flow phases, the
+    // wind map's reads), which made its cheap levels save more (were 0.879,
+    // 0.834, 0.781, 0.757): the bench on three of the scenes (cumulus-midday,
+    // sunset-backlit, cumulonimbus; its time limit ended the run there) gave
+    // 1, 0.942, 0.728, 0.633, 0.622 (cumulus-midday alone 0.48 at level 4),
+    // FrameBudget's uniform deck 0.77, 0.65, 0.57, 0.50 under ASan: these
+    // lie between the two until all five scenes are measured again. Its PSNR
+    // row is the five scenes' from before.
+    {"high", 5, {1.0, 0.9, 0.7, 0.6, 0.58}, {39.8, 37.7, 35.7, 32.7, 30.3}},
     {"medium", 2, {1.0, 0.918, 0, 0, 0}, {42.0, 41.4, 0, 0, 0}},
     {"low", 2, {1.0, 0.941, 0, 0, 0}, {40.2, 40.4, 0, 0, 0}},
     {"realtime", 2, {1.0, 0.957, 0, 0, 0}, {36.1, 36.3, 0, 0, 0}},
