@@ -51,16 +51,7 @@ int oktas(double cover) {
 
 Result<ConformanceQuery> parseConformanceQuery(std::string_view query) {
   ConformanceQuery q;
-  if (query.size() > 512) return fail(ErrorCode::InvalidArgument, "query: longer than 512 bytes");
-  std::set<std::string_view> seen;
-  while (!query.empty()) {
-    const std::size_t amp = query.find('&');
-    const std::string_view pair = query.substr(0, amp);
-    query = amp == std::string_view::npos ? std::string_view{} : query.substr(amp + 1);
-    const std::size_t eq = pair.find('=');
-    if (eq == std::string_view::npos) return fail(ErrorCode::Malformed, "query: '" + std::string(pair) + "' is not key=value");
-    const std::string_view key = pair.substr(0, eq), value = pair.substr(eq + 1);
-    if (!seen.insert(key).second) return fail(ErrorCode::InvalidArgument, std::string(key) + ": given twice");
+  const auto pairs = forEachQueryPair(query, [&](std::string_view key, std::string_view value) -> Result<void> {
     Result<double> v = 0.0;
     if (key == "stations") {
       if (!(v = queryNumber(key, value, 0, 10000))) return tl::unexpected(v.error());
@@ -80,7 +71,9 @@ Result<ConformanceQuery> parseConformanceQuery(std::string_view query) {
     } else {
       return fail(ErrorCode::InvalidArgument, "query: unknown key '" + std::string(key) + "'");
     }
-  }
+    return {};
+  });
+  if (!pairs) return tl::unexpected(pairs.error());
   if (q.lat_deg.has_value() != q.lon_deg.has_value() || q.lat_deg.has_value() != (q.radius_m > 0))
     return fail(ErrorCode::InvalidArgument, "lat_deg, lon_deg, radius_m: give all three or none");
   return q;
