@@ -23,7 +23,9 @@
 //   real2 airCloudShadow(AirFrame a, real3 p, real h, real muSun) // airSunShadow(a, p, h, muSun)
 //   real4 sampleAirTable(int part, real3 uvw)           // the frame's air table (air_table.glsl)
 //   real4 sampleSunMap(int layer, real2 uv)             // the frame's sun map (sun_map.glsl)
-// and the frame's sun map in gSunMap (a global; a data member in C++).
+// and the frame's sun map in gSunMap (a global; a data member in C++), and
+// kWindField: false where no layer's wind varies over the map (the flow's
+// code is then left out; on the GPU a pipeline constant, true in C++).
 // pLocal is camera-relative, local frame: x east, y north, z up (m).
 
 #include "core_common.glsl"
@@ -160,18 +162,21 @@ real flowMix(real a, real b, real wA) {
   return clamp(0.5 + (wA * (a - 0.5) + wB * (b - 0.5)) / sqrt(wA * wA + wB * wB), 0.0, 1.0);
 }
 
-// The flow's second read: 1 while a flowing layer's phases crossfade, else
-// 0. As a loop's trip count (lavapipe runs both sides of a branch for every
-// lane, but leaves a loop no lane is in), so the layers that do not flow,
-// and a flowing one outside its crossfades, read their noise once. Outside
-// a crossfade flowShift holds the one phase that shows (cloudSample).
-int flowReads(LayerSampling s) {
-  return s.flow.w > 0.5 && s.flow.z > 0.0 && s.flow.z < 1.0 ? 1 : 0;
+// A flowing layer's phases crossfade: the noise is read in both and mixed.
+// Outside a crossfade flowShift holds the one phase that shows
+// (cloudSample), and the noise is read once. Branches, not loops of zero or
+// one trip: llvmpipe gives an invocation 65535 loop iterations over all its
+// loops (docs/light-transport.md), and a loop per noise read in the light
+// march spent reference's budget. kWindField (the includer's; on the GPU a
+// pipeline constant) is false for frames without a wind field, so their
+// pipeline holds none of this.
+bool flowCrossfades(LayerSampling s) {
+  return kWindField && s.flow.w > 0.5 && s.flow.z > 0.0 && s.flow.z < 1.0;
 }
 
 real2 flowShape(LayerSampling s, real3 p) {
   real2 v = sampleShape(s, p);
-  for (int i = 0; i < flowReads(s); ++i) {
+  if (flowCrossfades(s)) {
     real2 b = sampleShape(flowPhaseB(s), p);
     v = real2(flowMix(v.x, b.x, s.flow.z), flowMix(v.y, b.y, s.flow.z));
   }
@@ -180,7 +185,7 @@ real2 flowShape(LayerSampling s, real3 p) {
 
 real2 flowCloudMap(LayerSampling s, real3 p) {
   real2 v = sampleCloudMap(s, p);
-  for (int i = 0; i < flowReads(s); ++i) {
+  if (flowCrossfades(s)) {
     real2 b = sampleCloudMap(flowPhaseB(s), p);
     v = real2(flowMix(v.x, b.x, s.flow.z), flowMix(v.y, b.y, s.flow.z));
   }
@@ -189,7 +194,7 @@ real2 flowCloudMap(LayerSampling s, real3 p) {
 
 real flowDetail(LayerSampling s, real3 p) {
   real v = sampleDetail(s, p);
-  for (int i = 0; i < flowReads(s); ++i) v = flowMix(v, sampleDetail(flowPhaseB(s), p), s.flow.z);
+  if (flowCrossfades(s)) v = flowMix(v, sampleDetail(flowPhaseB(s), p), s.flow.z);
   return v;
 }
 
@@ -399,8 +404,7 @@ struct CloudSample {
 // local wind's difference from the layer's own (with which the noise origins
 // drift already), in the two phases of the flow (flowShape and the others).
 CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
-  // A loop of one trip for a flowing layer, none for the others (flowReads).
-  for (int i = 0; i < int(L.sampling.flow.w); ++i) {
+  if (kWindField && L.sampling.flow.w > 0.5) {
     real3 rel = sampleWindLocal(L.sampling, p) - real3(L.sampling.windRef);
     rel.z = 0.0;
     // Phase A's shift first, or B's alone where only B shows.

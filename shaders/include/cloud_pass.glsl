@@ -39,6 +39,11 @@ layout(constant_id = 2) const bool kLayersShadowLayers = true;
 // march, the column, or a map), so a frame's pipeline holds only its way.
 layout(constant_id = 3) const int kSunMethod = 0;
 
+// kWindField false for frames none of whose layers has a wind that varies
+// over the map (SkyLayer::flow.w): the flow's reads of the wind map and
+// second noise phase are compiled out (cloud_core.glsl's flowCrossfades).
+layout(constant_id = 4) const bool kWindField = true;
+
 #define real float
 #define real2 vec2
 #define real3 vec3
@@ -88,11 +93,8 @@ vec2 airCloudShadow(AirFrame a, vec3 p, float h, float muSun) {
 // the uniform drift, or (a wind that varies) by the wind there times the
 // tiles' age (weather::upwindOf, in the map's plane).
 vec2 tilePlane(LayerSampling s, vec2 plane) {
-  // A loop, not a branch: lavapipe would read the wind map for every layer
-  // (cloud_core.glsl's flowReads).
-  vec2 shift = s.coverageShift.xy;
-  for (int i = 0; i < int(s.flow.w); ++i) shift = mapWind(s.coverageShift.z, plane) * s.windRef.w;
-  return plane - shift;
+  if (kWindField && s.flow.w > 0.5) return plane - mapWind(s.coverageShift.z, plane) * s.windRef.w;
+  return plane - s.coverageShift.xy;
 }
 
 vec3 sampleWeather(LayerSampling s, vec3 p) {

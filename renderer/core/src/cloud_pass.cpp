@@ -39,9 +39,9 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
 
   pass.airTableSize_ = airTable.enabled ? airTable : AirTableSettings{false, 8, 8, 4};
   pass.sunMapSize_ = sunMap;
-  // The one-layer variant now (its set layout is the descriptor set's), the
+  // The one-layer variant without a wind field now (its set layout is the descriptor set's), the
   // others when a frame first needs them.
-  auto first = pass.pipelineFor(ctx, Stage::Clouds, 1);
+  auto first = pass.pipelineFor(ctx, Stage::Clouds, 1, false);
   if (!first) return tl::unexpected(first.error());
 
   pass.noiseSampler_ = makeSampler(ctx, vk::SamplerAddressMode::eRepeat, "sky.noiseSampler");
@@ -158,11 +158,13 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
   return pass;
 }
 
-Result<const ComputePipeline*> CloudPass::pipelineFor(const GpuContext& ctx, Stage stage, std::uint32_t layersDrawn) {
+Result<const ComputePipeline*> CloudPass::pipelineFor(const GpuContext& ctx, Stage stage, std::uint32_t layersDrawn,
+                                                      bool windField) {
+  const std::size_t wind = windField ? 1 : 0;
   std::optional<ComputePipeline>& slot =
-      stage == Stage::SunMap     ? sunMapPipeline_
-      : stage == Stage::AirTable ? tablePipelines_[layersDrawn > 0 ? 1 : 0]
-                                 : cloudPipelines_[std::min<std::uint32_t>(layersDrawn, 2)];
+      stage == Stage::SunMap     ? sunMapPipelines_[wind]
+      : stage == Stage::AirTable ? tablePipelines_[wind][layersDrawn > 0 ? 1 : 0]
+                                 : cloudPipelines_[wind][std::min<std::uint32_t>(layersDrawn, 2)];
   if (slot) return &*slot;
   // Every variant of the three shaders gets the same bindings, so their set
   // layouts are identical and one descriptor set serves them all (Vulkan's
@@ -170,7 +172,8 @@ Result<const ComputePipeline*> CloudPass::pipelineFor(const GpuContext& ctx, Sta
   const char* name = stage == Stage::SunMap ? "sky.sunMap" : (stage == Stage::AirTable ? "sky.airTable" : "sky.clouds");
   const char* shader =
       stage == Stage::SunMap ? "sun_map.comp.spv" : (stage == Stage::AirTable ? "air_table.comp.spv" : "clouds.comp.spv");
-  ComputePipelineBuilder builder(std::string(name) + ".layers" + std::to_string(std::min<std::uint32_t>(layersDrawn, 2)));
+  ComputePipelineBuilder builder(std::string(name) + ".layers" + std::to_string(std::min<std::uint32_t>(layersDrawn, 2)) +
+                                 (windField ? ".wind" : ""));
   builder.binding(gpu::kBindingFrame, vk::DescriptorType::eStorageBuffer)
       .binding(gpu::kBindingShape, vk::DescriptorType::eCombinedImageSampler)
       .binding(gpu::kBindingWeather, vk::DescriptorType::eCombinedImageSampler)
@@ -187,7 +190,7 @@ Result<const ComputePipeline*> CloudPass::pipelineFor(const GpuContext& ctx, Sta
       .binding(gpu::kBindingSunMap, vk::DescriptorType::eCombinedImageSampler)
       .shader(shader)
       .constants({layersDrawn > 0 ? 1u : 0u, airTableSize_.enabled ? 1u : 0u, layersDrawn > 1 ? 1u : 0u,
-                  std::uint32_t(sunMapSize_.method)});
+                  std::uint32_t(sunMapSize_.method), windField ? 1u : 0u});
   auto built = builder.build(ctx);
   if (!built) return tl::unexpected(built.error());
   slot = std::move(*built);
@@ -209,11 +212,15 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
   std::uint32_t layersDrawn = 0;
   for (std::uint32_t i = 0; i < std::uint32_t(frame.weatherMap.y) && i < gpu::kMaxLayers; ++i)
     layersDrawn += frame.layers[i].ambient.w < 0.5f ? 1 : 0;
-  auto cloudPipeline = pipelineFor(ctx, Stage::Clouds, layersDrawn);
+  // With the flow's code only where a layer's wind varies over the map.
+  bool windField = false;
+  for (std::uint32_t i = 0; i < std::uint32_t(frame.weatherMap.y) && i < gpu::kMaxLayers; ++i)
+    windField = windField || frame.layers[i].flow.w > 0.5f;
+  auto cloudPipeline = pipelineFor(ctx, Stage::Clouds, layersDrawn, windField);
   if (!cloudPipeline) return tl::unexpected(cloudPipeline.error());
   const ComputePipeline* tablePipeline = nullptr;
   if (frame.airTable.x > 0) {
-    auto built = pipelineFor(ctx, Stage::AirTable, layersDrawn);
+    auto built = pipelineFor(ctx, Stage::AirTable, layersDrawn, windField);
     if (!built) return tl::unexpected(built.error());
     tablePipeline = *built;
   }
@@ -226,7 +233,7 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
   if (sunMapParts(sunMapSize_.method) > 0 && layersDrawn > 0 && sunRowEnd > sunRowBegin) {
     SKY_ASSERT(frame.sunMap.y == sunMapSize_.size && frame.sunMap.z == sunMapSize_.cascades);
     SKY_ASSERT(sunRowEnd <= sunMapSize_.size);
-    auto built = pipelineFor(ctx, Stage::SunMap, layersDrawn);
+    auto built = pipelineFor(ctx, Stage::SunMap, layersDrawn, windField);
     if (!built) return tl::unexpected(built.error());
     sunPipeline = *built;
   }

@@ -78,9 +78,10 @@ class CloudPass {
   // The shaders of the pass, in the order they run.
   enum class Stage { SunMap, AirTable, Clouds };
   // The variant of a stage's shader for a frame drawing layersDrawn layers,
-  // built now if it is not yet. Errors: Io/Malformed for the SPIR-V; Vulkan
-  // failures throw.
-  Result<const ComputePipeline*> pipelineFor(const GpuContext& ctx, Stage stage, std::uint32_t layersDrawn);
+  // with or without a layer whose wind varies over the map, built now if it
+  // is not yet. Errors: Io/Malformed for the SPIR-V; Vulkan failures throw.
+  Result<const ComputePipeline*> pipelineFor(const GpuContext& ctx, Stage stage, std::uint32_t layersDrawn,
+                                             bool windField);
 
   // Destroyed in reverse order: fence and command buffer first, the
   // descriptor set before its pool, buffers and images before the samplers
@@ -88,10 +89,11 @@ class CloudPass {
   // The pass's pipelines by variant (cloud_pass.glsl's specialisation
   // constants), built on first use: the clouds' by the layers a frame draws
   // (none: a clear sky; one; several, which shadow each other), the air
-  // table's without and with clouds. Set layouts all identical.
-  std::array<std::optional<ComputePipeline>, 3> cloudPipelines_;
-  std::array<std::optional<ComputePipeline>, 2> tablePipelines_;
-  std::optional<ComputePipeline> sunMapPipeline_;
+  // table's without and with clouds; each of them and the sun map's without
+  // and with a wind field (the first index). Set layouts all identical.
+  std::array<std::array<std::optional<ComputePipeline>, 3>, 2> cloudPipelines_;
+  std::array<std::array<std::optional<ComputePipeline>, 2>, 2> tablePipelines_;
+  std::array<std::optional<ComputePipeline>, 2> sunMapPipelines_;
   vk::raii::Sampler noiseSampler_{nullptr};
   vk::raii::Sampler airTableSampler_{nullptr};
   vk::raii::Sampler weatherSampler_{nullptr};

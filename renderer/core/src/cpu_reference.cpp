@@ -54,6 +54,7 @@ class CpuCore {
   real3 sampleMultipleScatteringLut(real2 uv) const { return atmosphere_.sampleMultipleScattering(uv); }
 
 #define SKY_CORE_CONST static constexpr
+  static constexpr bool kWindField = true;  // (cloud_core.glsl's flow: the layer's flow.w decides)
 #define SKY_AIR_TABLE_BUILDER
 #define SKY_SUN_MAP_BUILDER
 #include "cloud_core.glsl"
@@ -190,7 +191,7 @@ CpuCore::real2 CpuCore::windInPlane(LayerSampling s, real2 plane) {
 }
 
 CpuCore::real2 CpuCore::tilePlane(LayerSampling s, real2 plane) {
-  if (s.flow.w > 0.5) return plane - windInPlane(s, plane) * s.windRef.w;  // (as cloud_pass.glsl's loop)
+  if (s.flow.w > 0.5) return plane - windInPlane(s, plane) * s.windRef.w;  // (as cloud_pass.glsl's tilePlane)
   return plane - real2(s.coverageShift.x, s.coverageShift.y);
 }
 

@@ -44,6 +44,7 @@ class Core {
   }
 
 #define SKY_CORE_CONST static constexpr
+  static constexpr bool kWindField = true;  // (cloud_core.glsl: the layer's flow.w decides)
 #define SKY_AIR_TABLE_BUILDER
 #define SKY_SUN_MAP_BUILDER
 #include "cloud_core.glsl"
