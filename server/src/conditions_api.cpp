@@ -3,6 +3,7 @@
 
 #include "sky/server/live_weather.hpp"
 #include "sky/server/snapshot_builder.hpp"
+#include "sky/weather/air_field.hpp"
 #include "sky/weather/query.hpp"
 
 namespace sky::server {
@@ -28,6 +29,8 @@ nlohmann::json conditionsJson(const LiveWeather& weather, const ConditionsQuery&
   const weather::PointWeather pw =
       weather::weatherAt(snapshot.layers, weather::snapshotLookup(snapshot, clock_s), q.lat_deg, q.lon_deg, q.alt_m,
                          weather::snapshotWindLookup(snapshot));
+  // The forecast's air where the snapshot has it, else the standard atmosphere's.
+  const std::optional<weather::AirValues> air = weather::AirField(snapshot).at(q.lat_deg, q.lon_deg, q.alt_m);
   // Where each forecast layer's cover at the point comes from.
   nlohmann::json sources = nlohmann::json::object();
   if (field)
@@ -46,7 +49,9 @@ nlohmann::json conditionsJson(const LiveWeather& weather, const ConditionsQuery&
             {"vertical_mps", pw.wind.vertical_mps}}},
           {"cloud_density", pw.cloudDensity},
           {"layer_id", pw.layerId ? nlohmann::json(*pw.layerId) : nlohmann::json(nullptr)},
-          {"air_temperature_c", weather::isaTemperature_c(q.alt_m)},
+          {"air_temperature_c", air ? air->temperature_c : weather::isaTemperature_c(q.alt_m)},
+          {"humidity_pct", air && air->humidity_pct >= 0 ? nlohmann::json(air->humidity_pct) : nlohmann::json(nullptr)},
+          {"air_from", air ? "forecast" : "standard atmosphere"},
           {"pressure_hpa", weather::isaPressure_hpa(q.alt_m)},
           {"forecast_sources", sources}};
 }

@@ -7,6 +7,7 @@
 #include <numeric>
 #include <set>
 
+#include "forecast_axes.hpp"
 #include "sky/weather/query.hpp"
 
 namespace sky::server {
@@ -196,7 +197,7 @@ bool forecastWants(const GribMeta& m) {
     case kCatMass:
       return (m.number == kPressure || m.number == kGeopotentialHeight) &&
              (m.levelType == kCloudBase || m.levelType == kCloudTop || limitSlot(m.levelType) || isobaric);
-    case kCatMoisture: return m.number == kRelativeHumidity && isobaric;
+    case kCatMoisture: return m.number == kRelativeHumidity && (isobaric || nearGround);
     case kCatMomentum: return (m.number == 2 || m.number == 3 || m.number == 8 || m.number == 9) && (isobaric || nearGround);
     case kCatTemperature: return m.number == 0 && (isobaric || nearGround);
     default: return false;
@@ -329,6 +330,7 @@ Result<Forecast> Forecast::fromGrib(const std::vector<const GribFile*>& files, s
     fc.layers_.push_back(std::move(l));
   }
   fc.wind_ = ForecastWind::fromGrib(files, fc.notes_);
+  fc.air_ = ForecastAir::fromGrib(files, fc.notes_);
   fc.reference_unix_ = reference.value_or(0);
   fc.firstValid_unix_ = *valids.begin();
   fc.lastValid_unix_ = *valids.rbegin();
@@ -337,20 +339,14 @@ Result<Forecast> Forecast::fromGrib(const std::vector<const GribFile*>& files, s
 }
 
 float Forecast::coverage(const ForecastLayer& layer, double lat_deg, double lon_deg, double valid_unix) const {
-  const auto& steps = layer.steps;
-  auto at = [&](const ForecastLayer::Step& s) { return sampleField(s.cover->grid, s.cover->fraction, lat_deg, lon_deg); };
-  if (steps.size() == 1 || valid_unix <= static_cast<double>(steps.front().valid_unix)) return at(steps.front());
-  if (valid_unix >= static_cast<double>(steps.back().valid_unix)) return at(steps.back());
-  const auto next = std::upper_bound(steps.begin(), steps.end(), valid_unix, [](double t, const ForecastLayer::Step& s) {
-    return t < static_cast<double>(s.valid_unix);
-  });
-  const auto prev = next - 1;
-  const float a = at(*prev), b = at(*next);
-  if (std::isnan(a)) return b;
-  if (std::isnan(b)) return a;
-  const double t = (valid_unix - static_cast<double>(prev->valid_unix)) /
-                   static_cast<double>(next->valid_unix - prev->valid_unix);
-  return static_cast<float>(a + t * (b - a));
+  return atValidTime(
+      layer.steps, valid_unix,
+      [&](const ForecastLayer::Step& s) { return sampleField(s.cover->grid, s.cover->fraction, lat_deg, lon_deg); },
+      [](float a, float b, double t) {
+        if (std::isnan(a)) return b;
+        if (std::isnan(b)) return a;
+        return static_cast<float>(a + t * (b - a));
+      });
 }
 
 weather::CoverageTile Forecast::tileAt(const ForecastLayer& layer, double lat_deg, double lon_deg,
@@ -409,6 +405,15 @@ void ForecastField::sampleWind(std::uint32_t layerId, std::span<const weather::C
     const auto w = layer ? forecast_->windAt(*layer, at[k].lat_deg, at[k].lon_deg, valid_unix_) : std::nullopt;
     out[k] = w.value_or(weather::WindVector{kNone, kNone, kNone});
   }
+}
+
+std::vector<double> ForecastField::airLevels() const { return forecast_->air().levels_m(); }
+
+void ForecastField::sampleAir(std::size_t level, std::span<const weather::CellCentre> at,
+                              std::span<weather::AirValues> out) const {
+  constexpr double kNone = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t k = 0; k < at.size() && k < out.size(); ++k)
+    out[k] = forecast_->air().at(level, at[k].lat_deg, at[k].lon_deg, valid_unix_).value_or(weather::AirValues{kNone, kNone});
 }
 
 bool ForecastField::gives(std::uint32_t layerId) const {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 
+#include "forecast_axes.hpp"
 #include "sky/weather/query.hpp"
 
 namespace sky::server {
@@ -13,21 +14,10 @@ namespace {
 
 // GRIB2 code table 4.2, discipline 0 category 2 (momentum).
 constexpr long kCatMomentum = 2, kU = 2, kV = 3, kOmega = 8, kVerticalVelocity = 9;
-constexpr long kIsobaric = 100, kHeightAboveGround = 103;
+constexpr long kIsobaric = 100;
 constexpr double kGravity = 9.80665, kAirGasConstant = 287.05;
 // How far above the highest level and below the lowest its wind is taken.
 constexpr double kBeyondLevels_m = 1500;
-
-// A level's height: a pressure level's through the standard atmosphere (the
-// layers' heights come the same way, so a layer and its wind agree on where
-// a pressure is); 10 m above the ground is taken as 10 m MSL, as the
-// forecast carries no terrain the server reads.
-std::optional<double> levelAltitude(const GribMeta& m) {
-  if (!std::isfinite(m.level)) return std::nullopt;
-  if (m.levelType == kIsobaric && m.level > 0) return weather::isaAltitude_m(m.level / 100);
-  if (m.levelType == kHeightAboveGround && m.level >= 0 && m.level <= 200) return m.level;
-  return std::nullopt;
-}
 
 struct LevelFields {
   const GribField* u = nullptr;
@@ -46,7 +36,7 @@ ForecastWind ForecastWind::fromGrib(const std::vector<const GribFile*>& files, s
     for (const GribField& f : file->fields) {
       const GribMeta& m = f.meta;
       if (m.discipline != 0 || m.category != kCatMomentum) continue;
-      const auto alt = levelAltitude(m);
+      const auto alt = forecastLevelAltitude(m);
       if (!alt) continue;
       LevelFields& l = found[m.valid_unix][*alt];
       l.pressure_pa = m.levelType == kIsobaric ? m.level : 0;
@@ -147,19 +137,16 @@ std::optional<weather::WindVector> ForecastWind::atStep(const Step& step, double
 std::optional<weather::WindVector> ForecastWind::at(double lat_deg, double lon_deg, double alt_m,
                                                     double valid_unix) const {
   if (steps_.empty()) return std::nullopt;
-  if (steps_.size() == 1 || valid_unix <= static_cast<double>(steps_.front().valid_unix))
-    return atStep(steps_.front(), lat_deg, lon_deg, alt_m);
-  if (valid_unix >= static_cast<double>(steps_.back().valid_unix)) return atStep(steps_.back(), lat_deg, lon_deg, alt_m);
-  const auto next = std::upper_bound(steps_.begin(), steps_.end(), valid_unix,
-                                     [](double t, const Step& s) { return t < static_cast<double>(s.valid_unix); });
-  const auto prev = next - 1;
-  const auto a = atStep(*prev, lat_deg, lon_deg, alt_m), b = atStep(*next, lat_deg, lon_deg, alt_m);
-  if (!a) return b;
-  if (!b) return a;
-  const double t = (valid_unix - static_cast<double>(prev->valid_unix)) /
-                   static_cast<double>(next->valid_unix - prev->valid_unix);
-  return weather::WindVector{a->east_mps + t * (b->east_mps - a->east_mps), a->north_mps + t * (b->north_mps - a->north_mps),
-                             a->up_mps + t * (b->up_mps - a->up_mps)};
+  using Wind = std::optional<weather::WindVector>;
+  return atValidTime(
+      steps_, valid_unix, [&](const Step& s) { return atStep(s, lat_deg, lon_deg, alt_m); },
+      [](const Wind& a, const Wind& b, double t) -> Wind {
+        if (!a) return b;
+        if (!b) return a;
+        return weather::WindVector{a->east_mps + t * (b->east_mps - a->east_mps),
+                                   a->north_mps + t * (b->north_mps - a->north_mps),
+                                   a->up_mps + t * (b->up_mps - a->up_mps)};
+      });
 }
 
 }  // namespace sky::server

@@ -1,5 +1,6 @@
 // Snapshot building (see snapshot_builder.hpp).
 #include "sky/server/snapshot_builder.hpp"
+#include "sky/server/air_tiles.hpp"
 #include "sky/server/wind_tiles.hpp"
 
 #include <algorithm>
@@ -27,8 +28,8 @@ constexpr double kMeanEarthRadius_m = 6371008.8;
 // Cube faces: no covering of anything has fewer cells per level than this
 // bound allows for, so it is the smallest budget that can always be met.
 constexpr std::size_t kMinCells = 6;
-// The most of a frame wind tiles take from cover tiles (a quarter of it).
-constexpr std::size_t kMaxWindFrameTiles = kMaxWindLayers * kMaxWindCells;
+// The most of a frame wind and air tiles take from cover tiles (under a fifth of it).
+constexpr std::size_t kMaxFieldFrameTiles = kMaxWindLayers * kMaxWindCells + weather::kMaxAirLevels * kMaxAirCells;
 
 // Upper estimate of the cells covering `cap` at `level`: its area in cells plus
 // a ring of boundary cells. Only used to avoid asking S2 for a covering that
@@ -59,10 +60,12 @@ double reachOf(const weather::Region& r) {
   return 1.01 * (std::hypot(r.sizeX_m, r.sizeY_m) / 2 + r.transition_m) + 1000.0;
 }
 
-std::size_t cellBudget(std::size_t maxCells, std::size_t layerCount, std::size_t windTiles) {
+// fieldTiles: the snapshot's wind and air tiles, which take a cover tile's room each.
+std::size_t cellBudget(std::size_t maxCells, std::size_t layerCount, std::size_t fieldTiles) {
   static_assert(stream::kWindTileWireBytes == kTileWireBytes, "a wind tile takes a cover tile's room");
+  static_assert(stream::kAirTileWireBytes == kTileWireBytes, "an air tile takes a cover tile's room");
   const std::size_t tilesPerFrame =
-      (stream::kMaxFrameBytes - kFrameHeadroomBytes) / kTileWireBytes - std::min(windTiles, kMaxWindFrameTiles);
+      (stream::kMaxFrameBytes - kFrameHeadroomBytes) / kTileWireBytes - std::min(fieldTiles, kMaxFieldFrameTiles);
   const std::size_t byFrame = tilesPerFrame / std::max<std::size_t>(layerCount, 1);
   return std::max(kMinCells, std::min(maxCells, byFrame));
 }
@@ -497,7 +500,12 @@ BuiltSnapshot buildSnapshotWithGenerations(const stream::Subscribe& request,
   WindTiles wind = deriveWindTiles(request.area, table, regions, field, cache);
   snapshot.windTileLevel = wind.level;
   snapshot.windTiles = std::move(wind.tiles);
-  const std::size_t budget = cellBudget(maxCells, table.size(), snapshot.windTiles.size());
+  AirTiles air = deriveAirTiles(request.area, field, cache);
+  snapshot.airLevels_m = std::move(air.levels_m);
+  snapshot.airTileLevel = air.level;
+  snapshot.airTiles = std::move(air.tiles);
+  const std::size_t budget =
+      cellBudget(maxCells, table.size(), snapshot.windTiles.size() + snapshot.airTiles.size());
   // No region reaches the area: the weather there is uniform and needs no
   // tiles, so no covering either (the level is the one the budget allows).
   const auto& cap = request.area;

@@ -78,18 +78,27 @@ std::optional<weather::WeatherDelta> diffBuilt(const BuiltSnapshot& before, cons
   // when layers were reordered), from the tables alone.
   auto delta = weather::diffSnapshots(tableOf(before, afterLevel), tableOf(after, afterLevel));
   if (!delta) return std::nullopt;
-  // Wind tiles (a few thousand at most) by the general diff, on the tables.
-  if (!before.snapshot.windTiles.empty() || !after.snapshot.windTiles.empty() ||
-      before.snapshot.windTileLevel != after.snapshot.windTileLevel) {
-    weather::WeatherSnapshot windBefore = tableOf(before, afterLevel), windAfter = tableOf(after, afterLevel);
-    windBefore.windTileLevel = before.snapshot.windTileLevel;
-    windBefore.windTiles = before.snapshot.windTiles;
-    windAfter.windTileLevel = after.snapshot.windTileLevel;
-    windAfter.windTiles = after.snapshot.windTiles;
-    const auto wind = weather::diffSnapshots(windBefore, windAfter);
-    if (!wind) return std::nullopt;
-    delta->windTileLevel = wind->windTileLevel;
-    delta->windTiles = wind->windTiles;
+  // Wind and air tiles (thousands at most) by the general diff, on the tables.
+  const auto fields = [](const weather::WeatherSnapshot& s) {
+    return !s.windTiles.empty() || !s.airTiles.empty() || s.windTileLevel != 0 || s.airTileLevel != 0 ||
+           !s.airLevels_m.empty();
+  };
+  if (fields(before.snapshot) || fields(after.snapshot)) {
+    const auto withFields = [&](const BuiltSnapshot& s) {
+      weather::WeatherSnapshot t = tableOf(s, afterLevel);
+      t.windTileLevel = s.snapshot.windTileLevel;
+      t.windTiles = s.snapshot.windTiles;
+      t.airLevels_m = s.snapshot.airLevels_m;
+      t.airTileLevel = s.snapshot.airTileLevel;
+      t.airTiles = s.snapshot.airTiles;
+      return t;
+    };
+    const auto changed = weather::diffSnapshots(withFields(before), withFields(after));
+    if (!changed) return std::nullopt;
+    delta->windTileLevel = changed->windTileLevel;
+    delta->windTiles = changed->windTiles;
+    delta->airTileLevel = changed->airTileLevel;
+    delta->airTiles = changed->airTiles;
   }
   // Tiles, in the order of `after`'s: per layer, the tiles that differ from
   // the same layer's before. Any layer whose cells are not the ones it had

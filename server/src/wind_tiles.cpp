@@ -33,6 +33,33 @@ struct WindCells {
 
 }  // namespace
 
+void coverWithMargin(const weather::SphericalCap& cap, int wantedLevel, std::size_t maxCells, TileCache* cache,
+                     FieldCovering& out) {
+  // Two cell edges past the area, at the level the budget allows, found
+  // from the wanted one down (coarser cells: a wider margin at that level).
+  for (int level = wantedLevel;;) {
+    const weather::SphericalCap wider{cap.centerLat_deg, cap.centerLon_deg,
+                                      cap.radius_m + 2 * weather::averageCellEdge_m(level)};
+    if (cache) {
+      out.entry = &cache->covering(wider, level, maxCells);
+      out.cells = out.entry->covering.cells;
+      out.centres = out.entry->centres;
+      out.level = out.entry->covering.level;
+    } else {
+      out.local = coverArea(wider, level, maxCells);
+      out.cells = out.local.cells;
+      out.level = out.local.level;
+    }
+    if (out.level == level || out.level == 0) break;
+    level = out.level;
+  }
+  if (!cache) {
+    out.localCentres.clear();
+    for (std::uint64_t c : out.local.cells) out.localCentres.push_back(weather::cellCentre(c));
+    out.centres = out.localCentres;
+  }
+}
+
 WindTiles deriveWindTiles(const weather::SphericalCap& cap, std::span<const weather::CloudLayer> table,
                           std::span<const weather::Region> regions, const LayerField* field, TileCache* cache) {
   // The regions near the area, and for each layer whether anything can make
@@ -57,34 +84,12 @@ WindTiles deriveWindTiles(const weather::SphericalCap& cap, std::span<const weat
   std::sort(byBase.begin(), byBase.end());
   for (std::size_t n = kMaxWindLayers; n < byBase.size(); ++n) varies[byBase[n].second] = false;
 
-  // The covering, and each near region's weight at its cells. It reaches
-  // two cell edges past the area, so that the wind anywhere in the area has
-  // every cell the field's kernel weighs (a point query's area of one metre
-  // would otherwise be one cell, its neighbours taken as the layer's own
-  // wind); at the level the budget allows, found from the wanted one down.
-  Covering local;
-  std::vector<weather::CellCentre> localCentres;
-  TileCache::Entry* entry = nullptr;
-  WindCells at;
-  for (int level = kWindTileLevel;;) {
-    const weather::SphericalCap wider{cap.centerLat_deg, cap.centerLon_deg,
-                                      cap.radius_m + 2 * weather::averageCellEdge_m(level)};
-    if (cache) {
-      entry = &cache->covering(wider, level, kMaxWindCells);
-      at = {entry->covering.cells, entry->centres, entry->covering.level};
-    } else {
-      local = coverArea(wider, level, kMaxWindCells);
-      at = {local.cells, {}, local.level};
-    }
-    if (at.level == level || at.level == 0) break;
-    level = at.level;  // coarser cells: a wider margin at that level
-  }
-  if (cache) {
-    TileCache::makeRoomForShapes(*entry, near.size());
-  } else {
-    for (std::uint64_t c : local.cells) localCentres.push_back(weather::cellCentre(c));
-    at.centres = localCentres;
-  }
+  // The covering, and each near region's weight at its cells.
+  FieldCovering covering;
+  coverWithMargin(cap, kWindTileLevel, kMaxWindCells, cache, covering);
+  TileCache::Entry* entry = covering.entry;
+  if (cache) TileCache::makeRoomForShapes(*entry, near.size());
+  const WindCells at{covering.cells, covering.centres, covering.level};
   std::vector<std::vector<double>> weightOf(near.size());
   auto weights = [&](std::size_t k) -> const std::vector<double>& {
     std::vector<double>& w = weightOf[k];

@@ -24,6 +24,7 @@
 
 #include "child_process.hpp"
 #include "sky/cigi/codec.hpp"
+#include "sky/weather/query.hpp"
 #include "weatherd_process.hpp"
 
 namespace fs = std::filesystem;
@@ -71,6 +72,7 @@ constexpr double kLat = 46.2, kLon = 12.8;
 class CigiHost {
  public:
   CigiHost() : fd_(::socket(AF_INET, SOCK_DGRAM, 0)) {}
+  double ownshipLat_deg = kLat, ownshipLon_deg = kLon;  // where ownship() flies
   ~CigiHost() { ::close(fd_); }
   void send(unsigned port, const std::vector<cigi::Packet>& packets) {
     cigi::DatagramWriter w(cigi::ByteOrder::Big);
@@ -103,10 +105,10 @@ class CigiHost {
   std::uint32_t frame_ = 0;
 };
 
-cigi::EntityControl ownship() {
+cigi::EntityControl ownship(const CigiHost& host) {
   cigi::EntityControl e;
-  e.lat_deg = kLat;
-  e.lon_deg = kLon;
+  e.lat_deg = host.ownshipLat_deg;
+  e.lon_deg = host.ownshipLon_deg;
   e.alt_m = 900;
   e.yaw_deg = 90;
   return e;
@@ -131,7 +133,7 @@ IgAnswer ask(CigiHost& host, unsigned port, std::uint8_t id, const Point& p) {
   r.lon_deg = p.lon_deg;
   r.alt_m = p.alt_m;
   for (int attempt = 0; attempt < 100; ++attempt) {
-    host.send(port, {ownship(), r});
+    host.send(port, {ownship(host), r});
     for (auto until = std::chrono::steady_clock::now() + 2s; std::chrono::steady_clock::now() < until;) {
       auto d = host.receive(500ms);
       if (!d) continue;
@@ -164,7 +166,7 @@ template <class Wanted>
 bool waitForSnapshot(ChildProcess& render, CigiHost& host, unsigned cigiPort, Wanted wanted) {
   const std::string snapshot = "weather snapshot of area 0: ";
   for (auto until = std::chrono::steady_clock::now() + 180s; std::chrono::steady_clock::now() < until;) {
-    host.send(cigiPort, {ownship()});
+    host.send(cigiPort, {ownship(host)});
     while (host.receive(100ms)) {
     }
     const std::string log = render.log();
@@ -378,6 +380,61 @@ TEST(CigiConditions, TheRendererAnswersTheForecastsClouds) {
   EXPECT_GE(cloudy, 3) << "GFS has boundary-layer, low, middle and high cloud over 46.2 N 12.8 E on 2011-01-15 12Z";
   // The forecast's layers have no wind of their own: the boundary layer's is GFS's 10 m wind.
   EXPECT_GT(boundaryWind, 0.5);
+  EXPECT_EQ(render.stop(), 0) << render.log();
+  EXPECT_EQ(w.process->stop(), 0) << w.process->log();
+}
+
+// NAM's temperature and humidity (air tiles) reach the renderer through the
+// stream: its CIGI answers over Kansas carry the forecast's air at the
+// point, as the server's point query does, from the ground to the jet
+// stream, where without a forecast both answer the standard atmosphere.
+TEST(CigiConditions, TheRendererAnswersTheForecastsTemperatureAndHumidity) {
+  const fs::path dir = fs::path(SKY_TEST_OUTPUT_DIR) / "conditions-air";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  Weatherd w("conditions-air-weatherd", SKY_SCENARIO_CLEAR, false,
+             {"--grib", std::string(SKY_TEST_DATA_DIR) + "/grib/nam212-lambert-2004120812-f24.grib2"});
+  ASSERT_GT(w.httpPort, 0u) << w.process->log();
+  ChildProcess render = startRenderer(dir, w.streamPort);
+  const unsigned cigiPort = waitForPortFile((dir / "render.port").string(), 120s);
+  ASSERT_GT(cigiPort, 0u) << render.log();
+  CigiHost host;
+  host.ownshipLat_deg = 38.0;
+  host.ownshipLon_deg = -97.0;
+  // The scenario's layer and NAM's three (no cover tiles: NAM has no cloud
+  // over Kansas at this hour, so its layers are uniform there).
+  const bool layers = waitForSnapshot(render, host, cigiPort, [](int n, int) { return n >= 4; });
+  ASSERT_TRUE(layers) << "no snapshot with the forecast's layers:\n" << render.log();
+  const Point points[] = {
+      {"near the ground", 38.0, -97.0, 400},      {"at 850 hPa", 38.05, -97.1, 1457},
+      {"between 700 and 500 hPa", 37.9, -96.9, 4300}, {"in the jet stream's level", 38.0, -97.0, 10400},
+  };
+  double lowest = 1e9, highest = -1e9;
+  for (std::size_t i = 0; i < std::size(points); ++i) {
+    const Point& p = points[i];
+    const IgAnswer ig = ask(host, cigiPort, static_cast<std::uint8_t>(60 + i), p);
+    char target[160];
+    std::snprintf(target, sizeof target, "/api/conditions?lat_deg=%.9f&lon_deg=%.9f&alt_m=%.3f", p.lat_deg, p.lon_deg,
+                  p.alt_m);
+    const auto s = nlohmann::json::parse(w.request("GET", target, "", "").body);
+    ASSERT_TRUE(ig.weather) << p.what;
+    SCOPED_TRACE(std::string(p.what) + ": server " + s.dump());
+    EXPECT_EQ(s["air_from"], "forecast");
+    const double t = s["air_temperature_c"].get<double>();
+    // The renderer's area and the server's point query hold air tiles of
+    // different S2 levels, each smoothed by the same kernel, hence the
+    // tolerance; the standard atmosphere differs by several kelvin here.
+    EXPECT_NEAR(ig.weather->airTemperature_c, t, 0.6);
+    if (s["cloud_density"].get<double>() == 0 && !s["humidity_pct"].is_null()) {
+      EXPECT_NEAR(ig.weather->humidity_pct, s["humidity_pct"].get<double>(), 3.0);
+    }
+    lowest = std::min(lowest, t);
+    highest = std::max(highest, t);
+    std::printf("[conditions] %-26s IG %6.2f C humidity %3d %% | server %6.2f C humidity %s | ISA %6.2f C\n", p.what,
+                ig.weather->airTemperature_c, ig.weather->humidity_pct, t, s["humidity_pct"].dump().c_str(),
+                weather::isaTemperature_c(p.alt_m));
+  }
+  EXPECT_GT(highest - lowest, 40.0) << "from the ground to 10 km the air cools by tens of kelvin";
   EXPECT_EQ(render.stop(), 0) << render.log();
   EXPECT_EQ(w.process->stop(), 0) << w.process->log();
 }

@@ -191,6 +191,59 @@ Result<std::vector<weather::WindTile>> decodeWindTiles(const char* message, int 
   return out;
 }
 
+constexpr std::uint8_t kAirNoHumidity = 255;  // AirTile.humidity_half_pct: the source gives none
+
+// Air tiles of a message whose air levels number levelCount (a Delta's are
+// checked against its snapshot's when applied: kMaxAirLevels here).
+Result<std::vector<weather::AirTile>> decodeAirTiles(const char* message, int level, std::size_t levelCount,
+                                                     const flatbuffers::Vector<const fbs::AirTile*>* tiles) {
+  std::vector<weather::AirTile> out;
+  if (!tiles) return out;
+  if (auto r = checkCount(message, "air_tiles", tiles->size(), kMaxMessageTiles); !r) return tl::unexpected(r.error());
+  if (tiles->size() > 0 && reinterpret_cast<std::uintptr_t>(tiles->Data()) % alignof(fbs::AirTile) != 0)
+    return fail(ErrorCode::Malformed, std::string(message) + ".air_tiles: vector of structs is misaligned");
+  out.reserve(tiles->size());
+  for (flatbuffers::uoffset_t i = 0; i < tiles->size(); ++i) {
+    const fbs::AirTile* t = tiles->Get(i);
+    const std::string at = std::string(message) + ".air_tiles[" + std::to_string(i) + "]";
+    if (!weather::isCellAtLevel(t->cell_id(), level))
+      return fail(ErrorCode::InvalidArgument, at + ".cell_id " + std::to_string(t->cell_id()) +
+                                                  " is not an S2 cell of level " + std::to_string(level));
+    if (t->level() >= levelCount)
+      return fail(ErrorCode::InvalidArgument, at + ".level " + std::to_string(t->level()) + " past the " +
+                                                  std::to_string(levelCount) + " air levels");
+    if (t->temperature_dc() < -1000 || t->temperature_dc() > 600)
+      return fail(ErrorCode::InvalidArgument,
+                  at + ".temperature_dc " + std::to_string(t->temperature_dc()) + " outside [-1000, 600]");
+    if (t->humidity_half_pct() > 200 && t->humidity_half_pct() != kAirNoHumidity)
+      return fail(ErrorCode::InvalidArgument, at + ".humidity_half_pct " + std::to_string(t->humidity_half_pct()) +
+                                                  " outside [0, 200] and not 255 (none)");
+    out.push_back({t->cell_id(), t->level(), static_cast<float>(t->temperature_dc()) / 10.0f,
+                   t->humidity_half_pct() == kAirNoHumidity ? weather::kNoHumidity
+                                                           : static_cast<float>(t->humidity_half_pct()) / 2.0f});
+  }
+  return out;
+}
+
+// A Snapshot's air levels: at most kMaxAirLevels heights, finite, within
+// [-1000, 100000] m, strictly ascending.
+Result<std::vector<float>> decodeAirLevels(const flatbuffers::Vector<float>* levels) {
+  std::vector<float> out;
+  if (!levels) return out;
+  if (auto r = checkCount("Snapshot", "air_levels_m", levels->size(), weather::kMaxAirLevels); !r)
+    return tl::unexpected(r.error());
+  for (flatbuffers::uoffset_t i = 0; i < levels->size(); ++i) {
+    const float h = levels->Get(i);
+    const std::string field = "air_levels_m[" + std::to_string(i) + "]";
+    if (auto r = checkRange("Snapshot", field.c_str(), h, -1000, 100000); !r) return tl::unexpected(r.error());
+    if (!out.empty() && !(h > out.back()))
+      return fail(ErrorCode::InvalidArgument, "Snapshot." + field + " = " + std::to_string(h) +
+                                                  " is not above the level before it");
+    out.push_back(h);
+  }
+  return out;
+}
+
 Result<Message> decodeSnapshot(const fbs::Snapshot& s) {
   weather::WeatherSnapshot out;
   out.weatherClock_s = s.weather_clock_s();
@@ -214,6 +267,14 @@ Result<Message> decodeSnapshot(const fbs::Snapshot& s) {
   auto windTiles = decodeWindTiles("Snapshot", out.windTileLevel, s.wind_tiles());
   if (!windTiles) return tl::unexpected(windTiles.error());
   out.windTiles = std::move(*windTiles);
+  auto airLevels = decodeAirLevels(s.air_levels_m());
+  if (!airLevels) return tl::unexpected(airLevels.error());
+  out.airLevels_m = std::move(*airLevels);
+  out.airTileLevel = s.air_tile_level();
+  if (auto r = checkRange("Snapshot", "air_tile_level", out.airTileLevel, 0, 30); !r) return tl::unexpected(r.error());
+  auto airTiles = decodeAirTiles("Snapshot", out.airTileLevel, out.airLevels_m.size(), s.air_tiles());
+  if (!airTiles) return tl::unexpected(airTiles.error());
+  out.airTiles = std::move(*airTiles);
   // Every tile's layer by binary search in the sorted ids: O(tiles log layers).
   const auto ids = sortedUniqueIds("Snapshot", out.layers);
   if (!ids) return tl::unexpected(ids.error());
@@ -253,6 +314,11 @@ Result<Message> decodeDelta(const fbs::Delta& d) {
   auto windTiles = decodeWindTiles("Delta", out.windTileLevel, d.wind_tiles());
   if (!windTiles) return tl::unexpected(windTiles.error());
   out.windTiles = std::move(*windTiles);
+  out.airTileLevel = d.air_tile_level();
+  if (auto r = checkRange("Delta", "air_tile_level", out.airTileLevel, 0, 30); !r) return tl::unexpected(r.error());
+  auto airTiles = decodeAirTiles("Delta", out.airTileLevel, weather::kMaxAirLevels, d.air_tiles());
+  if (!airTiles) return tl::unexpected(airTiles.error());
+  out.airTiles = std::move(*airTiles);
   return Message(std::move(out));
 }
 
@@ -335,7 +401,20 @@ std::vector<fbs::WindTile> encodeWindTiles(const std::vector<weather::WindTile>&
   return out;
 }
 
+std::vector<fbs::AirTile> encodeAirTiles(const std::vector<weather::AirTile>& tiles) {
+  std::vector<fbs::AirTile> out;
+  out.reserve(tiles.size());
+  for (const auto& t : tiles) {
+    const weather::AirTile q = weather::quantizedAir(t);
+    out.emplace_back(t.cellId, static_cast<std::uint8_t>(t.level),
+                     q.humidity_pct < 0 ? kAirNoHumidity : static_cast<std::uint8_t>(std::lround(q.humidity_pct * 2.0f)),
+                     static_cast<std::int16_t>(std::lround(q.temperature_c * 10.0f)), 0u);
+  }
+  return out;
+}
+
 static_assert(sizeof(fbs::WindTile) == kWindTileWireBytes, "kWindTileWireBytes must match the schema's WindTile");
+static_assert(sizeof(fbs::AirTile) == kAirTileWireBytes, "kAirTileWireBytes must match the schema's AirTile");
 static_assert(sizeof(fbs::Tile) == kTileWireBytes, "kTileWireBytes must match the schema's Tile");
 static_assert(kMaxMessageTiles * kTileWireBytes == kMaxFrameBytes, "kMaxMessageTiles: the tiles of one full frame");
 
@@ -363,11 +442,15 @@ std::vector<std::uint8_t> encodeMessage(const Message& message) {
             for (const auto& l : s.layers) layers.push_back(encodeLayer(b, l));
             const std::vector<fbs::Tile> tiles = encodeTiles(s.tiles);
             const std::vector<fbs::WindTile> windTiles = encodeWindTiles(s.windTiles);
+            const std::vector<fbs::AirTile> airTiles = encodeAirTiles(s.airTiles);
             return std::pair{fbs::Body::Snapshot,
                              fbs::CreateSnapshotDirect(b, s.weatherClock_s, &layers,
                                                        static_cast<std::uint8_t>(s.tileLevel), &tiles,
                                                        s.areaIndex, static_cast<std::uint8_t>(s.windTileLevel),
-                                                       s.windTiles.empty() ? nullptr : &windTiles)
+                                                       s.windTiles.empty() ? nullptr : &windTiles,
+                                                       s.airLevels_m.empty() ? nullptr : &s.airLevels_m,
+                                                       static_cast<std::uint8_t>(s.airTileLevel),
+                                                       s.airTiles.empty() ? nullptr : &airTiles)
                                  .Union()};
           },
           [&](const Heartbeat& h) {
@@ -382,11 +465,14 @@ std::vector<std::uint8_t> encodeMessage(const Message& message) {
             for (const auto& l : d.layers) layers.push_back(encodeLayer(b, l));
             const std::vector<fbs::Tile> tiles = encodeTiles(d.tiles);
             const std::vector<fbs::WindTile> windTiles = encodeWindTiles(d.windTiles);
+            const std::vector<fbs::AirTile> airTiles = encodeAirTiles(d.airTiles);
             return std::pair{fbs::Body::Delta,
                              fbs::CreateDeltaDirect(b, d.weatherClock_s, &layers, &d.removedLayerIds,
                                                     static_cast<std::uint8_t>(d.tileLevel), &tiles, d.areaIndex,
                                                     static_cast<std::uint8_t>(d.windTileLevel),
-                                                    d.windTiles.empty() ? nullptr : &windTiles)
+                                                    d.windTiles.empty() ? nullptr : &windTiles,
+                                                    static_cast<std::uint8_t>(d.airTileLevel),
+                                                    d.airTiles.empty() ? nullptr : &airTiles)
                                  .Union()};
           },
           [&](const CameraReport& r) {

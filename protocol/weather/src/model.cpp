@@ -57,26 +57,53 @@ Result<void> validate(const CloudLayer& layer) {
 
 namespace {
 
-// Upserts `add` into `tiles` by (cell, layer); tiles of one kind share a level.
+// Tiles are keyed by (cell, layer); air tiles by (cell, air level), and
+// removing a layer does not touch them.
+std::pair<std::uint64_t, std::uint32_t> tileKey(const CoverageTile& t) { return {t.cellId, t.layerId}; }
+std::pair<std::uint64_t, std::uint32_t> tileKey(const WindTile& t) { return {t.cellId, t.layerId}; }
+std::pair<std::uint64_t, std::uint32_t> tileKey(const AirTile& t) { return {t.cellId, t.level}; }
+bool goesWithLayer(const CoverageTile& t, std::uint32_t id) { return t.layerId == id; }
+bool goesWithLayer(const WindTile& t, std::uint32_t id) { return t.layerId == id; }
+bool goesWithLayer(const AirTile&, std::uint32_t) { return false; }
+
+// Whether a delta's tile may go into the snapshot `next`: its layer exists
+// (its air level, for an air tile).
+Result<void> fits(const CoverageTile& t, const WeatherSnapshot& next, const char* what) {
+  if (std::any_of(next.layers.begin(), next.layers.end(), [&](const CloudLayer& l) { return l.id == t.layerId; }))
+    return {};
+  return fail(ErrorCode::InvalidArgument,
+              std::string("delta ") + what + " of layer " + std::to_string(t.layerId) + ", which does not exist");
+}
+Result<void> fits(const WindTile& t, const WeatherSnapshot& next, const char* what) {
+  if (std::any_of(next.layers.begin(), next.layers.end(), [&](const CloudLayer& l) { return l.id == t.layerId; }))
+    return {};
+  return fail(ErrorCode::InvalidArgument,
+              std::string("delta ") + what + " of layer " + std::to_string(t.layerId) + ", which does not exist");
+}
+Result<void> fits(const AirTile& t, const WeatherSnapshot& next, const char* what) {
+  if (t.level < next.airLevels_m.size()) return {};
+  return fail(ErrorCode::InvalidArgument, std::string("delta ") + what + " at air level " + std::to_string(t.level) +
+                                              ", the snapshot has " + std::to_string(next.airLevels_m.size()));
+}
+
+// Upserts `add` into `tiles` by key; tiles of one kind share a level.
 template <class Tile>
 Result<void> upsertTiles(std::vector<Tile>& tiles, int& level, const std::vector<Tile>& add, int addLevel,
-                         const std::vector<CloudLayer>& layers, const char* what) {
+                         const WeatherSnapshot& next, const char* what) {
   if (add.empty()) return {};
   if (!tiles.empty() && addLevel != level)
     return fail(ErrorCode::InvalidArgument, std::string("delta ") + what + "s at S2 level " + std::to_string(addLevel) +
                                                 ", the snapshot's are at " + std::to_string(level));
   level = addLevel;
-  std::map<std::pair<std::uint64_t, std::uint32_t>, std::size_t> index;  // (cell, layer) -> position
-  for (std::size_t i = 0; i < tiles.size(); ++i) index.emplace(std::pair{tiles[i].cellId, tiles[i].layerId}, i);
+  std::map<std::pair<std::uint64_t, std::uint32_t>, std::size_t> index;  // key -> position
+  for (std::size_t i = 0; i < tiles.size(); ++i) index.emplace(tileKey(tiles[i]), i);
   for (const Tile& t : add) {
-    if (std::none_of(layers.begin(), layers.end(), [&](const CloudLayer& l) { return l.id == t.layerId; }))
-      return fail(ErrorCode::InvalidArgument,
-                  std::string("delta ") + what + " of layer " + std::to_string(t.layerId) + ", which does not exist");
-    auto it = index.find({t.cellId, t.layerId});
+    if (auto r = fits(t, next, what); !r) return r;
+    auto it = index.find(tileKey(t));
     if (it != index.end()) {
       tiles[it->second] = t;
     } else {
-      index.emplace(std::pair{t.cellId, t.layerId}, tiles.size());
+      index.emplace(tileKey(t), tiles.size());
       tiles.push_back(t);
     }
   }
@@ -91,19 +118,18 @@ bool diffTiles(const std::vector<Tile>& before, const std::vector<Tile>& after, 
                const std::vector<std::uint32_t>& removedLayerIds, std::vector<Tile>& out) {
   // Fast path: the same tiles in the same order (one area, one covering).
   const bool sameOrder = before.size() == after.size() && removedLayerIds.empty() &&
-                         std::equal(before.begin(), before.end(), after.begin(), [](const Tile& a, const Tile& b) {
-                           return a.cellId == b.cellId && a.layerId == b.layerId;
-                         });
+                         std::equal(before.begin(), before.end(), after.begin(),
+                                    [](const Tile& a, const Tile& b) { return tileKey(a) == tileKey(b); });
   if (sameOrder) {
     for (std::size_t i = 0; i < after.size(); ++i)
       if (!(before[i] == after[i])) out.push_back(after[i]);
     return !(out.empty() && beforeLevel != afterLevel);
   }
   std::map<std::pair<std::uint64_t, std::uint32_t>, const Tile*> was;
-  for (const Tile& t : before) was[{t.cellId, t.layerId}] = &t;
+  for (const Tile& t : before) was[tileKey(t)] = &t;
   std::size_t matched = 0;
   for (const Tile& t : after) {
-    const auto it = was.find({t.cellId, t.layerId});
+    const auto it = was.find(tileKey(t));
     if (it == was.end()) {
       out.push_back(t);
       continue;
@@ -113,7 +139,9 @@ bool diffTiles(const std::vector<Tile>& before, const std::vector<Tile>& after, 
   }
   std::size_t kept = 0;  // tiles of `before` whose layer is not removed
   for (const Tile& t : before)
-    if (std::find(removedLayerIds.begin(), removedLayerIds.end(), t.layerId) == removedLayerIds.end()) ++kept;
+    if (std::none_of(removedLayerIds.begin(), removedLayerIds.end(),
+                     [&](std::uint32_t id) { return goesWithLayer(t, id); }))
+      ++kept;
   if (matched != kept) return false;  // a tile (or a layer's tiles) went away
   // With no tiles the delta cannot move the snapshot's level.
   return !(out.empty() && beforeLevel != afterLevel);
@@ -131,6 +159,19 @@ WindTile quantized(const WindTile& tile) {
   t.east_mps = dequantizeWind(quantizeWind(tile.east_mps, 150));
   t.north_mps = dequantizeWind(quantizeWind(tile.north_mps, 150));
   t.up_mps = dequantizeWind(quantizeWind(tile.up_mps, 50));
+  return t;
+}
+
+AirTile quantizedAir(const AirTile& tile) {
+  AirTile t = tile;
+  const double c = std::isfinite(tile.temperature_c)
+                       ? std::clamp(double(tile.temperature_c), kMinAirTemperature_c, kMaxAirTemperature_c)
+                       : 0.0;
+  t.temperature_c = static_cast<float>(static_cast<double>(std::lround(c * 10.0)) / 10.0);
+  if (std::isfinite(tile.humidity_pct) && tile.humidity_pct >= 0)
+    t.humidity_pct = static_cast<float>(static_cast<double>(std::lround(std::min(double(tile.humidity_pct), 100.0) * 2.0)) / 2.0);
+  else
+    t.humidity_pct = kNoHumidity;
   return t;
 }
 
@@ -163,10 +204,11 @@ Result<void> applyDelta(WeatherSnapshot& snapshot, const WeatherDelta& delta) {
     std::erase_if(next.tiles, [&](const CoverageTile& t) { return t.layerId == id; });
     std::erase_if(next.windTiles, [&](const WindTile& t) { return t.layerId == id; });
   }
-  if (auto r = upsertTiles(next.tiles, next.tileLevel, delta.tiles, delta.tileLevel, next.layers, "tile"); !r) return r;
-  if (auto r = upsertTiles(next.windTiles, next.windTileLevel, delta.windTiles, delta.windTileLevel, next.layers,
-                           "wind tile");
+  if (auto r = upsertTiles(next.tiles, next.tileLevel, delta.tiles, delta.tileLevel, next, "tile"); !r) return r;
+  if (auto r = upsertTiles(next.windTiles, next.windTileLevel, delta.windTiles, delta.windTileLevel, next, "wind tile");
       !r)
+    return r;
+  if (auto r = upsertTiles(next.airTiles, next.airTileLevel, delta.airTiles, delta.airTileLevel, next, "air tile"); !r)
     return r;
   snapshot = std::move(next);
   return {};
@@ -182,6 +224,11 @@ std::optional<WeatherDelta> diffSnapshots(const WeatherSnapshot& before, const W
   if (!before.windTiles.empty() && !after.windTiles.empty() && before.windTileLevel != after.windTileLevel)
     return std::nullopt;
   d.windTileLevel = after.windTileLevel;
+  if (!before.airTiles.empty() && !after.airTiles.empty() && before.airTileLevel != after.airTileLevel)
+    return std::nullopt;
+  // A delta's air tiles index the snapshot's air levels: other levels, a snapshot.
+  if (before.airLevels_m != after.airLevels_m) return std::nullopt;
+  d.airTileLevel = after.airTileLevel;
   // Layers: the ones kept must stay in their order, new ones come last.
   std::vector<std::uint32_t> kept;
   for (const CloudLayer& b : before.layers) {
@@ -212,6 +259,9 @@ std::optional<WeatherDelta> diffSnapshots(const WeatherSnapshot& before, const W
     return std::nullopt;
   if (!diffTiles(before.windTiles, after.windTiles, before.windTileLevel, after.windTileLevel, d.removedLayerIds,
                  d.windTiles))
+    return std::nullopt;
+  if (!diffTiles(before.airTiles, after.airTiles, before.airTileLevel, after.airTileLevel, d.removedLayerIds,
+                 d.airTiles))
     return std::nullopt;
   return d;
 }

@@ -3,20 +3,13 @@
 
 #include <cmath>
 #include <numbers>
-#include <vector>
 
-#include <s2/s2cell.h>
-#include <s2/s2cell_id.h>
-#include <s2/s2latlng.h>
+#include "cell_kernel.hpp"
 
 namespace sky::weather {
 
 namespace {
 constexpr double kDeg = std::numbers::pi / 180.0;
-// Kernel radius in cell edges: a tile's own value at its centre (its
-// neighbours' centres are about an edge away), the two cells' mean on their
-// shared edge, and only the 3x3 cells round a point within reach of it.
-constexpr double kReachInEdges = 1.0;
 }  // namespace
 
 WindVector toVector(const LayerWind& wind) {
@@ -46,26 +39,16 @@ WindVector WindField::at(const CloudLayer& layer, double lat_deg, double lon_deg
   const auto found = byLayer_.find(layer.id);
   if (found == byLayer_.end()) return own;
   const auto& cells = found->second;
-  const S2Point p = S2LatLng::FromDegrees(lat_deg, lon_deg).Normalized().ToPoint();
-  const S2CellId home = S2CellId(p).parent(level_);
-  std::vector<S2CellId> around{home};
-  home.AppendAllNeighbors(level_, &around);
-  // Angular reach from the cell's own size (S2 cells differ up to ~2x in
-  // size over a cube face, so not one constant per level).
-  const double reach = kReachInEdges * std::sqrt(S2Cell(home).ApproxArea());
   WindVector sum{0, 0, 0};
   double total = 0;
-  for (const S2CellId& c : around) {
-    const double d = p.Angle(c.ToPoint()) / reach;
-    if (d >= 1) continue;
-    const double w = (1 - d * d) * (1 - d * d);
-    const auto it = cells.find(c.id());
+  detail::forEachKernelCell(level_, lat_deg, lon_deg, [&](std::uint64_t cell, double w) {
+    const auto it = cells.find(cell);
     const WindVector& v = it != cells.end() ? it->second : own;
     sum.east_mps += w * v.east_mps;
     sum.north_mps += w * v.north_mps;
     sum.up_mps += w * v.up_mps;
     total += w;
-  }
+  });
   if (!(total > 0)) return own;
   return {sum.east_mps / total, sum.north_mps / total, sum.up_mps / total};
 }

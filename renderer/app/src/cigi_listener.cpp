@@ -3,9 +3,11 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 
 #include "sky/cigi/celestial_time.hpp"
 #include "sky/render/haze.hpp"
+#include "sky/weather/air_field.hpp"
 #include "sky/weather/query.hpp"
 
 #include <spdlog/spdlog.h>
@@ -273,10 +275,14 @@ std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRe
                                                         weather::snapshotWindLookup(reaching));
     cigi::WeatherConditionsResponse wcr;
     wcr.requestId = r.requestId;
-    wcr.humidity_pct = static_cast<std::uint8_t>(pw.cloudDensity > 0 ? 100 : air.humidity_pct);
-    // The ISA's lapse from the host's sea-level temperature and pressure.
-    wcr.airTemperature_c = static_cast<float>(weather::isaTemperature_c(r.alt_m) +
-                                              (air.seaLevelTemperature_c - kIsaSeaLevelTemperature_c));
+    // A forecast's temperature and humidity where the weather has them (air
+    // tiles); elsewhere the ISA's lapse from the host's sea-level temperature.
+    const std::optional<weather::AirValues> forecast = weather::AirField(reaching).at(r.lat_deg, r.lon_deg, r.alt_m);
+    const double humidity = forecast && forecast->humidity_pct >= 0 ? forecast->humidity_pct : air.humidity_pct;
+    wcr.humidity_pct = static_cast<std::uint8_t>(pw.cloudDensity > 0 ? 100 : std::lround(std::clamp(humidity, 0.0, 100.0)));
+    wcr.airTemperature_c = static_cast<float>(
+        forecast ? forecast->temperature_c
+                 : weather::isaTemperature_c(r.alt_m) + (air.seaLevelTemperature_c - kIsaSeaLevelTemperature_c));
     // In cloud the Koschmieder range of its extinction, never longer than the clear air's.
     const double cloud_m = render::koschmiederVisibility_m(kExtinctionPerDensity_perm * pw.cloudDensity);
     wcr.visibility_m = static_cast<float>(std::min(air.visibility_m, cloud_m));

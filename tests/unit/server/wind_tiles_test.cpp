@@ -10,6 +10,7 @@
 #include <memory>
 #include <numbers>
 
+#include "forecast_samples.hpp"
 #include "grib_tools.hpp"
 #include "sky/server/forecast.hpp"
 #include "sky/server/snapshot_builder.hpp"
@@ -23,29 +24,8 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-std::shared_ptr<const Forecast> load(const std::string& path) {
-  static std::map<std::string, std::pair<GribFile, std::shared_ptr<const Forecast>>> cache;
-  auto& slot = cache[path];
-  if (!slot.second) {
-    auto file = readGrib(readBytes(path), "sample", forecastWants);
-    EXPECT_TRUE(file) << (file ? "" : file.error().detail);
-    slot.first = std::move(*file);
-    auto fc = Forecast::fromGrib({&slot.first}, path.substr(path.rfind('/') + 1));
-    EXPECT_TRUE(fc) << (fc ? "" : fc.error().detail);
-    slot.second = std::make_shared<const Forecast>(std::move(*fc));
-  }
-  return slot.second;
-}
-
-const ForecastLayer& layerOf(const Forecast& fc, std::uint32_t slot) {
-  for (const auto& l : fc.layers())
-    if (l.layer.id == slot) return l;
-  ADD_FAILURE() << "no layer " << slot;
-  return fc.layers().front();
-}
-
 TEST(ForecastWinds, NamWindsAreTurnedFromItsGridToEastAndNorth) {
-  const auto fc = load(kNam);
+  const auto fc = loadSample(kNam);
   ASSERT_FALSE(fc->wind().empty());
   EXPECT_GE(fc->wind().levelCount(), 19u);
   // u and v at 500 hPa, messages 108 and 109, along the grid's axes.
@@ -86,7 +66,7 @@ TEST(ForecastWinds, NamWindsAreTurnedFromItsGridToEastAndNorth) {
 }
 
 TEST(ForecastWinds, GfsTenMetreWindReachesOnlyTheLowLayers) {
-  const auto fc = load(kGfs);
+  const auto fc = loadSample(kGfs);
   ASSERT_FALSE(fc->wind().empty());
   const auto u = gribGetData(kGfs, 7), v = gribGetData(kGfs, 8);
   ASSERT_EQ(u.size(), v.size());
@@ -104,7 +84,7 @@ TEST(ForecastWinds, GfsTenMetreWindReachesOnlyTheLowLayers) {
 }
 
 TEST(WindTilesOnTheServer, ANamSnapshotCarriesItsWindFieldWithinTheBudget) {
-  const auto fc = load(kNam);
+  const auto fc = loadSample(kNam);
   const double valid = static_cast<double>(fc->firstValid_unix());
   const ForecastField field(fc, 1, valid);
   std::vector<weather::CloudLayer> table;

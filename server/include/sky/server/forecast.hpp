@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "sky/core/result.hpp"
+#include "sky/server/forecast_air.hpp"
 #include "sky/server/forecast_wind.hpp"
 #include "sky/server/grib.hpp"
 #include "sky/server/snapshot_builder.hpp"
@@ -86,6 +87,8 @@ class Forecast {
   const std::vector<std::string>& notes() const { return notes_; }
   // The winds of the files (empty when they have none).
   const ForecastWind& wind() const { return wind_; }
+  // Their temperature and humidity (empty when they have none).
+  const ForecastAir& air() const { return air_; }
   // A layer's wind at a point: the forecast's at the middle of the layer's
   // height; nullopt where the forecast has no wind there.
   std::optional<weather::WindVector> windAt(const ForecastLayer& layer, double lat_deg, double lon_deg,
@@ -110,6 +113,7 @@ class Forecast {
   std::size_t stepCount_ = 0;
   std::vector<std::string> notes_;
   ForecastWind wind_;
+  ForecastAir air_;
 };
 
 // Where a forecast sits on the weather clock: at clock c the weather is the
@@ -140,6 +144,10 @@ class ForecastField final : public LayerField {
   bool givesWind(std::uint32_t layerId) const override;
   void sampleWind(std::uint32_t layerId, std::span<const weather::CellCentre> at,
                   std::span<weather::WindVector> out) const override;
+  // The forecast's temperature and humidity at its levels.
+  std::vector<double> airLevels() const override;
+  void sampleAir(std::size_t level, std::span<const weather::CellCentre> at,
+                 std::span<weather::AirValues> out) const override;
   double valid_unix() const { return valid_unix_; }
   const Forecast& forecast() const { return *forecast_; }
 

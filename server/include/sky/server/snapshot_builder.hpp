@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "sky/stream/messages.hpp"
+#include "sky/weather/air_field.hpp"
 #include "sky/weather/model.hpp"
 #include "sky/weather/region.hpp"
 #include "sky/weather/tiling.hpp"
@@ -39,8 +40,8 @@ double reachOf(const weather::Region& r);
 
 // Cells allowed for `layerCount` layers: maxCells, lowered so that cells ×
 // layers tiles still fit one stream frame (with room for the layer table and
-// `windTiles` wind tiles).
-std::size_t cellBudget(std::size_t maxCells, std::size_t layerCount, std::size_t windTiles = 0);
+// `fieldTiles` wind and air tiles).
+std::size_t cellBudget(std::size_t maxCells, std::size_t layerCount, std::size_t fieldTiles = 0);
 
 struct Covering {
   int level = 0;                     // S2 level actually used, <= the wanted one
@@ -131,6 +132,15 @@ class TileCache {
       std::vector<weather::WindTile> tiles;  // empty: the layer's own wind everywhere
     };
     std::map<std::uint32_t, WindMemo> windLayers;
+    // Its air tiles (air_tiles.cpp) and the key of the field they came from.
+    struct AirMemo {
+      bool valid = false;
+      std::uint64_t fieldKey = 0;
+      std::vector<float> levels_m;
+      int level = 0;
+      std::vector<weather::AirTile> tiles;
+    };
+    AirMemo air;
   };
   Entry& covering(const weather::SphericalCap& cap, int wantedLevel, std::size_t maxCells);
   // regionWeight(region, cell centre) of the cells of `entry` where it is
@@ -188,6 +198,17 @@ class LayerField {
   virtual void sampleWind(std::uint32_t layerId, std::span<const weather::CellCentre> at,
                           std::span<weather::WindVector> out) const {
     (void)layerId;
+    (void)at;
+    (void)out;
+  }
+  // The heights (m MSL, ascending) this field gives the air's temperature
+  // and humidity at (none: the standard atmosphere), and the air at level
+  // `level` at each point (temperature NaN where it has none, humidity NaN
+  // where it has no humidity).
+  virtual std::vector<double> airLevels() const { return {}; }
+  virtual void sampleAir(std::size_t level, std::span<const weather::CellCentre> at,
+                         std::span<weather::AirValues> out) const {
+    (void)level;
     (void)at;
     (void)out;
   }

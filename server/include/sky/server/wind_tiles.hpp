@@ -27,6 +27,26 @@ inline constexpr std::size_t kMaxWindCells = 2048;
 // their own wind (a quarter of a frame at most goes to wind).
 inline constexpr std::size_t kMaxWindLayers = 16;
 
+// The cells a field's tiles (wind, air) are given on: the area widened by
+// two cell edges, so that a point anywhere in it has every cell the fields'
+// kernel weighs (an area of one metre, as the point query's, would otherwise
+// be one cell with no neighbours), at `wantedLevel` or coarser within
+// maxCells. With a cache the cells and centres are its entry's (`entry`),
+// else this object's own; not copyable (the spans point into it).
+struct FieldCovering {
+  FieldCovering() = default;
+  FieldCovering(const FieldCovering&) = delete;
+  FieldCovering& operator=(const FieldCovering&) = delete;
+  std::span<const std::uint64_t> cells;
+  std::span<const weather::CellCentre> centres;
+  int level = 0;
+  TileCache::Entry* entry = nullptr;
+  Covering local;
+  std::vector<weather::CellCentre> localCentres;
+};
+void coverWithMargin(const weather::SphericalCap& cap, int wantedLevel, std::size_t maxCells, TileCache* cache,
+                     FieldCovering& out);
+
 struct WindTiles {
   int level = 0;  // 0 when there are no tiles
   std::vector<weather::WindTile> tiles;

@@ -23,8 +23,9 @@ inline constexpr std::uint16_t kProtocolVersion = 2;
 // Bytes one coverage tile takes on the wire (FlatBuffers struct Tile),
 // for budgeting tiles against kMaxFrameBytes.
 inline constexpr std::size_t kTileWireBytes = 16;
-// The same for a WindTile.
+// The same for a WindTile and an AirTile.
 inline constexpr std::size_t kWindTileWireBytes = 16;
+inline constexpr std::size_t kAirTileWireBytes = 16;
 
 // Caps on one Snapshot or Delta, checked before anything is decoded, so a
 // crafted frame costs O(n log n) in its counts and no more. Layers: a server

@@ -86,6 +86,26 @@ inline float dequantizeWind(std::int16_t cmps) { return static_cast<float>(cmps)
 // A tile as it arrives: every component rounded as on the wire.
 WindTile quantized(const WindTile& tile);
 
+// The air's temperature and humidity on one S2 cell at one of the
+// snapshot's air levels (heights), where a forecast gives them. Between
+// cells and levels, see sky/weather/air_field.hpp; where there is none the
+// standard atmosphere holds. On the wire the temperature is quantised to
+// 0.1 C and the humidity to 0.5 % (quantizedAir).
+struct AirTile {
+  std::uint64_t cellId = 0;  // S2CellId, at the snapshot's air tile level
+  std::uint32_t level = 0;   // index into the snapshot's airLevels_m, [0, kMaxAirLevels)
+  float temperature_c = 0;   // [-100, 60]
+  float humidity_pct = 0;    // relative to water, [0, 100]; kNoHumidity where the source gives none
+  bool operator==(const AirTile&) const = default;
+};
+inline constexpr std::size_t kMaxAirLevels = 32;
+inline constexpr float kNoHumidity = -1;
+inline constexpr double kMinAirTemperature_c = -100, kMaxAirTemperature_c = 60;
+// A tile as it arrives: temperature and humidity clamped to their ranges
+// and rounded as on the wire (a NaN temperature -> 0; a humidity that is
+// NaN or negative -> kNoHumidity).
+AirTile quantizedAir(const AirTile& tile);
+
 struct WeatherSnapshot {
   double weatherClock_s = 0;  // seconds on the weather clock
   std::vector<CloudLayer> layers;
@@ -98,10 +118,16 @@ struct WeatherSnapshot {
   // kilometres): their own S2 level.
   int windTileLevel = 0;
   std::vector<WindTile> windTiles;
+  // The air's temperature and humidity: the heights they are given at (m
+  // MSL, ascending, at most kMaxAirLevels) and tiles at their own S2 level.
+  std::vector<float> airLevels_m;
+  int airTileLevel = 0;
+  std::vector<AirTile> airTiles;
 };
 
 // A change to a snapshot: layers upserted by id, layers removed (with their
-// tiles and wind tiles), tiles and wind tiles upserted by (cell, layer).
+// tiles and wind tiles), tiles and wind tiles upserted by (cell, layer), air
+// tiles by (cell, level) at the snapshot's air levels.
 struct WeatherDelta {
   double weatherClock_s = 0;
   std::vector<CloudLayer> layers;
@@ -111,20 +137,23 @@ struct WeatherDelta {
   std::uint8_t areaIndex = 0;  // must equal the snapshot's
   int windTileLevel = 0;  // must equal the snapshot's when wind tiles are present
   std::vector<WindTile> windTiles;
+  int airTileLevel = 0;  // must equal the snapshot's when air tiles are present
+  std::vector<AirTile> airTiles;
 };
 
-// Applies a delta; on error (another area's delta, a tile or wind tile level
-// that differs from the snapshot's, a tile or wind tile of a layer that does
-// not exist afterwards, removal of an unknown layer) the snapshot is left
-// exactly as it was.
+// Applies a delta; on error (another area's delta, a tile, wind or air tile
+// level that differs from the snapshot's, a tile or wind tile of a layer that
+// does not exist afterwards, an air tile past the snapshot's air levels,
+// removal of an unknown layer) the snapshot is left exactly as it was.
 Result<void> applyDelta(WeatherSnapshot& snapshot, const WeatherDelta& delta);
 
 // The delta that takes `before` to `after` (applyDelta(before, delta) gives
 // after exactly: same layers in the same order, same tiles by (cell, layer)):
 // changed and new layers, removed layers, and the tiles and wind tiles that
-// differ. None when a delta cannot say it: another area, a different tile or
-// wind tile level, a layer losing tiles or wind tiles it had (a delta only
-// upserts them), or layers reordered; the caller then sends a snapshot.
+// differ. None when a delta cannot say it: another area, a different tile,
+// wind or air tile level, other air levels, a layer losing tiles or wind
+// tiles it had or an air tile going (a delta only upserts them), or layers
+// reordered; the caller then sends a snapshot.
 std::optional<WeatherDelta> diffSnapshots(const WeatherSnapshot& before, const WeatherSnapshot& after);
 
 // Fractions on the wire: [0, 1] -> 0..255, rounding to nearest; NaN -> 0.
