@@ -2,7 +2,8 @@
 // what its report says against what the renderers draw there (oktas per
 // layer, ceiling), and how many points of a loaded forecast's grid match
 // their grid values; rows out of tolerance first, in the warning colour.
-// And at a point: the weather there (GET /api/conditions) and where each
+// And at a point: the weather there (GET /api/conditions: cloud, the air's
+// temperature and humidity and whether a forecast gave them) and where each
 // forecast layer's cover comes from (file, field, grid point).
 import { $, el, note } from "./dom.js";
 import { request } from "./api.js";
@@ -33,8 +34,10 @@ export class ConformancePanel {
       return;
     }
     const c = r.body, sources = Object.entries(c.forecast_sources || {});
+    const humidity = c.humidity_pct === null || c.humidity_pct === undefined ? "" : `, humidity ${fmt(c.humidity_pct, 0)} %`;
     out.replaceChildren(
       el("li", {}, c.layer_id === null ? "clear air here" : `layer ${c.layer_id}, cloud density ${fmt(c.cloud_density, 2)}`),
+      el("li", {}, `air ${fmt(c.air_temperature_c, 1)} C${humidity} (${c.air_from || "standard atmosphere"})`),
       ...(sources.length ? sources.map(([id, src]) => el("li", {}, `layer ${id}: ${src}`))
         : [el("li", {}, "no forecast cover here (hand-made layers, regions and stations only)")]));
   }

@@ -239,9 +239,11 @@ const cases = {
     await a.page.fill('#source-form [name="lon"]', "14.4576");
     await a.page.fill('#source-form [name="alt"]', "1400");
     await a.page.click("#source-ask");
-    await until("the point's answer", async () => (await a.page.$$("#source-result li")).length === 2);
+    await until("the point's answer", async () => (await a.page.$$("#source-result li")).length === 3);
     const answer = await a.page.textContent("#source-result");
     assert(/layer \d+, cloud density/.test(answer) && /no forecast cover here/.test(answer), `the point's answer: ${answer}`);
+    // No forecast: the standard atmosphere's 5.9 C at 1400 m, no humidity.
+    assert(/air 5\.9 C \(standard atmosphere\)/.test(answer), `the point's air: ${answer}`);
     noProblems(a.problems);
   },
 
