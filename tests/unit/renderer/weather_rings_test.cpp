@@ -20,6 +20,7 @@
 #include <glm/vec2.hpp>
 #include <gtest/gtest.h>
 
+#include "sky/app/drawable_weather.hpp"
 #include "sky/geo/geodetic.hpp"
 #include "sky/weather/tiling.hpp"
 #include "frame_setup.hpp"
@@ -190,6 +191,55 @@ TEST(WeatherRings, NewWeatherAtTheSameAnchorReusesTheCells) {
   // Another anchor or tile level: the cells are found again, same result.
   const geo::Geodetic elsewhere = weatherAnchorFor({47.2, 8.0, 3000.0});
   EXPECT_EQ(buildWeatherField(&second, elsewhere, &a).texels, buildWeatherField(&second, elsewhere).texels);
+}
+
+// A continent's METAR stations as the server sends them for a 300 km area
+// (sky_server_tests' MetarContinent: 19 layers, level 10, 86583 tiles): the
+// channel keeps the four layers with most cloud (drawableWeather) and builds
+// its map from their tiles; printed: the selection, a fresh build, and a
+// rebuild after one station's report changed its layer's tiles nearby
+// (reusing the cells). The rebuild gives what a fresh build gives.
+TEST(WeatherRings, AContinentsStationsBuildTheMapOfTheDrawnLayers) {
+  constexpr int kLevel = 10;
+  const geo::Geodetic camera{47.0, 8.0, 3000.0};
+  const geo::Geodetic anchor = weatherAnchorFor(camera);
+  weather::WeatherSnapshot s;
+  s.tileLevel = kLevel;
+  const auto cells = weather::coverCap({47.0, 8.0, 300000.0}, kLevel, 8000);
+  for (std::uint32_t id = 40; id < 59; ++id) {
+    weather::CloudLayer l = tiledLayer();
+    l.id = id;
+    l.base_m = 300.0 + 250.0 * (id - 40);
+    l.thickness_m = 200;
+    s.layers.push_back(l);
+    for (std::size_t i = 0; i < cells.size(); ++i)
+      if ((i + id) % 5 != 0) s.tiles.push_back({cells[i], id, float((i * 7 + id) % 9) / 8.0f, 1.0f});
+  }
+  using Clock = std::chrono::steady_clock;
+  auto ms = [](Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); };
+  const auto t0 = Clock::now();
+  const weather::WeatherSnapshot drawn = app::drawableWeather(s, gpu::kMaxLayers, nullptr);
+  const auto t1 = Clock::now();
+  const WeatherField fresh = buildWeatherField(&drawn, anchor);
+  const auto t2 = Clock::now();
+  ASSERT_EQ(drawn.layers.size(), std::size_t(gpu::kMaxLayers));
+  // One station's newer report: its layer's tiles within 30 km change.
+  weather::WeatherSnapshot next = s;
+  const std::uint32_t changed = drawn.layers[1].id;
+  for (auto& t : next.tiles) {
+    const weather::CellCentre c = weather::cellCentre(t.cellId);
+    if (t.layerId == changed && std::abs(c.lat_deg - 47.1) < 0.27 && std::abs(c.lon_deg - 8.1) < 0.4) t.coverage = 1.0f;
+  }
+  const auto t3 = Clock::now();
+  const weather::WeatherSnapshot nextDrawn = app::drawableWeather(next, gpu::kMaxLayers, nullptr);
+  const WeatherField rebuilt = buildWeatherField(&nextDrawn, anchor, &fresh);
+  const auto t4 = Clock::now();
+  std::printf("[ rings    ] %zu layers, %zu tiles at level %d: the drawn %zu layers' %zu tiles chosen in %.1f ms, map "
+              "built in %.1f ms; one station's change: %.1f ms\n",
+              s.layers.size(), s.tiles.size(), kLevel, drawn.layers.size(), drawn.tiles.size(), ms(t1 - t0),
+              ms(t2 - t1), ms(t4 - t3));
+  EXPECT_EQ(rebuilt.texels, buildWeatherField(&nextDrawn, anchor).texels);
+  EXPECT_NE(rebuilt.texels, fresh.texels);
 }
 
 // The coverage the coarse snapshot gives a level-9 cell: varying from cell
