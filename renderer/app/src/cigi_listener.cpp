@@ -204,10 +204,13 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
   // Environmental Conditions Requests, answered with Start of Frame from the
   // weather this channel holds, by the query every process shares.
   std::vector<cigi::Packet> replies;
+  std::optional<ConditionsSource> source;  // once per datagram, when it asks
   for (const auto& packet : datagram->packets)
-    if (const auto* request = std::get_if<cigi::EnvironmentalConditionsRequest>(&packet))
-      for (auto& reply : answerConditions(*request, state_.weather(), now, ownship(state_), state_.atmosphere()))
+    if (const auto* request = std::get_if<cigi::EnvironmentalConditionsRequest>(&packet)) {
+      if (!source) source.emplace(state_.weather(), now);
+      for (auto& reply : answerConditions(*request, *source, ownship(state_), state_.atmosphere()))
         replies.push_back(std::move(reply));
+    }
   if (synchronous_ && !standby) {
     pendingReplies_ = std::move(replies);
     syncHost_ = from;
@@ -259,25 +262,40 @@ void CigiListener::takeView(const ViewPacket& packet, const char* name) {
   }
 }
 
+ConditionsSource::ConditionsSource(WeatherView v, std::chrono::steady_clock::time_point now)
+    : view(std::move(v)),
+      tiles(weather::snapshotLookup(view.snapshot, view.clockNow(now))),
+      coarseTiles(view.coarse ? weather::snapshotLookup(*view.coarse, view.clockNow(now)) : tiles),
+      wind(weather::snapshotWindLookup(view.snapshot)),
+      coarseWind(view.coarse ? weather::snapshotWindLookup(*view.coarse) : wind),
+      air(view.snapshot),
+      coarseAir(view.coarse ? weather::AirField(*view.coarse) : air) {}
+
 std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRequest& r, const WeatherView& view,
                                           std::chrono::steady_clock::time_point now,
                                           const std::optional<geo::Geodetic>& camera, const HostAtmosphere& air) {
+  return answerConditions(r, ConditionsSource(view, now), camera, air);
+}
+
+std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRequest& r,
+                                          const ConditionsSource& source, const std::optional<geo::Geodetic>& camera,
+                                          const HostAtmosphere& air) {
+  const WeatherView& view = source.view;
   std::vector<cigi::Packet> out;
   // The layers are the same in both areas' snapshots; the tiles and the wind
   // tiles come from the area that reaches the point.
   const auto& layers = view.snapshot.layers;
   const bool far = view.coarse && camera &&
                    geo::geodesicDistance_m(camera->lat_deg, camera->lon_deg, r.lat_deg, r.lon_deg) > kDetailedReach_m;
-  const weather::WeatherSnapshot& reaching = far ? *view.coarse : view.snapshot;
-  const auto lookup = weather::snapshotLookup(reaching, view.clockNow(now));
+  const weather::CoverageLookup& lookup = far ? source.coarseTiles : source.tiles;
   if (r.requestType & cigi::kRequestWeather) {
-    const weather::PointWeather pw = weather::weatherAt(layers, lookup, r.lat_deg, r.lon_deg, r.alt_m,
-                                                        weather::snapshotWindLookup(reaching));
+    const weather::PointWeather pw =
+        weather::weatherAt(layers, lookup, r.lat_deg, r.lon_deg, r.alt_m, far ? source.coarseWind : source.wind);
     cigi::WeatherConditionsResponse wcr;
     wcr.requestId = r.requestId;
     // A forecast's temperature and humidity where the weather has them (air
     // tiles); elsewhere the ISA's lapse from the host's sea-level temperature.
-    const std::optional<weather::AirValues> forecast = weather::AirField(reaching).at(r.lat_deg, r.lon_deg, r.alt_m);
+    const std::optional<weather::AirValues> forecast = (far ? source.coarseAir : source.air).at(r.lat_deg, r.lon_deg, r.alt_m);
     const double humidity = forecast && forecast->humidity_pct >= 0 ? forecast->humidity_pct : air.humidity_pct;
     wcr.humidity_pct = static_cast<std::uint8_t>(pw.cloudDensity > 0 ? 100 : std::lround(std::clamp(humidity, 0.0, 100.0)));
     wcr.airTemperature_c = static_cast<float>(

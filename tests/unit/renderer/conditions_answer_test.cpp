@@ -129,6 +129,24 @@ TEST(ConditionsAnswer, FarPointsFromTheCoarseArea) {
   EXPECT_FLOAT_EQ(concentration(std::nullopt), 0.3f) << "no camera: the detailed snapshot";
   r.lat_deg = 46.5;  // 56 km from the camera: inside the detailed area
   EXPECT_FLOAT_EQ(concentration(camera), 0.3f);
+  // A datagram's requests share one ConditionsSource (the listener builds it
+  // once per datagram): each answers as it would alone, near and far.
+  const ConditionsSource source(v, now);
+  for (const double lat : {46.5, farLat, 46.0}) {
+    r.lat_deg = lat;
+    r.requestType = cigi::kRequestWeather | cigi::kRequestAerosol;
+    const auto alone = answerConditions(r, v, now, camera);
+    const auto shared = answerConditions(r, source, camera, HostAtmosphere{});
+    ASSERT_EQ(alone.size(), shared.size());
+    const auto& a = std::get<cigi::WeatherConditionsResponse>(alone[0]);
+    const auto& b = std::get<cigi::WeatherConditionsResponse>(shared[0]);
+    EXPECT_EQ(a.humidity_pct, b.humidity_pct);
+    EXPECT_EQ(a.airTemperature_c, b.airTemperature_c);
+    EXPECT_EQ(a.visibility_m, b.visibility_m);
+    EXPECT_EQ(a.horizontalWind_mps, b.horizontalWind_mps);
+    EXPECT_EQ(std::get<cigi::AerosolConcentrationResponse>(alone[1]).concentration_gpm3,
+              std::get<cigi::AerosolConcentrationResponse>(shared[1]).concentration_gpm3);
+  }
 }
 
 }  // namespace

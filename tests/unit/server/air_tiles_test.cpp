@@ -163,5 +163,35 @@ TEST(AirTilesOnTheServer, ADeltaCarriesTheAirThatChanged) {
   EXPECT_TRUE(same->airTiles.empty());
 }
 
+// A field whose levels the wire cannot carry as they are (two heights a
+// float apart, one past the decoder's range): those are left out, and the
+// snapshot still decodes for every subscriber.
+class AwkwardLevels final : public LayerField {
+ public:
+  bool gives(std::uint32_t) const override { return false; }
+  void sample(std::uint32_t, std::span<const weather::CellCentre>, std::span<weather::CoverageTile>) const override {}
+  std::uint64_t key() const override { return 7; }
+  std::vector<double> airLevels() const override { return {0.0, 1000.0, 1000.00001, 2.0e5}; }
+  void sampleAir(std::size_t level, std::span<const weather::CellCentre> at,
+                 std::span<weather::AirValues> out) const override {
+    for (std::size_t k = 0; k < at.size(); ++k) out[k] = {15.0 - 6.5 * static_cast<double>(level), 50.0};
+  }
+};
+
+TEST(AirTilesOnTheServer, LevelsTheWireCannotCarryAreLeftOut) {
+  const AwkwardLevels field;
+  const AirTiles air = deriveAirTiles({38.0, -97.0, 50000}, &field);
+  EXPECT_EQ(air.levels_m, (std::vector<float>{0.0f, 1000.0f}));
+  weather::WeatherSnapshot s;
+  s.airLevels_m = air.levels_m;
+  s.airTileLevel = air.level;
+  s.airTiles = air.tiles;
+  const auto m = stream::decodeMessage(stream::encodeMessage(s));
+  ASSERT_TRUE(m) << describe(m.error());
+  const auto a = weather::AirField(std::get<weather::WeatherSnapshot>(*m)).at(38.0, -97.0, 500);
+  ASSERT_TRUE(a);
+  EXPECT_NEAR(a->temperature_c, 15.0 - 3.25, 1e-3);
+}
+
 }  // namespace
 }  // namespace sky::server

@@ -34,6 +34,8 @@
 #include "sky/app/host_atmosphere.hpp"
 #include "sky/app/host_clock.hpp"
 #include "sky/app/shared_state.hpp"
+#include "sky/weather/air_field.hpp"
+#include "sky/weather/query.hpp"
 #include "sky/cigi/codec.hpp"
 
 namespace sky::app {
@@ -57,6 +59,21 @@ std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRe
                                           const WeatherView& view, std::chrono::steady_clock::time_point now,
                                           const std::optional<geo::Geodetic>& camera = std::nullopt,
                                           const HostAtmosphere& atmosphere = {});
+
+// The weather a datagram's requests are answered from, at `now`: the view
+// and the lookups of both its areas (tiles, wind, air), built once for all
+// of them (a datagram may carry a thousand requests; each indexing the
+// snapshot's tiles again would take a thousand times as long).
+struct ConditionsSource {
+  ConditionsSource(WeatherView view, std::chrono::steady_clock::time_point now);
+  WeatherView view;
+  weather::CoverageLookup tiles, coarseTiles;
+  weather::WindLookup wind, coarseWind;
+  weather::AirField air, coarseAir;
+};
+std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRequest& request,
+                                          const ConditionsSource& source, const std::optional<geo::Geodetic>& camera,
+                                          const HostAtmosphere& atmosphere);
 
 // How far from the camera the detailed area always reaches: its radius less
 // the distance the camera goes before it is asked again (area_of_interest.hpp).
