@@ -116,7 +116,7 @@ const map = new MapView($("#map"), {
 const layers = new LayerPanel($("#layers"), app);
 const regions = new RegionPanel($("#region"), app);
 const metar = new MetarPanel($("#metar"), app);
-new ConformancePanel($("#conformance"));
+new ConformancePanel($("#conformance"), (stations) => map.stations.conformance(stations));
 new ClockPanel($("#clock"), app);
 const log = new EventLog($("#events"));
 

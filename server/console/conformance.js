@@ -14,8 +14,10 @@ const layersText = (layers) =>
 const ceilingText = (c) => (c === null || c === undefined ? "none" : `${fmt(ftFromM(c))} ft`);
 
 export class ConformancePanel {
-  constructor(root) {
+  // onChecked(stations): the check's station rows, for the map's markers.
+  constructor(root, onChecked = () => {}) {
     this.root = root;
+    this.onChecked = onChecked;
     $("#conformance-check", root).addEventListener("click", () => this.check());
     $("#source-form", root).addEventListener("submit", (e) => { e.preventDefault(); this.source(); });
   }
@@ -55,6 +57,7 @@ export class ConformancePanel {
     note(msg, `${sum.stations_ok} of ${sum.stations} stations and ${sum.grid_ok} of ${sum.grid_points} grid points ` +
       `within ${c.tolerances.oktas} okta and ${fmt(ftFromM(c.tolerances.ceiling_m))} ft; ${forecast}; visibility: ${c.visibility}`,
       sum.stations_ok === sum.stations && sum.grid_ok === sum.grid_points ? "ok" : "bad");
+    this.onChecked(c.stations);
     const rows = [...c.stations].sort((a, b) => Number(a.ok) - Number(b.ok));
     out.replaceChildren(
       el("thead", {}, el("tr", {}, el("th", {}, "station"), el("th", {}, "report"), el("th", {}, "drawn"),

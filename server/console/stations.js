@@ -49,6 +49,22 @@ export class StationLayer {
     this.markers = new Map();  // ICAO -> {marker, el, key}
     this.ref_deg = 0;
     this.list = [];
+    this.checked = new Map();  // ICAO -> the last conformance check's row for it
+  }
+
+  // The conformance check's rows (GET /api/conformance's stations): each
+  // checked station's marker says whether what the renderers draw there is
+  // within tolerance of its report (a yellow ring when it is not).
+  conformance(rows) {
+    this.checked = new Map(rows.filter((r) => r.icao).map((r) => [r.icao, r]));
+    for (const [icao, m] of this.markers) this.markConformance(icao, m);
+  }
+
+  markConformance(icao, m) {
+    const row = this.checked.get(icao);
+    m.el.dataset.conformance = row ? (row.ok ? "ok" : "off") : "";
+    m.el.title = m.el.dataset.titleBase + (!row ? ""
+      : row.ok ? "; drawn as reported" : `; drawn ${row.oktas_off}/8 off its report`);
   }
 
   show(on) {
@@ -82,7 +98,8 @@ export class StationLayer {
       m.key = key;
       m.el.className = `station cat-${category || "none"}`;
       m.el.dataset.category = category || "";
-      m.el.title = `${s.icao}: ${category || (s.report ? "category unknown" : "no report applied")}`;
+      m.el.dataset.titleBase = `${s.icao}: ${category || (s.report ? "category unknown" : "no report applied")}`;
+      this.markConformance(s.icao, m);
       m.marker.setLatLng([s.lat_deg, this.ref_deg + normalizeLon(s.lon_deg - this.ref_deg)]);
       m.marker.setPopupContent(popupContent(s, category));
     }

@@ -234,6 +234,10 @@ const cases = {
     assert(/LJLJ/.test(row) && /at 427\d ft/.test(row) && /0\/8$/.test(row.trim()), `LJLJ's conformance row: ${row}`);
     assert(await a.page.getAttribute("#conformance-result tbody tr", "class") === "ok", "LJLJ within tolerance");
     assert(/1 of 1 stations/.test(await a.page.textContent("#conformance .note")), "the summary");
+    // The map's marker of LJLJ says so too.
+    await until("LJLJ's marker checked", async () =>
+      await a.page.getAttribute('.station[data-icao="LJLJ"]', "data-conformance") === "ok");
+    assert(/drawn as reported/.test(await a.page.getAttribute('.station[data-icao="LJLJ"]', "title")), "LJLJ's title");
     // At a point: the weather there; no forecast is loaded, so no source.
     await a.page.fill('#source-form [name="lat"]', "46.2237");
     await a.page.fill('#source-form [name="lon"]', "14.4576");

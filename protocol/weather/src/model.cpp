@@ -67,14 +67,9 @@ bool goesWithLayer(const WindTile& t, std::uint32_t id) { return t.layerId == id
 bool goesWithLayer(const AirTile&, std::uint32_t) { return false; }
 
 // Whether a delta's tile may go into the snapshot `next`: its layer exists
-// (its air level, for an air tile).
-Result<void> fits(const CoverageTile& t, const WeatherSnapshot& next, const char* what) {
-  if (std::any_of(next.layers.begin(), next.layers.end(), [&](const CloudLayer& l) { return l.id == t.layerId; }))
-    return {};
-  return fail(ErrorCode::InvalidArgument,
-              std::string("delta ") + what + " of layer " + std::to_string(t.layerId) + ", which does not exist");
-}
-Result<void> fits(const WindTile& t, const WeatherSnapshot& next, const char* what) {
+// (a cover or wind tile), its air level does (an air tile).
+template <class LayerTile>
+Result<void> fits(const LayerTile& t, const WeatherSnapshot& next, const char* what) {
   if (std::any_of(next.layers.begin(), next.layers.end(), [&](const CloudLayer& l) { return l.id == t.layerId; }))
     return {};
   return fail(ErrorCode::InvalidArgument,
