@@ -205,6 +205,9 @@ Result<void> applyDelta(WeatherSnapshot& snapshot, const WeatherDelta& delta) {
     return r;
   if (auto r = upsertTiles(next.airTiles, next.airTileLevel, delta.airTiles, delta.airTileLevel, next, "air tile"); !r)
     return r;
+  if (const std::size_t n = next.tiles.size() + next.windTiles.size() + next.airTiles.size(); n > kMaxSnapshotTiles)
+    return fail(ErrorCode::TooLarge, "delta would grow the snapshot to " + std::to_string(n) + " tiles, more than " +
+                                         std::to_string(kMaxSnapshotTiles));
   snapshot = std::move(next);
   return {};
 }

@@ -196,5 +196,26 @@ TEST(AirTiles, ADeltaCarriesOnlyTheChangedAirTilesAndOtherLevelsMakeASnapshot) {
   EXPECT_EQ(kept.airTiles, before.airTiles);
 }
 
+// Deltas of new cells cannot grow a receiver's snapshot past what one frame
+// carries: the delta that would is refused and the snapshot kept.
+TEST(AirTiles, DeltasCannotGrowASnapshotWithoutEnd) {
+  WeatherSnapshot s;
+  s.airLevels_m = {0};
+  s.airTileLevel = 20;
+  // (applyDelta keys tiles by their cell id; it does not decode them)
+  std::uint64_t cell = cellAt(46, 14, 20);
+  for (std::size_t k = 0; k + 1 < kMaxSnapshotTiles; ++k, cell += 2) s.airTiles.push_back({cell, 0, 1, 2});
+  WeatherDelta d;
+  d.airTileLevel = 20;
+  d.airTiles = {{cell, 0, 1, 2}};
+  ASSERT_TRUE(applyDelta(s, d));  // the last tile that fits
+  d.airTiles = {{cell + 2, 0, 1, 2}};
+  const auto r = applyDelta(s, d);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, ErrorCode::TooLarge);
+  EXPECT_NE(describe(r.error()).find("more than 262144"), std::string::npos) << describe(r.error());
+  EXPECT_EQ(s.airTiles.size(), kMaxSnapshotTiles);
+}
+
 }  // namespace
 }  // namespace sky::weather

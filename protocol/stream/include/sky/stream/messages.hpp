@@ -34,6 +34,7 @@ inline constexpr std::size_t kAirTileWireBytes = 16;
 // in the largest frame (kMaxFrameBytes / kTileWireBytes = 262144).
 inline constexpr std::size_t kMaxMessageLayers = 256;
 inline constexpr std::size_t kMaxMessageTiles = (4u << 20) / kTileWireBytes;
+static_assert(kMaxMessageTiles == weather::kMaxSnapshotTiles, "a snapshot holds what one frame carries");
 
 // Bits of Hello::features: what a server takes beyond the base protocol of
 // its major version. A server from before the field sends 0.

@@ -141,10 +141,16 @@ struct WeatherDelta {
   std::vector<AirTile> airTiles;
 };
 
+// The most tiles of all kinds (cover, wind, air) a snapshot holds: as many
+// as one stream frame carries (sky/stream/messages.hpp's kMaxMessageTiles),
+// so that deltas of new cells cannot grow a receiver's snapshot without end.
+inline constexpr std::size_t kMaxSnapshotTiles = std::size_t(1) << 18;
+
 // Applies a delta; on error (another area's delta, a tile, wind or air tile
 // level that differs from the snapshot's, a tile or wind tile of a layer that
 // does not exist afterwards, an air tile past the snapshot's air levels,
-// removal of an unknown layer) the snapshot is left exactly as it was.
+// removal of an unknown layer, more than kMaxSnapshotTiles tiles afterwards)
+// the snapshot is left exactly as it was.
 Result<void> applyDelta(WeatherSnapshot& snapshot, const WeatherDelta& delta);
 
 // The delta that takes `before` to `after` (applyDelta(before, delta) gives
