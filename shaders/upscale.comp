@@ -30,6 +30,7 @@ layout(std430, set = 0, binding = kUpscaleBindingOutDepth) writeonly buffer OutD
 #define real2 vec2
 #define real3 vec3
 #define real4 vec4
+#define real3x3 mat3
 #define SKY_CORE_CONST const
 #include "core_common.glsl"
 

@@ -48,6 +48,7 @@ layout(constant_id = 4) const bool kWindField = true;
 #define real2 vec2
 #define real3 vec3
 #define real4 vec4
+#define real3x3 mat3
 #define SKY_CORE_CONST const
 
 // Copies of the frame's sampling numbers, set at the start of main.

@@ -1,6 +1,6 @@
 // Pieces of the shared model that the atmosphere and the clouds both use:
-// hashing, camera rays, exact ray-sphere distances for Earth-sized spheres,
-// and the energy-conserving integral of a scattering step. Written in the
+// hashing, camera rays, the weather map's projection, exact ray-sphere
+// distances for Earth-sized spheres, and the energy-conserving integral of a scattering step. Written in the
 // subset GLSL and C++ share (see cloud_core.glsl for what an includer defines).
 
 SKY_CORE_CONST real kPi = 3.14159265358979323846;
@@ -52,6 +52,19 @@ real2 frustumPixel(real4 frustum, real2 s, real width, real height) {
 real3 cameraRay(real3 forward, real3 right, real3 down, real4 frustum, real px, real py, real width, real height) {
   real2 s = frustumPoint(frustum, px + 0.5, py + 0.5, width, height);
   return normalize(forward + right * s.x - down * s.y);
+}
+
+// The weather map's plane: the gnomonic projection of a camera-local point p
+// onto the plane tangent to the weather anchor's sphere at the anchor,
+// x = R q.x / q.z and y = R q.y / q.z, with q the point in the anchor's frame
+// relative to the sphere's centre (the camera's position there: camInAnchor).
+// Returns (x, y, q.z): the plane point holds where q.z > 0, on the anchor's
+// side of the sphere (behind it the projection folds over). The GPU passes
+// (weather_map.glsl) and the CPU reference project through this one function.
+real3 anchorPlane(real3x3 camToAnchor, real3 camInAnchor, real radius, real3 p) {
+  real3 q = camToAnchor * p + camInAnchor;
+  real s = radius / q.z;
+  return real3(q.x * s, q.y * s, q.z);
 }
 
 // Ray from a point at distance r from the centre against the sphere with

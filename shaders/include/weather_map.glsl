@@ -1,6 +1,6 @@
 // The weather map's lookups for the GPU passes that read it (the clouds and
 // the reprojection): a camera-local point -> the weather anchor's frame ->
-// the gnomonic plane of the anchor sphere (x = R q.x / q.z) -> texture
+// the gnomonic plane of the anchor sphere (core_common.glsl's anchorPlane) -> texture
 // coordinates of the rings: the fine ring inside its blend band, the coarse
 // ring beyond, linear in the max norm between (the CPU's
 // WeatherField::sampleLayer and ringBlendWeight). The includer declares
@@ -11,9 +11,9 @@
 // blend band in fractions of the fine ring's half extent).
 
 bool weatherPlane(vec3 p, out vec2 plane) {
-  vec3 q = gCamToAnchor * p + gCamInAnchor.xyz;
-  plane = q.xy * (gCamInAnchor.w / q.z);
-  return q.z > 0.0;
+  vec3 a = anchorPlane(gCamToAnchor, gCamInAnchor.xyz, gCamInAnchor.w, p);
+  plane = a.xy;
+  return a.z > 0.0;
 }
 
 // Texture layer `base` of the fine ring (a cover slice, or kWindMapLayers +

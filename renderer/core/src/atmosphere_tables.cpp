@@ -27,6 +27,7 @@ class AirCore {
   using real2 = glm::dvec2;
   using real3 = glm::dvec3;
   using real4 = glm::dvec4;
+  using real3x3 = glm::dmat3;
   using uint = std::uint32_t;
 
   explicit AirCore(const AtmosphereTables* tables) : tables_(tables) {}

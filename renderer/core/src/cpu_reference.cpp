@@ -43,6 +43,7 @@ class CpuCore {
   using real2 = glm::dvec2;
   using real3 = glm::dvec3;
   using real4 = glm::dvec4;
+  using real3x3 = glm::dmat3;
   using uint = std::uint32_t;
 
   CpuCore(const FrameSetup& setup, const NoiseVolume& shape, const NoiseVolume& detail,
@@ -148,7 +149,7 @@ class CpuCore {
   // The weather map's plane point of a camera-local point (false behind the
   // anchor sphere's horizon), the layer's wind there (anchor east/north),
   // and where its tiles are read for it (as cloud_pass.glsl's).
-  bool weatherPlane(real3 p, real2& plane) const;
+  bool weatherPlane(real3 p, real2& plane);
   real2 windInPlane(LayerSampling s, real2 plane);
   real2 tilePlane(LayerSampling s, real2 plane);
 
@@ -179,10 +180,10 @@ void CpuCore::storeAirTable(int slice, real4 part0, real4 part1, real4 part2) {
 CpuCore::real4 CpuCore::sampleAirTable(int part, real3 uvw) { return airTable_.sample(part, uvw); }
 
 // The hooks mirror those of shaders/clouds.comp.
-bool CpuCore::weatherPlane(real3 p, real2& plane) const {
-  const real3 q = setup_.camToAnchor * p + setup_.camInAnchor_m;
-  plane = real2(q.x, q.y) * (setup_.anchorRadius_m / q.z);
-  return q.z > 0.0;
+bool CpuCore::weatherPlane(real3 p, real2& plane) {
+  const real3 a = anchorPlane(setup_.camToAnchor, setup_.camInAnchor_m, setup_.anchorRadius_m, p);
+  plane = real2(a.x, a.y);
+  return a.z > 0.0;
 }
 
 CpuCore::real2 CpuCore::windInPlane(LayerSampling s, real2 plane) {

@@ -46,6 +46,7 @@ struct Shared {
   using real2 = glm::dvec2;
   using real3 = glm::dvec3;
   using real4 = glm::dvec4;
+  using real3x3 = glm::dmat3;
   using uint = std::uint32_t;
 #define SKY_CORE_CONST static constexpr
 #include "core_common.glsl"

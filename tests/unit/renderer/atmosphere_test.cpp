@@ -35,6 +35,7 @@ class Air {
   using real2 = glm::dvec2;
   using real3 = glm::dvec3;
   using real4 = glm::dvec4;
+  using real3x3 = glm::dmat3;
   using uint = std::uint32_t;
 
   explicit Air(const AtmosphereTables* t) : tables(t) {}

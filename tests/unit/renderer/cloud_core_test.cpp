@@ -423,5 +423,37 @@ TEST(CloudCore, RayShellDistancesMatchHandComputedOnes) {
   EXPECT_NEAR(c.intersectSphere(rp, cp, -1.0).t0, h, 1e-6);
 }
 
+// The weather map's projection (anchorPlane, shared by the GPU passes and
+// the CPU reference): the gnomonic projection of the anchor sphere onto its
+// tangent plane at the anchor, x = R tan(angle east), whichever way the
+// camera's frame is turned; points past 90 degrees are flagged.
+TEST(CloudCore, AnchorPlaneIsTheGnomonicProjectionOfTheAnchorSphere) {
+  Core c;
+  const double R = 6371000.0, h = 1500;
+  const dvec3 camera(0, 0, R + h);  // above the anchor
+  for (const double yaw_deg : {0.0, 30.0, -135.0}) {
+    // camToAnchor: the camera's axes turned by yaw about the local vertical.
+    const double a = glm::radians(yaw_deg);
+    const dmat3 camToAnchor(dvec3(std::cos(a), std::sin(a), 0), dvec3(-std::sin(a), std::cos(a), 0), dvec3(0, 0, 1));
+    for (const double angle_deg : {0.0, 0.5, 10.0, 60.0}) {
+      const double t = glm::radians(angle_deg);
+      // A point on the sphere `angle` east and one `angle` north of the anchor,
+      // written camera-local (the inverse rotation of their anchor offsets).
+      const dvec3 east(R * std::sin(t), 0, R * std::cos(t)), north(0, R * std::sin(t), R * std::cos(t));
+      const dvec3 pe = glm::transpose(camToAnchor) * (east - camera);
+      const dvec3 pn = glm::transpose(camToAnchor) * (north - camera);
+      const dvec3 e = c.anchorPlane(camToAnchor, camera, R, pe), n = c.anchorPlane(camToAnchor, camera, R, pn);
+      EXPECT_NEAR(e.x, R * std::tan(t), 1e-6 * R * std::tan(t) + 1e-6) << yaw_deg << " " << angle_deg;
+      EXPECT_NEAR(e.y, 0, 1e-6);
+      EXPECT_NEAR(n.y, R * std::tan(t), 1e-6 * R * std::tan(t) + 1e-6);
+      EXPECT_NEAR(n.x, 0, 1e-6);
+      EXPECT_GT(e.z, 0);
+    }
+    // Past a quarter turn the point is behind the anchor's horizon: q.z < 0.
+    const dvec3 far(R * std::sin(2.0), 0, R * std::cos(2.0));
+    EXPECT_LT(c.anchorPlane(camToAnchor, camera, R, glm::transpose(camToAnchor) * (far - camera)).z, 0);
+  }
+}
+
 }  // namespace
 }  // namespace sky::test

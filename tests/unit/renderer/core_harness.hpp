@@ -25,6 +25,7 @@ class Core {
   using real2 = glm::dvec2;
   using real3 = glm::dvec3;
   using real4 = glm::dvec4;
+  using real3x3 = glm::dmat3;
   using uint = std::uint32_t;
 
   real coverage = 1.0, density = 1.0, blend = 0.0, noise = 1.0, detail = 0.5;
