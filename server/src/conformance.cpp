@@ -39,6 +39,9 @@ nlohmann::json layersJson(const std::vector<Layer>& layers) {
   return a;
 }
 
+// A weather clock as far as a century either way: any replay's or timeline's.
+constexpr double kMaxClockOffset_s = 100 * 365.25 * 86400;
+
 nlohmann::json optional(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
 
 }  // namespace
@@ -65,6 +68,9 @@ Result<ConformanceQuery> parseConformanceQuery(std::string_view query) {
     } else if (key == "lon_deg") {
       if (!(v = queryNumber(key, value, -180, 180))) return tl::unexpected(v.error());
       q.lon_deg = *v;
+    } else if (key == "clock_s") {
+      if (!(v = queryNumber(key, value, -kMaxClockOffset_s, kMaxClockOffset_s))) return tl::unexpected(v.error());
+      q.clock_s = *v;
     } else if (key == "radius_m") {
       if (!(v = queryNumber(key, value, 1, 2e7))) return tl::unexpected(v.error());
       q.radius_m = *v;
@@ -81,7 +87,7 @@ Result<ConformanceQuery> parseConformanceQuery(std::string_view query) {
 
 nlohmann::json conformanceJson(const LiveWeather& weather, std::span<const Station> stations,
                                const ConformanceQuery& q) {
-  const double clock_s = weather.clockNow();
+  const double clock_s = q.clock_s.value_or(weather.clockNow());
   const std::vector<weather::CloudLayer> globals = weather.layersAt(clock_s);
   const std::vector<weather::Region> regions = weather.regionsAt(clock_s);
   const std::vector<weather::CloudLayer> table = snapshotLayers(globals, regions);

@@ -41,7 +41,7 @@ HttpReply HttpApi::serve(Endpoint endpoint, const ApiRequest& r) {
     case Endpoint::Conformance: {
       auto q = parseConformanceQuery(r.query);
       if (!q) return error(400, q.error().detail);
-      return json(conformanceJson(weather_, options_.stations, *q));
+      return json(conformanceJson(weather_, metarStations_.known(options_.stations), *q));
     }
     case Endpoint::Wind: {
       auto q = parseWindQuery(r.query);

@@ -49,6 +49,14 @@ void MetarStationBoard::remember(const MetarRequest& request, const json& reply,
   }
 }
 
+std::vector<Station> MetarStationBoard::known(std::span<const Station> serverStations) const {
+  std::vector<Station> out(serverStations.begin(), serverStations.end());
+  for (const auto& [icao, e] : latest_)
+    if (std::none_of(serverStations.begin(), serverStations.end(), [&](const Station& s) { return s.icao == icao; }))
+      out.push_back(e.station);
+  return out;
+}
+
 json MetarStationBoard::list(std::span<const Station> serverStations, const WeatherView& now) const {
   std::map<std::uint32_t, const weather::Region*> regions;
   for (const auto& r : now.regions) regions[r.id] = &r;

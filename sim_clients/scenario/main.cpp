@@ -77,12 +77,13 @@ class ActionSender {
         queue_.pop_front();
       }
       nlohmann::json body = item.action.request;
-      if (body.is_object() && !body.contains("author")) body["author"] = "skyshell-scenario";
+      if (body.is_object() && !body.contains("author") && item.action.target == "/api/changes")
+        body["author"] = "skyshell-scenario";
       sky::sim::HttpRequest r;
       r.method = "POST";
       r.host = host_;
       r.port = port_;
-      r.target = "/api/changes";
+      r.target = item.action.target;
       r.body = body.dump();
       r.bearerToken = token_;
       auto response = sky::sim::httpRequest(r);
@@ -160,7 +161,8 @@ int main(int argc, char** argv) {
     std::printf("scenario: %s: flight %s (%.0f s), %zu actions\n", scenarioPath.c_str(),
                 scenario->flightFile.string().c_str(), flight->duration_s(), scenario->actions.size());
     for (const auto& a : scenario->actions)
-      std::printf("scenario: t=%.1f s: %s: POST /api/changes %s\n", a.at_s, a.what.c_str(), a.request.dump().c_str());
+      std::printf("scenario: t=%.1f s: %s: POST %s %s\n", a.at_s, a.what.c_str(), a.target.c_str(),
+                  a.request.dump().c_str());
     return 0;
   }
   if (!tokenFile.empty()) {

@@ -39,7 +39,7 @@ nlohmann::json toJson(const toml::node& node) {
 
 Result<ScenarioAction> parseAction(const toml::table& t, std::size_t index, const Where& where) {
   const std::string prefix = "action[" + std::to_string(index) + "].";
-  if (auto r = config::onlyKeys(t, {"at_s", "what", "request"}, prefix, where); !r) return tl::unexpected(r.error());
+  if (auto r = config::onlyKeys(t, {"at_s", "what", "api", "request"}, prefix, where); !r) return tl::unexpected(r.error());
   ScenarioAction a;
   a.line = t.source().begin.line;
   auto at = config::number(t, "at_s", prefix, where);
@@ -49,6 +49,14 @@ Result<ScenarioAction> parseAction(const toml::table& t, std::size_t index, cons
   auto what = config::string(t, "what", prefix, where);
   if (!what) return tl::unexpected(what.error());
   a.what = *what;
+  if (t.contains("api")) {
+    auto api = config::string(t, "api", prefix, where);
+    if (!api) return tl::unexpected(api.error());
+    if (*api != "changes" && *api != "metar")
+      return where.error(ErrorCode::InvalidArgument, t.get("api")->source(), prefix + "api",
+                         "must be \"changes\" or \"metar\"");
+    a.target = "/api/" + *api;
+  }
   auto request = config::table(t, "request", prefix, where);
   if (!request) return tl::unexpected(request.error());
   a.request = toJson(**request);

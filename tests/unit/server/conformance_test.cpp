@@ -2,6 +2,8 @@
 // stations and a GFS forecast: what the tiles draw at each station is its
 // report, whichever came first; a station region that does not replace
 // every layer (as a hand-made one) is caught; grid points match the grid.
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 #include "grib_tools.hpp"
@@ -149,8 +151,51 @@ TEST(Conformance, StationsSharingASlotKeepTheirOwnBases) {
   }
 }
 
+// A replay's frame drew the weather at its own clock: the check is made at
+// the clock asked, with the regions as they stand then. LJLJ's region gets
+// an overcast scheduled an hour ahead: before it the check reads the
+// report's three layers, after it the one overcast layer.
+TEST(Conformance, TheCheckIsMadeAtTheClockAsked) {
+  Fixture f;
+  f.metar(kReports);
+  const double now = f.weather.clockNow();
+  auto regions = f.weather.regionsAt(now);
+  const auto ljlj = std::find_if(regions.begin(), regions.end(),
+                                 [](const weather::Region& r) { return std::abs(r.centerLat_deg - 46.2237) < 1e-9; });
+  ASSERT_NE(ljlj, regions.end());
+  weather::Region later = *ljlj;
+  ASSERT_FALSE(later.layers.empty());
+  weather::CloudLayer overcast = later.layers.front();
+  overcast.coverage = 1;
+  later.layers = {overcast};
+  ASSERT_TRUE(f.weather.submit({{SetRegion{later, Timing{now + 3600, 0}}}, "test", "api"}));
+  ConformanceQuery q;
+  q.gridPoints = 0;
+  q.lat_deg = 46.2237;  // LJLJ; LOWK is 47 km away, LIPQ farther
+  q.lon_deg = 14.4576;
+  q.radius_m = 30000;
+  std::vector<std::size_t> reportedLayers;
+  for (const double at : {now + 60, now + 7200}) {
+    q.clock_s = at;
+    const auto j = conformanceJson(f.weather, kStations, q);
+    EXPECT_DOUBLE_EQ(j["clock_s"].get<double>(), at);
+    ASSERT_EQ(j["stations"].size(), 1u) << j.dump();
+    EXPECT_EQ(j["stations"][0]["icao"], "LJLJ");
+    EXPECT_TRUE(j["stations"][0]["ok"]) << j.dump();
+    reportedLayers.push_back(j["stations"][0]["reported"]["layers"].size());
+    if (at > now + 3600) {
+      EXPECT_EQ(j["stations"][0]["drawn"]["layers"][0]["oktas"], 8) << j.dump();
+    }
+  }
+  EXPECT_EQ(reportedLayers, (std::vector<std::size_t>{3, 1}));
+}
+
 TEST(Conformance, QueryKeysAreChecked) {
   EXPECT_TRUE(parseConformanceQuery(""));
+  EXPECT_TRUE(parseConformanceQuery("clock_s=-12.5"));
+  EXPECT_EQ(*parseConformanceQuery("clock_s=86400")->clock_s, 86400);
+  EXPECT_FALSE(parseConformanceQuery("clock_s=1e300"));
+  EXPECT_FALSE(parseConformanceQuery("clock_s=nan"));
   EXPECT_TRUE(parseConformanceQuery("stations=10&grid_points=5&lat_deg=46&lon_deg=14&radius_m=100000"));
   EXPECT_FALSE(parseConformanceQuery("lat_deg=46"));
   EXPECT_FALSE(parseConformanceQuery("stations=-1"));

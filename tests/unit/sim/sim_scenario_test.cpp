@@ -23,6 +23,7 @@ request = { changes = [ { op = "set_clock", rate = 60 } ] }
 [[action]]
 at_s = 30.0
 what = "thicken the deck"
+api = "changes"
 request.author = "instructor"
 request.changes = [ { op = "set_layer", ramp_s = 120, layer = { id = 1, coverage = 0.9, on = true } } ]
 )";
@@ -43,6 +44,28 @@ TEST(SimScenario, ParsesTheDocumentedFormat) {
       R"({"author":"instructor","changes":[{"op":"set_layer","ramp_s":120,"layer":{"id":1,"coverage":0.9,"on":true}}]})");
   EXPECT_EQ(s->actions[0].request, want);
   EXPECT_EQ(s->actions[1].request["changes"][0]["rate"], 60);
+  EXPECT_EQ(s->actions[0].target, "/api/changes");
+  EXPECT_EQ(s->actions[1].target, "/api/changes");  // the default
+}
+
+TEST(SimScenario, AnActionMayPostMetarReports) {
+  auto s = parseSimScenario(R"([flight]
+file = "a.csv"
+[[action]]
+at_s = 5
+what = "LIPA lowers"
+api = "metar"
+request = { apply = true, reports = ["METAR LIPA 221150Z 24008KT 9999 OVC008 12/06 Q1018"] }
+)",
+                            "s.toml", "/base");
+  ASSERT_TRUE(s) << s.error().detail;
+  EXPECT_EQ(s->actions[0].target, "/api/metar");
+  EXPECT_EQ(s->actions[0].request["reports"].size(), 1u);
+  auto bad = parseSimScenario("[flight]\nfile = \"a.csv\"\n[[action]]\nat_s = 1\nwhat = \"x\"\napi = \"state\"\nrequest = {}\n",
+                              "s.toml", ".");
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().detail.find("s.toml:6:7: action[0].api: must be \"changes\" or \"metar\""), std::string::npos)
+      << bad.error().detail;
 }
 
 TEST(SimScenario, ErrorsNameLineAndField) {
@@ -72,7 +95,7 @@ TEST(SimScenario, ErrorsNameLineAndField) {
 }
 
 TEST(SimScenario, BundledExamplesParse) {
-  for (const char* name : {"climb-into-sun.toml", "demo-live-weather.toml"}) {
+  for (const char* name : {"climb-into-sun.toml", "demo-live-weather.toml", "demo-forecast-weather.toml"}) {
     auto s = loadSimScenario(std::filesystem::path(SKY_SOURCE_DIR) / "deploy/sim-scenarios" / name);
     ASSERT_TRUE(s) << s.error().detail;
     EXPECT_TRUE(std::filesystem::exists(s->flightFile)) << s->flightFile;

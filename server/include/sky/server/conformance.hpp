@@ -5,7 +5,8 @@
 // at the point through the shared lookup (weather::snapshotLookup) and
 // compared with what the report or the grid says: cover in oktas per layer,
 // the ceiling (the lowest base with 5 oktas or more), and visibility (not in
-// the weather model yet: null). Tolerances: kOktaTolerance, kCeilingTolerance_m.
+// the weather model yet: null). At the weather clock now, or at a clock the
+// query gives (`clock_s`: what a replay's frame drew). Tolerances: kOktaTolerance, kCeilingTolerance_m.
 #pragma once
 
 #include <cstddef>
@@ -37,6 +38,9 @@ struct ConformanceQuery {
   // An area to look in (stations and grid points within radius of the centre).
   std::optional<double> lat_deg, lon_deg;
   double radius_m = 0;  // (0, 2e7] with a centre
+  // The weather clock to check at (a replay's frame drew its own): the
+  // layers, regions and forecast as they stand then. Default: now.
+  std::optional<double> clock_s;
 };
 
 Result<ConformanceQuery> parseConformanceQuery(std::string_view query);

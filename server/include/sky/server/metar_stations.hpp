@@ -10,6 +10,7 @@
 #include <map>
 #include <span>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -36,6 +37,10 @@ class MetarStationBoard {
   // centre) gets {"text": null, "region_id", "sequence": null, "clock_s":
   // null, "sky": "read", "layers"}.
   nlohmann::json list(std::span<const Station> serverStations, const WeatherView& now) const;
+
+  // The server's table, then the stations only requests brought (by ICAO):
+  // every station whose name the conformance check can give.
+  std::vector<Station> known(std::span<const Station> serverStations) const;
 
  private:
   struct Entry {

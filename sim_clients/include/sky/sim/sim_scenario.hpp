@@ -9,10 +9,12 @@
 //   [[action]]       # zero or more, sent when the flight reaches at_s
 //   at_s = 30.0      # flight time, s (>= start_s)
 //   what = "..."     # required: one line for the log
+//   api = "changes"  # optional: "changes" (default) or "metar", the endpoint
 //   request = { author = "...", changes = [ ... ] }
-//                    # the body of the weather server's POST /api/changes,
-//                    # written as TOML (converted to JSON as it stands; the
-//                    # server checks it and says what is wrong)
+//                    # the body of the weather server's POST /api/changes
+//                    # (or POST /api/metar: reports, apply), written as TOML
+//                    # (converted to JSON as it stands; the server checks it
+//                    # and says what is wrong)
 //
 // Strict: an unknown key, a missing key or a value out of range is an error
 // naming the file, line and field.
@@ -33,6 +35,7 @@ struct ScenarioAction {
   double at_s = 0;
   std::string what;
   nlohmann::json request;  // an object
+  std::string target = "/api/changes";  // the endpoint it is POSTed to: /api/changes or /api/metar
   std::size_t line = 0;    // where it was written, for messages
 };
 
