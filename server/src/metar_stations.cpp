@@ -51,9 +51,11 @@ void MetarStationBoard::remember(const MetarRequest& request, const json& reply,
 
 std::vector<Station> MetarStationBoard::known(std::span<const Station> serverStations) const {
   std::vector<Station> out(serverStations.begin(), serverStations.end());
-  for (const auto& [icao, e] : latest_)
+  for (const auto& entry : latest_) {
+    const std::string& icao = entry.first;
     if (std::none_of(serverStations.begin(), serverStations.end(), [&](const Station& s) { return s.icao == icao; }))
-      out.push_back(e.station);
+      out.push_back(entry.second.station);
+  }
   return out;
 }
 
