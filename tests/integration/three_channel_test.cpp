@@ -22,6 +22,8 @@
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+// This file is its own test program (it runs alone: tests/integration/CMakeLists.txt).
+#define STB_IMAGE_IMPLEMENTATION
 #include <stb_image.h>
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #include <stb_image_write.h>
@@ -121,7 +123,7 @@ DisplayRun runDisplay(const std::string& name, double sunAzimuth_deg, double sun
   {
     std::ofstream flight(d + "/hover.csv");
     flight << "time_s,lat_deg,lon_deg,alt_m,yaw_deg,pitch_deg,roll_deg\n"
-              "0,46.2,12.8,900,90,15,0\n2,46.2,12.8,900,90,15,0\n";
+              "0,46.2,12.8,900,90,15,0\n4,46.2,12.8,900,90,15,0\n";  // 20 host frames at 5 Hz
   }
   // Leak checking off in the renderers only: lavapipe's JIT (skeleton_test.cpp).
   std::vector<std::unique_ptr<ChildProcess>> channels;

@@ -4,11 +4,15 @@
 // reports) asked at points of the flight a headless replay drew, each at the
 // weather clock its frame drew. The points come from the replay's
 // frames.jsonl (skyshell-render's metadata, one JSON object a line); the
-// answers are joined into one table along the flight.
+// answers are joined into one table along the flight. The server answers
+// from its weather as it stands when asked, evaluated at each frame's clock
+// (ramps, scheduled changes and the forecast's time as at that clock; a
+// report applied during the replay counts for the frames before it too):
+// asked right after a replay, the check is of what the server streams.
 //
 // Both inputs come from outside the process (a file, a server's answer):
 // every field is checked for type and range, every count is bounded, and
-// text from them is cut and made well-formed before it reaches a table.
+// text from them is reduced to safe characters before it reaches a table.
 #pragma once
 
 #include <cstddef>
