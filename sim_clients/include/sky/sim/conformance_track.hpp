@@ -7,8 +7,9 @@
 // answers are joined into one table along the flight. The server answers
 // from its weather as it stands when asked, evaluated at each frame's clock
 // (ramps, scheduled changes and the forecast's time as at that clock; a
-// report applied during the replay counts for the frames before it too):
-// asked right after a replay, the check is of what the server streams.
+// change made while the replay ran counts from the weather clock it was made
+// at, as it did for the frames): asked right after a replay, the check is of
+// what the server streamed.
 //
 // Both inputs come from outside the process (a file, a server's answer):
 // every field is checked for type and range, every count is bounded, and
