@@ -51,11 +51,8 @@ void MetarStationBoard::remember(const MetarRequest& request, const json& reply,
 
 std::vector<Station> MetarStationBoard::known(std::span<const Station> serverStations) const {
   std::vector<Station> out(serverStations.begin(), serverStations.end());
-  for (const auto& entry : latest_) {
-    const std::string& icao = entry.first;
-    if (std::none_of(serverStations.begin(), serverStations.end(), [&](const Station& s) { return s.icao == icao; }))
-      out.push_back(entry.second.station);
-  }
+  for (const auto& entry : latest_)
+    if (!findStation(serverStations, entry.first)) out.push_back(entry.second.station);
   return out;
 }
 
@@ -92,9 +89,7 @@ json MetarStationBoard::list(std::span<const Station> serverStations, const Weat
     return station;
   };
   json out = json::array();
-  for (const Station& s : serverStations) out.push_back(withReport(s));
-  for (const auto& [icao, e] : latest_)
-    if (!findStation(serverStations, icao)) out.push_back(withReport(e.station));
+  for (const Station& s : known(serverStations)) out.push_back(withReport(s));
   return {{"stations", out}};
 }
 

@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "skyshell-conformance: GET %s: HTTP %d\n", request.target.c_str(), answer->status);
       return kExitRuntime;
     }
-    auto c = sky::sim::readPointCheck(p, answer->body);
+    auto c = sky::sim::readPointCheck(p, answer->body, check.stations);
     if (!c) {
       std::fprintf(stderr, "skyshell-conformance: GET %s: %s\n", request.target.c_str(),
                    sky::describe(c.error()).c_str());

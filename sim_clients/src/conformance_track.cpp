@@ -142,14 +142,15 @@ std::string conformanceTarget(const TrackPoint& at, const TrackCheckOptions& o) 
   return text;
 }
 
-Result<PointCheck> readPointCheck(const TrackPoint& at, std::string_view body) {
+Result<PointCheck> readPointCheck(const TrackPoint& at, std::string_view body, std::size_t maxStations) {
   const json doc = json::parse(body, nullptr, false);
   if (doc.is_discarded() || !doc.is_object()) return fail(ErrorCode::InvalidArgument, "answer: not a JSON object");
   PointCheck out;
   out.at = at;
   const auto stations = doc.find("stations");
   if (stations == doc.end() || !stations->is_array()) return fail(ErrorCode::InvalidArgument, "answer: stations: not an array");
-  for (std::size_t i = 0; i < stations->size() && i < kMaxStationsPerPoint; ++i) {
+  const std::size_t keep = std::min(maxStations, kMaxStationsPerPoint);
+  for (std::size_t i = 0; i < stations->size() && i < keep; ++i) {
     const json& s = (*stations)[i];
     const std::string where = "answer: stations[" + std::to_string(i) + "].";
     if (!s.is_object()) return fail(ErrorCode::InvalidArgument, where + ": not an object");

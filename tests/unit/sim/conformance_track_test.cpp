@@ -72,7 +72,7 @@ TEST(ConformanceTrack, AnAnswerBecomesTheTablesRows) {
        "drawn":{"ceiling_m":860},"oktas_off":2,"ok":false},
       {"region_id":102,"icao":null,"lat_deg":46.0,"lon_deg":13.1,"oktas_off":0,"ok":true}],
     "grid":[{"oktas_off":0,"ok":true},{"oktas_off":3,"ok":false},{"oktas_off":1,"ok":true}]})";
-  const auto c = readPointCheck(at, body);
+  const auto c = readPointCheck(at, body, 20);
   ASSERT_TRUE(c) << c.error().detail;
   ASSERT_EQ(c->stations.size(), 3u);
   EXPECT_EQ(c->stations[0].name, "LIPQ");
@@ -86,6 +86,8 @@ TEST(ConformanceTrack, AnAnswerBecomesTheTablesRows) {
   EXPECT_EQ(c->gridPoints, 3u);
   EXPECT_EQ(c->gridOk, 2u);
   EXPECT_EQ(c->worstGridOktasOff, 3);
+  // A server that sends more stations than were asked for is not followed.
+  EXPECT_EQ(readPointCheck(at, body, 2)->stations.size(), 2u);
 
   const std::vector<PointCheck> all{*c};
   const auto j = trackJson(all, {});
@@ -102,13 +104,13 @@ TEST(ConformanceTrack, AnAnswerBecomesTheTablesRows) {
 
 TEST(ConformanceTrack, AnswersNotAsTheApiGivesThemAreRefused) {
   const TrackPoint at{};
-  EXPECT_FALSE(readPointCheck(at, "[]"));
-  EXPECT_FALSE(readPointCheck(at, R"({"grid":[]})"));
-  EXPECT_FALSE(readPointCheck(at, R"({"stations":[{"lat_deg":1,"lon_deg":2,"oktas_off":9,"ok":true}]})"));
-  EXPECT_FALSE(readPointCheck(at, R"({"stations":[{"lat_deg":1,"lon_deg":2,"oktas_off":0,"ok":"yes"}]})"));
-  EXPECT_FALSE(readPointCheck(at, R"({"stations":[],"grid":{}})"));
-  EXPECT_TRUE(readPointCheck(at, R"({"stations":[]})"));
-  EXPECT_NE(trackMarkdown({*readPointCheck(at, R"({"stations":[]})")}, {}).find("No station or forecast grid point"),
+  EXPECT_FALSE(readPointCheck(at, "[]", 20));
+  EXPECT_FALSE(readPointCheck(at, R"({"grid":[]})", 20));
+  EXPECT_FALSE(readPointCheck(at, R"({"stations":[{"lat_deg":1,"lon_deg":2,"oktas_off":9,"ok":true}]})", 20));
+  EXPECT_FALSE(readPointCheck(at, R"({"stations":[{"lat_deg":1,"lon_deg":2,"oktas_off":0,"ok":"yes"}]})", 20));
+  EXPECT_FALSE(readPointCheck(at, R"({"stations":[],"grid":{}})", 20));
+  EXPECT_TRUE(readPointCheck(at, R"({"stations":[]})", 20));
+  EXPECT_NE(trackMarkdown({*readPointCheck(at, R"({"stations":[]})", 20)}, {}).find("No station or forecast grid point"),
             std::string::npos);
 }
 

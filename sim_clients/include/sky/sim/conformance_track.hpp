@@ -79,18 +79,19 @@ struct StationCheck {
 // The server's answer at one point.
 struct PointCheck {
   TrackPoint at;
-  std::vector<StationCheck> stations;  // at most kMaxStationsPerPoint
+  std::vector<StationCheck> stations;  // at most the number asked
   std::size_t gridPoints = 0, gridOk = 0;
   int worstGridOktasOff = 0;
 };
 
-// An answer naming more stations than this is cut (the query asks for at most
-// TrackCheckOptions::stations, and a server that sends more is not followed).
+// The most stations a point is asked for (the API's own bound).
 inline constexpr std::size_t kMaxStationsPerPoint = 10000;
 
-// Reads an answer of GET /api/conformance (its body). Errors
-// (InvalidArgument) name what is not as the API gives it.
-Result<PointCheck> readPointCheck(const TrackPoint& at, std::string_view body);
+// Reads an answer of GET /api/conformance (its body), keeping at most
+// maxStations stations (the number asked: a server that sends more is not
+// followed, so the points' rows stay within what the command line asked).
+// Errors (InvalidArgument) name what is not as the API gives it.
+Result<PointCheck> readPointCheck(const TrackPoint& at, std::string_view body, std::size_t maxStations);
 
 // The checks as JSON (the points, and a summary: stations met, passes and
 // failures, the worst okta and ceiling differences, grid points) and as a
