@@ -77,8 +77,7 @@ class ActionSender {
         queue_.pop_front();
       }
       nlohmann::json body = item.action.request;
-      if (body.is_object() && !body.contains("author") && item.action.target == "/api/changes")
-        body["author"] = "skyshell-scenario";
+      if (body.is_object() && !body.contains("author")) body["author"] = "skyshell-scenario";
       sky::sim::HttpRequest r;
       r.method = "POST";
       r.host = host_;
