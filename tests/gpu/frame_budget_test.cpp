@@ -82,7 +82,8 @@ std::size_t bestFitting(const std::vector<double>& levelMs, double budgetMs) {
 // After 10 frames to settle, the level the frames are drawn at most is the
 // most accurate one that fits at that speed or a neighbour (two neighbouring
 // levels are 5-10 % apart, less than the noise of separate measurement), and
-// the median frame fits (5 % over at most) unless no cheaper level exists.
+// the median frame fits (5 % over at most), or, when no level fits at that
+// speed, is within 5 % of the cheapest level's time.
 // The calibration also checks the ladder's relative costs, which the bench
 // measured on its scenes, against this renderer on this path (20 %), from
 // each level's fastest of 8 frames: a burst of the machine's other load
@@ -146,9 +147,11 @@ TEST(FrameBudget, HoldsABudgetBetweenTwoLevelsOverAReplay) {
               heldMs, budgetMs, most->first, most->second, held.size(), speed, best);
   EXPECT_GE(most->first + 1, best);
   EXPECT_LE(most->first, best + 1);
-  if (most->first < cheapest) {
-    EXPECT_LE(heldMs, 1.05 * budgetMs);
-  }
+  // When even the cheapest level is over the budget at the run's speed (CI
+  // once ran at 1.46x the calibration's times), the frames can only be held
+  // near that level's time; otherwise they fit the budget.
+  EXPECT_LE(heldMs, 1.05 * std::max(budgetMs, duringMs[best]))
+      << "the cheapest level takes " << duringMs[cheapest] << " ms at the run's speed";
 }
 
 }  // namespace
