@@ -87,7 +87,7 @@ Result<weather::CloudLayer> decodeLayer(const char* message, const fbs::Layer& l
   layer.id = l.id();
   if (l.cloud_type() > weather::kMaxCloudType)
     return fail(ErrorCode::InvalidArgument, std::string(message) + ".layers[id " + std::to_string(l.id()) +
-                                                "].cloud_type " + std::to_string(l.cloud_type()) + " outside [0, 10]");
+                                                "].cloud_type " + std::to_string(l.cloud_type()) + " outside [0, " + std::to_string(weather::kMaxCloudType) + "]");
   layer.type = static_cast<weather::CloudType>(l.cloud_type());
   layer.base_m = l.base_m();
   layer.thickness_m = l.thickness_m();
@@ -157,7 +157,7 @@ Result<std::vector<weather::CoverageTile>> decodeTiles(const char* message, int 
     if (t->blend_type() > weather::kMaxCloudType)
       return fail(ErrorCode::InvalidArgument, std::string(message) + ".tiles[" + std::to_string(i) +
                                                   "].blend_type " + std::to_string(t->blend_type()) +
-                                                  " outside [0, 10]");
+                                                  " outside [0, " + std::to_string(weather::kMaxCloudType) + "]");
     out.push_back({t->cell_id(), t->layer_id(), weather::dequantizeUnit(t->coverage()),
                    weather::dequantizeUnit(t->density()), static_cast<weather::CloudType>(t->blend_type()),
                    weather::dequantizeUnit(t->blend())});

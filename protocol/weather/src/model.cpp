@@ -12,7 +12,7 @@ namespace sky::weather {
 namespace {
 constexpr std::array<std::string_view, kMaxCloudType + 1> kNames = {
     "none",       "altocumulus",  "altostratus",  "cirrocumulus",  "cirrostratus", "cirrus",
-    "cumulonimbus", "cumulus",    "nimbostratus", "stratocumulus", "stratus"};
+    "cumulonimbus", "cumulus",    "nimbostratus", "stratocumulus", "stratus",      "fog"};
 
 Result<void> checkRange(const CloudLayer& layer, const char* field, double value, double lo,
                         double hi, bool openLow = false) {
@@ -40,7 +40,7 @@ Result<void> validate(const CloudLayer& layer) {
   if (static_cast<std::uint8_t>(layer.type) > kMaxCloudType)
     return fail(ErrorCode::InvalidArgument,
                 "layer " + std::to_string(layer.id) + ": cloud type " +
-                    std::to_string(static_cast<int>(layer.type)) + " outside [0, 10]");
+                    std::to_string(static_cast<int>(layer.type)) + " outside [0, " + std::to_string(kMaxCloudType) + "]");
   Result<void> r;
   // Tiles carry the layer id in 16 bits on the stream.
   if (!(r = checkRange(layer, "id", layer.id, 0, 65535))) return r;

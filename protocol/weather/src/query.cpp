@@ -122,6 +122,20 @@ WindLookup snapshotWindLookup(const WeatherSnapshot& snapshot) {
   };
 }
 
+double koschmiederVisibility_m(double extinction_perm) {
+  if (!(extinction_perm > 0)) return kUnlimitedVisibility_m;
+  return std::min(kKoschmiederDepth / extinction_perm, kUnlimitedVisibility_m);
+}
+
+double cloudVisibility_m(double cloudDensity) {
+  return koschmiederVisibility_m(kCloudExtinctionPerDensity_perm * cloudDensity);
+}
+
+double fogDensityForVisibility(double visibility_m) {
+  if (!(visibility_m > kMinFogVisibility_m)) return 1.0;
+  return kKoschmiederDepth / (kCloudExtinctionPerDensity_perm * visibility_m);
+}
+
 double isaTemperature_c(double alt_m) {
   const double h = std::clamp(alt_m, -1000.0, 20000.0);
   return h <= 11000.0 ? 15.0 - 0.0065 * h : -56.5;

@@ -301,8 +301,9 @@ std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRe
     wcr.airTemperature_c = static_cast<float>(
         forecast ? forecast->temperature_c
                  : weather::isaTemperature_c(r.alt_m) + (air.seaLevelTemperature_c - kIsaSeaLevelTemperature_c));
-    // In cloud the Koschmieder range of its extinction, never longer than the clear air's.
-    const double cloud_m = render::koschmiederVisibility_m(kExtinctionPerDensity_perm * pw.cloudDensity);
+    // In cloud and fog the Koschmieder range of its extinction (the fog type
+    // draws exactly that), never longer than the clear air's.
+    const double cloud_m = weather::cloudVisibility_m(pw.cloudDensity);
     wcr.visibility_m = static_cast<float>(std::min(air.visibility_m, cloud_m));
     // The weather's layer winds where it has layers; with none (clear sky,
     // no server yet), the host's Atmosphere Control wind when it sent one.

@@ -24,10 +24,19 @@
 //    their cell size (stratocumulus ~2 km, altocumulus ~0.6 km, cirrocumulus
 //    ~0.3 km "small grainy clouds", cumulonimbus ~4 km cells); the detail
 //    period is a few times finer than the cells.
+//  * fog (ours, CIGI leaves type 11 to the IG): a sheet that fills its layer
+//    uniformly (a soft threshold far below the noise's range, flat base, no
+//    density gradient), so a horizontal sight line through it sees the
+//    extinction its density stands for (weather::kCloudExtinctionPerDensity_perm,
+//    the same number the CIGI answer turns into a visibility); it thins over
+//    its top third, where real fog tops are ragged. Fog droplets 10-20 um
+//    (2 r_e ~ 12 um in radiation fog).
 // These are look-development numbers inside those bounds, not measurements.
 #include "cloud_types.hpp"
 
 #include <array>
+
+#include "sky/weather/query.hpp"
 
 namespace sky::render {
 
@@ -56,6 +65,9 @@ constexpr CloudTypeParams kCirrostratus{
     3.0e-4, 0.0,  0.30, 0.60, 1.00, 0.20, 0.0,  0.20, 0.30, 0.30, 0.60, 0.5,  0.30, 0.50, 0.60, 16000.0, 2000.0, 2.0};
 constexpr CloudTypeParams kCirrocumulus{
     1.0e-3, 0.0,  0.20, 0.40, 1.00, 0.30, 0.0,  0.50, 0.30, 0.30, 0.25, 0.0,  0.40, 0.30, 0.40, 1200.0,  400.0};
+constexpr CloudTypeParams kFog{
+    weather::kCloudExtinctionPerDensity_perm,
+            12.0, 0.01, 0.70, 1.00, 0.20, 0.0,  0.00, 0.01, 0.30, 0.05, 0.0,  0.10, 0.30, 0.85, 14000.0, 2000.0};
 
 // Indexed by the CIGI enum value (model.hpp).
 constexpr std::array<const CloudTypeParams*, weather::kMaxCloudType + 1> kTable = {
@@ -70,9 +82,10 @@ constexpr std::array<const CloudTypeParams*, weather::kMaxCloudType + 1> kTable 
     &kNimbostratus,  // 8
     &kStratocumulus, // 9
     &kStratus,       // 10
+    &kFog,           // 11 (ours)
 };
 
-static_assert(static_cast<int>(CloudType::Stratus) == weather::kMaxCloudType);
+static_assert(static_cast<int>(CloudType::Fog) == weather::kMaxCloudType);
 
 }  // namespace
 

@@ -20,7 +20,7 @@ using weather::CloudType;
 constexpr CloudType kAll[] = {CloudType::Altocumulus,  CloudType::Altostratus,  CloudType::Cirrocumulus,
                               CloudType::Cirrostratus, CloudType::Cirrus,       CloudType::Cumulonimbus,
                               CloudType::Cumulus,      CloudType::Nimbostratus, CloudType::Stratocumulus,
-                              CloudType::Stratus};
+                              CloudType::Stratus,      CloudType::Fog};
 
 bool isIce(CloudType t) {
   return t == CloudType::Cirrus || t == CloudType::Cirrostratus || t == CloudType::Cirrocumulus;

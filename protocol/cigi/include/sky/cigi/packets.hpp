@@ -117,7 +117,7 @@ struct WeatherControl {
   LayerId layerId = LayerId::CloudLayer1;
   std::uint8_t humidity_pct = 0;  // [0, 100]
   bool weatherEnable = true, scudEnable = false, randomWindsEnable = false, randomLightningEnable = false;
-  weather::CloudType cloudType = weather::CloudType::None;  // 11-15 rejected: IG-defined, we have none
+  weather::CloudType cloudType = weather::CloudType::None;  // 11 is our fog; 12-15 rejected (IG-defined, we have none)
   WeatherScope scope = WeatherScope::Global;
   std::uint8_t severity = 0;  // [0, 5]
   float airTemperature_c = 15;

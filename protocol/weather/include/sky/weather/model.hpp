@@ -25,8 +25,12 @@ enum class CloudType : std::uint8_t {
   Nimbostratus = 8,
   Stratocumulus = 9,
   Stratus = 10,
+  // CIGI leaves 11-15 to the IG. Ours: fog or mist at the ground (CIGI's
+  // ground-fog layer, METAR FG/BR/HZ), a uniform sheet whose density is its
+  // visibility (query.hpp, fogDensityForVisibility).
+  Fog = 11,
 };
-inline constexpr std::uint8_t kMaxCloudType = 10;
+inline constexpr std::uint8_t kMaxCloudType = 11;
 
 std::string_view toString(CloudType type);  // "cumulus"
 std::optional<CloudType> cloudTypeFromString(std::string_view name);

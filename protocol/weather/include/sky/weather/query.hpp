@@ -47,6 +47,28 @@ CoverageLookup snapshotLookup(const WeatherSnapshot& snapshot, double clock_s);
 // Each layer's wind at a point from the snapshot's wind tiles (WindField).
 WindLookup snapshotWindLookup(const WeatherSnapshot& snapshot);
 
+// Visibility in cloud and fog. A point's cloud density d (PointWeather::
+// cloudDensity) stands for an extinction of kCloudExtinctionPerDensity_perm
+// x d at 550 nm: the renderer's fog type draws exactly that
+// (renderer/core/src/cloud_types.cpp), and the CIGI answer and the
+// conditions API give its Koschmieder range as the visibility there.
+inline constexpr double kCloudExtinctionPerDensity_perm = 0.05;
+// Koschmieder: a black object's contrast falls to the 2 % threshold after an
+// optical depth of -ln 0.02 = 3.912 (WMO-No. 8's meteorological visibility);
+// the renderer's atmosphere_core.glsl holds the same number for its haze.
+inline constexpr double kKoschmiederDepth = 3.912;
+// What "no obscuration" answers as a range, m (past the atmosphere).
+inline constexpr double kUnlimitedVisibility_m = 1.0e9;
+// 3.912 / extinction_perm; kUnlimitedVisibility_m for no extinction.
+double koschmiederVisibility_m(double extinction_perm);
+// The visibility inside cloud of density d (a PointWeather::cloudDensity).
+double cloudVisibility_m(double cloudDensity);
+// The fog density whose visibility is visibility_m: 3.912 / (0.05 V),
+// at most 1 (so the thickest fog the model draws has V = 78 m; a shorter
+// visibility is drawn as that).
+double fogDensityForVisibility(double visibility_m);
+inline constexpr double kMinFogVisibility_m = kKoschmiederDepth / kCloudExtinctionPerDensity_perm;
+
 // ICAO standard atmosphere below 20 km (altitude MSL, m): 15 C and 1013.25 hPa
 // at sea level, -6.5 K/km to the tropopause at 11 km (-56.5 C, 226.32 hPa),
 // isothermal above. For the parts of a Weather Conditions Response the

@@ -40,8 +40,6 @@
 
 namespace sky::app {
 
-// Extinction per unit cloud density, 1/m: the renderer's (cloud_core.glsl).
-inline constexpr double kExtinctionPerDensity_perm = 0.05;
 // Liquid water of cloud at density 1, g/m^3 (cumulus 0.3-1, formulas.md).
 inline constexpr double kCloudLiquidWater_gpm3 = 0.5;
 
