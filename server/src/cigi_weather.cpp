@@ -5,6 +5,8 @@
 #include <string>
 #include <utility>
 
+#include "sky/weather/query.hpp"
+
 namespace sky::server {
 namespace {
 
@@ -28,7 +30,7 @@ bool sameRegion(const weather::Region& a, const weather::Region& b) {
 
 bool cloudLayerId(cigi::LayerId id) {
   auto n = static_cast<std::uint8_t>(id);
-  return (n >= 1 && n <= 3) || n >= 10;
+  return n <= 3 || n >= 10;  // ground fog (0) is our fog layer 0
 }
 
 std::string where(std::size_t index, const char* packet) {
@@ -54,14 +56,19 @@ Result<std::optional<weather::CloudLayer>> cloudLayerFrom(const cigi::WeatherCon
   if (!(p.coverage_pct >= 0 && p.coverage_pct <= 100)) return bad("coverage", p.coverage_pct, "[0, 100] %");
   if (!(p.windDirection_deg >= -180 && p.windDirection_deg <= 360))
     return bad("wind direction", p.windDirection_deg, "[-180, 360] deg");
+  const bool fog = p.layerId == cigi::LayerId::GroundFog;
+  if (fog && !(p.visibility_m > 0 && std::isfinite(p.visibility_m)))
+    return bad("visibility range", p.visibility_m, "(0, inf) m for ground fog");
   weather::CloudLayer layer;
   layer.id = static_cast<std::uint8_t>(p.layerId);
-  layer.type = p.cloudType;
+  layer.type = fog ? weather::CloudType::Fog : p.cloudType;
   layer.base_m = p.baseElevation_m;
   layer.thickness_m = p.thickness_m;
   layer.transitionBand_m = p.transitionBand_m;
   layer.coverage = p.coverage_pct / 100.0;
-  layer.density = 1;
+  // Ground fog's density is its visibility range; a cloud layer's visibility
+  // range (in cloud) is not used: the cloud's own density draws it.
+  layer.density = fog ? weather::fogDensityForVisibility(p.visibility_m) : 1.0;
   layer.wind.speed_mps = p.horizontalWind_mps;
   double from = std::fmod(static_cast<double>(p.windDirection_deg), 360.0);
   if (from < 0) from += 360;

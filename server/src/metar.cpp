@@ -425,6 +425,46 @@ bool isMilesBeforeUnit(std::string_view g, std::string_view next) {
   return allDigits(v.substr(0, slash)) && allDigits(v.substr(slash + 1));
 }
 
+constexpr double kMetresPerStatuteMile = 1609.344;
+// 9999 means 10 km or more (WMO FM 15).
+constexpr double kMetarMaxVisibility_m = 10000;
+
+// Miles of "10", "3/4", "P6", "M1/4" (the caller checked the shape); nullopt
+// for a zero denominator.
+std::optional<double> milesOf(std::string_view v, bool& above, bool& below) {
+  above = !v.empty() && v[0] == 'P';
+  below = !v.empty() && v[0] == 'M';
+  if (above || below) v.remove_prefix(1);
+  const std::size_t slash = v.find('/');
+  double miles = -1;
+  if (slash == std::string_view::npos) {
+    if (!v.empty()) miles = toInt(v);
+  } else if (slash > 0 && toInt(v.substr(slash + 1)) > 0) {
+    miles = double(toInt(v.substr(0, slash))) / toInt(v.substr(slash + 1));
+  }
+  if (miles < 0) return std::nullopt;
+  return miles;
+}
+
+// The prevailing visibility of the first visibility group: g (and the whole
+// miles before it, if any), "SM" already stripped when `miles`.
+void keepVisibility(MetarReport& out, std::string_view g, bool miles, int wholeMiles) {
+  if (out.visibility_m || out.visibilityAbove) return;  // a later group is a sector's minimum
+  if (g == "////") return;
+  bool above = false, below = false;
+  if (miles) {
+    const std::optional<double> m = milesOf(g, above, below);
+    if (!m) return;
+    out.visibility_m = (wholeMiles + *m) * kMetresPerStatuteMile;
+  } else {
+    const int metres = toInt(g.substr(0, 4));
+    above = metres >= 9999;
+    out.visibility_m = above ? kMetarMaxVisibility_m : metres;
+  }
+  out.visibilityAbove = above;
+  out.visibilityBelow = below;
+}
+
 bool sameCloud(const MetarCloud& a, const MetarCloud& b) {
   return a.amount == b.amount && a.height_ft == b.height_ft && a.convective == b.convective;
 }
@@ -443,6 +483,8 @@ void parseBody(Groups& in, MetarReport& out) {
     }
     if (g == "CAVOK") {
       out.cavok = true;
+      out.visibility_m = kMetarMaxVisibility_m;
+      out.visibilityAbove = true;
     } else if (g == "NSC" || g == "NCD" || g == "SKC" || g == "CLR") {
       out.noCloud = g == "NSC"   ? NoCloud::NSC
                     : g == "NCD" ? NoCloud::NCD
@@ -476,18 +518,28 @@ void parseBody(Groups& in, MetarReport& out) {
         in.skip(out, "vertical visibility is not three digits");
       }
     } else if (isWholeMilesBefore(g, in.peek(1))) {
-      in.advance();  // "1" of "1 1/2SM"; the fraction is the next group
-      continue;
+      // "1 1/2SM": the whole miles, then the fraction with its unit.
+      const std::string_view fraction = in.peek(1);
+      keepVisibility(out, fraction.substr(0, fraction.size() - 2), true, toInt(g));
+      in.advance();
     } else if (allDigits(g) && g.size() <= 2 && isMilesBeforeUnit(in.peek(1), in.peek(2)) &&
                in.peek(1).find('/') != std::string_view::npos) {
       // "1 1/4 SM": whole miles, the fraction and the unit apart.
+      keepVisibility(out, in.peek(1), true, toInt(g));
       in.join(out, 1, "fraction of the visibility before");
       in.join(out, 2, "unit of the visibility before");
       in.advance(2);
     } else if (isMilesBeforeUnit(g, in.peek(1))) {
+      keepVisibility(out, g, true, 0);
       in.join(out, 1, "unit of the visibility before");
       in.advance();
-    } else if (isVisibility(g) || isRunwayVisualRange(g) || isWeather(g) || g == "$") {
+    } else if (isVisibility(g)) {
+      const bool miles = endsWith(g, "SM");
+      keepVisibility(out, miles ? g.substr(0, g.size() - 2) : g, miles, 0);
+    } else if (isWeather(g)) {
+      if (g != "//" && g.substr(0, 2) != "RE" && out.weather.size() < kMaxNotedGroups)
+        out.weather.emplace_back(g.substr(0, kMaxNotedGroupBytes));
+    } else if (isRunwayVisualRange(g) || g == "$") {
       // recognised, not used by the mapping ("$": the station needs maintenance)
     } else if (g == "WS" && (in.peek(1).substr(0, 1) == "R" || in.peek(1) == "ALL")) {
       // Wind shear on a runway ("WS R27", "WS ALL RWY"): supplementary.

@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "sky/geo/geodetic.hpp"
+#include "sky/weather/query.hpp"
 
 namespace sky::server {
 
@@ -66,6 +67,115 @@ weather::LayerWind layerWind(const std::optional<MetarWind>& wind) {
   return out;
 }
 
+enum class Obscuration { None, ShallowFog, Fog, Mist, Haze, Precipitation };
+
+// What a present-weather group says obscures the view at the station, and
+// how much of the area it covers. In the vicinity (VC) is not at the station.
+Obscuration obscurationOf(std::string_view g, double& coverage) {
+  if (g.substr(0, 2) == "VC") return Obscuration::None;
+  if (!g.empty() && (g[0] == '+' || g[0] == '-')) g.remove_prefix(1);
+  std::string_view descriptor = g.substr(0, 2);
+  static constexpr std::string_view kDescriptors[] = {"MI", "PR", "BC", "DR", "BL", "SH", "TS", "FZ"};
+  bool hasDescriptor = false;
+  for (std::string_view d : kDescriptors) hasDescriptor = hasDescriptor || descriptor == d;
+  std::string_view phenomena = hasDescriptor ? g.substr(2) : g;
+  auto has = [&](std::string_view code) {
+    for (std::size_t i = 0; i + 1 < phenomena.size(); i += 2)
+      if (phenomena.substr(i, 2) == code) return true;
+    return false;
+  };
+  if (has("FG")) {
+    coverage = descriptor == "BC" ? kFogPatchesCoverage : descriptor == "PR" ? kPartialFogCoverage : 1.0;
+    return descriptor == "MI" ? Obscuration::ShallowFog : Obscuration::Fog;
+  }
+  coverage = 1.0;
+  if (has("BR")) return Obscuration::Mist;
+  for (std::string_view code : {"HZ", "FU", "DU", "SA", "VA"})
+    if (has(code)) return Obscuration::Haze;
+  for (std::string_view code : {"DZ", "RA", "SN", "SG", "PL", "GR", "GS", "IC", "UP"})
+    if (has(code)) return Obscuration::Precipitation;
+  return Obscuration::None;
+}
+
+// Which obscuration names the layer when a report has several.
+int rank(Obscuration o) {
+  switch (o) {
+    case Obscuration::Fog: return 5;
+    case Obscuration::ShallowFog: return 4;
+    case Obscuration::Mist: return 3;
+    case Obscuration::Haze: return 2;
+    case Obscuration::Precipitation: return 1;
+    case Obscuration::None: break;
+  }
+  return 0;
+}
+
+// The report's obscuration layer's thickness, visibility and coverage, if it
+// has one (metar.hpp's rule).
+struct ObscurationLayer {
+  double thickness_m = 0;
+  double visibility_m = 0;
+  double coverage = 1;
+};
+
+std::optional<ObscurationLayer> obscurationLayer(const MetarReport& report) {
+  Obscuration worst = Obscuration::None;
+  double coverage = 1.0;
+  // Fog before mist before haze before precipitation (rank).
+  for (const std::string& g : report.weather) {
+    double c = 1.0;
+    const Obscuration o = obscurationOf(g, c);
+    if (o == Obscuration::None) continue;
+    if (rank(o) > rank(worst)) {
+      worst = o;
+      coverage = c;
+    }
+  }
+  const std::optional<double> reported =
+      report.visibility_m && !report.visibilityAbove && *report.visibility_m < kClearVisibility_m
+          ? report.visibility_m
+          : std::nullopt;
+  ObscurationLayer out;
+  out.coverage = coverage;
+  if (report.verticalVisibility) {
+    out.thickness_m = std::max(report.verticalVisibility_ft.value_or(kUnknownVerticalVisibility_ft) * kMetresPerFoot,
+                               kMinFogThickness_m);
+    out.visibility_m = reported.value_or(kFogDefaultVisibility_m);
+    return out;
+  }
+  switch (worst) {
+    case Obscuration::None: return std::nullopt;
+    case Obscuration::Fog:
+      out.thickness_m = kFogThickness_m;
+      out.visibility_m = reported.value_or(kFogDefaultVisibility_m);
+      return out;
+    case Obscuration::ShallowFog:
+      out.thickness_m = kShallowFogThickness_m;
+      out.visibility_m = reported.value_or(kFogDefaultVisibility_m);
+      return out;
+    case Obscuration::Mist:
+      if (report.visibilityAbove || (report.visibility_m && *report.visibility_m >= kClearVisibility_m)) return std::nullopt;
+      out.thickness_m = kMistThickness_m;
+      out.visibility_m = reported.value_or(kMistDefaultVisibility_m);
+      return out;
+    case Obscuration::Haze:
+      if (report.visibilityAbove || (report.visibility_m && *report.visibility_m >= kClearVisibility_m)) return std::nullopt;
+      out.thickness_m = kHazeThickness_m;
+      out.visibility_m = reported.value_or(kHazeDefaultVisibility_m);
+      return out;
+    case Obscuration::Precipitation: {
+      if (!reported || *reported >= kHazeDefaultVisibility_m) return std::nullopt;
+      double lowest_m = kPrecipitationObscurationTop_m;
+      for (const MetarCloud& cloud : report.clouds)
+        if (cloud.height_ft) lowest_m = std::min(lowest_m, *cloud.height_ft * kMetresPerFoot);
+      out.thickness_m = std::max(lowest_m, kMinFogThickness_m);
+      out.visibility_m = *reported;
+      return out;
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 Result<MetarSky> skyFromMetar(const MetarReport& report, const Station& station) {
@@ -93,10 +203,9 @@ Result<MetarSky> skyFromMetar(const MetarReport& report, const Station& station)
     layers.push_back(layer);
   };
 
-  if (report.verticalVisibility) {
-    const double top_m =
-        report.verticalVisibility_ft.value_or(kUnknownVerticalVisibility_ft) * kMetresPerFoot;
-    add(weather::CloudType::Stratus, station.elevation_m, std::max(top_m, kMinFogThickness_m), 1.0);
+  if (const std::optional<ObscurationLayer> fog = obscurationLayer(report)) {
+    add(weather::CloudType::Fog, station.elevation_m, fog->thickness_m, fog->coverage);
+    layers.back().density = weather::fogDensityForVisibility(fog->visibility_m);
   }
   for (const MetarCloud& cloud : report.clouds) {
     if (!cloud.height_ft) continue;  // cannot place
@@ -123,7 +232,15 @@ Result<MetarSky> skyFromMetar(const MetarReport& report, const Station& station)
     if (auto ok = weather::validate(layer); !ok)
       return fail(ok.error().code, report.icao + ": " + ok.error().detail);
   const bool reportedClear = report.cavok || report.noCloud != NoCloud::None;
-  return MetarSky{!layers.empty() || reportedClear, std::move(layers)};
+  // Fog under a sky the report does not give ("1200 BR //////"): the sky
+  // around the station stays as it is, and so does its air (the station
+  // replaces every layer or none; fog over another source's clouds is not
+  // drawn).
+  const bool skyRead = reportedClear || report.verticalVisibility ||
+                       std::any_of(layers.begin(), layers.end(),
+                                   [](const weather::CloudLayer& l) { return l.type != weather::CloudType::Fog; });
+  if (!skyRead) layers.clear();
+  return MetarSky{skyRead, std::move(layers)};
 }
 
 std::vector<Result<StationWeather>> layersFromMetarBatch(std::span<const std::string> reports,

@@ -3,6 +3,7 @@
 // decoded by the protocol decoder, as the listener will; expected values are
 // worked out by hand from the packet fields.
 #include "sky/server/cigi_weather.hpp"
+#include "sky/weather/query.hpp"
 
 #include <gtest/gtest.h>
 
@@ -82,7 +83,7 @@ TEST_P(CigiWeather, DisableRemovesOnlyALayerItEnabled) {
   EXPECT_TRUE(m.map(roundTrip({off}, GetParam()))->empty());
 }
 
-TEST_P(CigiWeather, FogAndPrecipitationIgnoredIgDefinedKept) {
+TEST_P(CigiWeather, PrecipitationIgnoredIgDefinedKept) {
   CigiWeatherMapper m;
   auto rain = layer2();
   rain.layerId = cigi::LayerId::Rain;
@@ -94,6 +95,31 @@ TEST_P(CigiWeather, FogAndPrecipitationIgnoredIgDefinedKept) {
   ASSERT_EQ(changes->size(), 1u);
   EXPECT_EQ(std::get<SetLayer>((*changes)[0]).layer.id, 12u);
   EXPECT_EQ(m.ignoredLayers(), 1u);
+}
+
+TEST_P(CigiWeather, GroundFogIsAFogLayerOfItsVisibilityRange) {
+  CigiWeatherMapper m;
+  cigi::WeatherControl fog;
+  fog.layerId = cigi::LayerId::GroundFog;
+  fog.cloudType = weather::CloudType::Stratus;  // not used: ground fog is fog
+  fog.coverage_pct = 100;
+  fog.baseElevation_m = 120;
+  fog.thickness_m = 90;
+  fog.visibility_m = 400;
+  auto changes = m.map(roundTrip({fog}, GetParam()));
+  ASSERT_TRUE(changes) << changes.error().detail;
+  ASSERT_EQ(changes->size(), 1u);
+  const auto& set = std::get<SetLayer>((*changes)[0]);
+  EXPECT_EQ(set.layer.id, 0u);
+  EXPECT_EQ(set.layer.type, weather::CloudType::Fog);
+  EXPECT_DOUBLE_EQ(set.layer.base_m, 120);
+  EXPECT_DOUBLE_EQ(set.layer.thickness_m, 90);
+  EXPECT_NEAR(weather::cloudVisibility_m(set.layer.density), 400, 1e-3);  // the float's 400 exactly
+  // No visibility range: refused, naming the field; nothing changes.
+  fog.visibility_m = 0;
+  auto refused = m.map(roundTrip({fog}, GetParam()));
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().detail.find("visibility range"), std::string::npos) << refused.error().detail;
 }
 
 TEST_P(CigiWeather, RegionWithItsLayers) {

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -18,6 +19,7 @@
 
 #include "sky/geo/geodetic.hpp"
 #include "sky/server/metar.hpp"
+#include "sky/weather/query.hpp"
 
 namespace sky::server {
 namespace {
@@ -139,23 +141,39 @@ TEST(MetarRealReports, MappingPerCategory) {
         return l.type == CloudType::Cumulus && l.thickness_m == kToweringCumulusThickness_m;
       }));
     }
-    if (c == "CAVOK" || c == "SKC" || c == "CLR") { EXPECT_TRUE(layers->empty()); }
+    // The clear codes say there is no cloud; fog or mist may still be there
+    // ("0800 BCFG NSC").
+    auto noCloud = [](const std::vector<CloudLayer>& ls) {
+      return std::all_of(ls.begin(), ls.end(), [](const CloudLayer& l) { return l.type == CloudType::Fog; });
+    };
+    if (c == "CAVOK" || c == "SKC" || c == "CLR") { EXPECT_TRUE(noCloud(*layers)); }
     if (c == "NSC") {
       if (row.icao == "LLBG") {  // NSC only in the BECMG trend; the body has VV012
         ASSERT_EQ(layers->size(), 1u);
         EXPECT_EQ((*layers)[0].base_m, station.elevation_m);
       } else {
-        EXPECT_TRUE(layers->empty());
+        EXPECT_TRUE(noCloud(*layers));
       }
     }
-    if (c == "NCD") { EXPECT_TRUE(layers->empty()); }
+    if (c == "NCD") { EXPECT_TRUE(noCloud(*layers)); }
     if (c == "VV") {
       ASSERT_FALSE(layers->empty());
       const CloudLayer& fog = (*layers)[0];
-      EXPECT_EQ(fog.type, CloudType::Stratus);
+      EXPECT_EQ(fog.type, CloudType::Fog);
       EXPECT_EQ(fog.base_m, station.elevation_m);
       EXPECT_EQ(fog.coverage, 1.0);
       EXPECT_NEAR(fog.thickness_m, std::max(*report->verticalVisibility_ft * kFt, kMinFogThickness_m), 1e-9);
+    }
+    // A fog layer is first, at most one, and draws the reported visibility
+    // (the densest fog the model has for a shorter one).
+    for (std::size_t i = 0; i < layers->size(); ++i) {
+      const CloudLayer& l = (*layers)[i];
+      if (l.type != CloudType::Fog) continue;
+      EXPECT_EQ(i, 0u);
+      if (report->visibility_m && !report->visibilityAbove && *report->visibility_m < kClearVisibility_m) {
+        EXPECT_NEAR(weather::cloudVisibility_m(l.density), std::max(*report->visibility_m, weather::kMinFogVisibility_m),
+                    1e-6 * *report->visibility_m);
+      }
     }
     if (c == "VRB") {
       EXPECT_TRUE(report->wind && report->wind->variable);
@@ -166,9 +184,10 @@ TEST(MetarRealReports, MappingPerCategory) {
       EXPECT_EQ((*layers)[0].coverage, kFewCoverage);
       EXPECT_NEAR((*layers)[0].base_m, station.elevation_m + 7400 * kFt, 1e-9);
     }
-    if (row.icao == "DRRT") {  // "FEW040 FEW050 CB": the second is a cumulonimbus
-      ASSERT_EQ(layers->size(), 2u);
-      EXPECT_EQ((*layers)[1].type, CloudType::Cumulonimbus);
+    if (row.icao == "DRRT") {  // "3000 SA FEW040 FEW050 CB": sand haze, and the second cloud is a cumulonimbus
+      ASSERT_EQ(layers->size(), 3u);
+      EXPECT_EQ((*layers)[0].type, CloudType::Fog);
+      EXPECT_EQ((*layers)[2].type, CloudType::Cumulonimbus);
     }
     if (c == "gust") { EXPECT_TRUE(report->wind && report->wind->gust_kt); }
     if (c == "var_sector") { EXPECT_TRUE(report->wind && report->wind->variableFrom_deg); }
@@ -248,6 +267,47 @@ TEST(MetarParse, UnitsCalmVrbAndVisibilityForms) {
   auto missingWind = parseMetar("ABCD 010000Z /////KT 4000N //// // NCD");
   ASSERT_TRUE(missingWind) << missingWind.error().detail;
   EXPECT_FALSE(missingWind->wind);
+}
+
+// Prevailing visibility in every form real reports use, and the present
+// weather kept as written.
+TEST(MetarParse, VisibilityAndPresentWeather) {
+  struct Case {
+    const char* body;
+    std::optional<double> visibility_m;
+    bool above, below;
+  };
+  const double mile = 1609.344;
+  const Case cases[] = {
+      {"9999 SCT030", 10000, true, false},
+      {"CAVOK", 10000, true, false},
+      {"0800 FG", 800, false, false},
+      {"0000 FG", 0, false, false},
+      {"4000 1200SW BR", 4000, false, false},  // the second group is a sector's minimum
+      {"9999NDV", 10000, true, false},
+      {"//// //", std::nullopt, false, false},
+      {"10SM CLR", 10 * mile, false, false},
+      {"P6SM SKC", 6 * mile, true, false},
+      {"M1/4SM FG", 0.25 * mile, false, true},
+      {"3/4SM BR", 0.75 * mile, false, false},
+      {"1 1/2SM -RA", 1.5 * mile, false, false},
+      {"1/4 SM FG", 0.25 * mile, false, false},
+      {"2 1/4 SM BR", 2.25 * mile, false, false},
+      {"1/0SM", std::nullopt, false, false},  // a zero denominator reads as no visibility
+      {"SCT030", std::nullopt, false, false},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.body);
+    auto r = parseMetar(std::string("ABCD 010000Z 00000KT ") + c.body + " 10/08 Q1013");
+    ASSERT_TRUE(r) << r.error().detail;
+    ASSERT_EQ(r->visibility_m.has_value(), c.visibility_m.has_value());
+    if (c.visibility_m) { EXPECT_NEAR(*r->visibility_m, *c.visibility_m, 1e-9); }
+    EXPECT_EQ(r->visibilityAbove, c.above);
+    EXPECT_EQ(r->visibilityBelow, c.below);
+  }
+  auto wx = parseMetar("ABCD 010000Z 00000KT 0600 -SHRA BCFG VCTS // RERA NSC 10/08 Q1013");
+  ASSERT_TRUE(wx) << wx.error().detail;
+  EXPECT_EQ(wx->weather, (std::vector<std::string>{"-SHRA", "BCFG", "VCTS"}));
 }
 
 TEST(MetarParse, StopsAtTrendRemarksAndAfterPressure) {
@@ -406,7 +466,8 @@ TEST(MetarLayers, ConvectiveFogAndUnknownGroups) {
   auto layers = mapped("VRB05KT 0200 FG VV003 FEW030CB SCT040TCU //////CB BKN///  ///050 FEW060///");
   ASSERT_TRUE(layers) << layers.error().detail;
   ASSERT_EQ(layers->size(), 5u);  // VV, CB, TCU, ///050 (as FEW), FEW060///; the two without height dropped
-  EXPECT_EQ((*layers)[0].type, CloudType::Stratus);
+  EXPECT_EQ((*layers)[0].type, CloudType::Fog);
+  EXPECT_NEAR(weather::cloudVisibility_m((*layers)[0].density), 200, 1e-9);
   EXPECT_EQ((*layers)[0].base_m, 500);
   EXPECT_NEAR((*layers)[0].thickness_m, 300 * kFt, 1e-9);
   EXPECT_EQ((*layers)[0].coverage, 1);
@@ -431,6 +492,49 @@ TEST(MetarLayers, ConvectiveFogAndUnknownGroups) {
   EXPECT_EQ((*highCb)[0].thickness_m, kCumulonimbusMinThickness_m);
 }
 
+// Obscuration -> a fog layer first, drawing the reported visibility, as deep
+// as its kind, over the part of the area it covers.
+TEST(MetarLayers, ObscurationIsAFogLayerOfTheReportedVisibility) {
+  struct Case {
+    const char* body;
+    double visibility_m, thickness_m, coverage;
+  };
+  const Case cases[] = {
+      {"0300 FG OVC002", 300, kFogThickness_m, 1.0},
+      {"0600 BCFG NSC", 600, kFogThickness_m, kFogPatchesCoverage},
+      {"0900 PRFG SCT010", 900, kFogThickness_m, kPartialFogCoverage},
+      {"0200 MIFG NSC", 200, kShallowFogThickness_m, 1.0},
+      {"2500 BR BKN008", 2500, kMistThickness_m, 1.0},
+      {"4000 HZ NSC", 4000, kHazeThickness_m, 1.0},
+      {"3000 FU NSC", 3000, kHazeThickness_m, 1.0},
+      {"FG NSC", kFogDefaultVisibility_m, kFogThickness_m, 1.0},  // no visibility group: FG's default
+      {"2000 +RA BKN015", 2000, 1500 * kFt, 1.0},                 // rain: from the lowest base down
+      {"3000 SN NSC", 3000, kPrecipitationObscurationTop_m, 1.0},
+      {"0300 FG VV002", 300, 200 * kFt, 1.0},
+      {"0050 FG VV001", weather::kMinFogVisibility_m, 100 * kFt, 1.0},  // denser than the model draws
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.body);
+    auto layers = mapped(std::string("00000KT ") + c.body);
+    ASSERT_TRUE(layers) << layers.error().detail;
+    ASSERT_FALSE(layers->empty());
+    const CloudLayer& fog = (*layers)[0];
+    EXPECT_EQ(fog.type, CloudType::Fog);
+    EXPECT_EQ(fog.id, 1u);
+    EXPECT_EQ(fog.base_m, 500);
+    EXPECT_NEAR(fog.thickness_m, c.thickness_m, 1e-9);
+    EXPECT_EQ(fog.coverage, c.coverage);
+    EXPECT_NEAR(weather::cloudVisibility_m(fog.density), c.visibility_m, 1e-9 * c.visibility_m);
+    for (std::size_t i = 1; i < layers->size(); ++i) EXPECT_NE((*layers)[i].type, CloudType::Fog);
+  }
+  // Nothing to draw: 10 km or more, rain that leaves 5 km, fog in the vicinity.
+  for (const char* body : {"9999 BR NSC", "P6SM HZ SKC", "6000 -RA BKN020", "9999 VCFG NSC", "CAVOK"}) {
+    auto layers = mapped(std::string("00000KT ") + body);
+    ASSERT_TRUE(layers) << body;
+    for (const CloudLayer& l : *layers) EXPECT_NE(l.type, CloudType::Fog) << body;
+  }
+}
+
 TEST(MetarLayers, ClearCodesGiveNoLayers) {
   for (const char* body : {"00000KT CAVOK", "00000KT 9999 NSC", "00000KT 9999 NCD", "00000KT 10SM SKC",
                            "00000KT 10SM CLR"}) {
@@ -444,7 +548,7 @@ TEST(MetarLayers, VerticalVisibilityNotMeasuredIsFog) {
   auto fog = mapped("00000KT 0100 FG VV///");
   ASSERT_TRUE(fog) << fog.error().detail;
   ASSERT_EQ(fog->size(), 1u);
-  EXPECT_EQ((*fog)[0].type, CloudType::Stratus);
+  EXPECT_EQ((*fog)[0].type, CloudType::Fog);
   EXPECT_EQ((*fog)[0].base_m, 500);
   EXPECT_NEAR((*fog)[0].thickness_m, kUnknownVerticalVisibility_ft * kFt, 1e-9);
 }
@@ -490,7 +594,8 @@ TEST(MetarLayers, Errors) {
 
 // The sky a report maps to, written back as groups: "FEW025 SCT045CB VV001",
 // "clear", "not observed", or "refused: <reason>". Heights above the station
-// in hundreds of feet, rounded; amounts from the coverage.
+// in hundreds of feet, rounded; amounts from the coverage; a fog layer under
+// no VV as "FOG" and the visibility it draws in metres ("FOG0800").
 std::string skyText(const std::string& report, double elevation_m) {
   auto r = parseMetar(report);
   if (!r) return "refused: " + r.error().detail;
@@ -502,6 +607,11 @@ std::string skyText(const std::string& report, double elevation_m) {
   char buf[32];
   for (std::size_t i = 0; i < sky->layers.size(); ++i) {
     const CloudLayer& l = sky->layers[i];
+    if (l.type == CloudType::Fog && !r->verticalVisibility) {
+      std::snprintf(buf, sizeof buf, "%sFOG%04ld", out.empty() ? "" : " ", std::lround(weather::cloudVisibility_m(l.density)));
+      out += buf;
+      continue;
+    }
     const bool fog = i == 0 && r->verticalVisibility;
     const int hundreds = static_cast<int>(std::lround((fog ? l.thickness_m : l.base_m - elevation_m) / kFt / 100));
     const char* amount = fog                              ? "VV"
@@ -547,8 +657,8 @@ TEST(MetarOddities, EachMapsToWhatItSays) {
       {"METAR KBOS 221154Z 04012KT M1/4SM FG VV001 05/05 A2992 RMK AO2", "VV001"},
       {"METAR KDEN 221153Z 25012KT P6SM FEW080 SCT150 BKN250 10/M05 A3012 RMK AO2 SLP187",
        "FEW080 SCT150 BKN250"},
-      {"METAR KJFK 221151Z 31012KT 1/4 SM FG OVC002 08/08 A2990", "OVC002", "", "SM"},
-      {"METAR KSEA 221153Z 18010KT 1 1/4 SM -RA BR OVC008 10/09 A2985", "OVC008", "", "1/4 SM"},
+      {"METAR KJFK 221151Z 31012KT 1/4 SM FG OVC002 08/08 A2990", "FOG0402 OVC002", "", "SM"},
+      {"METAR KSEA 221153Z 18010KT 1 1/4 SM -RA BR OVC008 10/09 A2985", "FOG2012 OVC008", "", "1/4 SM"},
       {"METAR KOKC 221153Z 20025G35KT 1/2SM +FC BKN020CB 25/20 A2980", "BKN020CB"},
       {"METAR CYYZ 221200Z 27015G25KT 15SM FEW040 SCT250 M05/M12 A2990 RMK SC1CI3", "FEW040 SCT250"},
       {"METAR KORD 221151Z 27010KT 10SM BKN045 10/02 A2992 RMK AO2 SLP133 $", "BKN045"},
@@ -558,32 +668,32 @@ TEST(MetarOddities, EachMapsToWhatItSays) {
       {"METAR YSSY 221130Z 18015KT 9999 RERA FEW020 BKN035 15/12 Q1015", "FEW020 BKN035"},
       {"METAR EGLL 221150Z 27015KT 9999 SCT030 14/08 Q1013 WS R27L NOSIG", "SCT030"},
       {"METAR LFPG 221200Z 27015KT 9999 WS R27 SCT030 14/08 Q1013", "SCT030", "", "R27"},
-      {"METAR EGLL 221150Z 27010KT 0800 R24/P1500N FG BKN002 09/09 Q1018", "BKN002"},
+      {"METAR EGLL 221150Z 27010KT 0800 R24/P1500N FG BKN002 09/09 Q1018", "FOG0800 BKN002"},
       {"METAR LGAV 221150Z 36012KT 9999 FEW025 22/14 Q1013=", "FEW025"},
       // Metres per second, NDV, CAVOK, NSC.
       {"METAR UUEE 221130Z 18003MPS 9999 BKN020 08/04 Q1013=", "BKN020"},
       {"METAR LIRF 221150Z 24008KT 9999NDV SCT030CB 20/15 Q1012", "SCT030CB"},
       {"METAR ZBAA 221200Z 36004MPS CAVOK M05/M20 Q1030 NOSIG", "clear"},
-      {"METAR OMDB 221200Z 33012KT 5000 DU NSC 32/10 Q1008", "clear"},
-      {"METAR VIDP 221200Z 00000KT 0800 FG NSC 12/11 Q1019 NOSIG", "clear"},
+      {"METAR OMDB 221200Z 33012KT 5000 DU NSC 32/10 Q1008", "FOG5000"},
+      {"METAR VIDP 221200Z 00000KT 0800 FG NSC 12/11 Q1019 NOSIG", "FOG0800"},
       {"METAR SBGR 221200Z 16008KT CAVOK 25/14 Q1018", "clear"},
       {"METAR FAOR 221200Z 32008KT 9999 SCT080TCU 24/08 Q1022", "SCT080TCU"},
       {"METAR EGPD 221150Z 22015KT 9999 FEW012 SCT018 BKN025 OVC040 10/08 Q1005", "FEW012 SCT018 BKN025 OVC040"},
       {"METAR RJTT 221200Z 34005KT 9999 FEW030 SCT100 BKN/// 15/08 Q1022", "FEW030 SCT100"},
       // Groups no standard has: skipped, the sky still read.
       {"METAR LJLJ 221150Z 24008KT 9999 -VCTSRA FEW025 SCT045 12/06 Q1018", "FEW025 SCT045", "-VCTSRA"},
-      {"METAR DRRT 131600Z 12018KT 3000 SA FEW040 FEW050 CB 36/18 Q1009=", "FEW040 FEW050CB", "", "CB"},
+      {"METAR DRRT 131600Z 12018KT 3000 SA FEW040 FEW050 CB 36/18 Q1009=", "FOG3000 FEW040 FEW050CB", "", "CB"},
       {"METAR KLAX 221153Z 25008KT 10SM M FEW015 18/12 A2995", "FEW015", "M"},
       {"METAR LOWW 221150Z 30010KT 9999 BKN030 BKN030 08/03 Q1020", "BKN030", "BKN030"},
       {"METAR LOWI 221150Z 27005KT 9999 BKN0x5 SCT080 10/02 Q1020", "SCT080", "BKN0x5"},
       {"METAR LEMD 221200Z 9999 27010KT SCT040 18/05 Q1020", "SCT040"},
       {"METAR UKOO 141235Z 02002MPS 340V080 4200 -1004SE R34/////N -SHRA SCT012 SCT018CB 20/16 Q1013",
-       "SCT012 SCT018CB", "-1004SE"},
+       "FOG4200 SCT012 SCT018CB", "-1004SE"},
       {"metar lszh 221150z 24005kt 9999 few040 12/06 q1018", "FEW040"},
       {"2018/09/14 12:35 UKOO 141235Z 02002MPS 9999 SCT012 20/16 Q1013", "SCT012", "2018/09/14 12:35"},
       {"METAR: LJLJ 221150Z 24008KT 9999 BKN030 12/06 Q1018", "BKN030", "METAR:"},
       {"metar lszh 221150z 24005kt 9999 few040 xyz 12/06 q1018", "FEW040", "xyz"},  // quoted as written
-      {"SPECI KXYZ 221210Z 27010KT 3SM -TSRA BR SCT008 BKN020CB OVC050 20/18 A2992 RMK", "SCT008 BKN020CB OVC050"},
+      {"SPECI KXYZ 221210Z 27010KT 3SM -TSRA BR SCT008 BKN020CB OVC050 20/18 A2992 RMK", "FOG4828 SCT008 BKN020CB OVC050"},
       {"METAR CYSY NIL=", "refused: CYSY: NIL report (no observation)"},
   };
   int read = 0;

@@ -3,8 +3,11 @@
 //
 // Layer ids: CIGI Cloud Layer 1..3 become our layers 1..3; IG-defined ids
 // 10..255 are taken as further cloud layers with the same id. Ground Fog (0)
-// and the precipitation/obscurant ids 4..9 (rain, snow, sleet, hail, sand,
-// dust) have no counterpart in our model and are ignored (counted).
+// becomes our layer 0 of type fog, its density the packet's visibility range
+// (weather::fogDensityForVisibility; a range <= 0 is refused), its cloud type
+// field not used. The precipitation/obscurant ids 4..9 (rain, snow, sleet,
+// hail, sand, dust) have no counterpart in our model yet and are ignored
+// (counted).
 //
 // Weather Control, global scope: enabled -> SetLayer (coverage % / 100, base
 // elevation, thickness, transition band, cloud type, horizontal wind speed,
@@ -14,7 +17,7 @@
 // leaves) the layers of the region given by Entity/Region ID, and the region
 // is sent whole as SetRegion once an Environmental Region Control has placed
 // it. Entity scope is rejected (no entity weather in our model). Ignored
-// fields: humidity, air temperature, visibility, scud, random winds and
+// fields: humidity, air temperature, visibility (but ground fog's), scud, random winds and
 // lightning, severity, pressure, aerosol concentration.
 //
 // Environmental Region Control: Active -> SetRegion (centre, size, corner

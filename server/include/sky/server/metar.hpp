@@ -96,6 +96,17 @@ struct MetarReport {
   std::vector<MetarCloud> clouds;  // in report order (ascending height by rule)
   bool verticalVisibility = false;                // a VV group is present
   std::optional<int> verticalVisibility_ft;       // empty for "VV///"
+  // Prevailing visibility, m (statute miles converted; the first visibility
+  // group; a later one is a sector's minimum and is not kept). 9999 and
+  // CAVOK are "10 km or more", P6SM "more than 6 miles" (visibilityAbove);
+  // M1/4SM "less than a quarter mile" (visibilityBelow). Empty for "////"
+  // or no group.
+  std::optional<double> visibility_m;
+  bool visibilityAbove = false;
+  bool visibilityBelow = false;
+  // Present weather groups as reported ("-SHRA", "BCFG", "VCTS"), in order,
+  // at most kMaxNotedGroups; recent weather (RE..) and "//" not kept.
+  std::vector<std::string> weather;
   std::optional<int> temperature_degC;
   std::optional<int> dewpoint_degC;
   std::optional<double> qnh_hPa;  // Q in hPa, or A (hundredths of inHg) converted
@@ -148,6 +159,31 @@ inline constexpr double kScatteredCoverage = 3.5 / 8;
 inline constexpr double kBrokenCoverage = 6.0 / 8;
 inline constexpr double kOvercastCoverage = 1.0;
 
+// Obscuration (fog, mist, haze, or the rain or snow that cuts the
+// visibility) becomes a fog-type layer from the station up, whose density
+// gives the reported visibility (weather::fogDensityForVisibility). Its
+// depth when no VV group gives it: typical radiation fog 100-300 m deep, mist
+// a little deeper, haze and smoke the boundary layer's 1-2 km, shallow fog
+// (MIFG) under the eye's height of a tower, precipitation down from the
+// lowest cloud base (or kPrecipitationObscurationTop_m without one). Round
+// mid values, not measurements.
+inline constexpr double kFogThickness_m = 150;
+inline constexpr double kShallowFogThickness_m = 30;
+inline constexpr double kMistThickness_m = 300;
+inline constexpr double kHazeThickness_m = 1500;
+inline constexpr double kPrecipitationObscurationTop_m = 1000;
+// The visibility an obscuration group implies when the report gives none
+// (FG: below 1 km, BR: 1-5 km, HZ and the others: at most 5 km; WMO-No. 306).
+inline constexpr double kFogDefaultVisibility_m = 500;
+inline constexpr double kMistDefaultVisibility_m = 3000;
+inline constexpr double kHazeDefaultVisibility_m = 5000;
+// Visibility from which nothing is drawn: 9999 (10 km or more) is the
+// report's clear air.
+inline constexpr double kClearVisibility_m = 10000;
+// Patches (BC) and partial (PR) fog cover part of the area.
+inline constexpr double kFogPatchesCoverage = 0.5;
+inline constexpr double kPartialFogCoverage = 0.75;
+
 // VV/// (sky obscured, vertical visibility not measured, as automatic
 // stations send in fog): the fog is taken as deep as VV001, the smallest
 // vertical visibility above "less than 100 ft" a report can give.
@@ -171,8 +207,15 @@ struct MetarSky {
 //   station: low FEW/SCT cumulus, BKN stratocumulus, OVC stratus below
 //   kStratusMaxBase_m else stratocumulus; middle FEW/SCT altocumulus, BKN/OVC
 //   altostratus; high cirrus;
-// * VV hhh -> stratus (fog) from the station elevation, coverage 1, top at the
-//   vertical visibility (VV/// at kUnknownVerticalVisibility_ft);
+// * obscuration -> a fog-type layer first (id 1) from the station elevation,
+//   density for the prevailing visibility (or the group's default), when a
+//   report has VV, a fog/mist/haze group (FG, BR, HZ, FU, DU, SA, VA; not in
+//   the vicinity, VC) or a visibility under 5 km with precipitation; top at
+//   the vertical visibility (VV/// at kUnknownVerticalVisibility_ft, at
+//   least kMinFogThickness_m), else at the depth its group implies (above);
+//   BC patches and PR partial fog cover part of the area; a visibility of
+//   10 km or more draws no layer, except under a VV group (the sky is
+//   obscured whatever the visibility says: kFogDefaultVisibility_m);
 // * a cloud group with a height and unknown amount ("///074///", a ceilometer
 //   that saw a base but no amount) is taken as FEW: cloud is there, and FEW is
 //   the least the report can mean; a group with no height ("FEW///",
@@ -181,7 +224,9 @@ struct MetarSky {
 // * every layer gets the surface wind (VRB -> direction 0; calm or missing
 //   wind -> 0 m/s; gusts ignored);
 // * CAVOK/NSC/NCD/SKC/CLR with no cloud group -> observed, no layers;
-// * nothing of the above -> not observed (MetarSky::observed false).
+// * nothing of the above -> not observed (MetarSky::observed false), also
+//   when the report has fog but no sky ("1200 BR //////": the station's
+//   weather replaces every layer or none, so its fog is not drawn).
 // Errors (InvalidArgument): a NIL report, a station of another ICAO or with
 // non-finite position, a layer weather::validate rejects (BKN999: a base
 // above 20 km).
