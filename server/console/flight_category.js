@@ -86,11 +86,21 @@ export function flightCategory(text) {
 const CEILING_COVERAGE = 5 / 8;
 const FT_PER_M = 1 / 0.3048;
 
+// The weather model's fog: a density d stands for an extinction of 0.05 d
+// per metre, whose Koschmieder range (3.912 / extinction) is the visibility
+// (protocol/weather/include/sky/weather/query.hpp).
+const FOG_EXTINCTION_PER_DENSITY = 0.05, KOSCHMIEDER_DEPTH = 3.912;
+
 // The category from a station region's layers alone (the server restarted
-// and no longer has the report's text): the ceiling is the lowest base with
-// 5 oktas or more above the station; visibility is not in the weather model,
-// so a clear sky counts as VFR by its ceiling only.
+// and no longer has the report's text): the ceiling is the lowest cloud base
+// with 5 oktas or more above the station; the visibility is its fog's (the
+// layer of type "fog" a report's obscuration became), or unknown without.
 export function categoryFromLayers(layers, elevation_m) {
-  const bases = layers.filter((l) => l.coverage >= CEILING_COVERAGE).map((l) => (l.base_m - elevation_m) * FT_PER_M);
-  return categoryOf(bases.length ? Math.max(0, Math.min(...bases)) : Infinity, null);
+  const cloud = layers.filter((l) => l.type !== "fog" && l.coverage >= CEILING_COVERAGE);
+  const bases = cloud.map((l) => (l.base_m - elevation_m) * FT_PER_M);
+  const fog = layers.filter((l) => l.type === "fog" && l.coverage > 0 && l.density > 0);
+  const visibility_sm = fog.length
+    ? Math.min(...fog.map((l) => KOSCHMIEDER_DEPTH / (FOG_EXTINCTION_PER_DENSITY * l.coverage * l.density))) / STATUTE_MILE_M
+    : null;
+  return categoryOf(bases.length ? Math.max(0, Math.min(...bases)) : Infinity, visibility_sm);
 }

@@ -48,6 +48,10 @@ nlohmann::json conditionsJson(const LiveWeather& weather, const ConditionsQuery&
             {"from_deg", pw.wind.fromDirection_deg},
             {"vertical_mps", pw.wind.vertical_mps}}},
           {"cloud_density", pw.cloudDensity},
+          // In cloud or fog its Koschmieder range (what the renderers draw and
+          // their CIGI answer gives); null in clear air, whose haze the host sets.
+          {"visibility_m", pw.cloudDensity > 0 ? nlohmann::json(weather::cloudVisibility_m(pw.cloudDensity))
+                                               : nlohmann::json(nullptr)},
           {"layer_id", pw.layerId ? nlohmann::json(*pw.layerId) : nlohmann::json(nullptr)},
           {"air_temperature_c", air ? air->temperature_c : weather::isaTemperature_c(q.alt_m)},
           {"humidity_pct", air && air->humidity_pct >= 0 ? nlohmann::json(air->humidity_pct) : nlohmann::json(nullptr)},

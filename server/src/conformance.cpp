@@ -26,10 +26,12 @@ struct Layer {
   double base_m = 0;
 };
 
+// The lowest base with 5 oktas or more; fog (its slot) is an obscuration
+// whose visibility the check compares instead.
 std::optional<double> ceilingOf(const std::vector<Layer>& layers) {
   std::optional<double> c;
   for (const Layer& l : layers)
-    if (l.oktas >= 5 && (!c || l.base_m < *c)) c = l.base_m;
+    if (l.id != kMetarFogSlot && l.oktas >= 5 && (!c || l.base_m < *c)) c = l.base_m;
   return c;
 }
 
@@ -44,7 +46,29 @@ constexpr double kMaxClockOffset_s = 100 * 365.25 * 86400;
 
 nlohmann::json optional(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
 
+// A pilot's eye over the station's ground (the visibility a METAR reports).
+constexpr double kEyeHeight_m = 2;
+
+// The visibility a station reports (its fog slot as mapped: metar.hpp) or a
+// renderer draws at a point (the point query's cloud density), m; none: 10 km
+// or more, no obscuration in the weather.
+std::optional<double> fogVisibility(const std::vector<weather::CloudLayer>& layers) {
+  for (const auto& l : layers)
+    if (l.id == kMetarFogSlot && l.coverage > 0 && l.density > 0) return weather::cloudVisibility_m(l.coverage * l.density);
+  return std::nullopt;
+}
+std::optional<double> drawnVisibility(const weather::PointWeather& pw) {
+  if (!(pw.cloudDensity > 0)) return std::nullopt;
+  const double v = weather::cloudVisibility_m(pw.cloudDensity);
+  return v < kClearVisibility_m ? std::optional<double>(v) : std::nullopt;
+}
+
 }  // namespace
+
+double visibilityTolerance_m(double visibility_m) {
+  if (visibility_m <= 600) return 50;
+  return (visibility_m <= 1500 ? 0.1 : 0.2) * visibility_m;
+}
 
 int oktas(double cover) {
   if (!(cover > 0)) return 0;
@@ -100,6 +124,7 @@ nlohmann::json conformanceJson(const LiveWeather& weather, std::span<const Stati
   struct StationPoint {
     const weather::Region* region;
     std::string icao;
+    std::optional<double> elevation_m;
   };
   std::vector<StationPoint> stationPoints;
   std::size_t stationsInArea = 0;
@@ -108,11 +133,14 @@ nlohmann::json conformanceJson(const LiveWeather& weather, std::span<const Stati
     ++stationsInArea;
     if (stationPoints.size() >= q.maxStations) continue;
     std::string icao;
+    std::optional<double> elevation_m;
     // The region's centre is the station's (its longitude normalised).
     for (const Station& s : stations)
-      if (std::abs(s.lat_deg - r.centerLat_deg) < 1e-9 && std::abs(std::remainder(s.lon_deg - r.centerLon_deg, 360.0)) < 1e-9)
+      if (std::abs(s.lat_deg - r.centerLat_deg) < 1e-9 && std::abs(std::remainder(s.lon_deg - r.centerLon_deg, 360.0)) < 1e-9) {
         icao = s.icao;
-    stationPoints.push_back({&r, icao});
+        elevation_m = s.elevation_m;
+      }
+    stationPoints.push_back({&r, icao, elevation_m});
   }
   struct GridPoint {
     double lat, lon;
@@ -183,16 +211,28 @@ nlohmann::json conformanceJson(const LiveWeather& weather, std::span<const Stati
     for (const auto& [id, p] : byId) worst = std::max(worst, std::abs(p.second - p.first));
     const auto cr = ceilingOf(reported), cd = ceilingOf(drawn);
     const bool ceilingOk = (!cr && !cd) || (cr && cd && std::abs(*cr - *cd) <= kCeilingTolerance_m);
-    const bool ok = worst <= kOktaTolerance && ceilingOk;
+    // Visibility at a pilot's eye over the station's ground (the fog's base,
+    // else the station table's elevation), through the same point query the
+    // CIGI answer uses.
+    const std::optional<double> vr = fogVisibility(r.layers);
+    double ground_m = s.elevation_m.value_or(0);
+    for (const auto& l : r.layers)
+      if (l.id == kMetarFogSlot) ground_m = l.base_m;
+    const std::optional<double> vd =
+        drawnVisibility(weather::weatherAt(local, lookup, r.centerLat_deg, r.centerLon_deg, ground_m + kEyeHeight_m));
+    const bool visibilityOk = (!vr && !vd) || (vr && vd && std::abs(*vd - *vr) <= visibilityTolerance_m(*vr));
+    const bool ok = worst <= kOktaTolerance && ceilingOk && visibilityOk;
     stationsOk += ok;
     stationRows.push_back({{"region_id", r.id},
                            {"icao", s.icao.empty() ? nlohmann::json(nullptr) : nlohmann::json(s.icao)},
                            {"lat_deg", r.centerLat_deg},
                            {"lon_deg", r.centerLon_deg},
-                           {"reported", {{"layers", layersJson(reported)}, {"ceiling_m", optional(cr)}, {"visibility_m", nullptr}}},
-                           {"drawn", {{"layers", layersJson(drawn)}, {"ceiling_m", optional(cd)}, {"visibility_m", nullptr}}},
+                           {"reported", {{"layers", layersJson(reported)}, {"ceiling_m", optional(cr)}, {"visibility_m", optional(vr)}}},
+                           {"drawn", {{"layers", layersJson(drawn)}, {"ceiling_m", optional(cd)}, {"visibility_m", optional(vd)}}},
                            {"oktas_off", worst},
                            {"ceiling_off_m", cr && cd ? nlohmann::json(*cd - *cr) : nlohmann::json(nullptr)},
+                           {"visibility_off_m", vr && vd ? nlohmann::json(*vd - *vr) : nlohmann::json(nullptr)},
+                           {"visibility_ok", visibilityOk},
                            {"ok", ok}});
   }
 
@@ -226,8 +266,8 @@ nlohmann::json conformanceJson(const LiveWeather& weather, std::span<const Stati
 
   return {{"clock_s", clock_s},
           {"tile_level", kConformanceLevel},
-          {"tolerances", {{"oktas", kOktaTolerance}, {"ceiling_m", kCeilingTolerance_m}}},
-          {"visibility", "not in the weather model yet"},
+          {"tolerances", {{"oktas", kOktaTolerance}, {"ceiling_m", kCeilingTolerance_m},
+                          {"visibility", "WMO-No. 8: 50 m up to 600 m, 10 % to 1500 m, 20 % above"}}},
           {"forecast", field ? nlohmann::json(field->forecast().name()) : nlohmann::json(nullptr)},
           {"stations", stationRows},
           {"grid", gridRows},

@@ -40,8 +40,8 @@ std::vector<weather::CloudLayer> slotted(const StationWeather& s) {
   std::map<std::uint32_t, weather::CloudLayer> out;
   for (std::size_t i = 0; i < s.layers.size(); ++i) {
     weather::CloudLayer l = s.layers[i];
-    // A VV group comes first and starts at the station: fog.
-    const bool fog = s.report.verticalVisibility && i == 0;
+    // Fog (a VV group, or an obscuration: metar.hpp) comes first and starts at the station.
+    const bool fog = l.type == weather::CloudType::Fog;
     const std::uint32_t slot = fog ? kMetarFogSlot : metarSlot(l);
     l.id = slot;
     auto it = out.find(slot);

@@ -143,6 +143,10 @@ std::optional<ObscurationLayer> obscurationLayer(const MetarReport& report) {
     out.visibility_m = reported.value_or(kFogDefaultVisibility_m);
     return out;
   }
+  // 10 km or more: whatever obscures is elsewhere (patches around, haze
+  // aloft); nothing to draw at the station.
+  if (report.visibilityAbove || (report.visibility_m && *report.visibility_m >= kClearVisibility_m))
+    return std::nullopt;
   switch (worst) {
     case Obscuration::None: return std::nullopt;
     case Obscuration::Fog:
@@ -154,12 +158,10 @@ std::optional<ObscurationLayer> obscurationLayer(const MetarReport& report) {
       out.visibility_m = reported.value_or(kFogDefaultVisibility_m);
       return out;
     case Obscuration::Mist:
-      if (report.visibilityAbove || (report.visibility_m && *report.visibility_m >= kClearVisibility_m)) return std::nullopt;
       out.thickness_m = kMistThickness_m;
       out.visibility_m = reported.value_or(kMistDefaultVisibility_m);
       return out;
     case Obscuration::Haze:
-      if (report.visibilityAbove || (report.visibility_m && *report.visibility_m >= kClearVisibility_m)) return std::nullopt;
       out.thickness_m = kHazeThickness_m;
       out.visibility_m = reported.value_or(kHazeDefaultVisibility_m);
       return out;
@@ -205,7 +207,10 @@ Result<MetarSky> skyFromMetar(const MetarReport& report, const Station& station)
 
   if (const std::optional<ObscurationLayer> fog = obscurationLayer(report)) {
     add(weather::CloudType::Fog, station.elevation_m, fog->thickness_m, fog->coverage);
-    layers.back().density = weather::fogDensityForVisibility(fog->visibility_m);
+    // Patches denser than the prevailing visibility, so that a sight line
+    // through patches and gaps (and the point query's coverage x density)
+    // sees the reported one.
+    layers.back().density = std::min(1.0, weather::fogDensityForVisibility(fog->visibility_m) / fog->coverage);
   }
   for (const MetarCloud& cloud : report.clouds) {
     if (!cloud.height_ft) continue;  // cannot place

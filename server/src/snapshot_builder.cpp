@@ -82,7 +82,8 @@ Covering coverArea(const weather::SphericalCap& cap, int wantedLevel, std::size_
 }
 
 std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLayer> layers,
-                                                std::span<const weather::Region> regions, const weather::CellCentre* at) {
+                                                std::span<const weather::Region> regions, const weather::CellCentre* at,
+                                                double radius_m) {
   std::vector<weather::CloudLayer> table(layers.begin(), layers.end());
   std::map<std::uint32_t, weather::CloudLayer> regionOnly;
   std::vector<const weather::Region*> byId;
@@ -111,6 +112,24 @@ std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLa
           it->second = l;
           it->second.coverage = 0;
         }
+  }
+  if (at) {
+    // Fog: every region's in reach of the area, from the lowest base to the highest top.
+    std::map<std::uint32_t, std::pair<double, double>> fog;  // id -> base, top
+    for (const weather::Region* r : byId) {
+      if (sphereDistance_m(at->lat_deg, at->lon_deg, r->centerLat_deg, r->centerLon_deg) > radius_m + reachOf(*r)) continue;
+      for (const weather::CloudLayer& l : r->layers) {
+        if (l.type != weather::CloudType::Fog || !regionOnly.count(l.id)) continue;
+        const auto [it, fresh] = fog.try_emplace(l.id, l.base_m, l.base_m + l.thickness_m);
+        it->second = {std::min(it->second.first, l.base_m), std::max(it->second.second, l.base_m + l.thickness_m)};
+        (void)fresh;
+      }
+    }
+    for (const auto& [id, span] : fog) {
+      weather::CloudLayer& l = regionOnly[id];
+      l.base_m = span.first;
+      l.thickness_m = span.second - span.first;
+    }
   }
   for (const auto& [id, l] : regionOnly) table.push_back(l);
   return table;
@@ -491,7 +510,7 @@ BuiltSnapshot buildSnapshotWithGenerations(const stream::Subscribe& request,
                                            std::size_t maxCells, std::span<const weather::Region> regions,
                                            TileCache* cache, const LayerField* field) {
   const weather::CellCentre centre{request.area.centerLat_deg, request.area.centerLon_deg};
-  const std::vector<weather::CloudLayer> table = snapshotLayers(layers, regions, &centre);
+  const std::vector<weather::CloudLayer> table = snapshotLayers(layers, regions, &centre, request.area.radius_m);
   BuiltSnapshot built;
   weather::WeatherSnapshot& snapshot = built.snapshot;
   snapshot.weatherClock_s = clock_s;

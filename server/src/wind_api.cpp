@@ -19,7 +19,7 @@ nlohmann::json windJson(const LiveWeather& weather, const WindQuery& q) {
   const weather::SphericalCap cap{q.lat_deg, q.lon_deg, q.radius_m};
   // The layer table and wind tiles a subscriber of this area gets.
   const weather::CellCentre centre{q.lat_deg, q.lon_deg};
-  const std::vector<weather::CloudLayer> table = snapshotLayers(layers, regions, &centre);
+  const std::vector<weather::CloudLayer> table = snapshotLayers(layers, regions, &centre, q.radius_m);
   const WindTiles tiles = deriveWindTiles(cap, table, regions, field.get());
   const weather::WindField wind(tiles.level, tiles.tiles);
   const auto lookup = [&wind](const weather::CloudLayer& l, double lat, double lon) { return wind.windAt(l, lat, lon); };

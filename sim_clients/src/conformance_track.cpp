@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <map>
 #include <set>
+#include <tuple>
 
 #include "sky/core/assert.hpp"
 #include "sky/geo/geodetic.hpp"
@@ -174,9 +175,15 @@ Result<PointCheck> readPointCheck(const TrackPoint& at, std::string_view body, s
       const auto id = optionalNumber(s, "region_id");
       c.name = "region " + (id && *id >= 0 && *id < 1e9 ? std::to_string(static_cast<long>(*id)) : std::string("?"));
     }
-    for (const auto& [side, into] : {std::pair{"reported", &c.ceilingReported_m}, std::pair{"drawn", &c.ceilingDrawn_m}}) {
+    for (const auto& [side, ceiling, visibility] :
+         {std::tuple{"reported", &c.ceilingReported_m, &c.visibilityReported_m},
+          std::tuple{"drawn", &c.ceilingDrawn_m, &c.visibilityDrawn_m}}) {
       const auto part = s.find(side);
-      if (part != s.end() && part->is_object()) *into = optionalNumber(*part, "ceiling_m");
+      if (part == s.end() || !part->is_object()) continue;
+      *ceiling = optionalNumber(*part, "ceiling_m");
+      // A visibility is a range: a negative or absurd one is not shown.
+      const auto v = optionalNumber(*part, "visibility_m");
+      if (v && *v >= 0 && *v <= 1e9) *visibility = v;
     }
     c.distance_km = geo::geodesicDistance_m(at.lat_deg, at.lon_deg, c.lat_deg, c.lon_deg) / 1000;
     out.stations.push_back(std::move(c));
@@ -205,6 +212,7 @@ struct Totals {
   std::size_t gridPoints = 0, gridOk = 0;
   int worstOktasOff = 0;
   double worstCeilingOff_m = 0;
+  double worstVisibilityOff_m = 0;
 };
 
 Totals totalsOf(const std::vector<PointCheck>& checks) {
@@ -219,6 +227,9 @@ Totals totalsOf(const std::vector<PointCheck>& checks) {
       t.worstOktasOff = std::max(t.worstOktasOff, s.oktasOff);
       if (s.ceilingReported_m && s.ceilingDrawn_m)
         t.worstCeilingOff_m = std::max(t.worstCeilingOff_m, std::abs(*s.ceilingDrawn_m - *s.ceilingReported_m));
+      if (s.visibilityReported_m && s.visibilityDrawn_m)
+        t.worstVisibilityOff_m =
+            std::max(t.worstVisibilityOff_m, std::abs(*s.visibilityDrawn_m - *s.visibilityReported_m));
     }
     t.gridPoints += p.gridPoints;
     t.gridOk += p.gridOk;
@@ -240,7 +251,9 @@ json trackJson(const std::vector<PointCheck>& checks, const TrackCheckOptions& o
                           {"ok", s.ok},
                           {"oktas_off", s.oktasOff},
                           {"ceiling_reported_m", optionalJson(s.ceilingReported_m)},
-                          {"ceiling_drawn_m", optionalJson(s.ceilingDrawn_m)}});
+                          {"ceiling_drawn_m", optionalJson(s.ceilingDrawn_m)},
+                          {"visibility_reported_m", optionalJson(s.visibilityReported_m)},
+                          {"visibility_drawn_m", optionalJson(s.visibilityDrawn_m)}});
     points.push_back({{"frame", p.at.frame},
                       {"flight_s", p.at.flight_s},
                       {"lat_deg", p.at.lat_deg},
@@ -264,6 +277,7 @@ json trackJson(const std::vector<PointCheck>& checks, const TrackCheckOptions& o
             {"station_checks_ok", t.stationChecksOk},
             {"worst_oktas_off", t.worstOktasOff},
             {"worst_ceiling_off_m", t.worstCeilingOff_m},
+            {"worst_visibility_off_m", t.worstVisibilityOff_m},
             {"grid_points", t.gridPoints},
             {"grid_ok", t.gridOk}}}};
 }
@@ -276,10 +290,12 @@ std::string trackMarkdown(const std::vector<PointCheck>& checks, const TrackChec
   md += "Stations met: " + std::to_string(t.stationsMet.size()) + "; checks passed: " +
         std::to_string(t.stationChecksOk) + " of " + std::to_string(t.stationChecks) +
         "; worst layer difference: " + std::to_string(t.worstOktasOff) + " oktas; worst ceiling difference: " +
-        fixed(t.worstCeilingOff_m, 0) + " m; forecast grid points passed: " + std::to_string(t.gridOk) + " of " +
+        fixed(t.worstCeilingOff_m, 0) + " m; worst visibility difference: " + fixed(t.worstVisibilityOff_m, 0) +
+        " m; forecast grid points passed: " + std::to_string(t.gridOk) + " of " +
         std::to_string(t.gridPoints) + ".\n\n";
   if (t.pointsInReach == 0) return md + "No station or forecast grid point lies within reach of the flight.\n";
-  md += "| flight s | position | stations (distance km: ceiling reported / drawn m, oktas off) | grid points ok |\n";
+  md += "| flight s | position | stations (distance km: ceiling reported / drawn m, oktas off; visibility reported / "
+        "drawn m where under 10 km) | grid points ok |\n";
   md += "|---|---|---|---|\n";
   auto ceiling = [](const std::optional<double>& c) { return c ? fixed(*c, 0) : std::string("none"); };
   for (const PointCheck& p : checks) {
@@ -288,7 +304,11 @@ std::string trackMarkdown(const std::vector<PointCheck>& checks, const TrackChec
     for (const StationCheck& s : p.stations) {
       if (!cells.empty()) cells += "; ";
       cells += (s.ok ? "" : "**") + s.name + " (" + fixed(s.distance_km, 0) + ": " + ceiling(s.ceilingReported_m) +
-               " / " + ceiling(s.ceilingDrawn_m) + ", " + std::to_string(s.oktasOff) + ")" + (s.ok ? "" : " FAILS**");
+               " / " + ceiling(s.ceilingDrawn_m) + ", " + std::to_string(s.oktasOff) +
+               (s.visibilityReported_m || s.visibilityDrawn_m
+                    ? "; visibility " + ceiling(s.visibilityReported_m) + " / " + ceiling(s.visibilityDrawn_m)
+                    : std::string()) +
+               ")" + (s.ok ? "" : " FAILS**");
     }
     md += "| " + fixed(p.at.flight_s, 0) + " | " + fixed(p.at.lat_deg, 3) + ", " + fixed(p.at.lon_deg, 3) + " | " +
           (cells.empty() ? std::string("none") : cells) + " | " + std::to_string(p.gridOk) + " of " +

@@ -100,10 +100,15 @@ run("coverage", async () => {
   ]) assert(cat(groups) === want, `'${groups}' is ${cat(groups)}, expected ${want}`);
   assert(flightCategory("METAR LJLJ 221150Z 24008KT ////// 12/06 Q1018") === null, "no sky, no visibility: no category");
   // From a station region's layers alone (after a server restart): the
-  // lowest base of 5 oktas or more above the station, visibility unknown.
+  // lowest cloud base of 5 oktas or more above the station, the visibility
+  // its fog layer's (3.912 / (0.05 x coverage x density) m).
   const { categoryFromLayers } = await import("../../server/console/flight_category.js");
-  const layer = (coverage, base_m) => ({ coverage, base_m });
-  assert(categoryFromLayers([layer(1, 388 + 60)], 388) === "LIFR", "fog 200 ft above the station");
+  const layer = (coverage, base_m) => ({ type: "stratus", coverage, base_m, density: 1 });
+  const fog = (visibility_m, coverage = 1) => ({ type: "fog", coverage, base_m: 388, density: 3.912 / (0.05 * visibility_m * coverage) });
+  assert(categoryFromLayers([layer(1, 388 + 60)], 388) === "LIFR", "stratus 200 ft above the station");
+  assert(categoryFromLayers([fog(800)], 388) === "LIFR", "fog of 800 m: under 1 SM");
+  assert(categoryFromLayers([fog(4000), layer(0.75, 388 + 365.76)], 388) === "IFR", "mist of 2.5 SM under BKN012");
+  assert(categoryFromLayers([fog(7000, 0.5)], 388) === "MVFR", "haze patches: 4.3 SM, fog not a ceiling");
   assert(categoryFromLayers([layer(0.75, 388 + 300), layer(0.19, 388 + 100)], 388) === "IFR", "BKN at 984 ft; FEW below it no ceiling");
   assert(categoryFromLayers([layer(0, 300), layer(0.44, 1000)], 388) === "VFR", "no ceiling: VFR by ceiling");
   assert(categoryFromLayers([layer(1, 388 + 914.4)], 388) === "MVFR", "OVC at 3000 ft");

@@ -252,6 +252,11 @@ TEST(CigiConditions, TheRendererAnswersWhatTheServerSaysAtThePoint) {
     const double visibility = density > 0 ? std::min(kClearVisibility_m, 3.912 / (kExtinctionPerDensity * density))
                                           : kClearVisibility_m;
     EXPECT_NEAR(wcr.visibility_m, visibility, 1e-4 * visibility);
+    if (density > 0) {
+      EXPECT_NEAR(s["visibility_m"].get<double>(), 3.912 / (kExtinctionPerDensity * density), 1e-6);
+    } else {
+      EXPECT_TRUE(s["visibility_m"].is_null());
+    }
     // The densest layer's cloud water, in its Aerosol Concentration Response.
     if (!s["layer_id"].is_null()) {
       const auto layer = s["layer_id"].get<std::uint32_t>();
@@ -380,6 +385,64 @@ TEST(CigiConditions, TheRendererAnswersTheForecastsClouds) {
   EXPECT_GE(cloudy, 3) << "GFS has boundary-layer, low, middle and high cloud over 46.2 N 12.8 E on 2011-01-15 12Z";
   // The forecast's layers have no wind of their own: the boundary layer's is GFS's 10 m wind.
   EXPECT_GT(boundaryWind, 0.5);
+  EXPECT_EQ(render.stop(), 0) << render.log();
+  EXPECT_EQ(w.process->stop(), 0) << w.process->log();
+}
+
+// A METAR's fog reaches the renderer through the stream (a station region's
+// fog layer, its density in the tiles' 8 bits): the CIGI answer at a pilot's
+// eye over the station gives the reported visibility, as the server's point
+// query does (within WMO-No. 8's uncertainty, 20 % above 1500 m, which
+// covers the 8 bits), and 20 m above the mist's top the clear air's.
+TEST(CigiConditions, TheRendererAnswersAMetarsVisibility) {
+  const fs::path dir = fs::path(SKY_TEST_OUTPUT_DIR) / "conditions-fog";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  Weatherd w("conditions-fog-weatherd", SKY_SCENARIO_CLEAR);
+  ASSERT_GT(w.httpPort, 0u) << w.process->log();
+  const auto applied = w.request("POST", "/api/metar", R"({"apply": true, "reports": [
+      "METAR LIPA 221150Z 00000KT 0400 FG VV002 05/05 Q1025", "METAR LIPH 221150Z 24004KT 2500 BR SCT015 08/07 Q1021"],
+    "stations": [{"icao": "LIPA", "lat_deg": 46.0319, "lon_deg": 12.5965, "elevation_m": 125},
+                 {"icao": "LIPH", "lat_deg": 45.6484, "lon_deg": 12.1944, "elevation_m": 18}]})");
+  ASSERT_EQ(applied.status, 200) << applied.body;
+  ChildProcess render = startRenderer(dir, w.streamPort);
+  const unsigned cigiPort = waitForPortFile((dir / "render.port").string(), 120s);
+  ASSERT_GT(cigiPort, 0u) << render.log();
+  CigiHost host;
+  host.ownshipLat_deg = 45.85;
+  host.ownshipLon_deg = 12.4;
+  ASSERT_TRUE(waitForSnapshot(render, host, cigiPort, [](int layers, int count) { return layers >= 2 && count > 0; }))
+      << "no snapshot with the stations' tiles:\n" << render.log();
+  struct Case {
+    Point p;
+    double visibility_m;  // 0: clear air (the renderer's, kClearVisibility_m)
+  };
+  const Case cases[] = {
+      {{"LIPA, fog", 46.0319, 12.5965, 125 + 2}, 400},
+      {{"LIPH, mist", 45.6484, 12.1944, 18 + 2}, 2500},
+      {{"above LIPH's mist", 45.6484, 12.1944, 18 + 300 + 300 * 0.1 + 20}, 0},
+  };
+  for (std::size_t i = 0; i < std::size(cases); ++i) {
+    const Case& c = cases[i];
+    const IgAnswer ig = ask(host, cigiPort, static_cast<std::uint8_t>(60 + i), c.p);
+    ASSERT_TRUE(ig.weather) << c.p.what;
+    char target[160];
+    std::snprintf(target, sizeof target, "/api/conditions?lat_deg=%.6f&lon_deg=%.6f&alt_m=%.3f", c.p.lat_deg,
+                  c.p.lon_deg, c.p.alt_m);
+    const auto s = nlohmann::json::parse(w.request("GET", target, "", "").body);
+    SCOPED_TRACE(std::string(c.p.what) + ": server " + s.dump());
+    if (c.visibility_m == 0) {
+      EXPECT_EQ(ig.weather->visibility_m, kClearVisibility_m);
+      EXPECT_TRUE(s["visibility_m"].is_null());
+    } else {
+      const double tolerance = c.visibility_m <= 600 ? 50 : 0.2 * c.visibility_m;
+      EXPECT_NEAR(ig.weather->visibility_m, c.visibility_m, tolerance);
+      EXPECT_NEAR(s["visibility_m"].get<double>(), ig.weather->visibility_m, 1e-3 * c.visibility_m);
+      EXPECT_EQ(ig.weather->humidity_pct, 100);
+    }
+    std::printf("[conditions] %-20s reported %6.0f m, CIGI answer %8.1f m, server %s\n", c.p.what, c.visibility_m,
+                ig.weather->visibility_m, s["visibility_m"].dump().c_str());
+  }
   EXPECT_EQ(render.stop(), 0) << render.log();
   EXPECT_EQ(w.process->stop(), 0) << w.process->log();
 }

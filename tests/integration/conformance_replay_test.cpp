@@ -1,6 +1,6 @@
 // The conformance check along a replayed flight (issue 22): a weather server
 // with the GFS forecast and three METAR stations round the bundled glider
-// flight (NE Italy), a headless replay of a minute of it, and
+// flight (NE Italy, one of them in mist), a headless replay of a minute of it, and
 // skyshell-conformance asking the server's check at the replay's frames,
 // each at the weather clock the frame drew. Every station in reach draws its
 // report, the forecast's grid points their cover, and the table says so.
@@ -23,7 +23,7 @@ namespace {
 
 constexpr const char* kMetar = R"({"apply": true, "reports": [
     "METAR LIPA 221150Z 24008KT 9999 BKN020 12/06 Q1018",
-    "METAR LIPH 221150Z 24008KT 9999 FEW015 OVC040 12/06 Q1018",
+    "METAR LIPH 221150Z 24008KT 2500 BR FEW015 OVC040 12/06 Q1018",
     "METAR LIPQ 221150Z 24008KT CAVOK 12/06 Q1018"],
   "stations": [{"icao": "LIPA", "lat_deg": 46.0319, "lon_deg": 12.5965, "elevation_m": 125},
                {"icao": "LIPH", "lat_deg": 45.6484, "lon_deg": 12.1944, "elevation_m": 18},
@@ -83,6 +83,13 @@ TEST(ConformanceAlongAReplay, EveryStationInReachDrawsItsReport) {
       if (s["name"] == "LIPQ") {
         EXPECT_TRUE(s["ceiling_reported_m"].is_null());  // CAVOK
         EXPECT_TRUE(s["ceiling_drawn_m"].is_null());
+        EXPECT_TRUE(s["visibility_drawn_m"].is_null());
+      }
+      if (s["name"] == "LIPH") {
+        // 2500 BR: mist of that visibility; the ceiling is the overcast's, not the mist's.
+        EXPECT_NEAR(s["visibility_reported_m"].get<double>(), 2500, 1e-6);
+        EXPECT_NEAR(s["visibility_drawn_m"].get<double>(), 2500, 0.2 * 2500);
+        EXPECT_NEAR(s["ceiling_reported_m"].get<double>(), 18 + 4000 * 0.3048, 1);
       }
     }
     // The forecast's grid (2.5 degrees) has two points within 150 km (45 N

@@ -81,7 +81,8 @@ struct TypedLayer {
 };
 
 // Each type at a height and depth it has in the weather (the cirriform ones
-// thin and high), the camera in the middle of it looking slightly up.
+// thin and high, fog on the ground), the camera in the middle of it looking
+// slightly up.
 TEST(StabilityLimits, InsideALayerOfEveryCloudType) {
   SKY_RENDERER(r, kW, kH);
   const render::CpuReference reference = referenceFor(r);
@@ -90,7 +91,7 @@ TEST(StabilityLimits, InsideALayerOfEveryCloudType) {
       {T::Cumulus, 1500, 1500},      {T::Stratocumulus, 1200, 600}, {T::Stratus, 500, 400},
       {T::Nimbostratus, 1000, 2500}, {T::Cumulonimbus, 1000, 9000}, {T::Altocumulus, 4000, 800},
       {T::Altostratus, 4500, 1500},  {T::Cirrus, 9000, 400},        {T::Cirrostratus, 9000, 600},
-      {T::Cirrocumulus, 8000, 300},
+      {T::Cirrocumulus, 8000, 300},  {T::Fog, 0, 200},
   };
   for (const TypedLayer& t : layers) {
     const std::string name = std::string("inside_") + std::string(weather::toString(t.type));

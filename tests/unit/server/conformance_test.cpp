@@ -3,6 +3,8 @@
 // report, whichever came first; a station region that does not replace
 // every layer (as a hand-made one) is caught; grid points match the grid.
 #include <algorithm>
+#include <cstdio>
+#include <map>
 
 #include <gtest/gtest.h>
 
@@ -149,6 +151,49 @@ TEST(Conformance, StationsSharingASlotKeepTheirOwnBases) {
     ASSERT_NE(it, snap.layers.end());
     EXPECT_NEAR(it->base_m, base, 1) << "round " << lat << ", " << lon;
   }
+}
+
+// Fog and mist at three stations, clear air at two: each draws its reported
+// visibility at a pilot's eye over its ground (within WMO-No. 8's
+// uncertainty, which also covers the stream's 8-bit density), the clear ones
+// none; a station whose fog is taken away (a hand-made region) is caught.
+TEST(Conformance, StationsDrawTheirReportedVisibility) {
+  Fixture f;
+  f.gfs();
+  f.metar({"METAR LJLJ 221150Z 00000KT 0200 FG VV001 05/05 Q1025", "METAR LIPQ 221150Z 24008KT 3000 BR NSC 12/11 Q1018",
+           "METAR LOWK 221150Z 00000KT 0800 BCFG SCT004 04/04 Q1027", "METAR LIPA 221150Z 24008KT CAVOK 12/06 Q1018",
+           "METAR LIPH 221150Z 24008KT 9999 FEW030 12/06 Q1018"});
+  const auto j = f.check(0);
+  ASSERT_EQ(j["stations"].size(), 5u) << j.dump();
+  std::map<std::string, nlohmann::json> rows;
+  for (const auto& s : j["stations"]) rows[s["icao"].get<std::string>()] = s;
+  for (const auto& [icao, want] : std::map<std::string, double>{{"LJLJ", 200}, {"LIPQ", 3000}, {"LOWK", 800}}) {
+    const auto& s = rows[icao];
+    EXPECT_TRUE(s["ok"]) << s.dump();
+    EXPECT_NEAR(s["reported"]["visibility_m"].get<double>(), want, 1e-6 * want) << icao;
+    const double drawn = s["drawn"]["visibility_m"].get<double>();
+    EXPECT_NEAR(drawn, want, visibilityTolerance_m(want)) << icao;
+    std::printf("[ conformance ] %s visibility reported %.0f m, drawn %.0f m\n", icao.c_str(), want, drawn);
+  }
+  for (const char* icao : {"LIPA", "LIPH"}) {
+    EXPECT_TRUE(rows[icao]["ok"]) << rows[icao].dump();
+    EXPECT_TRUE(rows[icao]["reported"]["visibility_m"].is_null());
+    EXPECT_TRUE(rows[icao]["drawn"]["visibility_m"].is_null());
+  }
+  // LJLJ's region without its fog: reported fog, none drawn: caught.
+  auto regions = f.weather.regionsAt(f.weather.clockNow());
+  for (auto& r : regions)
+    if (std::abs(r.centerLat_deg - 46.2237) < 1e-9) {
+      for (auto& l : r.layers)
+        if (l.id == kMetarFogSlot) l.density = 0.001;  // 78 km: clear
+      ASSERT_TRUE(f.weather.submit({{SetRegion{r, {}}}, "test", "api"}));
+    }
+  const auto after = f.check(0);
+  for (const auto& s : after["stations"])
+    if (s["icao"] == "LJLJ") {
+      EXPECT_FALSE(s["visibility_ok"]) << s.dump();
+      EXPECT_FALSE(s["ok"]);
+    }
 }
 
 // A replay's frame drew the weather at its own clock: the check is made at

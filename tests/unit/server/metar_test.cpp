@@ -171,7 +171,7 @@ TEST(MetarRealReports, MappingPerCategory) {
       if (l.type != CloudType::Fog) continue;
       EXPECT_EQ(i, 0u);
       if (report->visibility_m && !report->visibilityAbove && *report->visibility_m < kClearVisibility_m) {
-        EXPECT_NEAR(weather::cloudVisibility_m(l.density), std::max(*report->visibility_m, weather::kMinFogVisibility_m),
+        EXPECT_NEAR(weather::cloudVisibility_m(l.coverage * l.density), std::max(*report->visibility_m, weather::kMinFogVisibility_m / l.coverage),
                     1e-6 * *report->visibility_m);
       }
     }
@@ -524,11 +524,11 @@ TEST(MetarLayers, ObscurationIsAFogLayerOfTheReportedVisibility) {
     EXPECT_EQ(fog.base_m, 500);
     EXPECT_NEAR(fog.thickness_m, c.thickness_m, 1e-9);
     EXPECT_EQ(fog.coverage, c.coverage);
-    EXPECT_NEAR(weather::cloudVisibility_m(fog.density), c.visibility_m, 1e-9 * c.visibility_m);
+    EXPECT_NEAR(weather::cloudVisibility_m(fog.coverage * fog.density), c.visibility_m, 1e-9 * c.visibility_m);
     for (std::size_t i = 1; i < layers->size(); ++i) EXPECT_NE((*layers)[i].type, CloudType::Fog);
   }
   // Nothing to draw: 10 km or more, rain that leaves 5 km, fog in the vicinity.
-  for (const char* body : {"9999 BR NSC", "P6SM HZ SKC", "6000 -RA BKN020", "9999 VCFG NSC", "CAVOK"}) {
+  for (const char* body : {"9999 BR NSC", "P6SM HZ SKC", "6000 -RA BKN020", "9999 VCFG NSC", "9999 BCFG NSC", "CAVOK"}) {
     auto layers = mapped(std::string("00000KT ") + body);
     ASSERT_TRUE(layers) << body;
     for (const CloudLayer& l : *layers) EXPECT_NE(l.type, CloudType::Fog) << body;

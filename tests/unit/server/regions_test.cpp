@@ -4,6 +4,7 @@
 // moves with its wind, and the tiles a renderer advects from an older
 // snapshot agree with a fresh one; a refused region leaves everything as it
 // was; regions survive a restart (same state hash); the JSON names bad fields.
+#include <algorithm>
 #include <filesystem>
 
 #include <GeographicLib/Geodesic.hpp>
@@ -105,6 +106,41 @@ TEST(Regions, AClearingAndAStormInTheTiles) {
   EXPECT_EQ(inStorm->blendType, weather::CloudType::None) << "layer 6's own type";
   EXPECT_NEAR(tileAt(s, 6, offset(46, 13.39, 0, 12000))->coverage, 0.0, 1e-6);
   EXPECT_NEAR(tileAt(s, 1, offset(46, 13.39, 0, 0))->coverage, 0.8, 1e-6) << "the storm has no layer 1";
+}
+
+// One base and top per layer id in a snapshot's table: a cloud layer only
+// regions have takes the geometry of the region weighing most at the
+// subscriber's centre; fog takes the lowest base and highest top of every
+// region in reach of the subscriber's area, so two stations' fog at 18 m
+// (300 m deep) and 125 m (61 m deep) both cover their own ground.
+TEST(Regions, FogInTheTableSpansEveryStationsFogInTheArea) {
+  auto fog = [](double base, double thickness) {
+    weather::CloudLayer l = layer(40, weather::CloudType::Fog, 1.0);
+    l.base_m = base;
+    l.thickness_m = thickness;
+    return l;
+  };
+  auto cloud = [](double base) {
+    weather::CloudLayer l = layer(45, weather::CloudType::Stratus, 1.0);
+    l.base_m = base;
+    return l;
+  };
+  const std::vector<weather::Region> regions = {cell(7, 45.65, 12.19, 4000, 20000, {fog(18, 300), cloud(600)}),
+                                                cell(8, 46.03, 12.60, 4000, 20000, {fog(125, 61), cloud(700)}),
+                                                cell(9, 40.0, 12.0, 4000, 20000, {fog(-50, 1000)})};  // 650 km south
+  const weather::CellCentre nearB{46.0, 12.6};
+  const auto table = snapshotLayers({}, regions, &nearB, 120000);
+  auto find = [&](std::uint32_t id) { return *std::find_if(table.begin(), table.end(), [&](const auto& l) { return l.id == id; }); };
+  EXPECT_EQ(find(40).base_m, 18);
+  EXPECT_EQ(find(40).base_m + find(40).thickness_m, 318);
+  EXPECT_EQ(find(40).coverage, 0);  // outside its regions there is none
+  EXPECT_EQ(find(45).base_m, 700);  // a cloud layer: the nearest station's
+  // A point query's table (radius 0) at the first station: its own fog.
+  const weather::CellCentre atA{45.65, 12.19};
+  const auto local = snapshotLayers({}, regions, &atA);
+  const auto it = std::find_if(local.begin(), local.end(), [](const auto& l) { return l.id == 40; });
+  EXPECT_EQ(it->base_m, 18);
+  EXPECT_EQ(it->thickness_m, 300);
 }
 
 TEST(Regions, AnotherTypeInARegionBlendsIntoTheLayer) {

@@ -66,10 +66,10 @@ TEST(ConformanceTrack, TheTargetAsksAtTheFramesClockAndPlace) {
 TEST(ConformanceTrack, AnAnswerBecomesTheTablesRows) {
   const TrackPoint at{7, 30, 46.0, 13.0, 1500, 5000};
   const std::string body = R"({"stations":[
-      {"region_id":100,"icao":"LIPQ","lat_deg":45.8275,"lon_deg":13.4722,"reported":{"ceiling_m":null},
-       "drawn":{"ceiling_m":null},"oktas_off":0,"ok":true},
+      {"region_id":100,"icao":"LIPQ","lat_deg":45.8275,"lon_deg":13.4722,"reported":{"ceiling_m":null,"visibility_m":800},
+       "drawn":{"ceiling_m":null,"visibility_m":795.5},"oktas_off":0,"ok":true},
       {"region_id":101,"icao":"L|P*\nA","lat_deg":46.0,"lon_deg":13.0,"reported":{"ceiling_m":800},
-       "drawn":{"ceiling_m":860},"oktas_off":2,"ok":false},
+       "drawn":{"ceiling_m":860,"visibility_m":-5},"oktas_off":2,"ok":false},
       {"region_id":102,"icao":null,"lat_deg":46.0,"lon_deg":13.1,"oktas_off":0,"ok":true}],
     "grid":[{"oktas_off":0,"ok":true},{"oktas_off":3,"ok":false},{"oktas_off":1,"ok":true}]})";
   const auto c = readPointCheck(at, body, 20);
@@ -82,6 +82,9 @@ TEST(ConformanceTrack, AnAnswerBecomesTheTablesRows) {
   EXPECT_FALSE(c->stations[1].ok);
   EXPECT_EQ(c->stations[1].oktasOff, 2);
   EXPECT_EQ(*c->stations[1].ceilingDrawn_m, 860);
+  EXPECT_EQ(*c->stations[0].visibilityReported_m, 800);
+  EXPECT_EQ(*c->stations[0].visibilityDrawn_m, 795.5);
+  EXPECT_FALSE(c->stations[1].visibilityDrawn_m) << "a negative range is not shown";
   EXPECT_EQ(c->stations[2].name, "region 102");
   EXPECT_EQ(c->gridPoints, 3u);
   EXPECT_EQ(c->gridOk, 2u);
@@ -95,8 +98,10 @@ TEST(ConformanceTrack, AnAnswerBecomesTheTablesRows) {
   EXPECT_EQ(j["summary"]["station_checks_ok"], 2);
   EXPECT_EQ(j["summary"]["stations_failed"], nlohmann::json::array({"L?P??A"}));
   EXPECT_DOUBLE_EQ(j["summary"]["worst_ceiling_off_m"].get<double>(), 60);
+  EXPECT_DOUBLE_EQ(j["summary"]["worst_visibility_off_m"].get<double>(), 4.5);
+  EXPECT_EQ(j["points"][0]["stations"][0]["visibility_drawn_m"], 795.5);
   const std::string md = trackMarkdown(all, {});
-  EXPECT_NE(md.find("| 30 | 46.000, 13.000 | LIPQ (41: none / none, 0); **L?P??A (0: 800 / 860, 2) FAILS**; region 102"),
+  EXPECT_NE(md.find("| 30 | 46.000, 13.000 | LIPQ (41: none / none, 0; visibility 800 / 796); **L?P??A (0: 800 / 860, 2) FAILS**; region 102"),
             std::string::npos)
       << md;
   EXPECT_NE(md.find("checks passed: 2 of 3"), std::string::npos) << md;

@@ -4,9 +4,12 @@
 // ones a renderer's snapshot carries, in the 8 bits the stream has) are read
 // at the point through the shared lookup (weather::snapshotLookup) and
 // compared with what the report or the grid says: cover in oktas per layer,
-// the ceiling (the lowest base with 5 oktas or more), and visibility (not in
-// the weather model yet: null). At the weather clock now, or at a clock the
-// query gives (`clock_s`: what a replay's frame drew). Tolerances: kOktaTolerance, kCeilingTolerance_m.
+// the ceiling (the lowest base with 5 oktas or more, fog not counted), and the visibility at
+// a pilot's eye over the station (the report's as mapped to its fog layer:
+// metar.hpp; null for 10 km or more) against the point query's there (what
+// the CIGI answer gives and the fog drawn has). At the weather clock now, or
+// at a clock the query gives (`clock_s`: what a replay's frame drew).
+// Tolerances: kOktaTolerance, kCeilingTolerance_m, visibilityTolerance_m.
 #pragma once
 
 #include <cstddef>
@@ -28,6 +31,10 @@ class LiveWeather;
 // within 100 ft.
 inline constexpr int kOktaTolerance = 1;
 inline constexpr double kCeilingTolerance_m = 30.48;
+// A visibility passes within WMO-No. 8's required measurement uncertainty
+// for meteorological optical range: 50 m up to 600 m, 10 % up to 1500 m,
+// 20 % above (it also covers the 8 bits the stream gives a tile's density).
+double visibilityTolerance_m(double visibility_m);
 // The tile level the renderers' detailed area gets (skyshell-render's 120 km
 // subscription), so the check reads the tiles they read.
 inline constexpr int kConformanceLevel = 11;

@@ -213,9 +213,11 @@ struct MetarSky {
 //   the vicinity, VC) or a visibility under 5 km with precipitation; top at
 //   the vertical visibility (VV/// at kUnknownVerticalVisibility_ft, at
 //   least kMinFogThickness_m), else at the depth its group implies (above);
-//   BC patches and PR partial fog cover part of the area; a visibility of
-//   10 km or more draws no layer, except under a VV group (the sky is
-//   obscured whatever the visibility says: kFogDefaultVisibility_m);
+//   BC patches and PR partial fog cover part of the area, denser by as much
+//   (so coverage x density, what a sight line through patches and gaps
+//   meets, is the reported visibility's); a visibility of 10 km or more
+//   draws no layer, except under a VV group (the sky is obscured whatever
+//   the visibility says: kFogDefaultVisibility_m);
 // * a cloud group with a height and unknown amount ("///074///", a ceilometer
 //   that saw a base but no amount) is taken as FEW: cloud is there, and FEW is
 //   the least the report can mean; a group with no height ("FEW///",

@@ -7,7 +7,7 @@
 // The scheme (what a station's region holds):
 // * Slots. A snapshot holds one base and one thickness per layer id, so a
 //   layer id must mean clouds at about the same height wherever it is used.
-//   Each reported group becomes its own layer in a slot: fog (VV) 40,
+//   Each reported group becomes its own layer in a slot: fog (VV, FG, BR...) 40,
 //   cumulonimbus 41, towering cumulus 42, and the other groups by the band of
 //   their base above mean sea level, 43 + band (kMetarBandTops_m). Two groups
 //   of one station in one band (FEW015 SCT016) merge into one layer: the

@@ -58,10 +58,15 @@ Covering coverArea(const weather::SphericalCap& cap, int wantedLevel, std::size_
 // it. Such a layer's other values (base, thickness, type) are those of the
 // region that weighs most at `at` (a subscriber's centre: near a METAR
 // station, its own report's base), or with none there, or no `at`, of the
-// lowest region id that has it.
+// lowest region id that has it. Fog hugs the ground, whose height differs
+// from station to station: a fog layer's base and top are instead the lowest
+// base and the highest top of that layer in every region that reaches within
+// radius_m of `at` (the subscriber's area), so each station's fog covers its
+// own ground and the tiles' density gives each its visibility (the fog is
+// drawn as deep as the deepest in the area).
 std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLayer> layers,
                                                 std::span<const weather::Region> regions,
-                                                const weather::CellCentre* at = nullptr);
+                                                const weather::CellCentre* at = nullptr, double radius_m = 0);
 
 // One layer's tiles over a covering (every cell, in the covering's order),
 // with what lets two of them be compared without reading them all: the value

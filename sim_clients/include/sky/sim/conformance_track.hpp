@@ -74,6 +74,8 @@ struct StationCheck {
   bool ok = false;
   int oktasOff = 0;        // the largest okta difference of a layer
   std::optional<double> ceilingReported_m, ceilingDrawn_m;
+  // At a pilot's eye over the station; none: 10 km or more.
+  std::optional<double> visibilityReported_m, visibilityDrawn_m;
 };
 
 // The server's answer at one point.
