@@ -131,50 +131,47 @@ std::optional<ObscurationLayer> obscurationLayer(const MetarReport& report) {
       coverage = c;
     }
   }
-  const std::optional<double> reported =
-      report.visibility_m && !report.visibilityAbove && *report.visibility_m < kClearVisibility_m
-          ? report.visibility_m
-          : std::nullopt;
+  // The visibility the report gives under 10 km; -1: none given.
+  const double given_m = report.visibility_m && !report.visibilityAbove && *report.visibility_m < kClearVisibility_m
+                             ? *report.visibility_m
+                             : -1.0;
+  const auto reportedOr = [given_m](double fallback_m) { return given_m >= 0 ? given_m : fallback_m; };
   ObscurationLayer out;
   out.coverage = coverage;
   if (report.verticalVisibility) {
     out.thickness_m = std::max(report.verticalVisibility_ft.value_or(kUnknownVerticalVisibility_ft) * kMetresPerFoot,
                                kMinFogThickness_m);
-    out.visibility_m = reported.value_or(kFogDefaultVisibility_m);
+    out.visibility_m = reportedOr(kFogDefaultVisibility_m);
     return out;
   }
   // 10 km or more: whatever obscures is elsewhere (patches around, haze
   // aloft); nothing to draw at the station.
   if (report.visibilityAbove || (report.visibility_m && *report.visibility_m >= kClearVisibility_m))
     return std::nullopt;
-  switch (worst) {
-    case Obscuration::None: return std::nullopt;
-    case Obscuration::Fog:
-      out.thickness_m = kFogThickness_m;
-      out.visibility_m = reported.value_or(kFogDefaultVisibility_m);
-      return out;
-    case Obscuration::ShallowFog:
-      out.thickness_m = kShallowFogThickness_m;
-      out.visibility_m = reported.value_or(kFogDefaultVisibility_m);
-      return out;
-    case Obscuration::Mist:
-      out.thickness_m = kMistThickness_m;
-      out.visibility_m = reported.value_or(kMistDefaultVisibility_m);
-      return out;
-    case Obscuration::Haze:
-      out.thickness_m = kHazeThickness_m;
-      out.visibility_m = reported.value_or(kHazeDefaultVisibility_m);
-      return out;
-    case Obscuration::Precipitation: {
-      if (!reported || *reported >= kHazeDefaultVisibility_m) return std::nullopt;
-      double lowest_m = kPrecipitationObscurationTop_m;
-      for (const MetarCloud& cloud : report.clouds)
-        if (cloud.height_ft) lowest_m = std::min(lowest_m, *cloud.height_ft * kMetresPerFoot);
-      out.thickness_m = std::max(lowest_m, kMinFogThickness_m);
-      out.visibility_m = *reported;
+  if (worst == Obscuration::Precipitation) {
+    if (given_m < 0 || given_m >= kHazeDefaultVisibility_m) return std::nullopt;
+    double lowest_m = kPrecipitationObscurationTop_m;
+    for (const MetarCloud& cloud : report.clouds)
+      if (cloud.height_ft) lowest_m = std::min(lowest_m, *cloud.height_ft * kMetresPerFoot);
+    out.thickness_m = std::max(lowest_m, kMinFogThickness_m);
+    out.visibility_m = given_m;
+    return out;
+  }
+  // Depth and the visibility a group implies without one given (metar.hpp).
+  struct Kind {
+    Obscuration kind;
+    double thickness_m, defaultVisibility_m;
+  };
+  static constexpr Kind kKinds[] = {{Obscuration::Fog, kFogThickness_m, kFogDefaultVisibility_m},
+                                    {Obscuration::ShallowFog, kShallowFogThickness_m, kFogDefaultVisibility_m},
+                                    {Obscuration::Mist, kMistThickness_m, kMistDefaultVisibility_m},
+                                    {Obscuration::Haze, kHazeThickness_m, kHazeDefaultVisibility_m}};
+  for (const Kind& k : kKinds)
+    if (k.kind == worst) {
+      out.thickness_m = k.thickness_m;
+      out.visibility_m = reportedOr(k.defaultVisibility_m);
       return out;
     }
-  }
   return std::nullopt;
 }
 

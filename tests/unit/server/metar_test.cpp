@@ -512,6 +512,7 @@ TEST(MetarLayers, ObscurationIsAFogLayerOfTheReportedVisibility) {
       {"3000 SN NSC", 3000, kPrecipitationObscurationTop_m, 1.0},
       {"0300 FG VV002", 300, 200 * kFt, 1.0},
       {"0050 FG VV001", weather::kMinFogVisibility_m, 100 * kFt, 1.0},  // denser than the model draws
+      {"0000 FG VV///", weather::kMinFogVisibility_m, 100 * kFt, 1.0},  // under 50 m: the densest
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.body);
