@@ -1,5 +1,8 @@
-// More layers than a frame draws: the channel keeps those with the most cloud
-// (ties by id), their tiles only, in their order, and names the rest.
+// More layers than a frame draws: the channel keeps fog that is there, then
+// those with the most cloud (ties by id), their tiles only, in their order,
+// and names the rest.
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 #include "sky/app/area_of_interest.hpp"
@@ -36,6 +39,32 @@ TEST(DrawableWeather, KeepsTheLayersWithMostCloud) {
   s.layers.resize(3);
   EXPECT_EQ(drawableWeather(s, 4, &dropped).layers.size(), 3u);
   EXPECT_TRUE(dropped.empty());
+}
+
+// A METAR's mist is thin by density (2.5 km visibility: 0.03) but what a
+// pilot at the station sees first: fog with any cover is kept before the
+// cumulus with the least; fog with none anywhere in the area ranks by its 0.
+TEST(DrawableWeather, FogThatIsThereIsKeptFirst) {
+  weather::WeatherSnapshot s;
+  s.tileLevel = 9;
+  auto add = [&](std::uint32_t id, weather::CloudType type, double coverage, double density) {
+    weather::CloudLayer l;
+    l.id = id;
+    l.type = type;
+    l.coverage = coverage;
+    l.density = density;
+    s.layers.push_back(l);
+  };
+  for (std::uint32_t id = 1; id <= 4; ++id) add(id, weather::CloudType::Cumulus, 0.2 * id, 1.0);
+  add(40, weather::CloudType::Fog, 0.0, 0.0);  // only a station's region has it: its tiles say where
+  s.tiles.push_back({100, 40, 1.0f, 0.03f});
+  add(0, weather::CloudType::Fog, 0.0, 0.5);  // a ground fog with no cover here
+  std::vector<std::uint32_t> dropped;
+  const auto d = drawableWeather(s, 4, &dropped);
+  ASSERT_EQ(d.layers.size(), 4u);
+  EXPECT_EQ(dropped, (std::vector<std::uint32_t>{0, 1})) << "the empty fog and the thinnest cumulus";
+  EXPECT_TRUE(std::any_of(d.layers.begin(), d.layers.end(), [](const auto& l) { return l.id == 40; }));
+  ASSERT_EQ(d.tiles.size(), 1u);
 }
 
 TEST(DrawableWeather, ALayerOnlyARegionHasRanksByItsTiles) {

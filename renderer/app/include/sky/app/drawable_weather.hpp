@@ -10,9 +10,9 @@
 
 namespace sky::app {
 
-// The snapshot with at most maxLayers layers: those with the most cloud
-// (coverage x density, the layer's own or its densest tile's), ties by lower
-// id; their tiles only. `dropped` gets the ids left out (empty when all fit).
+// The snapshot with at most maxLayers layers: fog with any cover first, then
+// those with the most cloud (coverage x density, the layer's own or its
+// densest tile's), ties by lower id; their tiles only. `dropped` gets the ids left out (empty when all fit).
 // Layer order is kept.
 weather::WeatherSnapshot drawableWeather(const weather::WeatherSnapshot& snapshot, std::size_t maxLayers,
                                          std::vector<std::uint32_t>* dropped = nullptr);
