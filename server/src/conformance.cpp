@@ -54,7 +54,10 @@ constexpr double kEyeHeight_m = 2;
 // or more, no obscuration in the weather.
 std::optional<double> fogVisibility(const std::vector<weather::CloudLayer>& layers) {
   for (const auto& l : layers)
-    if (l.id == kMetarFogSlot && l.coverage > 0 && l.density > 0) return weather::cloudVisibility_m(l.coverage * l.density);
+    if (l.id == kMetarFogSlot && l.coverage > 0 && l.density > 0) {
+      const double v = weather::cloudVisibility_m(l.coverage * l.density);
+      if (v < kClearVisibility_m) return v;
+    }
   return std::nullopt;
 }
 std::optional<double> drawnVisibility(const weather::PointWeather& pw) {
@@ -211,13 +214,14 @@ nlohmann::json conformanceJson(const LiveWeather& weather, std::span<const Stati
     for (const auto& [id, p] : byId) worst = std::max(worst, std::abs(p.second - p.first));
     const auto cr = ceilingOf(reported), cd = ceilingOf(drawn);
     const bool ceilingOk = (!cr && !cd) || (cr && cd && std::abs(*cr - *cd) <= kCeilingTolerance_m);
-    // Visibility at a pilot's eye over the station's ground (the fog's base,
-    // else the station table's elevation), through the same point query the
-    // CIGI answer uses.
+    // Visibility at a pilot's eye over the station's ground (the station
+    // table's elevation; for a station it does not know, the fog's base),
+    // through the same point query the CIGI answer uses.
     const std::optional<double> vr = fogVisibility(r.layers);
-    double ground_m = s.elevation_m.value_or(0);
+    double ground_m = 0;
     for (const auto& l : r.layers)
       if (l.id == kMetarFogSlot) ground_m = l.base_m;
+    ground_m = s.elevation_m.value_or(ground_m);
     const std::optional<double> vd =
         drawnVisibility(weather::weatherAt(local, lookup, r.centerLat_deg, r.centerLon_deg, ground_m + kEyeHeight_m));
     const bool visibilityOk = (!vr && !vd) || (vr && vd && std::abs(*vd - *vr) <= visibilityTolerance_m(*vr));

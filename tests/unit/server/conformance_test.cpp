@@ -180,12 +180,13 @@ TEST(Conformance, StationsDrawTheirReportedVisibility) {
     EXPECT_TRUE(rows[icao]["reported"]["visibility_m"].is_null());
     EXPECT_TRUE(rows[icao]["drawn"]["visibility_m"].is_null());
   }
-  // LJLJ's region without its fog: reported fog, none drawn: caught.
+  // LJLJ's fog lifted 300 m off its ground (a hand-made region): reported
+  // fog, clear air drawn at the eye over the station: caught.
   auto regions = f.weather.regionsAt(f.weather.clockNow());
   for (auto& r : regions)
     if (std::abs(r.centerLat_deg - 46.2237) < 1e-9) {
       for (auto& l : r.layers)
-        if (l.id == kMetarFogSlot) l.density = 0.001;  // 78 km: clear
+        if (l.id == kMetarFogSlot) l.base_m += 300;
       ASSERT_TRUE(f.weather.submit({{SetRegion{r, {}}}, "test", "api"}));
     }
   const auto after = f.check(0);
@@ -193,6 +194,8 @@ TEST(Conformance, StationsDrawTheirReportedVisibility) {
     if (s["icao"] == "LJLJ") {
       EXPECT_FALSE(s["visibility_ok"]) << s.dump();
       EXPECT_FALSE(s["ok"]);
+      EXPECT_NEAR(s["reported"]["visibility_m"].get<double>(), 200, 1e-6);
+      EXPECT_TRUE(s["drawn"]["visibility_m"].is_null()) << s.dump();
     }
 }
 
