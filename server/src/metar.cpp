@@ -236,8 +236,6 @@ bool isRunwayVisualRange(std::string_view g) {
 // is weather not observed; RE.. is recent weather, NSW no significant weather.
 bool isWeather(std::string_view g) {
   if (g == "//") return true;
-  static constexpr std::array<std::string_view, 8> kDescriptors{"MI", "PR", "BC", "DR",
-                                                                "BL", "SH", "TS", "FZ"};
   static constexpr std::array<std::string_view, 22> kPhenomena{
       "DZ", "RA", "SN", "SG", "IC", "PL", "GR", "GS", "UP", "BR", "FG",
       "FU", "VA", "DU", "SA", "HZ", "PY", "PO", "SQ", "FC", "SS", "DS"};
@@ -247,7 +245,7 @@ bool isWeather(std::string_view g) {
   else if (s.substr(0, 2) == "VC" || s.substr(0, 2) == "RE") s.remove_prefix(2);
   bool any = false;
   if (s.size() >= 2) {
-    for (std::string_view d : kDescriptors)
+    for (std::string_view d : kWeatherDescriptors)
       if (s.substr(0, 2) == d) {
         s.remove_prefix(2);
         any = true;

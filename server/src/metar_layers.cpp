@@ -75,9 +75,8 @@ Obscuration obscurationOf(std::string_view g, double& coverage) {
   if (g.substr(0, 2) == "VC") return Obscuration::None;
   if (!g.empty() && (g[0] == '+' || g[0] == '-')) g.remove_prefix(1);
   std::string_view descriptor = g.substr(0, 2);
-  static constexpr std::string_view kDescriptors[] = {"MI", "PR", "BC", "DR", "BL", "SH", "TS", "FZ"};
-  bool hasDescriptor = false;
-  for (std::string_view d : kDescriptors) hasDescriptor = hasDescriptor || descriptor == d;
+  const bool hasDescriptor = std::find(std::begin(kWeatherDescriptors), std::end(kWeatherDescriptors), descriptor) !=
+                             std::end(kWeatherDescriptors);
   std::string_view phenomena = hasDescriptor ? g.substr(2) : g;
   auto has = [&](std::string_view code) {
     for (std::size_t i = 0; i + 1 < phenomena.size(); i += 2)

@@ -120,9 +120,8 @@ std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLa
       if (sphereDistance_m(at->lat_deg, at->lon_deg, r->centerLat_deg, r->centerLon_deg) > radius_m + reachOf(*r)) continue;
       for (const weather::CloudLayer& l : r->layers) {
         if (l.type != weather::CloudType::Fog || !regionOnly.count(l.id)) continue;
-        const auto [it, fresh] = fog.try_emplace(l.id, l.base_m, l.base_m + l.thickness_m);
-        it->second = {std::min(it->second.first, l.base_m), std::max(it->second.second, l.base_m + l.thickness_m)};
-        (void)fresh;
+        auto& span = fog.try_emplace(l.id, l.base_m, l.base_m + l.thickness_m).first->second;
+        span = {std::min(span.first, l.base_m), std::max(span.second, l.base_m + l.thickness_m)};
       }
     }
     for (const auto& [id, span] : fog) {

@@ -83,6 +83,11 @@ struct MetarGroupNote {
 inline constexpr std::size_t kMaxNotedGroups = 32;
 inline constexpr std::size_t kMaxNotedGroupBytes = 32;
 
+// Present-weather descriptors (WMO FM 15): shallow, partial, patches, low
+// drifting, blowing, showers, thunderstorm, freezing. The decoder's and the
+// mapping's one list.
+inline constexpr std::string_view kWeatherDescriptors[] = {"MI", "PR", "BC", "DR", "BL", "SH", "TS", "FZ"};
+
 struct MetarReport {
   std::string icao;
   bool speci = false;
