@@ -88,19 +88,23 @@ const FT_PER_M = 1 / 0.3048;
 
 // The weather model's fog: a density d stands for an extinction of 0.05 d
 // per metre, whose Koschmieder range (3.912 / extinction) is the visibility
-// (protocol/weather/include/sky/weather/query.hpp).
-const FOG_EXTINCTION_PER_DENSITY = 0.05, KOSCHMIEDER_DEPTH = 3.912;
+// (protocol/weather/include/sky/weather/query.hpp); precipitation's density
+// for 0.01 d per metre (precipitation.hpp).
+const FOG_EXTINCTION_PER_DENSITY = 0.05, PRECIPITATION_EXTINCTION_PER_DENSITY = 0.01, KOSCHMIEDER_DEPTH = 3.912;
+const PRECIPITATION = ["rain", "snow", "sleet", "hail"];
 
 // The category from a station region's layers alone (the server restarted
 // and no longer has the report's text): the ceiling is the lowest cloud base
-// with 5 oktas or more above the station; the visibility is its fog's (the
-// layer of type "fog" a report's obscuration became), or unknown without.
+// with 5 oktas or more above the station; the visibility is that of its fog
+// and precipitation together (the layers a report's obscuration and
+// precipitation became), or unknown without.
 export function categoryFromLayers(layers, elevation_m) {
-  const cloud = layers.filter((l) => l.type !== "fog" && l.coverage >= CEILING_COVERAGE);
+  const obscures = (l) => l.type === "fog" || PRECIPITATION.includes(l.type);
+  const cloud = layers.filter((l) => !obscures(l) && l.coverage >= CEILING_COVERAGE);
   const bases = cloud.map((l) => (l.base_m - elevation_m) * FT_PER_M);
-  const fog = layers.filter((l) => l.type === "fog" && l.coverage > 0 && l.density > 0);
-  const visibility_sm = fog.length
-    ? Math.min(...fog.map((l) => KOSCHMIEDER_DEPTH / (FOG_EXTINCTION_PER_DENSITY * l.coverage * l.density))) / STATUTE_MILE_M
-    : null;
+  const seen = layers.filter((l) => obscures(l) && l.coverage > 0 && l.density > 0);
+  const extinction = seen.reduce((sum, l) => sum + l.coverage * l.density *
+    (l.type === "fog" ? FOG_EXTINCTION_PER_DENSITY : PRECIPITATION_EXTINCTION_PER_DENSITY), 0);
+  const visibility_sm = seen.length ? KOSCHMIEDER_DEPTH / extinction / STATUTE_MILE_M : null;
   return categoryOf(bases.length ? Math.max(0, Math.min(...bases)) : Infinity, visibility_sm);
 }

@@ -9,7 +9,7 @@ export const MPS_PER_KT = 1852 / 3600; // knot: one nautical mile (1852 m) per h
 export const OKTAS = 8;                // eighths of the sky
 
 export const CLOUD_TYPES = ["cumulus", "stratus", "stratocumulus", "cumulonimbus", "altocumulus", "altostratus",
-  "nimbostratus", "cirrus", "cirrostratus", "cirrocumulus", "fog", "none"];
+  "nimbostratus", "cirrus", "cirrostratus", "cirrocumulus", "fog", "rain", "snow", "sleet", "hail", "none"];
 
 // The server's ranges (model.cpp validate, region.cpp validate, change.hpp).
 export const LIMITS = {

@@ -5,6 +5,7 @@
 #include <string>
 #include <utility>
 
+#include "sky/weather/precipitation.hpp"
 #include "sky/weather/query.hpp"
 
 namespace sky::server {
@@ -30,7 +31,29 @@ bool sameRegion(const weather::Region& a, const weather::Region& b) {
 
 bool cloudLayerId(cigi::LayerId id) {
   auto n = static_cast<std::uint8_t>(id);
-  return n <= 3 || n >= 10;  // ground fog (0) is our fog layer 0
+  return n <= 7 || n >= 10;  // ground fog (0) is our fog layer 0; 4-7 precipitation
+}
+
+// Our type for a precipitation layer id (4-7), None for the others.
+weather::CloudType precipitationType(cigi::LayerId id) {
+  switch (id) {
+    case cigi::LayerId::Rain: return weather::CloudType::Rain;
+    case cigi::LayerId::Snow: return weather::CloudType::Snow;
+    case cigi::LayerId::Sleet: return weather::CloudType::Sleet;
+    case cigi::LayerId::Hail: return weather::CloudType::Hail;
+    default: return weather::CloudType::None;
+  }
+}
+
+// The rate a severity (0-5) stands for, mm/h.
+double severityRate_mmph(weather::CloudType type, std::uint8_t severity) {
+  const bool snow = type == weather::CloudType::Snow;
+  const double light = snow ? weather::kLightSnow_mmph : weather::kLightRain_mmph;
+  const double moderate = snow ? weather::kModerateSnow_mmph : weather::kModerateRain_mmph;
+  const double heavy = snow ? weather::kHeavySnow_mmph : weather::kHeavyRain_mmph;
+  if (severity <= 1) return light;
+  if (severity <= 3) return moderate;
+  return severity == 4 ? heavy : 2 * heavy;
 }
 
 std::string where(std::size_t index, const char* packet) {
@@ -59,9 +82,12 @@ Result<std::optional<weather::CloudLayer>> cloudLayerFrom(const cigi::WeatherCon
   const bool fog = p.layerId == cigi::LayerId::GroundFog;
   if (fog && !(p.visibility_m > 0 && std::isfinite(p.visibility_m)))
     return bad("visibility range", p.visibility_m, "(0, inf) m for ground fog");
+  const weather::CloudType precipitation = precipitationType(p.layerId);
+  if (precipitation != weather::CloudType::None && !(p.visibility_m >= 0 && std::isfinite(p.visibility_m)))
+    return bad("visibility range", p.visibility_m, "[0, inf) m for precipitation (0: by severity)");
   weather::CloudLayer layer;
   layer.id = static_cast<std::uint8_t>(p.layerId);
-  layer.type = fog ? weather::CloudType::Fog : p.cloudType;
+  layer.type = fog ? weather::CloudType::Fog : precipitation != weather::CloudType::None ? precipitation : p.cloudType;
   layer.base_m = p.baseElevation_m;
   layer.thickness_m = p.thickness_m;
   layer.transitionBand_m = p.transitionBand_m;
@@ -69,6 +95,10 @@ Result<std::optional<weather::CloudLayer>> cloudLayerFrom(const cigi::WeatherCon
   // Ground fog's density is its visibility range; a cloud layer's visibility
   // range (in cloud) is not used: the cloud's own density draws it.
   layer.density = fog ? weather::fogDensityForVisibility(p.visibility_m) : 1.0;
+  if (precipitation != weather::CloudType::None)
+    layer.density = p.visibility_m > 0 ? weather::precipitationDensityForVisibility(p.visibility_m)
+                                       : weather::precipitationDensityForRate(precipitation,
+                                                                              severityRate_mmph(precipitation, p.severity));
   layer.wind.speed_mps = p.horizontalWind_mps;
   double from = std::fmod(static_cast<double>(p.windDirection_deg), 360.0);
   if (from < 0) from += 360;

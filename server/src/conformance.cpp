@@ -12,6 +12,7 @@
 #include "sky/server/live_weather.hpp"
 #include "sky/server/metar_changes.hpp"
 #include "sky/server/snapshot_builder.hpp"
+#include "sky/weather/precipitation.hpp"
 #include "sky/weather/query.hpp"
 #include "sky/weather/region.hpp"
 #include "sky/weather/tiling.hpp"
@@ -49,22 +50,23 @@ nlohmann::json optional(const std::optional<double>& v) { return v ? nlohmann::j
 // A pilot's eye over the station's ground (the visibility a METAR reports).
 constexpr double kEyeHeight_m = 2;
 
-// The visibility a station reports (its fog slot as mapped: metar.hpp) or a
-// renderer draws at a point (the point query's cloud density), m; none: 10 km
-// or more, no obscuration in the weather.
-std::optional<double> fogVisibility(const std::vector<weather::CloudLayer>& layers) {
-  for (const auto& l : layers)
-    if (l.id == kMetarFogSlot && l.coverage > 0 && l.density > 0) {
-      const double v = weather::cloudVisibility_m(l.coverage * l.density);
-      if (v < kClearVisibility_m) return v;
-    }
-  return std::nullopt;
-}
-std::optional<double> drawnVisibility(const weather::PointWeather& pw) {
-  if (!(pw.cloudDensity > 0)) return std::nullopt;
-  const double v = weather::cloudVisibility_m(pw.cloudDensity);
+// The visibility a station reports (its fog and precipitation slots as
+// mapped: metar.hpp) or a renderer draws at a point (the point query's
+// extinction), m; none: 10 km or more, no obscuration in the weather.
+std::optional<double> clearOrLess(double extinction_perm) {
+  const double v = weather::koschmiederVisibility_m(extinction_perm);
   return v < kClearVisibility_m ? std::optional<double>(v) : std::nullopt;
 }
+std::optional<double> reportedVisibility(const std::vector<weather::CloudLayer>& layers) {
+  double extinction_perm = 0;
+  for (const auto& l : layers) {
+    if (l.id == kMetarFogSlot) extinction_perm += weather::kCloudExtinctionPerDensity_perm * l.coverage * l.density;
+    if (l.id == kMetarPrecipitationSlot)
+      extinction_perm += weather::kPrecipitationExtinctionPerDensity_perm * l.coverage * l.density;
+  }
+  return clearOrLess(extinction_perm);
+}
+std::optional<double> drawnVisibility(const weather::PointWeather& pw) { return clearOrLess(pw.extinction_perm); }
 
 }  // namespace
 
@@ -183,6 +185,7 @@ nlohmann::json conformanceJson(const LiveWeather& weather, std::span<const Stati
   auto drawnAt = [&](double lat, double lon) {
     std::vector<Layer> out;
     for (const auto& l : table) {
+      if (weather::isPrecipitation(l.type)) continue;  // not cloud: its visibility is checked
       const auto tile = lookup(l, lat, lon);
       const double cover = tile ? tile->coverage : l.coverage;
       if (const int o = oktas(cover); o > 0) out.push_back({l.id, o, l.base_m});
@@ -217,10 +220,10 @@ nlohmann::json conformanceJson(const LiveWeather& weather, std::span<const Stati
     // Visibility at a pilot's eye over the station's ground (the station
     // table's elevation; for a station it does not know, the fog's base),
     // through the same point query the CIGI answer uses.
-    const std::optional<double> vr = fogVisibility(r.layers);
+    const std::optional<double> vr = reportedVisibility(r.layers);
     double ground_m = 0;
     for (const auto& l : r.layers)
-      if (l.id == kMetarFogSlot) ground_m = l.base_m;
+      if (l.id == kMetarFogSlot || l.id == kMetarPrecipitationSlot) ground_m = l.base_m;
     ground_m = s.elevation_m.value_or(ground_m);
     const std::optional<double> vd =
         drawnVisibility(weather::weatherAt(local, lookup, r.centerLat_deg, r.centerLon_deg, ground_m + kEyeHeight_m));

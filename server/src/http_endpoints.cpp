@@ -12,6 +12,7 @@
 #include "sky/server/forecast_files.hpp"
 #include "sky/server/http_api.hpp"
 #include "sky/server/metar_api.hpp"
+#include "sky/server/radar_api.hpp"
 #include "sky/server/scenario_api.hpp"
 #include "sky/server/wind_api.hpp"
 
@@ -47,6 +48,11 @@ HttpReply HttpApi::serve(Endpoint endpoint, const ApiRequest& r) {
       auto q = parseWindQuery(r.query);
       if (!q) return error(400, q.error().detail);
       return json(windJson(weather_, *q));
+    }
+    case Endpoint::Radar: {
+      auto q = parseRadarQuery(r.query);
+      if (!q) return error(400, q.error().detail);
+      return json(radarJson(weather_, *q));
     }
     case Endpoint::Events: return events(r.query);
     case Endpoint::Changes: return changes(r);

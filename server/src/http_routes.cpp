@@ -25,6 +25,7 @@ constexpr std::array kRoutes = {
     Route{"/api/conditions", Endpoint::Conditions, kGet, 0, TokenRule::None},
     Route{"/api/conformance", Endpoint::Conformance, kGet, 0, TokenRule::None},
     Route{"/api/wind", Endpoint::Wind, kGet, 0, TokenRule::None},
+    Route{"/api/radar", Endpoint::Radar, kGet, 0, TokenRule::None},
     Route{"/api/events", Endpoint::Events, kGet, 0, TokenRule::None},
     Route{"/api/changes", Endpoint::Changes, kPost, kMaxBody_bytes, TokenRule::Always},
     Route{"/api/scenario", Endpoint::Scenario, kPost, kMaxScenarioBody_bytes, TokenRule::Always},

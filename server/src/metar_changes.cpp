@@ -11,6 +11,8 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "sky/weather/precipitation.hpp"
+
 namespace sky::server {
 
 std::uint32_t metarSlot(const weather::CloudLayer& layer) {
@@ -42,7 +44,8 @@ std::vector<weather::CloudLayer> slotted(const StationWeather& s) {
     weather::CloudLayer l = s.layers[i];
     // Fog (a VV group, or an obscuration: metar.hpp) comes first and starts at the station.
     const bool fog = l.type == weather::CloudType::Fog;
-    const std::uint32_t slot = fog ? kMetarFogSlot : metarSlot(l);
+    const std::uint32_t slot =
+        fog ? kMetarFogSlot : weather::isPrecipitation(l.type) ? kMetarPrecipitationSlot : metarSlot(l);
     l.id = slot;
     auto it = out.find(slot);
     if (it == out.end()) {

@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "sky/geo/geodetic.hpp"
+#include "sky/weather/precipitation.hpp"
 #include "sky/weather/query.hpp"
 
 namespace sky::server {
@@ -174,6 +175,74 @@ std::optional<ObscurationLayer> obscurationLayer(const MetarReport& report) {
   return std::nullopt;
 }
 
+// An obscured sky (VV) is a fog layer however much of the visibility the
+// precipitation takes: at least the extinction of a 10 km visibility.
+constexpr double kObscuredSkyFloor_perm = weather::kKoschmiederDepth / kClearVisibility_m;
+
+// The heaviest precipitation a report gives at the station (metar.hpp's rule).
+struct PrecipitationGroup {
+  weather::CloudType type = weather::CloudType::None;
+  double rate_mmph = 0;
+  bool showers = false;  // SH or TS: from a convective cloud
+  bool drizzle = false;  // drizzle alone (from stratus)
+};
+
+std::optional<PrecipitationGroup> precipitationOf(const MetarReport& report) {
+  std::optional<PrecipitationGroup> best;
+  for (std::string_view g : report.weather) {
+    if (g.substr(0, 2) == "VC") continue;
+    int intensity = 1;
+    if (!g.empty() && (g[0] == '+' || g[0] == '-')) {
+      intensity = g[0] == '+' ? 2 : 0;
+      g.remove_prefix(1);
+    }
+    const std::string_view descriptor = g.substr(0, 2);
+    bool hasDescriptor = false;
+    for (std::string_view d : kWeatherDescriptors) hasDescriptor = hasDescriptor || descriptor == d;
+    if (descriptor == "DR" || descriptor == "BL") continue;  // lifted by the wind, not falling
+    const std::string_view phenomena = hasDescriptor ? g.substr(2) : g;
+    auto has = [&](std::string_view code) {
+      for (std::size_t i = 0; i + 1 < phenomena.size(); i += 2)
+        if (phenomena.substr(i, 2) == code) return true;
+      return false;
+    };
+    const bool rain = has("RA") || has("UP"), drizzle = has("DZ"), snow = has("SN") || has("SG");
+    PrecipitationGroup p;
+    if (has("GR") || has("GS")) p.type = weather::CloudType::Hail;
+    else if (has("PL") || ((rain || drizzle) && snow)) p.type = weather::CloudType::Sleet;
+    else if (snow) p.type = weather::CloudType::Snow;
+    else if (rain || drizzle) p.type = weather::CloudType::Rain;
+    else continue;
+    const bool snowRates = p.type == weather::CloudType::Snow;
+    const double rates[3] = {snowRates ? weather::kLightSnow_mmph : weather::kLightRain_mmph,
+                             snowRates ? weather::kModerateSnow_mmph : weather::kModerateRain_mmph,
+                             snowRates ? weather::kHeavySnow_mmph : weather::kHeavyRain_mmph};
+    p.rate_mmph = rates[intensity] * (drizzle && !rain && !snow ? weather::kDrizzleFactor : 1.0);
+    p.showers = descriptor == "SH" || descriptor == "TS";
+    p.drizzle = drizzle && !rain && !snow;
+    if (!best || p.rate_mmph > best->rate_mmph) best = p;
+  }
+  return best;
+}
+
+// The cloud that drops the precipitation, among the report's mapped cloud
+// layers (metar.hpp's rule); null without one.
+weather::CloudLayer* carrierOf(std::vector<weather::CloudLayer>& layers, const PrecipitationGroup& p) {
+  weather::CloudLayer* lowest = nullptr;
+  weather::CloudLayer* lowestCeiling = nullptr;
+  weather::CloudLayer* convective = nullptr;
+  for (weather::CloudLayer& l : layers) {
+    if (l.type == weather::CloudType::Fog || weather::isPrecipitation(l.type)) continue;
+    if (!lowest || l.base_m < lowest->base_m) lowest = &l;
+    if (l.coverage >= kBrokenCoverage && (!lowestCeiling || l.base_m < lowestCeiling->base_m)) lowestCeiling = &l;
+    if ((l.type == weather::CloudType::Cumulonimbus || l.thickness_m >= kToweringCumulusThickness_m) &&
+        (!convective || l.base_m < convective->base_m))
+      convective = &l;
+  }
+  if (p.showers && convective) return convective;
+  return lowestCeiling ? lowestCeiling : lowest;
+}
+
 }  // namespace
 
 Result<MetarSky> skyFromMetar(const MetarReport& report, const Station& station) {
@@ -201,13 +270,8 @@ Result<MetarSky> skyFromMetar(const MetarReport& report, const Station& station)
     layers.push_back(layer);
   };
 
-  if (const std::optional<ObscurationLayer> fog = obscurationLayer(report)) {
-    add(weather::CloudType::Fog, station.elevation_m, fog->thickness_m, fog->coverage);
-    // Patches denser than the prevailing visibility, so that a sight line
-    // through patches and gaps (and the point query's coverage x density)
-    // sees the reported one.
-    layers.back().density = std::min(1.0, weather::fogDensityForVisibility(fog->visibility_m) / fog->coverage);
-  }
+  const std::optional<ObscurationLayer> fog = obscurationLayer(report);
+  if (fog) add(weather::CloudType::Fog, station.elevation_m, fog->thickness_m, fog->coverage);
   for (const MetarCloud& cloud : report.clouds) {
     if (!cloud.height_ft) continue;  // cannot place
     // A base seen without an amount: cloud is there, FEW the least it can be.
@@ -229,6 +293,53 @@ Result<MetarSky> skyFromMetar(const MetarReport& report, const Station& station)
     add(type, base_m, thickness_m, coverageOf(amount));
   }
 
+  // The precipitation's extinction at the station, which the fog's adds to.
+  double precipitationExtinction_perm = 0;
+  if (const std::optional<PrecipitationGroup> p = precipitationOf(report)) {
+    weather::CloudLayer* carrier = carrierOf(layers, *p);
+    if (carrier && !p->showers && !p->drizzle && carrier->coverage >= kBrokenCoverage &&
+        (carrier->type == weather::CloudType::Stratocumulus || carrier->type == weather::CloudType::Altostratus)) {
+      carrier->type = weather::CloudType::Nimbostratus;
+      carrier->thickness_m = std::max(carrier->thickness_m, kNimbostratusThickness_m);
+      carrier->transitionBand_m = kTransitionFraction * carrier->thickness_m;
+    }
+    double top_m = station.elevation_m + kPrecipitationObscurationTop_m, coverage = 1.0;
+    if (carrier) {
+      top_m = carrier->base_m + std::min(kPrecipitationInCloud_m, carrier->thickness_m);
+      coverage = carrier->coverage;
+    }
+    if (fog) top_m = std::max(top_m, station.elevation_m + fog->thickness_m);
+    // No more than the reported visibility allows (a 9999 caps it at 10 km),
+    // less what an obscured sky's fog keeps at least (below).
+    double rate = p->rate_mmph;
+    const std::optional<double> seen =
+        report.visibility_m && *report.visibility_m >= kClearVisibility_m ? std::optional<double>(kClearVisibility_m)
+                                                                           : report.visibility_m;
+    if (seen && !report.visibilityBelow) {
+      const double allowed_perm = weather::kKoschmiederDepth / *seen - (report.verticalVisibility ? kObscuredSkyFloor_perm : 0.0);
+      rate = std::min(rate, weather::precipitationRate_mmph(p->type, std::max(allowed_perm, 0.0) / coverage));
+    }
+    add(p->type, station.elevation_m, std::max(top_m - station.elevation_m, kMinFogThickness_m), coverage);
+    layers.back().density = weather::precipitationDensityForRate(p->type, rate);
+    layers.back().transitionBand_m = 0;  // it ends at the ground and inside its cloud
+    precipitationExtinction_perm = coverage * weather::precipitationExtinction_perm(
+                                                  p->type, weather::precipitationRateForDensity(p->type, layers.back().density));
+  }
+  if (fog) {
+    // What the precipitation leaves of the reported visibility's extinction;
+    // patches denser than the prevailing visibility, so that a sight line
+    // through patches and gaps (and the point query's coverage x density)
+    // sees the reported one.
+    double extinction_perm = weather::kKoschmiederDepth / fog->visibility_m - precipitationExtinction_perm;
+    if (report.verticalVisibility) extinction_perm = std::max(extinction_perm, kObscuredSkyFloor_perm);
+    if (extinction_perm > 0) {
+      layers.front().density = std::min(1.0, extinction_perm / weather::kCloudExtinctionPerDensity_perm / fog->coverage);
+    } else {
+      layers.erase(layers.begin());
+      for (std::size_t i = 0; i < layers.size(); ++i) layers[i].id = static_cast<std::uint32_t>(i + 1);
+    }
+  }
+
   for (const weather::CloudLayer& layer : layers)
     if (auto ok = weather::validate(layer); !ok)
       return fail(ok.error().code, report.icao + ": " + ok.error().detail);
@@ -239,7 +350,9 @@ Result<MetarSky> skyFromMetar(const MetarReport& report, const Station& station)
   // drawn).
   const bool skyRead = reportedClear || report.verticalVisibility ||
                        std::any_of(layers.begin(), layers.end(),
-                                   [](const weather::CloudLayer& l) { return l.type != weather::CloudType::Fog; });
+                                   [](const weather::CloudLayer& l) {
+                                     return l.type != weather::CloudType::Fog && !weather::isPrecipitation(l.type);
+                                   });
   if (!skyRead) layers.clear();
   return MetarSky{skyRead, std::move(layers)};
 }

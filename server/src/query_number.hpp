@@ -1,10 +1,11 @@
 // A number from a query string's value, checked against its range: shared by
-// the GET endpoints' query parsers (conditions, conformance, wind). Pure.
+// the GET endpoints' query parsers (conditions, conformance, wind, radar). Pure.
 #pragma once
 
 #include <charconv>
-#include <set>
 #include <cmath>
+#include <set>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -42,6 +43,30 @@ Result<void> forEachQueryPair(std::string_view query, F&& f) {
     if (auto r = f(key, value); !r) return r;
   }
   return {};
+}
+
+// A query of numbers only: each key fills *out, in [lo, hi], and marks
+// *seen (two names may share them: a synonym given with its twin is given
+// twice). An unknown key is refused, listing `known`.
+struct NumberKey {
+  std::string_view name;
+  bool* seen;
+  double* out;
+  double lo, hi;
+};
+inline Result<void> parseNumberKeys(std::string_view query, std::span<const NumberKey> keys, std::string_view known) {
+  return forEachQueryPair(query, [&](std::string_view key, std::string_view value) -> Result<void> {
+    for (const NumberKey& k : keys)
+      if (k.name == key) {
+        if (*k.seen) return fail(ErrorCode::InvalidArgument, std::string(key) + ": given twice");
+        const auto v = queryNumber(key, value, k.lo, k.hi);
+        if (!v) return tl::unexpected(v.error());
+        *k.out = *v;
+        *k.seen = true;
+        return {};
+      }
+    return fail(ErrorCode::InvalidArgument, "query: unknown key '" + std::string(key) + "' (" + std::string(known) + ")");
+  });
 }
 
 }  // namespace sky::server

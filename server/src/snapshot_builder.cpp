@@ -13,6 +13,7 @@
 
 #include "sky/core/assert.hpp"
 #include "sky/stream/framing.hpp"
+#include "sky/weather/precipitation.hpp"
 
 namespace sky::server {
 
@@ -114,12 +115,13 @@ std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLa
         }
   }
   if (at) {
-    // Fog: every region's in reach of the area, from the lowest base to the highest top.
+    // Fog and precipitation (both from the ground up): every region's in
+    // reach of the area, from the lowest base to the highest top.
     std::map<std::uint32_t, std::pair<double, double>> fog;  // id -> base, top
     for (const weather::Region* r : byId) {
       if (sphereDistance_m(at->lat_deg, at->lon_deg, r->centerLat_deg, r->centerLon_deg) > radius_m + reachOf(*r)) continue;
       for (const weather::CloudLayer& l : r->layers) {
-        if (l.type != weather::CloudType::Fog || !regionOnly.count(l.id)) continue;
+        if ((l.type != weather::CloudType::Fog && !weather::isPrecipitation(l.type)) || !regionOnly.count(l.id)) continue;
         auto& span = fog.try_emplace(l.id, l.base_m, l.base_m + l.thickness_m).first->second;
         span = {std::min(span.first, l.base_m), std::max(span.second, l.base_m + l.thickness_m)};
       }

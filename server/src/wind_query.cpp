@@ -8,28 +8,11 @@ namespace sky::server {
 Result<WindQuery> parseWindQuery(std::string_view query) {
   WindQuery q;
   bool lat = false, lon = false, alt = false, radius = false;
-  struct Key {
-    std::string_view name;
-    bool* seen;
-    double* out;
-    double lo, hi;
-  };
-  const Key keys[] = {{"lat_deg", &lat, &q.lat_deg, -90, 90},
-                      {"lon_deg", &lon, &q.lon_deg, -180, 180},
-                      {"alt_m", &alt, &q.alt_m, -1000, 20000},
-                      {"radius_m", &radius, &q.radius_m, 1000, 2e6}};
-  const auto pairs = forEachQueryPair(query, [&](std::string_view key, std::string_view value) -> Result<void> {
-    for (const Key& k : keys)
-      if (k.name == key) {
-        const auto v = queryNumber(key, value, k.lo, k.hi);
-        if (!v) return tl::unexpected(v.error());
-        *k.out = *v;
-        *k.seen = true;
-        return {};
-      }
-    return fail(ErrorCode::InvalidArgument,
-                "query: unknown key '" + std::string(key) + "' (lat_deg, lon_deg, alt_m, radius_m)");
-  });
+  const NumberKey keys[] = {{"lat_deg", &lat, &q.lat_deg, -90, 90},
+                            {"lon_deg", &lon, &q.lon_deg, -180, 180},
+                            {"alt_m", &alt, &q.alt_m, -1000, 20000},
+                            {"radius_m", &radius, &q.radius_m, 1000, 2e6}};
+  const auto pairs = parseNumberKeys(query, keys, "lat_deg, lon_deg, alt_m, radius_m");
   if (!pairs) return tl::unexpected(pairs.error());
   if (!lat) return fail(ErrorCode::InvalidArgument, "lat_deg: missing");
   if (!lon) return fail(ErrorCode::InvalidArgument, "lon_deg: missing");

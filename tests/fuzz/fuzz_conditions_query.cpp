@@ -1,5 +1,5 @@
 // libFuzzer target: query strings of the weather server's GET
-// /api/conditions and GET /api/wind. The parsers may refuse (naming the key),
+// /api/conditions, GET /api/wind and GET /api/radar. The parsers may refuse (naming the key),
 // never crash, hang or read out of bounds; what they accept is in range.
 // Seeds: tests/fuzz/corpus/conditions_query/.
 #include <cmath>
@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "sky/server/conditions_api.hpp"
+#include "sky/server/radar_api.hpp"
 #include "sky/server/wind_api.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -18,6 +19,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         !(w->radius_m >= 1000 && w->radius_m <= 2e6))
       std::abort();
   } else if (w.error().detail.empty()) {
+    std::abort();
+  }
+  if (const auto r = sky::server::parseRadarQuery(query)) {
+    if (!(std::abs(r->lat_deg) <= 90) || !(std::abs(r->lon_deg) <= 180) || !(r->range_km > 0 && r->range_km <= 300) ||
+        !(r->tilt_deg >= -2 && r->tilt_deg <= 30) || !(r->alt_m >= -500 && r->alt_m <= 10000) || r->size < 16 ||
+        r->size > sky::server::kMaxRadarSize)
+      std::abort();
+  } else if (r.error().detail.empty()) {
     std::abort();
   }
   const auto q = sky::server::parseConditionsQuery(query);

@@ -401,9 +401,11 @@ TEST(CigiConditions, TheRendererAnswersAMetarsVisibility) {
   Weatherd w("conditions-fog-weatherd", SKY_SCENARIO_CLEAR);
   ASSERT_GT(w.httpPort, 0u) << w.process->log();
   const auto applied = w.request("POST", "/api/metar", R"({"apply": true, "reports": [
-      "METAR LIPA 221150Z 00000KT 0400 FG VV002 05/05 Q1025", "METAR LIPH 221150Z 24004KT 2500 BR SCT015 08/07 Q1021"],
+      "METAR LIPA 221150Z 00000KT 0400 FG VV002 05/05 Q1025", "METAR LIPH 221150Z 24004KT 2500 BR SCT015 08/07 Q1021",
+      "METAR LIPQ 221150Z 20008KT 3000 +RA BKN010 OVC030 10/09 Q1005"],
     "stations": [{"icao": "LIPA", "lat_deg": 46.0319, "lon_deg": 12.5965, "elevation_m": 125},
-                 {"icao": "LIPH", "lat_deg": 45.6484, "lon_deg": 12.1944, "elevation_m": 18}]})");
+                 {"icao": "LIPH", "lat_deg": 45.6484, "lon_deg": 12.1944, "elevation_m": 18},
+                 {"icao": "LIPQ", "lat_deg": 45.8275, "lon_deg": 13.4722, "elevation_m": 12}]})");
   ASSERT_EQ(applied.status, 200) << applied.body;
   ChildProcess render = startRenderer(dir, w.streamPort);
   const unsigned cigiPort = waitForPortFile((dir / "render.port").string(), 120s);
@@ -420,6 +422,8 @@ TEST(CigiConditions, TheRendererAnswersAMetarsVisibility) {
   const Case cases[] = {
       {{"LIPA, fog", 46.0319, 12.5965, 125 + 2}, 400},
       {{"LIPH, mist", 45.6484, 12.1944, 18 + 2}, 2500},
+      // Heavy rain under a broken deck and the mist the rain leaves of 3 km.
+      {{"LIPQ, rain", 45.8275, 13.4722, 12 + 2}, 3000},
       {{"above LIPH's mist", 45.6484, 12.1944, 18 + 300 + 300 * 0.1 + 20}, 0},
   };
   for (std::size_t i = 0; i < std::size(cases); ++i) {
@@ -439,6 +443,16 @@ TEST(CigiConditions, TheRendererAnswersAMetarsVisibility) {
       EXPECT_NEAR(ig.weather->visibility_m, c.visibility_m, tolerance);
       EXPECT_NEAR(s["visibility_m"].get<double>(), ig.weather->visibility_m, 1e-3 * c.visibility_m);
       EXPECT_EQ(ig.weather->humidity_pct, 100);
+    }
+    if (std::string_view(c.p.what).starts_with("LIPQ")) {
+      // The rain itself: heavy (15 mm/h) over the deck's 6/8, so its mean
+      // over the tile is 0.75^(1/0.63) of it (the extinction is averaged),
+      // within the 8 bits' 12 %.
+      ASSERT_FALSE(s["precipitation"].is_null());
+      EXPECT_EQ(s["precipitation"]["type"], "rain");
+      EXPECT_NEAR(s["precipitation"]["rate_mmph"].get<double>(), 15 * std::pow(0.75, 1 / 0.63), 0.12 * 9.5);
+    } else {
+      EXPECT_TRUE(s["precipitation"].is_null());
     }
     std::printf("[conditions] %-20s reported %6.0f m, CIGI answer %8.1f m, server %s\n", c.p.what, c.visibility_m,
                 ig.weather->visibility_m, s["visibility_m"].dump().c_str());

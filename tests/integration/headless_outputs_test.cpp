@@ -7,6 +7,8 @@
 // sun, preset, settings, seeds, resolution and GPU time per pass, summed up
 // per pass in report.json; and the noise cache across starts of the process.
 #include <algorithm>
+#include <array>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -260,6 +262,41 @@ TEST(HeadlessOutputs, FrameBudgetIsRecordedPerFrame) {
                        {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
   EXPECT_EQ(refused.wait(120s).value_or(-1), 2);
   EXPECT_NE(refused.log().find("--frame-budget-ms"), std::string::npos) << refused.log();
+}
+
+// --radar: a weather radar picture beside every frame, from the weather the
+// frame drew. Rain of 10 mm/h up to 1.5 km over the whole area, the flight
+// level at 900 m: every cell within the range echoes Marshall-Palmer's 39.0
+// dBZ (10 log10(200 x 10^1.6); the file's layers are uniform, no 8-bit
+// tiles), the scale's 35-40 dBZ step (yellow), none past the range.
+TEST(HeadlessOutputs, RadarPictureBesideEveryFrame) {
+  const fs::path scenario = fs::path(SKY_TEST_OUTPUT_DIR) / "radar-rain.toml";
+  {
+    std::ofstream f(scenario);
+    f << "[clock]\nstart_s = 0.0\nrate = 1.0\n\n[[layer]]\nid = 1\ntype = \"nimbostratus\"\nbase_m = 1500.0\n"
+         "thickness_m = 2500.0\ntransition_band_m = 0.0\ncoverage = 1.0\ndensity = 1.0\n"
+         "wind = { speed_mps = 5.0, from_deg = 270.0, vertical_mps = 0.0 }\n\n[[layer]]\nid = 2\ntype = \"rain\"\n"
+         "base_m = 0.0\nthickness_m = 2500.0\ntransition_band_m = 0.0\ncoverage = 1.0\ndensity = 0.1067\n"
+         "wind = { speed_mps = 5.0, from_deg = 270.0, vertical_mps = 0.0 }\n";
+  }
+  const ReplayResult run = replay("radar", scenario.string(), {"--radar", "40"});
+  ASSERT_EQ(run.frames.size(), kFrames);
+  for (std::size_t i = 0; i < kFrames; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "radar_%06zu.png", i);
+    const fs::path png = run.dir / "frames" / name;
+    int w = 0, h = 0, n = 0;
+    unsigned char* px = stbi_load(png.c_str(), &w, &h, &n, 3);
+    ASSERT_NE(px, nullptr) << png;
+    ASSERT_EQ(w, 160);
+    ASSERT_EQ(h, 160);
+    auto at = [&](int x, int y) { return std::array<int, 3>{px[(y * w + x) * 3], px[(y * w + x) * 3 + 1], px[(y * w + x) * 3 + 2]}; };
+    // Half way to the range, north-east: the 35-40 dBZ colour.
+    EXPECT_EQ(at(110, 50), (std::array<int, 3>{253, 248, 2})) << png;
+    // A corner is past the range: black.
+    EXPECT_EQ(at(2, 2), (std::array<int, 3>{0, 0, 0})) << png;
+    stbi_image_free(px);
+  }
 }
 
 // --sun-shadow: the run draws with the chosen way of shadowing the clouds,

@@ -91,7 +91,8 @@ TEST(StabilityLimits, InsideALayerOfEveryCloudType) {
       {T::Cumulus, 1500, 1500},      {T::Stratocumulus, 1200, 600}, {T::Stratus, 500, 400},
       {T::Nimbostratus, 1000, 2500}, {T::Cumulonimbus, 1000, 9000}, {T::Altocumulus, 4000, 800},
       {T::Altostratus, 4500, 1500},  {T::Cirrus, 9000, 400},        {T::Cirrostratus, 9000, 600},
-      {T::Cirrocumulus, 8000, 300},  {T::Fog, 0, 200},
+      {T::Cirrocumulus, 8000, 300},  {T::Fog, 0, 200},             {T::Rain, 0, 1500},
+      {T::Snow, 0, 1200},
   };
   for (const TypedLayer& t : layers) {
     const std::string name = std::string("inside_") + std::string(weather::toString(t.type));

@@ -246,7 +246,9 @@ Result<WeatherControl> Codec<WeatherControl>::read(PacketReader& r) {
   p.randomWindsEnable = isSet(f, 2);
   p.randomLightningEnable = isSet(f, 3);
   const std::uint8_t type = f >> 4;
-  if (type > weather::kMaxCloudType) r.invalid(6, "cloud type " + std::to_string(type) + " is IG-defined; we define 11 (fog)");
+  // 12-15 are our precipitation types, which a host sets by layer id (4-7), not as a cloud type.
+  if (type > static_cast<std::uint8_t>(weather::CloudType::Fog))
+    r.invalid(6, "cloud type " + std::to_string(type) + " is IG-defined; we define 11 (fog)");
   p.cloudType = static_cast<weather::CloudType>(type);
   const std::uint8_t s = r.u8(7);
   if ((s & 0x03) == 3) r.invalid(7, "scope 3 is undefined");

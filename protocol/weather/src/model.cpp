@@ -12,7 +12,8 @@ namespace sky::weather {
 namespace {
 constexpr std::array<std::string_view, kMaxCloudType + 1> kNames = {
     "none",       "altocumulus",  "altostratus",  "cirrocumulus",  "cirrostratus", "cirrus",
-    "cumulonimbus", "cumulus",    "nimbostratus", "stratocumulus", "stratus",      "fog"};
+    "cumulonimbus", "cumulus",    "nimbostratus", "stratocumulus", "stratus",      "fog",
+    "rain",       "snow",         "sleet",        "hail"};
 
 Result<void> checkRange(const CloudLayer& layer, const char* field, double value, double lo,
                         double hi, bool openLow = false) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sky/weather/advection.hpp"
+#include "sky/weather/precipitation.hpp"
 #include "sky/weather/tiling.hpp"
 #include "sky/weather/wind_field.hpp"
 
@@ -35,8 +36,14 @@ PointWeather weatherAt(std::span<const CloudLayer> layers, const CoverageLookup&
   std::vector<CloudLayer> local(layers.begin(), layers.end());
   if (windLookup)
     for (CloudLayer& l : local) l.wind = windLookup(l, lat_deg, lon_deg);
+  // A precipitation layer has the wind of the cloud that drops it and of
+  // the air it falls through, not a wind of its own that would replace the
+  // air's under the cloud: the winds are the other layers'.
   std::vector<const CloudLayer*> byBase;
-  for (const auto& l : local) byBase.push_back(&l);
+  for (const auto& l : local)
+    if (!isPrecipitation(l.type)) byBase.push_back(&l);
+  if (byBase.empty())
+    for (const auto& l : local) byBase.push_back(&l);
   std::sort(byBase.begin(), byBase.end(), [](const CloudLayer* a, const CloudLayer* b) { return a->base_m < b->base_m; });
 
   // Wind.
@@ -81,11 +88,19 @@ PointWeather weatherAt(std::span<const CloudLayer> layers, const CoverageLookup&
       }
     }
     const double d = coverage * density * p;
-    if (d > out.cloudDensity) {
+    if (isPrecipitation(l.type)) {
+      const double rate = precipitationRateForDensity(l.type, d);
+      if (rate > out.precipitationRate_mmph) {
+        out.precipitationRate_mmph = rate;
+        out.precipitationType = l.type;
+      }
+    } else if (d > out.cloudDensity) {
       out.cloudDensity = d;
       out.layerId = l.id;
     }
   }
+  out.extinction_perm = kCloudExtinctionPerDensity_perm * out.cloudDensity +
+                        precipitationExtinction_perm(out.precipitationType, out.precipitationRate_mmph);
   return out;
 }
 
@@ -130,6 +145,8 @@ double koschmiederVisibility_m(double extinction_perm) {
 double cloudVisibility_m(double cloudDensity) {
   return koschmiederVisibility_m(kCloudExtinctionPerDensity_perm * cloudDensity);
 }
+
+double visibilityAt_m(const PointWeather& point) { return koschmiederVisibility_m(point.extinction_perm); }
 
 double fogDensityForVisibility(double visibility_m) {
   if (!(visibility_m > kMinFogVisibility_m)) return 1.0;

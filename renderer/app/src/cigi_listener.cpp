@@ -8,6 +8,7 @@
 #include "sky/cigi/celestial_time.hpp"
 #include "sky/render/haze.hpp"
 #include "sky/weather/air_field.hpp"
+#include "sky/weather/precipitation.hpp"
 #include "sky/weather/query.hpp"
 
 #include <spdlog/spdlog.h>
@@ -301,10 +302,10 @@ std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRe
     wcr.airTemperature_c = static_cast<float>(
         forecast ? forecast->temperature_c
                  : weather::isaTemperature_c(r.alt_m) + (air.seaLevelTemperature_c - kIsaSeaLevelTemperature_c));
-    // In cloud and fog the Koschmieder range of its extinction (the fog type
-    // draws exactly that), never longer than the clear air's.
-    const double cloud_m = weather::cloudVisibility_m(pw.cloudDensity);
-    wcr.visibility_m = static_cast<float>(std::min(air.visibility_m, cloud_m));
+    // In cloud, fog and precipitation the Koschmieder range of their
+    // extinction (the fog and precipitation types draw exactly that), never
+    // longer than the clear air's.
+    wcr.visibility_m = static_cast<float>(std::min(air.visibility_m, weather::visibilityAt_m(pw)));
     // The weather's layer winds where it has layers; with none (clear sky,
     // no server yet), the host's Atmosphere Control wind when it sent one.
     const bool hostWind = layers.empty() && air.source != AtmosphereSource::Default;
@@ -319,12 +320,29 @@ std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRe
     // CIGI cloud layers 1-3 are our layers of those ids; their liquid water
     // at the point, g/m^3.
     for (const auto& l : layers) {
-      if (l.id < 1 || l.id > 3) continue;
+      if (l.id < 1 || l.id > 3 || weather::isPrecipitation(l.type)) continue;
       const weather::PointWeather one = weather::weatherAt(std::span(&l, 1), lookup, r.lat_deg, r.lon_deg, r.alt_m);
       cigi::AerosolConcentrationResponse a;
       a.requestId = r.requestId;
       a.layerId = static_cast<cigi::LayerId>(l.id);
       a.concentration_gpm3 = static_cast<float>(kCloudLiquidWater_gpm3 * one.cloudDensity);
+      out.push_back(a);
+    }
+    // CIGI's precipitation layers (rain, snow, sleet, hail: 4-7) are our
+    // layers of those types, whatever their ids: the water they hold at the
+    // point (rate over fall speed), where the weather has one.
+    for (const cigi::LayerId id : {cigi::LayerId::Rain, cigi::LayerId::Snow, cigi::LayerId::Sleet, cigi::LayerId::Hail}) {
+      const weather::CloudType type = static_cast<weather::CloudType>(
+          static_cast<int>(weather::CloudType::Rain) + static_cast<int>(id) - static_cast<int>(cigi::LayerId::Rain));
+      std::vector<weather::CloudLayer> ofType;
+      for (const auto& l : layers)
+        if (l.type == type) ofType.push_back(l);
+      if (ofType.empty()) continue;
+      const weather::PointWeather one = weather::weatherAt(ofType, lookup, r.lat_deg, r.lon_deg, r.alt_m);
+      cigi::AerosolConcentrationResponse a;
+      a.requestId = r.requestId;
+      a.layerId = id;
+      a.concentration_gpm3 = static_cast<float>(weather::precipitationWater_gpm3(type, one.precipitationRate_mmph));
       out.push_back(a);
     }
   }

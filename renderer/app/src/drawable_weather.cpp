@@ -5,6 +5,8 @@
 #include <map>
 #include <set>
 
+#include "sky/weather/precipitation.hpp"
+
 namespace sky::app {
 
 namespace {
@@ -38,10 +40,13 @@ weather::WeatherSnapshot drawableWeather(const weather::WeatherSnapshot& s, std:
   }
   std::vector<const weather::CloudLayer*> ranked;
   for (const auto& l : s.layers) ranked.push_back(&l);
-  // Fog that is there comes first: it is thin by density (a 4 km mist is
-  // 0.02) but seen along kilometres of sight line at the ground, and the
-  // CIGI answer and the conformance check count on it being drawn.
-  const auto fogThere = [&](const weather::CloudLayer* l) { return l->type == weather::CloudType::Fog && most[l->id] > 0; };
+  // Fog and precipitation that are there come first: they are thin by
+  // density (a 4 km mist is 0.02, moderate rain 0.06) but seen along
+  // kilometres of sight line at the ground, and the CIGI answer and the
+  // conformance check count on them being drawn.
+  const auto fogThere = [&](const weather::CloudLayer* l) {
+    return (l->type == weather::CloudType::Fog || weather::isPrecipitation(l->type)) && most[l->id] > 0;
+  };
   std::stable_sort(ranked.begin(), ranked.end(), [&](const weather::CloudLayer* a, const weather::CloudLayer* b) {
     if (fogThere(a) != fogThere(b)) return fogThere(a);
     const double ca = most[a->id], cb = most[b->id];

@@ -20,6 +20,7 @@
 #include "sky/app/fallback_weather.hpp"
 #include "sky/app/frame_writer.hpp"
 #include "sky/app/pose_source.hpp"
+#include "sky/app/radar_image.hpp"
 #include "sky/app/replay_outputs.hpp"
 #include "sky/app/shared_state.hpp"
 #include "sky/app/weather_client.hpp"
@@ -232,6 +233,16 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
       break;
     }
     if (weather) weather->reportCamera(pose, i, view.version, request.weatherClock_s);
+    if (o.radarRange_m) {
+      char name[48];
+      std::snprintf(name, sizeof name, "/frames/radar_%06zu.png", i);
+      if (auto ok = writeRadarPicture(view.snapshot, request.weatherClock_s, pose.position, *o.radarRange_m, o.outDir + name);
+          !ok) {
+        std::fprintf(stderr, "skyshell-render: %s\n", describe(ok.error()).c_str());
+        exitCode = 2;
+        break;
+      }
+    }
     const FrameRecord& record = drawn->record;
     renderMs.push_back(record.render_ms);
     if (record.budget) ++framesPerLevel[record.budget->name];

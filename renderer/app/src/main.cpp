@@ -84,6 +84,7 @@ struct Options {
   std::string replayFlight;
   double replayStep_s = 1.0 / 30.0;
   double replayPace = 0;
+  double radarRange_km = 0;
   double replayStart_s = 0;
   double replayEnd_s = -1;
   double replayWeatherClock_s = std::numeric_limits<double>::quiet_NaN();
@@ -207,6 +208,10 @@ int main(int argc, char** argv) {
                  "with --replay: flight seconds per wall second; no frame is rendered before its time "
                  "(default 0: as fast as it renders)")
       ->check(CLI::Range(0.0, 3600.0));
+  app.add_option("--radar", o.radarRange_km,
+                 "with --replay: also write each frame's weather radar picture round the camera, this many km "
+                 "(frames/radar_NNNNNN.png: dBZ from the drawn weather's precipitation, a beam level with the camera)")
+      ->check(CLI::Range(1.0, 300.0));
   app.add_option("--replay-start", o.replayStart_s, "with --replay: start offset into the flight, s")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--replay-end", o.replayEnd_s, "with --replay: end offset into the flight, s (default: its end)")
@@ -351,6 +356,7 @@ int main(int argc, char** argv) {
     r.weatherFile = o.weatherFile;
     r.display = display ? &*display : nullptr;
     r.budget = budget ? &*budget : nullptr;
+    if (o.radarRange_km > 0) r.radarRange_m = o.radarRange_km * 1000.0;
     std::signal(SIGINT, onReplaySignal);
     std::signal(SIGTERM, onReplaySignal);
     return sky::app::runHeadlessReplay(r, **renderer, &gReplayStop);

@@ -31,11 +31,22 @@
 //    the same number the CIGI answer turns into a visibility); it thins over
 //    its top third, where real fog tops are ragged. Fog droplets 10-20 um
 //    (2 r_e ~ 12 um in radiation fog).
+//  * rain, snow, sleet, hail (ours, 12-15): shafts that fill their layer
+//    (from the ground or the virga height up into the cloud that drops them)
+//    like fog, their density being their extinction
+//    (weather::kPrecipitationExtinctionPerDensity_perm, from which the rate,
+//    the answers' visibility and the radar's reflectivity follow:
+//    precipitation.hpp); flat at the bottom, thinning over the top third
+//    where they enter their cloud; the shape noise at a storm cell's scale
+//    breaks a partial coverage into shafts. Raindrops (0.5-3 mm) are far
+//    past the Mie fit's 50 um, so rain takes its most forward-peaked end;
+//    snow, ice pellets and hail scatter as ice.
 // These are look-development numbers inside those bounds, not measurements.
 #include "cloud_types.hpp"
 
 #include <array>
 
+#include "sky/weather/precipitation.hpp"
 #include "sky/weather/query.hpp"
 
 namespace sky::render {
@@ -68,6 +79,12 @@ constexpr CloudTypeParams kCirrocumulus{
 constexpr CloudTypeParams kFog{
     weather::kCloudExtinctionPerDensity_perm,
             12.0, 0.01, 0.70, 1.00, 0.20, 0.0,  0.00, 0.01, 0.30, 0.05, 0.0,  0.10, 0.30, 0.85, 14000.0, 2000.0};
+constexpr CloudTypeParams kRain{
+    weather::kPrecipitationExtinctionPerDensity_perm,
+            50.0, 0.01, 0.70, 1.00, 0.10, 0.0,  0.00, 0.01, 0.30, 0.05, 0.0,  0.10, 0.30, 0.85, 8000.0,  1500.0};
+constexpr CloudTypeParams kSnow{
+    weather::kPrecipitationExtinctionPerDensity_perm,
+            0.0,  0.01, 0.70, 1.00, 0.10, 0.0,  0.00, 0.01, 0.30, 0.05, 0.0,  0.10, 0.30, 0.85, 8000.0,  1500.0};
 
 // Indexed by the CIGI enum value (model.hpp).
 constexpr std::array<const CloudTypeParams*, weather::kMaxCloudType + 1> kTable = {
@@ -83,9 +100,13 @@ constexpr std::array<const CloudTypeParams*, weather::kMaxCloudType + 1> kTable 
     &kStratocumulus, // 9
     &kStratus,       // 10
     &kFog,           // 11 (ours)
+    &kRain,          // 12 (ours)
+    &kSnow,          // 13 (ours)
+    &kSnow,          // 14 sleet (ours): ice pellets
+    &kSnow,          // 15 hail (ours): ice
 };
 
-static_assert(static_cast<int>(CloudType::Fog) == weather::kMaxCloudType);
+static_assert(static_cast<int>(CloudType::Hail) == weather::kMaxCloudType);
 
 }  // namespace
 

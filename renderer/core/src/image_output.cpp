@@ -76,4 +76,13 @@ Result<void> writePng(const Image& image, const std::string& path) {
   return {};
 }
 
+Result<void> writeRgbPng(const std::vector<std::uint8_t>& rgb, std::uint32_t width, std::uint32_t height,
+                         const std::string& path) {
+  if (width == 0 || height == 0 || rgb.size() != std::size_t(width) * height * 3)
+    return fail(ErrorCode::InvalidArgument, "writeRgbPng " + path + ": size does not match the pixels");
+  if (stbi_write_png(path.c_str(), int(width), int(height), 3, rgb.data(), int(width) * 3) == 0)
+    return fail(ErrorCode::Io, "writeRgbPng " + path + ": cannot write file");
+  return {};
+}
+
 }  // namespace sky::render

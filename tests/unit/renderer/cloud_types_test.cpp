@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "cloud_types.hpp"
+#include "sky/weather/precipitation.hpp"
 #include "sky/weather/tiling.hpp"
 #include "weather_field.hpp"
 
@@ -20,10 +21,16 @@ using weather::CloudType;
 constexpr CloudType kAll[] = {CloudType::Altocumulus,  CloudType::Altostratus,  CloudType::Cirrocumulus,
                               CloudType::Cirrostratus, CloudType::Cirrus,       CloudType::Cumulonimbus,
                               CloudType::Cumulus,      CloudType::Nimbostratus, CloudType::Stratocumulus,
-                              CloudType::Stratus,      CloudType::Fog};
+                              CloudType::Stratus,      CloudType::Fog,          CloudType::Rain,
+                              CloudType::Snow,         CloudType::Sleet,        CloudType::Hail};
 
 bool isIce(CloudType t) {
   return t == CloudType::Cirrus || t == CloudType::Cirrostratus || t == CloudType::Cirrocumulus;
+}
+
+// Snow, ice pellets and hail: ice, but dense as precipitation.
+bool isFrozenPrecipitation(CloudType t) {
+  return t == CloudType::Snow || t == CloudType::Sleet || t == CloudType::Hail;
 }
 
 TEST(CloudTypes, EveryTypeIsInsideTheModelsRanges) {
@@ -31,7 +38,12 @@ TEST(CloudTypes, EveryTypeIsInsideTheModelsRanges) {
     SCOPED_TRACE(std::string(weather::toString(t)));
     const CloudTypeParams& p = cloudTypeParams(t);
     // formulas.md: water clouds 0.01-0.15 1/m, cirrus 1e-4-1e-3.
-    if (isIce(t)) {
+    if (weather::isPrecipitation(t)) {
+      // The density is the extinction the answers and the radar assume.
+      EXPECT_EQ(p.extinction_perm, weather::kPrecipitationExtinctionPerDensity_perm);
+      EXPECT_EQ(p.dropletDiameter_um, isFrozenPrecipitation(t) ? 0.0 : 50.0)
+          << "ice: HG phase; raindrops: the droplet fit's most forward end";
+    } else if (isIce(t)) {
       EXPECT_GE(p.extinction_perm, 1e-4);
       EXPECT_LE(p.extinction_perm, 1e-3);
       EXPECT_EQ(p.dropletDiameter_um, 0.0) << "ice: HG phase, not the droplet fit";

@@ -13,6 +13,7 @@
 
 #include "cloud_types.hpp"
 #include "core_harness.hpp"
+#include "sky/weather/precipitation.hpp"
 #include "sky/weather/query.hpp"
 
 namespace sky::test {
@@ -25,16 +26,17 @@ using weather::CloudType;
 // mean over its values. The harness's noise is one value per march, so the
 // march runs once per value of a midpoint grid (shape x detail) and the
 // optical depths are averaged.
-double sightLineTransmittance(double visibility_m, double fogThickness_m, double eyeHeight_m, double distance_m) {
+double sightLineTransmittance(CloudType type, double density, double fogThickness_m, double eyeHeight_m,
+                              double distance_m) {
   const double R = 6371000;
   Core c;
   c.coverage = 1.0;
-  c.density = weather::fogDensityForVisibility(visibility_m);
+  c.density = density;
   c.cloudMap = Core::real2(0.5, 1.0);
   Core::CoreFrame f = frameOver(R, eyeHeight_m, 0);
   f.layerCount = 1;
   c.layers[0] = shellLayer(f, eyeHeight_m, 0.0, fogThickness_m,
-                           render::coreCloudType<Core::CloudType>(render::cloudTypeParams(CloudType::Fog)));
+                           render::coreCloudType<Core::CloudType>(render::cloudTypeParams(type)));
   const Core::Span span = c.layerSpan(f, c.layers[0], 0.0, distance_m);  // horizontal, ends at the target
   EXPECT_NEAR(span.t1 - span.t0, distance_m, 1e-6) << "the sight line stays in the fog up to the target";
   constexpr int kShape = 40, kDetail = 8;
@@ -49,6 +51,11 @@ double sightLineTransmittance(double visibility_m, double fogThickness_m, double
   return std::exp(-tau / (kShape * kDetail));
 }
 
+double sightLineTransmittance(double visibility_m, double fogThickness_m, double eyeHeight_m, double distance_m) {
+  return sightLineTransmittance(CloudType::Fog, weather::fogDensityForVisibility(visibility_m), fogThickness_m,
+                                eyeHeight_m, distance_m);
+}
+
 // The fog's soft coverage threshold (0.05 of the noise's range) thins 2.5 %
 // of the sheet: T = exp(-3.912 x 0.975) = 0.0219 predicted. Tolerance: the
 // contrast within 0.020 +- 0.003 (the visibility within about 5 %).
@@ -60,6 +67,28 @@ TEST(Fog, ABlackTargetAtTheVisibilityKeepsTwoPercentContrast) {
     EXPECT_NEAR(t, 0.02, 0.003);
     // Half way the target keeps sqrt of it (Beer-Lambert in a uniform sheet).
     EXPECT_NEAR(sightLineTransmittance(v, 300, 60, 0.5 * v), std::sqrt(t), 0.01);
+  }
+}
+
+// Rain and snow draw the extinction their rate stands for
+// (precipitation.hpp): a target at the Koschmieder visibility of the rate,
+// seen at a pilot's eye through the shaft, keeps 2 % of its contrast (the
+// same soft threshold as fog's: 0.0219 predicted; tolerance 0.003).
+TEST(Precipitation, ABlackTargetAtTheRatesVisibilityKeepsTwoPercentContrast) {
+  struct Case {
+    CloudType type;
+    double rate_mmph;
+  };
+  for (const Case c : {Case{CloudType::Rain, weather::kModerateRain_mmph}, Case{CloudType::Rain, weather::kHeavyRain_mmph},
+                       Case{CloudType::Snow, weather::kModerateSnow_mmph}, Case{CloudType::Sleet, weather::kLightRain_mmph}}) {
+    const double v = weather::koschmiederVisibility_m(weather::precipitationExtinction_perm(c.type, c.rate_mmph));
+    SCOPED_TRACE(std::string(weather::toString(c.type)) + " " + std::to_string(c.rate_mmph) + " mm/h, visibility " +
+                 std::to_string(v) + " m");
+    const double t =
+        sightLineTransmittance(c.type, weather::precipitationDensityForRate(c.type, c.rate_mmph), 2000, 60, v);
+    std::printf("[ precip   ] %s %.1f mm/h: visibility %.0f m, transmittance to a target there %.4f\n",
+                std::string(weather::toString(c.type)).c_str(), c.rate_mmph, v, t);
+    EXPECT_NEAR(t, 0.02, 0.003);
   }
 }
 

@@ -3,6 +3,7 @@
 // decoded by the protocol decoder, as the listener will; expected values are
 // worked out by hand from the packet fields.
 #include "sky/server/cigi_weather.hpp"
+#include "sky/weather/precipitation.hpp"
 #include "sky/weather/query.hpp"
 
 #include <gtest/gtest.h>
@@ -83,18 +84,53 @@ TEST_P(CigiWeather, DisableRemovesOnlyALayerItEnabled) {
   EXPECT_TRUE(m.map(roundTrip({off}, GetParam()))->empty());
 }
 
-TEST_P(CigiWeather, PrecipitationIgnoredIgDefinedKept) {
+TEST_P(CigiWeather, SandAndDustIgnoredIgDefinedKept) {
   CigiWeatherMapper m;
-  auto rain = layer2();
-  rain.layerId = cigi::LayerId::Rain;
-  rain.cloudType = weather::CloudType::None;
+  auto sand = layer2();
+  sand.layerId = cigi::LayerId::Sand;
+  sand.cloudType = weather::CloudType::None;
   auto ig = layer2();
   ig.layerId = cigi::LayerId{12};
-  auto changes = m.map(roundTrip({rain, ig}, GetParam()));
+  auto changes = m.map(roundTrip({sand, ig}, GetParam()));
   ASSERT_TRUE(changes);
   ASSERT_EQ(changes->size(), 1u);
   EXPECT_EQ(std::get<SetLayer>((*changes)[0]).layer.id, 12u);
   EXPECT_EQ(m.ignoredLayers(), 1u);
+}
+
+// Rain, snow, sleet and hail (4-7) are our precipitation layers of those
+// ids: the rate from the visibility range, or from the severity without one.
+TEST_P(CigiWeather, PrecipitationLayersTakeTheirRateFromVisibilityOrSeverity) {
+  CigiWeatherMapper m;
+  cigi::WeatherControl rain = layer2();
+  rain.layerId = cigi::LayerId::Rain;
+  rain.cloudType = weather::CloudType::None;  // not used
+  rain.baseElevation_m = 0;
+  rain.thickness_m = 1500;
+  rain.coverage_pct = 100;
+  rain.visibility_m = 2500;
+  cigi::WeatherControl snow = rain;
+  snow.layerId = cigi::LayerId::Snow;
+  snow.visibility_m = 0;
+  snow.severity = 4;  // heavy
+  auto changes = m.map(roundTrip({rain, snow}, GetParam()));
+  ASSERT_TRUE(changes) << changes.error().detail;
+  ASSERT_EQ(changes->size(), 2u);
+  const auto& r = std::get<SetLayer>((*changes)[0]).layer;
+  const auto& s = std::get<SetLayer>((*changes)[1]).layer;
+  EXPECT_EQ(r.id, 4u);
+  EXPECT_EQ(r.type, weather::CloudType::Rain);
+  EXPECT_NEAR(weather::koschmiederVisibility_m(weather::kPrecipitationExtinctionPerDensity_perm * r.density), 2500, 1e-3);
+  EXPECT_EQ(s.id, 5u);
+  EXPECT_EQ(s.type, weather::CloudType::Snow);
+  EXPECT_NEAR(weather::precipitationRateForDensity(weather::CloudType::Snow, s.density), weather::kHeavySnow_mmph, 1e-9);
+  EXPECT_EQ(m.ignoredLayers(), 0u);
+  // A visibility range the codec would not pass (negative, not finite) is
+  // refused by the mapping too, naming the field.
+  rain.visibility_m = -1;
+  auto refused = cloudLayerFrom(rain);
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().detail.find("visibility range"), std::string::npos) << refused.error().detail;
 }
 
 TEST_P(CigiWeather, GroundFogIsAFogLayerOfItsVisibilityRange) {

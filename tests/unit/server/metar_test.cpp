@@ -19,6 +19,7 @@
 
 #include "sky/geo/geodetic.hpp"
 #include "sky/server/metar.hpp"
+#include "sky/weather/precipitation.hpp"
 #include "sky/weather/query.hpp"
 
 namespace sky::server {
@@ -28,6 +29,18 @@ using weather::CloudLayer;
 using weather::CloudType;
 
 constexpr double kFt = 0.3048;
+
+// The visibility the mapped layers draw at the station: the fog's and the
+// precipitation's extinctions (coverage x density x their constant) added.
+double drawnVisibility_m(const std::vector<weather::CloudLayer>& layers) {
+  double sigma = 0;
+  for (const weather::CloudLayer& l : layers) {
+    if (l.type == weather::CloudType::Fog) sigma += weather::kCloudExtinctionPerDensity_perm * l.coverage * l.density;
+    if (weather::isPrecipitation(l.type))
+      sigma += weather::kPrecipitationExtinctionPerDensity_perm * l.coverage * l.density;
+  }
+  return weather::koschmiederVisibility_m(sigma);
+}
 
 struct Row {
   std::string category, source, icao, date, report;
@@ -164,15 +177,23 @@ TEST(MetarRealReports, MappingPerCategory) {
       EXPECT_EQ(fog.coverage, 1.0);
       EXPECT_NEAR(fog.thickness_m, std::max(*report->verticalVisibility_ft * kFt, kMinFogThickness_m), 1e-9);
     }
-    // A fog layer is first, at most one, and draws the reported visibility
-    // (the densest fog the model has for a shorter one).
+    // A fog layer is first, at most one, and with the precipitation draws the
+    // reported visibility (the densest fog the model has for a shorter one).
     for (std::size_t i = 0; i < layers->size(); ++i) {
       const CloudLayer& l = (*layers)[i];
       if (l.type != CloudType::Fog) continue;
       EXPECT_EQ(i, 0u);
-      if (report->visibility_m && !report->visibilityAbove && *report->visibility_m < kClearVisibility_m) {
-        EXPECT_NEAR(weather::cloudVisibility_m(l.coverage * l.density), std::max(*report->visibility_m, weather::kMinFogVisibility_m / l.coverage),
-                    1e-6 * *report->visibility_m);
+      if (report->visibility_m && !report->visibilityAbove && *report->visibility_m < kClearVisibility_m &&
+          l.density < 1) {
+        EXPECT_NEAR(drawnVisibility_m(*layers), *report->visibility_m, 1e-6 * *report->visibility_m);
+      }
+    }
+    // At most one precipitation layer, from the station up.
+    const auto wet = std::count_if(layers->begin(), layers->end(), [](const CloudLayer& l) { return weather::isPrecipitation(l.type); });
+    EXPECT_LE(wet, 1);
+    for (const CloudLayer& l : *layers) {
+      if (weather::isPrecipitation(l.type)) {
+        EXPECT_EQ(l.base_m, station.elevation_m);
       }
     }
     if (c == "VRB") {
@@ -509,7 +530,6 @@ TEST(MetarLayers, ObscurationIsAFogLayerOfTheReportedVisibility) {
       {"3000 FU NSC", 3000, kHazeThickness_m, 1.0},
       {"FG NSC", kFogDefaultVisibility_m, kFogThickness_m, 1.0},  // no visibility group: FG's default
       {"2000 +RA BKN015", 2000, 1500 * kFt, 1.0},                 // rain: from the lowest base down
-      {"3000 SN NSC", 3000, kPrecipitationObscurationTop_m, 1.0},
       {"0300 FG VV002", 300, 200 * kFt, 1.0},
       {"0050 FG VV001", weather::kMinFogVisibility_m, 100 * kFt, 1.0},  // denser than the model draws
       {"0000 FG VV///", weather::kMinFogVisibility_m, 100 * kFt, 1.0},  // under 50 m: the densest
@@ -525,7 +545,8 @@ TEST(MetarLayers, ObscurationIsAFogLayerOfTheReportedVisibility) {
     EXPECT_EQ(fog.base_m, 500);
     EXPECT_NEAR(fog.thickness_m, c.thickness_m, 1e-9);
     EXPECT_EQ(fog.coverage, c.coverage);
-    EXPECT_NEAR(weather::cloudVisibility_m(fog.coverage * fog.density), c.visibility_m, 1e-9 * c.visibility_m);
+    // With the precipitation's (drawn beside it) the reported visibility.
+    EXPECT_NEAR(drawnVisibility_m(*layers), c.visibility_m, 1e-9 * c.visibility_m);
     for (std::size_t i = 1; i < layers->size(); ++i) EXPECT_NE((*layers)[i].type, CloudType::Fog);
   }
   // Nothing to draw: 10 km or more, rain that leaves 5 km, fog in the vicinity.
@@ -534,6 +555,95 @@ TEST(MetarLayers, ObscurationIsAFogLayerOfTheReportedVisibility) {
     ASSERT_TRUE(layers) << body;
     for (const CloudLayer& l : *layers) EXPECT_NE(l.type, CloudType::Fog) << body;
   }
+}
+
+// Precipitation -> a layer of its type from the station up into the cloud
+// that drops it, at the intensity's rate unless the visibility says less.
+TEST(MetarLayers, PrecipitationIsALayerFromTheStationIntoItsCloud) {
+  struct Case {
+    const char* body;
+    CloudType type;
+    double rate_mmph;   // expected rate (coverage 1 where the cap binds)
+    double carrierBase_ft;  // the cloud it falls from (its base); < 0: none, kPrecipitationObscurationTop_m deep
+    double coverage;
+  };
+  // The rule's cap: the rate whose extinction over the covered part gives
+  // the reported visibility (a 9999: 10 km), less an obscured sky's fog's
+  // least (a 10 km visibility's extinction).
+  auto capped = [](CloudType t, double rate, double visibility_m, double coverage, bool obscured = false) {
+    const double allowed = 3.912 / visibility_m - (obscured ? 3.912 / 10000 : 0.0);
+    return std::min(rate, weather::precipitationRate_mmph(t, allowed / coverage));
+  };
+  const double bkn = kBrokenCoverage;
+  const Case cases[] = {
+      // Steady rain from the lowest ceiling, 1000 m into it; 8 km caps the
+      // moderate rate at 2.9 mm/h.
+      {"8000 RA FEW008 OVC015", CloudType::Rain, capped(CloudType::Rain, weather::kModerateRain_mmph, 8000, 1), 1500, 1.0},
+      // Light rain under a broken deck: its coverage, the light rate (21 km).
+      {"9999 -RA BKN030", CloudType::Rain, weather::kLightRain_mmph, 3000, bkn},
+      // Showers fall from the cumulonimbus, not the lower deck.
+      {"4000 +TSRA SCT010 BKN025CB", CloudType::Rain, capped(CloudType::Rain, weather::kHeavyRain_mmph, 4000, bkn), 2500, bkn},
+      // Snow at its own rates.
+      {"1200 SN OVC010", CloudType::Snow, capped(CloudType::Snow, weather::kModerateSnow_mmph, 1200, 1), 1000, 1.0},
+      {"0600 +SN VV005", CloudType::Snow, capped(CloudType::Snow, weather::kHeavySnow_mmph, 600, 1, true), -1, 1.0},
+      // Rain and snow together, and ice pellets: sleet; hail.
+      {"3000 RASN BKN008", CloudType::Sleet, capped(CloudType::Sleet, weather::kModerateRain_mmph, 3000, bkn), 800, bkn},
+      {"5000 -PL OVC020", CloudType::Sleet, capped(CloudType::Sleet, weather::kLightRain_mmph, 5000, 1), 2000, 1.0},
+      {"3000 TSGR BKN030CB", CloudType::Hail, weather::kModerateRain_mmph, 3000, bkn},
+      // Drizzle: a tenth of rain's rate.
+      {"5000 DZ OVC004", CloudType::Rain, weather::kModerateRain_mmph * weather::kDrizzleFactor, 400, 1.0},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.body);
+    auto layers = mapped(std::string("00000KT ") + c.body);
+    ASSERT_TRUE(layers) << layers.error().detail;
+    const auto wet = std::find_if(layers->begin(), layers->end(), [](const CloudLayer& l) { return weather::isPrecipitation(l.type); });
+    ASSERT_NE(wet, layers->end());
+    EXPECT_EQ(wet->type, c.type);
+    EXPECT_EQ(wet->base_m, 500);
+    double depth_m = kPrecipitationObscurationTop_m;
+    if (c.carrierBase_ft >= 0) {
+      const auto carrier = std::find_if(layers->begin(), layers->end(), [&](const CloudLayer& l) {
+        return !weather::isPrecipitation(l.type) && std::abs(l.base_m - (500 + c.carrierBase_ft * kFt)) < 1e-6;
+      });
+      ASSERT_NE(carrier, layers->end());
+      depth_m = carrier->base_m - 500 + std::min(kPrecipitationInCloud_m, carrier->thickness_m);
+      EXPECT_EQ(wet->coverage, carrier->coverage);
+    }
+    EXPECT_NEAR(wet->thickness_m, depth_m, 1e-6);
+    EXPECT_EQ(wet->coverage, c.coverage);
+    EXPECT_NEAR(weather::precipitationRateForDensity(c.type, wet->density), c.rate_mmph, 1e-6 * c.rate_mmph);
+    // What the layers draw at the station is never clearer than reported.
+    const auto report = parseMetar(std::string("ABCD 010000Z 00000KT ") + c.body);
+    ASSERT_TRUE(report);
+    // (Under 5 km, where the rest is drawn as mist: a 5000 DZ draws the
+    // drizzle alone.)
+    if (report->visibility_m && *report->visibility_m < kHazeDefaultVisibility_m) {
+      EXPECT_NEAR(drawnVisibility_m(*layers), *report->visibility_m, 1e-6 * *report->visibility_m);
+    }
+  }
+  // The deck steady rain falls from is nimbostratus, deeper and darker
+  // than the same group without rain; drizzle falls from stratus as it is.
+  {
+    auto wet = mapped("00000KT 8000 RA OVC015");
+    auto dry = mapped("00000KT 9999 OVC015");
+    auto drizzle = mapped("00000KT 5000 DZ OVC004");
+    ASSERT_TRUE(wet && dry && drizzle);
+    EXPECT_EQ(dry->front().type, CloudType::Stratocumulus);
+    EXPECT_EQ(wet->front().type, CloudType::Nimbostratus);
+    EXPECT_EQ(wet->front().thickness_m, kNimbostratusThickness_m);
+    EXPECT_EQ(wet->front().base_m, dry->front().base_m);
+    EXPECT_EQ(drizzle->front().type, CloudType::Stratus);
+  }
+  // Not at the station, or not falling: no precipitation layer.
+  for (const char* body : {"9999 VCSH FEW030", "9999 BLSN BKN010", "9999 DRSN SCT020", "9999 TS FEW030CB", "9999 BR NSC"}) {
+    auto layers = mapped(std::string("00000KT ") + body);
+    ASSERT_TRUE(layers) << body;
+    for (const CloudLayer& l : *layers) EXPECT_FALSE(weather::isPrecipitation(l.type)) << body;
+  }
+  // Rain under a sky the report does not give: not observed (the station
+  // replaces every layer or none).
+  EXPECT_FALSE(mapped("00000KT 5000 RA //////"));
 }
 
 TEST(MetarLayers, ClearCodesGiveNoLayers) {
@@ -613,6 +723,14 @@ std::string skyText(const std::string& report, double elevation_m) {
       out += buf;
       continue;
     }
+    if (weather::isPrecipitation(l.type)) {
+      std::string name(weather::toString(l.type));
+      for (char& ch : name) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+      std::snprintf(buf, sizeof buf, "%s%s%.1f", out.empty() ? "" : " ", name.c_str(),
+                    weather::precipitationRateForDensity(l.type, l.density));
+      out += buf;
+      continue;
+    }
     const bool fog = i == 0 && r->verticalVisibility;
     const int hundreds = static_cast<int>(std::lround((fog ? l.thickness_m : l.base_m - elevation_m) / kFt / 100));
     const char* amount = fog                              ? "VV"
@@ -659,13 +777,13 @@ TEST(MetarOddities, EachMapsToWhatItSays) {
       {"METAR KDEN 221153Z 25012KT P6SM FEW080 SCT150 BKN250 10/M05 A3012 RMK AO2 SLP187",
        "FEW080 SCT150 BKN250"},
       {"METAR KJFK 221151Z 31012KT 1/4 SM FG OVC002 08/08 A2990", "FOG0402 OVC002", "", "SM"},
-      {"METAR KSEA 221153Z 18010KT 1 1/4 SM -RA BR OVC008 10/09 A2985", "FOG2012 OVC008", "", "1/4 SM"},
+      {"METAR KSEA 221153Z 18010KT 1 1/4 SM -RA BR OVC008 10/09 A2985", "FOG2308 OVC008 RAIN1.0", "", "1/4 SM"},
       {"METAR KOKC 221153Z 20025G35KT 1/2SM +FC BKN020CB 25/20 A2980", "BKN020CB"},
       {"METAR CYYZ 221200Z 27015G25KT 15SM FEW040 SCT250 M05/M12 A2990 RMK SC1CI3", "FEW040 SCT250"},
       {"METAR KORD 221151Z 27010KT 10SM BKN045 10/02 A2992 RMK AO2 SLP133 $", "BKN045"},
       {"METAR KMIA 221153Z 09010KT 10SM VCSH FEW025 SCT045 28/22 A3001 RMK AO2", "FEW025 SCT045"},
       // Supplementary groups after the pressure, and before it.
-      {"METAR YSSY 221130Z 18015KT 9999 -SHRA FEW020 BKN035 15/12 Q1015 RERA", "FEW020 BKN035"},
+      {"METAR YSSY 221130Z 18015KT 9999 -SHRA FEW020 BKN035 15/12 Q1015 RERA", "FEW020 BKN035 RAIN1.0"},
       {"METAR YSSY 221130Z 18015KT 9999 RERA FEW020 BKN035 15/12 Q1015", "FEW020 BKN035"},
       {"METAR EGLL 221150Z 27015KT 9999 SCT030 14/08 Q1013 WS R27L NOSIG", "SCT030"},
       {"METAR LFPG 221200Z 27015KT 9999 WS R27 SCT030 14/08 Q1013", "SCT030", "", "R27"},
@@ -689,12 +807,12 @@ TEST(MetarOddities, EachMapsToWhatItSays) {
       {"METAR LOWI 221150Z 27005KT 9999 BKN0x5 SCT080 10/02 Q1020", "SCT080", "BKN0x5"},
       {"METAR LEMD 221200Z 9999 27010KT SCT040 18/05 Q1020", "SCT040"},
       {"METAR UKOO 141235Z 02002MPS 340V080 4200 -1004SE R34/////N -SHRA SCT012 SCT018CB 20/16 Q1013",
-       "FOG4200 SCT012 SCT018CB", "-1004SE"},
+       "FOG4759 SCT012 SCT018CB RAIN1.0", "-1004SE"},
       {"metar lszh 221150z 24005kt 9999 few040 12/06 q1018", "FEW040"},
       {"2018/09/14 12:35 UKOO 141235Z 02002MPS 9999 SCT012 20/16 Q1013", "SCT012", "2018/09/14 12:35"},
       {"METAR: LJLJ 221150Z 24008KT 9999 BKN030 12/06 Q1018", "BKN030", "METAR:"},
       {"metar lszh 221150z 24005kt 9999 few040 xyz 12/06 q1018", "FEW040", "xyz"},  // quoted as written
-      {"SPECI KXYZ 221210Z 27010KT 3SM -TSRA BR SCT008 BKN020CB OVC050 20/18 A2992 RMK", "FOG4828 SCT008 BKN020CB OVC050"},
+      {"SPECI KXYZ 221210Z 27010KT 3SM -TSRA BR SCT008 BKN020CB OVC050 20/18 A2992 RMK", "FOG6282 SCT008 BKN020CB OVC050 RAIN1.0"},
       {"METAR CYSY NIL=", "refused: CYSY: NIL report (no observation)"},
   };
   int read = 0;

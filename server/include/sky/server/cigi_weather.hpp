@@ -5,9 +5,13 @@
 // 10..255 are taken as further cloud layers with the same id. Ground Fog (0)
 // becomes our layer 0 of type fog, its density the packet's visibility range
 // (weather::fogDensityForVisibility; a range <= 0 is refused), its cloud type
-// field not used. The precipitation/obscurant ids 4..9 (rain, snow, sleet,
-// hail, sand, dust) have no counterpart in our model yet and are ignored
-// (counted).
+// field not used. The precipitation ids 4..7 (rain, snow, sleet, hail)
+// become our layers 4..7 of those types (precipitation.hpp): the rate from
+// the packet's visibility range when it gives one (> 0: the visibility in
+// the precipitation), else from its severity (0-1 light, 2-3 moderate, 4
+// heavy, 5 twice heavy); base, thickness, coverage and wind as a cloud
+// layer's, the cloud type field not used. Sand and dust (8, 9) have no
+// counterpart in our model yet and are ignored (counted).
 //
 // Weather Control, global scope: enabled -> SetLayer (coverage % / 100, base
 // elevation, thickness, transition band, cloud type, horizontal wind speed,
@@ -17,8 +21,9 @@
 // leaves) the layers of the region given by Entity/Region ID, and the region
 // is sent whole as SetRegion once an Environmental Region Control has placed
 // it. Entity scope is rejected (no entity weather in our model). Ignored
-// fields: humidity, air temperature, visibility (but ground fog's), scud, random winds and
-// lightning, severity, pressure, aerosol concentration.
+// fields: humidity, air temperature, visibility (but ground fog's and
+// precipitation's), scud, random winds and lightning, severity (but
+// precipitation's), pressure, aerosol concentration.
 //
 // Environmental Region Control: Active -> SetRegion (centre, size, corner
 // radius, rotation, transition perimeter, with the layers given so far);

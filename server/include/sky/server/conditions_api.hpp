@@ -13,6 +13,8 @@
 #include <nlohmann/json.hpp>
 
 #include "sky/core/result.hpp"
+#include "sky/weather/model.hpp"
+#include "sky/weather/tiling.hpp"
 
 namespace sky::server {
 
@@ -34,6 +36,12 @@ struct ConditionsQuery {
 // optional "level="). Pure. An unknown, repeated, missing or out-of-range
 // key is an error naming it.
 Result<ConditionsQuery> parseConditionsQuery(std::string_view query);
+
+// The snapshot a renderer subscribed to `cap` at tile level `level` holds at
+// weather clock clock_s (its tiles' fractions quantised as the stream
+// carries them): what the point answers are computed from.
+weather::WeatherSnapshot subscriberSnapshot(const LiveWeather& weather, double clock_s, const weather::SphericalCap& cap,
+                                           int level);
 
 // The answer at the server's weather clock now (see API.md).
 nlohmann::json conditionsJson(const LiveWeather& weather, const ConditionsQuery& q);

@@ -21,6 +21,7 @@ enum class Endpoint {
   Conditions,
   Conformance,
   Wind,  // GET /api/wind (wind_api.hpp)
+  Radar,  // GET /api/radar (radar_api.hpp)
   Events,
   Changes,
   Scenario,

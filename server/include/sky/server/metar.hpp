@@ -189,6 +189,27 @@ inline constexpr double kClearVisibility_m = 10000;
 inline constexpr double kFogPatchesCoverage = 0.5;
 inline constexpr double kPartialFogCoverage = 0.75;
 
+// Precipitation at the station (the heaviest present-weather group with RA,
+// DZ, SN, SG, PL, GR, GS or UP; not in the vicinity, not snow blowing or
+// drifting) becomes a precipitation layer (precipitation.hpp) from the
+// station up into the cloud that drops it: for showers and thunderstorms
+// (SH, TS) the cumulonimbus or towering cumulus group, else the lowest
+// broken or overcast group, else the lowest group; kPrecipitationInCloud_m
+// into it (at most its depth), with its coverage. Without a cloud group
+// (VV, NSC) up to kPrecipitationObscurationTop_m, coverage 1. Its rate is
+// the intensity's (precipitation.hpp: kLightRain_mmph ...; drizzle a tenth;
+// rain and snow together, and PL, are sleet; GR and GS hail at rain's
+// rates), at most the rate whose extinction gives the reported visibility
+// (a 9999 caps it at 10 km), so that the visibility drawn at the station is
+// the reported one; what the precipitation leaves of the reported
+// visibility's extinction is drawn as the fog layer's (below).
+inline constexpr double kPrecipitationInCloud_m = 1000;
+// A broken or overcast deck of stratocumulus or altostratus that steady
+// rain, snow or sleet falls from (not drizzle, which falls from stratus) is
+// the rain cloud, nimbostratus, and as deep as one: darker than the deck
+// the same groups give without precipitation.
+inline constexpr double kNimbostratusThickness_m = 2500;
+
 // VV/// (sky obscured, vertical visibility not measured, as automatic
 // stations send in fog): the fog is taken as deep as VV001, the smallest
 // vertical visibility above "less than 100 ft" a report can give.
@@ -212,8 +233,11 @@ struct MetarSky {
 //   station: low FEW/SCT cumulus, BKN stratocumulus, OVC stratus below
 //   kStratusMaxBase_m else stratocumulus; middle FEW/SCT altocumulus, BKN/OVC
 //   altostratus; high cirrus;
+// * precipitation -> a precipitation layer (above), after the cloud layers;
+//   a steady one's deck becomes nimbostratus (kNimbostratusThickness_m);
 // * obscuration -> a fog-type layer first (id 1) from the station elevation,
-//   density for the prevailing visibility (or the group's default), when a
+//   density for the prevailing visibility (or the group's default) less the
+//   precipitation's extinction (none left: no fog layer, but under VV), when a
 //   report has VV, a fog/mist/haze group (FG, BR, HZ, FU, DU, SA, VA; not in
 //   the vicinity, VC) or a visibility under 5 km with precipitation; top at
 //   the vertical visibility (VV/// at kUnknownVerticalVisibility_ft, at

@@ -67,13 +67,15 @@ inline constexpr std::uint32_t kMetarFirstBandSlot = 43;
 // Tops of the base bands, m MSL (the last band is open above). About 150 m
 // (500 ft) wide near the ground, where approach minima (200, 500, 1000 ft)
 // make the ceiling matter, each band about 20 % wider than the one below it
-// up to 9.2 km. With fog and the two convective slots METAR uses 22 layer ids,
-// leaving 10 of the 32 a snapshot may hold (kMaxScenarioLayers) to the global
-// and other regional layers.
+// up to 9.2 km. With fog, precipitation and the two convective slots METAR
+// uses 23 layer ids, leaving 9 of the 32 a snapshot may hold
+// (kMaxScenarioLayers) to the global and other regional layers.
 inline constexpr std::array<double, 18> kMetarBandTops_m = {150,  300,  450,  600,  800,  1000,
                                                             1250, 1500, 1800, 2100, 2500, 3000,
                                                             3600, 4300, 5200, 6300, 7600, 9200};
 inline constexpr std::uint32_t kMetarLastSlot = kMetarFirstBandSlot + kMetarBandTops_m.size();
+// A station's precipitation (metar.hpp), after the cloud slots.
+inline constexpr std::uint32_t kMetarPrecipitationSlot = kMetarLastSlot + 1;
 
 // Core radius of a station: METAR reports the aerodrome and its vicinity
 // ("VC": within 8 km); 5 km also holds the centre of the level 11 S2 cell

@@ -29,8 +29,15 @@ enum class CloudType : std::uint8_t {
   // ground-fog layer, METAR FG/BR/HZ), a uniform sheet whose density is its
   // visibility (query.hpp, fogDensityForVisibility).
   Fog = 11,
+  // Precipitation below (and in) the cloud that drops it, whose density is
+  // its extinction (precipitation.hpp): CIGI's precipitation layers 4-7 and
+  // METAR's RA/DZ, SN/SG, PL and GR/GS.
+  Rain = 12,
+  Snow = 13,
+  Sleet = 14,
+  Hail = 15,
 };
-inline constexpr std::uint8_t kMaxCloudType = 11;
+inline constexpr std::uint8_t kMaxCloudType = 15;
 
 std::string_view toString(CloudType type);  // "cumulus"
 std::optional<CloudType> cloudTypeFromString(std::string_view name);

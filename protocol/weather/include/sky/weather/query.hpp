@@ -16,8 +16,15 @@ namespace sky::weather {
 
 struct PointWeather {
   LayerWind wind;                       // see weatherAt for the interpolation
-  double cloudDensity = 0;              // [0, 1]: coverage x density x vertical presence, densest layer
+  double cloudDensity = 0;              // [0, 1]: coverage x density x vertical presence, densest cloud or fog layer
   std::optional<std::uint32_t> layerId; // the layer whose cloud that is (none: clear air)
+  // The heaviest precipitation at the point (precipitation.hpp): its type
+  // (None: none) and rate from coverage x density x vertical presence.
+  CloudType precipitationType = CloudType::None;
+  double precipitationRate_mmph = 0;
+  // Extinction at 550 nm, 1/m: the cloud's (kCloudExtinctionPerDensity_perm
+  // x cloudDensity) plus the precipitation's, as the renderer draws them.
+  double extinction_perm = 0;
 };
 
 // Coverage (and density, type blend) of one layer at a surface point, when it
@@ -33,7 +40,8 @@ using WindLookup = std::function<LayerWind(const CloudLayer& layer, double lat_d
 // the one above; below the lowest or above the highest, the nearest layer's;
 // no layers: calm. Cloud: each layer is fully present from base to top and
 // fades linearly to nothing over its transition band above and below; the
-// densest layer at the point wins.
+// densest layer at the point wins. Precipitation layers the same way, apart
+// from the cloud: the heaviest wins.
 PointWeather weatherAt(std::span<const CloudLayer> layers, const CoverageLookup& lookup, double lat_deg,
                        double lon_deg, double alt_m, const WindLookup& windLookup = {});
 
@@ -63,6 +71,8 @@ inline constexpr double kUnlimitedVisibility_m = 1.0e9;
 double koschmiederVisibility_m(double extinction_perm);
 // The visibility inside cloud of density d (a PointWeather::cloudDensity).
 double cloudVisibility_m(double cloudDensity);
+// The visibility at a point: the Koschmieder range of its extinction.
+double visibilityAt_m(const PointWeather& point);
 // The fog density whose visibility is visibility_m: 3.912 / (0.05 V),
 // at most 1 (so the thickest fog the model draws has V = 78 m; a shorter
 // visibility is drawn as that).

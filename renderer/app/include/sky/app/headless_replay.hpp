@@ -53,6 +53,9 @@ struct ReplayOptions {
   // Holds the frames to a time budget (--frame-budget-ms); the report
   // counts the frames per level. Not owned; null: none.
   render::FrameBudget* budget = nullptr;
+  // With a range (m): each frame's weather radar picture round the camera
+  // (radar_image.hpp), frames/radar_NNNNNN.png.
+  std::optional<double> radarRange_m;
 };
 
 // Runs the replay to the end (or until *stop turns true, or the window is

@@ -456,5 +456,9 @@ ImageStats computeStats(const Image& image);
 // (Narkowicz 2015 fit), sRGB transfer. Errors: InvalidArgument for an empty or
 // inconsistent image, Io when the file cannot be written.
 Result<void> writePng(const Image& image, const std::string& path);
+// Writes 8-bit RGB pixels as they are (rows top to bottom, width x height x
+// 3 bytes): pictures that are not radiance (a radar's false colours).
+Result<void> writeRgbPng(const std::vector<std::uint8_t>& rgb, std::uint32_t width, std::uint32_t height,
+                         const std::string& path);
 
 }  // namespace sky::render
