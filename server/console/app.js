@@ -232,6 +232,7 @@ const link = new LiveLink({
     autoFocus();
     map.redraw();
     map.windField.weatherChanged();
+    map.radar.weatherChanged();
   },
   event: (e) => {
     log.add(e);
@@ -286,6 +287,7 @@ $("#zoom-out").addEventListener("click", () => map.zoomBy(-1));
 $("#show-land").addEventListener("change", (e) => map.base.show("land", e.target.checked));
 $("#show-borders").addEventListener("change", (e) => map.base.show("borders", e.target.checked));
 $("#show-stations").addEventListener("change", (e) => map.stations.show(e.target.checked));
+$("#show-radar").addEventListener("change", (e) => map.radar.set(e.target.checked));
 $("#show-wind-field").addEventListener("change", (e) => {
   map.setWindField({ shown: e.target.checked });
   saveView();

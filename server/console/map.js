@@ -19,6 +19,7 @@ import { regionEdgeDistance_m, regionOutline, regionPoint } from "./coverage.js"
 import { direct, inverse, MERCATOR_MAX_LAT_DEG, normalizeLon } from "./geo.js";
 import { StationLayer } from "./stations.js";
 import { fmt, ftFromM } from "./units.js";
+import { RadarLayer } from "./radar.js";
 import { WeatherOverlay, WindFieldLayer } from "./weather_overlay.js";
 
 const L = window.L;
@@ -123,6 +124,7 @@ export class MapView {
     // one set of arrows on the map at a time.
     this.overlay = new WeatherOverlay({ ...data, layerWind: () => !this.windField.shown }, "coverage").addTo(map);
     this.windField = new WindFieldLayer("coverage").addTo(map);
+    this.radar = new RadarLayer("coverage").addTo(map);
     this.regionGroup = L.layerGroup().addTo(map);
     this.draftGroup = L.layerGroup().addTo(map);
     this.rendererGroup = L.layerGroup().addTo(map);

@@ -943,6 +943,44 @@ cases.wind_field = async (cleanup) => {
   noProblems(a.problems);
 };
 
+// The weather radar on the map (GET /api/radar): with rain of 10 mm/h
+// everywhere up to 2 km, the checkbox draws the picture round the view's
+// centre; what the page drew is the server's answer to the page's own query
+// (asked again here), Marshall-Palmer's 39.0 dBZ (10 log10(200 x 10^1.6),
+// the 8-bit tiles within 0.2 dB), and its centre has the 35-40 dBZ colour.
+cases.radar = async (cleanup) => {
+  const { w, browser } = await setup("radar", cleanup);
+  const r = await w.api("POST", "/api/changes", { author: "radar-test", changes: [{ op: "set_layer", layer: {
+    id: 9, type: "rain", base_m: 0, thickness_m: 2000, transition_band_m: 0, coverage: 1, density: 0.1067,
+    wind: { speed_mps: 5, from_deg: 270, vertical_mps: 0 } } }] });
+  assert(r.status === 200, `API change: ${r.text}`);
+  const a = await openConsole(browser, w, { name: "A", hash: "#focus=46.2,14.5&zoom=8" });
+  await a.page.check("#show-radar");
+  const drawn = await until("the radar picture", async () => {
+    const d = await a.page.evaluate(() => ({ ...document.querySelector("#map").dataset }));
+    return d.radarQuery && Number(d.radarEchoes) > 0 && d;
+  }, 30000);
+  const answer = (await w.api("GET", drawn.radarQuery)).json;
+  console.log(`  ${drawn.radarQuery}: ${drawn.radarEchoes} cells echo, max ${drawn.radarMaxDbz} dBZ`);
+  assert(Number(drawn.radarMaxDbz) === answer.max_dbz, `the page drew the server's answer: ${drawn.radarMaxDbz} vs ${answer.max_dbz}`);
+  assert(Math.abs(answer.max_dbz - 39.0) < 0.2, `Marshall-Palmer of 10 mm/h: ${answer.max_dbz}`);
+  const centre = await a.page.evaluate(async () => {
+    const img = document.querySelector("img.radar-image");
+    if (!img.complete) await new Promise((res) => img.addEventListener("load", res, { once: true }));
+    const c = document.createElement("canvas");
+    c.width = img.naturalWidth;
+    c.height = img.naturalHeight;
+    const g = c.getContext("2d");
+    g.drawImage(img, 0, 0);
+    return [...g.getImageData(c.width / 2, c.height / 2, 1, 1).data];
+  });
+  assert(centre[0] === 253 && centre[1] === 248 && centre[2] === 2, `the 35-40 dBZ colour at the centre: ${centre}`);
+  // Unchecked: gone.
+  await a.page.uncheck("#show-radar");
+  await until("the picture removed", async () => (await a.page.$("img.radar-image")) === null);
+  noProblems(a.problems);
+};
+
 const name = process.argv[2];
 if (!cases[name]) {
   console.log(`usage: node console_test.mjs <${Object.keys(cases).join("|")}>`);

@@ -44,11 +44,11 @@ weather::WeatherSnapshot drawableWeather(const weather::WeatherSnapshot& s, std:
   // density (a 4 km mist is 0.02, moderate rain 0.06) but seen along
   // kilometres of sight line at the ground, and the CIGI answer and the
   // conformance check count on them being drawn.
-  const auto fogThere = [&](const weather::CloudLayer* l) {
+  const auto obscuresThere = [&](const weather::CloudLayer* l) {
     return (l->type == weather::CloudType::Fog || weather::isPrecipitation(l->type)) && most[l->id] > 0;
   };
   std::stable_sort(ranked.begin(), ranked.end(), [&](const weather::CloudLayer* a, const weather::CloudLayer* b) {
-    if (fogThere(a) != fogThere(b)) return fogThere(a);
+    if (obscuresThere(a) != obscuresThere(b)) return obscuresThere(a);
     const double ca = most[a->id], cb = most[b->id];
     return ca != cb ? ca > cb : a->id < b->id;
   });

@@ -67,6 +67,29 @@ TEST(DrawableWeather, FogThatIsThereIsKeptFirst) {
   ASSERT_EQ(d.tiles.size(), 1u);
 }
 
+// Rain is thin by density too (moderate rain 0.06) and seen along the whole
+// sight line under its cloud: kept with the fog before the thin cumulus.
+TEST(DrawableWeather, PrecipitationThatIsThereIsKeptFirst) {
+  weather::WeatherSnapshot s;
+  s.tileLevel = 9;
+  auto add = [&](std::uint32_t id, weather::CloudType type, double coverage, double density) {
+    weather::CloudLayer l;
+    l.id = id;
+    l.type = type;
+    l.coverage = coverage;
+    l.density = density;
+    s.layers.push_back(l);
+  };
+  for (std::uint32_t id = 1; id <= 4; ++id) add(id, weather::CloudType::Cumulus, 0.2 * id, 1.0);
+  add(62, weather::CloudType::Rain, 0.8, 0.06);
+  add(63, weather::CloudType::Snow, 0.0, 0.0);  // none here
+  std::vector<std::uint32_t> dropped;
+  const auto d = drawableWeather(s, 4, &dropped);
+  ASSERT_EQ(d.layers.size(), 4u);
+  EXPECT_EQ(dropped, (std::vector<std::uint32_t>{1, 63})) << "the thinnest cumulus and the snow that is not there";
+  EXPECT_TRUE(std::any_of(d.layers.begin(), d.layers.end(), [](const auto& l) { return l.id == 62; }));
+}
+
 TEST(DrawableWeather, ALayerOnlyARegionHasRanksByItsTiles) {
   // Layer 9 is a storm cell's: absent globally (coverage 0) but dense in its
   // tiles; it outranks the thin global layers.
