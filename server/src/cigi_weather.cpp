@@ -5,6 +5,7 @@
 #include <string>
 #include <utility>
 
+#include "sky/cigi/precipitation_layers.hpp"
 #include "sky/weather/precipitation.hpp"
 #include "sky/weather/query.hpp"
 
@@ -32,17 +33,6 @@ bool sameRegion(const weather::Region& a, const weather::Region& b) {
 bool cloudLayerId(cigi::LayerId id) {
   auto n = static_cast<std::uint8_t>(id);
   return n <= 7 || n >= 10;  // ground fog (0) is our fog layer 0; 4-7 precipitation
-}
-
-// Our type for a precipitation layer id (4-7), None for the others.
-weather::CloudType precipitationType(cigi::LayerId id) {
-  switch (id) {
-    case cigi::LayerId::Rain: return weather::CloudType::Rain;
-    case cigi::LayerId::Snow: return weather::CloudType::Snow;
-    case cigi::LayerId::Sleet: return weather::CloudType::Sleet;
-    case cigi::LayerId::Hail: return weather::CloudType::Hail;
-    default: return weather::CloudType::None;
-  }
 }
 
 // The rate a severity (0-5) stands for, mm/h.
@@ -82,7 +72,7 @@ Result<std::optional<weather::CloudLayer>> cloudLayerFrom(const cigi::WeatherCon
   const bool fog = p.layerId == cigi::LayerId::GroundFog;
   if (fog && !(p.visibility_m > 0 && std::isfinite(p.visibility_m)))
     return bad("visibility range", p.visibility_m, "(0, inf) m for ground fog");
-  const weather::CloudType precipitation = precipitationType(p.layerId);
+  const weather::CloudType precipitation = cigi::precipitationTypeOf(p.layerId);
   if (precipitation != weather::CloudType::None && !(p.visibility_m >= 0 && std::isfinite(p.visibility_m)))
     return bad("visibility range", p.visibility_m, "[0, inf) m for precipitation (0: by severity)");
   weather::CloudLayer layer;

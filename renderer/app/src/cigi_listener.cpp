@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "sky/cigi/celestial_time.hpp"
+#include "sky/cigi/precipitation_layers.hpp"
 #include "sky/render/haze.hpp"
 #include "sky/weather/air_field.hpp"
 #include "sky/weather/precipitation.hpp"
@@ -331,9 +332,8 @@ std::vector<cigi::Packet> answerConditions(const cigi::EnvironmentalConditionsRe
     // CIGI's precipitation layers (rain, snow, sleet, hail: 4-7) are our
     // layers of those types, whatever their ids: the water they hold at the
     // point (rate over fall speed), where the weather has one.
-    for (const cigi::LayerId id : {cigi::LayerId::Rain, cigi::LayerId::Snow, cigi::LayerId::Sleet, cigi::LayerId::Hail}) {
-      const weather::CloudType type = static_cast<weather::CloudType>(
-          static_cast<int>(weather::CloudType::Rain) + static_cast<int>(id) - static_cast<int>(cigi::LayerId::Rain));
+    for (const cigi::LayerId id : cigi::kPrecipitationLayerIds) {
+      const weather::CloudType type = cigi::precipitationTypeOf(id);
       std::vector<weather::CloudLayer> ofType;
       for (const auto& l : layers)
         if (l.type == type) ofType.push_back(l);

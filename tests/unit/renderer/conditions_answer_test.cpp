@@ -1,6 +1,8 @@
 // The renderer's answers to Environmental Conditions Requests, from a weather
 // view: wind of the layer the point is in, standard-atmosphere temperature
 // and pressure, cloud liquid water per CIGI cloud layer, only the parts asked.
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "sky/app/cigi_listener.hpp"
@@ -48,6 +50,35 @@ TEST(ConditionsAnswer, WeatherAndCloudAtThePoint) {
   EXPECT_EQ(a.requestId, 42);
   EXPECT_EQ(a.layerId, cigi::LayerId::CloudLayer1);
   EXPECT_FLOAT_EQ(a.concentration_gpm3, 0.3f);  // 0.5 g/m^3 x 0.6
+}
+
+// Rain of 4 mm/h (our layer 62, a station's slot) under the cloud: the
+// answer's visibility is the rain's Koschmieder range, 3.912 / (0.25 x
+// 4^0.63 /km) = 6.53 km, and CIGI's rain layer (4) answers its water,
+// R / (3.6 v) = 4 / (3.6 x 6 m/s) = 0.185 g/m^3; no snow layer, no snow answer.
+TEST(ConditionsAnswer, RainBelowTheCloud) {
+  WeatherView v = viewWithOneLayer();
+  weather::CloudLayer rain;
+  rain.id = 62;
+  rain.type = weather::CloudType::Rain;
+  rain.base_m = 0;
+  rain.thickness_m = 2500;
+  rain.coverage = 1;
+  rain.density = 0.25e-3 * std::pow(4.0, 0.63) / 0.01;  // extinction over 0.01 /m
+  v.snapshot.layers.push_back(rain);
+  cigi::EnvironmentalConditionsRequest r;
+  r.requestType = cigi::kRequestWeather | cigi::kRequestAerosol;
+  r.lat_deg = 46;
+  r.lon_deg = 8;
+  r.alt_m = 500;  // under the cloud, in the rain
+  const auto replies = answerConditions(r, v, std::chrono::steady_clock::now());
+  ASSERT_EQ(replies.size(), 3u);  // weather, cloud layer 1, rain
+  const auto& w = std::get<cigi::WeatherConditionsResponse>(replies[0]);
+  EXPECT_NEAR(w.visibility_m, 3912.0 / (0.25 * std::pow(4.0, 0.63)), 1.0);
+  EXPECT_FLOAT_EQ(w.horizontalWind_mps, 12.0f) << "the cloud's wind under it, not the rain layer's calm";
+  const auto& a = std::get<cigi::AerosolConcentrationResponse>(replies[2]);
+  EXPECT_EQ(a.layerId, cigi::LayerId::Rain);
+  EXPECT_NEAR(a.concentration_gpm3, 4.0 / (3.6 * 6.0), 1e-4);
 }
 
 TEST(ConditionsAnswer, ClearAirBelowAndOnlyWhatIsAsked) {
