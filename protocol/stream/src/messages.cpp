@@ -382,6 +382,34 @@ Result<Message> decodeCameraReport(const fbs::CameraReport& r) {
   return Message(std::move(out));
 }
 
+Result<Message> decodeLightning(const fbs::Lightning& l) {
+  Lightning out;
+  out.weatherClock_s = l.weather_clock_s();
+  if (auto r = checkFinite("Lightning", "weather_clock_s", out.weatherClock_s); !r) return tl::unexpected(r.error());
+  if (const auto* fs = l.flashes()) {
+    if (fs->size() > kMaxMessageFlashes)
+      return fail(ErrorCode::TooLarge, "Lightning: " + std::to_string(fs->size()) + " flashes, at most " +
+                                           std::to_string(kMaxMessageFlashes));
+    out.flashes.reserve(fs->size());
+    for (flatbuffers::uoffset_t i = 0; i < fs->size(); ++i) {
+      const fbs::Flash* f = fs->Get(i);
+      weather::LightningFlash flash;
+      flash.seed = f->seed();
+      flash.time_s = f->time_s();
+      flash.lat_deg = f->lat_deg();
+      flash.lon_deg = f->lon_deg();
+      flash.energy_j = f->energy_j();
+      flash.bottom_m = f->bottom_m();
+      flash.top_m = f->top_m();
+      flash.kind = static_cast<weather::FlashKind>(f->kind());
+      if (auto r = weather::validate(flash); !r)
+        return fail(ErrorCode::InvalidArgument, "Lightning.flashes[" + std::to_string(i) + "]: " + r.error().detail);
+      out.flashes.push_back(flash);
+    }
+  }
+  return Message(std::move(out));
+}
+
 std::vector<fbs::Tile> encodeTiles(const std::vector<weather::CoverageTile>& tiles) {
   std::vector<fbs::Tile> out;
   out.reserve(tiles.size());
@@ -486,6 +514,15 @@ std::vector<std::uint8_t> encodeMessage(const Message& message) {
                                  r.weatherVersion, r.weatherClock_s)
                                  .Union()};
           },
+          [&](const Lightning& l) {
+            std::vector<fbs::Flash> flashes;
+            flashes.reserve(l.flashes.size());
+            for (const auto& f : l.flashes)
+              flashes.emplace_back(f.seed, f.time_s, f.lat_deg, f.lon_deg, f.energy_j, static_cast<float>(f.bottom_m),
+                                   static_cast<float>(f.top_m), static_cast<std::uint8_t>(f.kind), 0, 0, 0u);
+            return std::pair{fbs::Body::Lightning,
+                             fbs::CreateLightningDirect(b, l.weatherClock_s, &flashes).Union()};
+          },
           [&](const UnknownKind& u) {
             // An empty table under a type byte we do not define: what a newer
             // peer's message looks like to this build.
@@ -533,6 +570,7 @@ Result<Message> decodeMessage(std::span<const std::uint8_t> payload) {
     }
     case fbs::Body::Delta: return decodeDelta(*m->body_as_Delta());
     case fbs::Body::CameraReport: return decodeCameraReport(*m->body_as_CameraReport());
+    case fbs::Body::Lightning: return decodeLightning(*m->body_as_Lightning());
     case fbs::Body::NONE: return fail(ErrorCode::Malformed, "message has no body");
   }
   // A kind appended to the schema after this build: the verifier could not
@@ -548,6 +586,7 @@ const char* kindName(const Message& message) {
                                [](const StreamError&) { return "Error"; },
                                [](const weather::WeatherDelta&) { return "Delta"; },
                                [](const CameraReport&) { return "CameraReport"; },
+                               [](const Lightning&) { return "Lightning"; },
                                [](const UnknownKind&) { return "an unknown kind"; }},
                     message);
 }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "sky/core/result.hpp"
+#include "sky/weather/lightning.hpp"
 #include "sky/weather/model.hpp"
 #include "sky/weather/tiling.hpp"
 
@@ -90,6 +91,14 @@ struct CameraReport {
   double weatherClock_s = 0;  // weather clock of that frame, finite
 };
 
+// Server to renderer: lightning flashes (sky/weather/lightning.hpp), each
+// sent once. At most kMaxMessageFlashes a message.
+inline constexpr std::size_t kMaxMessageFlashes = 1024;
+struct Lightning {
+  double weatherClock_s = 0;
+  std::vector<weather::LightningFlash> flashes;
+};
+
 // A message of a kind this build does not know (a newer peer of the same
 // major version sent it): decoded so the receiver can ignore it. Encoding one
 // writes an empty table of that kind (for tests of that rule).
@@ -98,7 +107,7 @@ struct UnknownKind {
 };
 
 using Message = std::variant<Hello, Subscribe, weather::WeatherSnapshot, Heartbeat, StreamError,
-                             weather::WeatherDelta, CameraReport, UnknownKind>;
+                             weather::WeatherDelta, CameraReport, Lightning, UnknownKind>;
 
 std::vector<std::uint8_t> encodeMessage(const Message& message);
 
