@@ -130,6 +130,12 @@ int main(int argc, char** argv) {
                  "Directory POST /api/grib may load files from by path (default: none, only uploaded files)");
   app.add_option("--grib-decoder", gribDecoder,
                  "The GRIB decoder executable (default: skyshell-grib-decode beside this executable)");
+  app.add_option("--lightning-rate", options.lightning.rate_perMin100km2,
+                 "Lightning flashes a minute per 100 km^2 of cumulonimbus at density 1 (0: only asked-for flashes)")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
+  app.add_option("--lightning-seed", options.lightning.seed, "Seed of the lightning process (same seed, same flashes)")
+      ->capture_default_str();
   app.add_option("--log-level", logLevel, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
@@ -314,6 +320,8 @@ int main(int argc, char** argv) {
     hooks.extraMetrics = moreMetrics;
     hooks.renderers = [&s] { return sky::server::renderersJson(s.renderers()); };
     hooks.rejections = &s.rejections();
+    hooks.triggerLightning = [&s](const sky::server::FlashRequest& r) { return s.triggerLightning(r); };
+    hooks.flashes = [&s](std::size_t limit) { return s.recentFlashes(limit); };
     http.gribDecoder = decoder;
     http.gribDir = gribDir;
     auto created = sky::server::HttpApi::create(s.io(), http, s.weather(), std::move(hooks));

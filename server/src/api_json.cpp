@@ -231,6 +231,49 @@ Result<ChangeRequest> parseChangeRequest(std::string_view body) {
   return req;
 }
 
+Result<FlashRequest> parseFlashRequest(std::string_view body) {
+  const json doc = json::parse(body, nullptr, false);
+  if (doc.is_discarded()) return fail(ErrorCode::Malformed, "body: not JSON");
+  if (!doc.is_object()) return bad("body", "expected an object");
+  if (auto r = onlyKeys(doc, {"lightning"}, ""); !r) return tl::unexpected(r.error());
+  if (!doc.contains("lightning") || !doc.at("lightning").is_object())
+    return bad("lightning", "expected an object (the only event one can ask for)");
+  const json& o = doc.at("lightning");
+  if (auto r = onlyKeys(o, {"lat_deg", "lon_deg", "kind", "energy_j"}, "lightning"); !r) return tl::unexpected(r.error());
+  FlashRequest req;
+  auto lat = number(o, "lat_deg", "lightning");
+  if (!lat) return tl::unexpected(lat.error());
+  if (!(*lat >= -90 && *lat <= 90)) return bad("lightning.lat_deg", "outside [-90, 90]");
+  auto lon = number(o, "lon_deg", "lightning");
+  if (!lon) return tl::unexpected(lon.error());
+  if (!(*lon >= -180 && *lon <= 180)) return bad("lightning.lon_deg", "outside [-180, 180]");
+  req.lat_deg = *lat;
+  req.lon_deg = *lon;
+  if (o.contains("kind")) {
+    const json& k = o.at("kind");
+    const auto kind = k.is_string() ? weather::flashKindFromString(k.get<std::string>()) : std::nullopt;
+    if (!kind) return bad("lightning.kind", "expected \"cloud-to-ground\" or \"in-cloud\"");
+    req.kind = *kind;
+  }
+  auto energy = optionalNumber(o, "energy_j", "lightning");
+  if (!energy) return tl::unexpected(energy.error());
+  if (*energy && !(**energy > 0 && **energy <= weather::kMaxFlashEnergy_j))
+    return bad("lightning.energy_j", "outside (0, 1e11]");
+  req.energy_j = energy->value_or(weather::kTypicalFlashEnergy_j);
+  return req;
+}
+
+nlohmann::json toJson(const weather::LightningFlash& f) {
+  return {{"seed", std::to_string(f.seed)},  // a string: JSON numbers lose 64-bit integers
+          {"time_s", f.time_s},
+          {"lat_deg", f.lat_deg},
+          {"lon_deg", f.lon_deg},
+          {"bottom_m", f.bottom_m},
+          {"top_m", f.top_m},
+          {"kind", weather::toString(f.kind)},
+          {"energy_j", f.energy_j}};
+}
+
 Result<WeatherChange> changeFromJson(const nlohmann::json& object, const std::string& path) {
   return change(object, path);
 }

@@ -54,7 +54,7 @@ HttpReply HttpApi::serve(Endpoint endpoint, const ApiRequest& r) {
       if (!q) return error(400, q.error().detail);
       return json(radarJson(weather_, *q));
     }
-    case Endpoint::Events: return events(r.query);
+    case Endpoint::Events: return r.method == "POST" ? lightning(r) : events(r.query);
     case Endpoint::Changes: return changes(r);
     case Endpoint::Scenario: return scenario(r);
     case Endpoint::Metar: return metar(r);
@@ -98,7 +98,21 @@ HttpReply HttpApi::events(std::string_view query) {
   }
   nlohmann::json list = nlohmann::json::array();
   for (const auto& e : weather_.events(limit)) list.push_back(toJson(e));
-  return json({{"events", list}});
+  nlohmann::json flashes = nlohmann::json::array();
+  if (hooks_.flashes)
+    for (const auto& f : hooks_.flashes(std::min(limit, kMaxRecentFlashes))) flashes.push_back(toJson(f));
+  return json({{"events", list}, {"lightning", flashes}});
+}
+
+HttpReply HttpApi::lightning(const ApiRequest& r) {
+  auto request = parseFlashRequest(r.body);
+  if (!request) {
+    ++counters_.rejected;
+    refused(RejectReason::HttpInvalid, request.error().detail);
+    return error(400, request.error().detail);
+  }
+  if (!hooks_.triggerLightning) return error(501, "lightning: this server has no stream to send a flash on");
+  return {201, "application/json", dumpJson({{"lightning", toJson(hooks_.triggerLightning(*request))}})};
 }
 
 HttpReply HttpApi::unauthorized(const char* what) {

@@ -104,8 +104,11 @@ HttpExchange::Next HttpExchange::headerChecks() {
   const std::string expected = "Bearer " + api_.options_.token;
   hasToken_ = !api_.options_.token.empty() && constantTimeEqual(view(req[http::field::authorization]), expected);
   // Before the body: a request that cannot be applied is not read.
-  if (route_ && route_->token == TokenRule::Always && !hasToken_) {
+  const bool needsToken = route_ && (route_->token == TokenRule::Always ||
+                                     (route_->token == TokenRule::WhenPosting && method == "POST"));
+  if (needsToken && !hasToken_) {
     Next n = answer(api_.unauthorized(route_->endpoint == Endpoint::Scenario ? "loading a scenario needs the token"
+                                      : route_->endpoint == Endpoint::Events ? "asking for a flash needs the token"
                                                                                : "changes need the token"));
     response_.set(http::field::www_authenticate, "Bearer");
     return n;

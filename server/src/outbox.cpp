@@ -23,17 +23,31 @@ void Outbox::requestSnapshot(const stream::Subscribe& request) {
   snapshots_[request.areaIndex] = request;
 }
 
+void Outbox::pushEvent(Frame frame) {
+  events_.push_back(std::move(frame));
+  while (events_.size() > kMaxEventFrames) {
+    events_.pop_front();
+    ++droppedEvents_;
+  }
+}
+
 void Outbox::setHeartbeat(Frame frame) { heartbeat_ = std::move(frame); }
 
 void Outbox::dropWeather() {
   for (auto& s : snapshots_) s.reset();
   heartbeat_.reset();
+  events_.clear();
 }
 
 std::optional<Outbox::Item> Outbox::takeNext() {
   if (!control_.empty()) {
     Frame f = std::move(control_.front());
     control_.pop_front();
+    return Item(std::move(f));
+  }
+  if (!events_.empty()) {
+    Frame f = std::move(events_.front());
+    events_.pop_front();
     return Item(std::move(f));
   }
   for (auto& pending : snapshots_)
@@ -52,7 +66,7 @@ std::optional<Outbox::Item> Outbox::takeNext() {
 }
 
 bool Outbox::empty() const {
-  return control_.empty() && !heartbeat_ &&
+  return control_.empty() && events_.empty() && !heartbeat_ &&
          std::none_of(snapshots_.begin(), snapshots_.end(), [](const auto& s) { return s.has_value(); });
 }
 

@@ -77,7 +77,8 @@ Server::Server(ServerOptions options, WeatherState state)
       acceptor_(io_),
       acceptRetry_(io_),
       heartbeat_(io_),
-      timelineTimer_(io_) {
+      timelineTimer_(io_),
+      lightning_(options_.lightning) {
   // Every accepted change, from whichever input, reaches every subscriber;
   // it may have moved the clock or brought a new timeline.
   weather_.addListener([this](const ChangeEvent&) {
@@ -219,7 +220,44 @@ void Server::scheduleHeartbeat() {
     registry_.forEach([&frame](Session& s) { s.sendHeartbeat(frame); });
     // While a change ramps, subscribers follow it at the heartbeat's pace.
     if (weather_.changing(clockNow())) weatherChanged();
+    drawLightning();
     scheduleHeartbeat();
+  });
+}
+
+void Server::drawLightning() {
+  std::vector<weather::SphericalCap> areas;
+  registry_.forEachConst([&areas](const Session& s) {
+    for (const weather::SphericalCap& a : s.areas()) areas.push_back(a);
+  });
+  const auto before = lightning_.counters();
+  const std::vector<weather::LightningFlash> flashes = lightning_.tick(weather_, clockNow(), areas);
+  streamCounters_.flashesDrawn.fetch_add(lightning_.counters().drawn - before.drawn, std::memory_order_relaxed);
+  streamCounters_.flashesCapped.fetch_add(lightning_.counters().dropped - before.dropped, std::memory_order_relaxed);
+  sendFlashes(flashes);
+}
+
+weather::LightningFlash Server::triggerLightning(const FlashRequest& request) {
+  const weather::LightningFlash flash = lightning_.trigger(weather_, clockNow(), request);
+  streamCounters_.flashesTriggered.fetch_add(1, std::memory_order_relaxed);
+  log_->info("event=lightning_triggered kind={} lat_deg={:.5f} lon_deg={:.5f} clock_s={:.3f}",
+             weather::toString(flash.kind), flash.lat_deg, flash.lon_deg, flash.time_s);
+  sendFlashes({flash});
+  return flash;
+}
+
+void Server::sendFlashes(const std::vector<weather::LightningFlash>& flashes) {
+  if (flashes.empty()) return;
+  registry_.forEach([&](Session& s) {
+    stream::Lightning message{clockNow(), {}};
+    const std::vector<weather::SphericalCap> areas = s.areas();
+    for (const weather::LightningFlash& f : flashes)
+      if (std::any_of(areas.begin(), areas.end(), [&](const auto& a) { return flashReaches(a, f); }))
+        message.flashes.push_back(f);
+    if (message.flashes.empty()) return;
+    const std::uint64_t droppedBefore = s.droppedEvents();
+    s.sendEvent(stream::encodeFrame(stream::encodeMessage(message)));
+    streamCounters_.eventsDropped.fetch_add(s.droppedEvents() - droppedBefore, std::memory_order_relaxed);
   });
 }
 
@@ -299,6 +337,14 @@ std::string Server::streamMetrics() const {
        streamCounters_.acceptFailures.load());
   line("skyshell_handler_exceptions_total", "exceptions caught by the io loop's last boundary",
        streamCounters_.handlerExceptions.load());
+  line("skyshell_lightning_flashes_total", "lightning flashes drawn by the storm process",
+       streamCounters_.flashesDrawn.load());
+  line("skyshell_lightning_triggered_total", "lightning flashes asked for (POST /api/events)",
+       streamCounters_.flashesTriggered.load());
+  line("skyshell_lightning_capped_total", "flashes past the per-tick cap, not sent",
+       streamCounters_.flashesCapped.load());
+  line("skyshell_stream_events_dropped_total", "event frames dropped for subscribers not reading",
+       streamCounters_.eventsDropped.load());
   return m;
 }
 

@@ -89,6 +89,19 @@ void Session::sendHeartbeat(const Frame& heartbeat) {
   writeNext();
 }
 
+void Session::sendEvent(const Frame& frame) {
+  if (state_ != State::Open) return;
+  outbox_.pushEvent(frame);
+  writeNext();
+}
+
+std::vector<weather::SphericalCap> Session::areas() const {
+  std::vector<weather::SphericalCap> out;
+  for (const Area& a : areas_)
+    if (a.subscription) out.push_back(a.subscription->area);
+  return out;
+}
+
 void Session::weatherChanged() {
   if (state_ != State::Open) return;
   bool any = false;

@@ -207,20 +207,29 @@ std::vector<BoltSegment> boltSegments(const LightningFlash& flash) {
   return out;
 }
 
-std::vector<StormCell> stormCells(const WeatherSnapshot& snapshot, double rate_perMin100km2) {
-  std::unordered_map<std::uint32_t, const CloudLayer*> byId;
-  for (const CloudLayer& l : snapshot.layers) byId[l.id] = &l;
-  std::unordered_map<std::uint64_t, StormCell> cells;
+std::vector<StormCell> stormCells(const WeatherSnapshot& snapshot, std::span<const std::uint64_t> areaCells,
+                                  double rate_perMin100km2) {
   if (!(rate_perMin100km2 > 0)) return {};
-  for (const CoverageTile& t : snapshot.tiles) {
-    const auto it = byId.find(t.layerId);
-    if (it == byId.end()) continue;
-    const CloudLayer& l = *it->second;
+  std::unordered_map<std::uint64_t, StormCell> cells;
+  auto add = [&](std::uint64_t cellId, const CloudLayer& l, const CoverageTile& t) {
     const double cover = static_cast<double>(t.coverage) * static_cast<double>(t.density) * cumulonimbusWeight(l, t);
-    if (!(cover > 0)) continue;
-    const double perSecond = cover * cellArea_m2(t.cellId) / 1.0e8 * rate_perMin100km2 / 60.0;
-    StormCell& c = cells[t.cellId];
-    if (perSecond > c.flashesPerSecond) c = {t.cellId, perSecond, l.base_m, l.base_m + l.thickness_m};
+    if (!(cover > 0)) return;
+    const double perSecond = cover * cellArea_m2(cellId) / 1.0e8 * rate_perMin100km2 / 60.0;
+    StormCell& c = cells[cellId];
+    if (perSecond > c.flashesPerSecond) c = {cellId, perSecond, l.base_m, l.base_m + l.thickness_m};
+  };
+  for (const CloudLayer& l : snapshot.layers) {
+    // As a renderer reads the snapshot: a cell's tile where it has one,
+    // else the layer's own coverage and density.
+    std::unordered_map<std::uint64_t, const CoverageTile*> tiles;
+    for (const CoverageTile& t : snapshot.tiles)
+      if (t.layerId == l.id) tiles[t.cellId] = &t;
+    const CoverageTile own{0, l.id, static_cast<float>(l.coverage), static_cast<float>(l.density), CloudType::None, 0.0f};
+    if (tiles.empty() && cumulonimbusWeight(l, own) == 0) continue;
+    for (std::uint64_t id : areaCells) {
+      const auto it = tiles.find(id);
+      add(id, l, it == tiles.end() ? own : *it->second);
+    }
   }
   std::vector<StormCell> out;
   out.reserve(cells.size());

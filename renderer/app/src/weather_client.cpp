@@ -192,6 +192,7 @@ void WeatherClient::onFrame(std::span<const std::uint8_t> payload) {
                    ++malformed_;
                    spdlog::warn("weather stream: a server must not send CameraReport; dropped");
                  },
+                 [&](const stream::Lightning& l) { state_.addFlashes(l.flashes, l.weatherClock_s); },
                  [&](const stream::UnknownKind&) {
                    // A newer server of our major version: ignore what we do not know.
                  }},

@@ -151,7 +151,8 @@ TEST(Lightning, StormCellsAreWhereTheCumulonimbusIs) {
   s.tiles = {{a, 1, 0.5f, 1.0f, CloudType::None, 0.0f},
              {b, 2, 0.8f, 0.5f, CloudType::Cumulonimbus, 0.5f},
              {c, 2, 1.0f, 1.0f, CloudType::None, 0.0f}};
-  const auto cells = stormCells(s, 2.0);
+  const std::uint64_t area[] = {a, b, c};
+  const auto cells = stormCells(s, area, 2.0);
   ASSERT_EQ(cells.size(), 2u) << "plain cumulus does not flash";
   for (const StormCell& sc : cells) {
     const double km2 = cellArea_m2(sc.cellId) / 1e6;
@@ -165,7 +166,15 @@ TEST(Lightning, StormCellsAreWhereTheCumulonimbusIs) {
       EXPECT_NEAR(sc.flashesPerSecond, 0.8 * 0.5 * 0.5 * km2 / 100.0 * 2.0 / 60.0, 1e-9) << "the tile holds 0.8 as a float";
     }
   }
-  EXPECT_TRUE(stormCells(s, 0.0).empty()) << "a rate of 0 turns lightning off";
+  EXPECT_TRUE(stormCells(s, area, 0.0).empty()) << "a rate of 0 turns lightning off";
+  // A layer without tiles is the same over the whole area (the stream sends
+  // none for it): every cell of the area flashes at its coverage.
+  s.tiles.clear();
+  s.layers[0].coverage = 0.25;
+  const auto uniform = stormCells(s, area, 2.0);
+  ASSERT_EQ(uniform.size(), 3u);
+  for (const StormCell& sc : uniform)
+    EXPECT_NEAR(sc.flashesPerSecond, 0.25 * cellArea_m2(sc.cellId) / 1e8 * 2.0 / 60.0, 1e-12);
 }
 
 TEST(Lightning, AnAskedForFlashSitsUnderItsCloud) {

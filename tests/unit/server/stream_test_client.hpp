@@ -70,7 +70,8 @@ class TestClient {
     return stream::decodeMessage(payload);
   }
 
-  // The next message of type T, skipping heartbeats and deltas (unless T is one).
+  // The next message of type T, skipping heartbeats, deltas and lightning
+  // (unless T is one).
   template <class T>
   Result<T> readNext() {
     for (;;) {
@@ -78,7 +79,8 @@ class TestClient {
       if (!m) return tl::unexpected(m.error());
       if (auto* t = std::get_if<T>(&*m)) return *t;
       // Heartbeats, and deltas of weather changes, come between the others.
-      if (!std::holds_alternative<stream::Heartbeat>(*m) && !std::holds_alternative<weather::WeatherDelta>(*m))
+      if (!std::holds_alternative<stream::Heartbeat>(*m) && !std::holds_alternative<weather::WeatherDelta>(*m) &&
+          !std::holds_alternative<stream::Lightning>(*m))
         return fail(ErrorCode::Malformed, std::string("unexpected ") + stream::kindName(*m));
     }
   }

@@ -30,6 +30,7 @@
 
 #include "sky/core/result.hpp"
 #include "sky/server/change.hpp"
+#include "sky/server/lightning_service.hpp"
 
 namespace sky::server {
 
@@ -64,5 +65,11 @@ Result<WeatherChange> changeFromJson(const nlohmann::json& object, const std::st
 // Author, source and summary come from outside (and from databases written
 // by older versions): made valid UTF-8 here.
 nlohmann::json toJson(const ChangeEvent& event);
+
+// POST /api/events: {"lightning": {"lat_deg", "lon_deg", "kind"?
+// ("cloud-to-ground", the default, or "in-cloud"), "energy_j"? (J, (0,
+// 1e11], default 1e9)}}. The error names the field.
+Result<FlashRequest> parseFlashRequest(std::string_view body);
+nlohmann::json toJson(const weather::LightningFlash& flash);
 
 }  // namespace sky::server

@@ -39,6 +39,7 @@
 
 #include "sky/core/result.hpp"
 #include "sky/server/console_feed.hpp"
+#include "sky/server/lightning_service.hpp"
 #include "sky/server/grib_isolated.hpp"
 #include "sky/server/http_guard.hpp"
 #include "sky/server/http_routes.hpp"
@@ -88,6 +89,10 @@ struct HttpApiHooks {
   std::function<std::string()> extraMetrics;     // more Prometheus text for /metrics (other inputs)
   std::function<nlohmann::json()> renderers;     // GET /api/renderers: the array
   Rejections* rejections = nullptr;              // counted here, shown in /metrics and health
+  // POST /api/events (a flash now, sent to the renderers) and the newest
+  // flashes for GET /api/events. Without them the API has no lightning.
+  std::function<weather::LightningFlash(const FlashRequest&)> triggerLightning;
+  std::function<std::vector<weather::LightningFlash>(std::size_t)> flashes;
 };
 
 class HttpApi {
@@ -125,6 +130,7 @@ class HttpApi {
   HttpReply serve(Endpoint endpoint, const ApiRequest& request);
   HttpReply metrics();
   HttpReply events(std::string_view query);
+  HttpReply lightning(const ApiRequest& request);
   HttpReply changes(const ApiRequest& request);
   HttpReply scenario(const ApiRequest& request);
   HttpReply metar(const ApiRequest& request);

@@ -37,6 +37,7 @@ enum class TokenRule {
   Always,        // checked after the header, before the body is read: 401 without reading it
   WhenApplying,  // POST /api/metar: a preview reads, "apply": true changes the weather; the
                  // body decides, so the endpoint checks it after parsing (ApiRequest::hasToken)
+  WhenPosting,   // /api/events: GET reads, POST asks for a flash (checked like Always for a POST)
 };
 
 // Methods as a bit set.

@@ -23,6 +23,7 @@
 #include "sky/server/session.hpp"
 #include "sky/server/session_registry.hpp"
 #include "sky/server/snapshot_builder.hpp"
+#include "sky/server/lightning_service.hpp"
 #include "sky/server/live_weather.hpp"
 #include "sky/server/rejections.hpp"
 #include "sky/server/weather_state.hpp"
@@ -52,6 +53,7 @@ struct ServerOptions {
   // A connection past this many subscribers is sent an Error (TooLarge,
   // "server full") and closed.
   std::size_t maxSubscribers = kDefaultMaxSubscribers;
+  LightningOptions lightning;  // the flash process (lightning_service.hpp)
   std::function<WallClock::time_point()> wallNow = [] { return WallClock::now(); };
   std::shared_ptr<spdlog::logger> log;  // null: log nothing
 };
@@ -87,10 +89,17 @@ class Server final : private SessionHandler {
     std::atomic<std::uint64_t> frames{0}, bytes{0}, stalledDropped{0};
     std::atomic<std::uint64_t> acceptFailures{0};  // accept() calls that failed (e.g. EMFILE)
     std::atomic<std::uint64_t> handlerExceptions{0};  // exceptions that reached run() (the last boundary)
+    // Lightning flashes drawn by the process, asked for, left out by the
+    // per-tick cap, and event frames dropped for subscribers not reading.
+    std::atomic<std::uint64_t> flashesDrawn{0}, flashesTriggered{0}, flashesCapped{0}, eventsDropped{0};
   };
   const StreamCounters& streamCounters() const { return streamCounters_; }
   // Prometheus text of the stream counters.
   std::string streamMetrics() const;
+  // A flash now at the request's place, sent to every subscriber it
+  // reaches, and the newest flashes (oldest first). Call on the io thread.
+  weather::LightningFlash triggerLightning(const FlashRequest& request);
+  std::vector<weather::LightningFlash> recentFlashes(std::size_t limit) const { return lightning_.recent(limit); }
   // Runs on the io thread when the server shuts down: whatever else lives on
   // its io_context (the HTTP API, the CIGI input) closes there too, so run()
   // can return. Every function added runs, in the order added.
@@ -111,6 +120,10 @@ class Server final : private SessionHandler {
   void accept();
   void onAccept(const boost::system::error_code& ec, boost::asio::ip::tcp::socket socket);
   void scheduleHeartbeat();
+  // The flash process's flashes since the last call, sent to the
+  // subscribers they reach.
+  void drawLightning();
+  void sendFlashes(const std::vector<weather::LightningFlash>& flashes);
   // Sets the timeline timer for the next scenario timeline entry, by the
   // weather clock's rate (a frozen clock waits for the next clock change).
   void armTimeline();
@@ -151,6 +164,7 @@ class Server final : private SessionHandler {
   Rejections rejections_;
   std::vector<std::function<void()>> onRenderersChanged_;
   TileCache tileCache_;
+  LightningService lightning_;
   std::uint16_t port_ = 0;
   std::uint64_t nextSessionId_ = 1;
   bool stopped_ = false;

@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -74,6 +75,11 @@ class Session : public std::enable_shared_from_this<Session> {
   // replaces whatever is still waiting to be sent; it goes out as a Delta
   // from what the peer holds for that area when it can, else as a Snapshot.
   void weatherChanged();
+  // Queues an event frame (Lightning) for the peer. Ignored once closing.
+  void sendEvent(const Frame& frame);
+  std::uint64_t droppedEvents() const { return outbox_.droppedEvents(); }
+  // The areas the peer subscribed to (none before its first Subscribe).
+  std::vector<weather::SphericalCap> areas() const;
   // Closes the socket now, cancelling pending I/O. Idempotent.
   void close();
 

@@ -92,11 +92,14 @@ struct StormCell {
   double base_m = 0, top_m = 0;  // the cumulonimbus there
 };
 inline constexpr double kDefaultFlashRate_perMin100km2 = 1.0;
-// Storm cells at the snapshot's tile level: where a layer is cumulonimbus
-// (its own type, or a tile's blend into it), coverage x density x that
-// weight x the cell's area x rate_perMin100km2 flashes a minute (the
-// heaviest layer per cell). Cells with no cumulonimbus are left out.
-std::vector<StormCell> stormCells(const WeatherSnapshot& snapshot, double rate_perMin100km2);
+// Storm cells among areaCells (S2 cells at the snapshot's tile level, the
+// area's covering), each read as a renderer reads the snapshot (its tile,
+// or the layer's own coverage and density where it has none): where a layer
+// is cumulonimbus (its own type, or a tile's blend into it), coverage x
+// density x that weight x the cell's area x rate_perMin100km2 flashes a
+// minute (the heaviest layer per cell). Cells with none are left out.
+std::vector<StormCell> stormCells(const WeatherSnapshot& snapshot, std::span<const std::uint64_t> areaCells,
+                                  double rate_perMin100km2);
 
 // The flashes of the seeded process over `cells` with first strokes in the
 // weather-clock interval (from_s, to_s]. Each whole second of the clock in

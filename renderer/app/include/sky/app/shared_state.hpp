@@ -10,12 +10,14 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "sky/app/host_atmosphere.hpp"
 #include "sky/app/host_clock.hpp"
 #include "sky/app/view_state.hpp"
 #include "sky/geo/geodetic.hpp"
 #include "sky/weather/clock.hpp"
+#include "sky/weather/lightning.hpp"
 #include "sky/weather/model.hpp"
 
 namespace sky::app {
@@ -47,6 +49,12 @@ struct WeatherView {
 
   double clockNow(std::chrono::steady_clock::time_point now) const { return clock.at(now); }
 };
+
+// Flashes a channel holds at most (a storm flashes a few times a second),
+// and how long past its light one is kept (a frame drawn a little behind
+// the stream's clock still sees it).
+inline constexpr std::size_t kMaxHeldFlashes = 256;
+inline constexpr double kFlashGrace_s = 2.0;
 
 class SharedState {
  public:
@@ -114,6 +122,16 @@ class SharedState {
       detailedSeen_ = true;
     }
     ++weather_.version;
+  }
+  // Keeps the flashes of a Lightning message (events: each arrives once).
+  void addFlashes(const std::vector<weather::LightningFlash>& flashes, double clock_s) {
+    std::lock_guard lock(mutex_);
+    auto& held = weather_.flashes;
+    held.insert(held.end(), flashes.begin(), flashes.end());
+    std::erase_if(held, [clock_s](const weather::LightningFlash& f) {
+      return f.time_s + weather::kFlashLifetime_s < clock_s - kFlashGrace_s;
+    });
+    if (held.size() > kMaxHeldFlashes) held.erase(held.begin(), held.end() - static_cast<std::ptrdiff_t>(kMaxHeldFlashes));
   }
   // Applies a Delta to the held snapshot of its area; on error nothing changes.
   Result<void> applyDelta(const weather::WeatherDelta& d, std::chrono::steady_clock::time_point now) {

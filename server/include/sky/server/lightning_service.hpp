@@ -1,0 +1,84 @@
+// The server's lightning: the flash process (sky/weather/lightning.hpp) run
+// on the weather clock over the storms of the areas renderers watch, the
+// flashes an operator asks for, and the recent flashes for the API. Each
+// flash is an event sent once to the subscribers it reaches; a storm nobody
+// watches draws no flashes (the process is seeded per cell and second, so a
+// renderer that subscribes later sees the same flashes another already did).
+// Runs on the io thread; pure bookkeeping, no I/O.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "sky/weather/lightning.hpp"
+#include "sky/weather/tiling.hpp"
+
+namespace sky::server {
+
+class LiveWeather;
+
+struct LightningOptions {
+  // Flashes a minute per 100 km^2 of cumulonimbus at density 1; 0 draws none
+  // (asked-for flashes still go out).
+  double rate_perMin100km2 = weather::kDefaultFlashRate_perMin100km2;
+  std::uint64_t seed = 1;
+};
+
+// Storm cells are S2 cells of this level (~80 km^2, a thunderstorm cell's
+// size), whatever a subscriber's own tile level: so every area that holds a
+// storm draws the same flashes from it.
+inline constexpr int kLightningTileLevel = 10;
+// Flashes are drawn within this distance of an area's centre (a flash
+// farther than that is below the horizon of a camera near it, or hidden in
+// haze): it bounds the cells per area to ~900.
+inline constexpr double kLightningReach_m = 150e3;
+inline constexpr std::size_t kMaxLightningAreas = 64;
+inline constexpr std::size_t kMaxFlashesPerTick = 256;
+inline constexpr std::size_t kMaxRecentFlashes = 1000;
+// A clock that moved by more than this between ticks (set, jumped, or
+// frozen and restarted) draws nothing for the gap.
+inline constexpr double kMaxLightningGap_s = 60;
+
+// What an operator asks for (POST /api/events).
+struct FlashRequest {
+  double lat_deg = 0, lon_deg = 0;
+  weather::FlashKind kind = weather::FlashKind::CloudToGround;
+  double energy_j = weather::kTypicalFlashEnergy_j;
+};
+
+class LightningService {
+ public:
+  explicit LightningService(LightningOptions options) : options_(options) {}
+
+  // The process's flashes since the last tick, with first strokes up to
+  // clock_s, in the storms of `areas`.
+  std::vector<weather::LightningFlash> tick(const LiveWeather& weather, double clock_s,
+                                            std::span<const weather::SphericalCap> areas);
+  // A flash now at the request's place, under the cloud there.
+  weather::LightningFlash trigger(const LiveWeather& weather, double clock_s, const FlashRequest& request);
+  // The newest flashes, oldest first, at most `limit`.
+  std::vector<weather::LightningFlash> recent(std::size_t limit) const;
+
+  struct Counters {
+    std::uint64_t drawn = 0, triggered = 0, dropped = 0;
+  };
+  const Counters& counters() const { return counters_; }
+
+ private:
+  void record(const weather::LightningFlash& flash);
+
+  LightningOptions options_;
+  std::optional<double> last_s_;
+  std::deque<weather::LightningFlash> recent_;
+  Counters counters_;
+};
+
+// Whether a flash is within an area a subscriber asked for (its cap, widened
+// by kLightningReach_m: a flash lights the sky beyond the tiles one holds).
+bool flashReaches(const weather::SphericalCap& area, const weather::LightningFlash& flash);
+
+}  // namespace sky::server

@@ -1,0 +1,95 @@
+// The server's lightning (see lightning_service.hpp).
+#include "sky/server/lightning_service.hpp"
+
+#include <algorithm>
+#include <map>
+
+#include "sky/server/conditions_api.hpp"
+#include "sky/server/live_weather.hpp"
+#include "sky/server/snapshot_builder.hpp"
+
+namespace sky::server {
+
+namespace {
+
+bool anyCumulonimbus(const std::vector<weather::CloudLayer>& layers, const std::vector<weather::Region>& regions) {
+  auto cb = [](const weather::CloudLayer& l) { return l.type == weather::CloudType::Cumulonimbus; };
+  if (std::any_of(layers.begin(), layers.end(), cb)) return true;
+  return std::any_of(regions.begin(), regions.end(),
+                     [&](const weather::Region& r) { return std::any_of(r.layers.begin(), r.layers.end(), cb); });
+}
+
+}  // namespace
+
+std::vector<weather::LightningFlash> LightningService::tick(const LiveWeather& weather, double clock_s,
+                                                            std::span<const weather::SphericalCap> areas) {
+  const std::optional<double> last = last_s_;
+  last_s_ = clock_s;
+  if (!last || !(clock_s > *last) || clock_s - *last > kMaxLightningGap_s || !(options_.rate_perMin100km2 > 0))
+    return {};
+  const std::vector<weather::CloudLayer> layers = weather.layersAt(clock_s);
+  const std::vector<weather::Region> regions = weather.regionsAt(clock_s);
+  if (!anyCumulonimbus(layers, regions)) return {};
+  // One storm cell per S2 cell, whichever areas hold it.
+  std::map<std::uint64_t, weather::StormCell> cells;
+  for (std::size_t i = 0; i < areas.size() && i < kMaxLightningAreas; ++i) {
+    weather::SphericalCap cap = areas[i];
+    cap.radius_m = std::min(cap.radius_m, kLightningReach_m);
+    const weather::WeatherSnapshot snapshot = subscriberSnapshot(weather, clock_s, cap, kLightningTileLevel);
+    if (snapshot.tileLevel != kLightningTileLevel) continue;  // not at the process's level: none drawn
+    const std::vector<std::uint64_t> covering = weather::coverCap(cap, kLightningTileLevel, kDefaultMaxCells);
+    for (const weather::StormCell& c : weather::stormCells(snapshot, covering, options_.rate_perMin100km2))
+      cells.emplace(c.cellId, c);
+  }
+  std::vector<weather::StormCell> list;
+  list.reserve(cells.size());
+  for (const auto& [id, c] : cells) list.push_back(c);
+  std::size_t dropped = 0;
+  std::vector<weather::LightningFlash> flashes =
+      weather::drawFlashes(options_.seed, list, *last, clock_s, kMaxFlashesPerTick, &dropped);
+  counters_.drawn += flashes.size();
+  counters_.dropped += dropped;
+  for (const auto& f : flashes) record(f);
+  return flashes;
+}
+
+weather::LightningFlash LightningService::trigger(const LiveWeather& weather, double clock_s,
+                                                  const FlashRequest& request) {
+  // The cloud at the place, as a subscriber there would hold it.
+  const weather::WeatherSnapshot snapshot =
+      subscriberSnapshot(weather, clock_s, {request.lat_deg, request.lon_deg, 1.0}, kLightningTileLevel);
+  std::vector<weather::CloudLayer> present;
+  for (const weather::CloudLayer& l : snapshot.layers) {
+    bool tiled = false, covered = false;
+    for (const weather::CoverageTile& t : snapshot.tiles)
+      if (t.layerId == l.id) {
+        tiled = true;
+        covered = covered || t.coverage > 0;
+      }
+    if (tiled ? covered : l.coverage > 0) present.push_back(l);
+  }
+  ++counters_.triggered;
+  // The seed: the asked-for flashes counted, apart from the process's.
+  const weather::LightningFlash f = weather::triggeredFlash(options_.seed ^ (counters_.triggered << 32), clock_s,
+                                                            request.lat_deg, request.lon_deg, request.kind, present,
+                                                            request.energy_j);
+  record(f);
+  return f;
+}
+
+std::vector<weather::LightningFlash> LightningService::recent(std::size_t limit) const {
+  const std::size_t n = std::min(limit, recent_.size());
+  return {recent_.end() - static_cast<std::ptrdiff_t>(n), recent_.end()};
+}
+
+void LightningService::record(const weather::LightningFlash& flash) {
+  recent_.push_back(flash);
+  while (recent_.size() > kMaxRecentFlashes) recent_.pop_front();
+}
+
+bool flashReaches(const weather::SphericalCap& area, const weather::LightningFlash& flash) {
+  return sphereDistance_m(area.centerLat_deg, area.centerLon_deg, flash.lat_deg, flash.lon_deg) <=
+         area.radius_m + kLightningReach_m;
+}
+
+}  // namespace sky::server
