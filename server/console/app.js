@@ -7,6 +7,7 @@ import { ClockPanel } from "./clock.js";
 import { layerIds } from "./coverage.js";
 import { $, $$, note, showErrors } from "./dom.js";
 import { LayerPanel } from "./layers.js";
+import { LightningPanel } from "./lightning.js";
 import { EventLog, renderHealth, renderRenderers } from "./log.js";
 import { MapView } from "./map.js";
 import { MetarPanel } from "./metar.js";
@@ -93,6 +94,7 @@ const map = new MapView($("#map"), {
   selectedLayer: () => app.overlayLayer,
   selectedRegion: () => regions.selectedId,
   canEdit: () => app.canEdit(),
+  clockNow: () => app.clockNow(),
 }, {
   place: (kind, lat, lon, half_m) => regions.place(kind, lat, lon, half_m),
   placed: () => setMode("pan"),
@@ -118,6 +120,7 @@ const regions = new RegionPanel($("#region"), app);
 const metar = new MetarPanel($("#metar"), app);
 new ConformancePanel($("#conformance"), (stations) => map.stations.conformance(stations));
 new ClockPanel($("#clock"), app);
+new LightningPanel($("#lightning"), app, () => map.focus, (flash) => map.lightning.add([flash]));
 const log = new EventLog($("#events"));
 
 // The view in this browser and in the address (a link shows the same place,

@@ -4,8 +4,9 @@
 // wind on a canvas overlay, the wind field at a height when shown (both
 // weather_overlay.js), every region's edge and transition perimeter, the
 // region tool's draft with its size and perimeter handles, the METAR
-// stations coloured by flight category (stations.js), and each connected
-// renderer as an aircraft at its camera position and heading. Leaflet pans
+// stations coloured by flight category (stations.js), each connected
+// renderer as an aircraft at its camera position and heading, and the recent
+// lightning flashes (lightning.js). Leaflet pans
 // and zooms; in a placing mode a click (or a press and drag, for its size)
 // puts a storm cell or a clearing there.
 //
@@ -19,6 +20,7 @@ import { regionEdgeDistance_m, regionOutline, regionPoint } from "./coverage.js"
 import { direct, inverse, MERCATOR_MAX_LAT_DEG, normalizeLon } from "./geo.js";
 import { StationLayer } from "./stations.js";
 import { fmt, ftFromM } from "./units.js";
+import { LightningLayer } from "./lightning.js";
 import { RadarLayer } from "./radar.js";
 import { WeatherOverlay, WindFieldLayer } from "./weather_overlay.js";
 
@@ -36,8 +38,9 @@ const CLICK_SLOP_PX = 4;
 // A renderer whose last report is older than this is drawn as stale.
 const STALE_AFTER_S = 5;
 // Panes above Leaflet's tile pane (200) and below its marker pane (600): the
-// ground, then coverage, wind and graticule, then the regions' outlines.
-const PANES = [["basemap", 250], ["coverage", 350], ["regions", 420]];
+// ground, then coverage, wind and graticule, then the regions' outlines,
+// then lightning flashes (under the aircraft and stations, which are clicked).
+const PANES = [["basemap", 250], ["coverage", 350], ["regions", 420], ["flashes", 450]];
 // Names of stations and aircraft are shown from this zoom in (about 2.4 km
 // per CSS px at 46 N below it: a hundred stations' names would overlap).
 const LABELS_FROM_ZOOM = 6;
@@ -97,7 +100,7 @@ function aircraftElement() {
 
 export class MapView {
   // container: the map's element. data: {state(), renderers(), draft(),
-  // selectedLayer(), selectedRegion(), canEdit()}. on: {place, placed,
+  // selectedLayer(), selectedRegion(), canEdit(), clockNow()}. on: {place, placed,
   // reshape, pick, cursor, view, basemap}.
   constructor(container, data, on) {
     this.container = container;
@@ -125,6 +128,7 @@ export class MapView {
     this.overlay = new WeatherOverlay({ ...data, layerWind: () => !this.windField.shown }, "coverage").addTo(map);
     this.windField = new WindFieldLayer("coverage").addTo(map);
     this.radar = new RadarLayer("coverage").addTo(map);
+    this.lightning = new LightningLayer("flashes", data.clockNow).addTo(map);
     this.regionGroup = L.layerGroup().addTo(map);
     this.draftGroup = L.layerGroup().addTo(map);
     this.rendererGroup = L.layerGroup().addTo(map);

@@ -981,6 +981,48 @@ cases.radar = async (cleanup) => {
   noProblems(a.problems);
 };
 
+// Lightning asked for from the console (POST /api/events): an in-cloud
+// flash at the map's centre as the page reports it (#map data-focus) is in
+// GET /api/events, asked here, at that place (1e-6 deg) and of that kind; the
+// page draws its marker where Web Mercator, computed here, puts that place;
+// the API refuses a flash without the token (401) and one off the globe (400
+// naming the field).
+cases.lightning = async (cleanup) => {
+  const { w, browser } = await setup("lightning", cleanup);
+  const a = await openConsole(browser, w, { token: TOKEN, name: "A", hash: "#focus=46.1,13.2&zoom=9" });
+  await settled(a.page, w);
+  await a.page.selectOption("#lightning-kind", "in-cloud");
+  const [lat0, lon0] = (await a.page.getAttribute("#map", "data-focus")).split(",").map(Number);
+  await a.page.click("#lightning-flash");
+  await until("the page's note to say a flash", async () => /in-cloud flash at/.test(await a.page.textContent("#lightning .note")));
+  const flash = await until("the flash in GET /api/events", async () => {
+    const r = await w.api("GET", "/api/events?limit=50");
+    assert(r.status === 200 && Array.isArray(r.json.lightning), `GET /api/events: ${r.text}`);
+    return r.json.lightning.find((f) => Math.abs(f.lat_deg - lat0) <= 1e-6 && Math.abs(f.lon_deg - lon0) <= 1e-6);
+  });
+  console.log(`  flash ${flash.seed} at ${flash.lat_deg}, ${flash.lon_deg} (centre ${lat0}, ${lon0}), ` +
+    `${flash.kind}, ${flash.bottom_m}-${flash.top_m} m, clock ${flash.time_s} s`);
+  assert(flash.kind === "in-cloud", `the flash is in-cloud: ${flash.kind}`);
+  const marker = `.flash[data-seed="${flash.seed}"]`;
+  await until("the flash's marker", async () => (await a.page.$(marker)) !== null);
+  assert((await a.page.getAttribute(marker, "data-kind")) === "in-cloud", "the marker is of the flash's kind");
+  assert(Number(await a.page.getAttribute("#map", "data-flashes")) >= 1, "the map counts the flash drawn");
+  const box = await a.page.locator(marker).boundingBox();
+  const want = await screenOf(a.page, flash.lat_deg, flash.lon_deg);
+  const off_px = Math.hypot(box.x + box.width / 2 - want.x, box.y + box.height / 2 - want.y);
+  assert(off_px < 2, `the marker is drawn at the flash: ${off_px.toFixed(2)} px off`);
+  const opacity = Number(await a.page.$eval(marker, (e) => e.style.opacity));
+  assert(opacity > 0.5, `a new flash is nearly opaque: ${opacity}`);
+  // The API's refusals, asked from outside the browser.
+  const place = { lat_deg: 46.1, lon_deg: 13.2 };
+  const noToken = await w.api("POST", "/api/events", { lightning: place }, null);
+  assert(noToken.status === 401, `a flash without the token: ${noToken.status} ${noToken.text}`);
+  const offGlobe = await w.api("POST", "/api/events", { lightning: { ...place, lat_deg: 95 } });
+  assert(offGlobe.status === 400 && offGlobe.json && offGlobe.json.field === "lightning.lat_deg" &&
+    /lightning\.lat_deg/.test(offGlobe.json.error), `a flash at 95 N: ${offGlobe.status} ${offGlobe.text}`);
+  noProblems(a.problems);
+};
+
 const name = process.argv[2];
 if (!cases[name]) {
   console.log(`usage: node console_test.mjs <${Object.keys(cases).join("|")}>`);

@@ -46,6 +46,10 @@ struct WeatherView {
   // and Heartbeat (protocol/'s WeatherClock: the same formula as the server's).
   weather::WeatherClock clock;
   bool connected = false;
+  // Lightning flashes the server sent, oldest first: those still giving
+  // light (kFlashLifetime_s plus kFlashGrace_s after the newest message's
+  // clock), at most kMaxHeldFlashes.
+  std::vector<weather::LightningFlash> flashes;
 
   double clockNow(std::chrono::steady_clock::time_point now) const { return clock.at(now); }
 };
