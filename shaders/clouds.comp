@@ -51,6 +51,9 @@ void main() {
   f.march = MarchParams(int(frame.dispatch.y), int(frame.dispatch.z), frame.weatherMap.z, frame.weatherMap.w,
                         frame.steps.x, frame.steps.y, frame.steps.z);
   f.layerCount = frameLayerCount();
+  f.flashCount = int(frame.flashInfo.x);
+  f.boltCount = int(frame.flashInfo.y);
+  f.pixelAngle = frame.flashInfo.z;
   // The pixel's step offset: the blue-noise tile's, or the hash's (SkyFrame::steps.w).
   uint tileIndex = (px.y & (kBlueNoiseSize - 1u)) * kBlueNoiseSize + (px.x & (kBlueNoiseSize - 1u));
   // Where in the pixel the ray goes: its centre, or with pixelJitter an

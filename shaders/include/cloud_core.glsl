@@ -23,9 +23,11 @@
 //   real2 airCloudShadow(AirFrame a, real3 p, real h, real muSun) // airSunShadow(a, p, h, muSun)
 //   real4 sampleAirTable(int part, real3 uvw)           // the frame's air table (air_table.glsl)
 //   real4 sampleSunMap(int layer, real2 uv)             // the frame's sun map (sun_map.glsl)
+//   flashAt, boltStartAt, boltEndAt                      // the frame's lightning (lightning.glsl)
 // and the frame's sun map in gSunMap (a global; a data member in C++), and
 // kWindField: false where no layer's wind varies over the map (the flow's
-// code is then left out; on the GPU a pipeline constant, true in C++).
+// code is then left out; on the GPU a pipeline constant, true in C++), and
+// kLightning: false where the frame lights no flash (the same).
 // pLocal is camera-relative, local frame: x east, y north, z up (m).
 
 #include "core_common.glsl"
@@ -36,6 +38,7 @@
 #include "air_table.glsl"
 #include "cloud_density.glsl"
 #include "wind_map.glsl"
+#include "lightning.glsl"
 
 // Single-scattering albedo of cloud droplets and ice in the visible
 // (formulas.md: 0.999+).
@@ -241,6 +244,11 @@ struct CoreFrame {
   MarchParams march;
   real3 groundIrradiance;  // sky irradiance on horizontal ground, linear units
   int layerCount;
+  // The frame's lightning (lightning.glsl): flashes lit, bolt segments, and
+  // a pixel's angle (rad) for the bolt's width.
+  int flashCount;
+  int boltCount;
+  real pixelAngle;
 };
 
 struct Span {
@@ -613,6 +621,7 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
     shade.x = above >= 0.0 ? 1.0 : shade.x;
     real3 scattered = sun * (shade.x * octaveSum(mix(phases1, phases2, cs.blend), tauSun)) +
                       diffuseLight(L, ct, ph, cs.coverage, cs.densityScale) * shade.y;
+    if (kLightning) scattered += flashInscatter(f.flashCount, p);
     // Hillaire 2016 energy-conserving step: integral over the step of
     // sigma_s L e^{-sigma_t s} = albedo L (1 - e^{-sigma_t len}); its limit
     // as sigma_t -> 0 is sigma_s L len (scatterFraction).
@@ -746,6 +755,18 @@ PixelResult shadePixel(CoreFrame f, real3 dir, real jitter) {
   }
   radiance += (air.inscatter[n] - airBefore) * transmittance;
   radiance += backgroundRadiance(f, dir, tEnd) * air.transmittance[n] * transmittance;
+  // A lightning channel, seen through the layers whose light comes from in
+  // front of it and the air between.
+  for (int once = kLightning && f.boltCount > 0 ? 1 : 0; once > 0; --once) {
+    real2 bolt = boltRadiance(f.boltCount, f.pixelAngle, dir);
+    real seen = 1.0;
+    for (int k = 0; k < n; ++k) seen *= layers[k].depth < bolt.y ? layers[k].transmittance : 1.0;
+    // The air up to the bolt, a few kilometres: its extinction at the
+    // middle of the path, with the view ray's haze (marchAir's).
+    real hMid = f.air.h + 0.5 * dir.z * bolt.y;
+    real3 sigma = airExtinction(hMid) + real3(f.air.aerosolExcess * kMieExtinction_perm * mieDensity(hMid));
+    radiance += flashColour() * (bolt.x * seen) * exp(-sigma * bolt.y);
+  }
   real depth = transmittance < 1.0 ? depthSum / (1.0 - transmittance) : 0.0;
   return PixelResult(radiance, transmittance, depth);
 }

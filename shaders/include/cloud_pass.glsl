@@ -44,6 +44,10 @@ layout(constant_id = 3) const int kSunMethod = 0;
 // second noise phase are compiled out (cloud_core.glsl's flowCrossfades).
 layout(constant_id = 4) const bool kWindField = true;
 
+// kLightning false for frames that light no flash (SkyFrame::flashInfo):
+// the flash's light in the march and the bolt are compiled out.
+layout(constant_id = 5) const bool kLightning = false;
+
 #define real float
 #define real2 vec2
 #define real3 vec3
@@ -176,6 +180,10 @@ CloudType unpackType(SkyCloudType t) {
   c.unused = 0.0;
   return c;
 }
+
+real4 flashAt(int k) { return frame.flashes[k]; }
+real4 boltStartAt(int k) { return frame.boltStart[k]; }
+real3 boltEndAt(int k) { return frame.boltEnd[k].xyz; }
 
 CoreLayer layerAt(int li) {
   SkyLayer l = frame.layers[li];

@@ -58,6 +58,12 @@ SKY_SHARED_CONST kMaxLayers = 4u;
 SKY_SHARED_CONST kWindMapLayers = 2u * kMaxLayers;
 SKY_SHARED_CONST kWindMapScale_mps = 150u;
 
+// Lightning a frame draws (lightning.glsl): flashes lighting their clouds,
+// and the segments of one cloud-to-ground channel (the protocol's
+// weather::kMaxBoltSegments).
+SKY_SHARED_CONST kMaxFrameFlashes = 4u;
+SKY_SHARED_CONST kMaxFrameBoltSegments = 48u;
+
 // A cloud type's 15 numbers (cloud_density.glsl's CloudType, in its order,
 // four per vec4; the last one unused).
 struct SkyCloudType {
@@ -147,6 +153,12 @@ struct SkyFrame {
   vec4 sunBuildShells;  // x, y: its top and base shells as sunMapShells; z: the first texel row built this
                         // frame, w: one past the last (of every cascade)
   vec4 sunBuildOrigin;  // xyz: its centre, local frame (m); w unused
+  vec4 flashInfo;       // x: flashes lit this frame, y: bolt segments drawn, z: a pixel's angle (rad); w unused
+  vec4 flashes[kMaxFrameFlashes];        // xyz: a flash's light centre, local frame (m); w: its intensity
+                                         // (linear units x m^2: the irradiance at 1 m)
+  vec4 boltStart[kMaxFrameBoltSegments]; // xyz: a channel segment's start, local frame (m); w: the
+                                         // channel's intensity per metre (linear units x m, per sr)
+  vec4 boltEnd[kMaxFrameBoltSegments];   // xyz: its end; w unused
 };
 
 #ifdef __cplusplus
@@ -173,7 +185,8 @@ static_assert(offsetof(SkyFrame, raster) == 272 + 288 * kMaxLayers + 48);
 static_assert(offsetof(SkyFrame, frustum) == 272 + 288 * kMaxLayers + 80);
 static_assert(offsetof(SkyFrame, airTable) == 272 + 288 * kMaxLayers + 96);
 static_assert(offsetof(SkyFrame, sunMap) == 272 + 288 * kMaxLayers + 112);
-static_assert(sizeof(SkyFrame) == 272 + 288 * kMaxLayers + 272);
+static_assert(offsetof(SkyFrame, flashInfo) == 272 + 288 * kMaxLayers + 272);
+static_assert(sizeof(SkyFrame) == 272 + 288 * kMaxLayers + 288 + 16 * (kMaxFrameFlashes + 2 * kMaxFrameBoltSegments));
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

@@ -62,6 +62,10 @@ TEST(SharedLayout, GlslangOffsetsMatchCpp) {
       {"frame.layers.secondary.a", layers + offsetof(SkyLayer, secondary) + offsetof(SkyCloudType, a)},
       {"frame.layers.secondary.d", layers + offsetof(SkyLayer, secondary) + offsetof(SkyCloudType, d)},
       {"frame.steps", offsetof(SkyFrame, steps)},
+      {"frame.flashInfo", offsetof(SkyFrame, flashInfo)},
+      {"frame.flashes", offsetof(SkyFrame, flashes)},
+      {"frame.boltStart", offsetof(SkyFrame, boltStart)},
+      {"frame.boltEnd", offsetof(SkyFrame, boltEnd)},
   };
   // Lines look like "frame.layers.shape: offset 288, type 8b52, ..., topLevelArrayStride 80".
   std::map<std::string, std::size_t> seen;

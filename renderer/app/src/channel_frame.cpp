@@ -34,6 +34,7 @@ tl::expected<DrawnFrame, FrameFailure> ChannelFrames::draw(const FrameRequest& r
   }
   in.weatherVersion = drawnVersion_;
   in.weatherClock_s = r.weatherClock_s;
+  in.flashes = view.flashes;
   in.patternIndex = r.patternIndex;
   in.sunAzimuth_deg = r.sunAzimuth_deg;
   in.sunElevation_deg = r.sunElevation_deg;

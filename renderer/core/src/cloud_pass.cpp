@@ -159,12 +159,13 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
 }
 
 Result<const ComputePipeline*> CloudPass::pipelineFor(const GpuContext& ctx, Stage stage, std::uint32_t layersDrawn,
-                                                      bool windField) {
+                                                      bool windField, bool lightning) {
   const std::size_t wind = windField ? 1 : 0;
+  lightning = lightning && stage == Stage::Clouds;  // the other stages draw no light
   std::optional<ComputePipeline>& slot =
       stage == Stage::SunMap     ? sunMapPipelines_[wind]
       : stage == Stage::AirTable ? tablePipelines_[wind][layersDrawn > 0 ? 1 : 0]
-                                 : cloudPipelines_[wind][std::min<std::uint32_t>(layersDrawn, 2)];
+                                 : cloudPipelines_[wind][std::min<std::uint32_t>(layersDrawn, 2)][lightning ? 1 : 0];
   if (slot) return &*slot;
   // Every variant of the three shaders gets the same bindings, so their set
   // layouts are identical and one descriptor set serves them all (Vulkan's
@@ -173,7 +174,7 @@ Result<const ComputePipeline*> CloudPass::pipelineFor(const GpuContext& ctx, Sta
   const char* shader =
       stage == Stage::SunMap ? "sun_map.comp.spv" : (stage == Stage::AirTable ? "air_table.comp.spv" : "clouds.comp.spv");
   ComputePipelineBuilder builder(std::string(name) + ".layers" + std::to_string(std::min<std::uint32_t>(layersDrawn, 2)) +
-                                 (windField ? ".wind" : ""));
+                                 (windField ? ".wind" : "") + (lightning ? ".lightning" : ""));
   builder.binding(gpu::kBindingFrame, vk::DescriptorType::eStorageBuffer)
       .binding(gpu::kBindingShape, vk::DescriptorType::eCombinedImageSampler)
       .binding(gpu::kBindingWeather, vk::DescriptorType::eCombinedImageSampler)
@@ -190,7 +191,7 @@ Result<const ComputePipeline*> CloudPass::pipelineFor(const GpuContext& ctx, Sta
       .binding(gpu::kBindingSunMap, vk::DescriptorType::eCombinedImageSampler)
       .shader(shader)
       .constants({layersDrawn > 0 ? 1u : 0u, airTableSize_.enabled ? 1u : 0u, layersDrawn > 1 ? 1u : 0u,
-                  std::uint32_t(sunMapSize_.method), windField ? 1u : 0u});
+                  std::uint32_t(sunMapSize_.method), windField ? 1u : 0u, lightning ? 1u : 0u});
   auto built = builder.build(ctx);
   if (!built) return tl::unexpected(built.error());
   slot = std::move(*built);
@@ -216,7 +217,9 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
   bool windField = false;
   for (std::uint32_t i = 0; i < std::uint32_t(frame.weatherMap.y) && i < gpu::kMaxLayers; ++i)
     windField = windField || frame.layers[i].flow.w > 0.5f;
-  auto cloudPipeline = pipelineFor(ctx, Stage::Clouds, layersDrawn, windField);
+  // With lightning's code only in a frame a flash lights.
+  const bool lightning = frame.flashInfo.x > 0.5f || frame.flashInfo.y > 0.5f;
+  auto cloudPipeline = pipelineFor(ctx, Stage::Clouds, layersDrawn, windField, lightning);
   if (!cloudPipeline) return tl::unexpected(cloudPipeline.error());
   const ComputePipeline* tablePipeline = nullptr;
   if (frame.airTable.x > 0) {

@@ -81,7 +81,7 @@ class CloudPass {
   // with or without a layer whose wind varies over the map, built now if it
   // is not yet. Errors: Io/Malformed for the SPIR-V; Vulkan failures throw.
   Result<const ComputePipeline*> pipelineFor(const GpuContext& ctx, Stage stage, std::uint32_t layersDrawn,
-                                             bool windField);
+                                             bool windField, bool lightning = false);
 
   // Destroyed in reverse order: fence and command buffer first, the
   // descriptor set before its pool, buffers and images before the samplers
@@ -91,7 +91,8 @@ class CloudPass {
   // (none: a clear sky; one; several, which shadow each other), the air
   // table's without and with clouds; each of them and the sun map's without
   // and with a wind field (the first index). Set layouts all identical.
-  std::array<std::array<std::optional<ComputePipeline>, 3>, 2> cloudPipelines_;
+  // By wind field, layers drawn (0, 1, more) and lightning.
+  std::array<std::array<std::array<std::optional<ComputePipeline>, 2>, 3>, 2> cloudPipelines_;
   std::array<std::array<std::optional<ComputePipeline>, 2>, 2> tablePipelines_;
   std::array<std::optional<ComputePipeline>, 2> sunMapPipelines_;
   vk::raii::Sampler noiseSampler_{nullptr};

@@ -55,6 +55,7 @@ class CpuCore {
   real3 sampleMultipleScatteringLut(real2 uv) const { return atmosphere_.sampleMultipleScattering(uv); }
 
 #define SKY_CORE_CONST static constexpr
+  static constexpr bool kLightning = true;  // (lightning.glsl: the frame's counts decide)
   static constexpr bool kWindField = true;  // (cloud_core.glsl's flow: the layer's flow.w decides)
 #define SKY_AIR_TABLE_BUILDER
 #define SKY_SUN_MAP_BUILDER
@@ -81,6 +82,9 @@ class CpuCore {
                           double(setup_.march.emptyStride), setup_.march.cloudStep_m, setup_.march.emptyStep_m,
                           setup_.march.stepGrowth};
     f.layerCount = int(setup_.layers.size());
+    f.flashCount = int(setup_.flashes.lights.size());
+    f.boltCount = int(setup_.flashes.boltStart.size());
+    f.pixelAngle = setup_.flashes.pixelAngle_rad;
     f.air.shadowLayers = setup_.march.cloudShadows ? f.layerCount : 0;
     const auto drawn =
         std::count_if(setup_.layers.begin(), setup_.layers.end(), [](const LayerSetup& l) { return !l.absent; });
@@ -168,6 +172,9 @@ class CpuCore {
 };
 
 CpuCore::CoreLayer CpuCore::layerAt(int li) { return layers_[li]; }
+CpuCore::real4 CpuCore::flashAt(int k) { return setup_.flashes.lights[std::size_t(k)]; }
+CpuCore::real4 CpuCore::boltStartAt(int k) { return setup_.flashes.boltStart[std::size_t(k)]; }
+CpuCore::real3 CpuCore::boltEndAt(int k) { return setup_.flashes.boltEnd[std::size_t(k)]; }
 CpuCore::real2 CpuCore::airCloudShadow(AirFrame a, real3 p, real h, real muSun) {
   return airSunShadow(a, p, h, muSun);
 }

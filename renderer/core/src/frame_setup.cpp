@@ -302,6 +302,9 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
   s.camDown = inFrame(enu, axes.down);
   s.localToEcef = glm::dmat3(toGlm(enu.east), toGlm(enu.north), toGlm(enu.up));
   s.cameraEcef_m = toGlm(enu.originEcef_m);
+  // A pixel's angle at the image's centre, for the width a bolt is drawn at.
+  s.flashes = prepareFlashes(in.flashes, in.weatherClock_s, in.exposure_s, enu,
+                             (s.frustum.y - s.frustum.x) / std::max(s.rasterWidth, 1.0));
 
   const geo::EnuFrame& a = field.frame;
   s.camToAnchor = glm::dmat3(inFrame(a, enu.east), inFrame(a, enu.north), inFrame(a, enu.up));
@@ -566,6 +569,15 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
   f.sunBuildV = v4(b.axisV, 0.0);
   f.sunBuildShells = gpu::vec4(float(b.top_m), float(b.base_m), float(plan.rowBegin), float(plan.rowEnd));
   f.sunBuildOrigin = v4(b.origin);
+  const FlashSetup& fl = s.flashes;
+  SKY_ASSERT(fl.lights.size() <= gpu::kMaxFrameFlashes && fl.boltStart.size() <= gpu::kMaxFrameBoltSegments &&
+             fl.boltEnd.size() == fl.boltStart.size());
+  f.flashInfo = gpu::vec4(float(fl.lights.size()), float(fl.boltStart.size()), float(fl.pixelAngle_rad), 0.0f);
+  for (std::size_t k = 0; k < fl.lights.size(); ++k) f.flashes[k] = gpu::vec4(fl.lights[k]);
+  for (std::size_t k = 0; k < fl.boltStart.size(); ++k) {
+    f.boltStart[k] = gpu::vec4(fl.boltStart[k]);
+    f.boltEnd[k] = v4(fl.boltEnd[k]);
+  }
 
   for (std::size_t i = 0; i < s.layers.size(); ++i) {
     const LayerSetup& l = s.layers[i];

@@ -15,6 +15,7 @@
 
 #include "atmosphere_tables.hpp"
 #include "cloud_types.hpp"
+#include "flash_setup.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky_shared.h"
 #include "weather_field.hpp"
@@ -144,6 +145,8 @@ struct FrameSetup {
     std::uint32_t rowBegin = 0, rowEnd = 0;  // rows of every cascade built; none when equal
   };
   std::optional<SunMapFrame> sunMapPlan;
+  // The lightning this frame draws (flash_setup.hpp).
+  FlashSetup flashes;
 };
 
 // Haggstrom 2018's coverage ramp of the step length (sec. 4.2.2, eq. 34):

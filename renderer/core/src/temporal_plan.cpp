@@ -143,6 +143,8 @@ std::string TemporalPlanner::resetReason(const Remembered& prev, const Remembere
   if (turned_deg > settings_.resetRotation_deg) return "view turned " + rounded(turned_deg, 1) + " deg";
   const double step_s = now.clock_s - prev.clock_s;
   if (std::abs(step_s) > settings_.resetClockStep_s) return "weather clock stepped " + rounded(step_s, 1) + " s";
+  // A flash's light comes and goes within a few frames: no history holds it.
+  if (now.flashLit || prev.flashLit) return "lightning";
   if (now.moonLit != prev.moonLit) return now.moonLit ? "the moon took over the light" : "the sun took over the light";
   const double sunTurn_deg = angleBetween_deg(now.keyLightEcef, prev.keyLightEcef);
   if (sunTurn_deg > settings_.resetSunTurn_deg) return "key light moved " + rounded(sunTurn_deg, 2) + " deg";
@@ -164,6 +166,7 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   now.frustum = setup.frustum;
   now.keyLightEcef = setup.localToEcef * setup.sunDir;
   now.moonLit = setup.moonLit;
+  now.flashLit = !setup.flashes.lights.empty();
   now.clock_s = inputs.weatherClock_s;
   if (!inputs.weatherVersion || inputs.weatherVersion != keyVersion_) {
     versionStructureKey_ = weatherStructureKey(inputs.weather, inputs.coarseWeather);

@@ -98,6 +98,7 @@ class TemporalPlanner {
     glm::dvec4 frustum{0};                     // FrameSetup::frustum
     glm::dvec3 keyLightEcef{0};
     bool moonLit = false;
+    bool flashLit = false;  // a lightning flash lit the frame (its light changes from frame to frame)
     double clock_s = 0;
     std::uint64_t structureKey = 0;  // weatherStructureKey
     std::uint64_t contentKey = 0;    // weatherContentKey

@@ -8,12 +8,14 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "sky/core/result.hpp"
 #include "sky/geo/geodetic.hpp"
 #include "sky/render/gpu_options.hpp"
+#include "sky/weather/lightning.hpp"
 #include "sky/weather/model.hpp"
 
 namespace sky::render {
@@ -271,6 +273,10 @@ struct RenderSettings {
 // horizontal half-angle from it and the aspect width / height.
 ViewFrustum symmetricFrustum(const RenderSettings& settings);
 
+// A frame's exposure of lightning, s: a 30 Hz frame's (a flash's stroke
+// lasts tens of milliseconds, so a frame sees it when its exposure holds it).
+inline constexpr double kDefaultExposure_s = 1.0 / 30.0;
+
 struct FrameInputs {
   geo::GeodeticPose camera;  // CIGI pose: lat/lon/alt (m above the ellipsoid, >= 0), yaw/pitch/roll deg
   const weather::WeatherSnapshot* weather = nullptr;  // layers + coverage tiles; nullptr = clear sky.
@@ -293,6 +299,11 @@ struct FrameInputs {
   // compare. Unset: it compares every frame.
   std::optional<std::uint64_t> weatherVersion;
   double weatherClock_s = 0;  // clouds advect with each layer's wind by this clock
+  // Lightning flashes (the server's events; kept by the caller while they
+  // give light): those giving light over the exposure before weatherClock_s
+  // light their clouds, the brightest cloud-to-ground one draws its channel.
+  std::span<const weather::LightningFlash> flashes;
+  double exposure_s = kDefaultExposure_s;
   double sunAzimuth_deg = 135, sunElevation_deg = 40;  // in the camera's local ENU frame
   // When set (UTC, s since 1970), the sun is where it is at that instant seen
   // from the camera (ephemeris.hpp), and the two angles above are ignored.
