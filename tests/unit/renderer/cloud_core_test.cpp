@@ -457,3 +457,60 @@ TEST(CloudCore, AnchorPlaneIsTheGnomonicProjectionOfTheAnchorSphere) {
 
 }  // namespace
 }  // namespace sky::test
+
+namespace sky::test {
+namespace {
+
+// lightning.glsl against closed forms: a flash's light at a point is its
+// intensity over the squared distance (softened within the core radius),
+// carried by the glow's exponential, times the isotropic phase; two flashes
+// add. A straight channel cut into segments draws as the uncut channel
+// (no light added where they meet), and across it the light integrates to
+// the intensity per metre over the distance.
+TEST(Lightning, AFlashsLightFallsAsAPointSourcesInItsGlow) {
+  Core c;
+  c.flashes = {Core::real4(0.0, 0.0, 2000.0, 5.0e6)};
+  for (double d : {0.0, 300.0, 1500.0, 6000.0}) {
+    const Core::real3 p(0.0, d, 2000.0);
+    const double expected = 5.0e6 * std::exp(-d / 1500.0) / (d * d + 150.0 * 150.0) / (4 * kPi);
+    EXPECT_NEAR(c.flashInscatter(1, p).z, expected * 1.0, 1e-12 * expected) << d;
+    EXPECT_NEAR(c.flashInscatter(1, p).x, expected * 0.85, 1e-12 * expected) << "the channel's bluish white";
+  }
+  c.flashes.push_back(Core::real4(0.0, 3000.0, 2000.0, 5.0e6));
+  const Core::real3 mid(0.0, 1500.0, 2000.0);
+  EXPECT_NEAR(c.flashInscatter(2, mid).z, 2 * c.flashInscatter(1, mid).z, 1e-9);
+  EXPECT_EQ(c.flashInscatter(0, mid).z, 0.0) << "no flash, no light";
+}
+
+TEST(Lightning, ASegmentedChannelDrawsAsOneLine) {
+  // A vertical channel 2 km ahead, from 500 m below the camera to 500 m
+  // above, of 10 (linear units x m) per metre: whole, and in 7 pieces.
+  const double pixel = 1e-3;
+  Core whole, cut;
+  whole.boltStarts = {Core::real4(0.0, 2000.0, -500.0, 10.0)};
+  whole.boltEnds = {Core::real3(0.0, 2000.0, 500.0)};
+  for (int k = 0; k < 7; ++k) {
+    cut.boltStarts.push_back(Core::real4(0.0, 2000.0, -500.0 + 1000.0 * k / 7, 10.0));
+    cut.boltEnds.push_back(Core::real3(0.0, 2000.0, -500.0 + 1000.0 * (k + 1) / 7));
+  }
+  double across = 0;
+  for (int i = -400; i <= 400; ++i) {
+    // Rays across the channel at two heights: one through a joint.
+    const double ax = i * pixel / 100;
+    for (double el : {0.0, std::atan((-500.0 + 1000.0 * 3 / 7) / 2000.0)}) {
+      const Core::real3 dir = glm::normalize(Core::real3(std::sin(ax), std::cos(ax), std::tan(el)));
+      const double w = whole.boltRadiance(1, pixel, dir).x, s = cut.boltRadiance(7, pixel, dir).x;
+      EXPECT_NEAR(s, w, 0.02 * w + 1e-12) << "at a joint the pieces' light is the whole channel's";
+      if (el == 0.0) across += w * (pixel / 100);
+    }
+  }
+  // Across the line: the intensity per metre over the distance, 10 / 2000.
+  EXPECT_NEAR(across, 10.0 / 2000.0, 0.01 * 10.0 / 2000.0);
+  // The distance it is seen at.
+  EXPECT_NEAR(whole.boltRadiance(1, pixel, Core::real3(0, 1, 0)).y, 2000.0, 1e-6);
+  // Behind the camera it is not seen.
+  EXPECT_EQ(whole.boltRadiance(1, pixel, Core::real3(0, -1, 0)).x, 0.0);
+}
+
+}  // namespace
+}  // namespace sky::test

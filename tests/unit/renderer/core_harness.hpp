@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -46,6 +47,7 @@ class Core {
 
 #define SKY_CORE_CONST static constexpr
   static constexpr bool kWindField = true;  // (cloud_core.glsl: the layer's flow.w decides)
+  static constexpr bool kLightning = true;  // (lightning.glsl: the frame's counts decide)
 #define SKY_AIR_TABLE_BUILDER
 #define SKY_SUN_MAP_BUILDER
 #include "cloud_core.glsl"
@@ -54,6 +56,9 @@ class Core {
 #undef SKY_CORE_CONST
 
   CoreLayer layers[kMaxLayers]{};
+  // The frame's lightning a test sets (lightning.glsl's hooks).
+  std::vector<real4> flashes, boltStarts;
+  std::vector<real3> boltEnds;
   // The air table a test built (buildAirTable), read by shadePixel when the
   // frame asks for it.
   sky::render::AirTableTexels airTexels;
@@ -76,6 +81,9 @@ class Core {
 };
 
 inline Core::CoreLayer Core::layerAt(int li) { return layers[li]; }
+inline Core::real4 Core::flashAt(int k) { return flashes[std::size_t(k)]; }
+inline Core::real4 Core::boltStartAt(int k) { return boltStarts[std::size_t(k)]; }
+inline Core::real3 Core::boltEndAt(int k) { return boltEnds[std::size_t(k)]; }
 inline Core::real3 Core::sampleWeather(LayerSampling, real3) {
   ++lookups;
   return real3(coverage, density, blend);
