@@ -68,9 +68,56 @@ Result<CameraKey> parseKey(const toml::table& t, bool onPath, const std::string&
   return key;
 }
 
+// A still's flash: { kind = "cloud-to-ground" | "in-cloud", lat_deg, lon_deg,
+// bottom_m, top_m, energy_j (default 1e9), before_s (default 0.02), seed
+// (default 1) }.
+Result<weather::LightningFlash> parseFlash(const toml::node& node, const std::string& path, const Where& where) {
+  auto ft = subTable(node, path, where);
+  if (!ft) return failWith(ft);
+  const std::string fp = path + ".";
+  if (auto r = onlyKeys(**ft, {"kind", "lat_deg", "lon_deg", "bottom_m", "top_m", "energy_j", "before_s", "seed"}, fp,
+                        where);
+      !r)
+    return failWith(r);
+  weather::LightningFlash f;
+  f.seed = 1;
+  f.energy_j = weather::kTypicalFlashEnergy_j;
+  f.time_s = 0.02;
+  auto kind = config::string(**ft, "kind", fp, where);
+  if (!kind) return failWith(kind);
+  const auto k = weather::flashKindFromString(*kind);
+  if (!k)
+    return where.error(ErrorCode::InvalidArgument, (*ft)->get("kind")->source(), fp + "kind",
+                       "'" + *kind + "' is not cloud-to-ground or in-cloud");
+  f.kind = *k;
+  const struct {
+    const char* key;
+    double lo, hi;
+    double* out;
+    bool required;
+  } fields[] = {{"lat_deg", -90, 90, &f.lat_deg, true},        {"lon_deg", -180, 180, &f.lon_deg, true},
+                {"bottom_m", -500, 20000, &f.bottom_m, true},  {"top_m", -500, 20000, &f.top_m, true},
+                {"energy_j", 1, weather::kMaxFlashEnergy_j, &f.energy_j, false},
+                {"before_s", 0, weather::kFlashLifetime_s, &f.time_s, false}};
+  for (const auto& field : fields) {
+    if (!field.required && !(*ft)->get(field.key)) continue;
+    auto v = numberIn(**ft, field.key, field.lo, field.hi, fp, where);
+    if (!v) return failWith(v);
+    *field.out = *v;
+  }
+  if ((*ft)->get("seed")) {
+    auto v = numberIn(**ft, "seed", 0, 9007199254740992.0, fp, where);
+    if (!v) return failWith(v);
+    f.seed = static_cast<std::uint64_t>(*v);
+  }
+  if (auto r = weather::validate(f); !r)
+    return where.error(ErrorCode::InvalidArgument, node.source(), path, r.error().detail);
+  return f;
+}
+
 Result<Scene> parseScene(const toml::table& t, std::size_t index, const Where& where) {
   const std::string prefix = "scene[" + std::to_string(index) + "].";
-  if (auto r = onlyKeys(t, {"name", "description", "weather", "vfov_deg", "sun", "camera", "path", "frames", "change"}, prefix,
+  if (auto r = onlyKeys(t, {"name", "description", "weather", "vfov_deg", "sun", "camera", "path", "frames", "change", "flash"}, prefix,
                         where);
       !r)
     return failWith(r);
@@ -126,6 +173,11 @@ Result<Scene> parseScene(const toml::table& t, std::size_t index, const Where& w
     auto key = parseKey(**ct, false, prefix + "camera.", where);
     if (!key) return failWith(key);
     scene.keys.push_back(*key);
+    if (const toml::node* flashNode = t.get("flash")) {
+      auto flash = parseFlash(*flashNode, prefix + "flash", where);
+      if (!flash) return failWith(flash);
+      scene.flash = *flash;
+    }
     return scene;
   }
   const toml::array* keys = path->as_array();
@@ -148,6 +200,8 @@ Result<Scene> parseScene(const toml::table& t, std::size_t index, const Where& w
     return where.error(ErrorCode::InvalidArgument, (*frames)->source(), prefix + "frames",
                        "must be an integer in [2, " + std::to_string(kMaxPathFrames) + "]");
   scene.frames = std::uint32_t(count->get());
+  if (t.get("flash"))
+    return where.error(ErrorCode::Malformed, t.get("flash")->source(), prefix + "flash", "only a still has a flash");
   if (const toml::node* changeNode = t.get("change")) {
     auto ct = subTable(*changeNode, prefix + "change", where);
     if (!ct) return failWith(ct);

@@ -98,7 +98,7 @@ Result<std::vector<LoadedScene>> loadSuite(const std::filesystem::path& suiteFil
     if (weatherPath.is_relative()) weatherPath = suiteFile.parent_path() / weatherPath;
     auto weather = loadWeatherFile(weatherPath);
     if (!weather) return fail(weather.error().code, "scene '" + s->name + "': " + weather.error().detail);
-    LoadedScene loaded{*s, std::move(*weather), std::nullopt, {}};
+    LoadedScene loaded{*s, std::move(*weather), std::nullopt, {}, {}};
     if (s->change) {
       auto tiles = changeTiles(loaded.weather.snapshot, *s->change, s->keys.front().pose);
       if (!tiles) return fail(tiles.error().code, "scene '" + s->name + "': " + tiles.error().detail);
@@ -123,6 +123,12 @@ render::FrameInputs frameInputs(const LoadedScene& scene, std::uint32_t frame) {
     in.weather = &scene.changing;
   }
   in.weatherClock_s = scene.weather.clockStart_s + scene.weather.clockRate * t;
+  if (scene.scene.flash) {
+    weather::LightningFlash f = *scene.scene.flash;
+    f.time_s = in.weatherClock_s - scene.scene.flash->time_s;  // the scene's time_s: seconds before the frame
+    scene.flashes = {f};
+    in.flashes = scene.flashes;
+  }
   in.sunAzimuth_deg = scene.scene.sunAzimuth_deg;
   in.sunElevation_deg = scene.scene.sunElevation_deg;
   in.frameIndex = frame;

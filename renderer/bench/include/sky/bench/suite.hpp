@@ -14,6 +14,7 @@
 
 #include "sky/core/result.hpp"
 #include "sky/geo/geodetic.hpp"
+#include "sky/weather/lightning.hpp"
 
 namespace sky::bench {
 
@@ -55,6 +56,9 @@ struct Scene {
   std::vector<CameraKey> keys;  // one key: a still; two or more: a path
   std::uint32_t frames = 1;     // a path's frames, evenly spaced from the first key's time to the last's, [2, kMaxPathFrames]
   std::optional<WeatherChange> change;  // a path's only
+  // A still's lightning flash (its time_s is the seconds before the frame's
+  // clock its first stroke struck: the frame sees it that long after).
+  std::optional<weather::LightningFlash> flash;
 
   bool isPath() const { return keys.size() > 1; }
 };

@@ -49,6 +49,8 @@ struct LoadedScene {
   // rewritten by each call, so the memory does not grow with the frames
   // (a path may have 600 of ~15000 tiles each).
   mutable weather::WeatherSnapshot changing;
+  // The still's flash at the frame's clock (Scene::flash), for frameInputs.
+  mutable std::vector<weather::LightningFlash> flashes;
 };
 
 // Reads the suite and each chosen scene's weather (relative paths from the
