@@ -7,6 +7,7 @@
 
 #include "sky/app/area_of_interest.hpp"
 #include "sky/app/drawable_weather.hpp"
+#include "sky/app/shared_state.hpp"
 
 namespace sky::app {
 namespace {
@@ -168,6 +169,38 @@ TEST(AreaTracker, AsksForEachAreaAgainAtItsOwnDistance) {
   ASSERT_EQ(asked.size(), 2u) << "70 km from the last detailed area, 110 km from the coarse one";
   EXPECT_EQ(asked[1].areaIndex, 1);
   EXPECT_DOUBLE_EQ(asked[1].area.centerLat_deg, pose.position.lat_deg);
+}
+
+}  // namespace
+}  // namespace sky::app
+
+namespace sky::app {
+namespace {
+
+// The flashes a channel holds (they arrive once, as events): those that can
+// still give light at the stream's clock, at most kMaxHeldFlashes, the
+// newest kept.
+TEST(HeldFlashes, OnlyThoseStillGivingLightAreKept) {
+  SharedState state;
+  auto flashAt = [](double t_s) {
+    weather::LightningFlash f;
+    f.time_s = t_s;
+    f.energy_j = 1e9;
+    return f;
+  };
+  state.addFlashes({flashAt(10.0), flashAt(11.0)}, 11.0);
+  EXPECT_EQ(state.weather().flashes.size(), 2u);
+  // Later: the first is past its light and the grace, the second not yet.
+  const double later = 10.0 + weather::kFlashLifetime_s + kFlashGrace_s + 0.5;
+  state.addFlashes({flashAt(later)}, later);
+  ASSERT_EQ(state.weather().flashes.size(), 2u);
+  EXPECT_EQ(state.weather().flashes[0].time_s, 11.0);
+  // A storm's burst: the newest kMaxHeldFlashes.
+  std::vector<weather::LightningFlash> burst;
+  for (int i = 0; i < 300; ++i) burst.push_back(flashAt(later + i * 1e-3));
+  state.addFlashes(burst, later + 0.3);
+  ASSERT_EQ(state.weather().flashes.size(), kMaxHeldFlashes);
+  EXPECT_EQ(state.weather().flashes.back().time_s, later + 299 * 1e-3);
 }
 
 }  // namespace
