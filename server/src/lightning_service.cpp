@@ -19,6 +19,29 @@ bool anyCumulonimbus(const std::vector<weather::CloudLayer>& layers, const std::
                      [&](const weather::Region& r) { return std::any_of(r.layers.begin(), r.layers.end(), cb); });
 }
 
+bool same(const weather::SphericalCap& a, const weather::SphericalCap& b) {
+  return a.centerLat_deg == b.centerLat_deg && a.centerLon_deg == b.centerLon_deg && a.radius_m == b.radius_m;
+}
+
+// The storm cells of the caps, one per S2 cell whichever caps hold it.
+std::vector<weather::StormCell> stormCellsIn(const LiveWeather& weather, double clock_s,
+                                             std::span<const weather::SphericalCap> caps, double rate) {
+  const std::vector<weather::CloudLayer> layers = weather.layersAt(clock_s);
+  const std::vector<weather::Region> regions = weather.regionsAt(clock_s);
+  if (!anyCumulonimbus(layers, regions)) return {};
+  std::map<std::uint64_t, weather::StormCell> cells;
+  for (const weather::SphericalCap& cap : caps) {
+    const weather::WeatherSnapshot snapshot = subscriberSnapshot(weather, clock_s, cap, kLightningTileLevel);
+    if (snapshot.tileLevel != kLightningTileLevel) continue;  // not at the process's level: none drawn
+    const std::vector<std::uint64_t> covering = weather::coverCap(cap, kLightningTileLevel, kDefaultMaxCells);
+    for (const weather::StormCell& c : weather::stormCells(snapshot, covering, rate)) cells.emplace(c.cellId, c);
+  }
+  std::vector<weather::StormCell> list;
+  list.reserve(cells.size());
+  for (const auto& [id, c] : cells) list.push_back(c);
+  return list;
+}
+
 }  // namespace
 
 std::vector<weather::LightningFlash> LightningService::tick(const LiveWeather& weather, double clock_s,
@@ -27,23 +50,26 @@ std::vector<weather::LightningFlash> LightningService::tick(const LiveWeather& w
   last_s_ = clock_s;
   if (!last || !(clock_s > *last) || clock_s - *last > kMaxLightningGap_s || !(options_.rate_perMin100km2 > 0))
     return {};
-  const std::vector<weather::CloudLayer> layers = weather.layersAt(clock_s);
-  const std::vector<weather::Region> regions = weather.regionsAt(clock_s);
-  if (!anyCumulonimbus(layers, regions)) return {};
-  // One storm cell per S2 cell, whichever areas hold it.
-  std::map<std::uint64_t, weather::StormCell> cells;
-  for (std::size_t i = 0; i < areas.size() && i < kMaxLightningAreas; ++i) {
-    weather::SphericalCap cap = areas[i];
+  // The channels of one simulator watch the same areas: each cap once.
+  std::vector<weather::SphericalCap> caps;
+  for (const weather::SphericalCap& a : areas) {
+    weather::SphericalCap cap = a;
     cap.radius_m = std::min(cap.radius_m, kLightningReach_m);
-    const weather::WeatherSnapshot snapshot = subscriberSnapshot(weather, clock_s, cap, kLightningTileLevel);
-    if (snapshot.tileLevel != kLightningTileLevel) continue;  // not at the process's level: none drawn
-    const std::vector<std::uint64_t> covering = weather::coverCap(cap, kLightningTileLevel, kDefaultMaxCells);
-    for (const weather::StormCell& c : weather::stormCells(snapshot, covering, options_.rate_perMin100km2))
-      cells.emplace(c.cellId, c);
+    const bool seen = std::any_of(caps.begin(), caps.end(), [&](const weather::SphericalCap& c) { return same(c, cap); });
+    if (!seen && caps.size() < kMaxLightningAreas) caps.push_back(cap);
   }
-  std::vector<weather::StormCell> list;
-  list.reserve(cells.size());
-  for (const auto& [id, c] : cells) list.push_back(c);
+  // The storm cells change with the weather (a change, a ramp) and as
+  // drifting regions move: computed again then, or kStormCellRefresh_s on.
+  const bool fresh = cells_ && cellsAccepted_ == weather.accepted() && !weather.changing(clock_s) &&
+                     clock_s >= cellsAt_s_ && clock_s - cellsAt_s_ < kStormCellRefresh_s &&
+                     std::equal(caps.begin(), caps.end(), cellsCaps_.begin(), cellsCaps_.end(), same);
+  if (!fresh) {
+    cells_ = stormCellsIn(weather, clock_s, caps, options_.rate_perMin100km2);
+    cellsCaps_ = caps;
+    cellsAccepted_ = weather.accepted();
+    cellsAt_s_ = clock_s;
+  }
+  const std::vector<weather::StormCell>& list = *cells_;
   std::size_t dropped = 0;
   std::vector<weather::LightningFlash> flashes =
       weather::drawFlashes(options_.seed, list, *last, clock_s, kMaxFlashesPerTick, &dropped);

@@ -42,6 +42,10 @@ inline constexpr std::size_t kMaxRecentFlashes = 1000;
 // A clock that moved by more than this between ticks (set, jumped, or
 // frozen and restarted) draws nothing for the gap.
 inline constexpr double kMaxLightningGap_s = 60;
+// The storm cells are computed again at least this often (s of weather
+// clock) while the weather stands still: drifting regions move a few
+// hundred metres in that time, a small part of a 9 km cell.
+inline constexpr double kStormCellRefresh_s = 10;
 
 // What an operator asks for (POST /api/events).
 struct FlashRequest {
@@ -73,6 +77,13 @@ class LightningService {
 
   LightningOptions options_;
   std::optional<double> last_s_;
+  // The storm cells of the last areas (a tick costs ~3 ms per 150 km area
+  // to compute them, measured in lightning_test.cpp): kept while the
+  // weather, its changes and the areas stand still.
+  std::optional<std::vector<weather::StormCell>> cells_;
+  std::vector<weather::SphericalCap> cellsCaps_;
+  std::uint64_t cellsAccepted_ = 0;
+  double cellsAt_s_ = 0;
   std::deque<weather::LightningFlash> recent_;
   Counters counters_;
 };
