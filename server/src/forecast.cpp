@@ -3,11 +3,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <set>
 
 #include "forecast_axes.hpp"
+#include "sky/weather/precipitation.hpp"
 #include "sky/weather/query.hpp"
 
 namespace sky::server {
@@ -27,6 +29,10 @@ constexpr long kLowBottom = 212, kLowTop = 213, kMiddleBottom = 222, kMiddleTop 
 constexpr long kCatTemperature = 0, kCatMoisture = 1, kCatMomentum = 2, kCatMass = 3, kCatCloud = 6;
 constexpr long kTotalCloudCover = 1, kLowCloudCover = 3, kMediumCloudCover = 4, kHighCloudCover = 5;
 constexpr long kRelativeHumidity = 1, kPressure = 0, kGeopotentialHeight = 5;
+constexpr long kSurface = 1, kPrecipitationRate = 7;
+// NCEP's local categorical precipitation types (0 or 1 per point).
+constexpr long kCategoricalRain = 192, kCategoricalFreezingRain = 193, kCategoricalIcePellets = 194,
+               kCategoricalSnow = 195;
 
 // Sundqvist et al. (1989, Mon. Wea. Rev. 117) diagnose cloud from relative
 // humidity above a critical value; 0.8 is the middle of the 0.75-0.85 range
@@ -55,7 +61,10 @@ constexpr SlotDefaults kSlots[] = {
     {kForecastMiddleSlot, weather::CloudType::Altocumulus, 3600, 1800, "middle"},
     {kForecastHighSlot, weather::CloudType::Cirrus, 8000, 1500, "high"},
     {kForecastConvectiveSlot, weather::CloudType::Cumulus, 1200, 5000, "convective"},
+    {kForecastPrecipitationSlot, weather::CloudType::Rain, 0, 2000, "precipitation"},
 };
+// The precipitation layer reaches this far (m) into the lowest cloud layer.
+constexpr double kPrecipitationIntoCloud_m = 500;
 
 const SlotDefaults& slotDefaults(std::uint32_t id) {
   for (const auto& s : kSlots)
@@ -124,7 +133,33 @@ struct StepFields {
   std::map<double, const GribField*> humidity, height;               // isobaric, by Pa
   const GribField* cloudBaseHeight = nullptr;
   const GribField* cloudBasePressure = nullptr;
+  const GribField* precipitationRate = nullptr;
+  std::map<long, const GribField*> categorical;  // by parameter number (192-195)
 };
+
+// The precipitation rate of a step as a grid (mm/h), and its points' votes
+// for a type from the categorical fields on the same grid.
+std::shared_ptr<CoverGrid> precipitationGrid(const StepFields& s, std::map<weather::CloudType, std::size_t>& votes) {
+  const GribField& f = *s.precipitationRate;
+  auto g = std::make_shared<CoverGrid>();
+  g->grid = f.meta.grid;
+  g->source = describe(f);
+  g->fraction.resize(f.values.size());
+  auto flagged = [&](long number, std::size_t k) {
+    const auto it = s.categorical.find(number);
+    return it != s.categorical.end() && it->second->meta.grid == g->grid && k < it->second->values.size() &&
+           it->second->values[k] > 0.5f;
+  };
+  for (std::size_t k = 0; k < f.values.size(); ++k) {
+    const float v = f.values[k];
+    g->fraction[k] = std::isnan(v) ? kNaN : std::max(0.0f, v * 3600.0f);  // kg m-2 s-1 = mm/s
+    if (!(g->fraction[k] >= kMinForecastPrecipitation_mmph)) continue;
+    if (flagged(kCategoricalSnow, k)) ++votes[weather::CloudType::Snow];
+    else if (flagged(kCategoricalIcePellets, k) || flagged(kCategoricalFreezingRain, k)) ++votes[weather::CloudType::Sleet];
+    else ++votes[weather::CloudType::Rain];
+  }
+  return g;
+}
 
 // Sundqvist cover per grid point for the pressure band (lo_pa, hi_pa], with
 // the heights of the lowest and highest cloudy level per point.
@@ -197,7 +232,10 @@ bool forecastWants(const GribMeta& m) {
     case kCatMass:
       return (m.number == kPressure || m.number == kGeopotentialHeight) &&
              (m.levelType == kCloudBase || m.levelType == kCloudTop || limitSlot(m.levelType) || isobaric);
-    case kCatMoisture: return m.number == kRelativeHumidity && (isobaric || nearGround);
+    case kCatMoisture:
+      return (m.number == kRelativeHumidity && (isobaric || nearGround)) ||
+             ((m.number == kPrecipitationRate || (m.number >= kCategoricalRain && m.number <= kCategoricalSnow)) &&
+              m.levelType == kSurface);
     case kCatMomentum: return (m.number == 2 || m.number == 3 || m.number == 8 || m.number == 9) && (isobaric || nearGround);
     case kCatTemperature: return m.number == 0 && (isobaric || nearGround);
     default: return false;
@@ -224,6 +262,9 @@ Result<Forecast> Forecast::fromGrib(const std::vector<const GribFile*>& files, s
         if (f.meta.levelType == kCloudBase) s.cloudBaseHeight = &f;
       } else if (f.meta.category == kCatMoisture && f.meta.number == kRelativeHumidity && pa) {
         s.humidity.emplace(f.meta.level, &f);
+      } else if (f.meta.category == kCatMoisture && f.meta.levelType == kSurface) {
+        if (f.meta.number == kPrecipitationRate && !s.precipitationRate) s.precipitationRate = &f;
+        if (f.meta.number >= kCategoricalRain && f.meta.number <= kCategoricalSnow) s.categorical.emplace(f.meta.number, &f);
       }
     }
   std::map<std::uint32_t, ForecastLayer> layers;
@@ -231,6 +272,7 @@ Result<Forecast> Forecast::fromGrib(const std::vector<const GribFile*>& files, s
   std::map<std::uint32_t, std::pair<double, double>> heights;
   std::map<std::uint32_t, std::string> heightFrom;
   bool baseFromCloudBase = false;
+  std::map<weather::CloudType, std::size_t> precipitationVotes;
   for (auto& [valid, s] : steps) {
     std::map<std::uint32_t, std::shared_ptr<const CoverGrid>> covers;
     for (const auto& [slot, f] : s.cover) {
@@ -294,6 +336,7 @@ Result<Forecast> Forecast::fromGrib(const std::vector<const GribFile*>& files, s
         }
       }
     }
+    if (s.precipitationRate) covers[kForecastPrecipitationSlot] = precipitationGrid(s, precipitationVotes);
     for (auto& [slot, g] : covers) {
       ForecastLayer& l = layers[slot];
       l.steps.push_back({valid, std::move(g)});
@@ -320,6 +363,24 @@ Result<Forecast> Forecast::fromGrib(const std::vector<const GribFile*>& files, s
       // A layer one level thick is still a layer: at least its typical depth's third.
       l.layer.thickness_m = std::clamp(h->second.second - l.layer.base_m, d.thickness_m / 3, 20000.0 - l.layer.base_m);
       l.heightFrom = heightFrom[slot];
+    }
+    if (slot == kForecastPrecipitationSlot) {
+      // From the ground into the lowest cloud layer (the slots before it
+      // are in fc.layers_ already), of the type most raining points have.
+      double lowest = std::numeric_limits<double>::infinity();
+      for (const ForecastLayer& other : fc.layers_) lowest = std::min(lowest, other.layer.base_m);
+      l.layer.base_m = 0;
+      if (std::isfinite(lowest)) {
+        l.layer.thickness_m = std::clamp(lowest + kPrecipitationIntoCloud_m, 500.0, 20000.0);
+        l.heightFrom = "from the ground to " + std::to_string(static_cast<int>(kPrecipitationIntoCloud_m)) +
+                       " m into the lowest cloud layer";
+      }
+      std::size_t most = 0;
+      for (const auto& [type, n] : precipitationVotes)
+        if (n > most) {
+          most = n;
+          l.layer.type = type;
+        }
     }
     l.layer.transitionBand_m = std::min(200.0, l.layer.thickness_m / 4);
     for (const auto& st : l.steps) valids.insert(st.valid_unix);
@@ -352,6 +413,13 @@ float Forecast::coverage(const ForecastLayer& layer, double lat_deg, double lon_
 weather::CoverageTile Forecast::tileAt(const ForecastLayer& layer, double lat_deg, double lon_deg,
                                        double valid_unix) const {
   weather::CoverageTile t{0, layer.layer.id, coverage(layer, lat_deg, lon_deg, valid_unix), 1.0f};
+  if (layer.layer.id == kForecastPrecipitationSlot) {
+    const float rate = t.coverage;  // the precipitation layer's grid holds its rate
+    if (std::isnan(rate)) return t;
+    t.coverage = rate >= kMinForecastPrecipitation_mmph ? 1.0f : 0.0f;
+    t.density = static_cast<float>(weather::precipitationDensityForRate(layer.layer.type, rate));
+    return t;
+  }
   if (layer.layer.id == kForecastConvectiveSlot && t.coverage > kCbFrom) {
     t.blendType = weather::CloudType::Cumulonimbus;
     t.blend = std::clamp((t.coverage - kCbFrom) / (kCbFull - kCbFrom), 0.0f, 1.0f);

@@ -12,6 +12,7 @@
 #include "grib_tools.hpp"
 #include "sky/server/forecast.hpp"
 #include "sky/server/grib_isolated.hpp"
+#include "sky/weather/precipitation.hpp"
 
 namespace sky::server {
 namespace {
@@ -259,6 +260,79 @@ TEST(Forecast, AFileWithoutCloudIsRefusedByName) {
   auto fc = Forecast::fromGrib({&wind}, "wind-only.grib2");
   ASSERT_FALSE(fc);
   EXPECT_NE(fc.error().detail.find("wind-only.grib2: no field gives cloud cover"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sky::server
+
+namespace sky::server {
+namespace {
+
+// A GFS surface precipitation rate (prate) with its categorical snow: made
+// from the sample's low-cloud message by grib_set (the samples have no
+// precipitation), its values scaled to kg m-2 s-1 (cover % x 1e-5: up to
+// 3.6 mm/h), next to the sample's cloud layers. The precipitation layer's
+// tiles cover the points with at least 0.1 mm/h at the density of their
+// rate (grib_get_data's value x 3600, through precipitation.hpp's law), it
+// reaches from the ground into the lowest cloud layer, and it is snow where
+// the categorical field says snow at most raining points.
+TEST(Forecast, PrecipitationRateIsALayerOfItsRate) {
+  const auto dir = std::filesystem::temp_directory_path() / ("sky-prate-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto one = dir / "one.grib2", prate = dir / "prate.grib2", csnow = dir / "csnow.grib2";
+  const std::string cmd =
+      std::string(SKY_GRIB_COPY) + " -w count=1 '" + kGfs + "' '" + one.string() + "' && " + SKY_GRIB_SET +
+      " -s discipline=0,parameterCategory=1,parameterNumber=7,typeOfFirstFixedSurface=1,"
+      "typeOfSecondFixedSurface=255,scaleValuesBy=0.00001 '" + one.string() + "' '" + prate.string() + "' && " +
+      SKY_GRIB_SET + " -s discipline=0,parameterCategory=1,parameterNumber=195,typeOfFirstFixedSurface=1,"
+      "typeOfSecondFixedSurface=255,scaleValuesBy=0.02 '" + one.string() + "' '" + csnow.string() + "'";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  const GribFile rate = isolated(prate.string(), GribSelection::Forecast);
+  const GribFile cloud = isolated(kGfs, GribSelection::Forecast);
+  ASSERT_EQ(rate.fields.size(), 1u) << "the decoder keeps prate";
+  auto fc = Forecast::fromGrib({&cloud, &rate}, "gfs+prate");
+  ASSERT_TRUE(fc) << fc.error().detail;
+  const ForecastLayer* p = layerOf(*fc, kForecastPrecipitationSlot);
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(p->layer.type, weather::CloudType::Rain) << "no categorical field: rain";
+  EXPECT_EQ(p->layer.base_m, 0.0);
+  double lowest = 1e9;
+  for (const auto& l : fc->layers())
+    if (l.layer.id != kForecastPrecipitationSlot) lowest = std::min(lowest, l.layer.base_m);
+  EXPECT_EQ(p->layer.thickness_m, lowest + 500.0) << "into the lowest cloud layer";
+  const auto truth = gribGetData(prate.string(), 1);  // kg m-2 s-1, as ecCodes decodes them
+  ASSERT_EQ(truth.size(), 144u * 73u);
+  int raining = 0, dry = 0;
+  for (std::size_t k = 0; k < truth.size(); k += 5) {
+    const double mmph = truth[k].value * 3600;
+    const weather::CoverageTile t = fc->tileAt(*p, truth[k].lat, truth[k].lon, fc->firstValid_unix());
+    if (mmph >= kMinForecastPrecipitation_mmph + 1e-3) {
+      ++raining;
+      EXPECT_EQ(t.coverage, 1.0f);
+      EXPECT_NEAR(t.density, weather::precipitationDensityForRate(weather::CloudType::Rain, mmph), 1e-4) << mmph;
+    } else if (mmph < kMinForecastPrecipitation_mmph - 1e-3) {
+      ++dry;
+      EXPECT_EQ(t.coverage, 0.0f) << mmph;
+    }
+  }
+  EXPECT_GT(raining, 100);
+  EXPECT_GT(dry, 100);
+  // With csnow (the cover's % x 0.02: 1 where the low cloud covers more
+  // than half, which is most raining points), the layer is snow.
+  const GribFile snow = isolated(csnow.string(), GribSelection::Forecast);
+  ASSERT_EQ(snow.fields.size(), 1u) << "the decoder keeps csnow";
+  auto wintry = Forecast::fromGrib({&cloud, &rate, &snow}, "gfs+prate+csnow");
+  ASSERT_TRUE(wintry) << wintry.error().detail;
+  const ForecastLayer* s = layerOf(*wintry, kForecastPrecipitationSlot);
+  ASSERT_NE(s, nullptr);
+  std::size_t snowy = 0, wet = 0;
+  const auto cover = gribGetData(kGfs, 1);  // csnow is this cover (%) x 0.02
+  for (std::size_t k = 0; k < cover.size(); ++k)
+    if (truth[k].value * 3600 >= kMinForecastPrecipitation_mmph) (cover[k].value * 0.02 > 0.5 ? snowy : wet)++;
+  EXPECT_EQ(s->layer.type, snowy > wet ? weather::CloudType::Snow : weather::CloudType::Rain)
+      << snowy << " snowy, " << wet << " wet points";
+  EXPECT_GT(snowy, wet) << "the sample's low cloud is mostly over half where it is over 3 %";
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

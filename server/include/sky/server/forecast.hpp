@@ -24,6 +24,14 @@
 //   the weather model has one per layer, and tiles vary cover, not height.
 // * Type: each slot's (stratocumulus, altocumulus, cirrus, ...); the
 //   convective layer is cumulus blending to cumulonimbus as its cover grows.
+// * Precipitation: the surface precipitation rate (`prate`, discipline 0,
+//   category 1, number 7, kg m-2 s-1 = mm/s) becomes a precipitation layer
+//   (slot 35) from the ground to 500 m above the lowest cloud layer's base,
+//   covering the points with at least kMinForecastPrecipitation_mmph at
+//   their rate's density (precipitation.hpp). Its type is the one NCEP's
+//   categorical fields (crain, cfrzr, cicep, csnow: category 1, numbers
+//   192-195) give most of the raining points (freezing rain and ice pellets
+//   as sleet), rain without them.
 // Missing values stay missing: a point with no value (bitmap, outside the
 // grid) gives no cover there, never 0.
 #pragma once
@@ -44,7 +52,9 @@
 namespace sky::server {
 
 inline constexpr std::uint32_t kForecastBoundarySlot = 30, kForecastLowSlot = 31, kForecastMiddleSlot = 32,
-                               kForecastHighSlot = 33, kForecastConvectiveSlot = 34;
+                               kForecastHighSlot = 33, kForecastConvectiveSlot = 34, kForecastPrecipitationSlot = 35;
+// Below this rate (mm/h) a grid point has no precipitation layer: a trace.
+inline constexpr double kMinForecastPrecipitation_mmph = 0.1;
 
 // The fields a forecast reads (the decoder keeps only these): cloud cover,
 // pressure and height of cloud bases, tops and layer limits, relative
@@ -55,7 +65,8 @@ bool forecastWants(const GribMeta& meta);
 // One layer's cover at one valid time, as a fraction on a grid.
 struct CoverGrid {
   GribGrid grid;
-  std::vector<float> fraction;  // [0, 1] per grid point (valueIndex), NaN: missing
+  std::vector<float> fraction;  // [0, 1] per grid point (valueIndex), NaN: missing; the
+                                // precipitation layer's holds the rate, mm/h, instead
   std::string source;           // "tcc lowCloudLayer, field 1" or "Sundqvist on r at 12 levels, fields 40-51"
 };
 
@@ -99,7 +110,8 @@ class Forecast {
   // space. NaN where no step has a value there.
   float coverage(const ForecastLayer& layer, double lat_deg, double lon_deg, double valid_unix) const;
   // The tile of a layer at a point (coverage, density 1, the convective
-  // layer's cumulonimbus blend); coverage NaN where the forecast has none.
+  // layer's cumulonimbus blend; the precipitation layer's: coverage 1 where
+  // it rains, density its rate's); coverage NaN where the forecast has none.
   weather::CoverageTile tileAt(const ForecastLayer& layer, double lat_deg, double lon_deg, double valid_unix) const;
   // Where a point's cover comes from, for the console: the step(s), the
   // field, and the nearest grid point ("nam.grib2: Sundqvist on r ..., grid
