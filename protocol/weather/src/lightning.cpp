@@ -99,17 +99,15 @@ std::vector<Stroke> strokesOf(const LightningFlash& flash) {
   Draws d(flash.seed ^ 0x5354524f4b45ull);  // "STROKE": apart from the bolt's draws
   const double extra = flash.kind == FlashKind::CloudToGround ? kExtraStrokesGround : kExtraStrokesInCloud;
   const int n = 1 + d.poisson(extra, kMaxStrokes - 1);
+  // The optical energy shared by weight: the first stroke's kFirstStrokeWeight, 1 each after it.
+  const double unit = flash.energy_j * kOpticalEfficiency / (kFirstStrokeWeight + (n - 1));
   std::vector<Stroke> strokes;
-  double t = flash.time_s, weights = 0;
+  double t = flash.time_s;
   for (int k = 0; k < n; ++k) {
     if (k > 0)
       t += std::min(kMaxStrokeGap_s, kMinStrokeGap_s - kMeanStrokeGap_s * std::log(1.0 - d.uniform()));
-    const double w = k == 0 ? kFirstStrokeWeight : 1.0;
-    strokes.push_back({t, w});
-    weights += w;
+    strokes.push_back({t, unit * (k == 0 ? kFirstStrokeWeight : 1.0)});
   }
-  const double optical = flash.energy_j * kOpticalEfficiency;
-  for (Stroke& s : strokes) s.energy_j = optical * s.energy_j / weights;
   return strokes;
 }
 
