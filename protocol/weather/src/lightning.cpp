@@ -40,8 +40,10 @@ constexpr double kInCloudLowest = 0.35, kInCloudHighest = 0.85;
 // Without a cloud to take it from (a flash asked for under a clear sky):
 // a cumulonimbus from 1500 m to 10 km.
 constexpr double kDefaultStormBase_m = 1500, kDefaultStormTop_m = 10000;
-// A bolt leaves its cloud up to this far (m) sideways from its ground point,
-// and bends at every scale by up to this share of the piece it splits.
+// A bolt leaves its cloud up to this share of its drop sideways from its
+// ground point, at most this far (m): channels run mostly down, and bend at
+// every scale by up to kTortuosity of the piece they split.
+constexpr double kMaxBoltLeanShare = 0.4;
 constexpr double kMaxBoltLean_m = 2000;
 constexpr double kTortuosity = 0.18;
 constexpr int kMainChannelDepth = 5;  // 2^5 = 32 segments
@@ -177,7 +179,7 @@ std::vector<BoltSegment> boltSegments(const LightningFlash& flash) {
   if (flash.kind != FlashKind::CloudToGround || !(flash.top_m > flash.bottom_m)) return {};
   Draws d(flash.seed ^ 0x424f4c54ull);  // "BOLT"
   const double height = flash.top_m - flash.bottom_m;
-  const double lean = kMaxBoltLean_m * std::sqrt(d.uniform()), azimuth = 2 * std::numbers::pi * d.uniform();
+  const double lean = std::min(kMaxBoltLean_m, kMaxBoltLeanShare * height) * std::sqrt(d.uniform()), azimuth = 2 * std::numbers::pi * d.uniform();
   constexpr std::size_t kPoints = (std::size_t(1) << kMainChannelDepth) + 1;
   std::vector<std::array<double, 3>> pts(kPoints);
   pts.front() = {lean * std::sin(azimuth), lean * std::cos(azimuth), height};

@@ -78,7 +78,7 @@ struct BoltSegment {
 };
 inline constexpr std::size_t kMaxBoltSegments = 48;
 // The channel of a cloud-to-ground flash from its top (the cloud base,
-// offset horizontally) down to its ground point, tortuous at every scale
+// offset horizontally by up to 0.4 of the drop and 2 km) down to its ground point, tortuous at every scale
 // (midpoint displacement), with a few branches that stop short of the
 // ground; at most kMaxBoltSegments, the main channel's first. Empty for an
 // in-cloud flash. A function of the flash alone.
