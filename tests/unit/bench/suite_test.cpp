@@ -50,7 +50,7 @@ TEST(Suite, ShippedSuiteLoadsEveryScene) {
   for (const char* n : {"cumulus-midday", "sunset-backlit", "overcast-below", "inside-cloud", "above-deck-10km",
                         "cumulonimbus", "cirrus-over-cumulus", "polar", "godrays", "fast-turn", "cumulus-fly-through",
                         "glider-thermal", "airliner-climb", "roll-pitch-in-cloud", "cell-grows", "cell-step", "fog-at-dawn",
-                        "inside-fog", "rain-under-nimbostratus", "thunderstorm-dusk"})
+                        "inside-fog", "rain-under-nimbostratus", "thunderstorm-dusk", "thunderstorm-lightning"})
     EXPECT_TRUE(names.count(n)) << n;
   EXPECT_EQ(paths, 7u);
   auto two = loadSuite(SKY_BENCH_SUITE_FILE, {"polar", "fast-turn"});
@@ -60,6 +60,38 @@ TEST(Suite, ShippedSuiteLoadsEveryScene) {
   auto unknown = loadSuite(SKY_BENCH_SUITE_FILE, {"no-such-scene"});
   ASSERT_FALSE(unknown);
   EXPECT_NE(unknown.error().detail.find("cumulus-midday"), std::string::npos);  // lists the known scenes
+}
+
+// A still's lightning flash: parsed with its defaults, handed to the frame
+// at the frame's clock less before_s; refused on a path, with a bad kind or
+// a field out of range, naming the field.
+TEST(Suite, AStillMayCarryAFlash) {
+  auto scenes = loadSuite(SKY_BENCH_SUITE_FILE, {"thunderstorm-lightning"});
+  ASSERT_TRUE(scenes) << describe(scenes.error());
+  const LoadedScene& ls = (*scenes)[0];
+  ASSERT_TRUE(ls.scene.flash);
+  EXPECT_EQ(ls.scene.flash->kind, weather::FlashKind::CloudToGround);
+  EXPECT_EQ(ls.scene.flash->energy_j, weather::kTypicalFlashEnergy_j) << "the default";
+  const render::FrameInputs in = frameInputs(ls, 0);
+  ASSERT_EQ(in.flashes.size(), 1u);
+  EXPECT_NEAR(in.flashes[0].time_s, in.weatherClock_s - 0.02, 1e-9) << "struck before_s before the frame";
+  const std::string still = "[[scene]]\nname = \"s\"\nweather = \"w.toml\"\nsun = { azimuth_deg = 0.0, elevation_deg = 10.0 }\n"
+                            "camera = { lat_deg = 46.0, lon_deg = 13.0, alt_m = 400.0, yaw_deg = 0.0, pitch_deg = 0.0, roll_deg = 0.0 }\n";
+  const std::pair<std::string, const char*> bad[] = {
+      {"flash = { kind = \"sheet\", lat_deg = 46.0, lon_deg = 13.0, bottom_m = 0.0, top_m = 800.0 }\n", "flash.kind"},
+      {"flash = { kind = \"in-cloud\", lat_deg = 95.0, lon_deg = 13.0, bottom_m = 0.0, top_m = 800.0 }\n", "flash.lat_deg"},
+      {"flash = { kind = \"in-cloud\", lat_deg = 46.0, lon_deg = 13.0, bottom_m = 900.0, top_m = 800.0 }\n", "top_m"},
+      {"flash = { kind = \"in-cloud\", lat_deg = 46.0, lon_deg = 13.0, bottom_m = 0.0, top_m = 800.0, colour = 1 }\n",
+       "flash.colour"},
+  };
+  for (const auto& [line, field] : bad) {
+    auto r = parseSuite(still + line, "s.toml");
+    ASSERT_FALSE(r) << line;
+    EXPECT_NE(describe(r.error()).find(field), std::string::npos) << describe(r.error());
+  }
+  ASSERT_TRUE(parseSuite(still + "flash = { kind = \"in-cloud\", lat_deg = 46.0, lon_deg = 13.0, bottom_m = 3000.0, "
+                                 "top_m = 6000.0, energy_j = 2e9, before_s = 0.1, seed = 7 }\n",
+                         "s.toml"));
 }
 
 TEST(Suite, StillParses) {
@@ -137,7 +169,7 @@ TEST(Suite, AChangeRampsTheDiscsTiles) {
   EXPECT_GT(tiles->disc.size(), 5u);
   EXPECT_LT(tiles->disc.size(), tiles->tiled.tiles.size() / 50);
   // Frames at 0, 0.5, 1, 1.5 and 2 s: the ramp from 0.5 s to 1.5 s.
-  LoadedScene scene{s, {before, 0, 1}, std::move(*tiles), {}};
+  LoadedScene scene{s, {before, 0, 1}, std::move(*tiles), {}, {}};
   scene.changing = scene.change->tiled;
   const float expected[] = {0.5f, 0.5f, 0.7f, 0.9f, 0.9f};
   for (std::uint32_t f = 0; f < 5; ++f) {
