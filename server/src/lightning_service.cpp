@@ -28,7 +28,9 @@ std::vector<weather::StormCell> stormCellsIn(const LiveWeather& weather, double 
                                              std::span<const weather::SphericalCap> caps, double rate) {
   const std::vector<weather::CloudLayer> layers = weather.layersAt(clock_s);
   const std::vector<weather::Region> regions = weather.regionsAt(clock_s);
-  if (!anyCumulonimbus(layers, regions)) return {};
+  // A forecast's convective layer is cumulus whose tiles blend into
+  // cumulonimbus: with a forecast loaded the tiles decide.
+  if (!anyCumulonimbus(layers, regions) && !weather.forecast()) return {};
   std::map<std::uint64_t, weather::StormCell> cells;
   for (const weather::SphericalCap& cap : caps) {
     const weather::WeatherSnapshot snapshot = subscriberSnapshot(weather, clock_s, cap, kLightningTileLevel);
