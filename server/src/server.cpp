@@ -206,7 +206,7 @@ void Server::onAccept(const boost::system::error_code& ec, tcp::socket socket) {
              registry_.size() + 1);
   registry_.add(session);
   const stream::Hello hello{stream::kProtocolVersion, options_.serverId, clockNow(), weather_.clock().rate(),
-                            stream::kFeatureCameraReports | stream::kFeatureAreas};
+                            stream::kFeatureCameraReports | stream::kFeatureAreas | stream::kFeatureHostClock};
   session->start(stream::encodeFrame(stream::encodeMessage(hello)));
   renderersChanged();
   accept();
@@ -343,6 +343,10 @@ std::string Server::streamMetrics() const {
        streamCounters_.flashesTriggered.load());
   line("skyshell_lightning_capped_total", "flashes past the per-tick cap, not sent",
        streamCounters_.flashesCapped.load());
+  line("skyshell_host_clock_proposals_total", "CIGI host clock estimates proposed by renderers",
+       streamCounters_.hostClockProposals.load());
+  line("skyshell_host_clock_changes_total", "times a host's clock offset was set anew (first channel, or a jump)",
+       streamCounters_.hostClockChanges.load());
   line("skyshell_stream_events_dropped_total", "event frames dropped for subscribers not reading",
        streamCounters_.eventsDropped.load());
   return m;
@@ -360,6 +364,22 @@ void Server::sessionClosed(Session& session) {
 }
 
 void Server::rendererChanged(Session&) { renderersChanged(); }
+
+void Server::hostClockProposed(Session& session, const stream::HostClock& proposal) {
+  streamCounters_.hostClockProposals.fetch_add(1, std::memory_order_relaxed);
+  const HostClockAnswer answer = hostClocks_.propose(proposal);
+  const Frame frame = stream::encodeFrame(stream::encodeMessage(answer.held));
+  if (!answer.changed) {
+    session.sendEvent(frame);
+    return;
+  }
+  streamCounters_.hostClockChanges.fetch_add(1, std::memory_order_relaxed);
+  log_->info("event=host_clock host={:?} offset_s={:.6f} rate={} from_session={}", answer.held.host,
+             answer.held.offset_s, answer.held.rate, session.id());
+  registry_.forEach([&](Session& s) {
+    if (s.hostClockHost() == answer.held.host) s.sendEvent(frame);
+  });
+}
 
 void Server::protocolRejected(Session& session, const Error& error) {
   rejections_.count(RejectReason::StreamMalformed);

@@ -177,6 +177,9 @@ void Session::handleMessage(const stream::Message& message) {
     report_ = *report;
     reportAt_ = std::chrono::steady_clock::now();
     handler_.rendererChanged(*this);
+  } else if (const auto* proposal = std::get_if<stream::HostClock>(&message)) {
+    hostClockHost_ = proposal->host;
+    handler_.hostClockProposed(*this, *proposal);
   } else if (const auto* unknown = std::get_if<stream::UnknownKind>(&message)) {
     // A newer client of our major version: what we do not know, we ignore.
     if (!unknownKindLogged_)

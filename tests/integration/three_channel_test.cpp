@@ -44,27 +44,32 @@ constexpr double kChannelWidth_deg = 60;
 constexpr int kWidth = 120, kHeight = 68;
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
 
-// The bound on the colour step across a seam: the mean over the seam's rows
-// of |displayed left - displayed right| (x / (1 + x) per channel, averaged
-// over rgb), against the same step between neighbouring columns next to the
-// seam inside each image (the left image's last two, the right image's
-// first two: the scene's own gradient there). The pixels either side of a
-// seam are one pixel apart in angle (checked from the metadata), so a
-// seamless display steps across it as it does between any two neighbours.
-// Measured on this still scene (lavapipe, 120x68, `high`; the clouds drift
-// with the weather clock the run starts at, so runs differ): the worst seam
-// over all host frames stepped 1.30 x its neighbours in one run and 0.97 x
-// in another at noon, 1.18 x and 0.91 x at dawn (last host frame of the
-// first run: noon 0.0083 and 0.0108 across the two seams against 0.0069 and
-// 0.0128 beside them).
-// Against the same frames, a right channel misplaced by 1 pixel steps 1.75
-// and 1.32 x, by 3 pixels 2.3 and 2.0 x, and one drawing the left channel's
-// view (View Control ignored) 5.1 and 16.8 x. Bound: 1.5 x the neighbours'
-// step + 0.002 (the march's per-pixel noise): it catches a channel 3 pixels
-// off and a lost View Control; the ray geometry (from the metadata) pins the
-// placement to far under a pixel.
-constexpr double kSeamStepFactor = 1.5;
+// The colour check across a seam, row by row: the step across it,
+// |displayed left - displayed right| (x / (1 + x) per channel, averaged over
+// rgb), against the steps between the neighbouring columns beside it inside
+// each image (the left image's last two, the right image's first two: the
+// scene's own gradient there). The pixels either side of a seam are one
+// pixel apart in angle (checked from the metadata), so a seamless display
+// steps across it as it does between neighbours. A row "breaks" where the
+// step across is more than 2 x the neighbours' (mean of the two) + 0.002
+// (the march's per-pixel noise); the bound is on the fraction of rows that
+// break, worst over seams and host frames.
+// Why rows and not the mean over them: the clouds drift with the weather
+// clock the run starts at, and a cloud edge crossing a seam in a few rows
+// raised the mean step across one seam to 1.85-2.06 x its neighbours' in
+// correct noon runs (under load, with a later start), while a channel 3
+// pixels off stepped 2.0 x in another: the means overlap, the rows do not.
+// Measured (lavapipe, 120x68, `high`, ASan; the misplaced channels made
+// from the frames of two runs by taking the right image from column k
+// instead of 0): correct channels break in 1-16 % of rows (four runs under
+// load: noon at most 12 %, dawn 16 %); a right channel 1 pixel off in 10-26 %, 3 pixels off in
+// 18-57 % (worst over a run's frames 29 % and more), one drawing the left
+// channel's view (View Control ignored) in 68-100 %. Bound: 25 %: it catches
+// a channel 3 pixels off and a lost View Control; the ray geometry (from
+// the metadata) pins the placement to far under a pixel.
+constexpr double kSeamStepFactor = 2.0;
 constexpr double kSeamStepSlack = 0.002;
+constexpr double kMaxBrokenRows = 0.25;
 
 // The displayed value's step between two pixels, mean over rgb.
 double step(const float* a, const float* b) {
@@ -206,7 +211,7 @@ void checkDisplay(const std::string& name, double sunAzimuth_deg, double sunElev
   // The angular width of one pixel at the image centre, where pixels are
   // widest in angle (tangent spacing): the bound for rays "a pixel apart".
   const double pixel_deg = std::atan(2 * std::tan(kChannelWidth_deg / 2 / kRadToDeg) / kWidth) * kRadToDeg;
-  double worstEdge_deg = 0, worstCentres_deg = 0, worstRatio = 0, worstExcess = -1;
+  double worstEdge_deg = 0, worstCentres_deg = 0, worstRatio = 0, worstBroken = 0;
   std::size_t checked = 0;
   std::size_t startUp = 0;
   double arrivalSpread_s = 0, lockedOff_s = 0;  // the host clock lock's inputs and result
@@ -222,11 +227,12 @@ void checkDisplay(const std::string& name, double sunAzimuth_deg, double sunElev
       EXPECT_TRUE(trio[i]["view"]["frustum_from_host"].get<bool>());
       EXPECT_NEAR(trio[i]["view"]["rotation_deg"]["yaw"].get<double>(), (i - 1) * kChannelWidth_deg, 1e-4);
       EXPECT_NEAR(trio[i]["fov_deg"]["horizontal"].get<double>(), kChannelWidth_deg, 1e-4);
-      // One shared picture: the same clock (host_locked_clock.hpp) and seeds.
-      EXPECT_EQ(trio[i]["weather_clock_s"], trio[0]["weather_clock_s"]);
       EXPECT_EQ(trio[i]["noise_seeds"], trio[0]["noise_seeds"]);
       EXPECT_EQ(trio[i]["host_time_s"], trio[0]["host_time_s"]);
       settled = settled && trio[i]["weather_areas"].size() == 2;
+      // Until the server's offset for the host has come, a channel draws
+      // with its own estimate, which may snap a grid step from the others'.
+      settled = settled && trio[i]["weather_clock_lock"] == "server";
       // The server's clock at each channel's arrival of the frame: their
       // spread is what the lock's grid must absorb (host_locked_clock.hpp).
       const double server_s = trio[i]["weather_clock_server_s"].get<double>();
@@ -237,14 +243,20 @@ void checkDisplay(const std::string& name, double sunAzimuth_deg, double sunElev
     }
     // A channel subscribes at its first pose and draws once the detailed
     // area has come; the coarse area comes a moment later, so a channel may
-    // draw its first frame a version behind the others. Frames from when
-    // every channel holds both areas on must agree on the version and are
-    // the ones compared below.
+    // draw its first frame a version behind the others; and it proposes its
+    // clock offset at its first host frame and has the server's a round
+    // trip later. Frames from when every channel holds both areas and the
+    // server's offset on must agree on the version and clock and are the
+    // ones compared below.
     if (!settled) {
       ++startUp;
       continue;
     }
-    for (int i = 0; i < kChannels; ++i) EXPECT_EQ(trio[i]["weather_version"], trio[0]["weather_version"]);
+    for (int i = 0; i < kChannels; ++i) {
+      // One shared picture: the same clock (host_locked_clock.hpp), bit for bit.
+      EXPECT_EQ(trio[i]["weather_clock_s"], trio[0]["weather_clock_s"]);
+      EXPECT_EQ(trio[i]["weather_version"], trio[0]["weather_version"]);
+    }
     for (int i = 0; i + 1 < kChannels; ++i) {
       const auto &left = trio[i], &right = trio[i + 1];
       // Geometry from the metadata: the left channel's right edge is the
@@ -258,14 +270,18 @@ void checkDisplay(const std::string& name, double sunAzimuth_deg, double sunElev
       // Colours either side of the seam.
       const Pfm a = readPfm(run.pfm(i, left)), b = readPfm(run.pfm(i + 1, right));
       double seam = 0, near = 0;
+      int broken = 0;
       for (int y = 0; y < kHeight; ++y) {
-        seam += step(a.at(kWidth - 1, y), b.at(0, y));
-        near += 0.5 * (step(a.at(kWidth - 2, y), a.at(kWidth - 1, y)) + step(b.at(0, y), b.at(1, y)));
+        const double across = step(a.at(kWidth - 1, y), b.at(0, y));
+        const double beside = 0.5 * (step(a.at(kWidth - 2, y), a.at(kWidth - 1, y)) + step(b.at(0, y), b.at(1, y)));
+        if (across > kSeamStepFactor * beside + kSeamStepSlack) ++broken;
+        seam += across;
+        near += beside;
       }
       seam /= kHeight;
       near /= kHeight;
       worstRatio = std::max(worstRatio, seam / std::max(near, 1e-9));
-      worstExcess = std::max(worstExcess, seam - (kSeamStepFactor * near + kSeamStepSlack));
+      worstBroken = std::max(worstBroken, double(broken) / kHeight);
       if (host == run.frames.rbegin()->first)
         std::printf("[ seams    ] %s seam %d|%d: colour step across %.4f, between neighbours beside it %.4f\n",
                     name.c_str(), i, i + 1, seam, near);
@@ -282,14 +298,15 @@ void checkDisplay(const std::string& name, double sunAzimuth_deg, double sunElev
   // clock the wall's).
   EXPECT_LE(lockedOff_s, 0.5 * 1.0 + 0.05 + lagSwing_s);
   std::printf("[ seams    ] %s: %zu host frames (and %zu of start-up); edge rays %.2e deg apart, centre rays at most %.4f deg apart "
-              "(a centre pixel: %.4f deg); colour step across a seam at most %.2f x its neighbours'\n",
-              name.c_str(), checked, startUp, worstEdge_deg, worstCentres_deg, pixel_deg, worstRatio);
+              "(a centre pixel: %.4f deg); colour step across a seam at most %.2f x its neighbours' (mean over rows), "
+              "rows breaking at a seam at most %.0f %%\n",
+              name.c_str(), checked, startUp, worstEdge_deg, worstCentres_deg, pixel_deg, worstRatio, 100 * worstBroken);
   // Half-angles travel as CIGI floats and the pose through double geodesy:
   // the edges agree to float's 1e-7 relative (6e-6 deg); 1e-4 deg is 0.0002 px.
   EXPECT_LT(worstEdge_deg, 1e-4);
   EXPECT_LT(worstCentres_deg, pixel_deg);
-  EXPECT_LT(worstExcess, 0.0) << "a seam steps more than " << kSeamStepFactor << " x its neighbours + "
-                               << kSeamStepSlack;
+  EXPECT_LE(worstBroken, kMaxBrokenRows) << "rows where a seam steps more than " << kSeamStepFactor
+                                         << " x its neighbours + " << kSeamStepSlack;
   writeContactSheet(run, run.frames.rbegin()->second, (run.dir / (name + "-contact-sheet.png")).string());
 }
 

@@ -382,6 +382,24 @@ Result<Message> decodeCameraReport(const fbs::CameraReport& r) {
   return Message(std::move(out));
 }
 
+Result<Message> decodeHostClock(const fbs::HostClock& h) {
+  HostClock out;
+  const std::size_t bytes = h.host() ? h.host()->size() : 0;
+  if (bytes == 0 || bytes > kMaxChannelBytes)
+    return fail(ErrorCode::InvalidArgument, "HostClock.host: " + std::to_string(bytes) + " bytes, 1 to " +
+                                                std::to_string(kMaxChannelBytes));
+  out.host = h.host()->str();
+  if (!printableUtf8(out.host))
+    return fail(ErrorCode::InvalidArgument, "HostClock.host: not UTF-8 text without control characters");
+  out.offset_s = h.offset_s();
+  out.rate = h.rate();
+  for (auto c : {checkRange("HostClock", "offset_s", out.offset_s, -1.0e12, 1.0e12),
+                 checkRange("HostClock", "rate", out.rate, 0, 3600)})
+    if (!c) return tl::unexpected(c.error());
+  if (!(out.rate > 0)) return fail(ErrorCode::InvalidArgument, "HostClock.rate: 0, must be above 0");
+  return Message(std::move(out));
+}
+
 Result<Message> decodeLightning(const fbs::Lightning& l) {
   Lightning out;
   out.weatherClock_s = l.weather_clock_s();
@@ -523,6 +541,10 @@ std::vector<std::uint8_t> encodeMessage(const Message& message) {
             return std::pair{fbs::Body::Lightning,
                              fbs::CreateLightningDirect(b, l.weatherClock_s, &flashes).Union()};
           },
+          [&](const HostClock& h) {
+            return std::pair{fbs::Body::HostClock,
+                             fbs::CreateHostClockDirect(b, h.host.c_str(), h.offset_s, h.rate).Union()};
+          },
           [&](const UnknownKind& u) {
             // An empty table under a type byte we do not define: what a newer
             // peer's message looks like to this build.
@@ -571,6 +593,7 @@ Result<Message> decodeMessage(std::span<const std::uint8_t> payload) {
     case fbs::Body::Delta: return decodeDelta(*m->body_as_Delta());
     case fbs::Body::CameraReport: return decodeCameraReport(*m->body_as_CameraReport());
     case fbs::Body::Lightning: return decodeLightning(*m->body_as_Lightning());
+    case fbs::Body::HostClock: return decodeHostClock(*m->body_as_HostClock());
     case fbs::Body::NONE: return fail(ErrorCode::Malformed, "message has no body");
   }
   // A kind appended to the schema after this build: the verifier could not
@@ -587,6 +610,7 @@ const char* kindName(const Message& message) {
                                [](const weather::WeatherDelta&) { return "Delta"; },
                                [](const CameraReport&) { return "CameraReport"; },
                                [](const Lightning&) { return "Lightning"; },
+                               [](const HostClock&) { return "HostClock"; },
                                [](const UnknownKind&) { return "an unknown kind"; }},
                     message);
 }

@@ -72,6 +72,7 @@ tl::expected<DrawnFrame, FrameFailure> ChannelFrames::draw(const FrameRequest& r
   record.atmosphere = r.atmosphere;
   record.weatherClock_s = r.weatherClock_s;
   record.serverClockAtArrival_s = r.serverClockAtArrival_s;
+  record.weatherClockLock = r.weatherClockLock;
   record.weatherVersion = view.version;
   record.weatherConnected = r.weatherConnected;
   record.weatherSource = r.weatherSource;

@@ -151,6 +151,9 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
   }
   ++accepted_;
   const auto now = std::chrono::steady_clock::now();
+  // The channels one host drives share its clock (host_locked_clock.hpp) by
+  // the address they all see it at.
+  const std::string hostKey = from.address().to_string();
   clock_.advanceTo(timeline_.advance(ig->timestampValid, ig->timestamp_10us, now));
   // Reset/Standby forgets the pose once, on entry; no pose is taken while in it.
   const bool standby = ig->mode == cigi::IgMode::ResetStandby;
@@ -198,6 +201,7 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
     p.hostFrame = ig->hostFrame;
     p.hostTime_s = ig->timestampValid ? ig->timestamp_10us * 1.0e-5 : 0.0;
     p.hostTimeValid = ig->timestampValid;
+    p.host = hostKey;
     p.receivedAt = now;
     p.utc_s = clock_.utc_s();
     p.timeSource = clock_.source();

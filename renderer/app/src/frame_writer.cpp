@@ -164,7 +164,10 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
                         {"sea_level_temperature_c", a.seaLevelTemperature_c},
                         {"sea_level_pressure_hpa", a.seaLevelPressure_hpa},
                         {"haze_visibility_m", r.visibility_m ? nlohmann::json(*r.visibility_m) : nlohmann::json()}};
-  if (r.serverClockAtArrival_s) line["weather_clock_server_s"] = *r.serverClockAtArrival_s;
+  if (r.serverClockAtArrival_s) {
+    line["weather_clock_server_s"] = *r.serverClockAtArrival_s;
+    line["weather_clock_lock"] = toString(r.weatherClockLock);
+  }
   if (r.view) line.update(viewJson(*r.view));
   nlohmann::json gpu = nlohmann::json::object();
   for (const auto& t : r.gpu) gpu[t.pass] = gpu.value(t.pass, 0.0) + t.gpu_ms;

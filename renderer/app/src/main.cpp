@@ -550,8 +550,11 @@ int main(int argc, char** argv) {
     if (smoothed) {
       request.weatherClock_s = view.clockNow(now);
     } else {
-      request.weatherClock_s = hostClock.at(pose->hostTimeValid ? std::optional(pose->hostTime_s) : std::nullopt,
-                                            view.clock, pose->receivedAt);
+      const auto locked = hostClock.at(pose->hostTimeValid ? std::optional(pose->hostTime_s) : std::nullopt,
+                                       pose->host, view.clock, pose->receivedAt, state.hostClock());
+      if (locked.proposal) weather.proposeHostClock(*locked.proposal);
+      request.weatherClock_s = locked.weatherClock_s;
+      request.weatherClockLock = locked.source;
       request.patternIndex = pose->hostFrame;
       request.serverClockAtArrival_s = view.clock.at(pose->receivedAt);
     }

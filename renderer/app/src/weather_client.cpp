@@ -104,6 +104,7 @@ void WeatherClient::connect() {
 void WeatherClient::scheduleReconnect() {
   serverTakesReports_ = false;
   serverTakesAreas_ = false;
+  serverTakesHostClock_ = false;
   if (stopped_) return;
   state_.setConnected(false);
   boost::system::error_code ec;
@@ -155,6 +156,10 @@ void WeatherClient::onFrame(std::span<const std::uint8_t> payload) {
                    reportNow_ = reports;
                    const bool areas = (h.features & stream::kFeatureAreas) != 0;
                    serverTakesAreas_ = areas;
+                   // A server that restarted holds no host's clock: every
+                   // channel proposes again, and the first one wins for all.
+                   state_.setHostClock(std::nullopt);
+                   serverTakesHostClock_ = (h.features & stream::kFeatureHostClock) != 0;
                    spdlog::info("weather server '{}' protocol {} clock {:.1f} s x{}{}{}",
                                 flight::messageText(h.serverId, kMaxEchoedServerText),
                                 h.protocolVersion, h.weatherClock_s, h.clockRate,
@@ -193,6 +198,7 @@ void WeatherClient::onFrame(std::span<const std::uint8_t> payload) {
                    spdlog::warn("weather stream: a server must not send CameraReport; dropped");
                  },
                  [&](const stream::Lightning& l) { state_.addFlashes(l.flashes, l.weatherClock_s); },
+                 [&](const stream::HostClock& c) { state_.setHostClock(c); },
                  [&](const stream::UnknownKind&) {
                    // A newer server of our major version: ignore what we do not know.
                  }},
@@ -225,6 +231,13 @@ void WeatherClient::reportCamera(const geo::GeodeticPose& pose, std::uint64_t fr
   });
 }
 
+void WeatherClient::proposeHostClock(const stream::HostClock& proposal) {
+  if (!serverTakesHostClock_) return;
+  asio::post(io_, [this, proposal] {
+    if (socket_.is_open() && serverTakesHostClock_) send(proposal);
+  });
+}
+
 bool WeatherClient::reportWorthSending(const stream::CameraReport& r, Clock::time_point now) {
   std::lock_guard lock(reportMutex_);
   const bool forced = reportNow_.exchange(false);
@@ -251,6 +264,8 @@ void WeatherClient::send(const stream::Message& message) {
     // Coalesce: only the newest request of each area and the newest report matter.
     if (const auto* sub = std::get_if<stream::Subscribe>(&message))
       pendingSubscribe_[sub->areaIndex] = std::move(bytes);
+    else if (std::holds_alternative<stream::HostClock>(message))
+      pendingHostClock_ = std::move(bytes);
     else
       pendingReport_ = std::move(bytes);
     return;
@@ -264,7 +279,7 @@ void WeatherClient::flushWrite() {
     inFlight_.clear();
     if (ec) return;  // the read side notices and reconnects
     static_assert(stream::kMaxAreas == 2, "one pending Subscribe per area");
-    for (auto* pending : {&pendingSubscribe_[0], &pendingSubscribe_[1], &pendingReport_}) {
+    for (auto* pending : {&pendingSubscribe_[0], &pendingSubscribe_[1], &pendingHostClock_, &pendingReport_}) {
       if (!*pending) continue;
       inFlight_ = std::move(**pending);
       pending->reset();

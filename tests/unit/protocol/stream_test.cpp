@@ -329,6 +329,43 @@ TEST(CameraReports, TheChannelIsBoundedPrintableUtf8) {
   }
 }
 
+// The host clock offset travels as doubles, exactly (channels compare it
+// bit for bit); the host is a bounded, non-empty printable name, the offset
+// finite and bounded, the rate in (0, 3600].
+TEST(HostClocks, RoundTripExactAndEveryFieldIsChecked) {
+  const HostClock sent{"192.168.10.4", 4983.000123456789, 2.5};
+  auto m = decodeMessage(encodeMessage(sent));
+  ASSERT_TRUE(m) << m.error().detail;
+  const auto& got = std::get<HostClock>(*m);
+  EXPECT_EQ(got.host, sent.host);
+  EXPECT_EQ(got.offset_s, sent.offset_s);
+  EXPECT_EQ(got.rate, sent.rate);
+  EXPECT_STREQ(kindName(*m), "HostClock");
+  struct Case {
+    const char* field;
+    HostClock clock;
+  };
+  const Case cases[] = {
+      {"host", {"", 0, 1}},
+      {"host", {std::string(kMaxChannelBytes + 1, 'h'), 0, 1}},
+      {"host", {"tab\there", 0, 1}},
+      {"host", {"cut \xc3", 0, 1}},
+      {"offset_s", {"h", std::nan(""), 1}},
+      {"offset_s", {"h", INFINITY, 1}},
+      {"offset_s", {"h", 1.5e12, 1}},
+      {"rate", {"h", 0, 0}},
+      {"rate", {"h", 0, -1}},
+      {"rate", {"h", 0, 3600.5}},
+      {"rate", {"h", 0, std::nan("")}},
+  };
+  for (const Case& c : cases) {
+    auto bad = decodeMessage(encodeMessage(c.clock));
+    ASSERT_FALSE(bad) << c.field;
+    EXPECT_NE(bad.error().detail.find(std::string("HostClock.") + c.field), std::string::npos) << bad.error().detail;
+  }
+  EXPECT_TRUE(decodeMessage(encodeMessage(HostClock{std::string(kMaxChannelBytes, 'h'), -1.0e12, 3600})));
+}
+
 // Kinds appended to the schema after a build reach it as UnknownKind, which
 // the receiver ignores; only a missing body is malformed.
 TEST(Messages, AKindThisBuildDoesNotKnowDecodesAsUnknown) {

@@ -23,6 +23,7 @@
 #include "sky/server/session.hpp"
 #include "sky/server/session_registry.hpp"
 #include "sky/server/snapshot_builder.hpp"
+#include "sky/server/host_clocks.hpp"
 #include "sky/server/lightning_service.hpp"
 #include "sky/server/live_weather.hpp"
 #include "sky/server/rejections.hpp"
@@ -92,6 +93,8 @@ class Server final : private SessionHandler {
     // Lightning flashes drawn by the process, asked for, left out by the
     // per-tick cap, and event frames dropped for subscribers not reading.
     std::atomic<std::uint64_t> flashesDrawn{0}, flashesTriggered{0}, flashesCapped{0}, eventsDropped{0};
+    // Host clock proposals taken, and how many set a host's offset anew.
+    std::atomic<std::uint64_t> hostClockProposals{0}, hostClockChanges{0};
   };
   const StreamCounters& streamCounters() const { return streamCounters_; }
   // Prometheus text of the stream counters.
@@ -136,6 +139,7 @@ class Server final : private SessionHandler {
   void frameSent(std::size_t bytes) override;
   void sessionStalled(Session& session) override;
   void rendererChanged(Session& session) override;
+  void hostClockProposed(Session& session, const stream::HostClock& proposal) override;
   void protocolRejected(Session& session, const Error& error) override;
   void sessionFailed(Session& session, const std::string& what) override;
   void renderersChanged();
@@ -165,6 +169,7 @@ class Server final : private SessionHandler {
   std::vector<std::function<void()>> onRenderersChanged_;
   TileCache tileCache_;
   LightningService lightning_;
+  HostClocks hostClocks_;
   std::uint16_t port_ = 0;
   std::uint64_t nextSessionId_ = 1;
   bool stopped_ = false;

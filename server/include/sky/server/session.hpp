@@ -45,6 +45,8 @@ class SessionHandler {
   virtual void sessionStalled(Session& session) = 0;
   // The session's area or camera report changed.
   virtual void rendererChanged(Session& session) = 0;
+  // The peer proposed its estimate of a CIGI host's clock (host_clocks.hpp).
+  virtual void hostClockProposed(Session& session, const stream::HostClock& proposal) = 0;
   // The peer sent something the stream refuses (a bad frame or message, or a
   // kind clients must not send); the session is closing.
   virtual void protocolRejected(Session& session, const Error& error) = 0;
@@ -80,6 +82,8 @@ class Session : public std::enable_shared_from_this<Session> {
   std::uint64_t droppedEvents() const { return outbox_.droppedEvents(); }
   // The areas the peer subscribed to (none before its first Subscribe).
   std::vector<weather::SphericalCap> areas() const;
+  // The host whose clock the peer last proposed for (none before one).
+  const std::optional<std::string>& hostClockHost() const { return hostClockHost_; }
   // Closes the socket now, cancelling pending I/O. Idempotent.
   void close();
 
@@ -138,6 +142,7 @@ class Session : public std::enable_shared_from_this<Session> {
   std::optional<stream::CameraReport> report_;
   std::chrono::steady_clock::time_point reportAt_{};
   bool unknownKindLogged_ = false;
+  std::optional<std::string> hostClockHost_;
   std::array<std::uint8_t, 64 * 1024> readBuffer_{};
   Outbox outbox_;
   Frame writing_;  // the frame async_write is sending; untouched until it completes

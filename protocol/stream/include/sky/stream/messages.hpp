@@ -41,6 +41,7 @@ static_assert(kMaxMessageTiles == weather::kMaxSnapshotTiles, "a snapshot holds 
 // its major version. A server from before the field sends 0.
 inline constexpr std::uint32_t kFeatureCameraReports = 1u << 0;  // takes CameraReport
 inline constexpr std::uint32_t kFeatureAreas = 1u << 1;          // takes Subscribe.areaIndex > 0
+inline constexpr std::uint32_t kFeatureHostClock = 1u << 2;      // takes HostClock proposals
 
 // Areas of interest one connection may hold (Subscribe::areaIndex): a
 // renderer asks for its detailed area around the camera (0) and a wider one
@@ -99,6 +100,16 @@ struct Lightning {
   std::vector<weather::LightningFlash> flashes;
 };
 
+// Both ways: the weather clock of one CIGI host's frames, as weather clock =
+// offset_s + rate x host time (sky/weather/host_clock_lock.hpp). A renderer
+// proposes its estimate; the server answers with the offset it holds for the
+// host, the same for every channel of it.
+struct HostClock {
+  std::string host;     // UTF-8, no control characters, 1..kMaxChannelBytes bytes
+  double offset_s = 0;  // finite, |offset_s| <= 1e12
+  double rate = 1;      // (0, 3600]
+};
+
 // A message of a kind this build does not know (a newer peer of the same
 // major version sent it): decoded so the receiver can ignore it. Encoding one
 // writes an empty table of that kind (for tests of that rule).
@@ -107,7 +118,7 @@ struct UnknownKind {
 };
 
 using Message = std::variant<Hello, Subscribe, weather::WeatherSnapshot, Heartbeat, StreamError,
-                             weather::WeatherDelta, CameraReport, Lightning, UnknownKind>;
+                             weather::WeatherDelta, CameraReport, Lightning, HostClock, UnknownKind>;
 
 std::vector<std::uint8_t> encodeMessage(const Message& message);
 

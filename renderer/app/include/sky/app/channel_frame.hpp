@@ -30,6 +30,7 @@ struct FrameRequest {
   bool weatherConnected = false;
   double weatherClock_s = 0;
   std::optional<double> serverClockAtArrival_s;    // CIGI frames (host_locked_clock.hpp)
+  HostClockSource weatherClockLock = HostClockSource::None;
   std::optional<std::uint64_t> patternIndex;       // CIGI frames: the host frame
   double sunAzimuth_deg = 135, sunElevation_deg = 40;
   std::optional<double> utc_s;

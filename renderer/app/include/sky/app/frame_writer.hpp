@@ -14,6 +14,7 @@
 
 #include "sky/app/host_atmosphere.hpp"
 #include "sky/app/host_clock.hpp"
+#include "sky/app/host_locked_clock.hpp"
 #include "sky/app/shared_state.hpp"
 #include "sky/core/result.hpp"
 #include "sky/render/cloud_renderer.hpp"
@@ -46,6 +47,9 @@ struct FrameRecord {
   // host frame arrived; weatherClock_s is locked to the host's time instead
   // (host_locked_clock.hpp), and the two differ by at most half its grid.
   std::optional<double> serverClockAtArrival_s;
+  // Where weatherClock_s came from: the server's offset for the host (the
+  // same on every channel), this channel's own estimate, or no host time.
+  HostClockSource weatherClockLock = HostClockSource::None;
   std::uint64_t weatherVersion = 0;  // this channel's count of weather updates applied (snapshots, deltas)
   bool weatherConnected = false;     // the stream to the server was up when the frame was drawn
   // What the weather drawn came from: "server", "file" (--weather-file) or

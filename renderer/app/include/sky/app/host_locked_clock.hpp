@@ -1,49 +1,61 @@
-// The weather clock of a frame drawn for a CIGI host frame. Channels of one
-// display draw the same host frame at different wall times (each when its
-// GPU is free), so the server's clock read at render time (WeatherClock::at)
-// differs between them and the clouds would not line up across a seam. The
-// host's IG Control timestamp is the time all channels share: a frame's
-// weather clock is rate x host time + an offset, the offset between the
-// server's clock and the host's estimated at the frame's arrival and snapped
-// to a grid, so channels whose estimates differ by their arrival spread
-// (milliseconds) hold the same offset, bit for bit.
+// The weather clock of a frame drawn for a CIGI host frame: offset + rate x
+// host time (IG Control timestamp), with the offset every channel of the
+// host agrees on (sky/weather/host_clock_lock.hpp says why and how). This
+// channel estimates the offset from each frame's arrival; it draws with the
+// offset the server holds for the host when the server has sent one that
+// stands against the estimate, and otherwise with its own snapped estimate,
+// which it proposes to the server.
 #pragma once
 
 #include <chrono>
 #include <optional>
+#include <string>
 
+#include "sky/stream/messages.hpp"
 #include "sky/weather/clock.hpp"
 
 namespace sky::app {
 
-// The grid the offset snaps to, in wall seconds of the server's clock (times
-// its rate in weather seconds). 1 s: channels' estimates differ by their
-// arrival spread, measured 1.5-1.7 ms on loopback with three channels
-// (tests/integration/three_channel_test.cpp prints it), so they snap to
-// different points only when one lies within that spread of a grid line
-// (about 0.2 % of starts); the price is a frame's clock up to 0.5 s from the
-// server's, 5 m of cloud drift at 10 m/s wind, far below a cloud's size.
-inline constexpr double kHostClockGrid_s = 1.0;
-// The offset is estimated anew each frame and kept until the estimate moves
-// more than this many grid steps from it: the server's clock was set, or the
-// host's timestamp jumped (a replay looped); all channels see the same jump.
-inline constexpr double kHostClockRelatchSteps = 2.0;
+// Where a frame's weather clock came from (the frame metadata's
+// "weather_clock_lock").
+enum class HostClockSource {
+  None,    // no host time (or a stopped clock): the server's clock at arrival
+  Local,   // this channel's own snapped estimate
+  Server,  // the offset the server holds for the host: the same on every channel
+};
+const char* toString(HostClockSource source);
+
+struct HostClockReading {
+  double weatherClock_s = 0;
+  HostClockSource source = HostClockSource::None;
+  // This channel's estimate, to send to the server (when it takes them): set
+  // while the channel draws with its own, at most every kProposalInterval.
+  std::optional<stream::HostClock> proposal;
+};
 
 class HostLockedClock {
  public:
-  // The weather clock, s, of a frame stamped hostTime_s by the host (IG
-  // Control timestamp; nullopt when the host marks it invalid) that arrived
-  // at `receivedAt`, with the server's clock as this channel holds it.
-  // Without a host time, the server's clock at the arrival.
-  double at(std::optional<double> hostTime_s, const weather::WeatherClock& server,
-            std::chrono::steady_clock::time_point receivedAt);
+  // A proposal is repeated this often until the server's offset comes (a
+  // lost or refused one is not waited for forever).
+  static constexpr std::chrono::milliseconds kProposalInterval{500};
 
-  // The offset held (weather s), once one is.
-  std::optional<double> offset_s() const { return offset_s_; }
+  // The weather clock of a frame stamped hostTime_s by host `host` (nullopt
+  // when the host marks the time invalid) that arrived at `receivedAt`, with
+  // the server's clock as this channel holds it and the offset the server
+  // last sent (none before one comes, or from a server without
+  // kFeatureHostClock).
+  HostClockReading at(std::optional<double> hostTime_s, const std::string& host, const weather::WeatherClock& server,
+                      std::chrono::steady_clock::time_point receivedAt,
+                      const std::optional<stream::HostClock>& fromServer);
+
+  // The offset this channel's own estimate holds (weather s), once one is.
+  std::optional<double> localOffset_s() const { return offset_s_; }
 
  private:
   std::optional<double> offset_s_;
   double rate_ = 1;
+  std::optional<std::chrono::steady_clock::time_point> lastProposalAt_;
+  std::optional<double> lastProposal_s_;
 };
 
 }  // namespace sky::app

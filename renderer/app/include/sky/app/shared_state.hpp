@@ -16,6 +16,7 @@
 #include "sky/app/host_clock.hpp"
 #include "sky/app/view_state.hpp"
 #include "sky/geo/geodetic.hpp"
+#include "sky/stream/messages.hpp"
 #include "sky/weather/clock.hpp"
 #include "sky/weather/lightning.hpp"
 #include "sky/weather/model.hpp"
@@ -27,6 +28,7 @@ struct HostPose {
   std::uint32_t hostFrame = 0;
   double hostTime_s = 0;  // CIGI IG Control timestamp, s (0 when not valid)
   bool hostTimeValid = false;  // the host marked its timestamp valid
+  std::string host;  // the host's address, as its datagrams came from (keys its shared clock)
   std::uint64_t sequence = 0;  // increments with every pose received
   std::chrono::steady_clock::time_point receivedAt;
   // The time of day at this pose (s since 1970) and where it came from
@@ -162,6 +164,16 @@ class SharedState {
     std::lock_guard lock(mutex_);
     weather_.clock = weather::WeatherClock(clock_s, rate, now);
   }
+  // The offset the server holds for a host's clock (host_locked_clock.hpp),
+  // latest wins; none after a (re)connect until the server sends one.
+  void setHostClock(std::optional<stream::HostClock> h) {
+    std::lock_guard lock(mutex_);
+    hostClock_ = std::move(h);
+  }
+  std::optional<stream::HostClock> hostClock() const {
+    std::lock_guard lock(mutex_);
+    return hostClock_;
+  }
   void setConnected(bool c) {
     std::lock_guard lock(mutex_);
     weather_.connected = c;
@@ -188,6 +200,7 @@ class SharedState {
   ChannelView view_;
   WeatherView weather_;
   bool detailedSeen_ = false;  // a Snapshot of area 0 has arrived
+  std::optional<stream::HostClock> hostClock_;
 };
 
 }  // namespace sky::app

@@ -57,6 +57,12 @@ class WeatherClient {
   static constexpr double kReportMove_m = 100;
   static constexpr double kReportTurn_deg = 1;
 
+  // Thread-safe: proposes this channel's estimate of a host's clock
+  // (host_locked_clock.hpp) to a server that takes them (Hello's
+  // kFeatureHostClock); the server's answer lands in SharedState::hostClock.
+  void proposeHostClock(const stream::HostClock& proposal);
+  bool serverTakesHostClock() const { return serverTakesHostClock_.load(); }
+
   std::uint64_t reportsSent() const { return reportsSent_.load(); }
 
   std::uint64_t malformedFrames() const { return malformed_.load(); }
@@ -81,14 +87,17 @@ class WeatherClient {
   std::array<std::uint8_t, 16384> rx_{};
   std::array<std::optional<stream::Subscribe>, stream::kMaxAreas> areas_;  // by area index
   // Bounded outbound: one frame in flight; waiting, only the newest Subscribe
-  // of each area and the newest CameraReport (the Subscribes go first).
+  // of each area, the newest HostClock proposal and the newest CameraReport
+  // (in that order).
   std::vector<std::uint8_t> inFlight_;
   std::array<std::optional<std::vector<std::uint8_t>>, stream::kMaxAreas> pendingSubscribe_;
   std::optional<std::vector<std::uint8_t>> pendingReport_;
+  std::optional<std::vector<std::uint8_t>> pendingHostClock_;
   std::string channel_;
   // Set from the io thread on the server's Hello; read by reportCamera.
   std::atomic<bool> serverTakesReports_{false};
   std::atomic<bool> serverTakesAreas_{false};
+  std::atomic<bool> serverTakesHostClock_{false};
   std::atomic<bool> reportNow_{false};  // after a (re)connect: the next call reports
   std::atomic<std::uint64_t> reportsSent_{0};
   // reportCamera's throttle, on the caller's thread.
