@@ -255,9 +255,7 @@ void Server::sendFlashes(const std::vector<weather::LightningFlash>& flashes) {
       if (std::any_of(areas.begin(), areas.end(), [&](const auto& a) { return flashReaches(a, f); }))
         message.flashes.push_back(f);
     if (message.flashes.empty()) return;
-    const std::uint64_t droppedBefore = s.droppedEvents();
-    s.sendEvent(stream::encodeFrame(stream::encodeMessage(message)));
-    streamCounters_.eventsDropped.fetch_add(s.droppedEvents() - droppedBefore, std::memory_order_relaxed);
+    sendEventCounted(s, stream::encodeFrame(stream::encodeMessage(message)));
   });
 }
 
@@ -365,19 +363,29 @@ void Server::sessionClosed(Session& session) {
 
 void Server::rendererChanged(Session&) { renderersChanged(); }
 
+void Server::sendEventCounted(Session& session, const Frame& frame) {
+  const std::uint64_t droppedBefore = session.droppedEvents();
+  session.sendEvent(frame);
+  streamCounters_.eventsDropped.fetch_add(session.droppedEvents() - droppedBefore, std::memory_order_relaxed);
+}
+
 void Server::hostClockProposed(Session& session, const stream::HostClock& proposal) {
   streamCounters_.hostClockProposals.fetch_add(1, std::memory_order_relaxed);
   const HostClockAnswer answer = hostClocks_.propose(proposal);
   const Frame frame = stream::encodeFrame(stream::encodeMessage(answer.held));
   if (!answer.changed) {
-    session.sendEvent(frame);
+    sendEventCounted(session, frame);
     return;
   }
   streamCounters_.hostClockChanges.fetch_add(1, std::memory_order_relaxed);
-  log_->info("event=host_clock host={:?} offset_s={:.6f} rate={} from_session={}", answer.held.host,
-             answer.held.offset_s, answer.held.rate, session.id());
+  const auto now = std::chrono::steady_clock::now();
+  const bool loud = now - hostClockLoggedAt_ >= std::chrono::seconds(1);
+  if (loud) hostClockLoggedAt_ = now;
+  log_->log(loud ? spdlog::level::info : spdlog::level::debug,
+            "event=host_clock host={:?} offset_s={:.6f} rate={} from_session={}", answer.held.host,
+            answer.held.offset_s, answer.held.rate, session.id());
   registry_.forEach([&](Session& s) {
-    if (s.hostClockHost() == answer.held.host) s.sendEvent(frame);
+    if (s.hostClockHost() == answer.held.host) sendEventCounted(s, frame);
   });
 }
 

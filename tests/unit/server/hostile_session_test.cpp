@@ -12,8 +12,13 @@
 
 #include <chrono>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
+#include <string>
 #include <thread>
+
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
 
 #include "sky/server/scenario.hpp"
 #include "sky/server/server.hpp"
@@ -196,6 +201,64 @@ int acceptBackoffChild() {
   server->stop();
   thread.join();
   return code;
+}
+
+// A peer that proposes host clock offsets far apart, for one host and for
+// hundreds, changes the held offset at every proposal: counted, logged at
+// info at most once a second, and the server serves a real channel the
+// whole time, which gets the offset held at its own proposal.
+TEST(HostileStream, HostClockProposalsFloodNeitherTheLogNorTheServer) {
+  auto scenario = loadScenario(SKY_SOURCE_DIR "/deploy/scenarios/skeleton-cumulus.toml");
+  ASSERT_TRUE(scenario);
+  std::ostringstream logged;
+  auto log = std::make_shared<spdlog::logger>("hostile", std::make_shared<spdlog::sinks::ostream_sink_mt>(logged));
+  log->set_level(spdlog::level::info);
+  ServerOptions options;
+  options.port = 0;
+  options.heartbeatInterval = 1000ms;
+  options.handleSignals = false;
+  options.log = log;
+  auto created = Server::create(options, WeatherState(*scenario, WallClock::now()));
+  ASSERT_TRUE(created);
+  std::unique_ptr<Server> server = std::move(*created);
+  const auto start = std::chrono::steady_clock::now();
+  {
+    Running running(*server);
+    TestClient hostile(server->port());
+    ASSERT_TRUE(hostile.readNext<stream::Hello>());
+    constexpr int kProposals = 3000;
+    for (int i = 0; i < kProposals; ++i) {
+      const std::string host = i % 10 == 0 ? "host " + std::to_string(i) : "10.0.0.1";
+      hostile.send(stream::HostClock{host, (i % 2) * 1000.0, 1.0});
+    }
+    expectServes(server->port());
+    TestClient channel(server->port());
+    ASSERT_TRUE(channel.readNext<stream::Hello>());
+    channel.send(stream::HostClock{"10.0.0.1", 5000.0, 1.0});
+    auto got = channel.readNext<stream::HostClock>();
+    ASSERT_TRUE(got) << got.error().detail;
+    EXPECT_EQ(got->offset_s, 5000.0);  // 1000 or 0 held: 5000 does not stand against either, and replaces it
+    // The hostile connection's proposals may still be in the server's
+    // input when the channel's answer comes: wait for them all.
+    const auto until = std::chrono::steady_clock::now() + kTimeout;
+    while (server->streamCounters().hostClockProposals.load() < kProposals + 1u &&
+           std::chrono::steady_clock::now() < until)
+      std::this_thread::sleep_for(5ms);
+    EXPECT_EQ(server->streamCounters().hostClockProposals.load(), kProposals + 1u);
+    // Every new host name, and every offset for 10.0.0.1 1000 s from the
+    // one held, is a change: most of the proposals.
+    EXPECT_GE(server->streamCounters().hostClockChanges.load(), kProposals / 2u);
+    EXPECT_LE(server->streamCounters().hostClockChanges.load(), kProposals + 1u);
+  }
+  const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::size_t lines = 0;
+  const std::string text = logged.str();
+  for (std::size_t at = text.find("event=host_clock"); at != std::string::npos; at = text.find("event=host_clock", at + 1))
+    ++lines;
+  std::printf("[ flood    ] %llu host clock changes in %.2f s, %zu logged at info\n",
+              static_cast<unsigned long long>(server->streamCounters().hostClockChanges.load()), took_s, lines);
+  EXPECT_GE(lines, 1u);
+  EXPECT_LE(double(lines), took_s + 1);
 }
 
 TEST(HostileStream, AcceptBacksOffWhenOutOfDescriptors) {

@@ -127,6 +127,8 @@ class Server final : private SessionHandler {
   // subscribers they reach.
   void drawLightning();
   void sendFlashes(const std::vector<weather::LightningFlash>& flashes);
+  // Queues an event frame for a session, counting what its full queue drops.
+  void sendEventCounted(Session& session, const Frame& frame);
   // Sets the timeline timer for the next scenario timeline entry, by the
   // weather clock's rate (a frozen clock waits for the next clock change).
   void armTimeline();
@@ -170,6 +172,10 @@ class Server final : private SessionHandler {
   TileCache tileCache_;
   LightningService lightning_;
   HostClocks hostClocks_;
+  // When a host clock change was last logged at info: a peer that sends
+  // offsets far apart changes it at every proposal, and must not flood the
+  // log (the counter counts them all).
+  std::chrono::steady_clock::time_point hostClockLoggedAt_{};
   std::uint16_t port_ = 0;
   std::uint64_t nextSessionId_ = 1;
   bool stopped_ = false;
