@@ -27,7 +27,8 @@
 namespace sky::server {
 namespace {
 
-std::unique_ptr<Server> makeServer(std::size_t maxSubscribers = kDefaultMaxSubscribers) {
+std::unique_ptr<Server> makeServer(std::size_t maxSubscribers = kDefaultMaxSubscribers,
+                                   std::shared_ptr<spdlog::logger> log = nullptr) {
   auto scenario = loadScenario(SKY_SOURCE_DIR "/deploy/scenarios/skeleton-cumulus.toml");
   EXPECT_TRUE(scenario);
   ServerOptions options;
@@ -35,6 +36,7 @@ std::unique_ptr<Server> makeServer(std::size_t maxSubscribers = kDefaultMaxSubsc
   options.heartbeatInterval = 1000ms;
   options.handleSignals = false;
   options.maxSubscribers = maxSubscribers;
+  options.log = std::move(log);
   auto server = Server::create(options, WeatherState(*scenario, WallClock::now()));
   EXPECT_TRUE(server);
   return std::move(*server);
@@ -208,19 +210,11 @@ int acceptBackoffChild() {
 // info at most once a second, and the server serves a real channel the
 // whole time, which gets the offset held at its own proposal.
 TEST(HostileStream, HostClockProposalsFloodNeitherTheLogNorTheServer) {
-  auto scenario = loadScenario(SKY_SOURCE_DIR "/deploy/scenarios/skeleton-cumulus.toml");
-  ASSERT_TRUE(scenario);
   std::ostringstream logged;
   auto log = std::make_shared<spdlog::logger>("hostile", std::make_shared<spdlog::sinks::ostream_sink_mt>(logged));
   log->set_level(spdlog::level::info);
-  ServerOptions options;
-  options.port = 0;
-  options.heartbeatInterval = 1000ms;
-  options.handleSignals = false;
-  options.log = log;
-  auto created = Server::create(options, WeatherState(*scenario, WallClock::now()));
-  ASSERT_TRUE(created);
-  std::unique_ptr<Server> server = std::move(*created);
+  std::unique_ptr<Server> server = makeServer(kDefaultMaxSubscribers, log);
+  ASSERT_TRUE(server);
   const auto start = std::chrono::steady_clock::now();
   {
     Running running(*server);
