@@ -197,6 +197,7 @@ struct Run {
   bool exitedCleanly = false;
   std::string how;  // "killed by signal 11", "exit 1", "timed out"
   bool timedOut = false;
+  bool stopped = false;  // GribDecoder::stop was asked: the decoder was killed
 };
 
 Run spawnDecoder(const GribDecoder& d, const std::filesystem::path& file, std::size_t index, GribSelection selection, std::chrono::steady_clock::time_point deadline, std::size_t maxOut) {
@@ -226,26 +227,33 @@ Run spawnDecoder(const GribDecoder& d, const std::filesystem::path& file, std::s
     return run;
   }
   std::byte buf[65536];
-  for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
-    if (left.count() <= 0) {
-      run.timedOut = true;
-      break;
+  {
+    // Killed from the thread that asks to stop, so the read below ends at
+    // once. The callback is gone (destroyed, waiting for a running one)
+    // before waitpid reaps the child: until then its pid cannot be reused.
+    const std::stop_callback killOnStop(d.stop, [pid] { ::kill(pid, SIGKILL); });
+    for (;;) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+      if (left.count() <= 0) {
+        run.timedOut = true;
+        break;
+      }
+      pollfd p{pipefd[0], POLLIN, 0};
+      const int r = ::poll(&p, 1, static_cast<int>(std::min<long long>(left.count(), 1000)));
+      if (r < 0 && errno == EINTR) continue;
+      if (r <= 0) continue;
+      const ssize_t n = ::read(pipefd[0], buf, sizeof buf);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      if (run.out.size() + static_cast<std::size_t>(n) > maxOut) {
+        run.how = "wrote more than " + std::to_string(maxOut) + " bytes";
+        ::kill(pid, SIGKILL);
+        break;
+      }
+      run.out.insert(run.out.end(), buf, buf + n);
     }
-    pollfd p{pipefd[0], POLLIN, 0};
-    const int r = ::poll(&p, 1, static_cast<int>(std::min<long long>(left.count(), 1000)));
-    if (r < 0 && errno == EINTR) continue;
-    if (r <= 0) continue;
-    const ssize_t n = ::read(pipefd[0], buf, sizeof buf);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    if (run.out.size() + static_cast<std::size_t>(n) > maxOut) {
-      run.how = "wrote more than " + std::to_string(maxOut) + " bytes";
-      ::kill(pid, SIGKILL);
-      break;
-    }
-    run.out.insert(run.out.end(), buf, buf + n);
   }
+  run.stopped = d.stop.stop_requested();
   ::close(pipefd[0]);
   if (run.timedOut) ::kill(pid, SIGKILL);
   int status = 0;
@@ -338,8 +346,11 @@ Result<GribFile> readGribIsolated(const std::filesystem::path& file, std::string
   // A decoder writes no more than the values allowed plus a record per field.
   const std::size_t maxOut = limits.maxValuesKept * sizeof(float) + (split->fields.size() + 1) * (kMaxRecordJson + 16);
   std::size_t index = 0, kept = 0, restarts = 0;
+  const auto stopped = [&] { return fail(ErrorCode::Io, name + ": decoding stopped (the server is closing)"); };
   while (index < split->fields.size()) {
+    if (decoder.stop.stop_requested()) return stopped();
     Run run = spawnDecoder(decoder, file, index, selection, deadline, maxOut);
+    if (run.stopped) return stopped();
     auto out = parseDecoderOutput(run.out, limits, kept, result);
     if (!out) return fail(out.error().code, name + ": " + out.error().detail);
     if (out->error) return fail(out->error->code, name + ": " + out->error->detail);

@@ -64,7 +64,8 @@ struct HttpApi::Registry {
 };
 
 // One accepted connection: one request read through an HttpExchange, its
-// answer written, then a short lingering read, then closed.
+// answer written (at once, or when the endpoint gives it later), then a
+// short lingering read, then closed.
 class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
  public:
   HttpConnection(tcp::socket socket, std::shared_ptr<HttpApi::Registry> registry, std::uint64_t id)
@@ -72,6 +73,17 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
   ~HttpConnection() { registry_->open.erase(id_); }
 
   void start() {
+    // Called by the endpoint while this connection handles its request. The
+    // answer holds the connection (the registry only watches it), so a
+    // connection waiting for one lives as long as the endpoint's work keeps
+    // it; no member holds it, so nothing holds itself.
+    exchange_.waitWith([this] {
+      return LaterAnswer([self = shared_from_this()](std::function<HttpReply()> reply) {
+        if (!self->registry_->api || self->stopped_) return;
+        self->stream_.expires_after(kClientDeadline);  // for writing the answer
+        self->proceed([&] { return self->exchange_.afterLater(reply); });
+      });
+    });
     stream_.expires_after(kClientDeadline);
     http::async_read_header(stream_, buffer_, exchange_.parser(),
                             [self = shared_from_this()](beast::error_code ec, std::size_t) { self->onRead(ec, false); });
@@ -96,9 +108,15 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
   void onRead(beast::error_code ec, bool body) {
     if (!registry_->api || stopped_) return;
     headerDone_ = true;
+    proceed([&] { return ec ? exchange_.afterError(ec) : body ? exchange_.afterBody() : exchange_.afterHeader(); });
+  }
+
+  // One step of the exchange, then what it says.
+  template <class Step>
+  void proceed(Step&& step) {
     HttpExchange::Next next = HttpExchange::Next::Close;
     try {
-      next = ec ? exchange_.afterError(ec) : body ? exchange_.afterBody() : exchange_.afterHeader();
+      next = step();
     } catch (const std::exception& e) {
       // HttpExchange answers its own failures; this is the last resort (a
       // failure while building that answer): close, and count it.
@@ -119,6 +137,12 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
         // is the feed's from now on).
         stream_.expires_never();
         registry_->api->feed_.accept(stream_.release_socket(), exchange_.parser().release());
+        return;
+      case HttpExchange::Next::Wait:
+        // The endpoint's own work is bounded (a GRIB decode by its
+        // decoder's timeout); the client's deadline applies again to the
+        // answer's write.
+        stream_.expires_never();
         return;
       case HttpExchange::Next::Close: return;
     }
@@ -164,7 +188,8 @@ HttpApi::HttpApi(asio::io_context& io, HttpApiOptions options, LiveWeather& weat
             options_.log),
       acceptor_(io),
       acceptRetry_(io),
-      registry_(std::make_shared<Registry>()) {
+      registry_(std::make_shared<Registry>()),
+      gribDecodes_(io, kGribDecodeSlots) {
   registry_->api = this;
   // Every accepted change, from whichever input, goes to the console.
   weatherListener_ = weather_.addListener([this](const ChangeEvent& e) { feed_.changeAccepted(e); });
@@ -210,6 +235,7 @@ void HttpApi::close() {
   boost::system::error_code ignored;
   acceptor_.close(ignored);
   acceptRetry_.cancel();
+  gribDecodes_.close();
   registry_->api = nullptr;
   const auto open = registry_->open;  // a copy: stopping may end a connection
   for (auto& [id, weak] : open)

@@ -1,6 +1,11 @@
 // The HTTP API's endpoints (see http_api.hpp): what each route does once
 // HttpExchange has checked Host, Origin, the token rule and the body limit.
 #include <charconv>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <stop_token>
 
 #include <spdlog/spdlog.h>
 
@@ -27,9 +32,9 @@ HttpReply error(int status, std::string_view detail) { return {status, "applicat
 
 }  // namespace
 
-HttpReply HttpApi::serve(Endpoint endpoint, const ApiRequest& r) {
+std::optional<HttpReply> HttpApi::serve(Endpoint endpoint, const ApiRequest& r) {
   switch (endpoint) {
-    case Endpoint::Healthz: return {200, "text/plain", "ok\n"};
+    case Endpoint::Healthz: return HttpReply{200, "text/plain", "ok\n"};
     case Endpoint::Metrics: return metrics();
     case Endpoint::State: return json(apiStateJson(weather_));
     case Endpoint::Renderers:
@@ -237,44 +242,75 @@ std::string uploadName(std::string_view query) {
 
 }  // namespace
 
-HttpReply HttpApi::grib(const ApiRequest& r) {
-  auto refuse = [&](int status, const std::string& detail) {
-    ++counters_.rejected;
-    refused(RejectReason::HttpInvalid, detail);
-    if (options_.log) options_.log->info("event=grib_refused detail={:?}", detail);
-    return error(status, utf8::sanitiseAndCut(detail, 1024));
-  };
-  std::vector<GribInput> inputs;
-  std::string name;
-  Result<DecodedForecast> decoded = tl::unexpected(Error{ErrorCode::InvalidArgument, ""});
+HttpReply HttpApi::gribRefused(int status, const std::string& detail) {
+  ++counters_.rejected;
+  refused(RejectReason::HttpInvalid, detail);
+  if (options_.log) options_.log->info("event=grib_refused detail={:?}", detail);
+  return error(status, utf8::sanitiseAndCut(detail, 1024));
+}
+
+std::optional<HttpReply> HttpApi::grib(const ApiRequest& r) {
+  // What runs off the io thread: reading and decoding the files, building
+  // the forecast. `stop` is asked when the API closes.
+  std::function<Result<DecodedForecast>(std::stop_token stop)> decode;
+  // The forecast's first valid time goes where the weather clock is when it
+  // is asked for, however long the decode takes.
+  const double anchor_s = weather_.clockNow();
   if (r.body.size() >= 4 && r.body.substr(0, 4) == "GRIB") {
-    name = uploadName(r.query);
-    decoded = decodeUploadedForecast(std::as_bytes(std::span(r.body.data(), r.body.size())), name,
-                                     weather_.clockNow(), options_.gribDecoder);
+    decode = [bytes = std::string(r.body), name = uploadName(r.query), anchor_s,
+              decoder = options_.gribDecoder](std::stop_token stop) mutable {
+      decoder.stop = std::move(stop);
+      return decodeUploadedForecast(std::as_bytes(std::span(bytes.data(), bytes.size())), name, anchor_s, decoder);
+    };
   } else {
     const nlohmann::json body = nlohmann::json::parse(r.body, nullptr, false);
     if (body.is_discarded() || !body.is_object())
-      return refuse(400, "body: a GRIB2 file (starting 'GRIB') or a JSON object {\"path\": ...} or {\"remove\": true}");
+      return gribRefused(400, "body: a GRIB2 file (starting 'GRIB') or a JSON object {\"path\": ...} or {\"remove\": true}");
     if (body.value("remove", false) == true) {
       auto removed = weather_.removeForecast("api", "grib");
-      if (!removed) return refuse(400, removed.error().detail);
+      if (!removed) return gribRefused(400, removed.error().detail);
       ++counters_.applied;
       return json({{"sequence", removed->sequence}, {"summary", removed->summary}});
     }
-    if (!body.contains("path") || !body["path"].is_string()) return refuse(400, "path: missing (a file or directory inside --grib-dir)");
-    if (options_.gribDir.empty()) return refuse(403, "path: this server takes no GRIB paths (start it with --grib-dir)");
+    if (!body.contains("path") || !body["path"].is_string())
+      return gribRefused(400, "path: missing (a file or directory inside --grib-dir)");
+    if (options_.gribDir.empty()) return gribRefused(403, "path: this server takes no GRIB paths (start it with --grib-dir)");
     auto where = pathInside(options_.gribDir, body["path"].get<std::string>());
-    if (!where) return refuse(400, where.error().detail);
+    if (!where) return gribRefused(400, where.error().detail);
     auto found = gribInputs(*where);
-    if (!found) return refuse(404, "path: " + body["path"].get<std::string>() + ": no GRIB file there");
-    inputs = std::move(*found);
-    name = where->filename().string();
-    decoded = decodeForecast(inputs, name, weather_.clockNow(), options_.gribDecoder);
+    if (!found) return gribRefused(404, "path: " + body["path"].get<std::string>() + ": no GRIB file there");
+    decode = [inputs = std::move(*found), name = where->filename().string(), anchor_s,
+              decoder = options_.gribDecoder](std::stop_token stop) mutable {
+      decoder.stop = std::move(stop);
+      return decodeForecast(inputs, name, anchor_s, decoder);
+    };
   }
-  if (!decoded) return refuse(decoded.error().code == ErrorCode::TooLarge ? 413 : 400, decoded.error().detail);
+  // Without a transport that waits (HttpExchange::feed), decoded here.
+  if (!r.later) return gribDecoded(decode({}));
+  const bool started = gribDecodes_.tryStart([this, decode = std::move(decode), later = r.later](std::stop_token stop) {
+    try {
+      auto decoded = std::make_shared<Result<DecodedForecast>>(decode(std::move(stop)));
+      return WorkerSlots::Finish([this, later, decoded] { later([&] { return gribDecoded(std::move(*decoded)); }); });
+    } catch (...) {
+      // Rethrown where the answer is made, so it is answered as a failure
+      // inside any endpoint is (500; 503 out of memory).
+      return WorkerSlots::Finish([later, failure = std::current_exception()] {
+        later([&]() -> HttpReply { std::rethrow_exception(failure); });
+      });
+    }
+  });
+  if (started) return std::nullopt;
+  const std::string detail = "grib: another forecast is decoding (at most " + std::to_string(gribDecodes_.slots()) +
+                             " at a time); try again once it has loaded";
+  refused(RejectReason::GribBusy, detail);
+  return HttpReply{503, "application/json", errorJson(detail), kGribBusyRetryAfter_s};
+}
+
+HttpReply HttpApi::gribDecoded(Result<DecodedForecast> decoded) {
+  if (!decoded) return gribRefused(decoded.error().code == ErrorCode::TooLarge ? 413 : 400, decoded.error().detail);
   const std::vector<std::string> skipped = decoded->skipped;
   auto applied = applyForecast(weather_, std::move(*decoded), "api", "grib");
-  if (!applied) return refuse(applied.error().code == ErrorCode::Io ? 500 : 400, applied.error().detail);
+  if (!applied) return gribRefused(applied.error().code == ErrorCode::Io ? 500 : 400, applied.error().detail);
   ++counters_.applied;
   if (options_.log)
     options_.log->info("event=change_applied source=grib sequence={} summary={:?}", applied->sequence, applied->summary);

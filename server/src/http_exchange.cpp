@@ -2,6 +2,7 @@
 #include "sky/server/http_exchange.hpp"
 
 #include <new>
+#include <optional>
 
 #include <boost/asio/buffer.hpp>
 #include <boost/asio/error.hpp>
@@ -51,6 +52,10 @@ HttpExchange::Next HttpExchange::afterHeader() {
 
 HttpExchange::Next HttpExchange::afterBody() {
   return guarded([this] { return bodyChecks(); });
+}
+
+HttpExchange::Next HttpExchange::afterLater(const std::function<HttpReply()>& reply) {
+  return guarded([&] { return answer(reply()); });
 }
 
 HttpExchange::Next HttpExchange::afterError(boost::beast::error_code ec) {
@@ -143,7 +148,9 @@ HttpExchange::Next HttpExchange::bodyChecks() {
   request.query = question == std::string_view::npos ? std::string_view{} : target.substr(question + 1);
   request.body = req.body();
   request.hasToken = hasToken_;
-  return answer(api_.serve(route_->endpoint, request));
+  if (later_) request.later = later_();
+  std::optional<HttpReply> reply = api_.serve(route_->endpoint, request);
+  return reply ? answer(std::move(*reply)) : Next::Wait;
 }
 
 HttpExchange::Next HttpExchange::refuse(RejectReason reason, int status, std::string_view detail) {
@@ -162,6 +169,7 @@ HttpExchange::Next HttpExchange::answer(HttpReply reply) {
   response_.set("X-Content-Type-Options", "nosniff");
   response_.set("X-Frame-Options", "DENY");
   response_.set("Content-Security-Policy", "frame-ancestors 'none'");
+  if (reply.retryAfter_s > 0) response_.set(http::field::retry_after, std::to_string(reply.retryAfter_s));
   response_.keep_alive(false);
   response_.body() = std::move(reply.body);
   response_.prepare_payload();

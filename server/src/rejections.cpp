@@ -21,6 +21,7 @@ const char* toString(RejectReason reason) {
     case RejectReason::HttpBusy: return "http_busy";
     case RejectReason::HttpTimeout: return "http_timeout";
     case RejectReason::HttpInternal: return "http_internal";
+    case RejectReason::GribBusy: return "grib_busy";
     case RejectReason::SubscriberCap: return "subscriber_cap";
     case RejectReason::HandlerFailed: return "handler_failed";
     case RejectReason::Count_: break;

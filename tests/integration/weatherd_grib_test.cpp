@@ -2,13 +2,17 @@
 // POST /api/grib (uploads, paths inside --grib-dir, refusals that leave the
 // weather as it was), the weather stream's tiles against the grid values
 // ecCodes' grib_get_data prints, a forecast evolving between its steps on
-// the weather clock, and a restart that decodes the stored files again.
+// the weather clock, a restart that decodes the stored files again, and a
+// stop while a forecast decodes.
+#include <signal.h>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -220,6 +224,38 @@ TEST(WeatherdGrib, AForecastEvolvesBetweenItsStepsOnTheWeatherClock) {
   }
   EXPECT_EQ(samples, 8);
   EXPECT_EQ(w.process->stop(), 0) << w.process->log();
+}
+
+// SIGTERM while a forecast decodes off the io thread: the decoder is killed,
+// the process exits cleanly (not after the decoder's timeout, nor killed by
+// the test's SIGKILL), and the request is let go without an answer.
+TEST(WeatherdGrib, ATermDuringADecodeStopsTheDecoderAndExitsCleanly) {
+  const fs::path out = fs::path(SKY_TEST_OUTPUT_DIR) / "weatherd-grib-term-files";
+  fs::remove_all(out);
+  fs::create_directories(out / "grib");
+  fs::copy_file(kNam, out / "grib" / "nam.grib2");
+  const server::GatedDecoder gate(out / "gate",
+                                  (fs::path(SKY_WEATHERD).parent_path() / "skyshell-grib-decode").string());
+  Weatherd w("weatherd-grib-term", SKY_SCENARIO_CLEAR, false,
+             {"--grib-dir", (out / "grib").string(), "--grib-decoder", gate.executable().string()});
+  ASSERT_GT(w.httpPort, 0u) << w.process->log();
+  auto post = std::async(std::launch::async, [port = w.httpPort] {
+    sim::HttpRequest r;
+    r.method = "POST";
+    r.port = static_cast<unsigned short>(port);
+    r.target = "/api/grib";
+    r.body = R"({"path": "nam.grib2"})";
+    r.bearerToken = kToken;
+    r.timeout = 60s;
+    return sim::httpRequest(r);
+  });
+  const pid_t decoder = gate.waitUntilStarted(60s);
+  ASSERT_GT(decoder, 0) << w.process->log();
+  EXPECT_EQ(w.request("GET", "/healthz").status, 200) << "served while the forecast decodes";
+  EXPECT_EQ(w.process->stop(), 0) << w.process->log();
+  EXPECT_EQ(::kill(decoder, 0), -1) << "the decoder outlived the server";
+  const auto answer = post.get();
+  EXPECT_FALSE(answer) << "answered " << answer->status << " " << answer->body;
 }
 
 }  // namespace

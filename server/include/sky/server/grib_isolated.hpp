@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <span>
+#include <stop_token>
 #include <string>
 #include <string_view>
 
@@ -29,6 +30,10 @@ struct GribDecoder {
   std::chrono::milliseconds timeout{120000};       // the whole file, all decoders together
   std::size_t maxFileBytes = std::size_t{1} << 30; // 1 GiB: a whole 0.25 degree GFS run step is ~500 MB
   std::size_t maxRestarts = 64;                    // decoders that died before the file is refused
+  // Asked to stop (the server closing while an upload decodes): the decoder
+  // process is killed at once and the file refused (Io, "stopped"). The
+  // default token is never asked.
+  std::stop_token stop;
 };
 
 // The decoder next to this program's executable (the build tree and the
@@ -37,6 +42,8 @@ std::filesystem::path defaultGribDecoder();
 
 // Reads `file` (at most decoder.maxFileBytes) and decodes it in decoder
 // processes. Errors (Io, TooLarge, Malformed, Timeout) name `sourceName`.
+// Blocks for as long as the decoders take (up to decoder.timeout): callers
+// that serve sockets run it on a thread of their own (worker_slots.hpp).
 Result<GribFile> readGribIsolated(const std::filesystem::path& file, std::string_view sourceName,
                                   GribSelection selection, const GribDecoder& decoder, const GribLimits& limits = {});
 

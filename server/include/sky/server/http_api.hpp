@@ -15,6 +15,8 @@
 //   GET  /api/conditions the weather at points (conditions_api.hpp)
 //   GET  /api/wind       the wind field over an area at a height (wind_api.hpp)
 //   GET  /api/ws         WebSocket upgrade: the console's live feed (console_feed.hpp)
+//   POST /api/grib       a GRIB2 forecast (forecast_files.hpp); needs the token. Decoded
+//                        off the io thread (worker_slots.hpp), answered once loaded
 // Routes, their methods, body limits and token rules are one table
 // (http_routes.hpp); each request goes through HttpExchange
 // (http_exchange.hpp), which checks Host, Origin, the token and the body
@@ -28,6 +30,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -47,6 +50,7 @@
 #include "sky/server/metar.hpp"
 #include "sky/server/metar_stations.hpp"
 #include "sky/server/rejections.hpp"
+#include "sky/server/worker_slots.hpp"
 
 namespace spdlog {
 class logger;
@@ -57,6 +61,19 @@ namespace sky::server {
 class ConsoleFiles;
 class HttpConnection;
 class HttpExchange;
+struct DecodedForecast;
+
+// POST /api/grib decodes at most this many forecasts at once, off the io
+// thread; another request meanwhile is answered 503. One: the weather holds
+// one forecast, so a second decoding beside it would only replace it or be
+// replaced, and each decode holds its files' bytes three times over (the
+// request or the file, the decoder's reading, the store's copy) and a
+// decoder process on a core the io thread needs.
+inline constexpr std::size_t kGribDecodeSlots = 1;
+// The Retry-After of that 503, s: the bundled NAM file (0.9 MB) decodes in
+// about half a second on a 2-core machine, a regional forecast of a few MB
+// in a few seconds.
+inline constexpr int kGribBusyRetryAfter_s = 5;
 
 struct HttpApiOptions {
   std::string listenAddress = "127.0.0.1";
@@ -101,8 +118,9 @@ class HttpApi {
                                                  LiveWeather& weather, HttpApiHooks hooks);
   ~HttpApi();
   std::uint16_t port() const { return port_; }
-  // Stops accepting, closes the connections in flight and the console's
-  // WebSocket clients.
+  // Stops accepting, stops the GRIB decodes in flight (their decoder
+  // processes killed, their threads joined), closes the connections in
+  // flight and the console's WebSocket clients.
   void close();
   // The renderer list changed (a subscriber came, went or reported).
   void renderersChanged() { feed_.renderersChanged(); }
@@ -126,15 +144,19 @@ class HttpApi {
   void refused(RejectReason reason, std::string_view detail);
   nlohmann::json healthJson() const;
 
-  // The endpoints (http_endpoints.cpp), behind HttpExchange's checks.
-  HttpReply serve(Endpoint endpoint, const ApiRequest& request);
+  // The endpoints (http_endpoints.cpp), behind HttpExchange's checks. No
+  // reply: the endpoint answers later, through request.later.
+  std::optional<HttpReply> serve(Endpoint endpoint, const ApiRequest& request);
   HttpReply metrics();
   HttpReply events(std::string_view query);
   HttpReply lightning(const ApiRequest& request);
   HttpReply changes(const ApiRequest& request);
   HttpReply scenario(const ApiRequest& request);
   HttpReply metar(const ApiRequest& request);
-  HttpReply grib(const ApiRequest& request);
+  std::optional<HttpReply> grib(const ApiRequest& request);
+  // A forecast decoded for POST /api/grib, applied and answered (io thread).
+  HttpReply gribDecoded(Result<DecodedForecast> decoded);
+  HttpReply gribRefused(int status, const std::string& detail);
   HttpReply unauthorized(const char* what);
   HttpReply consoleFile(std::string_view method, std::string_view path) const;
   // The answer to a WebSocket upgrade while the feed is full (503).
@@ -154,6 +176,9 @@ class HttpApi {
   std::uint16_t port_ = 0;
   Counters counters_;
   MetarStationBoard metarStations_;  // the reports POST /api/metar applied
+  // POST /api/grib's decodes. Closed (its threads joined) by close(), before
+  // anything their results would touch goes.
+  WorkerSlots gribDecodes_;
   std::array<bool, kRejectReasons> logged_{};
   bool acceptErrorLogged_ = false;
   bool closed_ = false;

@@ -5,10 +5,13 @@
 // body is read: the header's size (431), a target and header values that are
 // valid UTF-8 (400), Host and Origin (403, http_guard.hpp), the route (404,
 // 405), the token for routes that always need it (401), the body's declared
-// length against the route's limit (413). Then the endpoint. Nothing thrown
-// inside leaves it: a failure is a 500 (503 out of memory) for this request.
+// length against the route's limit (413). Then the endpoint, which answers
+// at once or, when the transport can wait (waitWith), later (Next::Wait).
+// Nothing thrown inside leaves it: a failure is a 500 (503 out of memory)
+// for this request.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -47,9 +50,17 @@ class HttpExchange {
     Answer,    // write response(), then close
     Upgrade,   // hand the connection and parser().release() to the console feed
     Close,     // close without an answer (the client left, or was too slow)
+    Wait,      // the endpoint answers later, through the LaterAnswer waitWith made: then afterLater()
   };
 
   explicit HttpExchange(HttpApi& api);
+
+  // Lets endpoints answer later: `later` is called before an endpoint runs
+  // (inside afterHeader() or afterBody()) and makes the LaterAnswer it is
+  // given (ApiRequest::later), which must lead to afterLater() on the io
+  // thread. Without it every endpoint answers at once (feed(), whose caller
+  // reads the answer on return).
+  void waitWith(std::function<LaterAnswer()> later) { later_ = std::move(later); }
 
   Parser& parser() { return parser_; }
   Response& response() { return response_; }
@@ -60,6 +71,9 @@ class HttpExchange {
   // Reading the header or the body failed with `ec`: an answer (400, 413,
   // 431) or Close (the client left or was too slow).
   Next afterError(boost::beast::error_code ec);
+  // The endpoint's later answer (after Next::Wait): `reply` runs under the
+  // same guard as an endpoint. Answer.
+  Next afterLater(const std::function<HttpReply()>& reply);
 
   // Feeds a client's bytes through the same steps as the socket does, the
   // end of `bytes` being the client's end of stream. Returns the last step's
@@ -79,6 +93,7 @@ class HttpExchange {
   Response response_;
   const Route* route_ = nullptr;  // null: a console file or 404
   bool hasToken_ = false;
+  std::function<LaterAnswer()> later_;  // empty: answers are given at once
 };
 
 }  // namespace sky::server

@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -68,17 +69,31 @@ std::string allowedMethods(const Route& route);
 // (the route's own applies once the path is known).
 std::size_t maxBodyBytes();
 
-// One request, as an endpoint sees it.
-struct ApiRequest {
-  std::string_view method, path, query, body;
-  bool hasToken = false;  // the Authorization header carried the token (TokenRule::WhenApplying reads it)
-};
-
 // An endpoint's answer.
 struct HttpReply {
   int status = 200;
   std::string contentType = "application/json";
   std::string body;
+  int retryAfter_s = 0;  // > 0: a Retry-After header (a 503 for being busy)
+};
+
+// An answer an endpoint gives later, once work it started off the io thread
+// has ended (POST /api/grib's decode). Called once, on the io thread, with
+// what makes the reply: the transport runs that under the same guard as an
+// endpoint (an exception is a 500 for this request) and sends the reply. When
+// the API has closed meanwhile, it runs nothing. A client that left is found
+// out when the reply is written.
+using LaterAnswer = std::function<void(std::function<HttpReply()> reply)>;
+
+// One request, as an endpoint sees it.
+struct ApiRequest {
+  std::string_view method, path, query, body;
+  bool hasToken = false;  // the Authorization header carried the token (TokenRule::WhenApplying reads it)
+  // Set when the transport can wait for an answer (the API's sockets; not
+  // HttpExchange::feed, whose caller takes the answer when it returns). An
+  // endpoint that keeps it returns no reply and calls it later, from a
+  // handler of its own (never before it has returned).
+  LaterAnswer later;
 };
 
 }  // namespace sky::server

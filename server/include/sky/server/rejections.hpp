@@ -32,6 +32,7 @@ enum class RejectReason : std::size_t {
   HttpBusy,         // a connection past the cap on connections in flight (503)
   HttpTimeout,      // a client that did not finish its request within the deadline (dropped)
   HttpInternal,     // a request whose handling failed inside the server (500/503)
+  GribBusy,         // POST /api/grib while kGribDecodeSlots forecasts decode (503)
   SubscriberCap,    // a stream connection past ServerOptions::maxSubscribers (sent an Error, closed)
   HandlerFailed,    // a handler threw: the peer's connection or datagram was dropped, the server runs on
   Count_
