@@ -12,6 +12,7 @@
 #include "sky/server/live_weather.hpp"
 #include "sky/server/metar_changes.hpp"
 #include "sky/server/snapshot_builder.hpp"
+#include "sky/weather/clock.hpp"
 #include "sky/weather/precipitation.hpp"
 #include "sky/weather/query.hpp"
 #include "sky/weather/region.hpp"
@@ -41,9 +42,6 @@ nlohmann::json layersJson(const std::vector<Layer>& layers) {
   for (const Layer& l : layers) a.push_back({{"id", l.id}, {"oktas", l.oktas}, {"base_m", l.base_m}});
   return a;
 }
-
-// A weather clock as far as a century either way: any replay's or timeline's.
-constexpr double kMaxClockOffset_s = 100 * 365.25 * 86400;
 
 nlohmann::json optional(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
 
@@ -98,7 +96,8 @@ Result<ConformanceQuery> parseConformanceQuery(std::string_view query) {
       if (!(v = queryNumber(key, value, -180, 180))) return tl::unexpected(v.error());
       q.lon_deg = *v;
     } else if (key == "clock_s") {
-      if (!(v = queryNumber(key, value, -kMaxClockOffset_s, kMaxClockOffset_s))) return tl::unexpected(v.error());
+      if (!(v = queryNumber(key, value, -weather::kMaxAskedClock_s, weather::kMaxAskedClock_s)))
+        return tl::unexpected(v.error());
       q.clock_s = *v;
     } else if (key == "radius_m") {
       if (!(v = queryNumber(key, value, 1, 2e7))) return tl::unexpected(v.error());

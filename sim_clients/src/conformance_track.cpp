@@ -11,6 +11,7 @@
 
 #include "sky/core/assert.hpp"
 #include "sky/geo/geodetic.hpp"
+#include "sky/weather/clock.hpp"
 
 namespace sky::sim {
 
@@ -18,8 +19,6 @@ namespace {
 
 using nlohmann::json;
 
-// A weather clock within a century either way, as the API takes it.
-constexpr double kMaxClock_s = 100 * 365.25 * 86400;
 // Flight times and frame numbers a replay can reach (a week of flight).
 constexpr double kMaxFlightTime_s = 7 * 86400.0;
 constexpr double kMaxFrame = 1e12;
@@ -90,7 +89,7 @@ Result<TrackPoint> parseTrackLine(std::string_view line) {
   auto alt = numberField(o, "alt_m", kMinAlt_m, kMaxAlt_m, where);
   if (!alt) return tl::unexpected(alt.error());
   p.alt_m = *alt;
-  auto clock = numberField(o, "weather_clock_s", -kMaxClock_s, kMaxClock_s, where);
+  auto clock = numberField(o, "weather_clock_s", -weather::kMaxAskedClock_s, weather::kMaxAskedClock_s, where);
   if (!clock) return tl::unexpected(clock.error());
   p.weatherClock_s = *clock;
   return p;

@@ -1,7 +1,9 @@
 // GET /api/conformance's check (conformance.hpp) on a live weather with METAR
 // stations and a GFS forecast: what the tiles draw at each station is its
 // report, whichever came first; a station region that does not replace
-// every layer (as a hand-made one) is caught; grid points match the grid.
+// every layer (as a hand-made one) is caught; grid points match the grid;
+// the server's query and skyshell-conformance's reader share the clock's
+// bound.
 #include <algorithm>
 #include <cstdio>
 #include <map>
@@ -14,6 +16,8 @@
 #include "sky/server/live_weather.hpp"
 #include "sky/server/metar_changes.hpp"
 #include "sky/server/snapshot_builder.hpp"
+#include "sky/sim/conformance_track.hpp"
+#include "sky/weather/clock.hpp"
 
 namespace sky::server {
 namespace {
@@ -255,6 +259,38 @@ TEST(Conformance, QueryKeysAreChecked) {
   EXPECT_EQ(oktas(0.5), 4);
   EXPECT_EQ(oktas(0.99), 7);
   EXPECT_EQ(oktas(1), 8);
+}
+
+// The bound on the clock a check may be asked at is written once
+// (weather::kMaxAskedClock_s) and applied by the server's query parser and
+// by skyshell-conformance's frames reader: a frame at the bound is read and
+// the query the tool makes of it is answered; one second past it, either
+// way, both refuse.
+TEST(Conformance, TheServerAndTheToolAgreeOnTheClocksBound) {
+  auto frame = [](double clock_s) {
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  R"({"frame":1,"host_time_s":0,"lat_deg":46,"lon_deg":14,"alt_m":1500,"weather_clock_s":%.3f})",
+                  clock_s);
+    return std::string(line);
+  };
+  auto query = [](double clock_s) {
+    char q[64];
+    std::snprintf(q, sizeof q, "clock_s=%.3f", clock_s);
+    return std::string(q);
+  };
+  for (const double side : {1.0, -1.0}) {
+    SCOPED_TRACE(side > 0 ? "ahead" : "behind");
+    const double bound_s = side * weather::kMaxAskedClock_s, past_s = side * (weather::kMaxAskedClock_s + 1);
+    const auto point = sim::parseTrackLine(frame(bound_s));
+    ASSERT_TRUE(point) << point.error().detail;
+    const std::string target = sim::conformanceTarget(*point, {});
+    const auto asked = parseConformanceQuery(target.substr(target.find('?') + 1));
+    ASSERT_TRUE(asked) << target << ": " << asked.error().detail;
+    EXPECT_EQ(*asked->clock_s, bound_s);
+    EXPECT_FALSE(sim::parseTrackLine(frame(past_s)));
+    EXPECT_FALSE(parseConformanceQuery(query(past_s)));
+  }
 }
 
 }  // namespace

@@ -10,6 +10,14 @@ namespace sky::weather {
 
 using WallClock = std::chrono::steady_clock;
 
+// The farthest weather clock, s, either way from 0, that a question about the
+// weather at a given clock may name (GET /api/conformance?clock_s=, and the
+// frames skyshell-conformance reads to ask it): a century, past any replay's
+// or timeline's, yet a bound on the values a request can carry. The server's
+// query parser and the tool's reader both use it, so a frame the tool reads
+// is one the server answers.
+inline constexpr double kMaxAskedClock_s = 100 * 365.25 * 86400;
+
 class WeatherClock {
  public:
   WeatherClock() = default;
