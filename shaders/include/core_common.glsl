@@ -67,6 +67,17 @@ real3 anchorPlane(real3x3 camToAnchor, real3 camInAnchor, real radius, real3 p) 
   return real3(q.x * s, q.y * s, q.z);
 }
 
+// The coarse ring's weight at a point of the weather map's plane: 0 inside
+// the blend band's start, 1 past its end, linear in the max norm between;
+// invFineHalf is 1 / the fine ring's half extent, start and end are
+// fractions of it (weather_field.hpp's rings). The GPU passes
+// (weather_map.glsl) and WeatherField's CPU readers blend through this one
+// function.
+real ringBlendWeight(real2 plane, real invFineHalf, real start, real end) {
+  real e = max(abs(plane.x), abs(plane.y)) * invFineHalf;
+  return clamp((e - start) / (end - start), 0.0, 1.0);
+}
+
 // Ray from a point at distance r from the centre against the sphere with
 // c = h (2r - h) (h = height above it, exact from altitudes); mu = cos zenith.
 // Stable (citardauq) form, as protocol/geo/src/shell.cpp.

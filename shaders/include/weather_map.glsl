@@ -2,8 +2,8 @@
 // the reprojection): a camera-local point -> the weather anchor's frame ->
 // the gnomonic plane of the anchor sphere (core_common.glsl's anchorPlane) -> texture
 // coordinates of the rings: the fine ring inside its blend band, the coarse
-// ring beyond, linear in the max norm between (the CPU's
-// WeatherField::sampleLayer and ringBlendWeight). The includer declares
+// ring beyond, linear in the max norm between (core_common.glsl's
+// ringBlendWeight, which WeatherField::sampleLayer calls too). The includer declares
 // weatherTex (sampler2DArray, sky_shared.h's layout), gCamToAnchor (mat3,
 // camera-local -> anchor-local), gCamInAnchor (xyz: the camera relative to
 // the anchor sphere's centre, anchor frame; w: its radius), gMapScale (1 / the
@@ -19,8 +19,7 @@ bool weatherPlane(vec3 p, out vec2 plane) {
 // Texture layer `base` of the fine ring (a cover slice, or kWindMapLayers +
 // a slice) and its coarse ring's layer (+ kMaxLayers) at a plane point.
 vec4 sampleMapLayer(vec2 plane, float base) {
-  float e = 2.0 * max(abs(plane.x), abs(plane.y)) * gMapScale;
-  float w = clamp((e - gRings.y) / (gRings.z - gRings.y), 0.0, 1.0);
+  float w = ringBlendWeight(plane, 2.0 * gMapScale, gRings.y, gRings.z);
   vec4 v = vec4(0.0);
   if (w < 1.0) v = textureLod(weatherTex, vec3(plane * gMapScale + 0.5, base), 0.0);
   if (w > 0.0) v = mix(v, textureLod(weatherTex, vec3(plane * gRings.x + 0.5, base + float(kMaxLayers)), 0.0), w);

@@ -9,6 +9,7 @@
 
 #include "sky/core/assert.hpp"
 
+#include "core_common.hpp"
 #include "fresh_edges.hpp"
 #include "weather_field.hpp"
 
@@ -37,21 +38,6 @@ std::string rounded(double v, int digits) {
 }
 
 gpu::vec4 v4(const glm::dvec3& v, double w = 0) { return gpu::vec4(glm::dvec4(v, w)); }
-
-// The shaders' camera rays and projection (core_common.glsl), in double;
-// the GLSL calls GLM's built-ins unqualified.
-using namespace glm;
-struct Shared {
-  using real = double;
-  using real2 = glm::dvec2;
-  using real3 = glm::dvec3;
-  using real4 = glm::dvec4;
-  using real3x3 = glm::dmat3;
-  using uint = std::uint32_t;
-#define SKY_CORE_CONST static constexpr
-#include "core_common.glsl"
-#undef SKY_CORE_CONST
-};
 
 }  // namespace
 
@@ -84,7 +70,7 @@ glm::uvec4 TemporalPlanner::freshEdges(const Remembered& prev, const FrameSetup&
   const double rw = setup.rasterWidth, rh = setup.rasterHeight;
   const int w = int(setup.width), h = int(setup.height);
   if (w < 2 || h < 2 || !(rw > 0) || !(rh > 0)) return glm::uvec4(0);
-  Shared shared;
+  CoreCommon shared;
   // Where pixel (x, y)'s ray was in the previous image (continuous pixels;
   // far outside when it was behind that camera). The history's bilinear
   // lookup holds from 0 to the image's extent; past it on one side, the

@@ -8,6 +8,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core_common.hpp"
 #include "sky/core/assert.hpp"
 #include "sky/weather/tiling.hpp"
 #include "sky/weather/wind_field.hpp"
@@ -38,8 +39,8 @@ std::uint64_t bitsOf(double d) {
 }  // namespace
 
 double ringBlendWeight(double x_m, double y_m) {
-  const double e = std::max(std::abs(x_m), std::abs(y_m)) / kWeatherRingHalfExtent_m[0];
-  return std::clamp((e - kRingBlendStart) / (kRingBlendEnd - kRingBlendStart), 0.0, 1.0);
+  return CoreCommon{}.ringBlendWeight(glm::dvec2(x_m, y_m), 1.0 / kWeatherRingHalfExtent_m[0], kRingBlendStart,
+                                      kRingBlendEnd);
 }
 
 glm::dvec3 WeatherField::sample(std::uint32_t slice, double x_m, double y_m) const {
