@@ -25,8 +25,9 @@
 //   real4 sampleSunMap(int layer, real2 uv)             // the frame's sun map (sun_map.glsl)
 //   flashAt, boltStartAt, boltEndAt                      // the frame's lightning (lightning.glsl)
 // and the frame's sun map in gSunMap (a global; a data member in C++), and
-// kWindField: false where no layer's wind varies over the map (the flow's
-// code is then left out; on the GPU a pipeline constant, true in C++), and
+// kWindField: false where no layer's wind varies over the map and none is
+// in a crossfade of its flow's phases (the wind map's reads and the second
+// phase are then left out; on the GPU a pipeline constant, true in C++), and
 // kLightning: false where the frame lights no flash (the same).
 // pLocal is camera-relative, local frame: x east, y north, z up (m).
 
@@ -37,6 +38,7 @@
 #include "atmosphere_core.glsl"
 #include "air_table.glsl"
 #include "cloud_density.glsl"
+#include "sky/weather/layer_presence.glsl"
 #include "wind_map.glsl"
 #include "lightning.glsl"
 
@@ -130,6 +132,9 @@ struct CoreLayer {
   bool absent;         // no coverage anywhere on the weather map: not marched, casts no shadow
   real stepFactor;     // the march in metres' steps (cloud and empty) times this, > 0 (Haggstrom 2018
                        // eq. 34 and 36 from the layer's mean coverage and density; 1: off)
+  real band;           // the transition band's fraction of the shell at each end, [0, 0.5): the heights
+                       // above (hBase, hTop, thickness) are the shell's, base - band to top + band, and
+                       // the cloud fades across the band (layerPresence)
 };
 
 // The layers are read through this hook, not carried in CoreFrame: a frame
@@ -171,10 +176,10 @@ real flowMix(real a, real b, real wA) {
 // one trip: llvmpipe gives an invocation 65535 loop iterations over all its
 // loops (docs/light-transport.md), and a loop per noise read in the light
 // march spent reference's budget. kWindField (the includer's; on the GPU a
-// pipeline constant) is false for frames without a wind field, so their
-// pipeline holds none of this.
+// pipeline constant) is false for frames without a wind field or a
+// crossfade, so their pipeline holds none of this.
 bool flowCrossfades(LayerSampling s) {
-  return kWindField && s.flow.w > 0.5 && s.flow.z > 0.0 && s.flow.z < 1.0;
+  return kWindField && s.flow.z > 0.0 && s.flow.z < 1.0;
 }
 
 real2 flowShape(LayerSampling s, real3 p) {
@@ -367,8 +372,9 @@ real octaveSum(real4 phases, real tauSun) {
 // there is no density: lavapipe runs every branch for all lanes of a
 // subgroup, but leaves a loop once no lane is in it, so a zero trip count is
 // what skips the march.
-real lightOpticalDepth(real3 sunDir, real muSun, real thickness, real lightDistance, LayerSampling ls, CloudType t,
-                       real3 p, real ph, real c, real peakNoise, real densityScale, int lightSteps, int steps) {
+real lightOpticalDepth(real3 sunDir, real muSun, real thickness, real band, real lightDistance, LayerSampling ls,
+                       CloudType t, real3 p, real ph, real c, real peakNoise, real densityScale, int lightSteps,
+                       int steps) {
   real lightDt = lightDistance / real(lightSteps);
   real dph = lightDt * muSun / thickness;
   real tau = 0.0;
@@ -376,7 +382,7 @@ real lightOpticalDepth(real3 sunDir, real muSun, real thickness, real lightDista
     real3 q = p + sunDir * ((real(j) + 0.5) * lightDt);
     real qh = ph + (real(j) + 0.5) * dph;
     real sa = shapeProfile(t, qh, c, peakNoise);
-    tau += cloudShape(t, flowShape(ls, q), c, sa) * densityProfile(t, qh);
+    tau += cloudShape(t, flowShape(ls, q), c, sa) * densityProfile(t, qh) * layerPresence(qh, band);
   }
   return tau * t.extinction_perm * densityScale * lightDt;
 }
@@ -387,7 +393,7 @@ real lightOpticalDepth(real3 sunDir, real muSun, real thickness, real lightDista
 // The depth above is the type's mean column density (columnFill) times
 // coverage c and the weather density over the rest of the layer.
 real3 diffuseLight(CoreLayer L, CloudType t, real ph, real c, real densityScale) {
-  real tauAbove = t.extinction_perm * densityScale * c * t.columnFill * (1.0 - ph) * L.thickness;
+  real tauAbove = t.extinction_perm * densityScale * c * t.columnFill * layerPresenceAbove(ph, L.band) * L.thickness;
   real transmitted = 1.0 / (1.0 + 0.75 * (1.0 - kDiffuseAsymmetry) * tauAbove);
   real scatteredOut = 1.0 - exp(-tauAbove / max(L.sunCosine, kMinSunCosine));
   return (L.skyTop + L.sunDiffuseTop * scatteredOut) * transmitted;
@@ -408,17 +414,19 @@ struct CloudSample {
   real3 flowShiftB;
 };
 
-// For a layer whose wind varies over the map, its noise is carried by the
-// local wind's difference from the layer's own (with which the noise origins
-// drift already), in the two phases of the flow (flowShape and the others).
+// The noise is carried by the wind in the two phases of the flow
+// (flowShape and the others): the layer's own wind, or where it varies over
+// the map the local wind (its vertical part the layer's own).
 CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
+  real3 drift = real3(L.sampling.windRef);
   if (kWindField && L.sampling.flow.w > 0.5) {
-    real3 rel = sampleWindLocal(L.sampling, p) - real3(L.sampling.windRef);
+    real3 rel = sampleWindLocal(L.sampling, p) - drift;
     rel.z = 0.0;
-    // Phase A's shift first, or B's alone where only B shows.
-    L.sampling.flowShift = rel * (L.sampling.flow.z > 0.0 ? L.sampling.flow.x : L.sampling.flow.y);
-    L.sampling.flowShiftB = rel * L.sampling.flow.y;
+    drift += rel;
   }
+  // Phase A's shift first, or B's alone where only B shows.
+  L.sampling.flowShift = drift * (L.sampling.flow.z > 0.0 ? L.sampling.flow.x : L.sampling.flow.y);
+  L.sampling.flowShiftB = drift * L.sampling.flow.y;
   CloudSample cs;
   cs.rho = 0.0;
   cs.ct = L.primary;
@@ -444,7 +452,7 @@ CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
   if (sa <= 0.0) return cs;
   real shape = cloudShape(cs.ct, flowShape(L.sampling, p), cs.coverage, sa);
   if (shape <= 0.0) return cs;
-  real da = densityProfile(cs.ct, ph) * weather.y;
+  real da = densityProfile(cs.ct, ph) * weather.y * layerPresence(ph, L.band);
   if (da <= 0.0 || cheap) {
     cs.rho = max(da, 0.0) * shape;
     return cs;
@@ -496,7 +504,8 @@ real2 cloudShadow(AirFrame a, int count, int skip, real3 p, real hp, real muSun)
     real d = c2 / (rp * mu + sqrt(rp * rp * mu * mu + c2));
     real3 weather = sampleWeather(L.sampling, p + a.sunDir * d);
     CloudType t = L.blends ? mixCloudType(L.primary, L.secondary, weather.z) : L.primary;
-    real tau = t.extinction_perm * weather.y * t.columnFill * (top - lo);
+    real tau = t.extinction_perm * weather.y * t.columnFill * L.thickness *
+               layerPresenceAbove((lo - (a.h - L.hBase)) / L.thickness, L.band);
     real c = clamp(weather.x, 0.0, 1.0);
     direct *= brokenFieldTransmittance(c, tau, mu);
     diffuse *= 1.0 - c * (1.0 - 1.0 / (1.0 + 0.75 * (1.0 - kDiffuseAsymmetry) * tau));
@@ -601,14 +610,15 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
     LayerSampling lightSampling = L.sampling;
     lightSampling.flowShift = cs.flowShift;
     lightSampling.flowShiftB = cs.flowShiftB;
-    real tauSun = lightOpticalDepth(f.air.sunDir, muHere, L.thickness, L.lightDistance, lightSampling, ct, p, ph,
-                                    cs.coverage, cs.peakNoise, cs.densityScale, f.march.lightSteps,
+    real tauSun = lightOpticalDepth(f.air.sunDir, muHere, L.thickness, L.band, L.lightDistance, lightSampling, ct, p,
+                                    ph, cs.coverage, cs.peakNoise, cs.densityScale, f.march.lightSteps,
                                     march && cs.rho > 0.0 ? f.march.lightSteps : 0);
     real above = sunDepthAbove(f.air, p, muHere, f.march.lightSteps, f.layerCount);
     // Past the map's last cascade, the layer's own shadow at the weather
     // map's scale (diffuseLight's column above p, as cloudShadow takes a
     // layer's), and the other layers' from cloudShadow.
-    real ownAbove = ct.extinction_perm * cs.densityScale * ct.columnFill * (1.0 - ph) * L.thickness;
+    real ownAbove =
+        ct.extinction_perm * cs.densityScale * ct.columnFill * layerPresenceAbove(ph, L.band) * L.thickness;
     real ownFar = -log(max(brokenFieldTransmittance(cs.coverage, ownAbove, max(muHere, kMinSunCosine)), 1e-6));
     if (!march) tauSun = above >= 0.0 ? above : ownFar;
     // Sunlight at p through the clear air above it (reddened at low sun,

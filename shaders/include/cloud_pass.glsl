@@ -40,8 +40,9 @@ layout(constant_id = 2) const bool kLayersShadowLayers = true;
 layout(constant_id = 3) const int kSunMethod = 0;
 
 // kWindField false for frames none of whose layers has a wind that varies
-// over the map (SkyLayer::flow.w): the flow's reads of the wind map and
-// second noise phase are compiled out (cloud_core.glsl's flowCrossfades).
+// over the map (SkyLayer::flow.w) or is in a crossfade of its flow's phases
+// (flow.z strictly between 0 and 1): the wind map's reads and the second
+// noise phase are compiled out (cloud_core.glsl's flowCrossfades).
 layout(constant_id = 4) const bool kWindField = true;
 
 // kLightning false for frames that light no flash (SkyFrame::flashInfo):
@@ -192,7 +193,7 @@ CoreLayer layerAt(int li) {
                                   vec3(0.0), vec3(0.0));
   return CoreLayer(l.heights.x, l.heights.y, l.heights.z, l.heights.w, l.shape.x, l.shape.z, l.shape.w > 0.5,
                    unpackType(l.primary), unpackType(l.secondary), l.ambient.rgb, l.sunDiffuse.rgb,
-                   l.sunDiffuse.w, s, l.ambient.w > 0.5, l.coverageShift.z);
+                   l.sunDiffuse.w, s, l.ambient.w > 0.5, l.coverageShift.z, l.band.x);
 }
 
 // Copies the frame's sampling numbers into the globals the hooks read.

@@ -96,6 +96,8 @@ struct SkyLayer {
                        // weight, w: 1 when the layer's wind varies over the map (its wind slice is read), else 0
   vec4 windRef;        // xyz: the layer's own wind, camera-local (m/s), which the noise origins drift with;
                        // w: the age of the map's tiles, weather clock minus the snapshot's (s)
+  vec4 band;           // x: the transition band's fraction of the shell at each end (heights and
+                       // thickness above are the shell's: the cloud with its band); yzw: unused
 };
 
 struct SkyFrame {
@@ -164,7 +166,7 @@ struct SkyFrame {
 #ifdef __cplusplus
 static_assert(sizeof(vec4) == 16 && sizeof(uvec4) == 16);
 static_assert(sizeof(SkyCloudType) == 64);
-static_assert(sizeof(SkyLayer) == 288);
+static_assert(sizeof(SkyLayer) == 304);
 static_assert(offsetof(SkyLayer, shapeOrigin) == 32);
 static_assert(offsetof(SkyLayer, ambient) == 96);
 static_assert(offsetof(SkyLayer, sunDiffuse) == 112);
@@ -178,15 +180,16 @@ static_assert(offsetof(SkyFrame, dispatch) == 256);
 static_assert(offsetof(SkyFrame, layers) == 272);
 static_assert(offsetof(SkyLayer, cloudMapOrigin) == 64);
 static_assert(offsetof(SkyLayer, flow) == 256);
-static_assert(offsetof(SkyFrame, weatherRings) == 272 + 288 * kMaxLayers);
-static_assert(offsetof(SkyFrame, steps) == 272 + 288 * kMaxLayers + 16);
-static_assert(offsetof(SkyFrame, interleave) == 272 + 288 * kMaxLayers + 32);
-static_assert(offsetof(SkyFrame, raster) == 272 + 288 * kMaxLayers + 48);
-static_assert(offsetof(SkyFrame, frustum) == 272 + 288 * kMaxLayers + 80);
-static_assert(offsetof(SkyFrame, airTable) == 272 + 288 * kMaxLayers + 96);
-static_assert(offsetof(SkyFrame, sunMap) == 272 + 288 * kMaxLayers + 112);
-static_assert(offsetof(SkyFrame, flashInfo) == 272 + 288 * kMaxLayers + 272);
-static_assert(sizeof(SkyFrame) == 272 + 288 * kMaxLayers + 288 + 16 * (kMaxFrameFlashes + 2 * kMaxFrameBoltSegments));
+static_assert(offsetof(SkyLayer, band) == 288);
+static_assert(offsetof(SkyFrame, weatherRings) == 272 + 304 * kMaxLayers);
+static_assert(offsetof(SkyFrame, steps) == 272 + 304 * kMaxLayers + 16);
+static_assert(offsetof(SkyFrame, interleave) == 272 + 304 * kMaxLayers + 32);
+static_assert(offsetof(SkyFrame, raster) == 272 + 304 * kMaxLayers + 48);
+static_assert(offsetof(SkyFrame, frustum) == 272 + 304 * kMaxLayers + 80);
+static_assert(offsetof(SkyFrame, airTable) == 272 + 304 * kMaxLayers + 96);
+static_assert(offsetof(SkyFrame, sunMap) == 272 + 304 * kMaxLayers + 112);
+static_assert(offsetof(SkyFrame, flashInfo) == 272 + 304 * kMaxLayers + 272);
+static_assert(sizeof(SkyFrame) == 272 + 304 * kMaxLayers + 288 + 16 * (kMaxFrameFlashes + 2 * kMaxFrameBoltSegments));
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

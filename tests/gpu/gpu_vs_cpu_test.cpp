@@ -47,6 +47,7 @@ struct Case {
   std::optional<render::ViewFrustum> frustum = std::nullopt;  // unset: the settings' symmetric one
   double sunElevation_deg = 40;  // at azimuth 135
   double upperCoverage = 0;      // > 0: a second layer of this coverage at 5-5.6 km, drawn
+  double band_m = 0;             // the layer's transition band below and above
 };
 
 // Renders each scene on the GPU and the CPU reference and checks the mean
@@ -58,6 +59,7 @@ void compareScenes(render::CloudRenderer& r, const render::CpuReference& referen
     SCOPED_TRACE(prefix + s.name);
     weather::CloudLayer l = layer(1, 1500, 1000, s.coverage, s.density);
     l.wind = {s.windSpeed_mps, 300.0, 0.0};
+    l.transitionBand_m = s.band_m;
     weather::WeatherSnapshot snap;
     if (s.tiled) {
       snap = tiledSnapshot(s.camera.position, l, float(s.coverage), float(s.density));
@@ -109,6 +111,30 @@ TEST(GpuVsCpu, RmseWithinTolerance) {
       {"type_blend_to_ci", pose(47, 8, 3000, 60, 20), true, 0.6, 0, 0, weather::CloudType::Cirrus},
   };
   compareScenes(r, *reference, scenes, "", false);
+}
+
+render::RenderSettings metresSettings();
+
+// A layer with a transition band of 300 m (the cloud fading across it,
+// layer_presence.glsl): from inside the lower band looking up, and from the
+// upper band looking down on tiles; the march in metres as well (its long
+// steps test for cloud with the cheap density, which fades the same).
+TEST(GpuVsCpu, TransitionBandWithinTolerance) {
+  SKY_RENDERER(r, 64, 36);
+  auto reference = render::CpuReference::create(r.settings());
+  ASSERT_TRUE(reference) << describe(reference.error());
+  std::vector<Case> scenes = {
+      {"band_below", pose(47, 8, 1350, 30, 25), false, 0.7, 0, 0},
+      {"band_above_tiled", pose(60, -150, 2650, 45, -30), true, 0.6, 5, 60},
+  };
+  for (Case& c : scenes) c.band_m = 300;
+  compareScenes(r, *reference, scenes, "", false);
+  const render::RenderSettings settings = metresSettings();
+  auto metres = render::CloudRenderer::create(settings);
+  ASSERT_TRUE(metres) << describe(metres.error());
+  auto metresReference = render::CpuReference::create(settings);
+  ASSERT_TRUE(metresReference) << describe(metresReference.error());
+  compareScenes(**metres, *metresReference, scenes, "metres_", false);
 }
 
 // The sky and the aerial perspective read from the air table (the default)

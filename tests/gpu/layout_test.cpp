@@ -19,8 +19,8 @@ using sky::gpu::SkyFrame;
 using sky::gpu::SkyLayer;
 
 std::string reflect() {
-  const std::string cmd = std::string(SKY_GLSLANG) + " --target-env vulkan1.2 -I" + SKY_SHADER_SOURCE_DIR +
-                          "/include -q " + SKY_SHADER_SOURCE_DIR + "/clouds.comp 2>&1";
+  const std::string cmd = std::string(SKY_GLSLANG) + " --target-env vulkan1.2 " + SKY_SHADER_INCLUDE_FLAGS + " -q " +
+                          SKY_SHADER_SOURCE_DIR + "/clouds.comp 2>&1";
   std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(cmd.c_str(), "r"), pclose);
   std::string out;
   if (!pipe) return out;
@@ -57,6 +57,7 @@ TEST(SharedLayout, GlslangOffsetsMatchCpp) {
       {"frame.layers.coverageShift", layers + offsetof(SkyLayer, coverageShift)},
       {"frame.layers.ambient", layers + offsetof(SkyLayer, ambient)},
       {"frame.layers.sunDiffuse", layers + offsetof(SkyLayer, sunDiffuse)},
+      {"frame.layers.band", layers + offsetof(SkyLayer, band)},
       {"frame.layers.primary.a", layers + offsetof(SkyLayer, primary) + offsetof(SkyCloudType, a)},
       {"frame.layers.primary.d", layers + offsetof(SkyLayer, primary) + offsetof(SkyCloudType, d)},
       {"frame.layers.secondary.a", layers + offsetof(SkyLayer, secondary) + offsetof(SkyCloudType, a)},

@@ -15,15 +15,24 @@
 
 namespace sky::weather {
 
+// The GLSL's functions, of external linkage so one this file does not call
+// is no warning.
+namespace presence_glsl {
+using real = double;
+using std::clamp;
+using std::min;
+#include "sky/weather/layer_presence.glsl"
+}  // namespace presence_glsl
+
 namespace {
 
-// Vertical presence of a layer at an altitude, [0, 1].
+// Vertical presence of a layer at an altitude, [0, 1]: the renderer's
+// (layer_presence.glsl) over the layer's shell.
 double presence(const CloudLayer& l, double alt_m) {
-  const double top = l.base_m + l.thickness_m;
-  if (alt_m >= l.base_m && alt_m <= top) return 1.0;
-  if (l.transitionBand_m <= 0) return 0.0;
-  const double outside = alt_m < l.base_m ? l.base_m - alt_m : alt_m - top;
-  return std::max(0.0, 1.0 - outside / l.transitionBand_m);
+  const double band = std::max(l.transitionBand_m, 0.0);
+  const double shell = l.thickness_m + 2 * band;
+  if (!(shell > 0)) return 0.0;
+  return presence_glsl::layerPresence((alt_m - (l.base_m - band)) / shell, band / shell);
 }
 
 }  // namespace

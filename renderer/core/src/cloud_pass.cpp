@@ -213,10 +213,14 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
   std::uint32_t layersDrawn = 0;
   for (std::uint32_t i = 0; i < std::uint32_t(frame.weatherMap.y) && i < gpu::kMaxLayers; ++i)
     layersDrawn += frame.layers[i].ambient.w < 0.5f ? 1 : 0;
-  // With the flow's code only where a layer's wind varies over the map.
+  // With the flow's code only where a layer's wind varies over the map or
+  // its noise is crossfading from one phase to the other (a fifth of the
+  // time for a layer with wind).
   bool windField = false;
-  for (std::uint32_t i = 0; i < std::uint32_t(frame.weatherMap.y) && i < gpu::kMaxLayers; ++i)
-    windField = windField || frame.layers[i].flow.w > 0.5f;
+  for (std::uint32_t i = 0; i < std::uint32_t(frame.weatherMap.y) && i < gpu::kMaxLayers; ++i) {
+    const gpu::vec4& flow = frame.layers[i].flow;
+    windField = windField || flow.w > 0.5f || (flow.z > 0.0f && flow.z < 1.0f);
+  }
   // With lightning's code only in a frame a flash lights.
   const bool lightning = frame.flashInfo.x > 0.5f || frame.flashInfo.y > 0.5f;
   auto cloudPipeline = pipelineFor(ctx, Stage::Clouds, layersDrawn, windField, lightning);

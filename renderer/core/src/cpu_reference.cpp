@@ -109,12 +109,12 @@ class CpuCore {
                                     real4(l.cloudMapOrigin, 1.0 / l.cloudMapPeriod_m),
                                     real3(l.coverageShift_m, double(i)), l.shapeStretchZ, l.flow, l.windRef,
                                     real3(0.0), real3(0.0)},
-                      l.absent, l.stepFactor};
+                      l.absent, l.stepFactor, l.band};
       } else {
         c = CoreLayer{0.0, 0.0, 0.0, 0.0, 1.0, 1.0, false, cumulus, cumulus, real3(0.0), real3(0.0), 0.0,
                       LayerSampling{real4(0.0), real4(0.0), real4(0.0), real3(0.0, 0.0, double(i)), 1.0, real4(0.0),
                                     real4(0.0), real3(0.0), real3(0.0)},
-                      true, 1.0};
+                      true, 1.0, 0.0};
       }
     }
     return f;

@@ -373,7 +373,12 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
   for (std::size_t slice = 0; slice < in.weather->layers.size(); ++slice) {
     const weather::CloudLayer& layer = in.weather->layers[slice];
     LayerSetup l;
-    l.thickness_m = layer.thickness_m;
+    // The shell: the cloud and its transition band, which the point query's
+    // answers fade the cloud over as well (layerPresence).
+    const double band_m = std::max(layer.transitionBand_m, 0.0);
+    const double shellBase_m = layer.base_m - band_m;
+    l.thickness_m = layer.thickness_m + 2 * band_m;
+    l.band = band_m / l.thickness_m;
     l.absent = maxCoverage(field, std::uint32_t(slice)) <= 0;
     // A uniform layer's own numbers; a tiled one's means over the fine ring
     // (a pass over the map, skipped when both factors are off: then it is 1).
@@ -393,32 +398,40 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
     l.shapeStretchZ = 1.0 / l.primary.streak;
     // The diffuse light the layer's top receives, over the camera: the sky,
     // and the sun through the air (cloud_core.glsl's diffuseLight).
-    const double top_m = std::max(layer.base_m + layer.thickness_m, 0.0);
+    const double top_m = std::max(shellBase_m + l.thickness_m, 0.0);
     l.skyTop = skyLight(tables, top_m, groundRadius_m, s.sunDir, s.sunIrradiance).meanRadiance;
     l.sunCosine = std::max(s.sunDir.z, 0.0);
     l.sunDiffuseTop = s.sunIrradiance * sunTransmittanceAt(tables, top_m, s.sunDir.z, groundRadius_m) *
                       (l.sunCosine / std::numbers::pi);
-    l.hBase_m = alt_m - layer.base_m;
-    l.hTop_m = alt_m - (layer.base_m + layer.thickness_m);
+    l.hBase_m = alt_m - shellBase_m;
+    l.hTop_m = alt_m - (shellBase_m + l.thickness_m);
     l.cBase_m2 = l.hBase_m * (2 * s.r_m - l.hBase_m);
     l.cTop_m2 = l.hTop_m * (2 * s.r_m - l.hTop_m);
     const weather::WindVector own = weather::toVector(layer.wind);
     const glm::dvec3 windEnu_mps(own.east_mps, own.north_mps, own.up_mps);
-    // Earth-fixed noise that drifts with the layer's own wind: sample
-    // (x - wind t). The drift uses the wind's direction at the camera, so it
-    // turns slowly (~1 degree per 100 km) as the camera travels. A wind that
-    // varies over the map moves the noise further by its difference from this
-    // (cloudSample's flow) and the tiles by its own (sampleWeather).
+    // Earth-fixed noise that drifts with the wind: sampled at (x - wind t),
+    // with t a flow phase's age (at most kWindFlowPeriod_s), not the weather
+    // clock. The drift is along the wind at the camera, in the camera's
+    // frame, which turns as the camera travels (the east by the longitude
+    // flown, ~1 degree per 100 km): a drift of the whole clock would slide
+    // the noise under a moving camera by the clock's drift times that angle
+    // (after a day of a 10 m/s wind, 196 m per km flown east), the phases'
+    // by at most 0.94 m (NoiseDrift test). Every layer with a wind flows,
+    // phase to phase across the crossfade (cloud_core.glsl's cloudSample);
+    // one whose wind varies over the map flows by the local wind, and its
+    // tiles drift by their own (sampleWeather).
     l.windEnu_mps = windEnu_mps;
     l.windAtCamera_mps = windEnu_mps;
     l.windRef = glm::dvec4(windEnu_mps, sinceSnapshot_s);
+    const bool flows = field.windVaries[slice] || glm::length(windEnu_mps) > 0;
+    l.flow = flows ? glm::dvec4(flow.x, flow.y, flow.z, field.windVaries[slice] ? 1.0 : 0.0)
+                   : glm::dvec4(0.0, 0.0, 1.0, 0.0);  // still air: phase A alone, never shifted
     if (field.windVaries[slice]) {
-      l.flow = glm::dvec4(flow.x, flow.y, flow.z, 1.0);
       const weather::WindVector here =
           wind.at(layer, in.camera.position.lat_deg, in.camera.position.lon_deg);
       l.windAtCamera_mps = glm::dvec3(here.east_mps, here.north_mps, here.up_mps);
     }
-    const glm::dvec3 origin = toGlm(enu.originEcef_m) - s.localToEcef * windEnu_mps * in.weatherClock_s;
+    const glm::dvec3 origin = toGlm(enu.originEcef_m);
     auto inPeriods = [&](double period_m, double stretchZ) {
       glm::dvec3 out;
       for (int k = 0; k < 3; ++k) {
@@ -595,6 +608,7 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
     g.secondary = packCloudType(l.secondary);
     g.flow = gpu::vec4(l.flow);
     g.windRef = gpu::vec4(l.windRef);
+    g.band = gpu::vec4(float(l.band), 0.0f, 0.0f, 0.0f);
   }
   // Unused slots keep a positive thickness and valid types so the shader's
   // per-layer setup never divides by 0.

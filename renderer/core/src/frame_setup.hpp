@@ -32,7 +32,11 @@ struct LayerSetup {
   double hTop_m = 0;        // camera height above the top
   double cBase_m2 = 0;      // hBase (2r - hBase)
   double cTop_m2 = 0;       // hTop (2r - hTop)
+  // The heights above and thickness_m are the layer's shell: its cloud from
+  // base to top with the transition band below and above (band: the band's
+  // fraction of the shell at each end; layer_presence.glsl).
   double thickness_m = 0;
+  double band = 0;
   double lightDistance_m = 0;      // what the secondary march towards the sun covers
   CloudTypeParams primary;         // the layer's type
   CloudTypeParams secondary;       // the type its tiles blend towards (= primary when none)

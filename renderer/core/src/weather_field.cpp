@@ -146,6 +146,7 @@ std::uint64_t weatherStructureKey(const weather::WeatherSnapshot* snapshot, cons
     mixLayerContent(h, layer);
     mix64(h, bitsOf(layer.base_m));
     mix64(h, bitsOf(layer.thickness_m));
+    mix64(h, bitsOf(layer.transitionBand_m));
     mix64(h, bitsOf(layer.wind.speed_mps));
     mix64(h, bitsOf(layer.wind.fromDirection_deg));
     mix64(h, bitsOf(layer.wind.vertical_mps));

@@ -6,11 +6,14 @@
 // L) along vertical and slant rays; the step integration conserves energy
 // (a conservative slab in a uniform radiance field leaves it uniform) and
 // has its sigma -> 0 limit; Haggstrom's height functions and anvils at
-// hand-computed points; the diffuse light's two-stream depth; ray-shell
+// hand-computed points; the diffuse light's two-stream depth; a transition
+// band's linear fade and its column above a height; ray-shell
 // distances for vertical, horizontal and grazing rays; cloud shadows on the
 // ground, in the air and on lower layers by the layers' two-stream depth.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -138,6 +141,49 @@ TEST(CloudCore, UniformSlabTransmitsBeerLambert) {
   EXPECT_EQ(r.transmittance, 1.0);
   EXPECT_TRUE(std::isfinite(r.inscatter.x));
   EXPECT_LT(r.inscatter.x, 1e-20);
+}
+
+// A transition band b below and above the slab's cloud (CIGI Weather
+// Control's Transition Band): the cloud fades linearly to nothing across
+// each band, so a vertical ray through the shell sees the optical depth of
+// H + b (half of each band); rays that start inside a band see the part
+// above them. The shell is the layer's heights with the band
+// (frame_setup.cpp); layerPresence is what the point query fades by too.
+TEST(CloudCore, TransitionBandFadesTheSlabLinearly) {
+  Core c;
+  const double R = 6371000, base = 1500, H = 1000, b = 250, sigma = 1e-3;
+  for (double alt : {500.0, 1375.0}) {  // below the shell; half-way up the lower band
+    SCOPED_TRACE("camera at " + std::to_string(alt) + " m");
+    Core::CoreFrame f = frameAt(c, R, alt, base - b, H + 2 * b, uniformType(sigma));
+    c.layers[0].band = b / (H + 2 * b);
+    const Core::Span up = c.layerSpan(f, c.layers[0], 1.0, 1e12);
+    EXPECT_NEAR(up.t1, base + H + b - alt, 1e-6);
+    const double t = c.marchLayer(f, 0, Core::real3(0, 0, 1), up, 0.5, 1.0).transmittance;
+    // The part of the lower band above the camera: b/2 less the part below it,
+    // (alt - (base - b))^2 / (2 b).
+    const double under = std::max(alt - (base - b), 0.0);
+    const double lower = 0.5 * b - 0.5 * under * under / b;
+    EXPECT_NEAR(-std::log(t), sigma * (lower + H + 0.5 * b), 2e-3 * sigma * (H + b));
+  }
+  // No band: the layer as before, however the shell is given.
+  Core::CoreFrame f = frameAt(c, R, 500, base, H, uniformType(sigma));
+  EXPECT_EQ(c.layers[0].band, 0.0);
+  EXPECT_NEAR(c.marchLayer(f, 0, Core::real3(0, 0, 1), c.layerSpan(f, c.layers[0], 1.0, 1e12), 0.5, 1.0).transmittance,
+              std::exp(-sigma * H), 1e-4);
+}
+
+// The column of cloud above a height in the shell (cloudShadow's and the
+// diffuse light's depth above) is the presence's integral, by quadrature.
+TEST(CloudCore, PresenceAboveIsThePresencesIntegral) {
+  Core c;
+  for (double band : {0.0, 0.05, 0.25, 0.49})
+    for (double ph = -0.1; ph <= 1.1; ph += 0.02) {
+      constexpr int kN = 20000;
+      double sum = 0;
+      const double from = std::clamp(ph, 0.0, 1.0);
+      for (int i = 0; i < kN; ++i) sum += c.layerPresence(from + (i + 0.5) * (1 - from) / kN, band);
+      EXPECT_NEAR(c.layerPresenceAbove(ph, band), sum * (1 - from) / kN, 1e-6) << "band " << band << " ph " << ph;
+    }
 }
 
 // Hillaire's step integral conserves energy exactly: in a uniform, isotropic

@@ -184,7 +184,7 @@ inline Core::CoreLayer shellLayer(const Core::CoreFrame& f, double alt, double b
                          0.5 * thickness, false, t, t, Core::real3(0), Core::real3(0), 1.0,
                          Core::LayerSampling{Core::real4(0.0), Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), 1.0,
                                              Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), Core::real3(0.0)},
-                         false, 1.0};
+                         false, 1.0, 0.0};
 }
 
 }  // namespace sky::test
