@@ -206,7 +206,8 @@ void Server::onAccept(const boost::system::error_code& ec, tcp::socket socket) {
              registry_.size() + 1);
   registry_.add(session);
   const stream::Hello hello{stream::kProtocolVersion, options_.serverId, clockNow(), weather_.clock().rate(),
-                            stream::kFeatureCameraReports | stream::kFeatureAreas | stream::kFeatureHostClock};
+                            stream::kFeatureCameraReports | stream::kFeatureAreas | stream::kFeatureHostClock |
+                                stream::kFeatureTileDrift};
   session->start(stream::encodeFrame(stream::encodeMessage(hello)));
   renderersChanged();
   accept();

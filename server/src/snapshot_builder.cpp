@@ -506,12 +506,39 @@ std::size_t tileCount(const BuiltSnapshot& built) {
   return n;
 }
 
+namespace {
+
+// Which of the table's layers have tiles that move with the wind after the
+// snapshot's clock (CloudLayer::tilesDrift): those only drifting regions in
+// reach of the area give. A region that does not drift, a METAR station
+// (it replaces every layer round it) or the forecast's field holds its
+// tiles where they are; where both kinds give one layer it is held, and a
+// drifting region's part of it moves when the server sends it again.
+void markDriftingTiles(std::vector<weather::CloudLayer>& table, std::span<const weather::Region> regions,
+                       const weather::SphericalCap& cap, const LayerField* field) {
+  std::set<std::uint32_t> drifts, holds;
+  for (const weather::Region& r : regions) {
+    if (sphereDistance_m(cap.centerLat_deg, cap.centerLon_deg, r.centerLat_deg, r.centerLon_deg) >
+        cap.radius_m + reachOf(r))
+      continue;
+    std::set<std::uint32_t>& into = r.driftsWithWind ? drifts : holds;
+    if (r.replacesAllLayers)
+      for (const weather::CloudLayer& l : table) into.insert(l.id);
+    for (const weather::CloudLayer& l : r.layers) into.insert(l.id);
+  }
+  for (weather::CloudLayer& l : table)
+    l.tilesDrift = drifts.count(l.id) && !holds.count(l.id) && !(field && field->gives(l.id));
+}
+
+}  // namespace
+
 BuiltSnapshot buildSnapshotWithGenerations(const stream::Subscribe& request,
                                            std::span<const weather::CloudLayer> layers, double clock_s,
                                            std::size_t maxCells, std::span<const weather::Region> regions,
                                            TileCache* cache, const LayerField* field) {
   const weather::CellCentre centre{request.area.centerLat_deg, request.area.centerLon_deg};
-  const std::vector<weather::CloudLayer> table = snapshotLayers(layers, regions, &centre, request.area.radius_m);
+  std::vector<weather::CloudLayer> table = snapshotLayers(layers, regions, &centre, request.area.radius_m);
+  markDriftingTiles(table, regions, request.area, field);
   BuiltSnapshot built;
   weather::WeatherSnapshot& snapshot = built.snapshot;
   snapshot.weatherClock_s = clock_s;

@@ -27,7 +27,7 @@ flatbuffers::Offset<fbs::Layer> encodeLayer(flatbuffers::FlatBufferBuilder& b,
   return fbs::CreateLayer(b, l.id, static_cast<std::uint8_t>(l.type),
                           static_cast<float>(l.base_m), static_cast<float>(l.thickness_m),
                           static_cast<float>(l.transitionBand_m), static_cast<float>(l.coverage),
-                          static_cast<float>(l.density), &wind);
+                          static_cast<float>(l.density), &wind, l.tilesDrift);
 }
 
 Result<void> checkFinite(const char* message, const char* field, double v) {
@@ -95,6 +95,7 @@ Result<weather::CloudLayer> decodeLayer(const char* message, const fbs::Layer& l
   layer.coverage = l.coverage();
   layer.density = l.density();
   if (const fbs::Wind* w = l.wind()) layer.wind = {w->speed_mps(), w->from_deg(), w->vertical_mps()};
+  layer.tilesDrift = l.tiles_drift();
   if (auto r = weather::validate(layer); !r)
     return fail(ErrorCode::InvalidArgument, std::string(message) + ": " + r.error().detail);
   return layer;

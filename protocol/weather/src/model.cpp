@@ -248,7 +248,7 @@ std::optional<WeatherDelta> diffSnapshots(const WeatherSnapshot& before, const W
                         b->transitionBand_m == a.transitionBand_m && b->coverage == a.coverage &&
                         b->density == a.density && b->wind.speed_mps == a.wind.speed_mps &&
                         b->wind.fromDirection_deg == a.wind.fromDirection_deg &&
-                        b->wind.vertical_mps == a.wind.vertical_mps;
+                        b->wind.vertical_mps == a.wind.vertical_mps && b->tilesDrift == a.tilesDrift;
       if (!same) d.layers.push_back(a);
     } else {
       d.layers.push_back(a);

@@ -127,7 +127,9 @@ CoverageLookup snapshotLookup(const WeatherSnapshot& snapshot, double clock_s) {
   return [index, tiled, since_s, level, wind](const CloudLayer& layer, double lat_deg,
                                               double lon_deg) -> std::optional<CoverageTile> {
     if (!tiled->count(layer.id)) return std::nullopt;
-    const SurfacePoint upwind = upwindOf({lat_deg, lon_deg}, wind->at(layer, lat_deg, lon_deg), since_s);
+    const SurfacePoint upwind =
+        layer.tilesDrift ? upwindOf({lat_deg, lon_deg}, wind->at(layer, lat_deg, lon_deg), since_s)
+                         : SurfacePoint{lat_deg, lon_deg};
     const auto it = index->find({layer.id, cellAt(upwind.lat_deg, upwind.lon_deg, level)});
     if (it == index->end()) {
       CoverageTile empty;

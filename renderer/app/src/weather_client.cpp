@@ -39,6 +39,12 @@ std::string cutUtf8(std::string s, std::size_t max) {
   return s;
 }
 
+// A server without kFeatureTileDrift leaves Layer.tiles_drift unset and
+// meant every layer's tiles to move with the wind.
+void allTilesDrift(std::vector<weather::CloudLayer>& layers) {
+  for (weather::CloudLayer& l : layers) l.tilesDrift = true;
+}
+
 }  // namespace
 
 WeatherClient::WeatherClient(asio::io_context& io, SharedState& state, std::string host, unsigned short port,
@@ -160,6 +166,7 @@ void WeatherClient::onFrame(std::span<const std::uint8_t> payload) {
                    // channel proposes again, and the first one wins for all.
                    state_.setHostClock(std::nullopt);
                    serverTakesHostClock_ = (h.features & stream::kFeatureHostClock) != 0;
+                   serverMarksTileDrift_ = (h.features & stream::kFeatureTileDrift) != 0;
                    spdlog::info("weather server '{}' protocol {} clock {:.1f} s x{}{}{}",
                                 flight::messageText(h.serverId, kMaxEchoedServerText),
                                 h.protocolVersion, h.weatherClock_s, h.clockRate,
@@ -175,9 +182,21 @@ void WeatherClient::onFrame(std::span<const std::uint8_t> payload) {
                  [&](const weather::WeatherSnapshot& s) {
                    spdlog::info("weather snapshot of area {}: {} layers, {} tiles at S2 level {}", s.areaIndex,
                                 s.layers.size(), s.tiles.size(), s.tileLevel);
-                   state_.setSnapshot(s, now);
+                   if (serverMarksTileDrift_) {
+                     state_.setSnapshot(s, now);
+                   } else {
+                     weather::WeatherSnapshot drifting = s;
+                     allTilesDrift(drifting.layers);
+                     state_.setSnapshot(drifting, now);
+                   }
                  },
-                 [&](const weather::WeatherDelta& d) {
+                 [&](const weather::WeatherDelta& delta) {
+                   weather::WeatherDelta drifting;
+                   if (!serverMarksTileDrift_) {
+                     drifting = delta;
+                     allTilesDrift(drifting.layers);
+                   }
+                   const weather::WeatherDelta& d = serverMarksTileDrift_ ? delta : drifting;
                    if (auto r = state_.applyDelta(d, now); !r) {
                      ++malformed_;
                      spdlog::warn("weather stream: dropped a Delta: {}; asking for a new Snapshot", r.error().detail);

@@ -422,7 +422,11 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
     // tiles drift by their own (sampleWeather).
     l.windEnu_mps = windEnu_mps;
     l.windAtCamera_mps = windEnu_mps;
-    l.windRef = glm::dvec4(windEnu_mps, sinceSnapshot_s);
+    // How long the layer's tiles have moved with the wind since the
+    // snapshot: its age where they drift (a drifting region's), none where
+    // the server holds them in place (CloudLayer::tilesDrift).
+    const double tileAge_s = layer.tilesDrift ? sinceSnapshot_s : 0.0;
+    l.windRef = glm::dvec4(windEnu_mps, tileAge_s);
     const bool flows = field.windVaries[slice] || glm::length(windEnu_mps) > 0;
     l.flow = flows ? glm::dvec4(flow.x, flow.y, flow.z, field.windVaries[slice] ? 1.0 : 0.0)
                    : glm::dvec4(0.0, 0.0, 1.0, 0.0);  // still air: phase A alone, never shifted
@@ -448,15 +452,18 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
     l.shapeOrigin = inPeriods(l.shapePeriod_m, l.shapeStretchZ);
     l.detailOrigin = inPeriods(l.detailPeriod_m, 1.0);
     l.cloudMapOrigin = inPeriods(l.cloudMapPeriod_m, 1.0);
-    // The coverage tiles are the server's field at the snapshot's clock; the
-    // air over the camera now was, then, where the shared advection formula
-    // (weather::upwindOf, with the wind over the camera) says: the map is
-    // sampled that far upwind. East/north of the camera's frame. A layer
+    // The coverage tiles are the server's field at the snapshot's clock.
+    // Where they drift, the air over the camera now was, then, where the
+    // shared advection formula (weather::upwindOf, with the wind over the
+    // camera) says: the map is sampled that far upwind, east/north of the
+    // camera's frame, as one shift (at 100 km from the camera it parts from
+    // each point's own upwind by about 1.6 % of the drift: TileDrift test);
+    // where the server holds them, not at all. A layer
     // whose wind varies reads each point's own (sampleWeather), and this
     // shift only places its changed tiles for the history (history_drop).
     const weather::SurfacePoint upwind = weather::upwindOf(
         {in.camera.position.lat_deg, in.camera.position.lon_deg},
-        {l.windAtCamera_mps.x, l.windAtCamera_mps.y, l.windAtCamera_mps.z}, sinceSnapshot_s);
+        {l.windAtCamera_mps.x, l.windAtCamera_mps.y, l.windAtCamera_mps.z}, tileAge_s);
     const geo::Vec3d upwindEcef = geo::toEcef({upwind.lat_deg, upwind.lon_deg, alt_m});
     const glm::dvec3 drift = inFrame(enu, enu.originEcef_m - upwindEcef);
     // A uniform layer is the same everywhere: it does not drift off the map

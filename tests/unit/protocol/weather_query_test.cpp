@@ -70,6 +70,7 @@ TEST(WeatherQuery, SnapshotTilesAreCarriedByTheWind) {
   s.weatherClock_s = 100;
   s.tileLevel = kLevel;
   s.layers = {layer(1, 1000, 1000, 0, 0.0, {10, 270, 0}), layer(2, 3000, 500, 0, 0.4, {0, 0, 0})};
+  s.layers[0].tilesDrift = true;  // a drifting region's tiles
   const SurfacePoint p{47.0, 8.0};
   s.tiles.push_back({cellAt(p.lat_deg, p.lon_deg, kLevel), 1, 1.0f, 0.5f});
   // At the snapshot's clock: the tile is there, its neighbour cell is empty.
@@ -85,6 +86,12 @@ TEST(WeatherQuery, SnapshotTilesAreCarriedByTheWind) {
   EXPECT_GT(east.lon_deg, p.lon_deg + 0.1);
   EXPECT_DOUBLE_EQ(weatherAt(s.layers, later, east.lat_deg, east.lon_deg, 1500).cloudDensity, 0.5);
   EXPECT_DOUBLE_EQ(weatherAt(s.layers, later, p.lat_deg, p.lon_deg, 1500).cloudDensity, 0.0);
+  // Tiles the server holds in place (a still region's, a station's, a
+  // forecast's) are where they were, however old the snapshot.
+  s.layers[0].tilesDrift = false;
+  auto held = snapshotLookup(s, 1100);
+  EXPECT_DOUBLE_EQ(weatherAt(s.layers, held, p.lat_deg, p.lon_deg, 1500).cloudDensity, 0.5);
+  EXPECT_DOUBLE_EQ(weatherAt(s.layers, held, east.lat_deg, east.lon_deg, 1500).cloudDensity, 0.0);
 }
 
 TEST(WeatherQuery, StandardAtmosphere) {

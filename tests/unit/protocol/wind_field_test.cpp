@@ -136,6 +136,7 @@ TEST(WindFieldTest, AShearMovesEachSideByItsOwnWind) {
   // one cloud tile on each side. After 600 s each is found 6 km along its
   // own wind, and nothing where it was.
   CloudLayer l = layerWith(1, {0, 0, 0});
+  l.tilesDrift = true;  // a drifting region's tiles
   const int level = 12, windLevel = 9;
   WeatherSnapshot s;
   s.weatherClock_s = 1000;

@@ -19,6 +19,9 @@
 #include "atmosphere_tables.hpp"
 #include "frame_setup.hpp"
 #include "sky/geo/geodetic.hpp"
+#include "sky/weather/advection.hpp"
+#include "sky/weather/tiling.hpp"
+#include "sky/weather/wind_field.hpp"
 #include "weather_field.hpp"
 #include "weather_field_update.hpp"
 
@@ -27,7 +30,8 @@ namespace {
 
 constexpr double kLat = 46.0, kLon = 14.5, kPi = 3.14159265358979323846;
 
-FrameSetup frameAt(const weather::WeatherSnapshot& snap, double lat, double lon, double clock_s) {
+FrameSetup frameAt(const weather::WeatherSnapshot& snap, double lat, double lon, double clock_s,
+                   WeatherField* fieldOut = nullptr) {
   FrameInputs in;
   in.camera.position = {lat, lon, 500.0};
   in.camera.pitch_deg = 20;
@@ -39,6 +43,7 @@ FrameSetup frameAt(const weather::WeatherSnapshot& snap, double lat, double lon,
   settings.height = 18;
   WeatherFieldUpdater updater;
   updater.update(&snap, nullptr, weatherAnchorFor(in.camera.position));
+  if (fieldOut != nullptr) *fieldOut = updater.field();
   return prepareFrame(settings, in, updater.field(), sharedAtmosphereTables());
 }
 
@@ -63,17 +68,22 @@ double torusDistance(const glm::dvec3& a, const glm::dvec3& b, double period) {
   return std::sqrt(sum);
 }
 
-TEST(NoiseDrift, ACameraThatMovesDoesNotSlideTheNoiseAtAnyClock) {
-  weather::WeatherSnapshot snap;
+// Cumulus 1200-2700 m in a 10 m/s westerly.
+weather::CloudLayer westerlyCumulus(double coverage) {
   weather::CloudLayer l;
   l.id = 1;
   l.type = weather::CloudType::Cumulus;
   l.base_m = 1200;
   l.thickness_m = 1500;
-  l.coverage = 0.5;
+  l.coverage = coverage;
   l.density = 1;
   l.wind = {10.0, 270.0, 0.0};
-  snap.layers = {l};
+  return l;
+}
+
+TEST(NoiseDrift, ACameraThatMovesDoesNotSlideTheNoiseAtAnyClock) {
+  weather::WeatherSnapshot snap;
+  snap.layers = {westerlyCumulus(0.5)};
   const geo::Vec3d p = geo::toEcef({kLat + 0.15, kLon + 0.2, 1800.0});
   const glm::dvec3 x(p.x, p.y, p.z);
   // Clocks half-way through a flow period (frame_setup.hpp's
@@ -98,6 +108,77 @@ TEST(NoiseDrift, ACameraThatMovesDoesNotSlideTheNoiseAtAnyClock) {
     const FrameSetup later = frameAt(snap, kLat, kLon, clock_s + 10);
     const glm::dvec3 moved = shapeCoordinate(later, x) + a.localToEcef * glm::dvec3(100, 0, 0);
     EXPECT_LT(torusDistance(shapeCoordinate(a, x), moved, period), 0.01);
+  }
+}
+
+// The coverage tiles of a drifting region drift too: the server's tiles are
+// the weather at the snapshot's clock, and the map is read that far upwind.
+// For a layer with one wind everywhere the shift is the geodesic upwind of
+// the camera over the snapshot's age, applied as one flat shift in the
+// map's plane (frame_setup.cpp's coverageShift_m); the exact place is the
+// geodesic upwind of each point itself (weather::upwindOf, what the point
+// query reads). They part with the distance from the camera (the wind's
+// direction turns with the longitude) in proportion to the drift: measured
+// 1.6 % of it at 100 km east (98 m after 10 minutes of 10 m/s, 590 m after
+// an hour, 3.5 km after 6 hours), bounded here at 2 % so that a change for
+// the worse is seen. A camera moving 1 km under the same map anchor slides
+// the tiles by under 1 m at any age; when the map moves to the next anchor
+// (5 km on) the error's share there changes, a step of about 1.6 % of the
+// drift per 100 km (9 m after an hour, 177 m after 6 hours). Tiles the server holds in place (a still region, a station, a
+// forecast) are not shifted at all.
+TEST(TileDrift, TheFlatShiftPartsFromTheGeodesicByDistanceAndAge) {
+  constexpr int kLevel = 11;
+  weather::WeatherSnapshot snap;
+  snap.tileLevel = kLevel;
+  weather::CloudLayer l = westerlyCumulus(0);  // only the tiles make cloud
+  l.tilesDrift = true;
+  snap.layers = {l};
+  for (std::uint64_t cell : weather::coverCap({kLat, kLon, 20000.0}, kLevel, 4000)) snap.tiles.push_back({cell, 1, 0.5f, 1.0f});
+  const weather::WindVector wind = weather::toVector(l.wind);
+  // Where the map is read for the ground point (lat, lon): its plane point
+  // less the shift, brought back to the ground by the inverse gnomonic.
+  auto readAt = [](const WeatherField& f, const LayerSetup& layer, double lat, double lon) {
+    const geo::Vec3d d = geo::toEcef({lat, lon, 0.0}) - f.centreEcef_m;
+    const double u = geo::dot(d, f.frame.up);
+    const glm::dvec2 plane =
+        glm::dvec2(geo::dot(d, f.frame.east), geo::dot(d, f.frame.north)) * (f.radius_m / u) - layer.coverageShift_m;
+    const geo::Vec3d dir = geo::normalize(f.frame.east * plane.x + f.frame.north * plane.y + f.frame.up * f.radius_m);
+    return geo::fromEcef(f.centreEcef_m + dir * (f.radius_m - f.anchorAlt_m));
+  };
+  const double kmEast = 1.0 / (111.195 * std::cos(kLat * kPi / 180));
+  for (double age_s : {600.0, 3600.0, 6 * 3600.0}) {
+    SCOPED_TRACE("snapshot age " + std::to_string(age_s) + " s");
+    WeatherField field;
+    const FrameSetup s = frameAt(snap, kLat, kLon, age_s, &field);
+    ASSERT_TRUE(field.tiled.at(0));
+    const LayerSetup& layer = s.layers.at(0);
+    double worst = 0;
+    for (const auto& [name, dLat, dLon] : {std::tuple{"at the camera", 0.0, 0.0}, std::tuple{"50 km east", 0.0, 50 * kmEast},
+                                           std::tuple{"100 km east", 0.0, 100 * kmEast},
+                                           std::tuple{"100 km north", 100 / 111.195, 0.0}}) {
+      const geo::Geodetic read = readAt(field, layer, kLat + dLat, kLon + dLon);
+      const weather::SurfacePoint exact = weather::upwindOf({kLat + dLat, kLon + dLon}, wind, age_s);
+      const double off = geo::geodesicDistance_m(read.lat_deg, read.lon_deg, exact.lat_deg, exact.lon_deg);
+      worst = std::max(worst, off);
+      std::printf("[ tiles    ] snapshot %5.0f s old, point %-13s: the map is read %7.1f m from the geodesic upwind\n",
+                  age_s, name, off);
+    }
+    EXPECT_LT(worst, 0.02 * 10.0 * age_s);
+    // The camera 1 km east, the same anchor: the same point reads the same place.
+    WeatherField fieldB;
+    const FrameSetup b = frameAt(snap, kLat, kLon + kmEast, age_s, &fieldB);
+    ASSERT_TRUE(sameAnchor(field.anchor, fieldB.anchor));
+    const geo::Geodetic ra = readAt(field, layer, kLat, kLon + 50 * kmEast);
+    const geo::Geodetic rb = readAt(fieldB, b.layers.at(0), kLat, kLon + 50 * kmEast);
+    const double slide = geo::geodesicDistance_m(ra.lat_deg, ra.lon_deg, rb.lat_deg, rb.lon_deg);
+    std::printf("[ tiles    ] snapshot %5.0f s old: the camera 1 km east slides the tiles %.3f m\n", age_s, slide);
+    EXPECT_LT(slide, 1.0);
+    // Held in place: read where they are.
+    weather::WeatherSnapshot held = snap;
+    held.layers[0].tilesDrift = false;
+    const FrameSetup h = frameAt(held, kLat, kLon, age_s);
+    EXPECT_EQ(h.layers.at(0).coverageShift_m, glm::dvec2(0.0));
+    EXPECT_EQ(h.layers.at(0).windRef.w, 0.0);
   }
 }
 

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <numbers>
 #include <set>
+#include <utility>
+#include <vector>
 
 #include <s2/s1angle.h>
 #include <s2/s2cap.h>
@@ -15,6 +17,8 @@
 
 #include "sky/server/snapshot_builder.hpp"
 #include "sky/stream/framing.hpp"
+#include "sky/stream/messages.hpp"
+#include "sky/weather/query.hpp"
 #include "sky/weather/region.hpp"
 #include "sky/weather/tiling.hpp"
 
@@ -230,6 +234,80 @@ TEST(BuildSnapshot, ManyLayersOverALargeCapStillFitOneFrame) {
   auto decoded = stream::decodeMessage(payload);
   ASSERT_TRUE(decoded) << decoded.error().detail;
   EXPECT_EQ(std::get<weather::WeatherSnapshot>(*decoded).tiles.size(), s.tiles.size());
+}
+
+}  // namespace
+}  // namespace sky::server
+namespace sky::server {
+namespace {
+
+// A region that does not drift holds its cloud where it is, however old the
+// renderer's snapshot of it grows (no change, no new snapshot); a drifting
+// region's tiles move with its wind to where the server has it. Both read
+// as the renderers read them: through the stream's encoding and
+// snapshotLookup at later clocks. Before layers carried tilesDrift, every
+// tile moved: 10 minutes after the snapshot the still region's centre read
+// coverage 0 (it had blown 6 km east).
+TEST(BuildSnapshot, AStillRegionHoldsItsTilesAndADriftingOneMovesThem) {
+  weather::CloudLayer still = layer(1, 1.0, 1.0), moving = layer(2, 1.0, 1.0);
+  still.wind = moving.wind = {10.0, 270.0, 0.0};  // from the west
+  weather::CloudLayer globalStill = still, globalMoving = moving;
+  globalStill.coverage = globalMoving.coverage = 0;
+  const std::vector<weather::CloudLayer> layers = {globalStill, globalMoving};
+  weather::Region station;
+  station.id = 3;
+  station.centerLat_deg = 46;
+  station.centerLon_deg = 14;
+  station.sizeX_m = station.sizeY_m = 10'000;
+  station.layers = {still};
+  weather::Region cell = station;
+  cell.id = 4;
+  cell.centerLat_deg = 46.2;
+  cell.driftsWithWind = true;
+  cell.layers = {moving};
+  const std::vector<weather::Region> regions = {station, cell};
+  const weather::WeatherSnapshot built = buildSnapshot(request(46.1, 14.2, 60'000, 11), layers, 0.0, kDefaultMaxCells, regions);
+  // What a renderer receives.
+  auto decoded = stream::decodeMessage(stream::encodeMessage(built));
+  ASSERT_TRUE(decoded) << decoded.error().detail;
+  const auto& s = std::get<weather::WeatherSnapshot>(*decoded);
+  ASSERT_EQ(s.layers.size(), 2u);
+  EXPECT_FALSE(s.layers[0].tilesDrift) << "the still region's layer";
+  EXPECT_TRUE(s.layers[1].tilesDrift) << "the drifting region's layer";
+  for (double age_s : {0.0, 600.0, 3600.0}) {
+    SCOPED_TRACE("snapshot age " + std::to_string(age_s) + " s");
+    const weather::CoverageLookup lookup = weather::snapshotLookup(s, age_s);
+    const auto atStation = lookup(s.layers[0], station.centerLat_deg, station.centerLon_deg);
+    ASSERT_TRUE(atStation);
+    EXPECT_FLOAT_EQ(atStation->coverage, 1.0f);
+    // The drifting region where the server has it at that clock, and not
+    // where it was.
+    const weather::Region there = weather::regionAt(cell, age_s);
+    const auto atCell = lookup(s.layers[1], there.centerLat_deg, there.centerLon_deg);
+    ASSERT_TRUE(atCell);
+    EXPECT_FLOAT_EQ(atCell->coverage, 1.0f);
+    if (age_s >= 3600) {  // 36 km on: off the 10 km region's old place
+      const auto whereItWas = lookup(s.layers[1], cell.centerLat_deg, cell.centerLon_deg);
+      ASSERT_TRUE(whereItWas);
+      EXPECT_FLOAT_EQ(whereItWas->coverage, 0.0f);
+    }
+  }
+  // A layer both kinds give is held (the server sends it again when it
+  // changes); a METAR station holds every layer round it.
+  weather::Region sharing = cell;
+  sharing.layers = {still};
+  weather::Region metar = station;
+  metar.centerLat_deg = 46.2;
+  metar.centerLon_deg = 14.4;
+  metar.replacesAllLayers = true;
+  metar.layers = {};
+  for (const auto& [name, rs] : {std::pair{"a drifting and a still region on layer 1",
+                                           std::vector<weather::Region>{station, sharing}},
+                                 std::pair{"a METAR station beside the drifting region",
+                                           std::vector<weather::Region>{cell, metar}}}) {
+    const weather::WeatherSnapshot both = buildSnapshot(request(46.1, 14.2, 60'000, 11), layers, 0.0, kDefaultMaxCells, rs);
+    for (const auto& l : both.layers) EXPECT_FALSE(l.tilesDrift) << name << ": layer " << l.id;
+  }
 }
 
 }  // namespace

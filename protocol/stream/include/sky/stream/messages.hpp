@@ -42,6 +42,7 @@ static_assert(kMaxMessageTiles == weather::kMaxSnapshotTiles, "a snapshot holds 
 inline constexpr std::uint32_t kFeatureCameraReports = 1u << 0;  // takes CameraReport
 inline constexpr std::uint32_t kFeatureAreas = 1u << 1;          // takes Subscribe.areaIndex > 0
 inline constexpr std::uint32_t kFeatureHostClock = 1u << 2;      // takes HostClock proposals
+inline constexpr std::uint32_t kFeatureTileDrift = 1u << 3;      // sets Layer.tiles_drift (else: all drift)
 
 // Areas of interest one connection may hold (Subscribe::areaIndex): a
 // renderer asks for its detailed area around the camera (0) and a wider one

@@ -57,6 +57,13 @@ struct CloudLayer {
   double coverage = 0;          // fraction of area covered, [0, 1]
   double density = 1;           // multiplier of the type's extinction, [0, 1]
   LayerWind wind;
+  // Set by the server in a snapshot's or delta's layer table, not by an
+  // operator: whether this layer's coverage tiles move with the wind after
+  // the message's weather clock (they come from regions that drift) or stay
+  // where they are (regions that do not drift, METAR stations, a forecast's
+  // grid), the server sending them again when they change. Readers of the
+  // tiles (snapshotLookup, the renderers' weather map) place them by it.
+  bool tilesDrift = false;
 };
 
 // Checks every field against its range; the error names the first bad field,

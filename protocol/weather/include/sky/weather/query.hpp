@@ -46,9 +46,10 @@ PointWeather weatherAt(std::span<const CloudLayer> layers, const CoverageLookup&
                        double lon_deg, double alt_m, const WindLookup& windLookup = {});
 
 // A lookup over a snapshot's tiles at weather clock clock_s: the tile of the
-// point's S2 cell at the snapshot's level, the point first carried back by
-// the layer's wind at the point (its wind field's, upwindOf) from clock_s to
-// the snapshot's clock. A layer with tiles is empty where it has none; a
+// point's S2 cell at the snapshot's level; for a layer whose tiles drift
+// (CloudLayer::tilesDrift), the point first carried back by the layer's
+// wind at the point (its wind field's, upwindOf) from clock_s to the
+// snapshot's clock. A layer with tiles is empty where it has none; a
 // layer without tiles is uniform. The lookup keeps no reference to the
 // snapshot.
 CoverageLookup snapshotLookup(const WeatherSnapshot& snapshot, double clock_s);

@@ -98,6 +98,9 @@ class WeatherClient {
   std::atomic<bool> serverTakesReports_{false};
   std::atomic<bool> serverTakesAreas_{false};
   std::atomic<bool> serverTakesHostClock_{false};
+  // The server marks which layers' tiles drift (kFeatureTileDrift); an
+  // older server meant all of them to. Read on the stream's thread only.
+  bool serverMarksTileDrift_ = false;
   std::atomic<bool> reportNow_{false};  // after a (re)connect: the next call reports
   std::atomic<std::uint64_t> reportsSent_{0};
   // reportCamera's throttle, on the caller's thread.
