@@ -361,6 +361,20 @@ int main(int argc, char** argv) {
     std::signal(SIGTERM, onReplaySignal);
     return sky::app::runHeadlessReplay(r, **renderer, &gReplayStop);
   }
+  // A live channel builds every variant of the cloud pass now: built at the
+  // first frame that needs one (a flow's crossfade, the first flash), each
+  // stalled that frame by about half a second on lavapipe. A replay renders
+  // offline and builds them as it goes.
+  {
+    const auto started = Clock::now();
+    auto built = (*renderer)->buildAllVariants();
+    if (!built) {
+      std::fprintf(stderr, "skyshell-render: %s\n", sky::describe(built.error()).c_str());
+      return 3;
+    }
+    spdlog::info("built {} variants of the cloud pass in {:.1f} s", *built,
+                 std::chrono::duration<double>(Clock::now() - started).count());
+  }
   auto writer = sky::app::FrameWriter::open(o.outDir, outputs, {o.preset, (*renderer)->settings()});
   if (!writer) {
     std::fprintf(stderr, "skyshell-render: %s\n", sky::describe(writer.error()).c_str());

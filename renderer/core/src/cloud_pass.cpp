@@ -198,6 +198,35 @@ Result<const ComputePipeline*> CloudPass::pipelineFor(const GpuContext& ctx, Sta
   return &*slot;
 }
 
+Result<std::size_t> CloudPass::buildAllVariants(const GpuContext& ctx) {
+  const std::size_t before = variantsBuilt();
+  for (const bool wind : {false, true}) {
+    for (const std::uint32_t layers : {0u, 1u, 2u})
+      for (const bool lightning : {false, true})
+        if (auto built = pipelineFor(ctx, Stage::Clouds, layers, wind, lightning); !built)
+          return tl::unexpected(built.error());
+    // As run() asks for them: the table where it is on, the sun map where
+    // its method has a map (and only for frames with layers).
+    if (airTableSize_.enabled)
+      for (const std::uint32_t layers : {0u, 1u})
+        if (auto built = pipelineFor(ctx, Stage::AirTable, layers, wind); !built) return tl::unexpected(built.error());
+    if (sunMapParts(sunMapSize_.method) > 0)
+      if (auto built = pipelineFor(ctx, Stage::SunMap, 1, wind); !built) return tl::unexpected(built.error());
+  }
+  return variantsBuilt() - before;
+}
+
+std::size_t CloudPass::variantsBuilt() const {
+  std::size_t n = 0;
+  for (const auto& byLayers : cloudPipelines_)
+    for (const auto& byLightning : byLayers)
+      for (const auto& p : byLightning) n += p.has_value();
+  for (const auto& byLayers : tablePipelines_)
+    for (const auto& p : byLayers) n += p.has_value();
+  for (const auto& p : sunMapPipelines_) n += p.has_value();
+  return n;
+}
+
 void CloudPass::setCoverageMip(const std::vector<float>& mip) {
   SKY_ASSERT(mip.size() * sizeof(float) == coverageMip_.size);
   std::memcpy(coverageMip_.mapped, mip.data(), coverageMip_.size);

@@ -70,6 +70,13 @@ class CloudPass {
   // Replaces the max-coverage mip the march reads (coverage_mip.hpp; size
   // kMaxLayers x kCoverageMipSize^2). Call between runs.
   void setCoverageMip(const std::vector<float>& mip);
+  // Builds every variant of the pass's shaders not built yet, so that no
+  // later run waits for a compile: on lavapipe about 0.2 s a pipeline, and
+  // a wind crossfade's or a flash's first frame took 0.5 s longer than the
+  // next. Returns how many it built. Errors as run's.
+  Result<std::size_t> buildAllVariants(const GpuContext& ctx);
+  // How many variants are built (by either way).
+  std::size_t variantsBuilt() const;
   // GPU time of the last run's dispatches ("sun-map", "air-table", "clouds", then "reproject", "upscale").
   std::vector<PassTime> lastTimes() const { return timer_.results(); }
 

@@ -289,6 +289,12 @@ Result<bool> CloudRenderer::present(const Image& image) {
   });
 }
 
+Result<std::size_t> CloudRenderer::buildAllVariants() {
+  return atVulkanEdge("building the pass's variants", [&] { return impl_->pass.buildAllVariants(*impl_->ctx); });
+}
+
+std::size_t CloudRenderer::variantsBuilt() const { return impl_->pass.variantsBuilt(); }
+
 const std::string& CloudRenderer::noiseReport() const { return impl_->noiseReport; }
 
 const std::vector<PassTime>& CloudRenderer::lastPassTimes() const { return impl_->passTimes; }
