@@ -15,8 +15,8 @@
 
 namespace sky::weather {
 
-// The GLSL's functions, of external linkage so one this file does not call
-// is no warning.
+// The GLSL's functions in a named namespace (external linkage), so that one
+// this file does not call raises no unused-function warning.
 namespace presence_glsl {
 using real = double;
 using std::clamp;
