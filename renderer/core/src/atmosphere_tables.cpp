@@ -12,6 +12,7 @@
 
 #include "sky/core/assert.hpp"
 #include "sky/render/haze.hpp"
+#include "glsl_double.hpp"
 #include "sky_light_grid.hpp"
 
 namespace sky::render {
@@ -21,14 +22,8 @@ namespace {
 // The core calls GLSL built-ins unqualified; GLM provides them.
 using namespace glm;
 
-class AirCore {
+class AirCore : public GlslDouble {
  public:
-  using real = double;
-  using real2 = glm::dvec2;
-  using real3 = glm::dvec3;
-  using real4 = glm::dvec4;
-  using real3x3 = glm::dmat3;
-  using uint = std::uint32_t;
 
   explicit AirCore(const AtmosphereTables* tables) : tables_(tables) {}
 

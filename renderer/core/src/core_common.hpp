@@ -5,22 +5,16 @@
 // include it with the rest of the core instead.
 #pragma once
 
-#include <cstdint>
-
 #include <glm/glm.hpp>
+
+#include "glsl_double.hpp"
 
 namespace sky::render {
 
 namespace core_common_glsl {
 // The GLSL calls GLM's built-ins unqualified.
 using namespace glm;
-struct CoreCommon {
-  using real = double;
-  using real2 = glm::dvec2;
-  using real3 = glm::dvec3;
-  using real4 = glm::dvec4;
-  using real3x3 = glm::dmat3;
-  using uint = std::uint32_t;
+struct CoreCommon : GlslDouble {
 #define SKY_CORE_CONST static constexpr
 #include "core_common.glsl"
 #undef SKY_CORE_CONST

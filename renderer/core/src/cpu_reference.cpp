@@ -15,6 +15,7 @@
 #include "blue_noise.hpp"
 #include "coverage_mip.hpp"
 #include "frame_setup.hpp"
+#include "glsl_double.hpp"
 #include "noise_volume.hpp"
 #include "sky_shared.h"
 #include "weather_field.hpp"
@@ -37,14 +38,8 @@ using gpu::kMaxLayers;
 using gpu::kWindMapLayers;
 using gpu::kWindMapScale_mps;
 
-class CpuCore {
+class CpuCore : public GlslDouble {
  public:
-  using real = double;
-  using real2 = glm::dvec2;
-  using real3 = glm::dvec3;
-  using real4 = glm::dvec4;
-  using real3x3 = glm::dmat3;
-  using uint = std::uint32_t;
 
   CpuCore(const FrameSetup& setup, const NoiseVolume& shape, const NoiseVolume& detail,
           const AtmosphereTables& atmosphere, const WeatherField& weather, const std::vector<float>& blueNoise)

@@ -23,20 +23,15 @@
 #include "sky/render/ephemeris.hpp"
 #include "sky/render/haze.hpp"
 #include "weather_field.hpp"
+#include "glsl_double.hpp"
 
 namespace sky::render {
 namespace {
 
 using namespace glm;
 
-class Air {
+class Air : public GlslDouble {
  public:
-  using real = double;
-  using real2 = glm::dvec2;
-  using real3 = glm::dvec3;
-  using real4 = glm::dvec4;
-  using real3x3 = glm::dmat3;
-  using uint = std::uint32_t;
 
   explicit Air(const AtmosphereTables* t) : tables(t) {}
   real3 sampleTransmittanceLut(real2 uv) const { return tables->sampleTransmittance(uv); }

@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 
 #include "air_table_texels.hpp"
+#include "glsl_double.hpp"
 #include "sun_map_texels.hpp"
 #include "sky_shared.h"
 
@@ -20,14 +21,8 @@ using namespace glm;
 using gpu::kMaxLayers;
 using gpu::kWindMapScale_mps;
 
-class Core {
+class Core : public render::GlslDouble {
  public:
-  using real = double;
-  using real2 = glm::dvec2;
-  using real3 = glm::dvec3;
-  using real4 = glm::dvec4;
-  using real3x3 = glm::dmat3;
-  using uint = std::uint32_t;
 
   real coverage = 1.0, density = 1.0, blend = 0.0, noise = 1.0, detail = 0.5;
   real2 cloudMap = real2(0.5, 1.0);

@@ -7,15 +7,14 @@
 #include <glm/glm.hpp>
 #include <gtest/gtest.h>
 
+#include "glsl_double.hpp"
+
 namespace sky::test {
 namespace {
 
 using namespace glm;
 
-struct Clip {
-  using real = double;
-  using real3 = glm::dvec3;
-  using real4 = glm::dvec4;
+struct Clip : render::GlslDouble {
 #include "history_clip.glsl"
 };
 
