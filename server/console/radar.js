@@ -2,15 +2,18 @@
 // view's centre, from the same tiles the renderers draw, as an image in the
 // usual weather radar colours over the map's ground. Asked for after a move
 // ends, every RADAR_REFRESH_MS and when the weather changes, at most one
-// request in flight.
+// request in flight (request_loop.js).
 import { request } from "./api.js";
 import { direct, inverse, normalizeLon } from "./geo.js";
+import { RequestLoop } from "./request_loop.js";
 
 const L = window.L;
 
 // Cells a side of the picture asked for, and the API's range (km).
 const RADAR_SIZE = 128;
 const RADAR_RANGE_KM = [1, 300];
+// Asked again this long after the map stops, and this often while shown
+// (ms): the wind field's times (weather_overlay.js), for the same reasons.
 const RADAR_SETTLE_MS = 300, RADAR_REFRESH_MS = 5000;
 
 // From 5 dBZ in 5-dBZ steps, the last from 70 up: the renderer's
@@ -30,33 +33,41 @@ export const RadarLayer = L.Layer.extend({
     L.setOptions(this, { pane });
     this.shown = false;
     this.answer = null;  // the last answer drawn
-    this.inFlight = false;
-    this.again = false;
+    this.loop = new RequestLoop({
+      wanted: () => this.shown && !!this._map,
+      send: async () => {
+        const q = this.query();
+        const url = `/api/radar?lat=${q.lat.toFixed(5)}&lon=${q.lon.toFixed(5)}&range_km=${q.range_km}&size=${RADAR_SIZE}`;
+        return { r: await request("GET", url), url };
+      },
+      answered: ({ r, url }) => {
+        if (r.ok && r.body && Array.isArray(r.body.dbz)) this.draw(r.body, url);
+      },
+      settle_ms: RADAR_SETTLE_MS, refresh_ms: RADAR_REFRESH_MS,
+    });
   },
   onAdd(map) {
-    map.on("moveend zoomend resize", this.moved, this);
+    map.on("moveend zoomend resize", this.loop.moved, this.loop);
+    this.loop.start();
   },
   onRemove(map) {
-    map.off("moveend zoomend resize", this.moved, this);
+    map.off("moveend zoomend resize", this.loop.moved, this.loop);
     this.clear();
-    clearTimeout(this.settleTimer);
-    clearTimeout(this.refreshTimer);
+    this.loop.stop();
   },
 
   set(shown) {
     if (shown === this.shown) return;
     this.shown = shown;
-    if (shown) this.ask();
-    else this.clear();
+    if (shown) this.loop.ask();
+    else {
+      this.loop.cancel();
+      this.clear();
+    }
   },
 
   weatherChanged() {
-    if (this.shown) this.ask();
-  },
-
-  moved() {
-    clearTimeout(this.settleTimer);
-    if (this.shown) this.settleTimer = setTimeout(() => this.ask(), RADAR_SETTLE_MS);
+    this.loop.ask();
   },
 
   clear() {
@@ -78,28 +89,6 @@ export const RadarLayer = L.Layer.extend({
     }
     const range_km = Math.max(RADAR_RANGE_KM[0], Math.min(RADAR_RANGE_KM[1], Math.round(far_m / 1000)));
     return { lat, lon, range_km };
-  },
-
-  async ask() {
-    if (!this.shown || !this._map) return;
-    if (this.inFlight) {
-      this.again = true;
-      return;
-    }
-    clearTimeout(this.refreshTimer);
-    this.inFlight = true;
-    const q = this.query();
-    const url = `/api/radar?lat=${q.lat.toFixed(5)}&lon=${q.lon.toFixed(5)}&range_km=${q.range_km}&size=${RADAR_SIZE}`;
-    const r = await request("GET", url);
-    this.inFlight = false;
-    if (!this.shown) return;
-    if (r.ok && r.body && Array.isArray(r.body.dbz)) this.draw(r.body, url);
-    if (this.again) {
-      this.again = false;
-      this.ask();
-    } else {
-      this.refreshTimer = setTimeout(() => this.ask(), RADAR_REFRESH_MS);
-    }
   },
 
   draw(answer, url) {

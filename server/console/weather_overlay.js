@@ -8,6 +8,7 @@ import { request } from "./api.js";
 import { coverageAt, regionWeight } from "./coverage.js";
 import { el } from "./dom.js";
 import { inverse, MERCATOR_MAX_LAT_DEG, normalizeLon } from "./geo.js";
+import { RequestLoop } from "./request_loop.js";
 import { fmt, ftFromM, ktFromMps } from "./units.js";
 
 const L = window.L;
@@ -293,9 +294,17 @@ export const WindFieldLayer = L.Layer.extend({
     this.units = "m";
     this.answer = null;   // the last answer drawn: GET /api/wind's body and its query
     this.error = null;
-    this.inFlight = false;
-    this.again = false;
     this.drawn = [];      // [{x, y, tail, tip, arrow}] in container px, for picking
+    this.loop = new RequestLoop({
+      wanted: () => this.shown && !!this._map,
+      send: async () => {
+        const q = this.query();
+        return { q, r: await request("GET", `/api/wind?lat_deg=${q.lat_deg.toFixed(5)}&lon_deg=${q.lon_deg.toFixed(5)}` +
+          `&alt_m=${fmt(q.alt_m, 2)}&radius_m=${q.radius_m}`) };
+      },
+      answered: ({ q, r }) => this.answered(q, r),
+      settle_ms: WIND_SETTLE_MS, refresh_ms: WIND_REFRESH_MS, pauseHidden: true,
+    });
   },
   onAdd(map) {
     this.svg = L.SVG.create("svg");
@@ -303,22 +312,14 @@ export const WindFieldLayer = L.Layer.extend({
     this.getPane().appendChild(this.svg);
     this.legend = new WindLegend();
     map.on("moveend zoomend resize viewreset", this.moved, this);
-    // A tab in the background skips its refreshes and asks once it is back.
-    this.visible = () => {
-      if (document.hidden || !this.refreshSkipped) return;
-      this.refreshSkipped = false;
-      this.ask();
-    };
-    document.addEventListener("visibilitychange", this.visible);
+    this.loop.start();
     this.redraw();
   },
   onRemove(map) {
     L.DomUtil.remove(this.svg);
     if (this.shown) this.legend.remove();
     map.off("moveend zoomend resize viewreset", this.moved, this);
-    document.removeEventListener("visibilitychange", this.visible);
-    clearTimeout(this.settleTimer);
-    clearTimeout(this.refreshTimer);
+    this.loop.stop();
   },
 
   // Shows or hides the field; alt_m (MSL, WIND_ALT_LIMITS_M) and units ("m"
@@ -330,21 +331,20 @@ export const WindFieldLayer = L.Layer.extend({
     if (!shown) {
       this.answer = null;
       this.error = null;
-      clearTimeout(this.refreshTimer);
+      this.loop.cancel();
     }
-    if (ask) this.ask();
+    if (ask) this.loop.ask();
     this.redraw();
   },
 
   // The weather changed (a state message): ask again.
   weatherChanged() {
-    if (this.shown) this.ask();
+    this.loop.ask();
   },
 
   moved() {
     this.redraw();
-    clearTimeout(this.settleTimer);
-    if (this.shown) this.settleTimer = setTimeout(() => this.ask(), WIND_SETTLE_MS);
+    this.loop.moved();
   },
 
   // The cap that covers the view: its centre, and the distance to its
@@ -361,19 +361,8 @@ export const WindFieldLayer = L.Layer.extend({
     return { lat_deg, lon_deg, alt_m: this.alt_m, radius_m, capped: far_m * WIND_RADIUS_MARGIN > WIND_RADIUS_LIMITS_M[1] };
   },
 
-  async ask() {
-    if (!this.shown || !this._map) return;
-    if (this.inFlight) {
-      this.again = true;
-      return;
-    }
-    clearTimeout(this.refreshTimer);
-    this.inFlight = true;
-    const q = this.query();
-    const r = await request("GET", `/api/wind?lat_deg=${q.lat_deg.toFixed(5)}&lon_deg=${q.lon_deg.toFixed(5)}` +
-      `&alt_m=${fmt(q.alt_m, 2)}&radius_m=${q.radius_m}`);
-    this.inFlight = false;
-    if (!this.shown) return;
+  // GET /api/wind's answer to the query q: drawn, or why not in the legend.
+  answered(q, r) {
     if (r.ok && r.body && Array.isArray(r.body.arrows)) {
       this.answer = { ...r.body, query: q };
       this.error = null;
@@ -382,15 +371,6 @@ export const WindFieldLayer = L.Layer.extend({
         : `wind field not loaded: ${(r.body && r.body.error) || `HTTP ${r.status}`}`;
     }
     this.redraw();
-    if (this.again) {
-      this.again = false;
-      this.ask();
-    } else {
-      this.refreshTimer = setTimeout(() => {
-        if (document.hidden) this.refreshSkipped = true;
-        else this.ask();
-      }, WIND_REFRESH_MS);
-    }
   },
 
   redraw() {
