@@ -981,6 +981,115 @@ cases.radar = async (cleanup) => {
   noProblems(a.problems);
 };
 
+// A precipitation layer's type edited as an operator does it: rain of
+// density 0.2 (an extinction of 2 /km, exact in the stream's 8 bits) up to
+// 2 km, its row picked in the layer table, its type set to snow, applied
+// with the token. GET /api/state then has layer 9 as snow with every other
+// value as it was, and GET /api/conditions 500 m up under it answers snow at
+// the rate the snow law gives for that extinction (3.5 R^0.7 /km = 2: 0.449
+// mm/h; it answered rain at 0.25 R^0.63 /km = 2: 27.1 mm/h before) with
+// Gunn-Marshall's 26.1 dBZ (10 log10(2000 R^2)) and the same visibility (the
+// density is the extinction, whatever the type). The refused edits leave
+// the state and the answer as they were: a density of 1.5 (refused next to
+// its field, nothing sent); a second page, its editor disabled without the
+// token, and with a wrong one the server's 401 (read-only again after);
+// through the API hail of density 1.5 with the token (400 naming the
+// density) and hail without the token (401).
+cases.precipitation_type = async (cleanup) => {
+  const { w, browser } = await setup("precipitation_type", cleanup);
+  const density = 0.2, extinction_perkm = 10 * density;  // 0.01 /m per unit density (precipitation.hpp)
+  const rain = { id: 9, type: "rain", base_m: 0, thickness_m: 2000, transition_band_m: 0, coverage: 1, density,
+    wind: { speed_mps: 5, from_deg: 270, vertical_mps: 0 } };
+  const r = await w.api("POST", "/api/changes", { author: "precipitation-test",
+    changes: [{ op: "set_layer", layer: rain }] });
+  assert(r.status === 200, `API change: ${r.text}`);
+  // The layers as the server states them (its key order), to compare with after.
+  const start = await w.state();
+  const rain9 = start.layers.find((l) => l.id === 9), layer1 = start.layers.find((l) => l.id === 1);
+  assert(rain9 && rain9.type === "rain" && rain9.density === density, `layer 9 as sent: ${JSON.stringify(rain9)}`);
+  const point = "/api/conditions?lat_deg=46.2&lon_deg=14.5&alt_m=500";
+  const conditions = async () => {
+    const c = await w.api("GET", point);
+    assert(c.status === 200, `GET ${point}: ${c.status} ${c.text}`);
+    return c.json;
+  };
+  const rainRate_mmph = (extinction_perkm / 0.25) ** (1 / 0.63), snowRate_mmph = (extinction_perkm / 3.5) ** (1 / 0.7);
+  const before = await until("rain at the point", async () => {
+    const c = await conditions();
+    return c.precipitation && c.precipitation.type === "rain" && c;
+  });
+  console.log(`  before: ${JSON.stringify(before.precipitation)}, visibility ${before.visibility_m} m`);
+  near(before.precipitation.rate_mmph, rainRate_mmph, 0.01 * rainRate_mmph, "rain's rate at 2 /km");
+
+  const allowed = [{ text: /status of 401/, url: /\/api\/changes$/, why: "page B's wrong token, refused on purpose" }];
+  const a = await openConsole(browser, w, { token: TOKEN, name: "A" });
+  const typeField = '#layer-form [name="type"]';
+  await until("layer 9 in the table", async () => /rain/.test(await rowText(a.page, 9)));
+  await a.page.click('#layer-table tbody tr[data-id="9"]');
+  assert((await a.page.inputValue(typeField)) === "rain", "the editor shows layer 9's type");
+  await a.page.selectOption(typeField, "snow");
+  const edited = Date.now();
+  await a.page.click("#layer-apply");
+  await until("A's note to say applied", async () => /applied #/.test(await a.page.textContent("#layers .note")));
+  const s = await w.state();
+  const l9 = s.layers.find((l) => l.id === 9);
+  assert(JSON.stringify(l9) === JSON.stringify({ ...rain9, type: "snow" }),
+    `layer 9 as snow, nothing else changed: ${JSON.stringify(l9)} (was ${JSON.stringify(rain9)})`);
+  assert(JSON.stringify(s.layers.find((l) => l.id === 1)) === JSON.stringify(layer1), "layer 1 untouched");
+  const after = await until("snow at the point", async () => {
+    const c = await conditions();
+    return c.precipitation && c.precipitation.type === "snow" && c;
+  });
+  console.log(`  after: ${JSON.stringify(after.precipitation)}, visibility ${after.visibility_m} m ` +
+    `(${Date.now() - edited} ms from Apply)`);
+  near(after.precipitation.rate_mmph, snowRate_mmph, 0.01 * snowRate_mmph, "snow's rate at 2 /km");
+  near(after.precipitation.reflectivity_dbz, 10 * Math.log10(2000 * snowRate_mmph ** 2), 0.1, "Gunn-Marshall dBZ");
+  near(after.visibility_m, before.visibility_m, 0.005 * before.visibility_m, "the same extinction, the same visibility");
+  await until("A's table to say snow", async () => /snow/.test(await rowText(a.page, 9)));
+
+  // What the refused edits must leave as it is.
+  const unchanged = async (what) => {
+    const now = await w.state();
+    assert(now.sequence === s.sequence && JSON.stringify(now.layers) === JSON.stringify(s.layers),
+      `${what} changed the state: ${JSON.stringify(now.layers)}`);
+    const c = await conditions();
+    assert(c.precipitation && c.precipitation.type === "snow" &&
+      Math.abs(c.precipitation.rate_mmph - after.precipitation.rate_mmph) < 1e-9,
+    `${what} changed the point's answer: ${JSON.stringify(c.precipitation)}`);
+  };
+  // A's draft with a density out of range: named next to the field, not sent.
+  let posts = 0;
+  a.page.on("request", (req) => { if (req.method() === "POST") ++posts; });
+  await a.page.selectOption(typeField, "hail");
+  await a.page.fill('#layer-form [name="density"]', "1.5");
+  await a.page.click("#layer-apply");
+  await new Promise((res) => setTimeout(res, 500));
+  const densityError = await a.page.textContent('#layer-form [data-err="density"]');
+  assert(/outside 0–1/.test(densityError), `the density's message: ${densityError}`);
+  assert(posts === 0, `a draft with density 1.5 was sent (${posts} POSTs)`);
+  await unchanged("a draft with density 1.5");
+  // B without the token: read-only; with a wrong one the server refuses.
+  const b = await openConsole(browser, w, { name: "B", allowed });
+  for (const sel of ["#layer-apply", typeField]) assert(await b.page.isDisabled(sel), `${sel} disabled in B without the token`);
+  await b.page.fill('[name="token"]', "not-the-token");
+  await b.page.click("#token-use");
+  await b.page.click('#layer-table tbody tr[data-id="9"]');
+  await b.page.selectOption(typeField, "hail");
+  await b.page.click("#layer-apply");
+  await until("B's refusal", async () => /refused the token/.test(await b.page.textContent("#layers .note")));
+  assert(/read-only/.test(await b.page.textContent("#token-state")), "B is read-only after the refusal");
+  await unchanged("B's edit with a wrong token");
+  // The API's own refusals, asked from outside the browser.
+  const hail = { ...rain, type: "hail" };
+  const bad = await w.api("POST", "/api/changes", { changes: [{ op: "set_layer", layer: { ...hail, density: 1.5 } }] });
+  assert(bad.status === 400 && bad.json && /density/.test(bad.json.error), `hail of density 1.5: ${bad.status} ${bad.text}`);
+  console.log(`  refused: ${bad.text}`);
+  const noToken = await w.api("POST", "/api/changes", { changes: [{ op: "set_layer", layer: hail }] }, null);
+  assert(noToken.status === 401, `hail without the token: ${noToken.status} ${noToken.text}`);
+  await unchanged("the API's refused edits");
+  noProblems(a.problems, b.problems);
+};
+
 // Lightning asked for from the console (POST /api/events): an in-cloud
 // flash at the map's centre as the page reports it (#map data-focus) is in
 // GET /api/events, asked here, at that place (1e-6 deg) and of that kind; the
