@@ -2,7 +2,7 @@
 // one, each costs that frame a pipeline compile; a live channel builds them
 // all at start (CloudRenderer::buildAllVariants), and then no frame builds
 // one, whatever it draws: the flow's crossfade, a flash, one layer or two,
-// a clear sky. Counted, not timed (the machine is shared); the times are
+// a clear sky, rain at the camera (the near-precipitation pass). Counted, not timed (the machine is shared); the times are
 // printed.
 #include <chrono>
 #include <cstdio>
@@ -58,6 +58,10 @@ std::unique_ptr<render::CloudRenderer> fresh() {
 
 TEST(PassVariants, AfterBuildingThemAllNoFrameBuildsOne) {
   const weather::WeatherSnapshot one = windy(false), two = windy(true), clear;
+  weather::WeatherSnapshot rainy = windy(false);
+  weather::CloudLayer rain = layer(3, 0, 1500, 1.0, 0.1);
+  rain.type = weather::CloudType::Rain;
+  rainy.layers.push_back(rain);
   // Built as needed: the flow's first crossfade (clock 150 s of its 600 s
   // period) builds the wind variant at that frame.
   auto lazy = fresh();
@@ -98,7 +102,8 @@ TEST(PassVariants, AfterBuildingThemAllNoFrameBuildsOne) {
   };
   std::vector<Case> cases = {{"still phase", frameAt(&one, 0)},       {"crossfade", frameAt(&one, 150)},
                              {"two layers crossfading", frameAt(&two, 450)}, {"clear sky", frameAt(&clear, 10)},
-                             {"flash", frameAt(&one, 300.01)},         {"flash in a crossfade", frameAt(&two, 150.01)}};
+                             {"flash", frameAt(&one, 300.01)},         {"flash in a crossfade", frameAt(&two, 150.01)},
+                             {"rain at the camera", frameAt(&rainy, 20)}};
   weather::LightningFlash inCrossfade = flash;
   inCrossfade.time_s = 150;
   const std::vector<weather::LightningFlash> flashAt300{flash}, flashAt150{inCrossfade};
@@ -111,6 +116,7 @@ TEST(PassVariants, AfterBuildingThemAllNoFrameBuildsOne) {
     std::printf("[ variants ] %-24s %.0f ms\n", c.name, msSince(t));
     EXPECT_EQ(eager->variantsBuilt(), all) << c.name << " built a variant";
   }
+  EXPECT_GT(eager->lastNearPrecip().streaks, 0u) << "the rain case drew its drops";
   // Building them again builds none.
   auto again = eager->buildAllVariants();
   ASSERT_TRUE(again);

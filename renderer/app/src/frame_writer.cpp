@@ -53,6 +53,7 @@ nlohmann::json marchJson(const render::MarchSettings& m) {
           {"density_step_min", m.densityStepMin},
           {"air_steps", m.airSteps},
           {"cloud_shadows", m.cloudShadows},
+          {"near_precipitation", m.nearPrecipitation},
           {"air_table", m.airTable.enabled ? nlohmann::json{{"azimuths", m.airTable.azimuths},
                                                             {"zeniths", m.airTable.zeniths},
                                                             {"slices", m.airTable.slices}}
@@ -194,6 +195,15 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
                        {"reason", r.sunMap.reason},
                        {"rows", {r.sunMap.rowBegin, r.sunMap.rowEnd}},
                        {"completed", r.sunMap.completed}};
+  if (r.nearPrecip.type != weather::CloudType::None)
+    line["near_precipitation"] = {{"type", std::string(weather::toString(r.nearPrecip.type))},
+                                  {"rate_mmph", r.nearPrecip.rate_mmph},
+                                  {"drops", r.nearPrecip.drops},
+                                  {"capped", r.nearPrecip.capped},
+                                  {"streaks", r.nearPrecip.streaks},
+                                  {"faint", r.nearPrecip.faint},
+                                  {"drop_area_px2", r.nearPrecip.dropArea_px2},
+                                  {"camera_speed_mps", r.nearPrecip.cameraSpeed_mps}};
   if (outputs_.png) line["file"] = std::string(name) + ".png";
   if (outputs_.exr) line["exr"] = std::string(name) + ".exr";
   metadata_ << line.dump() << '\n';

@@ -28,6 +28,7 @@ Result<render::Image> timedRender(render::CloudRenderer& renderer, const render:
   record.gpu = renderer.lastPassTimes();
   record.temporal = renderer.lastTemporal();
   record.sunMap = renderer.lastSunMap();
+  record.nearPrecip = renderer.lastNearPrecip();
   record.weatherMap = renderer.lastWeatherMap();
   record.stats = render::computeStats(*image);
   // The same choice as the renderer's frame setup: the ephemeris when the

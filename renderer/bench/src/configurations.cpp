@@ -119,6 +119,7 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     else if (key == "depth-aware" && (v == 0 || v == 1)) c.settings.resolution.depthAware = v == 1;
     else if (key == "blue" && (v == 0 || v == 1)) m.blueNoise = v == 1;
     else if (key == "cloud-shadows" && (v == 0 || v == 1)) m.cloudShadows = v == 1;
+    else if (key == "near-precip" && (v == 0 || v == 1)) m.nearPrecipitation = v == 1;
     else if (key == "budget" && base && v == std::floor(v)) {
       // Level v of the base preset's frame-budget ladder (frame_budget.hpp).
       auto ladder = render::budgetLadder(*base);

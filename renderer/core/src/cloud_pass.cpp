@@ -150,7 +150,7 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
       vk::WriteDescriptorSet(set, gpu::kBindingSunMap, 0, vk::DescriptorType::eCombinedImageSampler, sunInfo)};
   device.updateDescriptorSets(writes, {});
 
-  pass.timer_ = GpuTimer(ctx, 5, "sky.clouds.timer");
+  pass.timer_ = GpuTimer(ctx, 6, "sky.clouds.timer");
   pass.commands_ = ctx.allocateCommandBuffer();
   ctx.name(pass.commands_, "sky.clouds.commands");
   pass.fence_ = vk::raii::Fence(device, vk::FenceCreateInfo());
@@ -235,6 +235,7 @@ void CloudPass::setCoverageMip(const std::vector<float>& mip) {
 Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, const Followers& next) {
   SKY_ASSERT((next.reproject == nullptr) == (next.reprojectParams == nullptr));
   SKY_ASSERT((next.upscale == nullptr) == (next.upscaleParams == nullptr));
+  SKY_ASSERT((next.nearPrecip == nullptr) == (next.nearPrecipFrame == nullptr));
   SKY_ASSERT(next.reproject != nullptr || frame.interleave.x == 1);
   std::memcpy(uniforms_.mapped, &frame, sizeof frame);
   // The variants for the layers this frame draws (with coverage somewhere:
@@ -337,6 +338,7 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
   if (next.reproject != nullptr) next.reproject->record(commands_, timer_, *next.reprojectParams, next.dropCells);
   if (next.upscale != nullptr)
     next.upscale->record(commands_, timer_, *next.upscaleParams);
+  if (next.nearPrecip != nullptr) next.nearPrecip->record(commands_, timer_, *next.nearPrecipFrame);
   if (next.reproject == nullptr && next.upscale == nullptr) {
     const std::array toHost{
         vk::BufferMemoryBarrier(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eHostRead,

@@ -17,6 +17,7 @@
 #include "gpu_context.hpp"
 #include "gpu_memory.hpp"
 #include "gpu_timer.hpp"
+#include "near_precip_pass.hpp"
 #include "noise_volume.hpp"
 #include "reproject_pass.hpp"
 #include "upscale_pass.hpp"
@@ -53,6 +54,9 @@ class CloudPass {
     std::span<const std::uint32_t> dropCells;  // the history-drop mask, when reprojectParams->drop.w is set
     UpscalePass* upscale = nullptr;
     const gpu::SkyUpscale* upscaleParams = nullptr;
+    // Last, over the image the others left: the drops near the camera.
+    NearPrecipPass* nearPrecip = nullptr;
+    const NearPrecipFrame* nearPrecipFrame = nullptr;
   };
 
   // Dispatches one frame and its followers and reads back the image the
@@ -77,7 +81,8 @@ class CloudPass {
   Result<std::size_t> buildAllVariants(const GpuContext& ctx);
   // How many variants are built (by either way).
   std::size_t variantsBuilt() const;
-  // GPU time of the last run's dispatches ("sun-map", "air-table", "clouds", then "reproject", "upscale").
+  // GPU time of the last run's dispatches ("sun-map", "air-table", "clouds", then "reproject", "upscale",
+  // "near-precip").
   std::vector<PassTime> lastTimes() const { return timer_.results(); }
 
  private:

@@ -19,6 +19,8 @@
 #include "coverage_mip.hpp"
 #include "frame_setup.hpp"
 #include "gpu_context.hpp"
+#include "near_precip.hpp"
+#include "near_precip_pass.hpp"
 #include "noise_volume.hpp"
 #include "presenter.hpp"
 #include "sun_map_plan.hpp"
@@ -49,6 +51,25 @@ struct CloudRenderer::Impl {
   TemporalReport temporal{};  // what the reprojection did with the last frame
   SunMapPlanner sunMaps{};
   SunMapReport sunMap{};      // what became of the sun map in the last frame
+  NearPrecipSource nearSource{};
+  NearPrecipFrame nearFrame{};  // the last frame's streaks (kept for its buffers)
+  NearPrecipReport nearReport{};
+  // Built at the first frame with drops to draw (or by buildAllVariants):
+  // a renderer that never meets precipitation never compiles its shaders.
+  std::optional<NearPrecipPass> nearPass{};
+
+  // The buffer of the image the frame ends with, which the host reads back.
+  const GpuBuffer& finalImage() const {
+    return upscale ? upscale->output() : reproject ? reproject->output() : pass.output();
+  }
+  Result<NearPrecipPass*> nearPrecipPass() {
+    if (!nearPass) {
+      auto created = NearPrecipPass::create(*ctx, settings.width, settings.height, finalImage());
+      if (!created) return tl::unexpected(created.error());
+      nearPass.emplace(std::move(*created));
+    }
+    return &*nearPass;
+  }
 };
 
 namespace {
@@ -255,6 +276,27 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
       next.upscale = &*impl_->upscale;
       next.upscaleParams = &upscaleBlock;
     }
+    // The drops near the camera, when it is in precipitation.
+    impl_->nearReport = {};
+    const NearPrecipInputs nearIn = impl_->nearSource.inputs(impl_->settings, inputs, setup);
+    impl_->nearReport.cameraSpeed_mps = glm::length(nearIn.cameraEnu_mps);
+    if (nearIn.type != weather::CloudType::None && nearIn.rate_mmph > 0) {
+      impl_->nearFrame = buildNearPrecip(nearIn);
+      const NearPrecipFrame& near = impl_->nearFrame;
+      impl_->nearReport.type = nearIn.type;
+      impl_->nearReport.rate_mmph = nearIn.rate_mmph;
+      impl_->nearReport.drops = near.population.count;
+      impl_->nearReport.capped = near.population.capped;
+      impl_->nearReport.streaks = std::uint32_t(near.streaks.size());
+      impl_->nearReport.faint = near.faint;
+      impl_->nearReport.dropArea_px2 = near.dropArea_px2;
+      if (!near.streaks.empty()) {
+        auto nearPass = impl_->nearPrecipPass();
+        if (!nearPass) return tl::unexpected(nearPass.error());
+        next.nearPrecip = *nearPass;
+        next.nearPrecipFrame = &near;
+      }
+    }
     auto image = impl_->pass.run(*impl_->ctx, frame, next);
     if (!image) {
       if (plan) impl_->planner.forget();
@@ -290,10 +332,16 @@ Result<bool> CloudRenderer::present(const Image& image) {
 }
 
 Result<std::size_t> CloudRenderer::buildAllVariants() {
-  return atVulkanEdge("building the pass's variants", [&] { return impl_->pass.buildAllVariants(*impl_->ctx); });
+  return atVulkanEdge("building the pass's variants", [&]() -> Result<std::size_t> {
+    auto built = impl_->pass.buildAllVariants(*impl_->ctx);
+    if (!built) return built;
+    const bool had = impl_->nearPass.has_value();
+    if (auto near = impl_->nearPrecipPass(); !near) return tl::unexpected(near.error());
+    return *built + (had ? 0 : 2);
+  });
 }
 
-std::size_t CloudRenderer::variantsBuilt() const { return impl_->pass.variantsBuilt(); }
+std::size_t CloudRenderer::variantsBuilt() const { return impl_->pass.variantsBuilt() + (impl_->nearPass ? 2 : 0); }
 
 const std::string& CloudRenderer::noiseReport() const { return impl_->noiseReport; }
 
@@ -304,6 +352,8 @@ const SunMapReport& CloudRenderer::lastSunMap() const { return impl_->sunMap; }
 const TemporalReport& CloudRenderer::lastTemporal() const { return impl_->temporal; }
 
 const WeatherMapReport& CloudRenderer::lastWeatherMap() const { return impl_->weather.lastUpdate(); }
+
+const NearPrecipReport& CloudRenderer::lastNearPrecip() const { return impl_->nearReport; }
 
 void CloudRenderer::resetHistory(const std::string& reason) { impl_->planner.forget(reason); }
 

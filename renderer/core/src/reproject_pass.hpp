@@ -50,6 +50,8 @@ class ReprojectPass {
   // The image the last record() wrote, in storage images: the next
   // record()'s history, and what the upscale reads.
   const PixelMirror& image() const { return *history_; }
+  // The image it writes for the host (copied into image() as it is recorded).
+  const GpuBuffer& output() const { return colour_; }
 
  private:
   ReprojectPass() = default;

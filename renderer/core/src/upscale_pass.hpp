@@ -42,6 +42,8 @@ class UpscalePass {
   void record(const vk::raii::CommandBuffer& commands, GpuTimer& timer, const gpu::SkyUpscale& params);
   // After the submission completed: the full-size image.
   Image readBack() const;
+  // The full-size image's buffer.
+  const GpuBuffer& output() const { return colour_; }
 
  private:
   UpscalePass() = default;

@@ -50,9 +50,10 @@ TEST(Suite, ShippedSuiteLoadsEveryScene) {
   for (const char* n : {"cumulus-midday", "sunset-backlit", "overcast-below", "inside-cloud", "above-deck-10km",
                         "cumulonimbus", "cirrus-over-cumulus", "polar", "godrays", "fast-turn", "cumulus-fly-through",
                         "glider-thermal", "airliner-climb", "roll-pitch-in-cloud", "cell-grows", "cell-step", "fog-at-dawn",
-                        "inside-fog", "rain-under-nimbostratus", "thunderstorm-dusk", "thunderstorm-lightning"})
+                        "inside-fog", "rain-under-nimbostratus", "thunderstorm-dusk", "thunderstorm-lightning", "rain-approach",
+                        "snow-hover"})
     EXPECT_TRUE(names.count(n)) << n;
-  EXPECT_EQ(paths, 7u);
+  EXPECT_EQ(paths, 8u);
   auto two = loadSuite(SKY_BENCH_SUITE_FILE, {"polar", "fast-turn"});
   ASSERT_TRUE(two);
   ASSERT_EQ(two->size(), 2u);

@@ -121,6 +121,11 @@ struct MarchSettings {
   // lookup per layer above each air step and each cloud sample. false: only
   // the ground is shadowed.
   bool cloudShadows = true;
+  // The drops or flakes within a few metres of a camera that is in
+  // precipitation, drawn as the streaks their motion leaves over the
+  // exposure (renderer/core/src/near_precip.hpp); false: only the
+  // precipitation's medium (its extinction and light) is drawn there.
+  bool nearPrecipitation = true;
   // Where along its first step each pixel's samples sit (a fraction of the
   // step, fixed per pixel): false, a white-noise hash of the pixel; true, a
   // 64x64 blue-noise tile repeated over the image (renderer/core/src/blue_noise.hpp),
@@ -344,6 +349,20 @@ struct SunMapReport {
   bool completed = false;  // it built the last rows, and read the new map
 };
 
+// The precipitation near the camera in the last frame
+// (MarchSettings::nearPrecipitation): what the point query answered at the
+// camera, how many drops were drawn and how many reached the image.
+struct NearPrecipReport {
+  weather::CloudType type = weather::CloudType::None;  // None: dry at the camera, or not drawn
+  double rate_mmph = 0;
+  std::uint32_t drops = 0;    // in the cube round the camera
+  bool capped = false;        // the rate asked for more drops than are drawn (near_precip.hpp)
+  std::uint32_t streaks = 0;  // of them, those whose path reached the image
+  std::uint32_t faint = 0;    // and those left out as too faint to change a pixel (near_precip.hpp)
+  double dropArea_px2 = 0;    // their image area, sum of pi r^2
+  double cameraSpeed_mps = 0; // the camera's speed the streaks were drawn with
+};
+
 struct TemporalReport {
   bool drawnWhole = false;
   std::string reason;  // why it was drawn whole ("first frame", "teleport 2.1 km", ...); empty otherwise
@@ -440,6 +459,8 @@ class CloudRenderer {
   const TemporalReport& lastTemporal() const;
   // What the weather map's update did for the last render().
   const WeatherMapReport& lastWeatherMap() const;
+  // The drops drawn near the camera in the last render().
+  const NearPrecipReport& lastNearPrecip() const;
   // Drops the temporal history: the next render() is drawn whole, with
   // `reason` in its TemporalReport (a host's IG reset).
   void resetHistory(const std::string& reason);
