@@ -110,6 +110,42 @@ double segmentDistance(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec
   return glm::length(p - (a + t * ab));
 }
 
+// Calls add(tx, ty) for every kNearPrecipTile tile whose centre is within
+// nearEnough of segment ab, visiting only tiles along the segment: for each
+// tile column (or row, whichever the segment crosses more of) the rows its
+// part of the segment spans, widened by nearEnough. A long streak costs its
+// length in tiles, not the area of its bounding box.
+template <class Add>
+void tilesAlong(glm::dvec2 a, glm::dvec2 b, double nearEnough, int tilesX, int tilesY, Add&& add) {
+  constexpr double kTile = gpu::kNearPrecipTile;
+  const bool xMajor = std::abs(b.x - a.x) >= std::abs(b.y - a.y);
+  const int major = xMajor ? 0 : 1, minor = 1 - major;
+  const int majorTiles = xMajor ? tilesX : tilesY, minorTiles = xMajor ? tilesY : tilesX;
+  const double du = b[major] - a[major];
+  const int c0 = std::max(0, int(std::floor((std::min(a[major], b[major]) - nearEnough) / kTile)));
+  const int c1 = std::min(majorTiles - 1, int(std::floor((std::max(a[major], b[major]) + nearEnough) / kTile)));
+  for (int c = c0; c <= c1; ++c) {
+    // The part of the segment within nearEnough of the column.
+    double t0 = 0, t1 = 1;
+    if (std::abs(du) > 1e-12) {
+      t0 = (c * kTile - nearEnough - a[major]) / du;
+      t1 = ((c + 1) * kTile + nearEnough - a[major]) / du;
+      if (t0 > t1) std::swap(t0, t1);
+      t0 = std::max(t0, 0.0);
+      t1 = std::min(t1, 1.0);
+      if (t0 > t1) continue;
+    }
+    const double v0 = a[minor] + t0 * (b[minor] - a[minor]), v1 = a[minor] + t1 * (b[minor] - a[minor]);
+    const int r0 = std::max(0, int(std::floor((std::min(v0, v1) - nearEnough) / kTile)));
+    const int r1 = std::min(minorTiles - 1, int(std::floor((std::max(v0, v1) + nearEnough) / kTile)));
+    for (int r = r0; r <= r1; ++r) {
+      const int tx = xMajor ? c : r, ty = xMajor ? r : c;
+      const glm::dvec2 centre((tx + 0.5) * kTile, (ty + 0.5) * kTile);
+      if (segmentDistance(centre, a, b) <= nearEnough) add(tx, ty);
+    }
+  }
+}
+
 }  // namespace
 
 NearPrecipFrame buildNearPrecip(const NearPrecipInputs& in) {
@@ -179,15 +215,8 @@ NearPrecipFrame buildNearPrecip(const NearPrecipInputs& in) {
     // tile's half diagonal of its centre line).
     const auto index = std::uint32_t(out.streaks.size());
     const std::size_t before = pairs.size();
-    const int tx0 = std::max(0, int(std::floor(lo.x / kTile))), tx1 = std::min(int(out.tilesX) - 1, int(hi.x / kTile));
-    const int ty0 = std::max(0, int(std::floor(lo.y / kTile))), ty1 = std::min(int(out.tilesY) - 1, int(hi.y / kTile));
-    const double nearEnough = reach + 0.5 * std::sqrt(2.0) * kTile;
-    for (int ty = ty0; ty <= ty1; ++ty)
-      for (int tx = tx0; tx <= tx1; ++tx) {
-        const glm::dvec2 centre((tx + 0.5) * kTile, (ty + 0.5) * kTile);
-        if (segmentDistance(centre, a.px, b.px) <= nearEnough)
-          pairs.emplace_back(std::uint32_t(ty) * out.tilesX + std::uint32_t(tx), index);
-      }
+    tilesAlong(a.px, b.px, reach + 0.5 * std::sqrt(2.0) * kTile, int(out.tilesX), int(out.tilesY),
+               [&](int tx, int ty) { pairs.emplace_back(std::uint32_t(ty) * out.tilesX + std::uint32_t(tx), index); });
     if (pairs.size() > kMaxNearEntries) {
       pairs.resize(before);
       out.entriesCapped = true;
