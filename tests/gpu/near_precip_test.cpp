@@ -16,8 +16,8 @@
 
 #include "atmosphere_tables.hpp"
 #include "frame_setup.hpp"
-#include "glsl_double.hpp"
 #include "near_precip.hpp"
+#include "precip_streak.hpp"
 #include "scenes.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky/render/presets.hpp"
@@ -27,13 +27,7 @@
 namespace sky::test {
 namespace {
 
-namespace streak_glsl {
-using namespace glm;
-struct Streak : render::GlslDouble {
-#include "precip_streak.glsl"
-};
-}  // namespace streak_glsl
-using streak_glsl::Streak;
+using Streak = render::PrecipStreak;
 
 constexpr std::uint32_t kW = 320, kH = 180;
 constexpr double kRate_mmph = 8;
@@ -95,8 +89,6 @@ Pair makePair(const char* preset) {
 // The wet frame as this test composes it: the dry image with the CPU's
 // streaks for the frame over it, each pixel covered by the streaks of its
 // tile, in the drops' radiance (the dry image's mean times the factor).
-// source: the renderer's own source of inputs, fed the frames the renderer
-// was fed, so it has the same camera history.
 std::vector<float> composed(const render::Image& dry, const render::NearPrecipFrame& near) {
   double mean[3] = {0, 0, 0};
   const std::size_t n = std::size_t(dry.width) * dry.height;
@@ -120,7 +112,9 @@ std::vector<float> composed(const render::Image& dry, const render::NearPrecipFr
   return out;
 }
 
-// What the renderer lists for a frame: its own source and setup, replayed.
+// What the renderer lists for a frame: the renderer's own source of inputs
+// and frame setup, fed the frames the renderer was fed (so it has the same
+// camera history).
 struct Lister {
   render::RenderSettings settings;
   render::NearPrecipSource source;

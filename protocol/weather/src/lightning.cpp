@@ -11,6 +11,7 @@
 #include <s2/s2cell_id.h>
 #include <s2/s2latlng.h>
 
+#include "sky/core/split_mix.hpp"
 #include "sky/weather/precipitation.hpp"
 #include "sky/weather/tiling.hpp"
 
@@ -56,13 +57,7 @@ constexpr double kMaxDrawSeconds = 600;
 // Per cell and second: a rate above this is a storm past any real one.
 constexpr double kMaxCellFlashesPerSecond = 20;
 
-std::uint64_t mix(std::uint64_t x) {
-  // splitmix64's finaliser: a bijection that scatters every input bit.
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
+std::uint64_t mix(std::uint64_t x) { return splitMix64(x); }
 
 // A small deterministic generator for one flash or one cell-second.
 class Draws {

@@ -6,6 +6,7 @@
 #include <mutex>
 
 #include "sky/core/assert.hpp"
+#include "sky/core/split_mix.hpp"
 
 namespace sky::render {
 
@@ -18,10 +19,9 @@ constexpr double kInitialFill = 0.1;
 
 // SplitMix64 step: the seed's stream of random numbers.
 std::uint64_t nextRandom(std::uint64_t& state) {
-  std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
+  const std::uint64_t z = splitMix64(state);
+  state += kSplitMixIncrement;
+  return z;
 }
 
 class Pattern {

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core_common.hpp"
+#include "sky/core/split_mix.hpp"
 #include "sky/weather/precipitation.hpp"
 
 namespace sky::render {
@@ -28,16 +29,9 @@ constexpr double kFlakeOverMelted = 2.154434690031884;  // 10^(1/3)
 constexpr double kFlakeSway_m = 0.08;
 constexpr double kFlakeSwayPeriod_s = 1.5;
 
-// SplitMix64: the drops' numbers from (seed, drop, which).
-std::uint64_t mix(std::uint64_t x) {
-  x += 0x9e3779b97f4a7c15ull;
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-  return x ^ (x >> 31);
-}
-
+// A drop's numbers in [0, 1) from (seed, drop, which).
 double uniform(std::uint32_t seed, std::uint32_t drop, std::uint32_t which) {
-  const std::uint64_t h = mix((std::uint64_t(seed) << 32 | drop) * 8 + which);
+  const std::uint64_t h = splitMix64((std::uint64_t(seed) << 32 | drop) * 8 + which);
   return double(h >> 11) * 0x1.0p-53;
 }
 

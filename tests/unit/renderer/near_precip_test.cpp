@@ -12,20 +12,14 @@
 #include <glm/glm.hpp>
 #include <gtest/gtest.h>
 
-#include "glsl_double.hpp"
 #include "near_precip.hpp"
+#include "precip_streak.hpp"
 #include "sky/weather/precipitation.hpp"
 
 namespace sky::test {
 namespace {
 
-namespace streak_glsl {
-using namespace glm;
-struct Streak : render::GlslDouble {
-#include "precip_streak.glsl"
-};
-}  // namespace streak_glsl
-using streak_glsl::Streak;
+using Streak = render::PrecipStreak;
 
 constexpr double kPi = 3.14159265358979323846;
 using weather::CloudType;
