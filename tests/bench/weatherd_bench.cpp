@@ -12,6 +12,9 @@
 // * frames and bytes sent (a change goes out as a Delta when that is smaller
 //   than a snapshot), and the size of one snapshot for a 300 km wide
 //   area with 3 layers, and of the frame one layer's coverage change costs.
+// With --storms 1 the lowest layer is cumulonimbus, so the server's lightning
+// process runs over every subscriber's area as well (its cost at idle and in
+// the storm of changes, which make it recompute its storm cells).
 // The server runs in this process on its own thread (real TCP sockets on
 // loopback); the subscribers share one client thread.
 #include <pthread.h>
@@ -56,6 +59,10 @@ struct Options {
   double radius_m = 120000;   // each subscriber's area (the renderer's)
   std::size_t maxTiles = 4096;  // the renderer's tile budget (levelForRadius)
   bool regional = false;  // the storm's weather has a region over every subscriber's area
+  // The lowest layer is cumulonimbus: the server's lightning process draws
+  // flashes over every subscriber's area at each heartbeat (its storm cells
+  // recomputed after every change and every 10 s of clock).
+  bool storms = false;
   std::string json;
 };
 
@@ -179,6 +186,7 @@ int main(int argc, char** argv) {
     else if (k == "--radius-m") o.radius_m = std::stod(v);
     else if (k == "--json") o.json = v;
     else if (k == "--regional") o.regional = v == "1";
+    else if (k == "--storms") o.storms = v == "1";
     else {
       std::fprintf(stderr, "unknown option %s\n", k.c_str());
       return 2;
@@ -186,10 +194,11 @@ int main(int argc, char** argv) {
   }
   if (argc % 2 == 0) {
     std::fprintf(stderr, "usage: sky_weatherd_bench [--subscribers N] [--rate HZ] [--seconds S] [--idle-seconds S] "
-                         "[--radius-m M] [--regional 0|1] [--json FILE]\n");
+                         "[--radius-m M] [--regional 0|1] [--storms 0|1] [--json FILE]\n");
     return 2;
   }
-  const auto layers = threeLayers();
+  auto layers = threeLayers();
+  if (o.storms) layers[0].type = sky::weather::CloudType::Cumulonimbus;
 
   // Sizes, without sockets: a 300 km wide area (150 km radius) at ~1 km
   // tiles, 3 layers all varying (a region 200 km across changes each), so
@@ -350,6 +359,9 @@ int main(int argc, char** argv) {
   std::printf("weatherd bench: %d subscribers (radius %.0f km, level %d), %zu changes at %.0f/s, %s weather\n",
               o.subscribers, o.radius_m / 1000, renderer.tileLevel, changes, o.rate,
               o.regional ? "regional (tiles in every snapshot; a storm cell moves)" : "uniform (layer tables only)");
+  if (o.storms)
+    std::printf("  lightning                   flashes drawn %llu (layer 1 cumulonimbus over every area)\n",
+                static_cast<unsigned long long>(server->streamCounters().flashesDrawn.load()));
   std::printf("  change-to-delivery latency  p50 %.2f ms  p99 %.2f ms  (%llu deliveries, %llu coalesced of %.0f)\n",
               p50, p99, static_cast<unsigned long long>(shared.deliveries),
               static_cast<unsigned long long>(shared.coalesced), expected);
@@ -364,7 +376,8 @@ int main(int argc, char** argv) {
               changeBytes, regionalChangeBytes, regionalDeltaTiles, regionalSnapshotBytes, regionalSnapshot.tileLevel,
               regionalSnapshot.tiles.size());
   if (!o.json.empty()) {
-    const nlohmann::json j = {{"subscribers", o.subscribers}, {"rate_hz", o.rate}, {"regional", o.regional}, {"changes", changes},
+    const nlohmann::json j = {{"subscribers", o.subscribers}, {"rate_hz", o.rate}, {"regional", o.regional},
+                              {"storms", o.storms}, {"changes", changes},
                               {"latency_p50_ms", p50}, {"latency_p99_ms", p99}, {"deliveries", shared.deliveries},
                               {"coalesced", shared.coalesced}, {"cpu_idle_pct", idlePct}, {"cpu_storm_pct", stormPct},
                               {"frames", frames}, {"bytes", bytes}, {"snapshot_300km_3layers_bytes", wideBytes},
