@@ -472,15 +472,20 @@ real brokenFieldTransmittance(real c, real tau, real mu) {
 // Transmission of sunlight and sky light down through the first `count`
 // layers to the point p (camera-relative, height hp above the ground
 // sphere): each layer above p (the part above p where p is inside it) by
-// its coverage c and density where the sun ray crosses the middle of that
-// part. A fraction c of the sun rays there meets a cloud column of optical
-// depth tau (the type's mean column depth times the density), the rest
-// passes clear, so the mean transmittance is 1 - c (1 - T(tau)) with the
-// two-stream split of diffuseLight: T = e^(-tau/mu) for the direct beam,
-// t(tau) for the light the clouds diffuse (the mean of the transmittance
-// over a broken field, not the transmittance of its mean depth, which at
-// half cover of a cumulus kilometres deep would be dark). x: direct sun
-// factor, y: diffuse factor for the sun's scattered part and the sky.
+// its coverage c and density at the middle of that part: for the direct
+// beam where the sun ray crosses it, for the diffuse light straight above p
+// (the sky's light and what the clouds diffuse come down from all over the
+// sky above p, most of it from near the zenith; where the sun ray crosses
+// is tens of kilometres away at a low sun, and a rain shaft under a storm
+// was lit by the open sky beyond it). A fraction c of the rays there meets
+// a cloud column of optical depth tau (the type's mean column depth times
+// the density), the rest passes clear, so the mean transmittance is
+// 1 - c (1 - T(tau)) with the two-stream split of diffuseLight:
+// T = e^(-tau/mu) for the direct beam, t(tau) for the light the clouds
+// diffuse (the mean of the transmittance over a broken field, not the
+// transmittance of its mean depth, which at half cover of a cumulus
+// kilometres deep would be dark). x: direct sun factor, y: diffuse factor
+// for the sun's scattered part and the sky.
 // Shadows at the weather map's scale (~1 km), without the noise's shapes:
 // on the ground, and in the air (the shade under an overcast, the light
 // shafts between regions of cloud).
@@ -502,13 +507,19 @@ real2 cloudShadow(AirFrame a, int count, int skip, real3 p, real hp, real muSun)
     // Distance along the sun from p up to the height hMid (stable sphere root).
     real c2 = (hMid - hp) * (2.0 * groundRadius + hMid + hp);
     real d = c2 / (rp * mu + sqrt(rp * rp * mu * mu + c2));
+    real presence = layerPresenceAbove((lo - (a.h - L.hBase)) / L.thickness, L.band);
     real3 weather = sampleWeather(L.sampling, p + a.sunDir * d);
     CloudType t = L.blends ? mixCloudType(L.primary, L.secondary, weather.z) : L.primary;
-    real tau = t.extinction_perm * weather.y * t.columnFill * L.thickness *
-               layerPresenceAbove((lo - (a.h - L.hBase)) / L.thickness, L.band);
-    real c = clamp(weather.x, 0.0, 1.0);
-    direct *= brokenFieldTransmittance(c, tau, mu);
-    diffuse *= 1.0 - c * (1.0 - 1.0 / (1.0 + 0.75 * (1.0 - kDiffuseAsymmetry) * tau));
+    real tau = t.extinction_perm * weather.y * t.columnFill * L.thickness * presence;
+    direct *= brokenFieldTransmittance(clamp(weather.x, 0.0, 1.0), tau, mu);
+    // Straight above p at hMid: p's own vertical, from the Earth's centre
+    // at (0, 0, -r) in the camera-relative frame.
+    real3 fromCentre = p + real3(0.0, 0.0, a.r);
+    real3 overhead = fromCentre * ((groundRadius + hMid) / length(fromCentre)) - real3(0.0, 0.0, a.r);
+    real3 above = sampleWeather(L.sampling, overhead);
+    CloudType ta = L.blends ? mixCloudType(L.primary, L.secondary, above.z) : L.primary;
+    real tauAbove = ta.extinction_perm * above.y * ta.columnFill * L.thickness * presence;
+    diffuse *= 1.0 - clamp(above.x, 0.0, 1.0) * (1.0 - 1.0 / (1.0 + 0.75 * (1.0 - kDiffuseAsymmetry) * tauAbove));
   }
   return real2(direct, diffuse);
 }

@@ -347,6 +347,31 @@ TEST(CloudCore, GroundShadowIsTheTwoStreamDepthOfTheLayersAbove) {
   EXPECT_NEAR(c.groundRadiance(f, Core::real3(0, 0, -1), alt).x, 0.1 / kPi * (2.0 * mu + 0.4), 1e-9);
 }
 
+// The sky's light under a storm a few kilometres across with the sun low:
+// the diffuse factor is the cover straight above (closed: dimmed by the
+// column's two-stream transmittance), while the direct beam comes in under
+// the storm's edge from the open sky (the sun ray meets the layer 57 km
+// away at 3 degrees). Beside the storm both are clear.
+TEST(CloudCore, TheSkysLightUnderAStormIsTheStormsNotTheSkyAlongTheSun) {
+  Core c;
+  const double R = 6371000, alt = 300, base = 1500, H = 3000;
+  Core::CloudType cb = uniformType(0.02);
+  cb.columnFill = 0.8;
+  Core::CoreFrame f = frameAt(c, R, alt, base, H, cb);
+  const double mu = std::sin(3 * kPi / 180);
+  f.air.sunDir = Core::real3(std::sqrt(1 - mu * mu), 0, mu);
+  c.density = 1.0;
+  // The storm: closed within 4 km of the camera's vertical.
+  c.coverageAt = [](Core::real3 p) { return std::hypot(p.x, p.y) < 4000 ? 1.0 : 0.0; };
+  const double tau = 0.02 * 1.0 * 0.8 * H;
+  const Core::real2 under = c.cloudShadow(f.air, 1, -1, Core::real3(0, 0, 0), alt, mu);
+  EXPECT_NEAR(under.y, 1 / (1 + 0.75 * (1 - 0.85) * tau), 1e-9) << "the storm overhead hides the sky";
+  EXPECT_EQ(under.x, 1.0) << "the low sun shines in under its edge";
+  const Core::real2 beside = c.cloudShadow(f.air, 1, -1, Core::real3(0, 9000, 0), alt, mu);
+  EXPECT_EQ(beside.x, 1.0);
+  EXPECT_EQ(beside.y, 1.0) << "beside the storm the sky is open";
+}
+
 // The clouds' shadow in the air (cloudShadow at a point of the air, and the
 // air march through it): under a layer the whole column's depth, inside it
 // the part above the point, over it none; and the air's in-scattering under

@@ -25,6 +25,9 @@ class Core : public render::GlslDouble {
  public:
 
   real coverage = 1.0, density = 1.0, blend = 0.0, noise = 1.0, detail = 0.5;
+  // When set, the weather's coverage at a camera-relative point (instead of
+  // the uniform `coverage`): a cell, a region.
+  std::function<real(real3)> coverageAt;
   real2 cloudMap = real2(0.5, 1.0);
   // Shape-noise lookups so far (primary and light march): the march's cost.
   std::uint64_t shapeLookups = 0;
@@ -79,9 +82,9 @@ inline Core::CoreLayer Core::layerAt(int li) { return layers[li]; }
 inline Core::real4 Core::flashAt(int k) { return flashes[std::size_t(k)]; }
 inline Core::real4 Core::boltStartAt(int k) { return boltStarts[std::size_t(k)]; }
 inline Core::real3 Core::boltEndAt(int k) { return boltEnds[std::size_t(k)]; }
-inline Core::real3 Core::sampleWeather(LayerSampling, real3) {
+inline Core::real3 Core::sampleWeather(LayerSampling, real3 p) {
   ++lookups;
-  return real3(coverage, density, blend);
+  return real3(coverageAt ? coverageAt(p) : coverage, density, blend);
 }
 inline Core::real2 Core::sampleCloudMap(LayerSampling, real3) {
   ++lookups;
