@@ -16,6 +16,7 @@ namespace {
 
 struct Options : sky::sim::ReplayOptions {
   std::string flightPath;
+  sky::flight::ReadOptions read;
 };
 
 }  // namespace
@@ -23,7 +24,9 @@ struct Options : sky::sim::ReplayOptions {
 int main(int argc, char** argv) {
   Options o;
   CLI::App app{"skyshell-replay: replay a recorded flight as a CIGI 3.3 host over UDP"};
-  app.add_option("flight", o.flightPath, "flight file: .csv (time_s,lat_deg,lon_deg,alt_m,yaw_deg,pitch_deg,roll_deg), .igc or .gpx")
+  app.add_option("flight", o.flightPath,
+                 "flight file: .csv (time_s,lat_deg,lon_deg,alt_m,yaw_deg,pitch_deg,roll_deg, or ADS-B columns "
+                 "such as OpenSky's), .igc or .gpx")
       ->required();
   app.add_option("--host", o.host, "IG (renderer) address");
   app.add_option("--port", o.port, "IG (renderer) CIGI UDP port")->check(CLI::Range(1, 65535));
@@ -56,14 +59,24 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 60.0));
   app.add_option("--conditions-csv", o.conditionsCsv,
                  "write every answer (wind, temperature, cloud per layer) to this CSV file");
+  app.add_option("--icao24", o.read.icao24,
+                 "ADS-B .csv holding several aircraft: replay this one (ICAO 24-bit address, hex)");
+  std::string altitudeUnit;
+  app.add_option("--altitude-unit", altitudeUnit,
+                 "ADS-B .csv: unit of the altitude columns, ft or m (default: as each column's name says)")
+      ->check(CLI::IsMember({"ft", "m"}));
   CLI11_PARSE(app, argc, argv);
+  if (!altitudeUnit.empty())
+    o.read.altitudeUnit = altitudeUnit == "ft" ? sky::flight::AltitudeUnit::Feet : sky::flight::AltitudeUnit::Metres;
 
-  auto flight = sky::sim::loadFlight(o.flightPath);
+  auto flight = sky::sim::loadFlight(o.flightPath, o.read);
   if (!flight) {
     std::fprintf(stderr, "skyshell-replay: %s\n", sky::describe(flight.error()).c_str());
     return 2;
   }
   for (const auto& warning : flight->warnings) std::fprintf(stderr, "skyshell-replay: warning: %s\n", warning.c_str());
+  if (!flight->altitudeSource.empty())
+    std::fprintf(stderr, "skyshell-replay: altitude: %s\n", flight->altitudeSource.c_str());
   try {
     asio::io_context io;
     asio::signal_set signals(io, SIGINT, SIGTERM);

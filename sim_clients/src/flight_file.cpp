@@ -8,12 +8,12 @@
 
 namespace sky::sim {
 
-Result<flight::ParsedFlight> loadFlight(const std::string& path) {
+Result<flight::ParsedFlight> loadFlight(const std::string& path, const flight::ReadOptions& options) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return fail(ErrorCode::Io, flight::messageText(path) + ": cannot open for reading");
   std::ostringstream text;
   text << in.rdbuf();
-  return flight::parseFlight(text.str(), path);
+  return flight::parseFlight(text.str(), path, options);
 }
 
 }  // namespace sky::sim

@@ -1,4 +1,5 @@
-// Capped warnings and the time-order rules shared by the IGC and GPX readers.
+// Capped warnings and the time-order rules shared by the IGC, GPX and ADS-B
+// readers, and the choice of reader for a file.
 #include "reader_common.hpp"
 
 #include "sky/flight/utf8_text.hpp"
@@ -15,7 +16,8 @@ constexpr std::size_t kMaxFieldChars = 40;  // enough for any IGC/GPX field
 constexpr std::array<const char*, static_cast<std::size_t>(WarningKind::Count_)> kKindNames = {
     "out-of-order fixes skipped", "duplicate-time fixes skipped", "gaps kept",
     "fixes with validity 'V' skipped", "fixes without altitude skipped",
-    "unreadable lines skipped", "other warnings"};
+    "unreadable lines skipped", "rows with an empty field skipped",
+    "rows on the ground without a geometric altitude skipped", "other warnings"};
 
 std::string seconds(double s) {
   char buf[32];
@@ -72,13 +74,33 @@ bool TimeOrder::accept(double t_s, std::size_t line, Warnings& warnings) {
 
 namespace sky::flight {
 
-Result<ParsedFlight> parseFlight(std::string_view text, std::string_view sourceName) {
+namespace {
+
+// The first line that is neither blank nor a '#' comment: the header of
+// either CSV format.
+std::string_view firstCsvLine(std::string_view text) {
+  std::string_view header;
+  bool found = false;
+  detail::forEachLine(text, [&](std::string_view line, std::size_t) {
+    if (found) return;
+    const auto start = line.find_first_not_of(" \t");
+    if (start == std::string_view::npos || line[start] == '#') return;
+    header = line;
+    found = true;
+  });
+  return header;
+}
+
+}  // namespace
+
+Result<ParsedFlight> parseFlight(std::string_view text, std::string_view sourceName, const ReadOptions& options) {
   const auto dot = sourceName.rfind('.');
   const auto slash = sourceName.rfind('/');
   std::string ext;
   if (dot != std::string_view::npos && (slash == std::string_view::npos || dot > slash))
     for (char c : sourceName.substr(dot + 1)) ext.push_back(c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c);
-  if (ext == "csv") return parseCsv(text, sourceName);
+  if (ext == "csv")
+    return isAdsbCsvHeader(firstCsvLine(text)) ? parseAdsbCsv(text, sourceName, options) : parseCsv(text, sourceName);
   if (ext == "igc") return parseIgc(text, sourceName);
   if (ext == "gpx") return parseGpx(text, sourceName);
   return fail(ErrorCode::Unsupported, messageText(sourceName) + ": unknown flight format '." + detail::printable(ext) +

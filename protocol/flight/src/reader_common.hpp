@@ -1,4 +1,4 @@
-// Pieces the IGC and GPX readers share: byte classes that ignore the locale,
+// Pieces the IGC, GPX and ADS-B readers share: byte classes that ignore the locale,
 // capped warnings, and the time-order rules documented in flight.hpp.
 // Private to protocol/flight/src.
 #pragma once
@@ -50,6 +50,8 @@ enum class WarningKind : std::size_t {
   Validity,
   NoAltitude,
   Junk,
+  EmptyField,
+  OnGround,
   Other,
   Count_,
 };

@@ -10,9 +10,10 @@
 namespace sky::sim {
 
 // Reads and parses a flight file; the format is chosen by extension, in any
-// letter case: .csv, .igc or .gpx. Errors name the file, and the parser's
-// errors the line and field; the parser's warnings come with the flight for
-// the caller to log.
-Result<flight::ParsedFlight> loadFlight(const std::string& path);
+// letter case: .csv (ours, or ADS-B by its header), .igc or .gpx; options go
+// to the reader (flight.hpp: ReadOptions). Errors name the file, and the
+// parser's errors the line and field; the parser's warnings come with the
+// flight for the caller to log.
+Result<flight::ParsedFlight> loadFlight(const std::string& path, const flight::ReadOptions& options = {});
 
 }  // namespace sky::sim

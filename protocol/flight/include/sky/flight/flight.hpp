@@ -1,9 +1,11 @@
 // Recorded flights: a time series of geodetic poses, read from text the
 // caller hands in (protocol/ opens no files), and sampled at any time.
-// Readers: CSV (our own format, with attitude), IGC (FAI glider loggers) and
-// GPX (XML tracks); the last two carry no attitude, which deriveAttitude fills.
+// Readers: CSV (our own format, with attitude), ADS-B CSV (OpenSky state
+// vectors and similar exports), IGC (FAI glider loggers) and GPX (XML
+// tracks); all but the first carry no attitude, which deriveAttitude fills.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -34,6 +36,31 @@ struct Flight {
 // as one; the warnings are for the main to log.
 struct ParsedFlight : Flight {
   std::vector<std::string> warnings;
+  // Where the altitudes came from, for a replay's report, when the format
+  // has more than one kind (ADS-B: geometric or barometric); empty otherwise.
+  // E.g. "geometric ('geoaltitude', m) for 118 fixes; barometric
+  // ('baroaltitude', m) to geometric by the ICAO standard atmosphere for 2".
+  std::string altitudeSource;
+  std::size_t geometricAltitudeFixes = 0;   // fixes whose altitude was recorded as geometric
+  std::size_t barometricAltitudeFixes = 0;  // fixes whose altitude was converted from barometric
+};
+
+// Unit of the altitude columns of an ADS-B CSV.
+enum class AltitudeUnit {
+  FromColumnName,  // as the column's name says ('baroaltitude': m, 'altitude_ft': ft, ...)
+  Metres,
+  Feet,
+};
+
+// What the caller of a reader may choose; the defaults suit a file that
+// holds one aircraft and names its altitude units.
+struct ReadOptions {
+  // ADS-B CSV: the aircraft to read, as its ICAO 24-bit address in hex (1 to
+  // 6 digits, any letter case); empty: the file must hold one aircraft.
+  std::string icao24;
+  // ADS-B CSV: the unit of every altitude column; FromColumnName: each
+  // column's name says, and a name that does not ('altitude') is an error.
+  AltitudeUnit altitudeUnit = AltitudeUnit::FromColumnName;
 };
 
 // Fixes dropped or kept with a warning, shared by the IGC and GPX readers
@@ -58,6 +85,54 @@ inline constexpr std::size_t kMaxWarningsPerKind = 8;
 // Ill-formed UTF-8 anywhere in the text is an error naming line and byte.
 // Never warns; startUtc_s stays empty.
 Result<ParsedFlight> parseCsv(std::string_view text, std::string_view sourceName);
+
+// ADS-B CSV flight (OpenSky state vectors, and exports with the same column
+// names): a header line naming the columns, in any order and letter case,
+// then one row per position report. Columns are found by name:
+//   time: 'time', 'timestamp' (Unix seconds, or ISO 8601 UTC
+//         'YYYY-MM-DD[T ]hh:mm:ss[.f][Z]')                     required
+//   latitude: 'lat', 'latitude'; longitude: 'lon', 'longitude' (deg) required
+//   barometric altitude: 'baroaltitude', 'baro_altitude' (m), 'altitude'
+//         (unit not named: needs ReadOptions::altitudeUnit), 'altitude_ft',
+//         'baroaltitude_ft', 'alt_baro' (ft), 'altitude_m' (m)
+//   geometric altitude: 'geoaltitude', 'geo_altitude' (m), 'geoaltitude_ft',
+//         'alt_geom' (ft)                            at least one altitude
+//   'icao24', 'callsign', 'onground' (true/false/1/0); 'velocity',
+//   'groundspeed', 'heading', 'track', 'vertrate', 'vertical_rate' are
+//   recognised and not read: attitude comes from the track (deriveAttitude).
+// Altitude: geometric when the row has it, else barometric (pressure
+// altitude) converted to geometric by the ICAO standard atmosphere
+// (sky/weather/standard_atmosphere.hpp, QNH 1013.25); ParsedFlight says
+// which. The altitude "ground" (readsb) without a geometric altitude, or
+// onground true with neither altitude (OpenSky): on the ground at an unknown
+// height, row skipped. Blank lines and lines starting with '#' are ignored;
+// fields may be in double quotes.
+// Rows skipped with a counted warning naming the line: an empty field
+// ('', 'nan', 'null'; OpenSky leaves unknown positions empty) among time,
+// lat, lon, altitude; on the ground without a geometric altitude; and the
+// shared time rules above. Rows of another aircraft than options.icao24 are
+// ignored. Errors (file, line and field): a header without time, lat, lon
+// or an altitude; a value that is not a number or out of range (lat
+// [-90, 90], lon [-180, 180], altitudes [-1, 20] km baro and [-1, 100] km
+// geometric); a line over kMaxAdsbLineBytes; more than kMaxAdsbRows rows or
+// kMaxAdsbAircraft aircraft; several aircraft and no options.icao24 (the
+// message lists each: icao24, callsign, fixes); options.icao24 absent from
+// the file; fewer than two fixes.
+// time_s is 0 at the whole second at or before the first kept fix;
+// startUtc_s is that second.
+Result<ParsedFlight> parseAdsbCsv(std::string_view text, std::string_view sourceName,
+                                  const ReadOptions& options = {});
+// Longest line, data rows and distinct aircraft parseAdsbCsv reads. An
+// OpenSky row is ~150 bytes; a day of one aircraft at 1 Hz is 86400 rows;
+// an hour of OpenSky over Europe holds a few thousand aircraft.
+inline constexpr std::size_t kMaxAdsbLineBytes = 4096;
+inline constexpr std::size_t kMaxAdsbRows = 10'000'000;
+inline constexpr std::size_t kMaxAdsbAircraft = 20'000;
+
+// Whether a header line names the columns of an ADS-B CSV (a time, a
+// latitude and a longitude column by the names above), not of our own CSV.
+// A line longer than kMaxAdsbLineBytes is not.
+bool isAdsbCsvHeader(std::string_view headerLine);
 
 // IGC flight (FAI Technical Specification for IGC-approved flight recorders,
 // Appendix A): one record per line, any line ending, bytes beyond ASCII
@@ -101,9 +176,13 @@ Result<ParsedFlight> parseIgc(std::string_view text, std::string_view sourceName
 // startUtc_s is that second. Attitude is derived by deriveAttitude.
 Result<ParsedFlight> parseGpx(std::string_view text, std::string_view sourceName);
 
-// Any of the three, chosen by the extension of sourceName in any letter case
-// (.csv, .igc, .gpx); Unsupported for another extension, naming it.
-Result<ParsedFlight> parseFlight(std::string_view text, std::string_view sourceName);
+// Any of the readers, chosen by the extension of sourceName in any letter
+// case (.csv, .igc, .gpx); a .csv whose first line that is neither blank nor
+// a '#' comment is an ADS-B header (isAdsbCsvHeader) is read by parseAdsbCsv
+// with options, any other .csv by parseCsv. Unsupported for another
+// extension, naming it.
+Result<ParsedFlight> parseFlight(std::string_view text, std::string_view sourceName,
+                                 const ReadOptions& options = {});
 
 // Text from the file is never echoed raw: a field quoted in a message shows
 // only printable ASCII ('?' for other bytes, cut at 40), and the source name
