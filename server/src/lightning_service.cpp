@@ -44,6 +44,19 @@ std::vector<weather::StormCell> stormCellsIn(const LiveWeather& weather, double 
   return list;
 }
 
+// The areas' caps, each cut to kLightningReach_m and taken once (the
+// channels of one simulator watch the same areas), at most kMaxLightningAreas.
+std::vector<weather::SphericalCap> distinctCaps(std::span<const weather::SphericalCap> areas) {
+  std::vector<weather::SphericalCap> caps;
+  for (const weather::SphericalCap& a : areas) {
+    weather::SphericalCap cap = a;
+    cap.radius_m = std::min(cap.radius_m, kLightningReach_m);
+    const bool seen = std::any_of(caps.begin(), caps.end(), [&](const weather::SphericalCap& c) { return same(c, cap); });
+    if (!seen && caps.size() < kMaxLightningAreas) caps.push_back(cap);
+  }
+  return caps;
+}
+
 }  // namespace
 
 std::vector<weather::LightningFlash> LightningService::tick(const LiveWeather& weather, double clock_s,
@@ -52,14 +65,7 @@ std::vector<weather::LightningFlash> LightningService::tick(const LiveWeather& w
   last_s_ = clock_s;
   if (!last || !(clock_s > *last) || clock_s - *last > kMaxLightningGap_s || !(options_.rate_perMin100km2 > 0))
     return {};
-  // The channels of one simulator watch the same areas: each cap once.
-  std::vector<weather::SphericalCap> caps;
-  for (const weather::SphericalCap& a : areas) {
-    weather::SphericalCap cap = a;
-    cap.radius_m = std::min(cap.radius_m, kLightningReach_m);
-    const bool seen = std::any_of(caps.begin(), caps.end(), [&](const weather::SphericalCap& c) { return same(c, cap); });
-    if (!seen && caps.size() < kMaxLightningAreas) caps.push_back(cap);
-  }
+  const std::vector<weather::SphericalCap> caps = distinctCaps(areas);
   // The storm cells change with the weather (a change, a ramp) and as
   // drifting regions move: computed again then, or kStormCellRefresh_s on.
   const bool fresh = cells_ && cellsAccepted_ == weather.accepted() && !weather.changing(clock_s) &&
@@ -102,7 +108,26 @@ weather::LightningFlash LightningService::trigger(const LiveWeather& weather, do
                                                             request.lat_deg, request.lon_deg, request.kind, present,
                                                             request.energy_j);
   record(f);
+  triggered_.push_back(f);
+  while (triggered_.size() > kMaxTriggeredKept) triggered_.pop_front();
   return f;
+}
+
+std::vector<weather::LightningFlash> LightningService::drawIn(const LiveWeather& weather, double from_s, double to_s,
+                                                              std::span<const weather::SphericalCap> areas) const {
+  std::vector<weather::LightningFlash> out;
+  if (!(to_s > from_s)) return out;
+  const std::vector<weather::SphericalCap> caps = distinctCaps(areas);
+  if (options_.rate_perMin100km2 > 0) {
+    const std::vector<weather::StormCell> cells = stormCellsIn(weather, to_s, caps, options_.rate_perMin100km2);
+    out = weather::drawFlashes(options_.seed, cells, from_s, to_s, kMaxFlashesPerRequest);
+  }
+  for (const weather::LightningFlash& f : triggered_)
+    if (f.time_s > from_s && f.time_s <= to_s && out.size() < kMaxFlashesPerRequest &&
+        std::any_of(caps.begin(), caps.end(), [&](const weather::SphericalCap& c) { return flashReaches(c, f); }))
+      out.push_back(f);
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.time_s < b.time_s; });
+  return out;
 }
 
 std::vector<weather::LightningFlash> LightningService::recent(std::size_t limit) const {

@@ -207,7 +207,7 @@ void Server::onAccept(const boost::system::error_code& ec, tcp::socket socket) {
   registry_.add(session);
   const stream::Hello hello{stream::kProtocolVersion, options_.serverId, clockNow(), weather_.clock().rate(),
                             stream::kFeatureCameraReports | stream::kFeatureAreas | stream::kFeatureHostClock |
-                                stream::kFeatureTileDrift};
+                                stream::kFeatureTileDrift | stream::kFeatureLightningRequests};
   session->start(stream::encodeFrame(stream::encodeMessage(hello)));
   renderersChanged();
   accept();
@@ -250,7 +250,7 @@ weather::LightningFlash Server::triggerLightning(const FlashRequest& request) {
 void Server::sendFlashes(const std::vector<weather::LightningFlash>& flashes) {
   if (flashes.empty()) return;
   registry_.forEach([&](Session& s) {
-    stream::Lightning message{clockNow(), {}};
+    stream::Lightning message{clockNow(), {}, std::nullopt};
     const std::vector<weather::SphericalCap> areas = s.areas();
     for (const weather::LightningFlash& f : flashes)
       if (std::any_of(areas.begin(), areas.end(), [&](const auto& a) { return flashReaches(a, f); }))
@@ -342,6 +342,8 @@ std::string Server::streamMetrics() const {
        streamCounters_.flashesTriggered.load());
   line("skyshell_lightning_capped_total", "flashes past the per-tick cap, not sent",
        streamCounters_.flashesCapped.load());
+  line("skyshell_lightning_requests_total", "renderers' requests for the flashes of an interval (headless replays)",
+       streamCounters_.lightningRequests.load());
   line("skyshell_host_clock_proposals_total", "CIGI host clock estimates proposed by renderers",
        streamCounters_.hostClockProposals.load());
   line("skyshell_host_clock_changes_total", "times a host's clock offset was set anew (first channel, or a jump)",
@@ -388,6 +390,13 @@ void Server::hostClockProposed(Session& session, const stream::HostClock& propos
   registry_.forEach([&](Session& s) {
     if (s.hostClockHost() == answer.held.host) sendEventCounted(s, frame);
   });
+}
+
+void Server::lightningRequested(Session& session, const stream::LightningRequest& request) {
+  const std::vector<weather::SphericalCap> areas = session.areas();
+  stream::Lightning answer{clockNow(), lightning_.drawIn(weather_, request.from_s, request.to_s, areas), request.to_s};
+  streamCounters_.lightningRequests.fetch_add(1, std::memory_order_relaxed);
+  sendEventCounted(session, stream::encodeFrame(stream::encodeMessage(answer)));
 }
 
 void Server::protocolRejected(Session& session, const Error& error) {

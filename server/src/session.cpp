@@ -180,6 +180,8 @@ void Session::handleMessage(const stream::Message& message) {
   } else if (const auto* proposal = std::get_if<stream::HostClock>(&message)) {
     hostClockHost_ = proposal->host;
     handler_.hostClockProposed(*this, *proposal);
+  } else if (const auto* asked = std::get_if<stream::LightningRequest>(&message)) {
+    handler_.lightningRequested(*this, *asked);
   } else if (const auto* unknown = std::get_if<stream::UnknownKind>(&message)) {
     // A newer client of our major version: what we do not know, we ignore.
     if (!unknownKindLogged_)

@@ -170,6 +170,75 @@ TEST_F(HeadlessReplay, WeatherClockFollowsFlightTimeAtTheServersRate) {
   EXPECT_EQ(live.stop(), 0) << live.log();
 }
 
+// Lightning at the frames' own clock: the server's process draws flashes as
+// its clock runs (near 0 s here), far from the replay's (5000 s on); the
+// replay asks the server for the flashes of each frame's clock, so its
+// frames show the storm's flashes, the same in every run.
+TEST_F(HeadlessReplay, FramesShowTheStormsLightningAtTheirOwnClock) {
+  std::ifstream cloudy(SKY_SCENARIO_CLOUDY);
+  std::ostringstream text;
+  text << cloudy.rdbuf();
+  std::string scenario = text.str();
+  const auto type = scenario.find("type = \"cumulus\"");
+  ASSERT_NE(type, std::string::npos);
+  scenario.replace(type, 16, "type = \"cumulonimbus\"");
+  std::ofstream(dir_ / "storm.toml") << scenario;
+  ChildProcess storm({SKY_WEATHERD, "--scenario", (dir_ / "storm.toml").string(), "--port", "0", "--port-file",
+                      (dir_ / "storm.port").string(), "--lightning-rate", "2", "--lightning-seed", "7"},
+                     (dir_ / "storm.log").string());
+  const unsigned port = waitForPortFile((dir_ / "storm.port").string(), 20s);
+  ASSERT_GT(port, 0u) << storm.log();
+  const ReplayRun a = replay(port, SKY_TEST_FLIGHT, dir_ / "sa", {"--no-video"});
+  ASSERT_EQ(a.exitCode, 0) << a.log;
+  const ReplayRun b = replay(port, SKY_TEST_FLIGHT, dir_ / "sb", {"--no-video"});
+  ASSERT_EQ(b.exitCode, 0) << b.log;
+  EXPECT_EQ(storm.stop(), 0) << storm.log();
+  const auto lit = [&](const char* run) {
+    std::vector<nlohmann::json> out;
+    std::ifstream jsonl(dir_ / run / "frames" / "frames.jsonl");
+    for (std::string line; std::getline(jsonl, line);) {
+      const auto f = nlohmann::json::parse(line);
+      out.push_back(f.value("lightning", nlohmann::json::array()));
+      const double clock = f["weather_clock_s"].get<double>();
+      for (const auto& flash : out.back()) {
+        EXPECT_LE(flash["time_s"].get<double>(), clock) << run;
+        EXPECT_GT(flash["time_s"].get<double>(), clock - 2.0) << run << ": a flash lights its sky for under 2 s";
+      }
+    }
+    return out;
+  };
+  const auto litA = lit("sa"), litB = lit("sb");
+  ASSERT_EQ(litA.size(), kFrames);
+  std::size_t flashes = 0;
+  for (const auto& l : litA) flashes += l.size();
+  // The storm covers every area the replay watches at 2 flashes a minute per
+  // 100 km^2: tens of flashes a second over the area, a few in each frame.
+  EXPECT_GT(flashes, kFrames) << a.log;
+  EXPECT_EQ(litA, litB) << "the same flashes at the same clocks in both runs";
+}
+
+// An ADS-B track with two aircraft: refused with both listed, until
+// --icao24 picks one, whose fixes the frames then follow.
+TEST_F(HeadlessReplay, AnAdsbFileWithTwoAircraftNeedsOneChosen) {
+  const std::string two = SKY_TEST_DATA_DIR "/adsb/opensky-two-aircraft.csv";
+  const std::vector<std::string> file = {"--weather-file", SKY_SCENARIO_CLOUDY, "--no-video", "--replay-end", "3"};
+  const ReplayRun refused = replay(port_, two, dir_ / "two", file);
+  EXPECT_EQ(refused.exitCode, 2) << refused.log;
+  EXPECT_NE(refused.log.find("3c6444"), std::string::npos) << refused.log;
+  EXPECT_NE(refused.log.find("4b1815"), std::string::npos) << refused.log;
+  std::vector<std::string> chosen = file;
+  chosen.insert(chosen.end(), {"--icao24", "4B1815"});
+  const ReplayRun one = replay(port_, two, dir_ / "one", chosen);
+  ASSERT_EQ(one.exitCode, 0) << one.log;
+  EXPECT_NE(one.log.find("altitude:"), std::string::npos) << "the altitude's source is said\n" << one.log;
+  std::ifstream jsonl(dir_ / "one" / "frames" / "frames.jsonl");
+  std::string line;
+  ASSERT_TRUE(std::getline(jsonl, line));
+  const auto f = nlohmann::json::parse(line);
+  EXPECT_NEAR(f["lat_deg"].get<double>(), 47.45, 1e-9) << "4b1815's first fix";
+  EXPECT_NEAR(f["alt_m"].get<double>(), 3050.0, 1e-6) << "its geometric altitude";
+}
+
 // Without a server: the weather of a scenario file, the same in every run.
 TEST_F(HeadlessReplay, WeatherFileWithoutAServer) {
   // The fixture's server is stopped first: nothing answers on its port.

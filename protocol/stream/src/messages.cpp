@@ -426,7 +426,24 @@ Result<Message> decodeLightning(const fbs::Lightning& l) {
       out.flashes.push_back(flash);
     }
   }
+  if (l.answers_to_s() != -1) {
+    if (auto r = checkRange("Lightning", "answers_to_s", l.answers_to_s(), -1.0e12, 1.0e12); !r)
+      return tl::unexpected(r.error());
+    out.answersTo_s = l.answers_to_s();
+  }
   return Message(std::move(out));
+}
+
+Result<Message> decodeLightningRequest(const fbs::LightningRequest& r) {
+  LightningRequest out{r.from_s(), r.to_s()};
+  for (auto c : {checkRange("LightningRequest", "from_s", out.from_s, -1.0e12, 1.0e12),
+                 checkRange("LightningRequest", "to_s", out.to_s, -1.0e12, 1.0e12)})
+    if (!c) return tl::unexpected(c.error());
+  if (!(out.to_s > out.from_s) || out.to_s - out.from_s > kMaxLightningRequestSpan_s)
+    return fail(ErrorCode::InvalidArgument, "LightningRequest.to_s: " + std::to_string(out.to_s) +
+                                                ", must be after from_s (" + std::to_string(out.from_s) +
+                                                ") by at most " + std::to_string(kMaxLightningRequestSpan_s) + " s");
+  return Message(out);
 }
 
 std::vector<fbs::Tile> encodeTiles(const std::vector<weather::CoverageTile>& tiles) {
@@ -540,11 +557,15 @@ std::vector<std::uint8_t> encodeMessage(const Message& message) {
               flashes.emplace_back(f.seed, f.time_s, f.lat_deg, f.lon_deg, f.energy_j, static_cast<float>(f.bottom_m),
                                    static_cast<float>(f.top_m), static_cast<std::uint8_t>(f.kind), 0, 0, 0u);
             return std::pair{fbs::Body::Lightning,
-                             fbs::CreateLightningDirect(b, l.weatherClock_s, &flashes).Union()};
+                             fbs::CreateLightningDirect(b, l.weatherClock_s, &flashes, l.answersTo_s.value_or(-1.0))
+                                 .Union()};
           },
           [&](const HostClock& h) {
             return std::pair{fbs::Body::HostClock,
                              fbs::CreateHostClockDirect(b, h.host.c_str(), h.offset_s, h.rate).Union()};
+          },
+          [&](const LightningRequest& r) {
+            return std::pair{fbs::Body::LightningRequest, fbs::CreateLightningRequest(b, r.from_s, r.to_s).Union()};
           },
           [&](const UnknownKind& u) {
             // An empty table under a type byte we do not define: what a newer
@@ -595,6 +616,7 @@ Result<Message> decodeMessage(std::span<const std::uint8_t> payload) {
     case fbs::Body::CameraReport: return decodeCameraReport(*m->body_as_CameraReport());
     case fbs::Body::Lightning: return decodeLightning(*m->body_as_Lightning());
     case fbs::Body::HostClock: return decodeHostClock(*m->body_as_HostClock());
+    case fbs::Body::LightningRequest: return decodeLightningRequest(*m->body_as_LightningRequest());
     case fbs::Body::NONE: return fail(ErrorCode::Malformed, "message has no body");
   }
   // A kind appended to the schema after this build: the verifier could not
@@ -612,6 +634,7 @@ const char* kindName(const Message& message) {
                                [](const CameraReport&) { return "CameraReport"; },
                                [](const Lightning&) { return "Lightning"; },
                                [](const HostClock&) { return "HostClock"; },
+                               [](const LightningRequest&) { return "LightningRequest"; },
                                [](const UnknownKind&) { return "an unknown kind"; }},
                     message);
 }

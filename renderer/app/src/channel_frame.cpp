@@ -71,6 +71,8 @@ tl::expected<DrawnFrame, FrameFailure> ChannelFrames::draw(const FrameRequest& r
   record.utcSource = r.utcSource;
   record.atmosphere = r.atmosphere;
   record.weatherClock_s = r.weatherClock_s;
+  for (const weather::LightningFlash& f : view.flashes)
+    if (weather::flashPower_w(f, r.weatherClock_s - in.exposure_s, r.weatherClock_s) > 0) record.flashesLit.push_back(f);
   record.serverClockAtArrival_s = r.serverClockAtArrival_s;
   record.weatherClockLock = r.weatherClockLock;
   record.weatherVersion = view.version;

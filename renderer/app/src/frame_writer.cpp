@@ -204,6 +204,13 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
                                   {"faint", r.nearPrecip.faint},
                                   {"drop_area_px2", r.nearPrecip.dropArea_px2},
                                   {"camera_speed_mps", r.nearPrecip.cameraSpeed_mps}};
+  if (!r.flashesLit.empty()) {
+    nlohmann::json lit = nlohmann::json::array();
+    for (const weather::LightningFlash& f : r.flashesLit)
+      lit.push_back({{"seed", std::to_string(f.seed)}, {"time_s", f.time_s}, {"kind", std::string(weather::toString(f.kind))},
+                     {"lat_deg", f.lat_deg}, {"lon_deg", f.lon_deg}});
+    line["lightning"] = lit;
+  }
   if (outputs_.png) line["file"] = std::string(name) + ".png";
   if (outputs_.exr) line["exr"] = std::string(name) + ".exr";
   metadata_ << line.dump() << '\n';

@@ -26,6 +26,7 @@
 #include "sky/app/weather_client.hpp"
 #include "sky/flight/flight.hpp"
 #include "sky/flight/utf8_text.hpp"
+#include "sky/weather/lightning.hpp"
 #include "sky/weather/scenario.hpp"
 
 namespace sky::app {
@@ -82,12 +83,14 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   // Flight files are read here and parsed by protocol/ (the renderer does
   // not link sim_clients/).
   auto text = readFile(o.flightPath);
-  auto flight = text ? flight::parseFlight(*text, o.flightPath) : Result<flight::ParsedFlight>(tl::unexpected(text.error()));
+  auto flight = text ? flight::parseFlight(*text, o.flightPath, o.read)
+                     : Result<flight::ParsedFlight>(tl::unexpected(text.error()));
   if (!flight) {
     std::fprintf(stderr, "skyshell-render: %s\n", describe(flight.error()).c_str());
     return 2;
   }
   for (const auto& w : flight->warnings) std::fprintf(stderr, "skyshell-render: warning: %s\n", w.c_str());
+  if (!flight->altitudeSource.empty()) std::fprintf(stderr, "skyshell-render: altitude: %s\n", flight->altitudeSource.c_str());
   const double first_s = flight->fixes.front().time_s;
   const double t0 = first_s + o.start_s;
   const double t1 = o.end_s ? std::min(first_s + *o.end_s, flight->fixes.back().time_s) : flight->fixes.back().time_s;
@@ -212,6 +215,20 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
         std::fprintf(stderr, "skyshell-render: warning: frame %zu: no weather for the new area within %.0f s; "
                              "drawing the old area's\n", i, o.weatherTimeout_s);
     }
+    const double frameClock_s = clockBase_s + (t - t0) * clockRate;
+    // The lightning at this frame's clock: the server's stream sends flashes
+    // as its own clock runs, which a replay's frames run ahead of or behind,
+    // so the replay asks for the flashes still giving light at its frame.
+    if (weather && weather->serverTakesLightningRequests()) {
+      weather->requestLightning(frameClock_s - weather::kFlashLifetime_s - render::kDefaultExposure_s, frameClock_s);
+      const auto answered = [&] {
+        const auto to = state.lightningAnsweredTo();
+        return to && *to >= frameClock_s;
+      };
+      if (!waitUntil(answered, o.weatherTimeout_s, stop))
+        std::fprintf(stderr, "skyshell-render: warning: frame %zu: no lightning answer from the server within %.0f s\n",
+                     i, o.weatherTimeout_s);
+    }
     const WeatherView view = state.weather();
     FrameRequest request;
     request.host = host;
@@ -220,7 +237,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     request.weather = &view;
     request.weatherSource = o.weatherFile.empty() ? "server" : "file";
     request.weatherConnected = view.connected;
-    request.weatherClock_s = clockBase_s + (t - t0) * clockRate;
+    request.weatherClock_s = frameClock_s;
     request.sunAzimuth_deg = o.sunAzimuth_deg;
     request.sunElevation_deg = o.sunElevation_deg;
     request.utc_s = host.utc_s;

@@ -167,6 +167,7 @@ void WeatherClient::onFrame(std::span<const std::uint8_t> payload) {
                    state_.setHostClock(std::nullopt);
                    serverTakesHostClock_ = (h.features & stream::kFeatureHostClock) != 0;
                    serverMarksTileDrift_ = (h.features & stream::kFeatureTileDrift) != 0;
+                   serverTakesLightningRequests_ = (h.features & stream::kFeatureLightningRequests) != 0;
                    spdlog::info("weather server '{}' protocol {} clock {:.1f} s x{}{}{}",
                                 flight::messageText(h.serverId, kMaxEchoedServerText),
                                 h.protocolVersion, h.weatherClock_s, h.clockRate,
@@ -216,7 +217,16 @@ void WeatherClient::onFrame(std::span<const std::uint8_t> payload) {
                    ++malformed_;
                    spdlog::warn("weather stream: a server must not send CameraReport; dropped");
                  },
-                 [&](const stream::Lightning& l) { state_.addFlashes(l.flashes, l.weatherClock_s); },
+                 [&](const stream::Lightning& l) {
+                   // An answer is at the asker's clock, which may be far from
+                   // the server's: its flashes are kept by that clock.
+                   state_.addFlashes(l.flashes, l.answersTo_s.value_or(l.weatherClock_s));
+                   if (l.answersTo_s) state_.setLightningAnsweredTo(*l.answersTo_s);
+                 },
+                 [&](const stream::LightningRequest&) {
+                   ++malformed_;
+                   spdlog::warn("weather stream: a server must not send LightningRequest; dropped");
+                 },
                  [&](const stream::HostClock& c) { state_.setHostClock(c); },
                  [&](const stream::UnknownKind&) {
                    // A newer server of our major version: ignore what we do not know.
@@ -257,6 +267,14 @@ void WeatherClient::proposeHostClock(const stream::HostClock& proposal) {
   });
 }
 
+void WeatherClient::requestLightning(double from_s, double to_s) {
+  if (!serverTakesLightningRequests_) return;
+  const stream::LightningRequest request{from_s, to_s};
+  asio::post(io_, [this, request] {
+    if (socket_.is_open() && serverTakesLightningRequests_) send(request);
+  });
+}
+
 bool WeatherClient::reportWorthSending(const stream::CameraReport& r, Clock::time_point now) {
   std::lock_guard lock(reportMutex_);
   const bool forced = reportNow_.exchange(false);
@@ -285,6 +303,8 @@ void WeatherClient::send(const stream::Message& message) {
       pendingSubscribe_[sub->areaIndex] = std::move(bytes);
     else if (std::holds_alternative<stream::HostClock>(message))
       pendingHostClock_ = std::move(bytes);
+    else if (std::holds_alternative<stream::LightningRequest>(message))
+      pendingLightning_ = std::move(bytes);
     else
       pendingReport_ = std::move(bytes);
     return;
@@ -298,7 +318,8 @@ void WeatherClient::flushWrite() {
     inFlight_.clear();
     if (ec) return;  // the read side notices and reconnects
     static_assert(stream::kMaxAreas == 2, "one pending Subscribe per area");
-    for (auto* pending : {&pendingSubscribe_[0], &pendingSubscribe_[1], &pendingHostClock_, &pendingReport_}) {
+    for (auto* pending :
+         {&pendingSubscribe_[0], &pendingSubscribe_[1], &pendingHostClock_, &pendingLightning_, &pendingReport_}) {
       if (!*pending) continue;
       inFlight_ = std::move(**pending);
       pending->reset();

@@ -218,7 +218,7 @@ weather::LightningFlash sampleFlash() {
 }
 
 TEST(LightningMessages, RoundTrip) {
-  Lightning l{43200.5, {sampleFlash(), sampleFlash()}};
+  Lightning l{43200.5, {sampleFlash(), sampleFlash()}, std::nullopt};
   l.flashes[1].kind = weather::FlashKind::InCloud;
   l.flashes[1].bottom_m = 3000;
   l.flashes[1].top_m = 7000.5;
@@ -228,6 +228,32 @@ TEST(LightningMessages, RoundTrip) {
   EXPECT_EQ(got.weatherClock_s, 43200.5);
   EXPECT_EQ(got.flashes, l.flashes) << "every field travels exactly (heights are floats that hold these values)";
   EXPECT_STREQ(kindName(*m), "Lightning");
+  EXPECT_FALSE(got.answersTo_s) << "flashes of the running clock answer no request";
+  // An answer carries the end of the interval asked for.
+  l.answersTo_s = 3630.25;
+  auto answer = decodeMessage(encodeMessage(l));
+  ASSERT_TRUE(answer) << answer.error().detail;
+  EXPECT_EQ(std::get<Lightning>(*answer).answersTo_s, 3630.25);
+}
+
+// A renderer's request for an interval's flashes: exact both ways; an
+// interval that is empty, runs backwards, is longer than 600 s or is not
+// finite is refused, naming the field.
+TEST(LightningMessages, ARequestForAnIntervalIsChecked) {
+  auto m = decodeMessage(encodeMessage(LightningRequest{3600.5, 3630.25}));
+  ASSERT_TRUE(m) << m.error().detail;
+  EXPECT_EQ(std::get<LightningRequest>(*m).from_s, 3600.5);
+  EXPECT_EQ(std::get<LightningRequest>(*m).to_s, 3630.25);
+  EXPECT_STREQ(kindName(*m), "LightningRequest");
+  const std::pair<LightningRequest, const char*> bad[] = {
+      {{10, 10}, "to_s"},           {{10, 5}, "to_s"},      {{0, 600.5}, "to_s"},
+      {{std::nan(""), 1}, "from_s"}, {{0, INFINITY}, "to_s"}, {{-2e12, 0}, "from_s"}};
+  for (const auto& [r, field] : bad) {
+    auto e = decodeMessage(encodeMessage(r));
+    ASSERT_FALSE(e) << r.from_s << " " << r.to_s;
+    EXPECT_NE(e.error().detail.find(std::string("LightningRequest.") + field), std::string::npos) << e.error().detail;
+  }
+  EXPECT_TRUE(decodeMessage(encodeMessage(LightningRequest{0, 600})));
 }
 
 TEST(LightningMessages, EveryFieldIsRangeChecked) {
@@ -246,14 +272,14 @@ TEST(LightningMessages, EveryFieldIsRangeChecked) {
       {"kind", [](weather::LightningFlash& f) { f.kind = static_cast<weather::FlashKind>(2); }},
   };
   for (const Case& c : cases) {
-    Lightning l{1.0, {sampleFlash(), sampleFlash()}};
+    Lightning l{1.0, {sampleFlash(), sampleFlash()}, std::nullopt};
     c.spoil(l.flashes[1]);
     auto m = decodeMessage(encodeMessage(l));
     ASSERT_FALSE(m) << c.field;
     EXPECT_NE(m.error().detail.find("flashes[1]"), std::string::npos) << m.error().detail;
     EXPECT_NE(m.error().detail.find(c.field), std::string::npos) << m.error().detail;
   }
-  Lightning many{1.0, std::vector<weather::LightningFlash>(kMaxMessageFlashes + 1, sampleFlash())};
+  Lightning many{1.0, std::vector<weather::LightningFlash>(kMaxMessageFlashes + 1, sampleFlash()), std::nullopt};
   auto m = decodeMessage(encodeMessage(many));
   ASSERT_FALSE(m);
   EXPECT_EQ(m.error().code, ErrorCode::TooLarge);

@@ -190,6 +190,43 @@ TEST(LightningOutbox, EventsWaitInOrderAndAreBounded) {
   EXPECT_TRUE(std::holds_alternative<stream::Subscribe>(*next));
 }
 
+// What a replay asks for (drawIn) is what the live process drew as its
+// clock ran through the same interval: the same flashes, in order, and an
+// asked-for flash of the interval that reaches the area; nothing is
+// counted as drawn, and another service with the same seed answers alike.
+TEST(LightningService, AnIntervalAskedForHoldsWhatTheLiveProcessDrewInIt) {
+  MovingWeather w;
+  w.set(storm(weather::CloudType::Cumulonimbus, 0.8));
+  LightningService live({6.0, 11});
+  const weather::SphericalCap area{46.0, 8.0, 20'000};
+  const weather::SphericalCap areas[] = {area};
+  const double from = w.weather.clockNow();
+  live.tick(w.weather, from, areas);
+  std::vector<weather::LightningFlash> drawn;
+  for (int s = 0; s < 60; ++s) {
+    w.now += 1s;
+    for (const auto& f : live.tick(w.weather, w.weather.clockNow(), areas)) drawn.push_back(f);
+    if (s == 30) drawn.push_back(live.trigger(w.weather, w.weather.clockNow(), {46.01, 8.0, weather::FlashKind::InCloud}));
+  }
+  const double to = w.weather.clockNow();
+  live.trigger(w.weather, to, {-33.9, 151.2, weather::FlashKind::InCloud});  // far away, and at `to`
+  ASSERT_GT(drawn.size(), 20u);
+  std::stable_sort(drawn.begin(), drawn.end(), [](const auto& a, const auto& b) { return a.time_s < b.time_s; });
+  const std::uint64_t drawnBefore = live.counters().drawn;
+  const std::vector<weather::LightningFlash> asked = live.drawIn(w.weather, from, to, areas);
+  EXPECT_EQ(asked, drawn);
+  EXPECT_EQ(live.counters().drawn, drawnBefore) << "an answer is not a new flash";
+  LightningService other({6.0, 11});
+  const auto again = other.drawIn(w.weather, from, to, areas);
+  EXPECT_EQ(again.size(), drawn.size() - 1) << "the same process; the asked-for flash is the first service's";
+  // A part of the interval: the flashes in it, cut where the clock is.
+  const double mid = from + 20.5;
+  std::size_t inFirst = 0;
+  for (const auto& f : drawn) inFirst += f.time_s <= mid ? 1 : 0;
+  EXPECT_EQ(live.drawIn(w.weather, from, mid, areas).size(), inFirst);
+  EXPECT_TRUE(live.drawIn(w.weather, to, to, areas).empty());
+}
+
 // A real server and two subscribers: one whose area holds the flash, one
 // on the other side of the Earth.
 TEST(LightningSocket, AFlashReachesTheSubscribersItLights) {
@@ -235,6 +272,52 @@ TEST(LightningSocket, AFlashReachesTheSubscribersItLights) {
   }
   EXPECT_EQ(server->streamCounters().flashesTriggered.load(), 1u);
   EXPECT_EQ(onIo(server->io(), [&] { return server->recentFlashes(5); }).size(), 1u);
+  server->stop();
+  thread.join();
+}
+
+// On real sockets: a renderer asks for the flashes of an interval and gets
+// them as one Lightning, marked as the answer to that interval's end.
+TEST(LightningSocket, ARendererAsksForTheFlashesOfAnInterval) {
+  Scenario scenario;
+  scenario.layers = {storm(weather::CloudType::Cumulonimbus, 1.0)};
+  const WallClock::time_point t0{std::chrono::seconds(1)};
+  ServerOptions options;
+  options.port = 0;
+  options.heartbeatInterval = 50ms;
+  options.handleSignals = false;
+  options.wallNow = [t0] { return t0; };  // frozen: the live process draws nothing
+  options.lightning = {60.0, 5};
+  auto created = Server::create(options, WeatherState(scenario, t0));
+  ASSERT_TRUE(created) << created.error().detail;
+  std::unique_ptr<Server> server = std::move(*created);
+  std::thread thread([&] { server->run(); });
+  TestClient client(server->port());
+  auto hello = client.readNext<stream::Hello>();
+  ASSERT_TRUE(hello);
+  EXPECT_NE(hello->features & stream::kFeatureLightningRequests, 0u);
+  stream::Subscribe a;
+  a.area = {47.0, 8.5, 20'000};
+  a.tileLevel = 8;
+  client.send(a);
+  ASSERT_TRUE(client.readNext<weather::WeatherSnapshot>());
+  // An hour ahead of the server's clock, as a replay may be.
+  const double from = 3600, to = 3630;
+  client.send(stream::LightningRequest{from, to});
+  auto got = client.readNext<stream::Lightning>();
+  ASSERT_TRUE(got) << got.error().detail;
+  ASSERT_TRUE(got->answersTo_s);
+  EXPECT_EQ(*got->answersTo_s, to);
+  ASSERT_FALSE(got->flashes.empty()) << "a closed storm at 60 a minute per 100 km^2 over 30 s";
+  for (const auto& f : got->flashes) {
+    EXPECT_GT(f.time_s, from);
+    EXPECT_LE(f.time_s, to);
+  }
+  client.send(stream::LightningRequest{from, to});
+  auto again = client.readNext<stream::Lightning>();
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->flashes, got->flashes) << "asked twice, the same flashes";
+  EXPECT_EQ(server->streamCounters().lightningRequests.load(), 2u);
   server->stop();
   thread.join();
 }

@@ -39,6 +39,8 @@ inline constexpr double kLightningReach_m = 150e3;
 inline constexpr std::size_t kMaxLightningAreas = 64;
 inline constexpr std::size_t kMaxFlashesPerTick = 256;
 inline constexpr std::size_t kMaxRecentFlashes = 1000;
+inline constexpr std::size_t kMaxFlashesPerRequest = 1024;  // stream::kMaxMessageFlashes
+inline constexpr std::size_t kMaxTriggeredKept = 256;
 // A clock that moved by more than this between ticks (set, jumped, or
 // frozen and restarted) draws nothing for the gap.
 inline constexpr double kMaxLightningGap_s = 60;
@@ -64,6 +66,15 @@ class LightningService {
                                             std::span<const weather::SphericalCap> areas);
   // A flash now at the request's place, under the cloud there.
   weather::LightningFlash trigger(const LiveWeather& weather, double clock_s, const FlashRequest& request);
+  // Every flash of the process in the weather-clock interval (from_s, to_s]
+  // over the storms of `areas` (the weather as it stands at to_s), and the
+  // asked-for flashes of that interval that reach them, at most
+  // kMaxFlashesPerRequest, the earliest: what a renderer drawing frames at
+  // its own clock asks for (stream::LightningRequest). The same process as
+  // tick's, so it draws the same flashes for the same storms and seconds;
+  // nothing is recorded or counted as drawn.
+  std::vector<weather::LightningFlash> drawIn(const LiveWeather& weather, double from_s, double to_s,
+                                              std::span<const weather::SphericalCap> areas) const;
   // The newest flashes, oldest first, at most `limit`.
   std::vector<weather::LightningFlash> recent(std::size_t limit) const;
 
@@ -85,6 +96,7 @@ class LightningService {
   std::uint64_t cellsAccepted_ = 0;
   double cellsAt_s_ = 0;
   std::deque<weather::LightningFlash> recent_;
+  std::deque<weather::LightningFlash> triggered_;  // the asked-for ones, for drawIn
   Counters counters_;
 };
 

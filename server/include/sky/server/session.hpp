@@ -47,6 +47,9 @@ class SessionHandler {
   virtual void rendererChanged(Session& session) = 0;
   // The peer proposed its estimate of a CIGI host's clock (host_clocks.hpp).
   virtual void hostClockProposed(Session& session, const stream::HostClock& proposal) = 0;
+  // The peer asked for the lightning process's flashes over an interval of
+  // the weather clock (a renderer drawing frames at its own clock).
+  virtual void lightningRequested(Session& session, const stream::LightningRequest& request) = 0;
   // The peer sent something the stream refuses (a bad frame or message, or a
   // kind clients must not send); the session is closing.
   virtual void protocolRejected(Session& session, const Error& error) = 0;

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <variant>
@@ -43,6 +44,7 @@ inline constexpr std::uint32_t kFeatureCameraReports = 1u << 0;  // takes Camera
 inline constexpr std::uint32_t kFeatureAreas = 1u << 1;          // takes Subscribe.areaIndex > 0
 inline constexpr std::uint32_t kFeatureHostClock = 1u << 2;      // takes HostClock proposals
 inline constexpr std::uint32_t kFeatureTileDrift = 1u << 3;      // sets Layer.tiles_drift (else: all drift)
+inline constexpr std::uint32_t kFeatureLightningRequests = 1u << 4;  // answers LightningRequest
 
 // Areas of interest one connection may hold (Subscribe::areaIndex): a
 // renderer asks for its detailed area around the camera (0) and a wider one
@@ -99,6 +101,18 @@ inline constexpr std::size_t kMaxMessageFlashes = 1024;
 struct Lightning {
   double weatherClock_s = 0;
   std::vector<weather::LightningFlash> flashes;
+  // The answer to a LightningRequest: its toSeconds; unset for flashes drawn
+  // as the server's clock ran or asked for by the operator.
+  std::optional<double> answersTo_s;
+};
+
+// Renderer to server: the flashes of the server's lightning process in the
+// weather-clock interval (from_s, to_s] over this session's areas (see the
+// schema). At most kMaxLightningRequestSpan_s long.
+inline constexpr double kMaxLightningRequestSpan_s = 600;
+struct LightningRequest {
+  double from_s = 0;  // finite, |from_s| <= 1e12
+  double to_s = 0;    // from_s < to_s <= from_s + kMaxLightningRequestSpan_s
 };
 
 // Both ways: the weather clock of one CIGI host's frames, as weather clock =
@@ -119,7 +133,7 @@ struct UnknownKind {
 };
 
 using Message = std::variant<Hello, Subscribe, weather::WeatherSnapshot, Heartbeat, StreamError,
-                             weather::WeatherDelta, CameraReport, Lightning, HostClock, UnknownKind>;
+                             weather::WeatherDelta, CameraReport, Lightning, HostClock, LightningRequest, UnknownKind>;
 
 std::vector<std::uint8_t> encodeMessage(const Message& message);
 

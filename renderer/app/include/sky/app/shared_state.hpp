@@ -130,10 +130,17 @@ class SharedState {
     ++weather_.version;
   }
   // Keeps the flashes of a Lightning message (events: each arrives once).
+  // A flash already held (the same seed and time: a replay's answer that
+  // overlaps the last, or the live stream's copy of one asked for) is kept once.
   void addFlashes(const std::vector<weather::LightningFlash>& flashes, double clock_s) {
     std::lock_guard lock(mutex_);
     auto& held = weather_.flashes;
-    held.insert(held.end(), flashes.begin(), flashes.end());
+    for (const weather::LightningFlash& f : flashes)
+      if (std::none_of(held.begin(), held.end(),
+                       [&](const weather::LightningFlash& h) { return h.seed == f.seed && h.time_s == f.time_s; }))
+        held.push_back(f);
+    std::stable_sort(held.begin(), held.end(),
+                     [](const weather::LightningFlash& a, const weather::LightningFlash& b) { return a.time_s < b.time_s; });
     std::erase_if(held, [clock_s](const weather::LightningFlash& f) {
       return f.time_s + weather::kFlashLifetime_s < clock_s - kFlashGrace_s;
     });
@@ -170,6 +177,16 @@ class SharedState {
     std::lock_guard lock(mutex_);
     hostClock_ = std::move(h);
   }
+  // The end of the last interval the server answered a LightningRequest for
+  // (WeatherClient::requestLightning); unset before the first answer.
+  void setLightningAnsweredTo(double to_s) {
+    std::lock_guard lock(mutex_);
+    lightningAnsweredTo_s_ = to_s;
+  }
+  std::optional<double> lightningAnsweredTo() const {
+    std::lock_guard lock(mutex_);
+    return lightningAnsweredTo_s_;
+  }
   std::optional<stream::HostClock> hostClock() const {
     std::lock_guard lock(mutex_);
     return hostClock_;
@@ -201,6 +218,7 @@ class SharedState {
   WeatherView weather_;
   bool detailedSeen_ = false;  // a Snapshot of area 0 has arrived
   std::optional<stream::HostClock> hostClock_;
+  std::optional<double> lightningAnsweredTo_s_;
 };
 
 }  // namespace sky::app

@@ -63,6 +63,14 @@ class WeatherClient {
   void proposeHostClock(const stream::HostClock& proposal);
   bool serverTakesHostClock() const { return serverTakesHostClock_.load(); }
 
+  // Thread-safe: asks a server that takes them (Hello's
+  // kFeatureLightningRequests) for its lightning process's flashes in the
+  // weather-clock interval (from_s, to_s] over this client's areas; the
+  // answer's flashes join SharedState's, and SharedState::lightningAnsweredTo
+  // becomes to_s. For a headless replay, whose frames run at their own clock.
+  void requestLightning(double from_s, double to_s);
+  bool serverTakesLightningRequests() const { return serverTakesLightningRequests_.load(); }
+
   std::uint64_t reportsSent() const { return reportsSent_.load(); }
 
   std::uint64_t malformedFrames() const { return malformed_.load(); }
@@ -87,17 +95,19 @@ class WeatherClient {
   std::array<std::uint8_t, 16384> rx_{};
   std::array<std::optional<stream::Subscribe>, stream::kMaxAreas> areas_;  // by area index
   // Bounded outbound: one frame in flight; waiting, only the newest Subscribe
-  // of each area, the newest HostClock proposal and the newest CameraReport
-  // (in that order).
+  // of each area, the newest HostClock proposal, the newest LightningRequest
+  // and the newest CameraReport (in that order).
   std::vector<std::uint8_t> inFlight_;
   std::array<std::optional<std::vector<std::uint8_t>>, stream::kMaxAreas> pendingSubscribe_;
   std::optional<std::vector<std::uint8_t>> pendingReport_;
   std::optional<std::vector<std::uint8_t>> pendingHostClock_;
+  std::optional<std::vector<std::uint8_t>> pendingLightning_;
   std::string channel_;
   // Set from the io thread on the server's Hello; read by reportCamera.
   std::atomic<bool> serverTakesReports_{false};
   std::atomic<bool> serverTakesAreas_{false};
   std::atomic<bool> serverTakesHostClock_{false};
+  std::atomic<bool> serverTakesLightningRequests_{false};
   // The server marks which layers' tiles drift (kFeatureTileDrift); an
   // older server meant all of them to. Read on the stream's thread only.
   bool serverMarksTileDrift_ = false;
