@@ -88,6 +88,8 @@ struct Options {
   double replayStart_s = 0;
   double replayEnd_s = -1;
   double replayWeatherClock_s = std::numeric_limits<double>::quiet_NaN();
+  sky::flight::ReadOptions replayRead;  // --icao24, --altitude-unit (ADS-B files)
+  std::string replayAltitudeUnit;
   bool noVideo = false;
   bool fixedSun = false;
   std::string utc;  // --utc: the time of day at the host's first datagram
@@ -212,6 +214,12 @@ int main(int argc, char** argv) {
                  "with --replay: also write each frame's weather radar picture round the camera, this many km "
                  "(frames/radar_NNNNNN.png: dBZ from the drawn weather's precipitation, a beam level with the camera)")
       ->check(CLI::Range(1.0, 300.0));
+  app.add_option("--icao24", o.replayRead.icao24,
+                 "with --replay of an ADS-B .csv holding several aircraft: this one (ICAO 24-bit address, hex)");
+  app.add_option("--altitude-unit", o.replayAltitudeUnit,
+                 "with --replay of an ADS-B .csv: unit of its altitude columns, ft or m (default: as each column's "
+                 "name says)")
+      ->check(CLI::IsMember({"ft", "m"}));
   app.add_option("--replay-start", o.replayStart_s, "with --replay: start offset into the flight, s")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--replay-end", o.replayEnd_s, "with --replay: end offset into the flight, s (default: its end)")
@@ -337,6 +345,9 @@ int main(int argc, char** argv) {
   if (!o.replayFlight.empty()) {
     sky::app::ReplayOptions r;
     r.flightPath = o.replayFlight;
+    r.read = o.replayRead;
+    if (!o.replayAltitudeUnit.empty())
+      r.read.altitudeUnit = o.replayAltitudeUnit == "ft" ? sky::flight::AltitudeUnit::Feet : sky::flight::AltitudeUnit::Metres;
     r.step_s = o.replayStep_s;
     r.pace = o.replayPace;
     r.start_s = o.replayStart_s;

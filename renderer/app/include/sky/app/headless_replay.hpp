@@ -21,13 +21,15 @@
 
 #include "sky/app/frame_writer.hpp"
 #include "sky/app/window_display.hpp"
+#include "sky/flight/flight.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky/render/frame_budget.hpp"
 
 namespace sky::app {
 
 struct ReplayOptions {
-  std::string flightPath;  // .csv, .igc or .gpx
+  std::string flightPath;  // .csv (ours or ADS-B), .igc or .gpx
+  flight::ReadOptions read;  // for an ADS-B file: the aircraft, the altitude unit
   double step_s = 1.0 / 30.0;           // flight seconds per frame, (0, 3600]
   double start_s = 0;                   // offset into the flight, s
   std::optional<double> end_s;          // offset into the flight, s (default: its end)
