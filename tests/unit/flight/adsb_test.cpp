@@ -12,6 +12,7 @@
 #include <string>
 
 #include "sky/flight/flight.hpp"
+#include "warnings.hpp"
 #include "sky/weather/standard_atmosphere.hpp"
 
 namespace sky::flight {
@@ -28,17 +29,6 @@ std::string readData(const std::string& name) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-bool anyWarningHas(const ParsedFlight& f, const std::string& needle) {
-  return std::any_of(f.warnings.begin(), f.warnings.end(),
-                     [&](const std::string& w) { return w.find(needle) != std::string::npos; });
-}
-
-std::string allWarnings(const ParsedFlight& f) {
-  std::string out;
-  for (const auto& w : f.warnings) out += w + "\n";
-  return out;
 }
 
 TEST(StandardAtmosphere, PressureAltitudeToGeometric) {

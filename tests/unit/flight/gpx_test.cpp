@@ -7,6 +7,7 @@
 #include <string>
 
 #include "sky/flight/flight.hpp"
+#include "warnings.hpp"
 
 namespace sky::flight {
 namespace {
@@ -33,11 +34,6 @@ void expectError(const std::string& text, const std::string& needle) {
   auto f = parseGpx(text, "bad.gpx");
   ASSERT_FALSE(f) << "parsed: " << text;
   EXPECT_NE(f.error().detail.find(needle), std::string::npos) << f.error().detail;
-}
-
-bool anyWarningHas(const ParsedFlight& f, const std::string& needle) {
-  return std::any_of(f.warnings.begin(), f.warnings.end(),
-                     [&](const std::string& w) { return w.find(needle) != std::string::npos; });
 }
 
 TEST(FlightGpx, ReadsATrack) {

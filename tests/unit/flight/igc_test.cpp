@@ -10,6 +10,7 @@
 #include <string>
 
 #include "sky/flight/flight.hpp"
+#include "warnings.hpp"
 
 namespace sky::flight {
 namespace {
@@ -24,17 +25,6 @@ std::string b(const std::string& hhmmss, char validity = 'A', int pressure_m = 9
 }
 
 const std::string kHeader = "AXXX001\r\nHFDTE030416\r\n";
-
-bool anyWarningHas(const ParsedFlight& f, const std::string& needle) {
-  return std::any_of(f.warnings.begin(), f.warnings.end(),
-                     [&](const std::string& w) { return w.find(needle) != std::string::npos; });
-}
-
-std::string allWarnings(const ParsedFlight& f) {
-  std::string out;
-  for (const auto& w : f.warnings) out += w + "\n";
-  return out;
-}
 
 TEST(FlightIgc, ReadsFixesAndShortDate) {
   auto f = parseIgc(kHeader + b("120000") + b("120001", 'A', 960, 1010, "4612500S01249000W"), "a.igc");
