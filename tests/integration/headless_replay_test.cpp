@@ -227,7 +227,7 @@ TEST_F(HeadlessReplay, AnAdsbFileWithTwoAircraftNeedsOneChosen) {
   EXPECT_NE(refused.log.find("3c6444"), std::string::npos) << refused.log;
   EXPECT_NE(refused.log.find("4b1815"), std::string::npos) << refused.log;
   std::vector<std::string> chosen = file;
-  chosen.insert(chosen.end(), {"--icao24", "4B1815"});
+  chosen.insert(chosen.end(), {"--icao24", "4B1815", "--exposure-ms", "4"});
   const ReplayRun one = replay(port_, two, dir_ / "one", chosen);
   ASSERT_EQ(one.exitCode, 0) << one.log;
   EXPECT_NE(one.log.find("altitude:"), std::string::npos) << "the altitude's source is said\n" << one.log;
@@ -237,6 +237,7 @@ TEST_F(HeadlessReplay, AnAdsbFileWithTwoAircraftNeedsOneChosen) {
   const auto f = nlohmann::json::parse(line);
   EXPECT_NEAR(f["lat_deg"].get<double>(), 47.45, 1e-9) << "4b1815's first fix";
   EXPECT_NEAR(f["alt_m"].get<double>(), 3050.0, 1e-6) << "its geometric altitude";
+  EXPECT_NEAR(f["exposure_s"].get<double>(), 0.004, 1e-12) << "--exposure-ms reaches the frame";
 }
 
 // Without a server: the weather of a scenario file, the same in every run.

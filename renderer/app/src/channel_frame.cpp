@@ -35,6 +35,7 @@ tl::expected<DrawnFrame, FrameFailure> ChannelFrames::draw(const FrameRequest& r
   in.weatherVersion = drawnVersion_;
   in.weatherClock_s = r.weatherClock_s;
   in.flashes = view.flashes;
+  in.exposure_s = exposure_s_;
   in.patternIndex = r.patternIndex;
   in.sunAzimuth_deg = r.sunAzimuth_deg;
   in.sunElevation_deg = r.sunElevation_deg;
@@ -71,6 +72,7 @@ tl::expected<DrawnFrame, FrameFailure> ChannelFrames::draw(const FrameRequest& r
   record.utcSource = r.utcSource;
   record.atmosphere = r.atmosphere;
   record.weatherClock_s = r.weatherClock_s;
+  record.exposure_s = in.exposure_s;
   for (const weather::LightningFlash& f : view.flashes)
     if (weather::flashPower_w(f, r.weatherClock_s - in.exposure_s, r.weatherClock_s) > 0) record.flashesLit.push_back(f);
   record.serverClockAtArrival_s = r.serverClockAtArrival_s;

@@ -204,6 +204,7 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
                                   {"faint", r.nearPrecip.faint},
                                   {"drop_area_px2", r.nearPrecip.dropArea_px2},
                                   {"camera_speed_mps", r.nearPrecip.cameraSpeed_mps}};
+  line["exposure_s"] = r.exposure_s;
   if (!r.flashesLit.empty()) {
     nlohmann::json lit = nlohmann::json::array();
     for (const weather::LightningFlash& f : r.flashesLit)

@@ -186,6 +186,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   std::size_t done = 0;
   ChannelFrames frames(renderer, *writer, o.display);
   frames.setBudget(o.budget);
+  frames.setExposure(o.exposure_s);
   std::map<std::string, std::size_t> framesPerLevel;
   for (std::size_t i = 0; i < frameCount; ++i) {
     if (stop && *stop) {
@@ -219,11 +220,13 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     // The lightning at this frame's clock: the server's stream sends flashes
     // as its own clock runs, which a replay's frames run ahead of or behind,
     // so the replay asks for the flashes still giving light at its frame.
+    // A server that goes away (its connection lost) ends the wait at once:
+    // the frame draws the flashes it holds, as it draws the weather it holds.
     if (weather && weather->serverTakesLightningRequests()) {
-      weather->requestLightning(frameClock_s - weather::kFlashLifetime_s - render::kDefaultExposure_s, frameClock_s);
+      weather->requestLightning(frameClock_s - weather::kFlashLifetime_s - o.exposure_s, frameClock_s);
       const auto answered = [&] {
         const auto to = state.lightningAnsweredTo();
-        return to && *to >= frameClock_s;
+        return (to && *to >= frameClock_s) || !weather->serverTakesLightningRequests();
       };
       if (!waitUntil(answered, o.weatherTimeout_s, stop))
         std::fprintf(stderr, "skyshell-render: warning: frame %zu: no lightning answer from the server within %.0f s\n",

@@ -89,6 +89,7 @@ struct Options {
   double replayEnd_s = -1;
   double replayWeatherClock_s = std::numeric_limits<double>::quiet_NaN();
   sky::flight::ReadOptions replayRead;  // --icao24, --altitude-unit (ADS-B files)
+  double exposure_ms = 1000.0 * sky::render::kDefaultExposure_s;
   std::string replayAltitudeUnit;
   bool noVideo = false;
   bool fixedSun = false;
@@ -214,6 +215,10 @@ int main(int argc, char** argv) {
                  "with --replay: also write each frame's weather radar picture round the camera, this many km "
                  "(frames/radar_NNNNNN.png: dBZ from the drawn weather's precipitation, a beam level with the camera)")
       ->check(CLI::Range(1.0, 300.0));
+  app.add_option("--exposure-ms", o.exposure_ms,
+                 "each frame's exposure, ms: what a lightning flash lights in it and how long the drops near the "
+                 "camera streak (shorter: shorter, brighter streaks)")
+      ->check(CLI::Range(0.1, 1000.0));
   app.add_option("--icao24", o.replayRead.icao24,
                  "with --replay of an ADS-B .csv holding several aircraft: this one (ICAO 24-bit address, hex)");
   app.add_option("--altitude-unit", o.replayAltitudeUnit,
@@ -346,6 +351,7 @@ int main(int argc, char** argv) {
     sky::app::ReplayOptions r;
     r.flightPath = o.replayFlight;
     r.read = o.replayRead;
+    r.exposure_s = o.exposure_ms / 1000.0;
     if (!o.replayAltitudeUnit.empty())
       r.read.altitudeUnit = o.replayAltitudeUnit == "ft" ? sky::flight::AltitudeUnit::Feet : sky::flight::AltitudeUnit::Metres;
     r.step_s = o.replayStep_s;
@@ -507,6 +513,7 @@ int main(int argc, char** argv) {
     source = std::make_unique<sky::app::CigiPoseSource>(state, *cigi, o.cigiSync);
   sky::app::ChannelFrames channelFrames(**renderer, *writer, display ? &*display : nullptr);
   channelFrames.setBudget(budget ? &*budget : nullptr);
+  channelFrames.setExposure(o.exposure_ms / 1000.0);
 
   std::uint64_t frames = 0, lastSequence = 0, resetsSeen = 0;
   sky::app::LatencyHistogram transportDelay, presentDelay;

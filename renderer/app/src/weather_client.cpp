@@ -111,6 +111,7 @@ void WeatherClient::scheduleReconnect() {
   serverTakesReports_ = false;
   serverTakesAreas_ = false;
   serverTakesHostClock_ = false;
+  serverTakesLightningRequests_ = false;
   if (stopped_) return;
   state_.setConnected(false);
   boost::system::error_code ec;

@@ -286,7 +286,7 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
       impl_->nearReport.type = nearIn.type;
       impl_->nearReport.rate_mmph = nearIn.rate_mmph;
       impl_->nearReport.drops = near.population.count;
-      impl_->nearReport.capped = near.population.capped;
+      impl_->nearReport.capped = near.population.capped || near.entriesCapped;
       impl_->nearReport.streaks = std::uint32_t(near.streaks.size());
       impl_->nearReport.faint = near.faint;
       impl_->nearReport.dropArea_px2 = near.dropArea_px2;

@@ -155,7 +155,7 @@ NearPrecipFrame buildNearPrecip(const NearPrecipInputs& in) {
   const glm::dmat3 ecefToLocal = glm::transpose(in.localToEcef);
   const double box = pop.box_m;
   const double pixelsPerTangent = double(in.width) / (in.frustum.y - in.frustum.x);
-  const double snow = isSnow(pop.type);
+  const bool snow = isSnow(pop.type);
   const double typeFall = weather::fallSpeed_mps(pop.type);
   // The camera's place in the pattern's frame, per axis in boxes (ECEF
   // metres are exact in double; only the fraction matters).

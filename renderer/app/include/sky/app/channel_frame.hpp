@@ -67,12 +67,16 @@ class ChannelFrames {
   // Holds the frames to a time budget: each frame is drawn at the budget's
   // level, and its time moves the budget on. Not owned; null: none.
   void setBudget(render::FrameBudget* budget) { budget_ = budget; }
+  // The exposure each frame stands for (s, > 0): what a flash lights in it,
+  // and how long the drops near the camera streak.
+  void setExposure(double exposure_s) { exposure_s_ = exposure_s; }
 
  private:
   render::CloudRenderer& renderer_;
   FrameWriter& writer_;
   WindowDisplay* display_;
   render::FrameBudget* budget_ = nullptr;
+  double exposure_s_ = render::kDefaultExposure_s;
   std::size_t appliedLevel_ = 0;
   std::uint64_t droppedWarnedAt_ = 0;
   // The renderer's weather version (FrameInputs::weatherVersion): a new one

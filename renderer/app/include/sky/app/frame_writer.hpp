@@ -76,6 +76,7 @@ struct FrameRecord {
   render::TemporalReport temporal;    // what the reprojection did (interleaved presets)
   render::SunMapReport sunMap;        // the sun map rebuilt or reused (map methods)
   render::NearPrecipReport nearPrecip;  // the drops drawn near the camera (in precipitation)
+  double exposure_s = 0;                            // the exposure the frame stands for
   std::vector<weather::LightningFlash> flashesLit;  // the flashes giving light over the frame's exposure
   render::WeatherMapReport weatherMap;  // what this frame changed in the weather map (per tile, or rebuilt and why)
   std::optional<bool> presented;      // windowed: whether the frame reached the window

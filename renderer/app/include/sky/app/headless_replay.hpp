@@ -52,6 +52,7 @@ struct ReplayOptions {
   // Windowed: every frame is also shown here; closing the window ends the
   // replay (exit code 0, report written). Not owned.
   WindowDisplay* display = nullptr;
+  double exposure_s = render::kDefaultExposure_s;  // --exposure-ms: each frame's exposure
   // Holds the frames to a time budget (--frame-budget-ms); the report
   // counts the frames per level. Not owned; null: none.
   render::FrameBudget* budget = nullptr;

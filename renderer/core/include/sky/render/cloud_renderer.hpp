@@ -356,7 +356,7 @@ struct NearPrecipReport {
   weather::CloudType type = weather::CloudType::None;  // None: dry at the camera, or not drawn
   double rate_mmph = 0;
   std::uint32_t drops = 0;    // in the cube round the camera
-  bool capped = false;        // the rate asked for more drops than are drawn (near_precip.hpp)
+  bool capped = false;        // the rate asked for more drops, or they for more tile entries, than are drawn (near_precip.hpp)
   std::uint32_t streaks = 0;  // of them, those whose path reached the image
   std::uint32_t faint = 0;    // and those left out as too faint to change a pixel (near_precip.hpp)
   double dropArea_px2 = 0;    // their image area, sum of pi r^2
