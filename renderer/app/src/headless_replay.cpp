@@ -127,6 +127,9 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     weatherSource = o.weatherFile;
   } else {
     weather.emplace(io, state, o.serverHost, o.serverPort);
+    // Its frames ask for their flashes (below): the ones the server sends
+    // at its own clock are not theirs.
+    weather->takeOnlyAskedFlashes();
     weather->start();
     weatherSource = o.serverHost + ":" + std::to_string(o.serverPort);
   }

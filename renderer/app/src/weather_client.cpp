@@ -219,6 +219,7 @@ void WeatherClient::onFrame(std::span<const std::uint8_t> payload) {
                    spdlog::warn("weather stream: a server must not send CameraReport; dropped");
                  },
                  [&](const stream::Lightning& l) {
+                   if (onlyAskedFlashes_ && serverTakesLightningRequests_ && !l.answersTo_s) return;
                    // An answer is at the asker's clock, which may be far from
                    // the server's: its flashes are kept by that clock.
                    state_.addFlashes(l.flashes, l.answersTo_s.value_or(l.weatherClock_s));

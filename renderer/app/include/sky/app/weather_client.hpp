@@ -69,6 +69,10 @@ class WeatherClient {
   // answer's flashes join SharedState's, and SharedState::lightningAnsweredTo
   // becomes to_s. For a headless replay, whose frames run at their own clock.
   void requestLightning(double from_s, double to_s);
+  // Call before start() on a client that asks for its flashes: while the
+  // server takes requests, the flashes it sends as its own clock runs are
+  // left out (their clock is not the asker's, and would prune its flashes).
+  void takeOnlyAskedFlashes() { onlyAskedFlashes_ = true; }
   bool serverTakesLightningRequests() const { return serverTakesLightningRequests_.load(); }
 
   std::uint64_t reportsSent() const { return reportsSent_.load(); }
@@ -108,6 +112,7 @@ class WeatherClient {
   std::atomic<bool> serverTakesAreas_{false};
   std::atomic<bool> serverTakesHostClock_{false};
   std::atomic<bool> serverTakesLightningRequests_{false};
+  bool onlyAskedFlashes_ = false;  // set before start(); read on the io thread
   // The server marks which layers' tiles drift (kFeatureTileDrift); an
   // older server meant all of them to. Read on the stream's thread only.
   bool serverMarksTileDrift_ = false;
