@@ -2,6 +2,8 @@
 #include "sky/server/lightning_service.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <iterator>
 #include <map>
 
 #include "sky/server/conditions_api.hpp"
@@ -114,13 +116,27 @@ weather::LightningFlash LightningService::trigger(const LiveWeather& weather, do
 }
 
 std::vector<weather::LightningFlash> LightningService::drawIn(const LiveWeather& weather, double from_s, double to_s,
-                                                              std::span<const weather::SphericalCap> areas) const {
+                                                              std::span<const weather::SphericalCap> areas,
+                                                              bool* computed) {
+  if (computed) *computed = false;
   std::vector<weather::LightningFlash> out;
   if (!(to_s > from_s)) return out;
   const std::vector<weather::SphericalCap> caps = distinctCaps(areas);
   if (options_.rate_perMin100km2 > 0) {
-    const std::vector<weather::StormCell> cells = stormCellsIn(weather, to_s, caps, options_.rate_perMin100km2);
-    out = weather::drawFlashes(options_.seed, cells, from_s, to_s, kMaxFlashesPerRequest);
+    const double start_s = std::floor(to_s / kStormCellRefresh_s) * kStormCellRefresh_s;
+    auto kept = std::find_if(requestCells_.begin(), requestCells_.end(), [&](const RequestCells& r) {
+      return r.intervalStart_s == start_s && r.accepted == weather.accepted() &&
+             std::equal(caps.begin(), caps.end(), r.caps.begin(), r.caps.end(), same);
+    });
+    if (kept == requestCells_.end()) {
+      if (computed) *computed = true;
+      ++counters_.requestCellsComputed;
+      requestCells_.push_back({start_s, caps, weather.accepted(),
+                               stormCellsIn(weather, start_s, caps, options_.rate_perMin100km2)});
+      while (requestCells_.size() > kRequestCellsKept) requestCells_.pop_front();
+      kept = std::prev(requestCells_.end());
+    }
+    out = weather::drawFlashes(options_.seed, kept->cells, from_s, to_s, kMaxFlashesPerRequest);
   }
   for (const weather::LightningFlash& f : triggered_)
     if (f.time_s > from_s && f.time_s <= to_s && out.size() < kMaxFlashesPerRequest &&

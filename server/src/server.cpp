@@ -344,6 +344,10 @@ std::string Server::streamMetrics() const {
        streamCounters_.flashesCapped.load());
   line("skyshell_lightning_requests_total", "renderers' requests for the flashes of an interval (headless replays)",
        streamCounters_.lightningRequests.load());
+  line("skyshell_lightning_request_cells_total", "lightning requests that computed their storm cells (the costly ones)",
+       streamCounters_.lightningCellsComputed.load());
+  line("skyshell_lightning_input_pauses_total", "times a session's input waited for its lightning budget",
+       streamCounters_.lightningInputPauses.load());
   line("skyshell_host_clock_proposals_total", "CIGI host clock estimates proposed by renderers",
        streamCounters_.hostClockProposals.load());
   line("skyshell_host_clock_changes_total", "times a host's clock offset was set anew (first channel, or a jump)",
@@ -392,11 +396,23 @@ void Server::hostClockProposed(Session& session, const stream::HostClock& propos
   });
 }
 
-void Server::lightningRequested(Session& session, const stream::LightningRequest& request) {
+bool Server::lightningRequested(Session& session, const stream::LightningRequest& request) {
   const std::vector<weather::SphericalCap> areas = session.areas();
-  stream::Lightning answer{clockNow(), lightning_.drawIn(weather_, request.from_s, request.to_s, areas), request.to_s};
+  bool computed = false;
+  stream::Lightning answer{clockNow(), lightning_.drawIn(weather_, request.from_s, request.to_s, areas, &computed),
+                           request.to_s};
   streamCounters_.lightningRequests.fetch_add(1, std::memory_order_relaxed);
+  if (computed) streamCounters_.lightningCellsComputed.fetch_add(1, std::memory_order_relaxed);
   sendEventCounted(session, stream::encodeFrame(stream::encodeMessage(answer)));
+  return computed;
+}
+
+void Server::inputPaused(Session& session) {
+  streamCounters_.lightningInputPauses.fetch_add(1, std::memory_order_relaxed);
+  warnOnce("lightning budget", "event=input_paused session=" + std::to_string(session.id()) + " peer=" +
+                                   session.peer() + " reason=\"LightningRequests over storm cells past " +
+                                   std::to_string(static_cast<int>(kLightningComputeRate_perS)) +
+                                   " computations a second\"; its input waits");
 }
 
 void Server::protocolRejected(Session& session, const Error& error) {

@@ -42,6 +42,7 @@ Session::Session(asio::ip::tcp::socket socket, std::uint64_t id, SessionHandler&
     : socket_(std::move(socket)),
       drainTimer_(socket_.get_executor()),
       stallTimer_(socket_.get_executor()),
+      pauseTimer_(socket_.get_executor()),
       stallTimeout_(stallTimeout),
       id_(id),
       handler_(handler),
@@ -120,6 +121,7 @@ void Session::close() {
   socket_.close(ignored);
   drainTimer_.cancel();
   stallTimer_.cancel();
+  pauseTimer_.cancel();
   handler_.sessionClosed(*this);
 }
 
@@ -143,25 +145,47 @@ void Session::handleRead(const boost::system::error_code& ec, std::size_t bytes)
     close();
     return;
   }
-  if (state_ == State::Open) {
-    decoder_.append(std::span<const std::uint8_t>(readBuffer_.data(), bytes));
-    while (state_ == State::Open) {
-      auto frame = decoder_.next();
-      if (!frame) {
-        protocolError(frame.error());
-        break;
-      }
-      if (!*frame) break;
-      auto message = stream::decodeMessage(**frame);
-      if (!message) {
-        protocolError(message.error());
-        break;
-      }
-      handleMessage(*message);
+  if (state_ == State::Open) decoder_.append(std::span<const std::uint8_t>(readBuffer_.data(), bytes));
+  handleDecoded();
+}
+
+void Session::handleDecoded() {
+  while (state_ == State::Open && !inputPaused_) {
+    auto frame = decoder_.next();
+    if (!frame) {
+      protocolError(frame.error());
+      break;
     }
+    if (!*frame) break;
+    auto message = stream::decodeMessage(**frame);
+    if (!message) {
+      protocolError(message.error());
+      break;
+    }
+    handleMessage(*message);
   }
   // After an Error the rest of the input is read and discarded until EOF.
-  if (state_ != State::Closed) readMore();
+  if (state_ != State::Closed && !inputPaused_) readMore();
+}
+
+void Session::spendLightningBudget() {
+  const auto now = std::chrono::steady_clock::now();
+  const double elapsed_s = std::chrono::duration<double>(now - lightningBudgetAt_).count();
+  lightningBudgetAt_ = now;
+  lightningBudget_ = std::min(kLightningComputeBurst, lightningBudget_ + elapsed_s * kLightningComputeRate_perS) - 1;
+  if (lightningBudget_ >= 0 || inputPaused_) return;
+  inputPaused_ = true;
+  handler_.inputPaused(*this);
+  log_.debug("event=input_paused session={} peer={} reason=lightning_budget", id_, peer_);
+  pauseTimer_.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(-lightningBudget_ / kLightningComputeRate_perS)));
+  pauseTimer_.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+    if (ec || self->state_ == State::Closed) return;
+    self->guarded("resume", [&] {
+      self->inputPaused_ = false;
+      self->handleDecoded();
+    });
+  });
 }
 
 void Session::handleMessage(const stream::Message& message) {
@@ -181,7 +205,7 @@ void Session::handleMessage(const stream::Message& message) {
     hostClockHost_ = proposal->host;
     handler_.hostClockProposed(*this, *proposal);
   } else if (const auto* asked = std::get_if<stream::LightningRequest>(&message)) {
-    handler_.lightningRequested(*this, *asked);
+    if (handler_.lightningRequested(*this, *asked)) spendLightningBudget();
   } else if (const auto* unknown = std::get_if<stream::UnknownKind>(&message)) {
     // A newer client of our major version: what we do not know, we ignore.
     if (!unknownKindLogged_)

@@ -324,3 +324,98 @@ TEST(LightningSocket, ARendererAsksForTheFlashesOfAnInterval) {
 
 }  // namespace
 }  // namespace sky::server
+
+namespace sky::server {
+namespace {
+
+// A replay's frames ask within one 10 s interval of weather clock many
+// times: the storm cells are computed once for them, and an answer does not
+// depend on what was asked before (a second service asked only the last
+// interval draws the same flashes). A weather change, or an interval asked
+// for after more than kRequestCellsKept others, computes them again.
+TEST(LightningService, TheFramesOfOneIntervalComputeItsStormCellsOnce) {
+  MovingWeather w;
+  w.set(storm(weather::CloudType::Cumulonimbus, 0.8));
+  LightningService service({60.0, 3});
+  const weather::SphericalCap areas[] = {{46.0, 8.0, 20'000}};
+  const double t0 = std::floor(w.weather.clockNow() / kStormCellRefresh_s) * kStormCellRefresh_s + 1000;
+  bool computed = false;
+  std::size_t flashes = 0;
+  for (int frame = 0; frame < 270; ++frame) {  // 9 s at 30 frames a second
+    const double from = t0 + frame / 30.0, to = from + 1 / 30.0;
+    flashes += service.drawIn(w.weather, from, to, areas, &computed).size();
+    EXPECT_EQ(computed, frame == 0) << "frame " << frame;
+  }
+  EXPECT_GT(flashes, 0u) << "a storm of 60 a minute per 100 km^2 over 9 s";
+  EXPECT_EQ(service.counters().requestCellsComputed, 1u);
+  const auto next = service.drawIn(w.weather, t0 + 10, t0 + 10.5, areas, &computed);
+  EXPECT_TRUE(computed) << "the next interval";
+  LightningService fresh({60.0, 3});
+  EXPECT_EQ(fresh.drawIn(w.weather, t0 + 10, t0 + 10.5, areas), next) << "the same answer without the history";
+  // More than kRequestCellsKept other intervals, then the first again.
+  for (std::size_t k = 2; k < kRequestCellsKept + 3; ++k)
+    service.drawIn(w.weather, t0 + 10.0 * static_cast<double>(k), t0 + 10.0 * static_cast<double>(k) + 1, areas);
+  service.drawIn(w.weather, t0, t0 + 1, areas, &computed);
+  EXPECT_TRUE(computed) << "forgotten: the cache holds at most kRequestCellsKept";
+  const std::uint64_t before = service.counters().requestCellsComputed;
+  service.drawIn(w.weather, t0, t0 + 1, areas, &computed);
+  EXPECT_FALSE(computed);
+  w.set(storm(weather::CloudType::Cumulonimbus, 0.3));
+  service.drawIn(w.weather, t0, t0 + 1, areas, &computed);
+  EXPECT_TRUE(computed) << "the weather changed";
+  EXPECT_EQ(service.counters().requestCellsComputed, before + 1);
+}
+
+// On a real socket: a peer that asks for 40 intervals all over the clock
+// (each computing storm cells) gets every answer, in order, but no faster
+// than its budget lets the server compute them: the storm cells computed
+// stay within the burst plus the rate times the time it took, and the
+// input was paused. Another subscriber is served meanwhile.
+TEST(LightningSocket, APeerAskingAllOverTheClockWaitsForItsBudget) {
+  Scenario scenario;
+  scenario.layers = {storm(weather::CloudType::Cumulonimbus, 1.0)};
+  const WallClock::time_point t0{std::chrono::seconds(1)};
+  ServerOptions options;
+  options.port = 0;
+  options.heartbeatInterval = 50ms;
+  options.handleSignals = false;
+  options.wallNow = [t0] { return t0; };
+  options.lightning = {60.0, 5};
+  auto created = Server::create(options, WeatherState(scenario, t0));
+  ASSERT_TRUE(created) << created.error().detail;
+  std::unique_ptr<Server> server = std::move(*created);
+  std::thread thread([&] { server->run(); });
+  TestClient greedy(server->port()), other(server->port());
+  ASSERT_TRUE(greedy.readNext<stream::Hello>());
+  ASSERT_TRUE(other.readNext<stream::Hello>());
+  stream::Subscribe a;
+  a.area = {47.0, 8.5, 20'000};
+  a.tileLevel = 8;
+  greedy.send(a);
+  ASSERT_TRUE(greedy.readNext<weather::WeatherSnapshot>());
+  constexpr int kAsked = 40;
+  const auto start = std::chrono::steady_clock::now();
+  for (int k = 0; k < kAsked; ++k) greedy.send(stream::LightningRequest{100.0 * k, 100.0 * k + 5});
+  // The other subscriber's snapshot while the greedy one's requests wait.
+  other.send(a);
+  ASSERT_TRUE(other.readNext<weather::WeatherSnapshot>());
+  for (int k = 0; k < kAsked; ++k) {
+    auto got = greedy.readNext<stream::Lightning>();
+    ASSERT_TRUE(got) << "answer " << k << ": " << got.error().detail;
+    ASSERT_TRUE(got->answersTo_s);
+    EXPECT_EQ(*got->answersTo_s, 100.0 * k + 5) << "in the order asked";
+  }
+  const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const auto& c = server->streamCounters();
+  EXPECT_EQ(c.lightningRequests.load(), static_cast<std::uint64_t>(kAsked));
+  EXPECT_EQ(c.lightningCellsComputed.load(), static_cast<std::uint64_t>(kAsked)) << "each a new interval";
+  EXPECT_GE(c.lightningInputPauses.load(), 1u);
+  // Every computation was within the budget: 40 take at least
+  // (40 - burst) / rate seconds.
+  EXPECT_GE(took_s, (kAsked - kLightningComputeBurst - 1) / kLightningComputeRate_perS);
+  server->stop();
+  thread.join();
+}
+
+}  // namespace
+}  // namespace sky::server

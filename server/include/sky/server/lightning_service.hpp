@@ -48,6 +48,10 @@ inline constexpr double kMaxLightningGap_s = 60;
 // clock) while the weather stands still: drifting regions move a few
 // hundred metres in that time, a small part of a 9 km cell.
 inline constexpr double kStormCellRefresh_s = 10;
+// The storm cells of LightningRequests kept: one per (refresh interval,
+// areas, weather version); a replay's frames ask within one interval for
+// hundreds of frames, several channels of it for the same areas.
+inline constexpr std::size_t kRequestCellsKept = 16;
 
 // What an operator asks for (POST /api/events).
 struct FlashRequest {
@@ -72,14 +76,21 @@ class LightningService {
   // kMaxFlashesPerRequest, the earliest: what a renderer drawing frames at
   // its own clock asks for (stream::LightningRequest). The same process as
   // tick's, so it draws the same flashes for the same storms and seconds;
-  // nothing is recorded or counted as drawn.
+  // nothing is recorded or counted as drawn. The storm cells are those at
+  // the start of to_s's kStormCellRefresh_s interval of weather clock,
+  // whatever was asked before (an answer depends only on the weather and
+  // the interval): kept, so the frames of one interval compute them once.
+  // `computed` (if given) says whether this call had to compute them, the
+  // cost (~6 ms per 150 km area over storms) a session's budget counts.
   std::vector<weather::LightningFlash> drawIn(const LiveWeather& weather, double from_s, double to_s,
-                                              std::span<const weather::SphericalCap> areas) const;
+                                              std::span<const weather::SphericalCap> areas,
+                                              bool* computed = nullptr);
   // The newest flashes, oldest first, at most `limit`.
   std::vector<weather::LightningFlash> recent(std::size_t limit) const;
 
   struct Counters {
     std::uint64_t drawn = 0, triggered = 0, dropped = 0;
+    std::uint64_t requestCellsComputed = 0;  // drawIn calls that computed their storm cells
   };
   const Counters& counters() const { return counters_; }
 
@@ -97,6 +108,13 @@ class LightningService {
   double cellsAt_s_ = 0;
   std::deque<weather::LightningFlash> recent_;
   std::deque<weather::LightningFlash> triggered_;  // the asked-for ones, for drawIn
+  struct RequestCells {
+    double intervalStart_s = 0;
+    std::vector<weather::SphericalCap> caps;
+    std::uint64_t accepted = 0;
+    std::vector<weather::StormCell> cells;
+  };
+  std::deque<RequestCells> requestCells_;  // newest last, at most kRequestCellsKept
   Counters counters_;
 };
 

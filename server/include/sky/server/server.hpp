@@ -95,8 +95,9 @@ class Server final : private SessionHandler {
     std::atomic<std::uint64_t> flashesDrawn{0}, flashesTriggered{0}, flashesCapped{0}, eventsDropped{0};
     // Host clock proposals taken, and how many set a host's offset anew.
     std::atomic<std::uint64_t> hostClockProposals{0}, hostClockChanges{0};
-    // LightningRequests answered.
-    std::atomic<std::uint64_t> lightningRequests{0};
+    // LightningRequests answered, those that computed storm cells, and the
+    // times a session's input waited for its budget (session.hpp).
+    std::atomic<std::uint64_t> lightningRequests{0}, lightningCellsComputed{0}, lightningInputPauses{0};
   };
   const StreamCounters& streamCounters() const { return streamCounters_; }
   // Prometheus text of the stream counters.
@@ -144,7 +145,8 @@ class Server final : private SessionHandler {
   void sessionStalled(Session& session) override;
   void rendererChanged(Session& session) override;
   void hostClockProposed(Session& session, const stream::HostClock& proposal) override;
-  void lightningRequested(Session& session, const stream::LightningRequest& request) override;
+  bool lightningRequested(Session& session, const stream::LightningRequest& request) override;
+  void inputPaused(Session& session) override;
   void protocolRejected(Session& session, const Error& error) override;
   void sessionFailed(Session& session, const std::string& what) override;
   void renderersChanged();

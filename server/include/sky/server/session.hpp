@@ -48,8 +48,12 @@ class SessionHandler {
   // The peer proposed its estimate of a CIGI host's clock (host_clocks.hpp).
   virtual void hostClockProposed(Session& session, const stream::HostClock& proposal) = 0;
   // The peer asked for the lightning process's flashes over an interval of
-  // the weather clock (a renderer drawing frames at its own clock).
-  virtual void lightningRequested(Session& session, const stream::LightningRequest& request) = 0;
+  // the weather clock (a renderer drawing frames at its own clock). Returns
+  // whether answering it had to compute storm cells (the costly part, which
+  // the session's budget counts).
+  virtual bool lightningRequested(Session& session, const stream::LightningRequest& request) = 0;
+  // The session's input waits for its lightning budget (kLightningCompute*).
+  virtual void inputPaused(Session& session) = 0;
   // The peer sent something the stream refuses (a bad frame or message, or a
   // kind clients must not send); the session is closing.
   virtual void protocolRejected(Session& session, const Error& error) = 0;
@@ -59,6 +63,15 @@ class SessionHandler {
  protected:
   ~SessionHandler() = default;
 };
+
+// Storm-cell computations one session's LightningRequests may cause: a
+// burst, then a steady rate. A replay computes once per 10 s of weather
+// clock (lightning_service.hpp), so only a peer asking for intervals all
+// over the clock meets the bound; its input then waits (TCP backpressure)
+// until the budget is back, and the other sessions are served meanwhile.
+// At ~6 ms per computation, the rate bounds one peer to ~6 % of a core.
+inline constexpr double kLightningComputeBurst = 20;
+inline constexpr double kLightningComputeRate_perS = 10;
 
 class Session : public std::enable_shared_from_this<Session> {
  public:
@@ -106,6 +119,11 @@ class Session : public std::enable_shared_from_this<Session> {
   void readMore();
   void onRead(const boost::system::error_code& ec, std::size_t bytes);
   void handleRead(const boost::system::error_code& ec, std::size_t bytes);
+  // Handles the complete frames the decoder holds, until it runs out or the
+  // session pauses; then reads more unless paused or closed.
+  void handleDecoded();
+  // One storm-cell computation spent; pauses the input when over budget.
+  void spendLightningBudget();
   void onStallTimer(const boost::system::error_code& ec, std::uint64_t generation);
   void handleMessage(const stream::Message& message);
   void protocolError(const Error& error);
@@ -120,6 +138,10 @@ class Session : public std::enable_shared_from_this<Session> {
   boost::asio::ip::tcp::socket socket_;
   boost::asio::steady_timer drainTimer_;
   boost::asio::steady_timer stallTimer_;
+  boost::asio::steady_timer pauseTimer_;  // ends a pause of the input
+  bool inputPaused_ = false;
+  double lightningBudget_ = kLightningComputeBurst;
+  std::chrono::steady_clock::time_point lightningBudgetAt_ = std::chrono::steady_clock::now();
   std::chrono::milliseconds stallTimeout_;
   std::uint64_t writeGeneration_ = 0;  // which write the stall timer is watching
   std::uint64_t id_;
