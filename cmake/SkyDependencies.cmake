@@ -99,3 +99,10 @@ endif()
 find_package(expat CONFIG REQUIRED)
 add_library(sky::expat INTERFACE IMPORTED)
 target_link_libraries(sky::expat INTERFACE expat::expat)
+
+# Compressed flight files (readsb's gzip-compressed traces, KMZ's zip
+# entries): zlib (zlib1g-dev), the reference deflate implementation; the zip
+# container itself is a few fixed headers read by protocol/flight.
+find_package(ZLIB REQUIRED)
+add_library(sky::zlib INTERFACE IMPORTED)
+target_link_libraries(sky::zlib INTERFACE ZLIB::ZLIB)

@@ -17,7 +17,8 @@ constexpr std::array<const char*, static_cast<std::size_t>(WarningKind::Count_)>
     "out-of-order fixes skipped", "duplicate-time fixes skipped", "gaps kept",
     "fixes with validity 'V' skipped", "fixes without altitude skipped",
     "unreadable lines skipped", "rows with an empty field skipped",
-    "rows on the ground without a geometric altitude skipped", "other warnings"};
+    "rows on the ground without a geometric altitude skipped", "new legs kept",
+    "stale positions skipped", "other warnings"};
 
 std::string seconds(double s) {
   char buf[32];
@@ -103,8 +104,9 @@ Result<ParsedFlight> parseFlight(std::string_view text, std::string_view sourceN
     return isAdsbCsvHeader(firstCsvLine(text)) ? parseAdsbCsv(text, sourceName, options) : parseCsv(text, sourceName);
   if (ext == "igc") return parseIgc(text, sourceName);
   if (ext == "gpx") return parseGpx(text, sourceName);
+  if (ext == "json") return parseReadsbTrace(text, sourceName, options);
   return fail(ErrorCode::Unsupported, messageText(sourceName) + ": unknown flight format '." + detail::printable(ext) +
-                                          "' (expected .csv, .igc or .gpx)");
+                                          "' (expected .csv, .igc, .gpx or .json)");
 }
 
 }  // namespace sky::flight

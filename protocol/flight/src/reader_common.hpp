@@ -52,6 +52,8 @@ enum class WarningKind : std::size_t {
   Junk,
   EmptyField,
   OnGround,
+  NewLeg,
+  Stale,
   Other,
   Count_,
 };

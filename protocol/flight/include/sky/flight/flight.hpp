@@ -1,8 +1,9 @@
 // Recorded flights: a time series of geodetic poses, read from text the
 // caller hands in (protocol/ opens no files), and sampled at any time.
 // Readers: CSV (our own format, with attitude), ADS-B CSV (OpenSky state
-// vectors and similar exports), IGC (FAI glider loggers) and GPX (XML
-// tracks); all but the first carry no attitude, which deriveAttitude fills.
+// vectors and similar exports), readsb/tar1090 trace JSON, IGC (FAI glider
+// loggers) and GPX (XML tracks); all but the first carry no attitude, which
+// deriveAttitude fills.
 #pragma once
 
 #include <cstddef>
@@ -134,6 +135,43 @@ inline constexpr std::size_t kMaxAdsbAircraft = 20'000;
 // A line longer than kMaxAdsbLineBytes is not.
 bool isAdsbCsvHeader(std::string_view headerLine);
 
+// readsb / tar1090 trace (trace_full_<icao>.json, trace_recent_<icao>.json,
+// as readsb writes them: gzip-compressed or plain JSON; readsb's
+// README-json.md, "trace"): an object with "icao" (hex, '~' for non-ICAO
+// addresses), "timestamp" (Unix s, the base) and "trace", an array of rows
+//   [offset_s, lat, lon, altitude, ground speed kt, track deg, flags,
+//    vertical rate fpm, details or null, source type, alt_geom, ...]
+// of which the reader uses offset (s after timestamp), lat and lon (deg),
+// altitude (ft: barometric, or geometric when flags bit 3 (8) is set;
+// "ground"; or null), flags and alt_geom (ft, geometric; optional, as is
+// every element after the fourth). Other keys and elements are ignored.
+// Altitude: geometric (alt_geom, or column 3 with flags bit 3) when the row
+// has it, else barometric converted by the ICAO standard atmosphere (QNH
+// 1013.25) as for the ADS-B CSV; ParsedFlight says which.
+// Fixes skipped with a counted warning naming the row ("trace[12]"): a null
+// lat or lon; no altitude (null); "ground" without a geometric altitude;
+// flags bit 0 (1, a stale position: the last one repeated); and the shared
+// time rules above. A row with flags bit 1 (2, a new leg: a landing and
+// take-off or a long gap lies before it) is kept with a warning.
+// Errors name the source and the JSON path and field ("a.json: JSON
+// '/trace/7/1' (lat): 91.2 is outside [-90, 90]"): not JSON, or nested
+// deeper than 16; no numeric "timestamp" or no "trace" array; a row that is
+// not an array of at least 4 elements; a value of the wrong type or out of
+// range (lat [-90, 90], lon [-180, 180], altitudes as for the ADS-B CSV,
+// offset within 1e7 s); options.icao24 not the file's "icao"; more than
+// kMaxReadsbTraceBytes (before or after gzip) or kMaxReadsbTraceRows rows;
+// fewer than two fixes.
+// time_s is 0 at the whole second at or before the first kept fix;
+// startUtc_s is that second. Attitude is derived by deriveAttitude.
+Result<ParsedFlight> parseReadsbTrace(std::string_view bytes, std::string_view sourceName,
+                                      const ReadOptions& options = {});
+// Largest trace parseReadsbTrace reads (bytes, after gzip) and most rows. A
+// day of one aircraft is a few MB and some 20 000 rows (readsb writes a
+// row every few seconds while something changes); the JSON tree in memory
+// is some ten times the text.
+inline constexpr std::size_t kMaxReadsbTraceBytes = std::size_t{64} << 20;
+inline constexpr std::size_t kMaxReadsbTraceRows = 1'000'000;
+
 // IGC flight (FAI Technical Specification for IGC-approved flight recorders,
 // Appendix A): one record per line, any line ending, bytes beyond ASCII
 // allowed in records we do not read.
@@ -177,7 +215,7 @@ Result<ParsedFlight> parseIgc(std::string_view text, std::string_view sourceName
 Result<ParsedFlight> parseGpx(std::string_view text, std::string_view sourceName);
 
 // Any of the readers, chosen by the extension of sourceName in any letter
-// case (.csv, .igc, .gpx); a .csv whose first line that is neither blank nor
+// case (.csv, .igc, .gpx, .json: a readsb trace); a .csv whose first line that is neither blank nor
 // a '#' comment is an ADS-B header (isAdsbCsvHeader) is read by parseAdsbCsv
 // with options, any other .csv by parseCsv. Unsupported for another
 // extension, naming it.
