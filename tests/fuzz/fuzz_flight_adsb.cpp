@@ -11,7 +11,9 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   sky::fuzz::checkFlightParse(sky::flight::parseFlight(text, "fuzz.csv"));
-  sky::fuzz::checkFlightParse(
-      sky::flight::parseAdsbCsv(text, "fuzz.csv", {"3c6444", sky::flight::AltitudeUnit::Feet}));
+  sky::flight::ReadOptions pick;
+  pick.icao24 = "3c6444";
+  pick.altitudeUnit = sky::flight::AltitudeUnit::Feet;
+  sky::fuzz::checkFlightParse(sky::flight::parseAdsbCsv(text, "fuzz.csv", pick));
   return 0;
 }

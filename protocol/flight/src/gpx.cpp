@@ -20,6 +20,7 @@ namespace sky::flight {
 namespace {
 
 using detail::isDigit;
+using detail::isoUtc_s;
 using detail::printable;
 
 // A number or timestamp is never longer; longer text is kept only this far,
@@ -44,42 +45,6 @@ std::optional<double> number(std::string_view s) {
   const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
   if (s.empty() || ec != std::errc() || ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
   return v;
-}
-
-// ISO 8601 / RFC 3339 date-time "YYYY-MM-DDThh:mm:ss[.fff][Z|+hh:mm|-hh:mm]"
-// as UTC seconds since 1970. A time zone is required (a local time is not a
-// recording time we can place).
-std::optional<double> isoUtc_s(std::string_view s) {
-  s = trim(s);
-  const auto num = [&](std::size_t at, std::size_t n) { return detail::digitsValue(detail::sub(s, at, n)); };
-  if (s.size() < 20 || s[4] != '-' || s[7] != '-' || (s[10] != 'T' && s[10] != 't') || s[13] != ':' ||
-      s[16] != ':')
-    return std::nullopt;
-  const long long y = num(0, 4), mo = num(5, 2), d = num(8, 2), h = num(11, 2), mi = num(14, 2), sec = num(17, 2);
-  if (y < 0 || mo < 1 || mo > 12 || d < 1 || d > 31 || h < 0 || h > 23 || mi < 0 || mi > 59 || sec < 0 ||
-      sec > 60)
-    return std::nullopt;
-  std::size_t i = 19;
-  double fraction = 0;
-  if (s[i] == '.') {
-    double scale = 0.1;
-    for (++i; i < s.size() && isDigit(s[i]); ++i, scale /= 10) fraction += (s[i] - '0') * scale;
-  }
-  if (i >= s.size()) return std::nullopt;
-  long long offset_s = 0;
-  if (s[i] == 'Z' || s[i] == 'z') {
-    ++i;
-  } else if (s[i] == '+' || s[i] == '-') {
-    const long long oh = num(i + 1, 2), om = num(i + 4, 2);
-    if (s.size() < i + 6 || s[i + 3] != ':' || oh < 0 || oh > 23 || om < 0 || om > 59) return std::nullopt;
-    offset_s = (s[i] == '+' ? 1 : -1) * (oh * 3600 + om * 60);
-    i += 6;
-  } else {
-    return std::nullopt;
-  }
-  if (i != s.size()) return std::nullopt;
-  const std::int64_t days = daysFromCivil(y, static_cast<unsigned>(mo), static_cast<unsigned>(d));
-  return static_cast<double>(days * 86400 + h * 3600 + mi * 60 + sec - offset_s) + fraction;
 }
 
 std::string_view localName(const XML_Char* name) {

@@ -1,5 +1,5 @@
-// Capped warnings and the time-order rules shared by the IGC, GPX and ADS-B
-// readers, and the choice of reader for a file.
+// Capped warnings, the time-order rules and ISO 8601 times shared by the readers,
+// and the choice of reader for a file.
 #include "reader_common.hpp"
 
 #include "sky/flight/utf8_text.hpp"
@@ -33,6 +33,41 @@ std::string printable(std::string_view s) {
   for (char c : s.substr(0, kMaxFieldChars)) out.push_back(c >= 0x20 && c < 0x7f ? c : '?');
   if (s.size() > kMaxFieldChars) out += "...";
   return out;
+}
+
+std::optional<double> isoUtc_s(std::string_view s) {
+  const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; };
+  while (!s.empty() && space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && space(s.back())) s.remove_suffix(1);
+  const auto num = [&](std::size_t at, std::size_t n) { return detail::digitsValue(detail::sub(s, at, n)); };
+  if (s.size() < 20 || s[4] != '-' || s[7] != '-' || (s[10] != 'T' && s[10] != 't') || s[13] != ':' ||
+      s[16] != ':')
+    return std::nullopt;
+  const long long y = num(0, 4), mo = num(5, 2), d = num(8, 2), h = num(11, 2), mi = num(14, 2), sec = num(17, 2);
+  if (y < 0 || mo < 1 || mo > 12 || d < 1 || d > 31 || h < 0 || h > 23 || mi < 0 || mi > 59 || sec < 0 ||
+      sec > 60)
+    return std::nullopt;
+  std::size_t i = 19;
+  double fraction = 0;
+  if (s[i] == '.') {
+    double scale = 0.1;
+    for (++i; i < s.size() && detail::isDigit(s[i]); ++i, scale /= 10) fraction += (s[i] - '0') * scale;
+  }
+  if (i >= s.size()) return std::nullopt;
+  long long offset_s = 0;
+  if (s[i] == 'Z' || s[i] == 'z') {
+    ++i;
+  } else if (s[i] == '+' || s[i] == '-') {
+    const long long oh = num(i + 1, 2), om = num(i + 4, 2);
+    if (s.size() < i + 6 || s[i + 3] != ':' || oh < 0 || oh > 23 || om < 0 || om > 59) return std::nullopt;
+    offset_s = (s[i] == '+' ? 1 : -1) * (oh * 3600 + om * 60);
+    i += 6;
+  } else {
+    return std::nullopt;
+  }
+  if (i != s.size()) return std::nullopt;
+  const std::int64_t days = daysFromCivil(y, static_cast<unsigned>(mo), static_cast<unsigned>(d));
+  return static_cast<double>(days * 86400 + h * 3600 + mi * 60 + sec - offset_s) + fraction;
 }
 
 Warnings::Warnings(std::string_view source) : source_(messageText(source)) {}
@@ -105,8 +140,10 @@ Result<ParsedFlight> parseFlight(std::string_view text, std::string_view sourceN
   if (ext == "igc") return parseIgc(text, sourceName);
   if (ext == "gpx") return parseGpx(text, sourceName);
   if (ext == "json") return parseReadsbTrace(text, sourceName, options);
+  if (ext == "kml") return parseKml(text, sourceName, options);
+  if (ext == "kmz") return parseKmz(text, sourceName, options);
   return fail(ErrorCode::Unsupported, messageText(sourceName) + ": unknown flight format '." + detail::printable(ext) +
-                                          "' (expected .csv, .igc, .gpx or .json)");
+                                          "' (expected .csv, .igc, .gpx, .json, .kml or .kmz)");
 }
 
 }  // namespace sky::flight

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -42,6 +43,12 @@ constexpr long long digitsValue(std::string_view s) {
 // Printable rendering of a field for a message: bytes outside ASCII
 // printables become '?', and long fields are cut.
 std::string printable(std::string_view s);
+
+// ISO 8601 / RFC 3339 date-time "YYYY-MM-DDThh:mm:ss[.fff][Z|+hh:mm|-hh:mm]"
+// (XML white space around it allowed) as UTC seconds since 1970, as GPX and
+// KML write times. A time zone is required (a local time is not a recording
+// time we can place).
+std::optional<double> isoUtc_s(std::string_view s);
 
 enum class WarningKind : std::size_t {
   OutOfOrder,

@@ -23,6 +23,14 @@ constexpr double kFt = 0.3048;
 constexpr double kR0_m = 6356766.0;
 double geometricOfGeopotential(double h_m) { return kR0_m * h_m / (kR0_m - h_m); }
 
+// ADS-B options: the aircraft and the altitude unit (the other fields kept).
+ReadOptions adsbOptions(const std::string& icao24, AltitudeUnit unit) {
+  ReadOptions options;
+  options.icao24 = icao24;
+  options.altitudeUnit = unit;
+  return options;
+}
+
 std::string readData(const std::string& name) {
   std::ifstream in(std::string(SKY_ADSB_DATA_DIR) + "/" + name, std::ios::binary);
   EXPECT_TRUE(in) << name;
@@ -122,14 +130,14 @@ TEST(FlightAdsb, AltitudeUnitFromOptionOrAnError) {
   auto none = parseAdsbCsv(text, "u.csv");
   ASSERT_FALSE(none);
   EXPECT_EQ(none.error().detail, "u.csv:1: column 'altitude' does not say its unit: give the altitude unit (ft or m)");
-  auto feet = parseAdsbCsv(text, "u.csv", {"", AltitudeUnit::Feet});
+  auto feet = parseAdsbCsv(text, "u.csv", adsbOptions("", AltitudeUnit::Feet));
   ASSERT_TRUE(feet) << feet.error().detail;
   EXPECT_NEAR(feet->fixes[0].pose.position.alt_m, geometricOfGeopotential(1000 * kFt), 1e-6);
-  auto metres = parseAdsbCsv(text, "u.csv", {"", AltitudeUnit::Metres});
+  auto metres = parseAdsbCsv(text, "u.csv", adsbOptions("", AltitudeUnit::Metres));
   ASSERT_TRUE(metres) << metres.error().detail;
   EXPECT_NEAR(metres->fixes[0].pose.position.alt_m, geometricOfGeopotential(1000), 1e-6);
   // The option overrides a unit the name gives.
-  auto over = parseAdsbCsv("time,lat,lon,geoaltitude\n0,1,2,1000\n1,1,2.001,1000\n", "o.csv", {"", AltitudeUnit::Feet});
+  auto over = parseAdsbCsv("time,lat,lon,geoaltitude\n0,1,2,1000\n1,1,2.001,1000\n", "o.csv", adsbOptions("", AltitudeUnit::Feet));
   ASSERT_TRUE(over) << over.error().detail;
   EXPECT_NEAR(over->fixes[0].pose.position.alt_m, 1000 * kFt, 1e-9);
 }
@@ -145,7 +153,7 @@ TEST(FlightAdsb, TwoAircraftAreAnErrorListingBoth) {
 
 TEST(FlightAdsb, Icao24OptionPicksOne) {
   const std::string text = readData("opensky-two-aircraft.csv");
-  auto f = parseFlight(text, "two.csv", {"4B1815", AltitudeUnit::FromColumnName});
+  auto f = parseFlight(text, "two.csv", adsbOptions("4B1815", AltitudeUnit::FromColumnName));
   ASSERT_TRUE(f) << f.error().detail;
   ASSERT_EQ(f->fixes.size(), 2u);
   EXPECT_NEAR(f->fixes[0].pose.position.lat_deg, 47.45, 1e-12);
@@ -153,15 +161,15 @@ TEST(FlightAdsb, Icao24OptionPicksOne) {
   EXPECT_NEAR(f->fixes[1].pose.position.alt_m, 3050, 1e-9);
   EXPECT_TRUE(f->warnings.empty()) << allWarnings(*f);
 
-  auto other = parseFlight(text, "two.csv", {"3c6444", AltitudeUnit::FromColumnName});
+  auto other = parseFlight(text, "two.csv", adsbOptions("3c6444", AltitudeUnit::FromColumnName));
   ASSERT_TRUE(other) << other.error().detail;
   EXPECT_EQ(other->fixes.size(), 3u);
 
-  auto absent = parseFlight(text, "two.csv", {"abcdef", AltitudeUnit::FromColumnName});
+  auto absent = parseFlight(text, "two.csv", adsbOptions("abcdef", AltitudeUnit::FromColumnName));
   ASSERT_FALSE(absent);
   EXPECT_EQ(absent.error().detail,
             "two.csv: no aircraft abcdef in the file; it holds 3c6444 DLH4AB (3 rows), 4b1815 SWR12 (2 rows)");
-  auto notHex = parseFlight(text, "two.csv", {"xyz", AltitudeUnit::FromColumnName});
+  auto notHex = parseFlight(text, "two.csv", adsbOptions("xyz", AltitudeUnit::FromColumnName));
   ASSERT_FALSE(notHex);
   EXPECT_EQ(notHex.error().detail, "two.csv: icao24 'xyz' is not 1 to 6 hex digits");
 }

@@ -2,8 +2,8 @@
 // caller hands in (protocol/ opens no files), and sampled at any time.
 // Readers: CSV (our own format, with attitude), ADS-B CSV (OpenSky state
 // vectors and similar exports), readsb/tar1090 trace JSON, IGC (FAI glider
-// loggers) and GPX (XML tracks); all but the first carry no attitude, which
-// deriveAttitude fills.
+// loggers), GPX (XML tracks) and KML/KMZ (flight trackers' exports); all
+// but the first carry no attitude, which deriveAttitude fills.
 #pragma once
 
 #include <cstddef>
@@ -62,6 +62,10 @@ struct ReadOptions {
   // ADS-B CSV: the unit of every altitude column; FromColumnName: each
   // column's name says, and a name that does not ('altitude') is an error.
   AltitudeUnit altitudeUnit = AltitudeUnit::FromColumnName;
+  // KML/KMZ: the track to read, by its name as the error listing the
+  // file's tracks shows it (a Placemark's <name>); empty: the file must hold
+  // one track.
+  std::string track;
 };
 
 // Fixes dropped or kept with a warning, shared by the IGC and GPX readers
@@ -214,8 +218,53 @@ Result<ParsedFlight> parseIgc(std::string_view text, std::string_view sourceName
 // startUtc_s is that second. Attitude is derived by deriveAttitude.
 Result<ParsedFlight> parseGpx(std::string_view text, std::string_view sourceName);
 
+// KML 2.2 track (OGC KML 2.2 with Google's gx: extension, as FlightAware
+// and Flightradar24 export flights). Candidate tracks, in document order:
+//  * each <gx:Track> in a <Placemark> (also inside <gx:MultiTrack>): its
+//    <when> (ISO 8601 with 'Z' or an offset) and <gx:coord> ("lon lat alt",
+//    degrees and metres) pair up one to one, in order; named by the
+//    Placemark's <name> ("track N" when it has none; " (part K)" added
+//    when one Placemark holds several);
+//  * the Placemarks of one <Folder> that each hold a <Point> with
+//    <coordinates> "lon,lat,alt" and a <TimeStamp><when> (Flightradar24's
+//    points): one track named "<folder name> (time-stamped points)".
+// A Point without a TimeStamp (an airport marker) is ignored; a LineString
+// has no times and is not a track: a file with LineStrings and no track is
+// an error saying it has a path but no times. One candidate is read; with
+// several, options.track picks one by name, and without it the error lists
+// them ('name' (N points)). Namespace prefixes are ignored.
+// altitudeMode must be 'absolute' (m above sea level, taken as the
+// ellipsoid height as for GPX: no geoid model); any other mode is an error
+// (heights above the ground need terrain); none at all is read as absolute
+// with a warning (KML's default, clampToGround, would drop the altitude).
+// Errors name source, XML line and field ("a.kml:31: field 'gx:coord':
+// ..."): malformed XML (expat's message); a time or position that does not
+// parse or is out of range (lat [-90, 90], lon [-180, 180], alt [-1000,
+// 1e6] m); a gx:Track whose <when> and <gx:coord> counts differ; more than
+// kMaxKmlBytes, kMaxKmlTracks tracks or kMaxKmlPoints points in all; fewer
+// than two usable points in the chosen track. The shared time rules above
+// apply to the chosen track (line of each <when>).
+// time_s is 0 at the whole second at or before the first kept point;
+// startUtc_s is that second. Attitude is derived by deriveAttitude.
+Result<ParsedFlight> parseKml(std::string_view text, std::string_view sourceName, const ReadOptions& options = {});
+// KMZ: a zip archive holding doc.kml (any letter case, at its top), else
+// its first *.kml entry, read from memory and parsed by parseKml (messages
+// name "a.kmz (doc.kml)"). Stored and deflate entries are read; ZIP64,
+// encrypted and other methods are errors, as are more than kMaxKmzEntries
+// entries, an entry over kMaxKmlBytes once decompressed (checked while
+// inflating, so a zip bomb stops there), and a CRC-32 mismatch.
+Result<ParsedFlight> parseKmz(std::string_view bytes, std::string_view sourceName, const ReadOptions& options = {});
+// Largest KML read (bytes, after unzipping), most candidate tracks and most
+// points in all of them. A FlightAware KML of a long-haul flight is about
+// 1 MB with a few thousand points; an ADS-B day at 1 Hz is 86 400 points.
+inline constexpr std::size_t kMaxKmlBytes = std::size_t{256} << 20;
+inline constexpr std::size_t kMaxKmlTracks = 10'000;
+inline constexpr std::size_t kMaxKmlPoints = 5'000'000;
+// Most entries in a KMZ's zip (a KMZ holds doc.kml and a few images).
+inline constexpr std::size_t kMaxKmzEntries = 10'000;
+
 // Any of the readers, chosen by the extension of sourceName in any letter
-// case (.csv, .igc, .gpx, .json: a readsb trace); a .csv whose first line that is neither blank nor
+// case (.csv, .igc, .gpx, .json: a readsb trace, .kml, .kmz); a .csv whose first line that is neither blank nor
 // a '#' comment is an ADS-B header (isAdsbCsvHeader) is read by parseAdsbCsv
 // with options, any other .csv by parseCsv. Unsupported for another
 // extension, naming it.
