@@ -400,6 +400,7 @@ Result<ParsedFlight> parseAdsbCsv(std::string_view text, std::string_view source
     const double alt_m = geo ? *geo : weather::pressureToGeometricAltitude_m(*baro);
     ++(geo ? flight.geometricAltitudeFixes : flight.barometricAltitudeFixes);
     unixTimes_s.push_back(t_s);
+    flight.fixLines.push_back(lineNo);
     flight.fixes.push_back(Fix{0, {{*values[static_cast<std::size_t>(Role::Lat)],
                                     *values[static_cast<std::size_t>(Role::Lon)], alt_m},
                                    0, 0, 0}});
@@ -433,6 +434,11 @@ Result<ParsedFlight> parseAdsbCsv(std::string_view text, std::string_view source
               fixes(flight.barometricAltitudeFixes);
   flight.altitudeSource = std::move(source);
   deriveAttitude(flight);
+  flight.attitudeFromTrack = true;
+  if (kept) {
+    const Aircraft& a = aircraft[*kept];
+    flight.aircraft = "icao24 " + a.icao24 + (a.callsign.empty() ? "" : ", callsign " + a.callsign);
+  }
   flight.warnings = warnings.finish();
   return flight;
 }

@@ -22,6 +22,19 @@ constexpr double kGravity_mps2 = 9.80665;
 // per-second heading jitter by several degrees; a thermalling turn takes
 // 20-30 s, so averaging over 5 s keeps the turn and removes the jitter.
 constexpr double kSmoothingWindow_s = 5.0;
+// Width of the centred windows the turn rate and the climb rate are fitted
+// over (weighted least-squares slope of the heading and of the altitude),
+// and the speed averaged over. Bank is a second derivative of position:
+// from 1 Hz ADS-B (10 m of position noise, positions up to 0.5 s older or
+// newer than their row, 25 ft altitude steps; attitude_noise_test.cpp) a 5 s
+// window left the derived bank jumping by up to 12 deg/s on a straight line
+// and 11 deg off a standard-rate turn's; with 20 s it still changed by up to
+// 0.76 deg/s; with 30 s by 0.3 deg/s, and stays within 0.7 deg of the turn's
+// closed form. A steady turn's heading is linear in time, so its slope is
+// exact at any width; what the width costs is a roll-in spread over ~30 s
+// instead of the 5-10 s an airliner or a glider takes, and wobbles within a
+// thermalling circle (20-30 s) smoothed away.
+constexpr double kRateWindow_s = 30.0;
 // A stationary GNSS logger wanders by a few metres over seconds (up to about
 // 1 m/s); nothing we replay flies slower than 5 m/s. Below this the heading
 // is held and pitch and bank are 0.
@@ -33,31 +46,64 @@ constexpr double kMinSpeedForHeading_mps = 2.0;
 constexpr double kMaxBank_deg = 60.0;
 constexpr double kMaxPitch_deg = 30.0;
 
-// Centred moving average of v over a time window; the half-width shrinks
-// symmetrically near segment ends (gaps and the record's ends), so a series
-// linear in time is returned unchanged.
-std::vector<double> smooth(const std::vector<double>& v, const std::vector<Fix>& fx,
-                           const std::vector<std::size_t>& segmentOf, const std::vector<std::size_t>& segFirst,
-                           const std::vector<std::size_t>& segLast) {
-  const std::size_t n = v.size();
-  std::vector<double> out(n);
+struct Segments {
+  std::vector<std::size_t> of, first, last;  // segment of each fix; first and last fix of each segment
+};
+
+// Calls f(j, u) for every fix j in the centred window of width window_s
+// about fix i, u = (t_j - t_i) / half-width in [-1, 1]; the half-width
+// shrinks symmetrically near segment ends (gaps and the record's ends), so
+// that a series linear in time keeps its value and its slope.
+template <class F>
+void forWindow(const std::vector<Fix>& fx, const Segments& seg, std::size_t i, double window_s, F&& f) {
   constexpr double kTimeSlack_s = 1e-6;  // fixes are whole seconds or close to
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t s = segmentOf[i];
-    const double t = fx[i].time_s;
-    const double half = std::min({kSmoothingWindow_s / 2, t - fx[segFirst[s]].time_s, fx[segLast[s]].time_s - t}) +
-                        kTimeSlack_s;
+  const std::size_t s = seg.of[i];
+  const double t = fx[i].time_s;
+  const double half =
+      std::min({window_s / 2, t - fx[seg.first[s]].time_s, fx[seg.last[s]].time_s - t}) + kTimeSlack_s;
+  for (std::size_t j = i + 1; j-- > seg.first[s] && fx[j].time_s >= t - half;) f(j, (fx[j].time_s - t) / half);
+  for (std::size_t j = i + 1; j <= seg.last[s] && fx[j].time_s <= t + half; ++j) f(j, (fx[j].time_s - t) / half);
+}
+
+// Centred moving average of v over window_s.
+std::vector<double> smooth(const std::vector<double>& v, const std::vector<Fix>& fx, const Segments& seg,
+                           double window_s) {
+  std::vector<double> out(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
     double sum = 0;
     std::size_t count = 0;
-    for (std::size_t j = i + 1; j-- > segFirst[s] && fx[j].time_s >= t - half;) {
+    forWindow(fx, seg, i, window_s, [&](std::size_t j, double) {
       sum += v[j];
       ++count;
-    }
-    for (std::size_t j = i + 1; j <= segLast[s] && fx[j].time_s <= t + half; ++j) {
-      sum += v[j];
-      ++count;
-    }
+    });
     out[i] = sum / static_cast<double>(count);
+  }
+  return out;
+}
+
+// Slope of v against time (per s) over the centred window: least squares
+// weighted by 1 - u^2 (Epanechnikov), so that a fix entering or leaving the
+// window as it slides moves the slope by little (with equal weights the
+// fixes at the window's edges have the most leverage, and the derived bank
+// stepped by up to 0.8 deg/s on noisy straight flight). Symmetric weights
+// keep the slope of a linear series exact. Where the window holds one fix
+// with weight (the ends of a segment): fallback[i].
+std::vector<double> slope(const std::vector<double>& v, const std::vector<Fix>& fx, const Segments& seg,
+                          double window_s, const std::vector<double>& fallback) {
+  std::vector<double> out(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    double sw = 0, st = 0, sv = 0, stt = 0, stv = 0;
+    forWindow(fx, seg, i, window_s, [&](std::size_t j, double u) {
+      const double w = std::max(0.0, 1 - u * u);
+      const double t = fx[j].time_s - fx[i].time_s;  // centred: no cancellation at large times
+      sw += w;
+      st += w * t;
+      sv += w * v[j];
+      stt += w * t * t;
+      stv += w * t * v[j];
+    });
+    const double den = sw * stt - st * st;
+    out[i] = den > 1e-12 ? (sw * stv - st * sv) / den : fallback[i];
   }
   return out;
 }
@@ -70,22 +116,22 @@ void deriveAttitude(Flight& flight) {
   SKY_ASSERT(n >= 2);
 
   // Segments: runs of fixes without a gap longer than kGapWarning_s.
-  std::vector<std::size_t> segmentOf(n), segFirst{0}, segLast;
+  Segments seg{std::vector<std::size_t>(n), {0}, {}};
   for (std::size_t i = 1; i < n; ++i) {
     if (fx[i].time_s - fx[i - 1].time_s > kGapWarning_s) {
-      segLast.push_back(i - 1);
-      segFirst.push_back(i);
+      seg.last.push_back(i - 1);
+      seg.first.push_back(i);
     }
-    segmentOf[i] = segFirst.size() - 1;
+    seg.of[i] = seg.first.size() - 1;
   }
-  segLast.push_back(n - 1);
+  seg.last.push_back(n - 1);
 
   // Central differences over the neighbours within the segment.
   std::vector<double> speed(n, 0), climb(n, 0), heading(n, 0);
   std::vector<bool> moving(n, false);
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t s = segmentOf[i];
-    const std::size_t a = i > segFirst[s] ? i - 1 : i, b = i < segLast[s] ? i + 1 : i;
+    const std::size_t s = seg.of[i];
+    const std::size_t a = i > seg.first[s] ? i - 1 : i, b = i < seg.last[s] ? i + 1 : i;
     if (a == b) continue;  // a lone fix between gaps
     const geo::Geodetic& pa = fx[a].pose.position;
     const geo::Geodetic& pb = fx[b].pose.position;
@@ -105,26 +151,34 @@ void deriveAttitude(Flight& flight) {
   }
   for (std::size_t i = 1; i < n; ++i) heading[i] = heading[i - 1] + geo::angleDiff_deg(heading[i - 1], heading[i]);
 
-  const std::vector<double> speedS = smooth(speed, fx, segmentOf, segFirst, segLast);
-  const std::vector<double> climbS = smooth(climb, fx, segmentOf, segFirst, segLast);
-  const std::vector<double> headingS = smooth(heading, fx, segmentOf, segFirst, segLast);
+  // Moving or not by the short window; the values by the long ones.
+  const std::vector<double> speedS = smooth(speed, fx, seg, kSmoothingWindow_s);
+  const std::vector<double> speedL = smooth(speed, fx, seg, kRateWindow_s);
+  std::vector<double> alt(n);
+  for (std::size_t i = 0; i < n; ++i) alt[i] = fx[i].pose.position.alt_m;
+  const std::vector<double> climbL = slope(alt, fx, seg, kRateWindow_s, climb);
+  const std::vector<double> headingS = smooth(heading, fx, seg, kSmoothingWindow_s);
+  std::vector<double> turn(n, 0);  // central differences, for the ends
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t s = seg.of[i];
+    const std::size_t a = i > seg.first[s] ? i - 1 : i, b = i < seg.last[s] ? i + 1 : i;
+    if (a != b) turn[i] = (heading[b] - heading[a]) / (fx[b].time_s - fx[a].time_s);
+  }
+  const std::vector<double> turnRate_degps = slope(heading, fx, seg, kRateWindow_s, turn);
 
   std::vector<double> bank(n, 0);
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t s = segmentOf[i];
-    const std::size_t a = i > segFirst[s] ? i - 1 : i, b = i < segLast[s] ? i + 1 : i;
-    if (a == b || !moving[i]) continue;
-    const double turnRate_radps = (headingS[b] - headingS[a]) * kDegToRad / (fx[b].time_s - fx[a].time_s);
+    if (!moving[i]) continue;
     // Coordinated turn: tan(bank) = v * omega / g (lift tilted to supply the
     // centripetal force); right turn (heading increasing) = right wing down.
-    bank[i] = std::atan(speedS[i] * turnRate_radps / kGravity_mps2) * kRadToDeg;
+    bank[i] = std::atan(speedL[i] * turnRate_degps[i] * kDegToRad / kGravity_mps2) * kRadToDeg;
   }
-  const std::vector<double> bankS = smooth(bank, fx, segmentOf, segFirst, segLast);
+  const std::vector<double> bankS = smooth(bank, fx, seg, kSmoothingWindow_s);
 
   for (std::size_t i = 0; i < n; ++i) {
     geo::GeodeticPose& p = fx[i].pose;
     p.yaw_deg = std::fmod(std::fmod(headingS[i], 360.0) + 360.0, 360.0);
-    const double pitch = speedS[i] >= kMinSpeedForHeading_mps ? std::atan2(climbS[i], speedS[i]) * kRadToDeg : 0.0;
+    const double pitch = speedS[i] >= kMinSpeedForHeading_mps ? std::atan2(climbL[i], speedL[i]) * kRadToDeg : 0.0;
     p.pitch_deg = std::clamp(pitch, -kMaxPitch_deg, kMaxPitch_deg);
     p.roll_deg = std::clamp(bankS[i], -kMaxBank_deg, kMaxBank_deg);
   }

@@ -101,6 +101,7 @@ Result<ParsedFlight> parseCsv(std::string_view text, std::string_view sourceName
       return fail(ErrorCode::InvalidArgument,
                   at + "field 'time_s': " + detail::printable(fields[0]) + " does not increase");
     flight.fixes.push_back(Fix{v[0], {{v[1], v[2], v[3]}, v[4], v[5], v[6]}});
+    flight.fixLines.push_back(lineNo);
     if (end == text.size()) break;
   }
   if (!headerSeen) return fail(ErrorCode::Malformed, src + ": no header line");

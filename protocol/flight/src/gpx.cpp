@@ -63,6 +63,7 @@ struct Point {
 struct Kept {
   double utc_s;
   geo::Geodetic position;
+  std::size_t line;  // of the <trkpt>
 };
 
 class GpxReader {
@@ -150,7 +151,7 @@ class GpxReader {
       return stop(ErrorCode::Malformed, p.timeLine,
                   "field 'time': '" + printable(trim(*p.time)) + "' is not an ISO 8601 UTC time");
     if (!order_.accept(*utc, p.line, warnings_)) return;
-    kept.push_back(Kept{*utc, {p.lat_deg, p.lon_deg, *ele}});
+    kept.push_back(Kept{*utc, {p.lat_deg, p.lon_deg, *ele}, p.line});
   }
 
   XML_Parser parser_;
@@ -195,8 +196,12 @@ Result<ParsedFlight> parseGpx(std::string_view text, std::string_view sourceName
   ParsedFlight flight;
   const double start_s = std::floor(reader.kept.front().utc_s);
   flight.startUtc_s = static_cast<std::int64_t>(start_s);
-  for (const Kept& k : reader.kept) flight.fixes.push_back(Fix{k.utc_s - start_s, {k.position, 0, 0, 0}});
+  for (const Kept& k : reader.kept) {
+    flight.fixes.push_back(Fix{k.utc_s - start_s, {k.position, 0, 0, 0}});
+    flight.fixLines.push_back(k.line);
+  }
   deriveAttitude(flight);
+  flight.attitudeFromTrack = true;
   flight.warnings = reader.warnings().finish();
   return flight;
 }

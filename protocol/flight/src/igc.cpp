@@ -220,6 +220,7 @@ Result<ParsedFlight> parseIgc(std::string_view text, std::string_view sourceName
       pressureNoted = true;
     }
     flight.fixes.push_back(Fix{t_s, {{b->lat_deg, b->lon_deg, alt_m}, 0, 0, 0}});
+    flight.fixLines.push_back(lineNo);
   });
 
   if (!dateSeen) warnings.add(WarningKind::Other, 0, "no HFDTE date record, no start date");
@@ -231,6 +232,7 @@ Result<ParsedFlight> parseIgc(std::string_view text, std::string_view sourceName
   if (date)
     flight.startUtc_s = daysFromCivil(date->y, date->m, date->d) * 86400 + static_cast<std::int64_t>(first_s);
   deriveAttitude(flight);
+  flight.attitudeFromTrack = true;
   flight.warnings = warnings.finish();
   return flight;
 }

@@ -44,9 +44,9 @@ TEST_P(CircleTest, BankAndHeadingMatchTheClosedForm) {
   Flight f = circle(radius_m, speed_mps, dir, 200);  // three turns, through north each time
   deriveAttitude(f);
   const double bank_deg = dir * std::atan(speed_mps * omega / kG_mps2) * 180 / kPi;  // 11.53 deg
-  // Near the ends the differences are one-sided and the windows narrow, twice
-  // (heading, then bank): 2 x 2.5 s + 1 s.
-  constexpr std::size_t kEdge = 7;
+  // Near the ends the differences are one-sided and the windows narrow: the
+  // turn-rate fit's half-width (15 s) + the bank average's (2.5 s) + 1 s.
+  constexpr std::size_t kEdge = 18;
   for (std::size_t i = kEdge; i + kEdge < f.fixes.size(); ++i) {
     const double t = f.fixes[i].time_s;
     // Tangent to the circle: bearing from the centre + 90 deg (turning right).

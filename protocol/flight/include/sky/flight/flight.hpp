@@ -44,6 +44,15 @@ struct ParsedFlight : Flight {
   std::string altitudeSource;
   std::size_t geometricAltitudeFixes = 0;   // fixes whose altitude was recorded as geometric
   std::size_t barometricAltitudeFixes = 0;  // fixes whose altitude was converted from barometric
+  // The file's line of each fix (fixLines[i] for fixes[i]) when the reader
+  // knows it, for the cleaning's report (clean.hpp); empty otherwise.
+  std::vector<std::size_t> fixLines;
+  // Whether deriveAttitude filled the attitude (the file records none), so
+  // that the cleaning derives it again from the fixes it keeps.
+  bool attitudeFromTrack = false;
+  // Who flew it, when the file says ("icao24 3c6444, callsign DLH9U"), for
+  // skyshell-replay --info; empty otherwise.
+  std::string aircraft;
 };
 
 // Unit of the altitude columns of an ADS-B CSV.
@@ -281,9 +290,12 @@ Result<ParsedFlight> parseFlight(std::string_view text, std::string_view sourceN
 //  * yaw: geodesic azimuth of the chord through the neighbouring fixes;
 //  * pitch: climb angle atan2(climb rate, ground speed);
 //  * roll: bank of a coordinated turn atan(v * omega / g) from the turn rate;
-// each smoothed by a centred moving average (angles unwrapped first) and
-// clamped to the limits in attitude.cpp. Differences never span a gap of more
-// than kGapWarning_s. Below a ground speed of 1 m/s the heading is held.
+// the climb and turn rates fitted (weighted least squares) and the speed
+// averaged over a centred 30 s window, so that noisy ADS-B does not shake
+// the camera; yaw and roll then smoothed by a centred 5 s moving average
+// (angles unwrapped first) and clamped to the limits in attitude.cpp.
+// Differences never span a gap of more than kGapWarning_s. Below a ground
+// speed of 2 m/s the heading is held.
 // Needs fixes.size() >= 2 (a precondition, asserted).
 void deriveAttitude(Flight& flight);
 
