@@ -415,8 +415,13 @@ Result<ParsedFlight> parseKml(std::string_view text, std::string_view sourceName
   ParsedFlight flight;
   const double start_s = std::floor(kept.front().utc_s);
   flight.startUtc_s = static_cast<std::int64_t>(start_s);
-  for (const Point& p : kept) flight.fixes.push_back(Fix{p.utc_s - start_s, {p.position, 0, 0, 0}});
+  for (const Point& p : kept) {
+    flight.fixes.push_back(Fix{p.utc_s - start_s, {p.position, 0, 0, 0}});
+    flight.fixLines.push_back(p.line);
+  }
   deriveAttitude(flight);
+  flight.attitudeFromTrack = true;
+  flight.aircraft = "track '" + messageText(chosen->name, kMaxNameChars) + "'";
   flight.warnings = warnings.finish();
   return flight;
 }

@@ -142,8 +142,9 @@ Result<ParsedFlight> parseFlight(std::string_view text, std::string_view sourceN
   if (ext == "json") return parseReadsbTrace(text, sourceName, options);
   if (ext == "kml") return parseKml(text, sourceName, options);
   if (ext == "kmz") return parseKmz(text, sourceName, options);
+  if (ext == "fdr") return parseFdr(text, sourceName);
   return fail(ErrorCode::Unsupported, messageText(sourceName) + ": unknown flight format '." + detail::printable(ext) +
-                                          "' (expected .csv, .igc, .gpx, .json, .kml or .kmz)");
+                                          "' (expected .csv, .igc, .gpx, .json, .kml, .kmz or .fdr)");
 }
 
 }  // namespace sky::flight

@@ -237,6 +237,11 @@ Result<ParsedFlight> parseReadsbTrace(std::string_view bytes, std::string_view s
               fixes(flight.barometricAltitudeFixes);
   flight.altitudeSource = std::move(source);
   deriveAttitude(flight);
+  flight.attitudeFromTrack = true;
+  if (!icao.empty()) flight.aircraft = "icao24 " + icao;
+  if (const auto r = doc.find("r"); r != doc.end() && r->is_string())
+    flight.aircraft += (flight.aircraft.empty() ? "" : ", ") + std::string("registration ") +
+                       printable(r->get<std::string>());
   flight.warnings = warnings.finish();
   return flight;
 }

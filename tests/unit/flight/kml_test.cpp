@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "sky/flight/flight.hpp"
 #include "warnings.hpp"
@@ -46,6 +47,10 @@ void expectFlightAwareTrack(const ParsedFlight& f, const std::string& source) {
   // Due east along the parallel: a geodesic between points 0.01 deg apart
   // at 50 N starts within a few thousandths of a degree of 90.
   EXPECT_NEAR(f.fixes[1].pose.yaw_deg, 90.0, 0.01);
+  // The <when> lines of the kept points (line 21 was the repeat).
+  EXPECT_EQ(f.fixLines, (std::vector<std::size_t>{18, 19, 20, 22}));
+  EXPECT_TRUE(f.attitudeFromTrack);
+  EXPECT_EQ(f.aircraft, "track 'DLH400'");
 }
 
 TEST(Kml, FlightAwareTrackGivesItsPointsAndIgnoresMarkersAndThePath) {

@@ -68,6 +68,8 @@ void expectHandMadeTrace(const ParsedFlight& f) {
   // = 0.01 cos 50 N / (0.001 M) = 6.447 and the azimuth is
   // 360 - atan(6.447) = 278.82 deg.
   EXPECT_NEAR(f.fixes[1].pose.yaw_deg, 278.82, 0.05);
+  EXPECT_TRUE(f.attitudeFromTrack);
+  EXPECT_EQ(f.aircraft, "icao24 3c6444, registration D-TEST");
 }
 
 TEST(ReadsbTrace, HandMadeTraceGivesTheRowsWorkedOutByHand) {

@@ -2,8 +2,9 @@
 // caller hands in (protocol/ opens no files), and sampled at any time.
 // Readers: CSV (our own format, with attitude), ADS-B CSV (OpenSky state
 // vectors and similar exports), readsb/tar1090 trace JSON, IGC (FAI glider
-// loggers), GPX (XML tracks) and KML/KMZ (flight trackers' exports); all
-// but the first carry no attitude, which deriveAttitude fills.
+// loggers), GPX (XML tracks), KML/KMZ (flight trackers' exports) and
+// X-Plane FDR; our CSV carries attitude, FDR pitch and roll, and
+// deriveAttitude fills the rest from the track.
 #pragma once
 
 #include <cstddef>
@@ -272,8 +273,61 @@ inline constexpr std::size_t kMaxKmlPoints = 5'000'000;
 // Most entries in a KMZ's zip (a KMZ holds doc.kml and a few images).
 inline constexpr std::size_t kMaxKmzEntries = 10'000;
 
+// X-Plane flight data recorder file (.fdr, text), versions 1 to 4. Sources:
+// X-Plane's "Creating FDR Files" (x-plane.com/kb/creating-fdr-files) for
+// the header rows; X-Plane's rule for version 4 rows as restated in the
+// header comment of the fdr module of a Rust FDR writer (crate "hangar")
+// and as written by 42fdr (github.com/MadReasonable/42fdr).
+// Layout: a line 'A' or 'I' (the writer's line ending), a line with the
+// version (1-4), then rows "KEY, values": DATE (MM/DD/YY or MM/DD/YYYY, the
+// US order X-Plane's files use) and TIME (zulu hh:mm:ss) are read; ACFT,
+// TAIL, PRES, TEMP, WIND, CALI, WARN, TEXT, MARK, EVNT, COMM, DREF and any
+// other four-capital key are skipped ("//" starts a comment anywhere).
+// Data rows:
+//  * version 4: bare CSV rows whose first 7 columns are zulu time
+//    (hh:mm:ss[.f], or seconds), longitude, latitude (deg), altitude (ft
+//    MSL), magnetic heading, pitch (nose up +), roll (right wing down +)
+//    (deg); DREF columns after them are not read;
+//  * "DATA, ..." rows (versions 1-3, also accepted in 4): time (s),
+//    temperature, longitude, latitude, altitude (ft MSL), ...; only those
+//    columns are read: the attitude columns of X-Plane's DATA table could
+//    not be confirmed offline, so a DATA row's attitude is derived.
+// Attitude: pitch and roll from version 4 rows as the file gives them;
+// yaw always from the track (deriveAttitude's heading), because the file's
+// heading is magnetic and no magnetic model is at hand; with DATA rows all
+// three come from the track. Altitude is the file's MSL altitude (no
+// barometric conversion: PRES, the sea-level pressure, is not needed).
+// Skipped with a warning: an unreadable DATE or TIME (no start date); in a
+// version 1-3 file, a line that is neither a key row nor a DATA row; the
+// shared time rules above. Zulu times that fall back by more than 12 h
+// cross midnight (a day added). Errors naming source, line and field: no
+// 'A'/'I' line or a version other than 1-4; a data row with too few columns
+// or a value that is not a number or out of range (lat [-90, 90], lon
+// [-180, 180], altitude -1 to 100 km, pitch [-90, 90], roll [-180, 180],
+// heading [-360, 360]); rows mixing zulu times and seconds; a line over
+// kMaxFdrLineBytes; more than kMaxFdrRows data rows; fewer than two fixes.
+// time_s is 0 at the whole zulu second at or before the first kept row (at
+// the first row when no zulu time is known); startUtc_s needs DATE and a
+// zulu time (hh:mm:ss rows, or TIME plus the rows' seconds).
+Result<ParsedFlight> parseFdr(std::string_view text, std::string_view sourceName);
+// Longest line and most data rows parseFdr reads. A row with a few dozen
+// DREF columns is under 2 KB; a 10 h flight at 10 Hz is 360 000 rows.
+inline constexpr std::size_t kMaxFdrLineBytes = 65536;
+inline constexpr std::size_t kMaxFdrRows = 10'000'000;
+
+// FlightGear recordings (.fgtape) are not read. FlightGear's
+// docs-mini/README-recordings.md describes the container (a magic string,
+// the Meta and Config property trees, then frames of a time and a signals
+// blob; Normal tapes inside simgear's gzContainer stream, Continuous ones
+// with per-frame flags and optional compression), but not the signals blob
+// itself: the order of the value kinds, how bools are packed, the byte
+// order (the writing machine's) and padding exist only in flightrecorder.cxx,
+// the gzContainer framing only in SimGear's source, and which signal holds
+// the position and attitude is set per aircraft by its flight-recorder
+// configuration. Without a documented layout or a real tape to test
+// against, a reader would be a guess.
 // Any of the readers, chosen by the extension of sourceName in any letter
-// case (.csv, .igc, .gpx, .json: a readsb trace, .kml, .kmz); a .csv whose first line that is neither blank nor
+// case (.csv, .igc, .gpx, .json: a readsb trace, .kml, .kmz, .fdr); a .csv whose first line that is neither blank nor
 // a '#' comment is an ADS-B header (isAdsbCsvHeader) is read by parseAdsbCsv
 // with options, any other .csv by parseCsv. Unsupported for another
 // extension, naming it.
