@@ -316,21 +316,23 @@ inline constexpr std::size_t kMaxFdrLineBytes = 65536;
 inline constexpr std::size_t kMaxFdrRows = 10'000'000;
 
 // FlightGear recordings (.fgtape) are not read. FlightGear's
-// docs-mini/README-recordings.md describes the container (a magic string,
-// the Meta and Config property trees, then frames of a time and a signals
-// blob; Normal tapes inside simgear's gzContainer stream, Continuous ones
-// with per-frame flags and optional compression), but not the signals blob
-// itself: the order of the value kinds, how bools are packed, the byte
-// order (the writing machine's) and padding exist only in flightrecorder.cxx,
-// the gzContainer framing only in SimGear's source, and which signal holds
-// the position and attitude is set per aircraft by its flight-recorder
-// configuration. Without a documented layout or a real tape to test
-// against, a reader would be a guess.
+// docs-mini/README-recordings.md (FlightGear/flightgear) describes the
+// container (a magic string, the Meta and Config property trees, then
+// frames of a time and a signals blob; Normal tapes inside SimGear's
+// gzContainer stream, Continuous ones with per-frame flags and optional
+// compression), but not the signals blob itself: the order of the value
+// kinds, how bools are packed, the byte order (the writing machine's) and
+// padding exist only in flightrecorder.cxx, the gzContainer framing only in
+// SimGear's source, and which signal holds the position and attitude is set
+// per aircraft by its flight-recorder configuration. Without a documented
+// layout or a real tape to test against, a reader would be a guess.
+
 // Any of the readers, chosen by the extension of sourceName in any letter
-// case (.csv, .igc, .gpx, .json: a readsb trace, .kml, .kmz, .fdr); a .csv whose first line that is neither blank nor
-// a '#' comment is an ADS-B header (isAdsbCsvHeader) is read by parseAdsbCsv
-// with options, any other .csv by parseCsv. Unsupported for another
-// extension, naming it.
+// case: .csv, .igc, .gpx, .json (a readsb trace), .kml, .kmz, .fdr. A .csv
+// whose first line that is neither blank nor a '#' comment is an ADS-B
+// header (isAdsbCsvHeader) is read by parseAdsbCsv with options, any other
+// .csv by parseCsv; options also reach the readsb and KML/KMZ readers.
+// Unsupported for another extension, naming it.
 Result<ParsedFlight> parseFlight(std::string_view text, std::string_view sourceName,
                                  const ReadOptions& options = {});
 
