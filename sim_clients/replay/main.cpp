@@ -2,11 +2,14 @@
 // real time (optionally scaled), so a renderer channel flies it as it would
 // fly a simulator's ownship.
 #include <cstdio>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
 #include <boost/asio.hpp>
 
+#include "sky/flight/clean.hpp"
+#include "sky/flight/info.hpp"
 #include "sky/sim/flight_file.hpp"
 #include "sky/sim/replay_session.hpp"
 
@@ -17,6 +20,9 @@ namespace {
 struct Options : sky::sim::ReplayOptions {
   std::string flightPath;
   sky::flight::ReadOptions read;
+  bool noClean = false;
+  bool info = false;
+  sky::flight::CleanOptions clean;
 };
 
 }  // namespace
@@ -65,18 +71,68 @@ int main(int argc, char** argv) {
   app.add_option("--altitude-unit", altitudeUnit,
                  "ADS-B .csv: unit of the altitude columns, ft or m (default: as each column's name says)")
       ->check(CLI::IsMember({"ft", "m"}));
+  app.add_flag("--no-clean", o.noClean,
+               "replay the track as read: no sorting, no dropping of repeats, speed glitches or spoofed jumps, "
+               "gaps interpolated whatever their length");
+  std::string maxSpeed;
+  app.add_option("--max-speed", maxSpeed,
+                 "cleaning: the fastest ground speed the aircraft flies, m/s or with a unit ('680kt', '350m/s'); "
+                 "a fix implying more is dropped (default 350 m/s: an airliner with a jet-stream tailwind)");
+  app.add_option("--max-gap", o.clean.maxGap_s,
+                 "cleaning: longest gap between fixes flown through in a straight line, s; longer gaps are held "
+                 "or end the replay (--long-gap)")
+      ->check(CLI::Range(1.0, 1e7));
+  std::string longGap = "hold";
+  app.add_option("--long-gap", longGap,
+                 "at a gap longer than --max-gap: hold (stay at the last fix, then jump to the next) or end")
+      ->check(CLI::IsMember({"hold", "end"}));
+  app.add_flag("--info", o.info,
+               "print what the file holds (format, aircraft, time span, fixes kept and dropped, bounding box, "
+               "altitude source) and exit without replaying");
   CLI11_PARSE(app, argc, argv);
   if (!altitudeUnit.empty())
     o.read.altitudeUnit = altitudeUnit == "ft" ? sky::flight::AltitudeUnit::Feet : sky::flight::AltitudeUnit::Metres;
+  if (!maxSpeed.empty()) {
+    const auto v = sky::flight::parseSpeed_mps(maxSpeed);
+    if (!v) {
+      std::fprintf(stderr, "skyshell-replay: --max-speed '%s' is not a speed (e.g. 350, 350m/s, 680kt)\n",
+                   maxSpeed.c_str());
+      return 2;
+    }
+    o.clean.maxGroundSpeed_mps = *v;
+  }
+  o.clean.longGap = longGap == "end" ? sky::flight::LongGap::End : sky::flight::LongGap::Hold;
 
-  auto flight = sky::sim::loadFlight(o.flightPath, o.read);
+  auto text = sky::sim::readFlightFile(o.flightPath);
+  auto flight = text ? sky::flight::parseFlight(*text, o.flightPath, o.read)
+                     : sky::Result<sky::flight::ParsedFlight>(tl::unexpected(text.error()));
   if (!flight) {
     std::fprintf(stderr, "skyshell-replay: %s\n", sky::describe(flight.error()).c_str());
     return 2;
   }
+  std::optional<sky::flight::CleanReport> cleaning;
+  if (!o.noClean) {
+    auto cleaned = sky::flight::clean(*flight, o.clean, o.flightPath);
+    if (!cleaned) {
+      std::fprintf(stderr, "skyshell-replay: %s\n", sky::describe(cleaned.error()).c_str());
+      return 2;
+    }
+    cleaning = std::move(*cleaned);
+  }
+  if (o.info) {
+    const auto lines = sky::flight::describeFlight(*flight, sky::flight::formatName(*text, o.flightPath),
+                                                   cleaning ? &*cleaning : nullptr, o.clean);
+    for (const auto& line : lines) std::printf("%s\n", line.c_str());
+    return 0;
+  }
   for (const auto& warning : flight->warnings) std::fprintf(stderr, "skyshell-replay: warning: %s\n", warning.c_str());
   if (!flight->altitudeSource.empty())
     std::fprintf(stderr, "skyshell-replay: altitude: %s\n", flight->altitudeSource.c_str());
+  if (cleaning)
+    for (const auto& line : cleaning->lines(o.clean))
+      std::fprintf(stderr, "skyshell-replay: cleaning: %s\n", line.c_str());
+  else
+    std::fprintf(stderr, "skyshell-replay: cleaning off (--no-clean): the track as read\n");
   try {
     asio::io_context io;
     asio::signal_set signals(io, SIGINT, SIGTERM);

@@ -3,6 +3,7 @@
 #include "sky/flight/clean.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <numeric>
@@ -128,7 +129,7 @@ std::size_t CleanReport::droppedFor(DropReason r) const {
 
 std::vector<std::string> CleanReport::lines(const CleanOptions& options) const {
   std::vector<std::string> out;
-  std::string head = "cleaning kept " + std::to_string(kept) + " of " + std::to_string(input) + " fixes";
+  std::string head = "kept " + std::to_string(kept) + " of " + std::to_string(input) + " fixes";
   if (reordered) head += "; " + std::to_string(reordered) + " out of time order sorted into place";
   for (const DropReason r : {DropReason::Repeat, DropReason::SameTime, DropReason::Speed, DropReason::Jump,
                              DropReason::AfterGap})
@@ -170,6 +171,29 @@ std::vector<std::string> CleanReport::lines(const CleanOptions& options) const {
   return out;
 }
 
+std::optional<double> parseSpeed_mps(std::string_view text) {
+  constexpr double kKnot_mps = 1852.0 / 3600.0;
+  const auto trimmed = [](std::string_view s) {
+    while (!s.empty() && s.front() == ' ') s.remove_prefix(1);
+    while (!s.empty() && s.back() == ' ') s.remove_suffix(1);
+    return s;
+  };
+  text = trimmed(text);
+  double scale = 1;
+  if (text.ends_with("kt")) {
+    scale = kKnot_mps;
+    text.remove_suffix(2);
+  } else if (text.ends_with("m/s")) {
+    text.remove_suffix(3);
+  }
+  text = trimmed(text);
+  double v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v) || !(v > 0))
+    return std::nullopt;
+  return v * scale;
+}
+
 Result<CleanReport> clean(ParsedFlight& flight, const CleanOptions& options, std::string_view sourceName) {
   CleanReport report;
   const std::size_t n = flight.fixes.size();
@@ -189,14 +213,13 @@ Result<CleanReport> clean(ParsedFlight& flight, const CleanOptions& options, std
   std::vector<Point> pts;  // every fix, in time order
   std::vector<int> reasonOf;  // DropReason of a dropped one, -1 for kept
   pts.reserve(n);
+  std::size_t firstOfTime = 0;  // the first fix of the latest time: the one kept
   for (const Point& p : sorted) {
     int reason = -1;
-    if (!pts.empty() && p.fix.time_s == pts.back().fix.time_s) {
-      // Compared with the first fix of that time, which is the one kept.
-      std::size_t k = pts.size() - 1;
-      while (k > 0 && pts[k - 1].fix.time_s == p.fix.time_s) --k;
-      reason = static_cast<int>(samePosition(pts[k].fix, p.fix) ? DropReason::Repeat : DropReason::SameTime);
-    }
+    if (!pts.empty() && p.fix.time_s == pts.back().fix.time_s)
+      reason = static_cast<int>(samePosition(pts[firstOfTime].fix, p.fix) ? DropReason::Repeat : DropReason::SameTime);
+    else
+      firstOfTime = pts.size();
     pts.push_back(p);
     reasonOf.push_back(reason);
   }

@@ -1,8 +1,8 @@
 // What a live channel draws without a server's weather (see fallback_weather.hpp).
 #include "sky/app/fallback_weather.hpp"
 
+#include <algorithm>
 #include <fstream>
-#include <sstream>
 
 #include <spdlog/spdlog.h>
 
@@ -10,12 +10,27 @@
 
 namespace sky::app {
 
-Result<std::string> readFile(const std::string& path) {
+Result<std::string> readFile(const std::string& path, std::size_t maxBytes) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return fail(ErrorCode::Io, flight::messageText(path) + ": cannot open for reading");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
+  // Read in chunks up to the bound (a pipe or a growing file has no size
+  // to check first).
+  constexpr std::size_t kChunkBytes = std::size_t{1} << 20;
+  std::string text;
+  while (in) {
+    const std::size_t at = text.size();
+    // One byte past the bound, to tell a file of maxBytes from a longer one.
+    const std::size_t left = maxBytes - at;  // text.size() <= maxBytes here
+    const std::size_t want = left < kChunkBytes ? left + 1 : kChunkBytes;
+    text.resize(at + want);
+    in.read(text.data() + at, static_cast<std::streamsize>(want));
+    text.resize(at + static_cast<std::size_t>(in.gcount()));
+    if (text.size() > maxBytes)
+      return fail(ErrorCode::TooLarge, flight::messageText(path) + ": larger than " + std::to_string(maxBytes) +
+                                           " bytes, the most read");
+  }
+  if (in.bad()) return fail(ErrorCode::Io, flight::messageText(path) + ": read error");
+  return text;
 }
 
 Result<WeatherView> scenarioWeather(const std::string& path, std::chrono::steady_clock::time_point now) {

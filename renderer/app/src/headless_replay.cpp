@@ -24,6 +24,8 @@
 #include "sky/app/replay_outputs.hpp"
 #include "sky/app/shared_state.hpp"
 #include "sky/app/weather_client.hpp"
+#include "sky/flight/clean.hpp"
+#include "sky/flight/file_limits.hpp"
 #include "sky/flight/flight.hpp"
 #include "sky/flight/utf8_text.hpp"
 #include "sky/weather/lightning.hpp"
@@ -77,12 +79,44 @@ bool waitForCoarse(const SharedState& state, double timeout_s, const std::atomic
   return waitUntil([&] { return state.coarseVersion() > 0; }, timeout_s, stop);
 }
 
+// The cleaning's report for report.json.
+nlohmann::json cleaningJson(const flight::CleanReport* r, const flight::CleanOptions& options) {
+  if (!r) return {{"enabled", false}};
+  nlohmann::json dropped = nlohmann::json::array(), gaps = nlohmann::json::array();
+  for (const auto& d : r->dropped) {
+    nlohmann::json j = {{"reason", flight::toString(d.reason)}, {"count", d.count}, {"time_s", {d.first_s, d.last_s}}};
+    if (d.firstLine) j["lines"] = {d.firstLine, d.lastLine};
+    if (d.reason == flight::DropReason::Speed || d.reason == flight::DropReason::Jump) j["off_track_m"] = d.offTrack_m;
+    if (d.reason == flight::DropReason::Speed) j["implied_speed_mps"] = d.impliedSpeed_mps;
+    dropped.push_back(std::move(j));
+  }
+  for (const auto& g : r->gaps) {
+    const char* action = g.action == flight::GapNote::Action::Held    ? "held"
+                         : g.action == flight::GapNote::Action::Ended ? "ended"
+                                                                       : "interpolated";
+    nlohmann::json j = {{"time_s", {g.from_s, g.to_s}}, {"distance_m", g.distance_m}, {"action", action}};
+    if (g.fromLine) j["lines"] = {g.fromLine, g.toLine};
+    gaps.push_back(std::move(j));
+  }
+  return {{"enabled", true},
+          {"max_ground_speed_mps", options.maxGroundSpeed_mps},
+          {"max_gap_s", options.maxGap_s},
+          {"long_gap", options.longGap == flight::LongGap::End ? "end" : "hold"},
+          {"fixes_in", r->input},
+          {"fixes_kept", r->kept},
+          {"reordered", r->reordered},
+          {"dropped", dropped},
+          {"gaps", gaps},
+          {"attitude_rederived", r->attitudeRederived},
+          {"summary", r->lines(options)}};
+}
+
 }  // namespace
 
 int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, const std::atomic<bool>* stop) {
   // Flight files are read here and parsed by protocol/ (the renderer does
   // not link sim_clients/).
-  auto text = readFile(o.flightPath);
+  auto text = readFile(o.flightPath, flight::kMaxFlightFileBytes);
   auto flight = text ? flight::parseFlight(*text, o.flightPath, o.read)
                      : Result<flight::ParsedFlight>(tl::unexpected(text.error()));
   if (!flight) {
@@ -91,6 +125,19 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   }
   for (const auto& w : flight->warnings) std::fprintf(stderr, "skyshell-render: warning: %s\n", w.c_str());
   if (!flight->altitudeSource.empty()) std::fprintf(stderr, "skyshell-render: altitude: %s\n", flight->altitudeSource.c_str());
+  std::optional<flight::CleanReport> cleaning;
+  if (o.clean) {
+    auto cleaned = flight::clean(*flight, o.cleanOptions, o.flightPath);
+    if (!cleaned) {
+      std::fprintf(stderr, "skyshell-render: %s\n", describe(cleaned.error()).c_str());
+      return 2;
+    }
+    cleaning = std::move(*cleaned);
+    for (const auto& line : cleaning->lines(o.cleanOptions))
+      std::fprintf(stderr, "skyshell-render: cleaning: %s\n", line.c_str());
+  } else {
+    std::fprintf(stderr, "skyshell-render: cleaning off (--no-clean): the track as read\n");
+  }
   const double first_s = flight->fixes.front().time_s;
   const double t0 = first_s + o.start_s;
   const double t1 = o.end_s ? std::min(first_s + *o.end_s, flight->fixes.back().time_s) : flight->fixes.back().time_s;
@@ -171,7 +218,16 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     std::fprintf(stderr, "skyshell-render: warning: no coarse-area weather within %.0f s; the coarse ring "
                          "holds the detailed area's\n", o.weatherTimeout_s);
   const WeatherView firstView = state.weather();
-  const double clockBase_s = o.weatherClock_s.value_or(firstView.clockNow(Clock::now()));
+  // The first frame's weather clock. From a file: the file's own clock (its
+  // start), never the wall clock's offset from when it was read, so that two
+  // runs draw the same frames byte for byte. From a server: its clock now,
+  // which differs between runs; --weather-clock pins it.
+  const double clockBase_s = o.weatherClock_s       ? *o.weatherClock_s
+                             : !o.weatherFile.empty() ? firstView.snapshot.weatherClock_s
+                                                      : firstView.clockNow(Clock::now());
+  const std::string clockFrom = o.weatherClock_s       ? "--weather-clock"
+                                : !o.weatherFile.empty() ? "the weather file's clock"
+                                                         : "the server's clock at the first frame";
   const double clockRate = firstView.clock.rate();
 
   // The real sun when the record says when it was flown.
@@ -338,6 +394,14 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   report["weather_source"] = weatherSource;
   report["weather_clock_s"] = {clockBase_s, clockBase_s + double(frameCount - 1) * o.step_s * clockRate};
   report["weather_clock_rate"] = clockRate;
+  report["weather_clock_from"] = clockFrom;
+  if (!o.weatherClock_s && o.weatherFile.empty()) {
+    char pin[160];
+    std::snprintf(pin, sizeof pin, "--weather-clock %.6f draws the same weather again (byte-identical frames)",
+                  clockBase_s);
+    report["weather_clock_pin"] = pin;
+  }
+  report["cleaning"] = cleaningJson(cleaning ? &*cleaning : nullptr, o.cleanOptions);
   report["weather_versions_seen"] = versionsSeen;
   report["non_finite_pixels"] = nonFinite;
   if (o.display) report["frames_presented"] = o.display->presented();

@@ -38,6 +38,7 @@
 #include "sky/app/timed_render.hpp"
 #include "sky/app/weather_client.hpp"
 #include "sky/app/window_display.hpp"
+#include "sky/flight/clean.hpp"
 #include "sky/flight/utf8_text.hpp"
 #include "sky/geo/geodetic.hpp"
 #include "sky/render/cloud_renderer.hpp"
@@ -91,6 +92,10 @@ struct Options {
   sky::flight::ReadOptions replayRead;  // --icao24, --altitude-unit (ADS-B files)
   double exposure_ms = 1000.0 * sky::render::kDefaultExposure_s;
   std::string replayAltitudeUnit;
+  bool noClean = false;                   // --no-clean
+  std::string maxSpeed;                   // --max-speed
+  sky::flight::CleanOptions cleanOptions;  // --max-gap, --long-gap
+  std::string longGap = "hold";
   bool noVideo = false;
   bool fixedSun = false;
   std::string utc;  // --utc: the time of day at the host's first datagram
@@ -230,9 +235,24 @@ int main(int argc, char** argv) {
   app.add_option("--replay-end", o.replayEnd_s, "with --replay: end offset into the flight, s (default: its end)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--weather-clock", o.replayWeatherClock_s,
-                 "with --replay: weather clock of the first frame, s (default: the server's); pin it for "
-                 "byte-identical re-renders");
+                 "with --replay: weather clock of the first frame, s (default: a --weather-file's own clock, else "
+                 "the server's at the first frame, which report.json gives); pin it for byte-identical re-renders "
+                 "from a server");
   app.add_flag("--no-video", o.noVideo, "with --replay: skip the MP4");
+  app.add_flag("--no-clean", o.noClean,
+               "with --replay: the track as read: no sorting, no dropping of repeats, speed glitches or spoofed "
+               "jumps, gaps interpolated whatever their length");
+  app.add_option("--max-speed", o.maxSpeed,
+                 "with --replay: cleaning's fastest ground speed, m/s or with a unit ('680kt', '350m/s'); a fix "
+                 "implying more is dropped (default 350 m/s: an airliner with a jet-stream tailwind)");
+  app.add_option("--max-gap", o.cleanOptions.maxGap_s,
+                 "with --replay: longest gap between fixes flown through in a straight line, s; longer gaps are "
+                 "held or end the replay (--long-gap)")
+      ->check(CLI::Range(1.0, 1e7));
+  app.add_option("--long-gap", o.longGap,
+                 "with --replay, at a gap longer than --max-gap: hold (stay at the last fix, then jump to the next) "
+                 "or end")
+      ->check(CLI::IsMember({"hold", "end"}));
   app.add_option("--weather-file", o.weatherFile,
                  "a scenario file (deploy/scenarios/*.toml): with --replay, the weather rendered instead of asking "
                  "--server; live, the weather drawn until the server's comes (default: clear sky)");
@@ -272,6 +292,15 @@ int main(int argc, char** argv) {
       return 2;
     }
     cigiHost = *parsed;
+  }
+  if (!o.maxSpeed.empty()) {
+    const auto v = sky::flight::parseSpeed_mps(o.maxSpeed);
+    if (!v) {
+      std::fprintf(stderr, "skyshell-render: --max-speed '%s' is not a speed (e.g. 350, 350m/s, 680kt)\n",
+                   shown(o.maxSpeed).c_str());
+      return 2;
+    }
+    o.cleanOptions.maxGroundSpeed_mps = *v;
   }
   std::optional<double> startUtc_s;
   if (!o.utc.empty()) {
@@ -366,6 +395,9 @@ int main(int argc, char** argv) {
     r.outDir = o.outDir;
     r.outputs = outputs;
     r.video = !o.noVideo;
+    r.clean = !o.noClean;
+    r.cleanOptions = o.cleanOptions;
+    r.cleanOptions.longGap = o.longGap == "end" ? sky::flight::LongGap::End : sky::flight::LongGap::Hold;
     r.sunAzimuth_deg = o.sunAzimuth_deg;
     r.sunElevation_deg = o.sunElevation_deg;
     r.fixedSun = o.fixedSun;

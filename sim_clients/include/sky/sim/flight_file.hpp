@@ -9,6 +9,10 @@
 
 namespace sky::sim {
 
+// The bytes of a flight file; more than flight::kMaxFlightFileBytes
+// (file_limits.hpp) is an error (TooLarge) found without reading further.
+Result<std::string> readFlightFile(const std::string& path);
+
 // Reads and parses a flight file; the format is chosen by extension, in any
 // letter case: .csv (ours, or ADS-B by its header), .igc or .gpx; options go
 // to the reader (flight.hpp: ReadOptions). Errors name the file, and the

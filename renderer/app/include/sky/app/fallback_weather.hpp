@@ -11,6 +11,8 @@
 #pragma once
 
 #include <chrono>
+#include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -21,7 +23,9 @@
 namespace sky::app {
 
 // The whole file at `path`; the error names it (cleaned for a message).
-Result<std::string> readFile(const std::string& path);
+// A file of more than maxBytes is an error (TooLarge), found by reading no
+// more than maxBytes + 1 bytes.
+Result<std::string> readFile(const std::string& path, std::size_t maxBytes = SIZE_MAX);
 
 // A scenario file's layers and clock, as a view anchored at `now` (no tiles:
 // each layer uniform at its coverage).

@@ -21,6 +21,7 @@
 
 #include "sky/app/frame_writer.hpp"
 #include "sky/app/window_display.hpp"
+#include "sky/flight/clean.hpp"
 #include "sky/flight/flight.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky/render/frame_budget.hpp"
@@ -30,11 +31,17 @@ namespace sky::app {
 struct ReplayOptions {
   std::string flightPath;  // .csv (ours or ADS-B), .igc or .gpx
   flight::ReadOptions read;  // for an ADS-B file: the aircraft, the altitude unit
+  bool clean = true;         // clean the track first (flight/clean.hpp); false: --no-clean
+  flight::CleanOptions cleanOptions;
   double step_s = 1.0 / 30.0;           // flight seconds per frame, (0, 3600]
   double start_s = 0;                   // offset into the flight, s
   std::optional<double> end_s;          // offset into the flight, s (default: its end)
   std::size_t maxFrames = 0;            // stop after this many frames (0: no limit)
-  std::optional<double> weatherClock_s; // weather clock of the first frame (default: the server's)
+  // Weather clock of the first frame. Default: from --weather-file, the
+  // file's own clock (its start, so that two runs draw the same frames);
+  // from a server, the server's clock when the first frame is drawn (the
+  // report says which, and this pins it).
+  std::optional<double> weatherClock_s;
   std::string weatherFile;  // a scenario TOML instead of a server (its layers, uniform; its clock)
   std::string serverHost;
   unsigned short serverPort = 0;

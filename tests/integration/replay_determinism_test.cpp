@@ -1,0 +1,152 @@
+// skyshell-render --replay from a weather file is byte-identical run to run
+// without --weather-clock: the first frame's weather clock is the file's own
+// (its [clock] start_s), not the file's clock advanced by however long the
+// renderer took between reading the file and drawing the first frame (which
+// made 2 of 31 frames differ between two runs of the same command at
+// --preset medium). Tiny frames, two runs, every PNG compared byte for byte.
+// Also the replay's cleaning flags and skyshell-replay --info, on a track
+// with a spoofed fix.
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "child_process.hpp"
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+namespace sky::test {
+namespace {
+
+std::string readAll(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+fs::path outputDir() {
+  const fs::path dir = fs::path(SKY_TEST_OUTPUT_DIR) /
+                       ("determinism-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+int run(std::vector<std::string> argv, const fs::path& log, std::string* text = nullptr) {
+  // Leak checking off for the renderer (lavapipe's JIT), as in the other replay tests.
+  ChildProcess child(std::move(argv), log.string(), {"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
+  const auto code = child.wait(300s);
+  if (text) *text = child.log();
+  return code.value_or(-1);
+}
+
+// The 6 s test flight at 0.2 s a frame: 31 frames, as in the report of the
+// bug, at 64x36 so that the two runs take seconds.
+std::vector<std::string> replayArgs(const fs::path& out) {
+  return {SKY_RENDER, "--headless", "--replay", SKY_TEST_FLIGHT, "--weather-file", SKY_SCENARIO_CLOUDY,
+          "--preset", "medium", "--step", "0.2", "--width", "64", "--height", "36", "--no-video",
+          "--out", out.string()};
+}
+
+TEST(ReplayDeterminism, TwoRunsFromAWeatherFileGiveTheSameBytes) {
+  const fs::path dir = outputDir();
+  std::string logA, logB;
+  ASSERT_EQ(run(replayArgs(dir / "a"), dir / "a.log", &logA), 0) << logA;
+  ASSERT_EQ(run(replayArgs(dir / "b"), dir / "b.log", &logB), 0) << logB;
+  std::size_t compared = 0, differing = 0;
+  for (const auto& entry : fs::directory_iterator(dir / "a" / "frames")) {
+    if (entry.path().extension() != ".png") continue;
+    ++compared;
+    if (readAll(entry.path()) != readAll(dir / "b" / "frames" / entry.path().filename())) {
+      ++differing;
+      ADD_FAILURE() << entry.path().filename() << " differs between the two runs";
+    }
+  }
+  EXPECT_EQ(compared, 31u);
+  EXPECT_EQ(differing, 0u);
+  const auto report = nlohmann::json::parse(readAll(dir / "a" / "report.json"));
+  // skeleton-cumulus.toml: [clock] start_s = 0.0, rate 1; frames 0.2 s apart.
+  EXPECT_EQ(report["weather_clock_s"][0], 0.0);
+  EXPECT_NEAR(report["weather_clock_s"][1].get<double>(), 6.0, 1e-9);
+  EXPECT_EQ(report["weather_clock_from"], "the weather file's clock");
+  EXPECT_FALSE(report.contains("weather_clock_pin"));
+  EXPECT_EQ(report["cleaning"]["enabled"], true);
+  EXPECT_EQ(report["cleaning"]["fixes_in"], 7);
+  EXPECT_EQ(report["cleaning"]["fixes_kept"], 7);
+}
+
+// The test flight with its fix at t = 3 s (line 8) moved 3 degrees of
+// latitude (333 km) north: a spoofed fix.
+fs::path spoofedFlight(const fs::path& dir) {
+  std::istringstream in(readAll(SKY_TEST_FLIGHT));
+  std::ostringstream out;
+  std::string line;
+  for (std::size_t n = 1; std::getline(in, line); ++n) {
+    if (line.rfind("3,46.2000,", 0) == 0) {
+      EXPECT_EQ(n, 8u);
+      line.replace(2, 7, "49.2000");
+    }
+    out << line << '\n';
+  }
+  const fs::path path = dir / "spoofed.csv";
+  std::ofstream(path) << out.str();
+  return path;
+}
+
+// The metadata of a replay's second frame (t = 3 s at --step 3).
+nlohmann::json secondFrame(const fs::path& out) {
+  std::ifstream jsonl(out / "frames" / "frames.jsonl");
+  std::string line;
+  std::getline(jsonl, line);
+  std::getline(jsonl, line);
+  return nlohmann::json::parse(line, nullptr, false);
+}
+
+TEST(ReplayDeterminism, TheCleaningDropsASpoofedFixAndSaysSo) {
+  const fs::path dir = outputDir();
+  const fs::path flight = spoofedFlight(dir);
+  std::vector<std::string> args = {SKY_RENDER, "--headless", "--replay", flight.string(), "--weather-file",
+                                   SKY_SCENARIO_CLOUDY, "--step", "3", "--width", "64", "--height", "36",
+                                   "--no-video", "--out", (dir / "clean").string()};
+  std::string log;
+  ASSERT_EQ(run(args, dir / "clean.log", &log), 0) << log;
+  EXPECT_NE(log.find("cleaning: 1 fix at line 8 (t 3.0 s) dropped"), std::string::npos) << log;
+  const auto report = nlohmann::json::parse(readAll(dir / "clean" / "report.json"));
+  ASSERT_EQ(report["cleaning"]["dropped"].size(), 1u) << report["cleaning"].dump();
+  EXPECT_EQ(report["cleaning"]["dropped"][0]["reason"], "speed");
+  EXPECT_EQ(report["cleaning"]["dropped"][0]["lines"][0], 8);
+  EXPECT_EQ(report["cleaning"]["fixes_kept"], 6);
+  // Interpolated past it, along the chord between t = 2 and 4 s re-projected: 0.2 mm off the parallel.
+  EXPECT_NEAR(secondFrame(dir / "clean")["lat_deg"].get<double>(), 46.2, 1e-6);
+  // --no-clean flies to the spoofed fix: the frame at t = 3 s is 3 deg north.
+  args[args.size() - 1] = (dir / "raw").string();
+  args.push_back("--no-clean");
+  ASSERT_EQ(run(args, dir / "raw.log", &log), 0) << log;
+  EXPECT_EQ(nlohmann::json::parse(readAll(dir / "raw" / "report.json"))["cleaning"]["enabled"], false);
+  EXPECT_NEAR(secondFrame(dir / "raw")["lat_deg"].get<double>(), 49.2, 1e-9);
+}
+
+TEST(ReplayInfo, SaysWhatTheFileHoldsWithoutReplaying) {
+  const fs::path dir = outputDir();
+  const fs::path flight = spoofedFlight(dir);
+  std::string out;
+  ASSERT_EQ(run({SKY_REPLAY, "--info", flight.string()}, dir / "info.log", &out), 0) << out;
+  EXPECT_NE(out.find("format: Skyshell CSV"), std::string::npos) << out;
+  EXPECT_NE(out.find("time: 0.0 s to 6.0 s of the record (0h00m06s)"), std::string::npos) << out;
+  EXPECT_NE(out.find("fixes: 6"), std::string::npos) << out;
+  EXPECT_NE(out.find("cleaning: kept 6 of 7 fixes; 1 dropped (speed)"), std::string::npos) << out;
+  EXPECT_NE(out.find("1 fix at line 8"), std::string::npos) << out;
+  // The box of the kept fixes: 46.2 N, 12.8000 to 12.8042 E (0.0007 deg/s for 6 s).
+  EXPECT_NE(out.find("bounding box: lat 46.20000 to 46.20000 deg, lon 12.80000 to 12.80420 deg"), std::string::npos)
+      << out;
+  ASSERT_EQ(run({SKY_REPLAY, "--info", "--no-clean", flight.string()}, dir / "raw.log", &out), 0) << out;
+  EXPECT_NE(out.find("fixes: 7"), std::string::npos) << out;
+  EXPECT_NE(out.find("lat 46.20000 to 49.20000 deg"), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace sky::test
