@@ -3,8 +3,8 @@
 // error and warning is well-formed UTF-8); a flight it returns keeps the
 // documented invariants (two or more fixes, increasing time); the cleaning
 // (clean.hpp) run on what it parsed, holding a long gap and ending at one,
-// keeps them too and reports in well-formed UTF-8. A broken promise aborts,
-// which libFuzzer reports with the input.
+// keeps them too and reports (and --info describes) in well-formed UTF-8.
+// A broken promise aborts, which libFuzzer reports with the input.
 #pragma once
 
 #include <cstddef>
@@ -12,6 +12,7 @@
 
 #include "sky/flight/clean.hpp"
 #include "sky/flight/flight.hpp"
+#include "sky/flight/info.hpp"
 #include "sky/flight/utf8_text.hpp"
 
 namespace sky::fuzz {
@@ -33,6 +34,8 @@ inline void checkCleaning(flight::ParsedFlight f, const flight::CleanOptions& op
   checkFlightInvariants(f);
   if (report->input != before || report->kept > before) std::abort();
   for (const auto& line : report->lines(options))
+    if (flight::firstInvalidUtf8(line)) std::abort();
+  for (const auto& line : flight::describeFlight(f, "fuzz", &*report, options))
     if (flight::firstInvalidUtf8(line)) std::abort();
 }
 

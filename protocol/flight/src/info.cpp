@@ -63,6 +63,7 @@ std::string formatName(std::string_view text, std::string_view sourceName) {
   if (ext == "json") return "readsb trace JSON";
   if (ext == "kml") return "KML";
   if (ext == "kmz") return "KMZ";
+  if (ext == "fdr") return "X-Plane FDR";
   std::string shown;
   for (char c : ext.substr(0, 16)) shown.push_back(c >= 0x20 && c < 0x7f ? c : '?');
   return "." + shown + " (unknown)";

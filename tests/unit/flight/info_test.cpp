@@ -26,7 +26,8 @@ TEST(FlightInfo, FormatByExtensionAndHeader) {
   EXPECT_EQ(formatName("", "a.gpx"), "GPX");
   EXPECT_EQ(formatName("", "trace_full_3c6444.json"), "readsb trace JSON");
   EXPECT_EQ(formatName("", "a.kmz"), "KMZ");
-  EXPECT_EQ(formatName("", "a.fdr"), ".fdr (unknown)");
+  EXPECT_EQ(formatName("", "a.FDR"), "X-Plane FDR");
+  EXPECT_EQ(formatName("", "a.fgtape"), ".fgtape (unknown)");
 }
 
 TEST(FlightInfo, LinesSayWhatTheFileHolds) {

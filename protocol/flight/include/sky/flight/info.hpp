@@ -15,7 +15,7 @@ namespace sky::flight {
 
 // The format parseFlight reads a file as, by sourceName's extension and
 // (for .csv) its header: "Skyshell CSV", "ADS-B CSV", "IGC", "GPX",
-// "readsb trace JSON", "KML", "KMZ"; any other extension as ".ext (unknown)".
+// "readsb trace JSON", "KML", "KMZ", "X-Plane FDR"; any other extension as ".ext (unknown)".
 std::string formatName(std::string_view text, std::string_view sourceName);
 
 // The lines of --info for a parsed (and, when cleaning is given, cleaned)
