@@ -27,8 +27,10 @@
 // and the frame's sun map in gSunMap (a global; a data member in C++), and
 // kWindField: false where no layer's wind varies over the map and none is
 // in a crossfade of its flow's phases (the wind map's reads and the second
-// phase are then left out; on the GPU a pipeline constant, true in C++), and
-// kLightning: false where the frame lights no flash (the same).
+// phase are then left out; on the GPU a pipeline constant, true in C++),
+// kLightning: false where the frame lights no flash (the same), and
+// kShowers: false where no precipitation layer falls under a carrier's
+// cells (the same).
 // pLocal is camera-relative, local frame: x east, y north, z up (m).
 
 #include "core_common.glsl"
@@ -135,6 +137,8 @@ struct CoreLayer {
   real band;           // the transition band's fraction of the shell at each end, [0, 0.5): the heights
                        // above (hBase, hTop, thickness) are the shell's, base - band to top + band, and
                        // the cloud fades across the band (layerPresence)
+  int carrier;         // a precipitation layer: the layer whose cells drop it (its shafts fall under
+                       // them, carrierFootprint), or -1
 };
 
 // The layers are read through this hook, not carried in CoreFrame: a frame
@@ -417,16 +421,24 @@ struct CloudSample {
 // The noise is carried by the wind in the two phases of the flow
 // (flowShape and the others): the layer's own wind, or where it varies over
 // the map the local wind (its vertical part the layer's own).
-CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
-  real3 drift = real3(L.sampling.windRef);
-  if (kWindField && L.sampling.flow.w > 0.5) {
-    real3 rel = sampleWindLocal(L.sampling, p) - drift;
+LayerSampling flowAt(LayerSampling s, real3 p) {
+  real3 drift = real3(s.windRef);
+  if (kWindField && s.flow.w > 0.5) {
+    real3 rel = sampleWindLocal(s, p) - drift;
     rel.z = 0.0;
     drift += rel;
   }
   // Phase A's shift first, or B's alone where only B shows.
-  L.sampling.flowShift = drift * (L.sampling.flow.z > 0.0 ? L.sampling.flow.x : L.sampling.flow.y);
-  L.sampling.flowShiftB = drift * L.sampling.flow.y;
+  s.flowShift = drift * (s.flow.z > 0.0 ? s.flow.x : s.flow.y);
+  s.flowShiftB = drift * s.flow.y;
+  return s;
+}
+
+// coverageGain: the weather map's coverage is taken times this (capped at
+// 1): a precipitation layer's coverage as a share of its carrier's
+// (carrierFootprint), 1 otherwise.
+CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap, real coverageGain) {
+  L.sampling = flowAt(L.sampling, p);
   CloudSample cs;
   cs.rho = 0.0;
   cs.ct = L.primary;
@@ -447,7 +459,8 @@ CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
   real2 map = flowCloudMap(L.sampling, p);
   cs.peakNoise = map.y;
   cs.densityScale = weather.y;
-  cs.coverage = anvilCoverage(cs.ct, ph, weather.x < 1.0 ? mappedCoverage(weather.x, map.x) : 1.0);
+  real cover = min(weather.x * coverageGain, 1.0);
+  cs.coverage = anvilCoverage(cs.ct, ph, cover < 1.0 ? mappedCoverage(cover, map.x) : 1.0);
   real sa = shapeProfile(cs.ct, ph, cs.coverage, map.y);
   if (sa <= 0.0) return cs;
   real shape = cloudShape(cs.ct, flowShape(L.sampling, p), cs.coverage, sa);
@@ -459,6 +472,50 @@ CloudSample cloudSample(CoreLayer L, real3 p, real ph, bool cheap) {
   }
   // Erosion leaves a full shape (1) full: the detail fetch only at the edges.
   cs.rho = (shape < 1.0 ? erodeShape(cs.ct, shape, flowDetail(L.sampling, p), cs.coverage, ph) : 1.0) * da;
+  return cs;
+}
+
+// Showers under their carrier's cells: a precipitation layer whose top is
+// inside a cloud layer (CoreLayer::carrier) falls only where that layer's
+// cells are, seen from below: where its shape noise at kFootprintHeight of
+// its shell over p is above its coverage there (after the cloud map, as
+// cloudSample's threshold for the body of its cloud before erosion), rising
+// to 1 over kFootprintEdge noise units inside; so showers fall under the
+// cumulus that drop them and not from the clear sky between.
+// carrierFootprint's x is that footprint; y the gain that makes the rain's
+// own coverage a share of the carrier's (its coverage over the carrier's,
+// capped at 1 by cloudSample), so that coverage c_p under cells of cover c_c
+// still wets c_p of the ground. A closed carrier (coverage 1) covers
+// everything. h: p's height above the camera's sphere of radius r.
+SKY_CORE_CONST real kFootprintHeight = 0.2;
+SKY_CORE_CONST real kFootprintEdge = 0.12;
+real2 carrierFootprint(CoreLayer C, real3 p, real h, real r) {
+  real3 q = p + upAt(p, r) * (kFootprintHeight * C.thickness - C.hBase - h);
+  LayerSampling s = flowAt(C.sampling, q);
+  real cover = sampleWeather(s, q).x;
+  if (cover <= 0.0) return real2(0.0, 1.0);
+  if (cover >= 1.0) return real2(1.0, 1.0);
+  real c = mappedCoverage(cover, flowCloudMap(s, q).x);
+  real2 shape = flowShape(s, q);
+  real n = mix(shape.x, shape.y, C.primary.fibrous);
+  return real2(saturate1((n - (1.0 - c)) / kFootprintEdge), 1.0 / cover);
+}
+
+// cloudSample of layer L, under its carrier's cells where it has one. The
+// footprint scales the cheap density as the full one, so the cheap sample
+// stays > 0 wherever the full one is (without it in the cheap sample the
+// long steps found rain wherever its own noise has it and marched the
+// whole shaft layer in short steps: slower). One cloudSample, the footprint
+// first: lavapipe runs both sides of a branch for all lanes, and two inlined
+// cloudSamples behind early returns cost more than reading the footprint
+// for every sample of the rain. The carrier is read per sample of a
+// precipitation layer only (a CoreLayer held live across the span's loop
+// costs every layer's march).
+CloudSample layerSample(CoreLayer L, real3 p, real h, real ph, bool cheap, real r) {
+  real2 foot = real2(1.0);
+  if (kShowers && L.carrier >= 0 && ph > 0.0 && ph < 1.0) foot = carrierFootprint(layerAt(L.carrier), p, h, r);
+  CloudSample cs = cloudSample(L, p, ph, cheap, foot.y);
+  cs.rho *= foot.x;
   return cs;
 }
 
@@ -587,7 +644,7 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
     real3 p = dir * t;
     real h = heightAboveCameraSphere(p, f.air.r);
     real ph = (h + L.hBase) / L.thickness;
-    CloudSample cs = cloudSample(L, p, ph, longSteps);
+    CloudSample cs = layerSample(L, p, h, ph, longSteps, f.air.r);
     if (longSteps) {
       // Cloud ahead: march this step again in short steps (it stays at
       // segStart); clear: the whole long step is.

@@ -49,6 +49,12 @@ layout(constant_id = 4) const bool kWindField = true;
 // the flash's light in the march and the bolt are compiled out.
 layout(constant_id = 5) const bool kLightning = false;
 
+// kShowers false for frames with no precipitation layer under a carrier
+// (SkyLayer::band.y): the carrier's footprint (cloud_core.glsl's
+// carrierFootprint) is compiled out. Present in the pipeline, even untaken,
+// it made high's march ~20 % slower on lavapipe.
+layout(constant_id = 6) const bool kShowers = false;
+
 #define real float
 #define real2 vec2
 #define real3 vec3
@@ -193,7 +199,7 @@ CoreLayer layerAt(int li) {
                                   vec3(0.0), vec3(0.0));
   return CoreLayer(l.heights.x, l.heights.y, l.heights.z, l.heights.w, l.shape.x, l.shape.z, l.shape.w > 0.5,
                    unpackType(l.primary), unpackType(l.secondary), l.ambient.rgb, l.sunDiffuse.rgb,
-                   l.sunDiffuse.w, s, l.ambient.w > 0.5, l.coverageShift.z, l.band.x);
+                   l.sunDiffuse.w, s, l.ambient.w > 0.5, l.coverageShift.z, l.band.x, int(l.band.y));
 }
 
 // Copies the frame's sampling numbers into the globals the hooks read.

@@ -97,7 +97,8 @@ struct SkyLayer {
   vec4 windRef;        // xyz: the layer's own wind, camera-local (m/s), which the noise origins drift with;
                        // w: the age of the map's tiles, weather clock minus the snapshot's (s)
   vec4 band;           // x: the transition band's fraction of the shell at each end (heights and
-                       // thickness above are the shell's: the cloud with its band); yzw: unused
+                       // thickness above are the shell's: the cloud with its band); y: the index of
+                       // the layer that carries this precipitation layer, or -1; zw: unused
 };
 
 struct SkyFrame {

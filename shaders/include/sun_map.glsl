@@ -189,8 +189,9 @@ SunColumn sunColumnMarch(AirFrame a, real3 o, real hO, real muO, SunLine line, r
     for (int i = 0; i < n; ++i) {
       real z = z1 - (real(i) + 0.5) * dz;
       real3 q = o + a.sunDir * z;
-      real ph = (heightAboveCameraSphere(q, a.r) + L.hBase) / L.thickness;
-      CloudSample cs = cloudSample(L, q, ph, false);
+      real hq = heightAboveCameraSphere(q, a.r);
+      real ph = (hq + L.hBase) / L.thickness;
+      CloudSample cs = layerSample(L, q, hq, ph, false, a.r);
       real dtau = cs.ct.extinction_perm * cs.rho * dz;
       c = sunColumnAdd(c, method, (line.entry - z) * invLength, 0.5 * dz * invLength, dtau);
     }

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -568,6 +569,54 @@ TEST(GpuVsCpu, SunMapRebuildIsSpreadOverFrames) {
   EXPECT_EQ((*spread)->lastSunMap().reason, "sun turned");
   EXPECT_EQ((*spread)->lastSunMap().rowEnd, 64u);
   EXPECT_TRUE((*spread)->lastSunMap().completed);
+}
+
+}  // namespace
+}  // namespace sky::test
+
+namespace sky::test {
+namespace {
+
+// Showers under cumulus (the rain layer's top inside the cumulus, so it
+// falls under their cells: cloud_core.glsl's carrierFootprint): from under
+// the rain looking at the shafts, from between the cells, and from above
+// the deck, within the same bounds. A GPU that read no carrier would draw
+// the rain of its own noise, as much again from the clear sky.
+TEST(GpuVsCpu, ShowersUnderTheirCumulusWithinTolerance) {
+  SKY_RENDERER(r, 64, 36);
+  auto reference = render::CpuReference::create(r.settings());
+  ASSERT_TRUE(reference) << describe(reference.error());
+  weather::WeatherSnapshot snap;
+  weather::CloudLayer cumulus = layer(1, 1500, 1200, 0.4, 1.0);
+  weather::CloudLayer rain = layer(2, 0, 1900, 0.4, 0.1);  // 0.1: ~10 mm/h
+  rain.type = weather::CloudType::Rain;
+  snap.layers = {cumulus, rain};
+  const std::pair<const char*, geo::GeodeticPose> views[] = {
+      {"showers_below", pose(47, 8, 300, 70, 5)},
+      {"showers_up", pose(47, 8, 600, 200, 35)},
+      {"showers_above", pose(47, 8, 4000, 10, -25)},
+  };
+  for (const auto& [name, camera] : views) {
+    SCOPED_TRACE(name);
+    render::FrameInputs in;
+    in.camera = camera;
+    in.weather = &snap;
+    in.sunElevation_deg = 40;
+    auto gpu = r.render(in);
+    ASSERT_TRUE(gpu) << describe(gpu.error());
+    auto cpu = reference->render(in);
+    ASSERT_TRUE(cpu) << describe(cpu.error());
+    savePng(*gpu, std::string("gpu_") + name);
+    savePng(*cpu, std::string("cpu_") + name);
+    const Diff d = diff(*gpu, *cpu);
+    const double mean = render::computeStats(*cpu).meanLuminance;
+    const double meanError = std::abs(render::computeStats(*gpu).meanLuminance - mean) / mean;
+    std::printf("[ gpu/cpu  ] %-26s mean %.4f (gpu %+.3f %%) displayed rmse %.2f %% (linear %.2f %%) max %.4f\n", name,
+                mean, 100 * meanError, 100 * d.displayedRmse / d.displayedMean, 100 * d.rmse / mean, d.maxAbs);
+    EXPECT_LT(meanError, kRelativeMeanTolerance);
+    EXPECT_EQ(render::computeStats(*gpu).nonFinite, 0u);
+    EXPECT_LT(d.displayedRmse, kRelativeRmseTolerance * d.displayedMean);
+  }
 }
 
 }  // namespace

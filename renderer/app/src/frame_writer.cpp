@@ -54,6 +54,7 @@ nlohmann::json marchJson(const render::MarchSettings& m) {
           {"air_steps", m.airSteps},
           {"cloud_shadows", m.cloudShadows},
           {"near_precipitation", m.nearPrecipitation},
+          {"showers_under_cells", m.showersUnderCells},
           {"air_table", m.airTable.enabled ? nlohmann::json{{"azimuths", m.airTable.azimuths},
                                                             {"zeniths", m.airTable.zeniths},
                                                             {"slices", m.airTable.slices}}

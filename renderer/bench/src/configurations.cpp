@@ -120,6 +120,7 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     else if (key == "blue" && (v == 0 || v == 1)) m.blueNoise = v == 1;
     else if (key == "cloud-shadows" && (v == 0 || v == 1)) m.cloudShadows = v == 1;
     else if (key == "near-precip" && (v == 0 || v == 1)) m.nearPrecipitation = v == 1;
+    else if (key == "shower-cells" && (v == 0 || v == 1)) m.showersUnderCells = v == 1;
     else if (key == "budget" && base && v == std::floor(v)) {
       // Level v of the base preset's frame-budget ladder (frame_budget.hpp).
       auto ladder = render::budgetLadder(*base);
@@ -151,7 +152,8 @@ Result<Configuration> customConfiguration(const std::string& spec) {
       return fail(ErrorCode::InvalidArgument,
                   "custom configuration '" + spec + "': unknown key '" + key +
                       "' (base, primary, light, exit, stride, cloud, empty, growth, air, multmin, divmin, scale, "
-                      "interleave 1|2|4, divisor 1|2|4, depth-aware 0|1, blue 0|1, cloud-shadows 0|1, air-table 0|1, "
+                      "interleave 1|2|4, divisor 1|2|4, depth-aware 0|1, blue 0|1, cloud-shadows 0|1, near-precip 0|1, shower-cells 0|1, "
+                      "air-table 0|1, "
                       "air-azimuths, air-zeniths, air-slices, budget 0..4 (after base), accumulate 0..0.95, "
                       "pixel-jitter 0|1, clip 0..4, dense-turn (px, 0 never), acc-motion (px, 0 off), edges 0|1, sharp 0|1, region-drop 0|1, shadow 0..5 (march, column, esm, bsm, fom, deep), shadow-size, "
                       "shadow-cascades, shadow-extent (m), shadow-steps, shadow-frames)");

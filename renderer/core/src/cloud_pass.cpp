@@ -159,13 +159,15 @@ Result<CloudPass> CloudPass::create(const GpuContext& ctx, std::uint32_t width, 
 }
 
 Result<const ComputePipeline*> CloudPass::pipelineFor(const GpuContext& ctx, Stage stage, std::uint32_t layersDrawn,
-                                                      bool windField, bool lightning) {
+                                                      bool windField, bool lightning, bool showers) {
   const std::size_t wind = windField ? 1 : 0;
   lightning = lightning && stage == Stage::Clouds;  // the other stages draw no light
+  showers = showers && stage != Stage::AirTable && layersDrawn > 1;  // a shower and its carrier: two layers
   std::optional<ComputePipeline>& slot =
-      stage == Stage::SunMap     ? sunMapPipelines_[wind]
+      stage == Stage::SunMap     ? sunMapPipelines_[wind][showers ? 1 : 0]
       : stage == Stage::AirTable ? tablePipelines_[wind][layersDrawn > 0 ? 1 : 0]
-                                 : cloudPipelines_[wind][std::min<std::uint32_t>(layersDrawn, 2)][lightning ? 1 : 0];
+                                 : cloudPipelines_[wind][std::min<std::uint32_t>(layersDrawn, 2) + (showers ? 1 : 0)]
+                                                  [lightning ? 1 : 0];
   if (slot) return &*slot;
   // Every variant of the three shaders gets the same bindings, so their set
   // layouts are identical and one descriptor set serves them all (Vulkan's
@@ -174,7 +176,8 @@ Result<const ComputePipeline*> CloudPass::pipelineFor(const GpuContext& ctx, Sta
   const char* shader =
       stage == Stage::SunMap ? "sun_map.comp.spv" : (stage == Stage::AirTable ? "air_table.comp.spv" : "clouds.comp.spv");
   ComputePipelineBuilder builder(std::string(name) + ".layers" + std::to_string(std::min<std::uint32_t>(layersDrawn, 2)) +
-                                 (windField ? ".wind" : "") + (lightning ? ".lightning" : ""));
+                                 (windField ? ".wind" : "") + (lightning ? ".lightning" : "") +
+                                 (showers ? ".showers" : ""));
   builder.binding(gpu::kBindingFrame, vk::DescriptorType::eStorageBuffer)
       .binding(gpu::kBindingShape, vk::DescriptorType::eCombinedImageSampler)
       .binding(gpu::kBindingWeather, vk::DescriptorType::eCombinedImageSampler)
@@ -191,7 +194,7 @@ Result<const ComputePipeline*> CloudPass::pipelineFor(const GpuContext& ctx, Sta
       .binding(gpu::kBindingSunMap, vk::DescriptorType::eCombinedImageSampler)
       .shader(shader)
       .constants({layersDrawn > 0 ? 1u : 0u, airTableSize_.enabled ? 1u : 0u, layersDrawn > 1 ? 1u : 0u,
-                  std::uint32_t(sunMapSize_.method), windField ? 1u : 0u, lightning ? 1u : 0u});
+                  std::uint32_t(sunMapSize_.method), windField ? 1u : 0u, lightning ? 1u : 0u, showers ? 1u : 0u});
   auto built = builder.build(ctx);
   if (!built) return tl::unexpected(built.error());
   slot = std::move(*built);
@@ -203,15 +206,19 @@ Result<std::size_t> CloudPass::buildAllVariants(const GpuContext& ctx) {
   for (const bool wind : {false, true}) {
     for (const std::uint32_t layers : {0u, 1u, 2u})
       for (const bool lightning : {false, true})
-        if (auto built = pipelineFor(ctx, Stage::Clouds, layers, wind, lightning); !built)
-          return tl::unexpected(built.error());
+        for (const bool showers : {false, true})
+          if (layers > 1 || !showers)
+            if (auto built = pipelineFor(ctx, Stage::Clouds, layers, wind, lightning, showers); !built)
+              return tl::unexpected(built.error());
     // As run() asks for them: the table where it is on, the sun map where
     // its method has a map (and only for frames with layers).
     if (airTableSize_.enabled)
       for (const std::uint32_t layers : {0u, 1u})
         if (auto built = pipelineFor(ctx, Stage::AirTable, layers, wind); !built) return tl::unexpected(built.error());
     if (sunMapParts(sunMapSize_.method) > 0)
-      if (auto built = pipelineFor(ctx, Stage::SunMap, 1, wind); !built) return tl::unexpected(built.error());
+      for (const std::uint32_t layers : {1u, 2u})
+        if (auto built = pipelineFor(ctx, Stage::SunMap, layers, wind, false, layers > 1); !built)
+          return tl::unexpected(built.error());
   }
   return variantsBuilt() - before;
 }
@@ -223,7 +230,8 @@ std::size_t CloudPass::variantsBuilt() const {
       for (const auto& p : byLightning) n += p.has_value();
   for (const auto& byLayers : tablePipelines_)
     for (const auto& p : byLayers) n += p.has_value();
-  for (const auto& p : sunMapPipelines_) n += p.has_value();
+  for (const auto& byShowers : sunMapPipelines_)
+    for (const auto& p : byShowers) n += p.has_value();
   return n;
 }
 
@@ -253,7 +261,12 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
   }
   // With lightning's code only in a frame a flash lights.
   const bool lightning = frame.flashInfo.x > 0.5f || frame.flashInfo.y > 0.5f;
-  auto cloudPipeline = pipelineFor(ctx, Stage::Clouds, layersDrawn, windField, lightning);
+  // With the showers' footprint only where a drawn precipitation layer has
+  // a carrier (frame_setup.cpp leaves it -1 when the carrier is not drawn).
+  bool showers = false;
+  for (std::uint32_t i = 0; i < std::uint32_t(frame.weatherMap.y) && i < gpu::kMaxLayers; ++i)
+    showers = showers || (frame.layers[i].ambient.w < 0.5f && frame.layers[i].band.y >= 0.0f);
+  auto cloudPipeline = pipelineFor(ctx, Stage::Clouds, layersDrawn, windField, lightning, showers);
   if (!cloudPipeline) return tl::unexpected(cloudPipeline.error());
   const ComputePipeline* tablePipeline = nullptr;
   if (frame.airTable.x > 0) {
@@ -270,7 +283,7 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
   if (sunMapParts(sunMapSize_.method) > 0 && layersDrawn > 0 && sunRowEnd > sunRowBegin) {
     SKY_ASSERT(frame.sunMap.y == sunMapSize_.size && frame.sunMap.z == sunMapSize_.cascades);
     SKY_ASSERT(sunRowEnd <= sunMapSize_.size);
-    auto built = pipelineFor(ctx, Stage::SunMap, layersDrawn, windField);
+    auto built = pipelineFor(ctx, Stage::SunMap, layersDrawn, windField, false, showers);
     if (!built) return tl::unexpected(built.error());
     sunPipeline = *built;
   }

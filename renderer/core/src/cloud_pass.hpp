@@ -93,7 +93,7 @@ class CloudPass {
   // with or without a layer whose wind varies over the map, built now if it
   // is not yet. Errors: Io/Malformed for the SPIR-V; Vulkan failures throw.
   Result<const ComputePipeline*> pipelineFor(const GpuContext& ctx, Stage stage, std::uint32_t layersDrawn,
-                                             bool windField, bool lightning = false);
+                                             bool windField, bool lightning = false, bool showers = false);
 
   // Destroyed in reverse order: fence and command buffer first, the
   // descriptor set before its pool, buffers and images before the samplers
@@ -103,10 +103,11 @@ class CloudPass {
   // (none: a clear sky; one; several, which shadow each other), the air
   // table's without and with clouds; each of them and the sun map's without
   // and with a wind field (the first index). Set layouts all identical.
-  // By wind field, layers drawn (0, 1, more) and lightning.
-  std::array<std::array<std::array<std::optional<ComputePipeline>, 2>, 3>, 2> cloudPipelines_;
+  // By wind field, layers drawn (0, 1, more, more with showers under their
+  // carrier's cells) and lightning; the sun map's by wind field and showers.
+  std::array<std::array<std::array<std::optional<ComputePipeline>, 2>, 4>, 2> cloudPipelines_;
   std::array<std::array<std::optional<ComputePipeline>, 2>, 2> tablePipelines_;
-  std::array<std::optional<ComputePipeline>, 2> sunMapPipelines_;
+  std::array<std::array<std::optional<ComputePipeline>, 2>, 2> sunMapPipelines_;
   vk::raii::Sampler noiseSampler_{nullptr};
   vk::raii::Sampler airTableSampler_{nullptr};
   vk::raii::Sampler weatherSampler_{nullptr};

@@ -51,6 +51,7 @@ class CpuCore : public GlslDouble {
 
 #define SKY_CORE_CONST static constexpr
   static constexpr bool kLightning = true;  // (lightning.glsl: the frame's counts decide)
+  static constexpr bool kShowers = true;    // (cloud_core.glsl: each layer's carrier decides)
   static constexpr bool kWindField = true;  // (cloud_core.glsl's flow: the layer's flow.w decides)
 #define SKY_AIR_TABLE_BUILDER
 #define SKY_SUN_MAP_BUILDER
@@ -104,12 +105,12 @@ class CpuCore : public GlslDouble {
                                     real4(l.cloudMapOrigin, 1.0 / l.cloudMapPeriod_m),
                                     real3(l.coverageShift_m, double(i)), l.shapeStretchZ, l.flow, l.windRef,
                                     real3(0.0), real3(0.0)},
-                      l.absent, l.stepFactor, l.band};
+                      l.absent, l.stepFactor, l.band, l.carrier};
       } else {
         c = CoreLayer{0.0, 0.0, 0.0, 0.0, 1.0, 1.0, false, cumulus, cumulus, real3(0.0), real3(0.0), 0.0,
                       LayerSampling{real4(0.0), real4(0.0), real4(0.0), real3(0.0, 0.0, double(i)), 1.0, real4(0.0),
                                     real4(0.0), real3(0.0), real3(0.0)},
-                      true, 1.0, 0.0};
+                      true, 1.0, 0.0, -1};
       }
     }
     return f;

@@ -11,6 +11,7 @@
 #include "sky/render/ephemeris.hpp"
 #include "sky/render/haze.hpp"
 #include "sky/weather/advection.hpp"
+#include "sky/weather/precipitation.hpp"
 #include "sky/weather/wind_field.hpp"
 
 #include "fresh_edges.hpp"
@@ -68,6 +69,21 @@ glm::dvec3 inFrame(const geo::EnuFrame& f, const geo::Vec3d& v) {
 std::string num(double v) { return std::to_string(v); }
 
 }  // namespace
+
+std::vector<int> precipitationCarriers(std::span<const weather::CloudLayer> layers) {
+  std::vector<int> out(layers.size(), -1);
+  for (std::size_t i = 0; i < layers.size(); ++i) {
+    if (!weather::isPrecipitation(layers[i].type)) continue;
+    const double top_m = layers[i].base_m + layers[i].thickness_m;
+    for (std::size_t j = 0; j < layers.size(); ++j) {
+      const weather::CloudLayer& c = layers[j];
+      if (weather::isPrecipitation(c.type) || c.type == weather::CloudType::Fog) continue;
+      if (!(c.base_m < top_m && top_m <= c.base_m + c.thickness_m)) continue;
+      if (out[i] < 0 || c.base_m < layers[std::size_t(out[i])].base_m) out[i] = int(j);
+    }
+  }
+  return out;
+}
 
 LayerMeans fineRingMeans(const WeatherField& field, std::uint32_t slice) {
   if (slice >= field.sliceCount) return {0.0, 1.0};
@@ -472,6 +488,13 @@ FrameSetup prepareFrame(const RenderSettings& settings, const FrameInputs& in, c
     l.coverageShift_m = field.tiled[slice] ? glm::dvec2(drift.x, drift.y) : glm::dvec2(0.0);
     s.layers.push_back(l);
   }
+  if (settings.march.showersUnderCells) {
+    const std::vector<int> carriers = precipitationCarriers(in.weather->layers);
+    for (std::size_t i = 0; i < s.layers.size(); ++i) {
+      const int c = carriers[i];
+      s.layers[i].carrier = c >= 0 && !s.layers[std::size_t(c)].absent ? c : -1;
+    }
+  }
   return s;
 }
 
@@ -615,12 +638,13 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
     g.secondary = packCloudType(l.secondary);
     g.flow = gpu::vec4(l.flow);
     g.windRef = gpu::vec4(l.windRef);
-    g.band = gpu::vec4(float(l.band), 0.0f, 0.0f, 0.0f);
+    g.band = gpu::vec4(float(l.band), float(l.carrier), 0.0f, 0.0f);
   }
   // Unused slots keep a positive thickness and valid types so the shader's
   // per-layer setup never divides by 0.
   for (std::size_t i = s.layers.size(); i < gpu::kMaxLayers; ++i) {
     f.layers[i].shape = gpu::vec4(1.0f, float(i), 1.0f, 0.0f);
+    f.layers[i].band = gpu::vec4(0.0f, -1.0f, 0.0f, 0.0f);
     f.layers[i].coverageShift.z = 1.0f;
     f.layers[i].coverageShift.w = 1.0f;
     f.layers[i].primary = f.layers[i].secondary = packCloudType(cloudTypeParams(weather::CloudType::Cumulus));

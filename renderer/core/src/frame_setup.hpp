@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include <glm/mat3x3.hpp>
@@ -66,6 +67,9 @@ struct LayerSetup {
   // No coverage anywhere on the weather map (the whole view: the map reaches
   // past the march's 150 km): the layer is not marched and casts no shadow.
   bool absent = false;
+  // A precipitation layer: the index of the layer whose cells drop it (its
+  // shafts fall under them; cloud_core.glsl's carrierFootprint), or -1.
+  int carrier = -1;
 };
 
 // The sun-space map's frame (sun_map.glsl, SunMap): two unit axes across the
@@ -181,6 +185,13 @@ struct LayerMeans {
 // for a slice with no cloud in it. prepareFrame uses it for tiled layers
 // (a uniform layer has its own coverage and density).
 LayerMeans fineRingMeans(const WeatherField& field, std::uint32_t slice);
+
+// Per layer: for a precipitation layer, the index of the layer whose cells
+// drop it, the cloud layer (not fog, not precipitation) whose cloud holds
+// the precipitation's top (METAR's and the console's precipitation reaches
+// a few hundred metres into its carrier; metar_layers.cpp), the lowest of
+// several; -1 for the others and for precipitation from no cloud.
+std::vector<int> precipitationCarriers(std::span<const weather::CloudLayer> layers);
 
 // Pixels along one edge of the image the cloud pass draws: a full edge of
 // `full` pixels over the resolution divisor, rounded up (FrameSetup::width).

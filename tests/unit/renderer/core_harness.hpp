@@ -46,6 +46,7 @@ class Core : public render::GlslDouble {
 #define SKY_CORE_CONST static constexpr
   static constexpr bool kWindField = true;  // (cloud_core.glsl: the layer's flow.w decides)
   static constexpr bool kLightning = true;  // (lightning.glsl: the frame's counts decide)
+  static constexpr bool kShowers = true;    // (cloud_core.glsl: each layer's carrier decides)
 #define SKY_AIR_TABLE_BUILDER
 #define SKY_SUN_MAP_BUILDER
 #include "cloud_core.glsl"
@@ -53,6 +54,9 @@ class Core : public render::GlslDouble {
 #undef SKY_AIR_TABLE_BUILDER
 #undef SKY_CORE_CONST
 
+  // When set, the shape noise of a layer (its sampling's coverageShift.z is
+  // its index) at a camera-relative point, instead of the uniform `noise`.
+  std::function<real2(LayerSampling, real3)> shapeAt;
   CoreLayer layers[kMaxLayers]{};
   // The frame's lightning a test sets (lightning.glsl's hooks).
   std::vector<real4> flashes, boltStarts;
@@ -95,10 +99,10 @@ inline Core::real Core::sampleMaxCoverage(LayerSampling, real3) {
   ++lookups;
   return coverage;
 }
-inline Core::real2 Core::sampleShape(LayerSampling, real3) {
+inline Core::real2 Core::sampleShape(LayerSampling s, real3 p) {
   ++lookups;
   ++shapeLookups;
-  return real2(noise, noise);
+  return shapeAt ? shapeAt(s, p) : real2(noise, noise);
 }
 inline Core::real Core::sampleDetail(LayerSampling, real3) {
   ++lookups;
@@ -182,7 +186,7 @@ inline Core::CoreLayer shellLayer(const Core::CoreFrame& f, double alt, double b
                          0.5 * thickness, false, t, t, Core::real3(0), Core::real3(0), 1.0,
                          Core::LayerSampling{Core::real4(0.0), Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), 1.0,
                                              Core::real4(0.0), Core::real4(0.0), Core::real3(0.0), Core::real3(0.0)},
-                         false, 1.0, 0.0};
+                         false, 1.0, 0.0, -1};
 }
 
 }  // namespace sky::test

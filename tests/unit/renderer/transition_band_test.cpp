@@ -61,8 +61,8 @@ double drawnPresence(const Drawn& d, double a) {
   L.band = s.band;
   const Core::real3 p(0, 0, a - d.cameraAlt_m);
   const double ph = (c.heightAboveCameraSphere(p, f.air.r) + L.hBase) / L.thickness;
-  const double inside = c.cloudSample(L, Core::real3(0, 0, s.thickness_m / 2 + shellBase - d.cameraAlt_m), 0.5, false).rho;
-  return c.cloudSample(L, p, ph, false).rho / inside;
+  const double inside = c.cloudSample(L, Core::real3(0, 0, s.thickness_m / 2 + shellBase - d.cameraAlt_m), 0.5, false, 1.0).rho;
+  return c.cloudSample(L, p, ph, false, 1.0).rho / inside;
 }
 
 TEST(TransitionBand, TheRendererDrawsTheBandWhereTheAnswersFadeIt) {

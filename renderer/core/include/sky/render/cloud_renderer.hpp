@@ -126,6 +126,11 @@ struct MarchSettings {
   // exposure (renderer/core/src/near_precip.hpp); false: only the
   // precipitation's medium (its extinction and light) is drawn there.
   bool nearPrecipitation = true;
+  // A precipitation layer whose top is inside a cloud layer falls only
+  // under that layer's cells (cloud_core.glsl's carrierFootprint: showers
+  // under their cumulus); false: its shafts follow its own noise, falling
+  // from the clear sky between the cells as often as under them.
+  bool showersUnderCells = true;
   // Where along its first step each pixel's samples sit (a fraction of the
   // step, fixed per pixel): false, a white-noise hash of the pixel; true, a
   // 64x64 blue-noise tile repeated over the image (renderer/core/src/blue_noise.hpp),
