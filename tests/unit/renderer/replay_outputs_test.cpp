@@ -1,7 +1,12 @@
 // The headless replay's outputs that need no GPU: which frames a contact sheet
-// shows, how it shrinks them, and the report's percentiles.
+// shows, how it shrinks them, and the report's percentiles; and its input's
+// bound (readFile, which reads a flight file at most kMaxFlightFileBytes).
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+
+#include "sky/app/fallback_weather.hpp"
 #include "sky/app/replay_outputs.hpp"
 
 namespace sky::app {
@@ -64,6 +69,26 @@ TEST(Percentiles, NearestRank) {
   EXPECT_DOUBLE_EQ(p.mean, 50.5);
   EXPECT_EQ(percentiles({}).p50, 0);
   EXPECT_EQ(percentiles({7}).p99, 7);
+}
+
+// A file of exactly the bound is read; one byte more is refused with its
+// name, having read no further than the bound plus one byte.
+TEST(ReadFile, RefusesAFileLargerThanItsBound) {
+  const auto path = std::filesystem::temp_directory_path() / "sky-readfile-bound.csv";
+  std::ofstream(path, std::ios::binary) << "0123456789";
+  const auto exact = readFile(path.string(), 10);
+  ASSERT_TRUE(exact);
+  EXPECT_EQ(*exact, "0123456789");
+  const auto over = readFile(path.string(), 9);
+  ASSERT_FALSE(over);
+  EXPECT_EQ(over.error().code, ErrorCode::TooLarge);
+  EXPECT_NE(over.error().detail.find("sky-readfile-bound.csv: larger than 9 bytes"), std::string::npos)
+      << over.error().detail;
+  // The default, no bound (SIZE_MAX: "bound + 1" must not wrap to a read of 0 bytes, forever).
+  const auto unbounded = readFile(path.string());
+  ASSERT_TRUE(unbounded);
+  EXPECT_EQ(unbounded->size(), 10u);
+  std::filesystem::remove(path);
 }
 
 }  // namespace
