@@ -67,6 +67,8 @@ int main(int argc, char** argv) {
                  "write every answer (wind, temperature, cloud per layer) to this CSV file");
   app.add_option("--icao24", o.read.icao24,
                  "ADS-B .csv holding several aircraft: replay this one (ICAO 24-bit address, hex)");
+  app.add_option("--track", o.read.track,
+                 "KML/KMZ holding several tracks: replay this one, by its name (the error without it lists them)");
   std::string altitudeUnit;
   app.add_option("--altitude-unit", altitudeUnit,
                  "ADS-B .csv: unit of the altitude columns, ft or m (default: as each column's name says)")

@@ -240,6 +240,38 @@ TEST_F(HeadlessReplay, AnAdsbFileWithTwoAircraftNeedsOneChosen) {
   EXPECT_NEAR(f["exposure_s"].get<double>(), 0.004, 1e-12) << "--exposure-ms reaches the frame";
 }
 
+// A KML with two aircraft's tracks: refused with both named, until --track
+// picks one, whose fixes the frames then follow.
+TEST_F(HeadlessReplay, AKmlWithTwoTracksNeedsOneChosen) {
+  const fs::path two = dir_ / "two-tracks.kml";
+  auto track = [](const char* name, double lat) {
+    std::string t = std::string("<Placemark><name>") + name + "</name><gx:Track><altitudeMode>absolute</altitudeMode>";
+    for (int i = 0; i < 5; ++i) t += "<when>2024-03-10T14:00:" + std::to_string(10 + 2 * i) + "Z</when>";
+    for (int i = 0; i < 5; ++i) t += "<gx:coord>" + std::to_string(12.80 + 0.002 * i) + " " + std::to_string(lat) + " 1200</gx:coord>";
+    return t + "</gx:Track></Placemark>\n";
+  };
+  std::ofstream(two) << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+                        "<kml xmlns=\"http://www.opengis.net/kml/2.2\" xmlns:gx=\"http://www.google.com/kml/ext/2.2\">"
+                        "<Document>\n"
+                     << track("DLH400", 46.20) << track("AUA123", 46.30) << "</Document></kml>\n";
+  const std::vector<std::string> file = {"--weather-file", SKY_SCENARIO_CLOUDY, "--no-video", "--replay-end", "4"};
+  const ReplayRun refused = replay(port_, two.string(), dir_ / "k2", file);
+  EXPECT_EQ(refused.exitCode, 2) << refused.log;
+  EXPECT_NE(refused.log.find("DLH400"), std::string::npos) << refused.log;
+  EXPECT_NE(refused.log.find("AUA123"), std::string::npos) << refused.log;
+  std::vector<std::string> chosen = file;
+  chosen.insert(chosen.end(), {"--track", "AUA123"});
+  const ReplayRun one = replay(port_, two.string(), dir_ / "k1", chosen);
+  ASSERT_EQ(one.exitCode, 0) << one.log;
+  std::ifstream jsonl(dir_ / "k1" / "frames" / "frames.jsonl");
+  std::string line;
+  ASSERT_TRUE(std::getline(jsonl, line));
+  const auto f = nlohmann::json::parse(line);
+  EXPECT_NEAR(f["lat_deg"].get<double>(), 46.30, 1e-9) << "AUA123's first fix";
+  EXPECT_NEAR(f["lon_deg"].get<double>(), 12.80, 1e-9);
+  EXPECT_NEAR(f["alt_m"].get<double>(), 1200.0, 1e-6);
+}
+
 // Without a server: the weather of a scenario file, the same in every run.
 TEST_F(HeadlessReplay, WeatherFileWithoutAServer) {
   // The fixture's server is stopped first: nothing answers on its port.

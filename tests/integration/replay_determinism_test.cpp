@@ -151,5 +151,27 @@ TEST(ReplayInfo, SaysWhatTheFileHoldsWithoutReplaying) {
   EXPECT_NE(out.find("lat 46.20000 to 49.20000 deg"), std::string::npos) << out;
 }
 
+// A KML with two tracks: --track picks the one --info describes; without it
+// the error names both.
+TEST(ReplayInfo, ATrackOfAKmlIsChosenByName) {
+  const fs::path dir = outputDir();
+  const fs::path kml = dir / "two.kml";
+  auto track = [](const char* name, double lat) {
+    std::string t = std::string("<Placemark><name>") + name + "</name><gx:Track>";
+    for (int i = 0; i < 3; ++i) t += "<when>2024-03-10T14:00:0" + std::to_string(2 * i) + "Z</when>";
+    for (int i = 0; i < 3; ++i) t += "<gx:coord>12.8 " + std::to_string(lat + 0.001 * i) + " 900</gx:coord>";
+    return t + "</gx:Track></Placemark>";
+  };
+  std::ofstream(kml) << "<kml xmlns=\"http://www.opengis.net/kml/2.2\" xmlns:gx=\"http://www.google.com/kml/ext/2.2\">"
+                        "<Document><altitudeMode>absolute</altitudeMode>"
+                     << track("ONE", 46.0) << track("TWO", 47.0) << "</Document></kml>\n";
+  std::string out;
+  EXPECT_NE(run({SKY_REPLAY, "--info", kml.string()}, dir / "both.log", &out), 0) << out;
+  EXPECT_NE(out.find("ONE"), std::string::npos) << out;
+  EXPECT_NE(out.find("TWO"), std::string::npos) << out;
+  ASSERT_EQ(run({SKY_REPLAY, "--info", "--track", "TWO", kml.string()}, dir / "two.log", &out), 0) << out;
+  EXPECT_NE(out.find("lat 47.00000 to 47.00200 deg"), std::string::npos) << out;
+}
+
 }  // namespace
 }  // namespace sky::test

@@ -89,7 +89,7 @@ struct Options {
   double replayStart_s = 0;
   double replayEnd_s = -1;
   double replayWeatherClock_s = std::numeric_limits<double>::quiet_NaN();
-  sky::flight::ReadOptions replayRead;  // --icao24, --altitude-unit (ADS-B files)
+  sky::flight::ReadOptions replayRead;  // --icao24, --altitude-unit (ADS-B files), --track (KML/KMZ)
   double exposure_ms = 1000.0 * sky::render::kDefaultExposure_s;
   std::string replayAltitudeUnit;
   bool noClean = false;                   // --no-clean
@@ -226,6 +226,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.1, 1000.0));
   app.add_option("--icao24", o.replayRead.icao24,
                  "with --replay of an ADS-B .csv holding several aircraft: this one (ICAO 24-bit address, hex)");
+  app.add_option("--track", o.replayRead.track,
+                 "with --replay of a KML/KMZ holding several tracks: this one, by its name (the error without it "
+                 "lists them)");
   app.add_option("--altitude-unit", o.replayAltitudeUnit,
                  "with --replay of an ADS-B .csv: unit of its altitude columns, ft or m (default: as each column's "
                  "name says)")
