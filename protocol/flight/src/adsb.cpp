@@ -23,15 +23,12 @@ namespace {
 using detail::printable;
 using detail::WarningKind;
 
-constexpr double kMetresPerFoot = 0.3048;  // international foot, exact
-// Barometric altitude: the domain of the standard atmosphere's pressure
-// (isaPressure_hpa, -1 to 20 km); geometric: from the Dead Sea to where
-// balloons still report, well past any aircraft.
-constexpr double kMinBaroAltitude_m = -1000.0, kMaxBaroAltitude_m = 20000.0;
-constexpr double kMinGeoAltitude_m = -1000.0, kMaxGeoAltitude_m = 100000.0;
-// Unix seconds up to the year 5138: beyond any recording, and small enough
-// that the whole second fits an int64 exactly.
-constexpr double kMaxUnixTime_s = 1.0e11;
+using detail::kMaxBaroAltitude_m;
+using detail::kMaxGeoAltitude_m;
+using detail::kMaxUnixTime_s;
+using detail::kMetresPerFoot;
+using detail::kMinBaroAltitude_m;
+using detail::kMinGeoAltitude_m;
 // ICAO 24-bit address: at most six hex digits.
 constexpr std::size_t kMaxIcao24Digits = 6;
 // A callsign is at most 8 characters (ICAO Doc 4444); longer is kept, cut.

@@ -21,10 +21,9 @@ namespace {
 using detail::printable;
 using detail::WarningKind;
 
-constexpr double kMetresPerFoot = 0.3048;  // international foot, exact
-// The same range as the ADS-B reader's geometric altitude: the Dead Sea to
-// where balloons still report.
-constexpr double kMinAlt_m = -1000.0, kMaxAlt_m = 100000.0;
+using detail::kMetresPerFoot;
+// The ADS-B reader's range of geometric altitude.
+constexpr double kMinAlt_m = detail::kMinGeoAltitude_m, kMaxAlt_m = detail::kMaxGeoAltitude_m;
 constexpr double kSecondsPerDay = 86400.0;
 // A row's time of day falling back by more than this is a crossing of
 // midnight UTC (as in IGC): a day is added.

@@ -12,6 +12,7 @@
 #include <expat.h>
 
 #include "reader_common.hpp"
+#include "xml_document.hpp"
 #include "sky/flight/flight.hpp"
 #include "sky/flight/utf8_text.hpp"
 
@@ -26,8 +27,6 @@ using detail::printable;
 // A number or timestamp is never longer; longer text is kept only this far,
 // so a huge text node cannot grow a buffer (and still fails to parse).
 constexpr std::size_t kMaxValueChars = 64;
-// expat takes int lengths: feed large documents in slices.
-constexpr std::size_t kChunkBytes = std::size_t{1} << 24;
 
 // Same bounds as the CSV reader: below the Dead Sea shore, above any balloon.
 constexpr double kMinEle_m = -1000.0, kMaxEle_m = 1.0e6;
@@ -163,32 +162,19 @@ class GpxReader {
   std::string* text_ = nullptr;  // where character data goes (inside <ele>/<time>)
 };
 
-struct ParserFree {
-  void operator()(XML_Parser p) const { XML_ParserFree(p); }
-};
-
 }  // namespace
 
 Result<ParsedFlight> parseGpx(std::string_view text, std::string_view sourceName) {
   const std::string src = messageText(sourceName);
-  const std::unique_ptr<XML_ParserStruct, ParserFree> parser(XML_ParserCreate(nullptr));
+  const detail::XmlParser parser(XML_ParserCreate(nullptr));
   if (!parser) return fail(ErrorCode::Io, src + ": cannot create an XML parser (out of memory)");
   GpxReader reader(parser.get(), sourceName);
   XML_SetUserData(parser.get(), &reader);
   XML_SetElementHandler(parser.get(), &GpxReader::onStart, &GpxReader::onEnd);
   XML_SetCharacterDataHandler(parser.get(), &GpxReader::onText);
 
-  std::size_t pos = 0;
-  do {
-    const std::size_t n = std::min(kChunkBytes, text.size() - pos);
-    const bool last = pos + n == text.size();
-    if (XML_Parse(parser.get(), text.data() + pos, static_cast<int>(n), last) != XML_STATUS_OK) {
-      if (reader.error) return tl::unexpected(*reader.error);
-      return fail(ErrorCode::Malformed, src + ":" + std::to_string(XML_GetCurrentLineNumber(parser.get())) +
-                                            ": XML: " + XML_ErrorString(XML_GetErrorCode(parser.get())));
-    }
-    pos += n;
-  } while (pos < text.size());
+  if (auto parsed = detail::parseXmlText(parser.get(), text, src, reader.error); !parsed)
+    return tl::unexpected(parsed.error());
 
   if (reader.kept.size() < 2)
     return fail(ErrorCode::Malformed, src + ": " + std::to_string(reader.kept.size()) +

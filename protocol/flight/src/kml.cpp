@@ -14,6 +14,7 @@
 #include <expat.h>
 
 #include "reader_common.hpp"
+#include "xml_document.hpp"
 #include "sky/flight/flight.hpp"
 #include "sky/flight/utf8_text.hpp"
 #include "zip.hpp"
@@ -33,8 +34,6 @@ constexpr std::size_t kMaxValueChars = 128;
 constexpr std::size_t kMaxNameChars = 80;
 // Tracks listed by name in the "several tracks" error; the rest counted.
 constexpr std::size_t kMaxListedTracks = 20;
-// expat takes int lengths: feed large documents in slices.
-constexpr std::size_t kChunkBytes = std::size_t{1} << 24;
 // Same bounds as GPX: below the Dead Sea shore, above any balloon.
 constexpr double kMinAlt_m = -1000.0, kMaxAlt_m = 1.0e6;
 
@@ -330,10 +329,6 @@ class KmlReader {
   std::size_t textCap_ = 0;
 };
 
-struct ParserFree {
-  void operator()(XML_Parser p) const { XML_ParserFree(p); }
-};
-
 std::string listTracks(const std::vector<const Track*>& tracks) {
   std::string out;
   for (std::size_t i = 0; i < tracks.size() && i < kMaxListedTracks; ++i)
@@ -350,23 +345,14 @@ Result<ParsedFlight> parseKml(std::string_view text, std::string_view sourceName
   if (text.size() > kMaxKmlBytes)
     return fail(ErrorCode::TooLarge, src + ": " + std::to_string(text.size()) + " bytes, at most " +
                                          std::to_string(kMaxKmlBytes) + " read");
-  const std::unique_ptr<XML_ParserStruct, ParserFree> parser(XML_ParserCreate(nullptr));
+  const detail::XmlParser parser(XML_ParserCreate(nullptr));
   if (!parser) return fail(ErrorCode::Io, src + ": cannot create an XML parser (out of memory)");
   KmlReader reader(parser.get(), sourceName);
   XML_SetUserData(parser.get(), &reader);
   XML_SetElementHandler(parser.get(), &KmlReader::onStart, &KmlReader::onEnd);
   XML_SetCharacterDataHandler(parser.get(), &KmlReader::onText);
-  std::size_t pos = 0;
-  do {
-    const std::size_t n = std::min(kChunkBytes, text.size() - pos);
-    const bool last = pos + n == text.size();
-    if (XML_Parse(parser.get(), text.data() + pos, static_cast<int>(n), last) != XML_STATUS_OK) {
-      if (reader.error) return tl::unexpected(*reader.error);
-      return fail(ErrorCode::Malformed, src + ":" + std::to_string(XML_GetCurrentLineNumber(parser.get())) +
-                                            ": XML: " + XML_ErrorString(XML_GetErrorCode(parser.get())));
-    }
-    pos += n;
-  } while (pos < text.size());
+  if (auto parsed = detail::parseXmlText(parser.get(), text, src, reader.error); !parsed)
+    return tl::unexpected(parsed.error());
 
   std::vector<const Track*> candidates;
   for (const Track& t : reader.tracks)

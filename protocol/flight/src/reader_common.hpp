@@ -24,6 +24,17 @@ constexpr std::string_view sub(std::string_view s, std::size_t pos, std::size_t 
   return pos > s.size() ? std::string_view() : s.substr(pos, n);
 }
 
+inline constexpr double kMetresPerFoot = 0.3048;  // international foot, exact
+// Altitudes the ADS-B, readsb and FDR readers accept. Barometric: the
+// domain of the standard atmosphere's pressure (isaPressure_hpa, -1 to
+// 20 km); geometric: from the Dead Sea to where balloons still report, well
+// past any aircraft.
+inline constexpr double kMinBaroAltitude_m = -1000.0, kMaxBaroAltitude_m = 20000.0;
+inline constexpr double kMinGeoAltitude_m = -1000.0, kMaxGeoAltitude_m = 100000.0;
+// Unix seconds up to the year 5138: beyond any recording, and small enough
+// that the whole second fits an int64 exactly.
+inline constexpr double kMaxUnixTime_s = 1.0e11;
+
 // Most digits digitsValue reads: 18 always fit a long long.
 constexpr std::size_t kMaxValueDigits = 18;
 

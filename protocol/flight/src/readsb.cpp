@@ -23,14 +23,12 @@ using detail::printable;
 using detail::WarningKind;
 using nlohmann::json;
 
-constexpr double kMetresPerFoot = 0.3048;  // international foot, exact
-// The same ranges as the ADS-B CSV reader: the standard atmosphere's -1 to
-// 20 km for pressure altitude; the Dead Sea to balloons for geometric.
-constexpr double kMinBaroAltitude_m = -1000.0, kMaxBaroAltitude_m = 20000.0;
-constexpr double kMinGeoAltitude_m = -1000.0, kMaxGeoAltitude_m = 100000.0;
-// Unix seconds up to the year 5138 (as the ADS-B reader): the whole second
-// fits an int64 exactly. A row's offset is within a day or so of the base.
-constexpr double kMaxUnixTime_s = 1.0e11;
+using detail::kMaxBaroAltitude_m;
+using detail::kMaxGeoAltitude_m;
+using detail::kMaxUnixTime_s;
+using detail::kMetresPerFoot;
+using detail::kMinBaroAltitude_m;
+using detail::kMinGeoAltitude_m;
 constexpr double kMaxOffset_s = 1.0e7;
 
 // Columns of a trace row (readsb README-json.md, "trace"):
