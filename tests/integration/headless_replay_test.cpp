@@ -231,6 +231,9 @@ TEST_F(HeadlessReplay, AnAdsbFileWithTwoAircraftNeedsOneChosen) {
   const ReplayRun one = replay(port_, two, dir_ / "one", chosen);
   ASSERT_EQ(one.exitCode, 0) << one.log;
   EXPECT_NE(one.log.find("altitude:"), std::string::npos) << "the altitude's source is said\n" << one.log;
+  const auto report = nlohmann::json::parse(readAll(dir_ / "one" / "report.json"));
+  ASSERT_TRUE(report["altitude_source"].is_string()) << report.dump(2);
+  EXPECT_NE(report["altitude_source"].get<std::string>().find("geometric"), std::string::npos) << report.dump(2);
   std::ifstream jsonl(dir_ / "one" / "frames" / "frames.jsonl");
   std::string line;
   ASSERT_TRUE(std::getline(jsonl, line));

@@ -430,7 +430,8 @@ Result<ParsedFlight> parseAdsbCsv(std::string_view text, std::string_view source
               unitName(h[Role::Baro]->toMetres) + ") to geometric by the ICAO standard atmosphere for " +
               fixes(flight.barometricAltitudeFixes);
   flight.altitudeSource = std::move(source);
-  deriveAttitude(flight);
+  flight.attitudeRateWindow_s = kAdsbRateWindow_s;
+  deriveAttitude(flight, flight.attitudeRateWindow_s);
   flight.attitudeFromTrack = true;
   if (kept) {
     const Aircraft& a = aircraft[*kept];

@@ -22,19 +22,20 @@ constexpr double kGravity_mps2 = 9.80665;
 // per-second heading jitter by several degrees; a thermalling turn takes
 // 20-30 s, so averaging over 5 s keeps the turn and removes the jitter.
 constexpr double kSmoothingWindow_s = 5.0;
-// Width of the centred windows the turn rate and the climb rate are fitted
-// over (weighted least-squares slope of the heading and of the altitude),
-// and the speed averaged over. Bank is a second derivative of position:
-// from 1 Hz ADS-B (10 m of position noise, positions up to 0.5 s older or
-// newer than their row, 25 ft altitude steps; attitude_noise_test.cpp) a 5 s
-// window left the derived bank jumping by up to 12 deg/s on a straight line
-// and 11 deg off a standard-rate turn's; with 20 s it still changed by up to
-// 0.76 deg/s; with 30 s by 0.3 deg/s, and stays within 0.7 deg of the turn's
-// closed form. A steady turn's heading is linear in time, so its slope is
-// exact at any width; what the width costs is a roll-in spread over ~30 s
-// instead of the 5-10 s an airliner or a glider takes, and wobbles within a
-// thermalling circle (20-30 s) smoothed away.
-constexpr double kRateWindow_s = 30.0;
+// The rate windows (flight.hpp's kLoggerRateWindow_s, kAdsbRateWindow_s):
+// the turn rate and the climb rate are a weighted least-squares slope of the
+// heading and of the altitude over them, and the speed their average. Bank
+// is a second derivative of position: from 1 Hz ADS-B (10 m of position
+// noise, positions up to 0.5 s older or newer than their row, 25 ft
+// altitude steps; attitude_noise_test.cpp) a 5 s window left the derived
+// bank jumping by up to 12 deg/s on a straight line and 11 deg off a
+// standard-rate turn's; with 20 s it still changed by up to 0.76 deg/s; with
+// 30 s by 0.3 deg/s, and stays within 0.7 deg of the turn's closed form. A
+// steady turn's heading is linear in time, so its slope is exact at any
+// width; what the width costs is a roll-in spread over it instead of the
+// 5-10 s an airliner or a glider takes, and wobbles within a thermalling
+// circle (20-30 s) smoothed away: a logger's track, far less noisy, keeps
+// 10 s.
 // A stationary GNSS logger wanders by a few metres over seconds (up to about
 // 1 m/s); nothing we replay flies slower than 5 m/s. Below this the heading
 // is held and pitch and bank are 0.
@@ -110,7 +111,7 @@ std::vector<double> slope(const std::vector<double>& v, const std::vector<Fix>& 
 
 }  // namespace
 
-void deriveAttitude(Flight& flight) {
+void deriveAttitude(Flight& flight, double rateWindow_s) {
   auto& fx = flight.fixes;
   const std::size_t n = fx.size();
   SKY_ASSERT(n >= 2);
@@ -153,10 +154,10 @@ void deriveAttitude(Flight& flight) {
 
   // Moving or not by the short window; the values by the long ones.
   const std::vector<double> speedS = smooth(speed, fx, seg, kSmoothingWindow_s);
-  const std::vector<double> speedL = smooth(speed, fx, seg, kRateWindow_s);
+  const std::vector<double> speedL = smooth(speed, fx, seg, rateWindow_s);
   std::vector<double> alt(n);
   for (std::size_t i = 0; i < n; ++i) alt[i] = fx[i].pose.position.alt_m;
-  const std::vector<double> climbL = slope(alt, fx, seg, kRateWindow_s, climb);
+  const std::vector<double> climbL = slope(alt, fx, seg, rateWindow_s, climb);
   const std::vector<double> headingS = smooth(heading, fx, seg, kSmoothingWindow_s);
   std::vector<double> turn(n, 0);  // central differences, for the ends
   for (std::size_t i = 0; i < n; ++i) {
@@ -164,7 +165,7 @@ void deriveAttitude(Flight& flight) {
     const std::size_t a = i > seg.first[s] ? i - 1 : i, b = i < seg.last[s] ? i + 1 : i;
     if (a != b) turn[i] = (heading[b] - heading[a]) / (fx[b].time_s - fx[a].time_s);
   }
-  const std::vector<double> turnRate_degps = slope(heading, fx, seg, kRateWindow_s, turn);
+  const std::vector<double> turnRate_degps = slope(heading, fx, seg, rateWindow_s, turn);
 
   std::vector<double> bank(n, 0);
   for (std::size_t i = 0; i < n; ++i) {

@@ -324,7 +324,7 @@ Result<CleanReport> clean(ParsedFlight& flight, const CleanOptions& options, std
     flight.fixLines.push_back(pts[i].line);
   }
   if (flight.attitudeFromTrack && kept.size() < n) {
-    deriveAttitude(flight);
+    deriveAttitude(flight, flight.attitudeRateWindow_s);
     report.attitudeRederived = true;
   }
   for (std::size_t h = holdBefore.size(); h-- > 0;) {

@@ -405,7 +405,8 @@ Result<ParsedFlight> parseKml(std::string_view text, std::string_view sourceName
     flight.fixes.push_back(Fix{p.utc_s - start_s, {p.position, 0, 0, 0}});
     flight.fixLines.push_back(p.line);
   }
-  deriveAttitude(flight);
+  flight.attitudeRateWindow_s = kAdsbRateWindow_s;
+  deriveAttitude(flight, flight.attitudeRateWindow_s);
   flight.attitudeFromTrack = true;
   flight.aircraft = "track '" + messageText(chosen->name, kMaxNameChars) + "'";
   flight.warnings = warnings.finish();

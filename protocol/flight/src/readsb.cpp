@@ -234,7 +234,8 @@ Result<ParsedFlight> parseReadsbTrace(std::string_view bytes, std::string_view s
               std::string("barometric ('alt_baro', ft) to geometric by the ICAO standard atmosphere for ") +
               fixes(flight.barometricAltitudeFixes);
   flight.altitudeSource = std::move(source);
-  deriveAttitude(flight);
+  flight.attitudeRateWindow_s = kAdsbRateWindow_s;
+  deriveAttitude(flight, flight.attitudeRateWindow_s);
   flight.attitudeFromTrack = true;
   if (!icao.empty()) flight.aircraft = "icao24 " + icao;
   if (const auto r = doc.find("r"); r != doc.end() && r->is_string())

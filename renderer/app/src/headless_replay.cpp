@@ -402,6 +402,11 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     report["weather_clock_pin"] = pin;
   }
   report["cleaning"] = cleaningJson(cleaning ? &*cleaning : nullptr, o.cleanOptions);
+  // Where the altitudes came from, where the format has more than one kind
+  // (ADS-B, readsb: geometric or barometric through the standard atmosphere);
+  // null where the file has one kind, taken as written.
+  report["altitude_source"] = flight->altitudeSource.empty() ? nlohmann::json(nullptr)
+                                                              : nlohmann::json(flight->altitudeSource);
   report["weather_versions_seen"] = versionsSeen;
   report["non_finite_pixels"] = nonFinite;
   if (o.display) report["frames_presented"] = o.display->presented();

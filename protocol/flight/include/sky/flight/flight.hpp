@@ -32,6 +32,15 @@ struct Flight {
   double duration_s() const { return fixes.empty() ? 0 : fixes.back().time_s - fixes.front().time_s; }
 };
 
+// Widths of the centred windows deriveAttitude fits the turn and climb rates
+// over (attitude.cpp says why). A logger's own track (IGC, GPX, X-Plane's
+// DATA rows): fixes on time and a few metres apart, so a turn's roll-in
+// stays within a few seconds. An ADS-B track (ADS-B CSV, readsb, flight
+// trackers' KML): 10 m of position noise and positions up to 0.5 s off
+// their time stamps, which a narrower window turns into a shaking bank.
+inline constexpr double kLoggerRateWindow_s = 10.0;
+inline constexpr double kAdsbRateWindow_s = 30.0;
+
 // What a reader returns: the flight plus what it chose to skip or assume,
 // one human line each ("a.igc:37: field 'validity': 'V' ... fix skipped").
 // It is a Flight (public base) so that code wanting only the fixes can take it
@@ -51,6 +60,9 @@ struct ParsedFlight : Flight {
   // Whether deriveAttitude filled the attitude (the file records none), so
   // that the cleaning derives it again from the fixes it keeps.
   bool attitudeFromTrack = false;
+  // The rate window deriveAttitude took for this format, which the cleaning
+  // takes again.
+  double attitudeRateWindow_s = kLoggerRateWindow_s;
   // Who flew it, when the file says ("icao24 3c6444, callsign DLH9U"), for
   // skyshell-replay --info; empty otherwise.
   std::string aircraft;
@@ -347,13 +359,15 @@ Result<ParsedFlight> parseFlight(std::string_view text, std::string_view sourceN
 //  * pitch: climb angle atan2(climb rate, ground speed);
 //  * roll: bank of a coordinated turn atan(v * omega / g) from the turn rate;
 // the climb and turn rates fitted (weighted least squares) and the speed
-// averaged over a centred 30 s window, so that noisy ADS-B does not shake
-// the camera; yaw and roll then smoothed by a centred 5 s moving average
+// averaged over a centred window of rateWindow_s (kAdsbRateWindow_s for
+// ADS-B tracks, so that their noise does not shake the camera; a steady
+// turn's rate is exact at any width, a roll-in is spread over the width);
+// yaw and roll then smoothed by a centred 5 s moving average
 // (angles unwrapped first) and clamped to the limits in attitude.cpp.
 // Differences never span a gap of more than kGapWarning_s. Below a ground
 // speed of 2 m/s the heading is held.
 // Needs fixes.size() >= 2 (a precondition, asserted).
-void deriveAttitude(Flight& flight);
+void deriveAttitude(Flight& flight, double rateWindow_s = kLoggerRateWindow_s);
 
 // Days from 1970-01-01 to the proleptic Gregorian date y-m-d (negative
 // before), month in [1, 12], day in [1, 31]. H. Hinnant, "chrono-Compatible
