@@ -1,10 +1,15 @@
-// The frame budget with the real renderer (renderer/core/src/frame_budget.cpp):
-// over a replayed camera path, a budget set between two levels' measured
-// times holds the frames near it, at the most accurate level that fits.
-#include <algorithm>
-#include <chrono>
+// The frame budget with the real renderer over a replayed camera path
+// (renderer/core/src/frame_budget.cpp): every frame is drawn at the level
+// the controller picked, and the controller is told the time that level
+// took on this path as recorded, times the machine's speed of the moment,
+// not the frame's wall-clock time, so what it picks does not depend on the
+// machine's other load. That the frames then hold within 20 % of the budget
+// in real time is a speed claim, measured by tests/bench/frame_budget_bench.cpp
+// (sky_frame_budget_bench), never asserted by a test.
+#include <array>
+#include <cmath>
 #include <cstdio>
-#include <map>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -16,13 +21,30 @@
 namespace sky::test {
 namespace {
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+// Each level of high's ladder on the path below at 320x180, ms: the medians
+// of 8 round-robin frames recorded with
+//   LP_NUM_THREADS=1 sky_frame_budget_bench --width 320 --height 180
+// (Release, 2-core AMD EPYC VM, lavapipe, 2026-12-05). Their shape is this
+// path's, not the ladder's (measured on the bench's still scenes): the
+// controller learns the machine's speed from frames, through the ladder.
+constexpr std::array<double, 5> kRecordedLevel_ms = {175.19, 144.88, 124.34, 109.38, 108.27};
+
+// The machine's speed over the replay, a phase of kPhaseFrames frames each:
+// as recorded, then 1.3x slower (CI has run at up to 1.46x a calibration's
+// times: then no level fits), then faster (the preset's own level fits),
+// then as recorded again.
+constexpr std::array<double, 4> kSpeeds = {1.0, 1.3, 0.75, 1.0};
+constexpr std::size_t kPhaseFrames = 25;
+// Frames a phase is given to settle before its frames are checked: the
+// controller's mean speed follows a change with weight 1/4 a frame.
+constexpr std::size_t kSettleFrames = 10;
+// Frame-to-frame noise on the recorded times, alternately up and down: more
+// than the controller's 5 % margin for moving to a dearer level would let
+// two levels alternate, so 3 %.
+constexpr double kNoise = 0.03;
 
 // The replayed path: east at 800 m under half-covered cumulus, turning 3
-// degrees a frame, looking 12 degrees up.
+// degrees a frame, looking 12 degrees up (the bench's path).
 render::FrameInputs pathFrame(const weather::WeatherSnapshot& snap, std::uint64_t i) {
   render::FrameInputs in;
   in.camera = pose(46.0, 13.0 + 2e-4 * double(i), 800, 30 + 3.0 * double(i), 12);
@@ -32,135 +54,105 @@ render::FrameInputs pathFrame(const weather::WeatherSnapshot& snap, std::uint64_
   return in;
 }
 
-double timedFrame(render::CloudRenderer& r, const render::FrameInputs& in) {
-  const auto t0 = std::chrono::steady_clock::now();
-  auto image = r.render(in);
-  EXPECT_TRUE(image) << describe(image.error());
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+// The most accurate level whose recorded time at `speed` fits budgetMs,
+// else the cheapest.
+std::size_t fitting(double speed, double budgetMs) {
+  for (std::size_t level = 0; level < kRecordedLevel_ms.size(); ++level)
+    if (speed * kRecordedLevel_ms[level] <= budgetMs) return level;
+  return kRecordedLevel_ms.size() - 1;
 }
 
-// Each level's frame time over `rounds` rounds, round-robin (the first
-// round also builds what each level needs and is not counted), so the
-// machine's drift falls on all levels alike: the median per level, and in
-// `fastest` the fastest (the machine's other load only adds time, so the
-// fastest frames give the levels' own relative costs best).
-std::vector<double> levelTimes(render::CloudRenderer& r, const std::vector<render::BudgetLevel>& ladder,
-                               const weather::WeatherSnapshot& snap, std::uint64_t rounds,
-                               std::vector<double>* fastest) {
-  std::vector<std::vector<double>> ms(ladder.size());
-  for (std::uint64_t round = 0; round < rounds; ++round)
-    for (std::size_t level = 0; level < ladder.size(); ++level) {
-      EXPECT_TRUE(r.setMarch(ladder[level].march));
-      const double t = timedFrame(r, pathFrame(snap, round));
-      if (round > 0) ms[level].push_back(t);
-    }
-  std::vector<double> out;
-  fastest->clear();
-  for (auto& m : ms) {
-    out.push_back(median(m));
-    fastest->push_back(*std::min_element(m.begin(), m.end()));
-  }
-  return out;
+bool allFinite(const render::Image& image) {
+  for (float v : image.rgba)
+    if (!std::isfinite(v)) return false;
+  return true;
 }
 
-// The most accurate level whose time fits the budget, else the cheapest.
-std::size_t bestFitting(const std::vector<double>& levelMs, double budgetMs) {
-  for (std::size_t level = 0; level < levelMs.size(); ++level)
-    if (levelMs[level] <= budgetMs) return level;
-  return levelMs.size() - 1;
-}
-
-// `high` at 320x180: every level's time on the path's first frames (8 each,
-// again up to three times, until level 3 is faster than level 1, 20 % apart on
-// the bench); the budget halfway between levels 1 and 3; then 40 frames
-// under the budget. This machine is shared and its speed drifts by a third
-// within a minute (CI once measured level 4 at 85 ms where the calibration
-// had put level 3 at 66), so the test does not assume the calibration still
-// holds while the budget runs: after each budgeted frame it draws a probe
-// frame at a fixed level, and the probes' median over the calibrated time of
-// that level (fitted from every level's, below) scales every level's time to
-// the machine's speed during the run.
-// After 10 frames to settle, the level the frames are drawn at most is the
-// most accurate one that fits at that speed or a neighbour (two neighbouring
-// levels are 5-10 % apart, less than the noise of separate measurement), and
-// the median frame fits (5 % over at most), or, when no level fits at that
-// speed, is within 5 % of the cheapest level's time.
-// The calibration also checks the ladder's relative costs, which the bench
-// measured on its scenes, against this renderer on this path (20 %), from
-// each level's fastest of 8 frames: a burst of the machine's other load
-// during one level's frames can move a median ratio past that.
+// The budget halfway between levels 1 and 3's recorded times. In each phase,
+// after it settles, every frame is drawn at the most accurate level that
+// fits at that phase's speed (a dearer one only when it fits with the
+// controller's 5 % to spare), and its time fits the budget unless no level
+// does, and stays there (two levels next to the budget do not alternate).
+// A slower machine moves it to a cheaper level within two frames, but no
+// cheaper than the level that fits with 5 % to spare; a faster
+// one back within the phase's settling. Each level's march renders (finite
+// pixels), and level 0 and the cheapest draw different images: the march
+// the controller picks is the one drawn.
 TEST(FrameBudget, HoldsABudgetBetweenTwoLevelsOverAReplay) {
   SKY_RENDERER(shared, 64, 36);  // keeps the driver loaded (renderer_fixture.hpp)
   (void)shared;
   auto preset = render::findPreset("high");
   ASSERT_TRUE(preset);
+  auto ladder = render::budgetLadder(*preset);
+  ASSERT_TRUE(ladder);
+  ASSERT_EQ(ladder->size(), kRecordedLevel_ms.size()) << "record the levels' times again (see kRecordedLevel_ms)";
+  // The times are recorded; the images only need to be drawn: 64x36.
   render::RenderSettings settings;
-  settings.width = 320;
-  settings.height = 180;
+  settings.width = 64;
+  settings.height = 36;
   settings.march = preset->march;
   auto r = render::CloudRenderer::create(settings);
   ASSERT_TRUE(r) << describe(r.error());
-  auto ladder = render::budgetLadder(*preset);
-  ASSERT_TRUE(ladder);
-  ASSERT_GE(ladder->size(), 4u);
   weather::WeatherSnapshot snap;
   snap.layers.push_back(layer(1, 1500, 1000, 0.5, 1.0));
 
-  std::vector<double> levelMs, fastestMs;
-  for (int attempt = 0; attempt < 3 && !(levelMs.size() > 3 && levelMs[3] < levelMs[1]); ++attempt)
-    levelMs = levelTimes(**r, *ladder, snap, 9, &fastestMs);
+  const double budgetMs = 0.5 * (kRecordedLevel_ms[1] + kRecordedLevel_ms[3]);
   const std::size_t cheapest = ladder->size() - 1;
-  const double budgetMs = 0.5 * (levelMs[1] + levelMs[3]);
-  std::printf("[ budget   ] levels 0-%zu:", cheapest);
-  for (double ms : levelMs) std::printf(" %.1f", ms);
-  std::printf(" ms; budget %.1f ms, level %zu fits\n", budgetMs, bestFitting(levelMs, budgetMs));
-  ASSERT_LT(levelMs[3], levelMs[1]) << "the ladder's levels must differ in time for the test to mean anything";
-  for (std::size_t level = 1; level < ladder->size(); ++level)
-    EXPECT_NEAR(fastestMs[level] / fastestMs[0], (*ladder)[level].relativeCost, 0.2 * (*ladder)[level].relativeCost)
-        << "level " << level << ": the bench's relative cost does not hold on this path";
-
-  constexpr std::size_t kProbe = 2;
+  ASSERT_EQ(fitting(1.0, budgetMs), 2u) << "the recorded times must put one level between 1 and 3";
   render::FrameBudget budget(budgetMs, *ladder);
-  std::vector<double> held, probes;
-  std::map<std::size_t, int> levels;
-  for (std::uint64_t i = 0; i < 40; ++i) {
-    ASSERT_TRUE((*r)->setMarch(budget.current().march));
-    const std::size_t drawnAt = budget.level();
-    const double ms = timedFrame(**r, pathFrame(snap, i));
-    budget.update(ms);
-    ASSERT_TRUE((*r)->setMarch((*ladder)[kProbe].march));
-    const double probe = timedFrame(**r, pathFrame(snap, i));
-    if (i >= 10) {
-      held.push_back(ms);
-      probes.push_back(probe);
-      ++levels[drawnAt];
+  std::vector<std::size_t> drawnAt;
+  for (std::size_t phase = 0; phase < kSpeeds.size(); ++phase) {
+    const double speed = kSpeeds[phase];
+    const std::size_t best = fitting(speed, budgetMs), bestWithSpare = fitting(speed, 0.95 * budgetMs);
+    std::printf("[ budget   ] phase %zu: %.2fx the recorded times, budget %.2f ms, level %zu fits (%zu with 5 %% to "
+                "spare):",
+                phase, speed, budgetMs, best, bestWithSpare);
+    for (std::size_t k = 0; k < kPhaseFrames; ++k) {
+      const std::uint64_t i = phase * kPhaseFrames + k;
+      const std::size_t level = budget.level();
+      drawnAt.push_back(level);
+      std::printf(" %zu", level);
+      ASSERT_TRUE((*r)->setMarch(budget.current().march)) << (*ladder)[level].name;
+      auto image = (*r)->render(pathFrame(snap, i));
+      ASSERT_TRUE(image) << describe(image.error());
+      EXPECT_TRUE(allFinite(*image)) << "frame " << i << " at " << (*ladder)[level].name;
+      const double noise = i % 2 ? 1 + kNoise : 1 - kNoise;
+      const std::size_t next = budget.update(kRecordedLevel_ms[level] * speed * noise);
+      // Cheaper only as far as it must: at most to the level that fits
+      // with 5 % to spare (the ladder's costs are not this path's, so the
+      // controller's own prediction may stop it short of that).
+      if (next > level) {
+        EXPECT_LE(next, bestWithSpare) << "after frame " << i << " it went cheaper than it had to";
+      }
+      if (k < kSettleFrames) continue;
+      SCOPED_TRACE("frame " + std::to_string(i) + ", phase " + std::to_string(phase));
+      if (k > kSettleFrames) {
+        EXPECT_EQ(level, drawnAt[drawnAt.size() - 2]) << "settled frames stay at one level";
+      }
+      EXPECT_GE(level, best) << "drawn at a level that does not fit";
+      EXPECT_LE(level, bestWithSpare) << "a dearer level fits with 5 % to spare";
+      if (speed * kRecordedLevel_ms[cheapest] <= budgetMs) {
+        EXPECT_LE(speed * kRecordedLevel_ms[level], budgetMs);
+      }
     }
+    std::printf("\n");
   }
-  // The probe level's calibrated time from every level's, through the
-  // ladder's relative costs (checked above to 20 %): one level's reading can
-  // be off by a burst of the machine's other load (CI once read level 2
-  // slower than level 1, and scaled by it, put the fitting level two off).
-  std::vector<double> perUnitCost;
-  for (std::size_t level = 0; level < ladder->size(); ++level)
-    perUnitCost.push_back(levelMs[level] / (*ladder)[level].relativeCost);
-  const double probeCalibratedMs = median(perUnitCost) * (*ladder)[kProbe].relativeCost;
-  const double speed = median(probes) / probeCalibratedMs;
-  std::vector<double> duringMs;
-  for (double ms : levelMs) duringMs.push_back(ms * speed);
-  const std::size_t best = bestFitting(duringMs, budgetMs);
-  const double heldMs = median(held);
-  const auto most = std::max_element(levels.begin(), levels.end(),
-                                     [](const auto& a, const auto& b) { return a.second < b.second; });
-  std::printf("[ budget   ] held %.1f ms (budget %.1f); level %zu in %d of %zu frames; the machine ran at %.2fx the "
-              "calibration's times, where level %zu fits\n",
-              heldMs, budgetMs, most->first, most->second, held.size(), speed, best);
-  EXPECT_GE(most->first + 1, best);
-  EXPECT_LE(most->first, best + 1);
-  // When even the cheapest level is over the budget at the run's speed (CI
-  // once ran at 1.46x the calibration's times), the frames can only be held
-  // near that level's time; otherwise they fit the budget.
-  EXPECT_LE(heldMs, 1.05 * std::max(budgetMs, duringMs[best]))
-      << "the cheapest level takes " << duringMs[cheapest] << " ms at the run's speed";
+  // The first frame of the slower phase is 30 % over, but moves the mean
+  // speed by a quarter of that (under the 10 % that moves at once): the
+  // frame after the second is cheaper.
+  EXPECT_GT(drawnAt[kPhaseFrames + 2], drawnAt[kPhaseFrames - 1]);
+  // Back at the recorded speed, back at the recorded speed's level.
+  EXPECT_EQ(drawnAt.back(), drawnAt[kPhaseFrames - 1]);
+
+  // The same frame at the preset's level and at the cheapest.
+  std::vector<std::vector<float>> drawn;
+  for (const render::BudgetLevel* level : {&ladder->front(), &ladder->back()}) {
+    ASSERT_TRUE((*r)->setMarch(level->march));
+    auto image = (*r)->render(pathFrame(snap, 0));
+    ASSERT_TRUE(image) << describe(image.error());
+    drawn.push_back(image->rgba);
+  }
+  EXPECT_NE(drawn[0], drawn[1]) << "the cheapest level's march draws the same image as the preset's";
 }
 
 }  // namespace
