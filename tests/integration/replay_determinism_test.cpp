@@ -5,7 +5,8 @@
 // made 2 of 31 frames differ between two runs of the same command at
 // --preset medium). Tiny frames, two runs, every PNG compared byte for byte.
 // Also the replay's cleaning flags and skyshell-replay --info, on a track
-// with a spoofed fix.
+// with a spoofed fix, and the recorded-flight readers (issue 25: readsb
+// traces, X-Plane FDR) end to end, with what report.json says of the file.
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -171,6 +172,87 @@ TEST(ReplayInfo, ATrackOfAKmlIsChosenByName) {
   EXPECT_NE(out.find("TWO"), std::string::npos) << out;
   ASSERT_EQ(run({SKY_REPLAY, "--info", "--track", "TWO", kml.string()}, dir / "two.log", &out), 0) << out;
   EXPECT_NE(out.find("lat 47.00000 to 47.00200 deg"), std::string::npos) << out;
+}
+
+// The recorded-flight formats end to end (issue 25): a file replayed
+// headless at 64x36 from the bundled scenario file, a few frames, and what
+// report.json says of it (format, where the altitude came from, the
+// cleaning) and of its frames. The samples are the readers' unit-test files,
+// hand-made in the formats' published layouts (tests/data/readsb/README.md,
+// tests/data/fdr/README.md), not recordings.
+struct Recorded {
+  const char* file;      // under tests/data
+  const char* step_s;    // --step
+  const char* format;    // report.json's flight_format
+  const char* altitude;  // its altitude_source
+  int fixes;             // the fixes the reader keeps, all kept by the cleaning
+  int frames;
+  double lat_deg, lon_deg, alt_m;  // the first kept fix: the first frame's camera
+};
+
+// Replays `r` headless and checks report.json and the first frame; returns
+// the frames' metadata (frames.jsonl), empty when the replay failed.
+std::vector<nlohmann::json> expectReplayedAndReported(const Recorded& r, const fs::path& out) {
+  const std::vector<std::string> args = {SKY_RENDER, "--headless", "--replay", std::string(SKY_TEST_DATA_DIR "/") + r.file,
+                                         "--weather-file", SKY_SCENARIO_CLOUDY, "--step", r.step_s, "--width", "64",
+                                         "--height", "36", "--no-video", "--out", out.string()};
+  std::string log;
+  const int code = run(args, out.string() + ".log", &log);
+  EXPECT_EQ(code, 0) << log;
+  if (code != 0) return {};
+  const auto report = nlohmann::json::parse(readAll(out / "report.json"));
+  EXPECT_EQ(report["flight_format"], r.format);
+  EXPECT_EQ(report["altitude_source"], r.altitude);
+  EXPECT_EQ(report["frames"], r.frames);
+  EXPECT_EQ(report["complete"], true);
+  EXPECT_EQ(report["non_finite_pixels"], 0);
+  const auto& cleaning = report["cleaning"];
+  EXPECT_EQ(cleaning["enabled"], true) << cleaning.dump();
+  EXPECT_EQ(cleaning["fixes_in"], r.fixes) << cleaning.dump();
+  EXPECT_EQ(cleaning["fixes_kept"], r.fixes) << cleaning.dump();
+  EXPECT_TRUE(cleaning["summary"].is_array() && !cleaning["summary"].empty() &&
+              cleaning["summary"][0].get<std::string>().rfind("kept " + std::to_string(r.fixes) + " of ", 0) == 0)
+      << cleaning.dump();
+  std::vector<nlohmann::json> frames;
+  std::ifstream jsonl(out / "frames" / "frames.jsonl");
+  for (std::string line; std::getline(jsonl, line);)
+    if (!line.empty()) frames.push_back(nlohmann::json::parse(line));
+  EXPECT_EQ(frames.size(), std::size_t(r.frames));
+  if (frames.empty()) return frames;
+  EXPECT_NEAR(frames[0]["lat_deg"].get<double>(), r.lat_deg, 1e-9);
+  EXPECT_NEAR(frames[0]["lon_deg"].get<double>(), r.lon_deg, 1e-9);
+  EXPECT_NEAR(frames[0]["alt_m"].get<double>(), r.alt_m, 1e-6);
+  return frames;
+}
+
+constexpr double kFt_m = 0.3048;
+
+// trace_full_3c6444.json: the reader keeps 4 of its 9 rows, 0.5 to 40.5 s
+// after the trace's whole second (readsb_test.cpp works them out), three
+// with alt_geom and one barometric; at --step 10, frames at 0, 10, ..., 40
+// s. The first kept, row 1: 50.001 N 8.49 E, alt_geom 1100 ft.
+TEST(ReplayRecorded, AReadsbTraceReplaysHeadlessAndIsReported) {
+  expectReplayedAndReported({"readsb/trace_full_3c6444.json", "10", "readsb trace JSON",
+                             "geometric ('alt_geom', ft) for 3 fixes; barometric ('alt_baro', ft) to geometric by the "
+                             "ICAO standard atmosphere for 1 fix",
+                             4, 5, 50.001, 8.49, 1100 * kFt_m},
+                            outputDir() / "readsb");
+}
+
+// xplane-v4.fdr: four rows kept (the repeated time skipped by the reader),
+// 0.5 to 3.5 s after 23:59:58 UTC, altitude ft MSL, pitch and roll from the
+// file; at --step 1, frames at 0, 1, 2, 3 s. The first row: 37.5 N 122 W,
+// 1000 ft, pitch 2.0 and roll -1.5, which the frame takes as the file gives
+// them.
+TEST(ReplayRecorded, AnXPlaneFdrFileReplaysHeadlessAndIsReported) {
+  const auto frames = expectReplayedAndReported(
+      {"fdr/xplane-v4.fdr", "1", "X-Plane FDR",
+       "MSL (the FDR altitude column, ft) for 4 fixes; pitch and roll from the file, heading from the track", 4, 4,
+       37.5, -122.0, 1000 * kFt_m},
+      outputDir() / "fdr");
+  ASSERT_FALSE(frames.empty());
+  EXPECT_NEAR(frames[0]["pitch_deg"].get<double>(), 2.0, 1e-9);
+  EXPECT_NEAR(frames[0]["roll_deg"].get<double>(), -1.5, 1e-9);
 }
 
 }  // namespace

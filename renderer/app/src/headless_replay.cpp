@@ -27,6 +27,7 @@
 #include "sky/flight/clean.hpp"
 #include "sky/flight/file_limits.hpp"
 #include "sky/flight/flight.hpp"
+#include "sky/flight/info.hpp"
 #include "sky/flight/utf8_text.hpp"
 #include "sky/weather/lightning.hpp"
 #include "sky/weather/scenario.hpp"
@@ -363,6 +364,8 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   }
   const Percentiles ms = percentiles(renderMs);
   report["flight"] = o.flightPath;
+  // The format the file was read as (as skyshell-replay --info names it).
+  report["flight_format"] = flight::formatName(*text, o.flightPath);
   report["flight_window_s"] = {t0 - first_s, t1 - first_s};
   report["step_s"] = o.step_s;
   report["frames"] = done;
