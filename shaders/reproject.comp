@@ -88,6 +88,7 @@ uint gLayers;
 vec4 gBand[kReprojectMaxLayers];
 vec3 gMotion[kReprojectMaxLayers];
 bool gHasHistory;
+uint gHistoryTries;  // 2 with a history: from the frame, so the loop over them stays a loop (reuseHistory)
 uvec4 gEdges;      // the fresh edges' widths (SkyReproject::freshEdges)
 uint gEdgeBase;    // where in the packed image their samples start (after the drawn pixels)
 float gPackedW;    // the packed image's width
@@ -218,19 +219,22 @@ bool sharpHistoryAt(ivec2 i0, vec2 f, float expected, out vec4 colour, out float
 
 // The history at continuous position p, bilinear over the taps whose depth
 // agrees with `expected`; exactly the nearest pixel when p is (within 1e-3
-// px) a pixel centre, so a still view keeps its pixels bit for bit. False
-// unless the agreeing taps hold at least half the bilinear weight (else a
-// neighbour with a sliver of weight would stand in for a pixel that shows
-// something else).
+// px) a pixel centre, so a still view keeps its pixels bit for bit: there
+// the fraction is snapped to 0, where both resamplings weigh that pixel 1
+// and every other 0 (one path for both cases: lavapipe would run a
+// separate branch for the centre in every vector). False unless the agreeing
+// taps hold at least half the bilinear weight (else a neighbour with a
+// sliver of weight would stand in for a pixel that shows something else).
 // seenDepth: the history's cloud depth there, blended as the colour (0
 // where no tap that agreed saw cloud).
 bool historyAt(vec2 p, float expected, out vec4 colour, out float seenDepth) {
   vec2 q = p - 0.5;
   ivec2 i0 = ivec2(floor(q));
   vec2 f = q - vec2(i0);
+  bvec2 centre = lessThan(abs(f - round(f)), vec2(1e-3));
   colour = vec4(0.0);
   seenDepth = 0.0;
-  if (all(lessThan(abs(f - round(f)), vec2(1e-3)))) {
+  if (all(centre)) {
     ivec2 c = i0 + ivec2(round(f));
     if (!insideImage(c)) return false;
     float hd = historyDepthAtPixel(c);
@@ -292,26 +296,26 @@ float nearestDrawnDepth(ivec2 px) {
 // (reusedDepth). from: where in the previous image it was taken (pixels).
 uint reuseHistory(ivec2 px, out vec4 colour, inout float depth, out vec2 from) {
   vec3 dir = cameraRay(gForward, gRight, gDown, gFrustum, float(px.x), float(px.y), gRaster.x, gRaster.y);
-  // First guess of the pixel's cloud depth: its own block's drawn pixel's
-  // (upscale's nearest); then what the history holds where that leads.
-  vec2 p;
-  float expected, seen;
   colour = vec4(0.0);
   from = vec2(px) + 0.5;
-  if (!previousPixel(dir, depth, p, expected) || !insideImage(ivec2(floor(p)))) return kStatOffscreen;
-  if (historyAt(p, expected, colour, seen)) {
-    depth = reusedDepth(depth, expected, seen);
-    from = p;
-    return kStatReused;
+  // Two tries: the first guess of the pixel's cloud depth (its own block's
+  // drawn pixel's, upscale's nearest), then what the history holds where
+  // that led. A loop, not two copies, and its count not a constant the
+  // compiler could unroll: lavapipe leaves a loop when no lane of the 8 is
+  // still in it, so the second try costs only the vectors where a lane needs it.
+  float guess = depth;
+  for (uint attempt = 0u; attempt < gHistoryTries; ++attempt) {
+    vec2 p;
+    float expected, seen;
+    if (!previousPixel(dir, guess, p, expected) || !insideImage(ivec2(floor(p)))) return kStatOffscreen;
+    if (historyAt(p, expected, colour, seen)) {
+      depth = reusedDepth(guess, expected, seen);
+      from = p;
+      return kStatReused;
+    }
+    guess = historyDepthNear(p);
   }
-  float guess = historyDepthNear(p);
-  vec2 p2;
-  if (!previousPixel(dir, guess, p2, expected) || !insideImage(ivec2(floor(p2)))) return kStatOffscreen;
-  if (historyAt(p2, expected, colour, seen)) {
-    depth = reusedDepth(guess, expected, seen);
-    from = p2;
-    return kStatReused;
-  }
+  colour = vec4(0.0);
   return kStatDisoccluded;
 }
 
@@ -355,41 +359,46 @@ bool droppedHere(ivec2 px) {
   return dropCells[c.y * gDropGrid.x + c.x] != 0u;
 }
 
+// lavapipe runs both sides of a branch for all 8 lanes of a vector when any
+// lane takes each, and one block in 16 (4 x 4 interleave) has its drawn pixel
+// among the lanes of nearly every vector: so the drawn and the reprojected
+// pixels share one history lookup, one clip and one upscale, each taken
+// once for the lanes that need it, where a branch per case ran each twice.
 uint resolvePixel(ivec2 px, out vec4 colour, out float depth) {
-  ivec2 drawn;
-  bool dropped = droppedHere(px);
-  if (drawnHere(px, drawn)) {
-    colour = freshAt(drawn);
-    depth = freshDepthAt(drawn);
-    // Temporal accumulation: the redrawn pixel blended with its history,
-    // found through the motion at the depth just drawn (depth stays as drawn).
-    if (gHasHistory && gAccumulation > 0.0 && !dropped) {
-      vec4 before;
-      float guess = depth;
-      vec2 from;
-      if (reuseHistory(px, before, guess, from) == kStatReused) {
-        // In motion the history is resampled (blurred) and partly upscaled:
-        // its share falls with how far the pixel moved since the previous
-        // frame, to half at gAccumulationMotion pixels. Not to none: inside
-        // a cloud the single march's noise, which the mean averages away,
-        // costs more than the lag (docs/motion.md).
-        float moved = length(from - (vec2(px) + 0.5));
-        float share = gAccumulationMotion > 0.0 ? gAccumulation * clamp(1.0 - moved / gAccumulationMotion, 0.5, 1.0)
-                                                : gAccumulation;
-        colour = mix(colour, clippedHistory(px, before), share);
-      }
+  ivec2 drawnTexel;
+  bool drawn = drawnHere(px, drawnTexel);
+  vec4 fresh = freshAt(drawnTexel);
+  float freshDepth = freshDepthAt(drawnTexel);
+  // A drawn pixel looks its history up at the depth it was drawn at, blends
+  // it in and keeps that depth; any other pixel starts from the nearest
+  // drawn pixel's depth, and takes the history's (reusedDepth).
+  bool wantHistory = gHasHistory && (!drawn || (gAccumulation > 0.0 && !droppedHere(px)));
+  float guess = drawn ? freshDepth : nearestDrawnDepth(px);
+  uint outcome = gHasHistory ? kStatDisoccluded : kStatNoHistory;
+  vec4 history = vec4(0.0);
+  vec2 from = vec2(px) + 0.5;
+  if (wantHistory) outcome = reuseHistory(px, history, guess, from);
+  bool reused = wantHistory && outcome == kStatReused;
+  if (reused) history = clippedHistory(px, history);
+  if (drawn) {
+    colour = fresh;
+    depth = freshDepth;
+    if (reused) {
+      // In motion the history is resampled (blurred) and partly upscaled:
+      // its share falls with how far the pixel moved since the previous
+      // frame, to half at gAccumulationMotion pixels. Not to none: inside
+      // a cloud the single march's noise, which the mean averages away,
+      // costs more than the lag (docs/motion.md).
+      float moved = length(from - (vec2(px) + 0.5));
+      float share = gAccumulationMotion > 0.0 ? gAccumulation * clamp(1.0 - moved / gAccumulationMotion, 0.5, 1.0)
+                                              : gAccumulation;
+      colour = mix(colour, history, share);
     }
     return kStatFresh;
   }
-  if (!gHasHistory) {
-    upscale(px, colour, depth);
-    return kStatNoHistory;
-  }
-  depth = nearestDrawnDepth(px);
-  vec2 from;
-  uint outcome = reuseHistory(px, colour, depth, from);
-  if (outcome != kStatReused) upscale(px, colour, depth);
-  else colour = clippedHistory(px, colour);
+  colour = history;
+  depth = guess;
+  if (!reused) upscale(px, colour, depth);
   return outcome;
 }
 
@@ -399,6 +408,7 @@ void main() {
   gN = params.image.z;
   gShift = gN == 4u ? 2 : gN == 2u ? 1 : 0;
   gHasHistory = params.image.w != 0u;
+  gHistoryTries = gHasHistory ? 2u : 0u;
   gEdges = params.freshEdges;
   uint packedW = params.phase.z;
   gPackedW = float(packedW);

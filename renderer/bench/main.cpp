@@ -97,6 +97,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--pitch", sbs.pitch_deg, "side-by-side: camera pitch, deg")->capture_default_str();
   app.add_option("--yaw", sbs.yaw_deg, "side-by-side: camera heading, deg")->capture_default_str();
+  app.add_option("--turn", sbs.turn_deg, "side-by-side: heading added per frame, deg (a turning camera)")
+      ->capture_default_str();
   app.add_option("--vfov", sbs.verticalFov_deg, "side-by-side: vertical field of view, deg")->capture_default_str();
   app.add_option("--sun", sun, "side-by-side: direction to the sun east,north,up")->capture_default_str();
   app.add_option("--lat", sbs.lat_deg, "side-by-side: camera latitude, deg")->capture_default_str();

@@ -59,15 +59,16 @@ Result<void> runSideBySide(const SideBySideOptions& o, std::FILE* out, std::FILE
   // bench times its stills.
   const std::uint32_t warmup = std::max(o.warmup, render::historyWarmupFrames(s.temporal));
   std::fprintf(err, "# skyshell-bench side-by-side: %ux%u (rendered %ux%u, configuration %s) on %s, camera %.1f m above "
-               "the ellipsoid at %.4f %.4f, heading %.1f pitch %.1f, vfov %.1f, sun azimuth %.2f elevation %.2f; "
+               "the ellipsoid at %.4f %.4f, heading %.1f (+%.2f a frame) pitch %.1f, vfov %.1f, sun azimuth %.2f elevation %.2f; "
                "%u warm-up frames not printed; LP_NUM_THREADS=%s\n",
                o.width, o.height, s.width, s.height, o.configuration.name.c_str(), (*renderer)->deviceName().c_str(),
-               o.heightAboveGround_m, o.lat_deg, o.lon_deg, o.yaw_deg, o.pitch_deg, o.verticalFov_deg,
-               sun->azimuth_deg, sun->elevation_deg, warmup,
+               o.heightAboveGround_m, o.lat_deg, o.lon_deg, o.yaw_deg, o.turn_deg, o.pitch_deg,
+               o.verticalFov_deg, sun->azimuth_deg, sun->elevation_deg, warmup,
                std::getenv("LP_NUM_THREADS") ? std::getenv("LP_NUM_THREADS") : "(unset)");
   bool announced = false;
   for (std::uint32_t i = 0; i < warmup + o.frames; ++i) {
     in.frameIndex = i;
+    in.camera.yaw_deg = o.yaw_deg + o.turn_deg * double(i);
     const CpuSnapshot before = sampleCpu();
     const auto t0 = std::chrono::steady_clock::now();
     auto image = (*renderer)->render(in);

@@ -19,6 +19,9 @@ struct SideBySideOptions {
   double heightAboveGround_m = 800;
   double lat_deg = 46.0, lon_deg = 13.0;
   double yaw_deg = 0, pitch_deg = 0;  // CIGI heading and pitch
+  // Heading added per frame (warm-up frames included): a camera in a turn,
+  // so the temporal passes are timed on a moving view, not only a still one.
+  double turn_deg = 0;
   double verticalFov_deg = 60;
   double sunEast = -0.5, sunNorth = 0.5, sunUp = 1.0;  // direction towards the sun, local ENU, any length > 0
   std::uint32_t width = 640, height = 360;
