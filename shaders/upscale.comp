@@ -41,11 +41,12 @@ float gRadius, gGroundC;
 vec2 gRaster;  // the small image's extent for the camera rays
 
 // Whether the ray through pixel (x, y) of a width x height image hits the
-// ground: the cloud pass's test (cloud_core.glsl, shadePixel).
+// ground: the cloud pass's test (cloud_core.glsl, shadePixel: the ground
+// sphere's far root ahead), in the form without roots (rayMeetsSphere),
+// as it runs for every pixel of the full size.
 bool seesGround(vec2 px, vec2 size) {
-  vec3 dir = cameraRay(gForward, gRight, gDown, gFrustum, px.x, px.y, size.x, size.y);
-  Roots ground = intersectSphere(gRadius, gGroundC, dir.z);
-  return ground.hit && ground.t1 > 0.0;
+  vec2 s = frustumPoint(gFrustum, px.x + 0.5, px.y + 0.5, size.x, size.y);
+  return rayMeetsSphere(gForward + gRight * s.x - gDown * s.y, gRadius, gGroundC);
 }
 
 void main() {

@@ -92,6 +92,19 @@ Roots intersectSphere(real r, real c, real mu) {
   return Roots(true, min(ta, tb), max(ta, tb));
 }
 
+// Whether a view ray along v (camera-local, z up, any length) from the
+// camera at distance r from the centre meets the sphere of constant c ahead:
+// intersectSphere(r, c, normalize(v).z)'s hit with t1 > 0, worked out
+// without the normalisation, the square root and the division, for passes
+// that only classify pixels (the upscale's ground test). Inside the sphere
+// (c < 0) every ray meets it; on or outside it, the ray goes down and not
+// above the horizon: mu < 0 and mu <= -sqrt(c) / r, that is v.z < 0 and
+// v.z^2 r^2 >= c |v|^2.
+bool rayMeetsSphere(real3 v, real r, real c) {
+  if (c < real(0.0)) return true;
+  return v.z < real(0.0) && v.z * v.z * (r * r) >= c * dot(v, v);
+}
+
 // Height of p above the sphere through the camera, m, without forming
 // |p - centre| - r from two Earth-sized numbers: (|q|^2 - r^2) / (|q| + r).
 real heightAboveCameraSphere(real3 p, real r) {

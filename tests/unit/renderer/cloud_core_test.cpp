@@ -494,6 +494,38 @@ TEST(CloudCore, RayShellDistancesMatchHandComputedOnes) {
   EXPECT_NEAR(c.intersectSphere(rp, cp, -1.0).t0, h, 1e-6);
 }
 
+// The upscale's ground test without roots (rayMeetsSphere) is
+// intersectSphere's "hit with the far root ahead" for rays of any length,
+// from the ground up to orbit and below the ground, all round the horizon:
+// 20 000 directions per height, skipping only those within 1e-9 of the
+// horizon's cosine, where both are rounding.
+TEST(CloudCore, TheRootlessGroundTestIsTheSpheresHitAhead) {
+  Core c;
+  const double Rs = 6371000;
+  std::uint32_t seed = 12345u, met = 0, missed = 0;
+  auto uniform = [&seed] {
+    seed = seed * 1664525u + 1013904223u;
+    return double(seed >> 8) / double(1u << 24);
+  };
+  for (const double h : {-50.0, 0.0, 1.0, 800.0, 12000.0, 400000.0}) {
+    const double r = Rs + std::max(h, 0.0), cc = h * (2 * r - h);
+    const double horizonMu = cc > 0 ? -std::sqrt(cc) / r : 0.0;
+    for (int k = 0; k < 20000; ++k) {
+      // Cosines crowded round the horizon's, half of them within 0.01 of it.
+      const double mu = k % 2 == 0 ? 2 * uniform() - 1 : std::clamp(horizonMu + 0.02 * (uniform() - 0.5), -1.0, 1.0);
+      if (std::abs(mu - horizonMu) < 1e-9) continue;
+      const double phi = 6.283185307179586 * uniform(), s = std::sqrt(1 - mu * mu), length = 0.1 + 10 * uniform();
+      const dvec3 v(length * s * std::cos(phi), length * s * std::sin(phi), length * mu);
+      const auto roots = c.intersectSphere(r, cc, mu);
+      const bool expected = roots.hit && roots.t1 > 0.0;
+      ASSERT_EQ(c.rayMeetsSphere(v, r, cc), expected) << "h " << h << " mu " << mu;
+      (expected ? met : missed) += 1;
+    }
+  }
+  EXPECT_GT(met, 30000u);
+  EXPECT_GT(missed, 30000u);
+}
+
 // The weather map's projection (anchorPlane, shared by the GPU passes and
 // the CPU reference): the gnomonic projection of the anchor sphere onto its
 // tangent plane at the anchor, x = R tan(angle east), whichever way the
