@@ -93,12 +93,6 @@ bool isIcao24(std::string_view s) {
          std::all_of(s.begin(), s.end(), [](char c) { return detail::isDigit(c) || (c >= 'a' && c <= 'f'); });
 }
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
-  return s;
-}
-
 // Splits a line at commas outside double quotes; a quoted field is returned
 // without its quotes (a doubled quote inside stays doubled: no field we read
 // holds one).
@@ -109,8 +103,8 @@ void splitFields(std::string_view line, std::vector<std::string_view>& out) {
   for (std::size_t i = 0; i <= line.size(); ++i) {
     if (i < line.size() && line[i] == '"') quoted = !quoted;
     if (i == line.size() || (line[i] == ',' && !quoted)) {
-      std::string_view f = trim(line.substr(start, i - start));
-      if (f.size() >= 2 && f.front() == '"' && f.back() == '"') f = trim(f.substr(1, f.size() - 2));
+      std::string_view f = detail::trimSpace(line.substr(start, i - start));
+      if (f.size() >= 2 && f.front() == '"' && f.back() == '"') f = detail::trimSpace(f.substr(1, f.size() - 2));
       out.push_back(f);
       start = i + 1;
     }
@@ -124,14 +118,6 @@ bool isEmpty(std::string_view f) {
   if (f.size() > 4) return false;
   const std::string l = lowered(f);
   return l == "nan" || l == "null" || l == "none";
-}
-
-std::optional<double> number(std::string_view f) {
-  double v = 0;
-  if (!f.empty() && f.front() == '+') f.remove_prefix(1);
-  const auto [ptr, ec] = std::from_chars(f.data(), f.data() + f.size(), v);
-  if (ec != std::errc() || ptr != f.data() + f.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
 }
 
 bool isLeap(std::int64_t y) { return (y % 4 == 0 && y % 100 != 0) || y % 400 == 0; }
@@ -253,7 +239,7 @@ bool isAdsbCsvHeader(std::string_view headerLine) {
 Result<ParsedFlight> parseAdsbCsv(std::string_view text, std::string_view sourceName, const ReadOptions& options) {
   detail::Warnings warnings(sourceName);
   const std::string& src = warnings.source();
-  const std::string wanted = lowered(trim(options.icao24));
+  const std::string wanted = lowered(detail::trimSpace(options.icao24));
   if (!options.icao24.empty() && !isIcao24(wanted))
     return fail(ErrorCode::InvalidArgument,
                 src + ": icao24 '" + printable(options.icao24) + "' is not 1 to 6 hex digits");
@@ -277,7 +263,7 @@ Result<ParsedFlight> parseAdsbCsv(std::string_view text, std::string_view source
                                              std::to_string(kMaxAdsbLineBytes) + " read"};
       return;
     }
-    const std::string_view line = trim(rawLine);
+    const std::string_view line = detail::trimSpace(rawLine);
     if (line.empty() || line.front() == '#') return;
     splitFields(line, fields);
     if (!header) {
@@ -333,7 +319,7 @@ Result<ParsedFlight> parseAdsbCsv(std::string_view text, std::string_view source
     Aircraft& craft = aircraft[it->second];
     ++craft.rows;
     if (h[Role::Callsign] && craft.callsign.empty())
-      craft.callsign = printable(trim(field(Role::Callsign)).substr(0, kMaxCallsignChars));
+      craft.callsign = printable(detail::trimSpace(field(Role::Callsign)).substr(0, kMaxCallsignChars));
     if (!wanted.empty() && icao != wanted) return;
 
     std::optional<double> values[kRoles];
@@ -342,7 +328,7 @@ Result<ParsedFlight> parseAdsbCsv(std::string_view text, std::string_view source
       const std::string_view f = field(r);
       if ((r == Role::Geo || r == Role::Baro) && lowered(f) == "ground") continue;
       auto& v = values[static_cast<std::size_t>(r)];
-      v = number(f);
+      v = detail::parseDecimal(f);
       if (!v && r == Role::Time) v = isoTime(f);
       if (!v) {
         bad(r, r == Role::Time ? "is neither Unix seconds nor an ISO 8601 UTC time" : "is not a number");

@@ -17,18 +17,12 @@ namespace {
 constexpr std::array<std::string_view, 7> kColumns = {"time_s",  "lat_deg",   "lon_deg", "alt_m",
                                                        "yaw_deg", "pitch_deg", "roll_deg"};
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
-
 std::vector<std::string_view> split(std::string_view line) {
   std::vector<std::string_view> out;
   std::size_t start = 0;
   for (std::size_t i = 0; i <= line.size(); ++i) {
     if (i == line.size() || line[i] == ',') {
-      out.push_back(trim(line.substr(start, i - start)));
+      out.push_back(detail::trimSpace(line.substr(start, i - start)));
       start = i + 1;
     }
   }
@@ -65,7 +59,7 @@ Result<ParsedFlight> parseCsv(std::string_view text, std::string_view sourceName
   }
   while (pos <= text.size()) {
     const std::size_t end = std::min(text.find('\n', pos), text.size());
-    const std::string_view line = trim(text.substr(pos, end - pos));
+    const std::string_view line = detail::trimSpace(text.substr(pos, end - pos));
     pos = end + 1;
     ++lineNo;
     if (line.empty() || line.front() == '#') {

@@ -52,27 +52,12 @@ constexpr std::size_t kMaxTailChars = 16;
 // columns beyond are not split.
 constexpr std::size_t kMaxSplitFields = 8;
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
-  return s;
-}
-
-std::optional<double> number(std::string_view f) {
-  f = trim(f);
-  if (!f.empty() && f.front() == '+') f.remove_prefix(1);
-  double v = 0;
-  const auto [ptr, ec] = std::from_chars(f.data(), f.data() + f.size(), v);
-  if (f.empty() || ec != std::errc() || ptr != f.data() + f.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
-
 // The first max fields of a comma-separated line (the rest not split).
 void splitFields(std::string_view line, std::vector<std::string_view>& out, std::size_t max) {
   out.clear();
   while (out.size() < max) {
     const auto comma = line.find(',');
-    out.push_back(trim(line.substr(0, comma)));
+    out.push_back(detail::trimSpace(line.substr(0, comma)));
     if (comma == std::string_view::npos) return;
     line.remove_prefix(comma + 1);
   }
@@ -80,7 +65,7 @@ void splitFields(std::string_view line, std::vector<std::string_view>& out, std:
 
 // "hh:mm:ss[.fff]" as seconds of the day.
 std::optional<double> timeOfDay(std::string_view f) {
-  f = trim(f);
+  f = detail::trimSpace(f);
   if (f.size() < 8 || f[2] != ':' || f[5] != ':') return std::nullopt;
   const long long h = detail::digitsValue(f.substr(0, 2)), m = detail::digitsValue(f.substr(3, 2)),
                   s = detail::digitsValue(f.substr(6, 2));
@@ -106,7 +91,7 @@ struct Date {
 // "MM/DD/YY" or "MM/DD/YYYY" (X-Plane writes the US order: the files of
 // 42fdr and xpwebapi say "01/18/2023").
 std::optional<Date> date(std::string_view f) {
-  f = trim(f);
+  f = detail::trimSpace(f);
   const auto a = f.find('/');
   const auto b = a == std::string_view::npos ? a : f.find('/', a + 1);
   if (b == std::string_view::npos) return std::nullopt;
@@ -151,7 +136,7 @@ Result<ParsedFlight> parseFdr(std::string_view text, std::string_view sourceName
     }
     std::string_view line = rawLine;
     if (const auto comment = line.find("//"); comment != std::string_view::npos) line = line.substr(0, comment);
-    line = trim(line);
+    line = detail::trimSpace(line);
     if (line.empty()) return;
     if (!lineEndingSeen) {
       if (line != "A" && line != "I") {
@@ -173,7 +158,7 @@ Result<ParsedFlight> parseFdr(std::string_view text, std::string_view sourceName
     const bool isKey = line.size() >= 4 && detail::isUpper(line[0]) && detail::isUpper(line[1]) &&
                        detail::isUpper(line[2]) && detail::isUpper(line[3]) && (line.size() == 4 || line[4] == ',');
     const std::string_view key = isKey ? line.substr(0, 4) : std::string_view();
-    const std::string_view value = isKey && line.size() > 5 ? trim(line.substr(5)) : std::string_view();
+    const std::string_view value = isKey && line.size() > 5 ? detail::trimSpace(line.substr(5)) : std::string_view();
     if (isKey && key != "DATA") {
       if (key == "DATE") {
         day = date(value);
@@ -211,7 +196,7 @@ Result<ParsedFlight> parseFdr(std::string_view text, std::string_view sourceName
       return;
     }
     const auto value_ = [&](std::size_t col, std::string_view name, double lo, double hi) -> std::optional<double> {
-      const auto v = number(fields[col]);
+      const auto v = detail::parseDecimal(fields[col]);
       if (!v) {
         error = Error{ErrorCode::Malformed, at + "field '" + std::string(name) + "': '" + printable(fields[col]) +
                                                "' is not a number"};
@@ -233,7 +218,7 @@ Result<ParsedFlight> parseFdr(std::string_view text, std::string_view sourceName
     } else {
       t = value_(timeCol, "time", 0, kMaxSeconds_s);
       if (!t) {
-        if (!dataRow && !number(fields[timeCol]))
+        if (!dataRow && !detail::parseDecimal(fields[timeCol]))
           error = Error{ErrorCode::Malformed, at + "field 'time': '" + printable(fields[timeCol]) +
                                                  "' is neither hh:mm:ss[.f] (zulu) nor seconds"};
         return;

@@ -31,21 +31,6 @@ constexpr std::size_t kMaxValueChars = 64;
 // Same bounds as the CSV reader: below the Dead Sea shore, above any balloon.
 constexpr double kMinEle_m = -1000.0, kMaxEle_m = 1.0e6;
 
-std::string_view trim(std::string_view s) {
-  const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; };
-  while (!s.empty() && space(s.front())) s.remove_prefix(1);
-  while (!s.empty() && space(s.back())) s.remove_suffix(1);
-  return s;
-}
-
-std::optional<double> number(std::string_view s) {
-  s = trim(s);
-  double v = 0;
-  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (s.empty() || ec != std::errc() || ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
-
 std::string_view localName(const XML_Char* name) {
   const std::string_view n(name);
   const auto colon = n.rfind(':');
@@ -117,7 +102,7 @@ class GpxReader {
   void readCoordinate(const XML_Char** attrs, std::string_view field, double limit, double& out) {
     for (std::size_t i = 0; attrs[i]; i += 2) {
       if (localName(attrs[i]) != field) continue;
-      const auto v = number(attrs[i + 1]);
+      const auto v = detail::parseDecimal(attrs[i + 1]);
       if (!v) {
         stop(ErrorCode::Malformed, point_->line,
              "field '" + std::string(field) + "': '" + printable(attrs[i + 1]) + "' is not a number");
@@ -141,14 +126,14 @@ class GpxReader {
     point_.reset();
     if (!p.ele) return stop(ErrorCode::Malformed, p.line, "field 'ele': missing from <trkpt>");
     if (!p.time) return stop(ErrorCode::Malformed, p.line, "field 'time': missing from <trkpt>");
-    const auto ele = number(*p.ele);
+    const auto ele = detail::parseDecimal(*p.ele);
     if (!ele) return stop(ErrorCode::Malformed, p.eleLine, "field 'ele': '" + printable(*p.ele) + "' is not a number");
     if (*ele < kMinEle_m || *ele > kMaxEle_m)
       return stop(ErrorCode::InvalidArgument, p.eleLine, "field 'ele': " + printable(*p.ele) + " m out of range");
     const auto utc = isoUtc_s(*p.time);
     if (!utc)
       return stop(ErrorCode::Malformed, p.timeLine,
-                  "field 'time': '" + printable(trim(*p.time)) + "' is not an ISO 8601 UTC time");
+                  "field 'time': '" + printable(detail::trimSpace(*p.time)) + "' is not an ISO 8601 UTC time");
     if (!order_.accept(*utc, p.line, warnings_)) return;
     kept.push_back(Kept{*utc, {p.lat_deg, p.lon_deg, *ele}, p.line});
   }

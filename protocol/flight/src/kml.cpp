@@ -37,22 +37,6 @@ constexpr std::size_t kMaxListedTracks = 20;
 // Same bounds as GPX: below the Dead Sea shore, above any balloon.
 constexpr double kMinAlt_m = -1000.0, kMaxAlt_m = 1.0e6;
 
-std::string_view trim(std::string_view s) {
-  const auto space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; };
-  while (!s.empty() && space(s.front())) s.remove_prefix(1);
-  while (!s.empty() && space(s.back())) s.remove_suffix(1);
-  return s;
-}
-
-std::optional<double> number(std::string_view s) {
-  s = trim(s);
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  double v = 0;
-  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (s.empty() || ec != std::errc() || ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
-
 // Splits s at any of seps (runs count as one), at most max + 1 parts.
 std::vector<std::string_view> split(std::string_view s, std::string_view seps, std::size_t max) {
   std::vector<std::string_view> out;
@@ -189,20 +173,20 @@ class KmlReader {
   // "lon lat alt" (gx:coord) or "lon,lat,alt" (coordinates) as a position.
   std::optional<geo::Geodetic> position(std::string_view text, std::string_view seps, std::string_view field,
                                         std::size_t at) {
-    const auto parts = split(trim(text), seps, 3);
+    const auto parts = split(detail::trimSpace(text), seps, 3);
     if (parts.size() != 3) {
-      stop(ErrorCode::Malformed, at, "field '" + std::string(field) + "': '" + printable(trim(text)) +
+      stop(ErrorCode::Malformed, at, "field '" + std::string(field) + "': '" + printable(detail::trimSpace(text)) +
                                          "' is not three numbers (longitude, latitude, altitude m)");
       return std::nullopt;
     }
-    const auto lon = number(parts[0]), lat = number(parts[1]), alt = number(parts[2]);
+    const auto lon = detail::parseDecimal(parts[0]), lat = detail::parseDecimal(parts[1]), alt = detail::parseDecimal(parts[2]);
     if (!lon || !lat || !alt) {
-      stop(ErrorCode::Malformed, at, "field '" + std::string(field) + "': '" + printable(trim(text)) +
+      stop(ErrorCode::Malformed, at, "field '" + std::string(field) + "': '" + printable(detail::trimSpace(text)) +
                                          "' holds something that is not a number");
       return std::nullopt;
     }
     if (std::fabs(*lat) > 90 || std::fabs(*lon) > 180 || *alt < kMinAlt_m || *alt > kMaxAlt_m) {
-      stop(ErrorCode::InvalidArgument, at, "field '" + std::string(field) + "': '" + printable(trim(text)) +
+      stop(ErrorCode::InvalidArgument, at, "field '" + std::string(field) + "': '" + printable(detail::trimSpace(text)) +
                                                "' is out of range (longitude [-180, 180], latitude [-90, 90], "
                                                "altitude [-1000, 1e6] m)");
       return std::nullopt;
@@ -212,7 +196,7 @@ class KmlReader {
 
   std::optional<double> time(std::string_view text, std::size_t at) {
     const auto t = detail::isoUtc_s(text);
-    if (!t) stop(ErrorCode::Malformed, at, "field 'when': '" + printable(trim(text)) + "' is not an ISO 8601 UTC time");
+    if (!t) stop(ErrorCode::Malformed, at, "field 'when': '" + printable(detail::trimSpace(text)) + "' is not an ISO 8601 UTC time");
     return t;
   }
 
@@ -224,7 +208,7 @@ class KmlReader {
 
   // up: the element holding the <altitudeMode>.
   void altitudeMode(std::string_view mode, std::string_view up, std::size_t at) {
-    mode = trim(mode);
+    mode = detail::trimSpace(mode);
     if (mode != "absolute")
       return stop(ErrorCode::Unsupported, at,
                   "field 'altitudeMode': '" + printable(mode) +
@@ -243,8 +227,8 @@ class KmlReader {
     text_ = nullptr;
     if (error) return;
     switch (what) {
-      case Capture::PlacemarkName: placemark_->name = std::string(trim(captured_)); break;
-      case Capture::FolderName: folders_.back().second = std::string(trim(captured_)); break;
+      case Capture::PlacemarkName: placemark_->name = std::string(detail::trimSpace(captured_)); break;
+      case Capture::FolderName: folders_.back().second = std::string(detail::trimSpace(captured_)); break;
       case Capture::TrackWhen:
         if (const auto t = time(captured_, captureLine_); t && countPoint(captureLine_)) {
           tracks[*track_].whens.push_back(*t);

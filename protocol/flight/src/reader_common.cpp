@@ -2,6 +2,10 @@
 // and the choice of reader for a file.
 #include "reader_common.hpp"
 
+#include <charconv>
+#include <cmath>
+#include <system_error>
+
 #include "sky/flight/utf8_text.hpp"
 
 #include <cstdio>
@@ -27,6 +31,15 @@ std::string seconds(double s) {
 }
 
 }  // namespace
+
+std::optional<double> parseDecimal(std::string_view s) {
+  s = trimSpace(s);
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  double v = 0;
+  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (s.empty() || ec != std::errc() || ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
 
 std::string printable(std::string_view s) {
   std::string out;

@@ -51,6 +51,20 @@ constexpr long long digitsValue(std::string_view s) {
   return v;
 }
 
+// s without the white space around it: spaces, tabs and line ends (a CRLF
+// file's '\r' at the end of a row, XML's newlines and indentation).
+constexpr std::string_view trimSpace(std::string_view s) {
+  constexpr auto space = [](char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; };
+  while (!s.empty() && space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && space(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+// The finite decimal number that is all of s (white space around it and a
+// leading '+' allowed, as CSV exports and XML Schema's decimals write it),
+// or nullopt: no locale, no trailing junk, no inf or nan.
+std::optional<double> parseDecimal(std::string_view s);
+
 // Printable rendering of a field for a message: bytes outside ASCII
 // printables become '?', and long fields are cut.
 std::string printable(std::string_view s);
