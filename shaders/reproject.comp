@@ -219,22 +219,22 @@ bool sharpHistoryAt(ivec2 i0, vec2 f, float expected, out vec4 colour, out float
 
 // The history at continuous position p, bilinear over the taps whose depth
 // agrees with `expected`; exactly the nearest pixel when p is (within 1e-3
-// px) a pixel centre, so a still view keeps its pixels bit for bit: there
-// the fraction is snapped to 0, where both resamplings weigh that pixel 1
-// and every other 0 (one path for both cases: lavapipe would run a
-// separate branch for the centre in every vector). False unless the agreeing
-// taps hold at least half the bilinear weight (else a neighbour with a
-// sliver of weight would stand in for a pixel that shows something else).
+// px) a pixel centre, so a still view keeps its pixels bit for bit. That
+// case returns early: lavapipe then skips the resampling's loads for the
+// lanes that took it (snapping the fraction to 0 and resampling instead
+// gives the same pixels and cost a still 1280x720 `realtime` frame 7 ms,
+// docs/light-transport.md). False unless the agreeing taps hold at least
+// half the bilinear weight (else a neighbour with a sliver of weight would
+// stand in for a pixel that shows something else).
 // seenDepth: the history's cloud depth there, blended as the colour (0
 // where no tap that agreed saw cloud).
 bool historyAt(vec2 p, float expected, out vec4 colour, out float seenDepth) {
   vec2 q = p - 0.5;
   ivec2 i0 = ivec2(floor(q));
   vec2 f = q - vec2(i0);
-  bvec2 centre = lessThan(abs(f - round(f)), vec2(1e-3));
   colour = vec4(0.0);
   seenDepth = 0.0;
-  if (all(centre)) {
+  if (all(lessThan(abs(f - round(f)), vec2(1e-3)))) {
     ivec2 c = i0 + ivec2(round(f));
     if (!insideImage(c)) return false;
     float hd = historyDepthAtPixel(c);
@@ -294,6 +294,7 @@ float nearestDrawnDepth(ivec2 px) {
 // pixel's) seen from the previous camera; failing that, the point at the
 // depth the history holds there. `depth` becomes the reused pixel's depth
 // (reusedDepth). from: where in the previous image it was taken (pixels).
+// colour is meaningful only when it returns kStatReused.
 uint reuseHistory(ivec2 px, out vec4 colour, inout float depth, out vec2 from) {
   vec3 dir = cameraRay(gForward, gRight, gDown, gFrustum, float(px.x), float(px.y), gRaster.x, gRaster.y);
   colour = vec4(0.0);
@@ -315,7 +316,6 @@ uint reuseHistory(ivec2 px, out vec4 colour, inout float depth, out vec2 from) {
     }
     guess = historyDepthNear(p);
   }
-  colour = vec4(0.0);
   return kStatDisoccluded;
 }
 
