@@ -12,14 +12,14 @@
 namespace sky::server {
 
 weather::WeatherSnapshot subscriberSnapshot(const LiveWeather& weather, double clock_s, const weather::SphericalCap& cap,
-                                           int level) {
+                                           int level, TileCache* cache) {
   const std::vector<weather::CloudLayer> layers = weather.layersAt(clock_s);
   const std::vector<weather::Region> regions = weather.regionsAt(clock_s);
   stream::Subscribe area;
   area.area = cap;
   area.tileLevel = level;
   const auto field = weather.fieldAt(clock_s);
-  weather::WeatherSnapshot snapshot = buildSnapshot(area, layers, clock_s, kDefaultMaxCells, regions, nullptr, field.get());
+  weather::WeatherSnapshot snapshot = buildSnapshot(area, layers, clock_s, kDefaultMaxCells, regions, cache, field.get());
   // As a subscriber holds them: the stream carries a tile's fractions in 8
   // bits (stream/messages.cpp).
   for (weather::CoverageTile& t : snapshot.tiles) {

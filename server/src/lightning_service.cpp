@@ -27,7 +27,8 @@ bool same(const weather::SphericalCap& a, const weather::SphericalCap& b) {
 
 // The storm cells of the caps, one per S2 cell whichever caps hold it.
 std::vector<weather::StormCell> stormCellsIn(const LiveWeather& weather, double clock_s,
-                                             std::span<const weather::SphericalCap> caps, double rate) {
+                                             std::span<const weather::SphericalCap> caps, double rate,
+                                             TileCache* cache) {
   const std::vector<weather::CloudLayer> layers = weather.layersAt(clock_s);
   const std::vector<weather::Region> regions = weather.regionsAt(clock_s);
   // A forecast's convective layer is cumulus whose tiles blend into
@@ -35,9 +36,13 @@ std::vector<weather::StormCell> stormCellsIn(const LiveWeather& weather, double 
   if (!anyCumulonimbus(layers, regions) && !weather.forecast()) return {};
   std::map<std::uint64_t, weather::StormCell> cells;
   for (const weather::SphericalCap& cap : caps) {
-    const weather::WeatherSnapshot snapshot = subscriberSnapshot(weather, clock_s, cap, kLightningTileLevel);
+    const weather::WeatherSnapshot snapshot = subscriberSnapshot(weather, clock_s, cap, kLightningTileLevel, cache);
     if (snapshot.tileLevel != kLightningTileLevel) continue;  // not at the process's level: none drawn
-    const std::vector<std::uint64_t> covering = weather::coverCap(cap, kLightningTileLevel, kDefaultMaxCells);
+    // The cache's covering at the level is coverCap's at it.
+    const TileCache::Entry* entry = cache ? &cache->covering(cap, kLightningTileLevel, kDefaultMaxCells) : nullptr;
+    const std::vector<std::uint64_t> covering = entry && entry->covering.level == kLightningTileLevel
+                                                    ? entry->covering.cells
+                                                    : weather::coverCap(cap, kLightningTileLevel, kDefaultMaxCells);
     for (const weather::StormCell& c : weather::stormCells(snapshot, covering, rate)) cells.emplace(c.cellId, c);
   }
   std::vector<weather::StormCell> list;
@@ -74,7 +79,7 @@ std::vector<weather::LightningFlash> LightningService::tick(const LiveWeather& w
                      clock_s >= cellsAt_s_ && clock_s - cellsAt_s_ < kStormCellRefresh_s &&
                      std::equal(caps.begin(), caps.end(), cellsCaps_.begin(), cellsCaps_.end(), same);
   if (!fresh) {
-    cells_ = stormCellsIn(weather, clock_s, caps, options_.rate_perMin100km2);
+    cells_ = stormCellsIn(weather, clock_s, caps, options_.rate_perMin100km2, cache_);
     cellsCaps_ = caps;
     cellsAccepted_ = weather.accepted();
     cellsAt_s_ = clock_s;
@@ -132,7 +137,7 @@ std::vector<weather::LightningFlash> LightningService::drawIn(const LiveWeather&
       if (computed) *computed = true;
       ++counters_.requestCellsComputed;
       requestCells_.push_back({start_s, caps, weather.accepted(),
-                               stormCellsIn(weather, start_s, caps, options_.rate_perMin100km2)});
+                               stormCellsIn(weather, start_s, caps, options_.rate_perMin100km2, cache_)});
       while (requestCells_.size() > kRequestCellsKept) requestCells_.pop_front();
       kept = std::prev(requestCells_.end());
     }

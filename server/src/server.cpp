@@ -78,7 +78,11 @@ Server::Server(ServerOptions options, WeatherState state)
       acceptRetry_(io_),
       heartbeat_(io_),
       timelineTimer_(io_),
-      lightning_(options_.lightning) {
+      // A covering for every area the subscribers may hold at once, and the
+      // lightning's own.
+      tileCache_(std::max(TileCache::kDefaultMaxCoverings,
+                          options_.maxSubscribers * stream::kMaxAreas + kMaxLightningAreas)),
+      lightning_(options_.lightning, &tileCache_) {
   // Every accepted change, from whichever input, reaches every subscriber;
   // it may have moved the clock or brought a new timeline.
   weather_.addListener([this](const ChangeEvent&) {
@@ -301,18 +305,26 @@ void Server::fireTimeline() {
 double Server::clockNow() const { return weather_.clock().at(options_.wallNow()); }
 
 void Server::weatherChanged() {
+  areaFrames_.clear(std::chrono::steady_clock::now());
   registry_.forEach([](Session& s) { s.weatherChanged(); });
 }
 
-BuiltSnapshot Server::snapshotFor(const stream::Subscribe& request) {
-  const double clock_s = clockNow();
-  const auto field = weather_.fieldAt(clock_s);
-  BuiltSnapshot built =
-      buildSnapshotWithGenerations(request, weather_.layersAt(clock_s), clock_s, options_.maxCellsPerSnapshot,
-                                   weather_.regionsAt(clock_s), &tileCache_, field.get());
-  log_->debug("event=snapshot level={} asked={} tiles={}", built.snapshot.tileLevel, request.tileLevel,
-              tileCount(built));
-  return built;
+std::shared_ptr<const AreaSnapshot> Server::snapshotFor(const stream::Subscribe& request) {
+  return areaFrames_.snapshot(request, std::chrono::steady_clock::now(), [&] {
+    const double clock_s = clockNow();
+    const auto field = weather_.fieldAt(clock_s);
+    BuiltSnapshot built =
+        buildSnapshotWithGenerations(request, weather_.layersAt(clock_s), clock_s, options_.maxCellsPerSnapshot,
+                                     weather_.regionsAt(clock_s), &tileCache_, field.get());
+    log_->debug("event=snapshot level={} asked={} tiles={}", built.snapshot.tileLevel, request.tileLevel,
+                tileCount(built));
+    return built;
+  });
+}
+
+std::shared_ptr<const Frame> Server::frameFor(const std::shared_ptr<const AreaSnapshot>& held,
+                                              const std::shared_ptr<const AreaSnapshot>& now) {
+  return areaFrames_.frame(held, now);
 }
 
 void Server::frameSent(std::size_t bytes) {

@@ -29,12 +29,6 @@ Frame encodeErrorFrame(const Error& error) {
   return stream::encodeFrame(stream::encodeMessage(message));
 }
 
-bool sameArea(const stream::Subscribe& a, const stream::Subscribe& b) {
-  return a.areaIndex == b.areaIndex && a.area.centerLat_deg == b.area.centerLat_deg && a.area.centerLon_deg == b.area.centerLon_deg &&
-         a.area.radius_m == b.area.radius_m && a.altMin_m == b.altMin_m && a.altMax_m == b.altMax_m &&
-         a.tileLevel == b.tileLevel;
-}
-
 }  // namespace
 
 Session::Session(asio::ip::tcp::socket socket, std::uint64_t id, SessionHandler& handler,
@@ -280,20 +274,11 @@ void Session::onStallTimer(const boost::system::error_code& ec, std::uint64_t ge
 }
 
 Frame Session::weatherFrame(const stream::Subscribe& request) {
-  BuiltSnapshot built = handler_.snapshotFor(request);
+  std::shared_ptr<const AreaSnapshot> now = handler_.snapshotFor(request);
   Area& area = areas_[request.areaIndex];
-  std::optional<Frame> frame;
-  if (area.peerHolds && area.peerHoldsFor && sameArea(*area.peerHoldsFor, request)) {
-    // A delta that resends most tiles is no better than the snapshot (tiles
-    // are nearly all of either's size).
-    if (auto delta = diffBuilt(*area.peerHolds, built);
-        delta && (delta->tiles.empty() || 4 * delta->tiles.size() < 3 * tileCount(built)))
-      frame = stream::encodeFrame(stream::encodeMessage(*delta));
-  }
-  if (!frame) frame = stream::encodeFrame(stream::encodeMessage(wholeSnapshot(built)));
-  area.peerHolds = std::move(built);
-  area.peerHoldsFor = request;
-  return std::move(*frame);
+  const std::shared_ptr<const Frame> frame = handler_.frameFor(area.peerHolds, now);
+  area.peerHolds = std::move(now);
+  return *frame;
 }
 
 void Session::onWritten(const boost::system::error_code& ec) {

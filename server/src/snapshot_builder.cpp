@@ -145,11 +145,13 @@ constexpr double kDegToRad = std::numbers::pi / 180.0;
 struct ReachBound {
   UnitVector centre;
   double minDot = -2;  // a reach past the antipode reaches everything
+  double angle_rad = 0;
 };
 
 ReachBound reachBound(const weather::Region& r) {
   const double angle_rad = reachOf(r) / kMeanEarthRadius_m;
-  return {unitVector(r.centerLat_deg, r.centerLon_deg), angle_rad >= std::numbers::pi ? -2.0 : std::cos(angle_rad)};
+  return {unitVector(r.centerLat_deg, r.centerLon_deg), angle_rad >= std::numbers::pi ? -2.0 : std::cos(angle_rad),
+          angle_rad};
 }
 
 double dot(const UnitVector& a, const UnitVector& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
@@ -161,16 +163,65 @@ TileCache::ShapeKey shapeKey(const weather::Region& r) {
           bitsOf(r.cornerRadius_m), bitsOf(r.rotation_deg), bitsOf(r.transition_m)};
 }
 
-// Bounds of the cache: areas (renderers re-subscribe as they move), region
+// Bounds of the cache (besides its areas, TileCache::maxCoverings_): region
 // shapes (a drifting or moving region has a new shape at every change) across
 // coverings, and shapes per covering.
-constexpr std::size_t kMaxCachedCoverings = 256;
 constexpr std::size_t kMaxCachedShapes = 64;
 // Cell weights kept across coverings, ~60 bytes each in the hash maps: 1M is
 // ~60 MB, and a storm cell 60 km across reaches ~400 cells of each of 64
 // subscribers' level 11 coverings (the bench), mostly the same ones.
 constexpr std::size_t kMaxCachedCellWeights = 1'000'000;
 constexpr std::size_t kMaxShapesPerCovering = 8;
+
+// Cells per group of a covering (TileCache::Entry::groups): a parent this
+// many levels coarser has up to 4^3 = 64 children, so a 120 km area at
+// level 11 (~2900 cells) is ~50 groups, and a storm cell 60 km across
+// tests ~10 groups' cells instead of all of them.
+constexpr int kGroupLevels = 3;
+// Rounding in the group test (acos near 0 and 1 loses ~1e-8 rad).
+constexpr double kGroupSlack_rad = 1e-6;
+
+// The parent of S2 cell `id` at `level` (<= its own): S2CellId::parent,
+// whose lowest set bit marks a cell's level (s2cellid.h).
+std::uint64_t parentCell(std::uint64_t id, int level) {
+  const std::uint64_t lsb = std::uint64_t{1} << (2 * (30 - level));
+  return (id & (~lsb + 1)) | lsb;
+}
+
+std::vector<TileCache::Entry::CellGroup> cellGroups(std::span<const std::uint64_t> cells, int level,
+                                                    std::span<const UnitVector> units) {
+  std::vector<TileCache::Entry::CellGroup> groups;
+  const int parentLevel = std::max(0, level - kGroupLevels);
+  std::uint64_t parent = 0;
+  for (std::size_t ci = 0; ci < cells.size(); ++ci) {
+    const std::uint64_t p = parentCell(cells[ci], parentLevel);
+    if (groups.empty() || p != parent) {
+      groups.push_back({static_cast<std::uint32_t>(ci), static_cast<std::uint32_t>(ci), {0, 0, 0}, 0});
+      parent = p;
+    }
+    groups.back().end = static_cast<std::uint32_t>(ci + 1);
+  }
+  for (auto& g : groups) {
+    UnitVector sum{0, 0, 0};
+    for (std::size_t ci = g.begin; ci < g.end; ++ci) {
+      sum.x += units[ci].x;
+      sum.y += units[ci].y;
+      sum.z += units[ci].z;
+    }
+    const double norm = std::sqrt(sum.x * sum.x + sum.y * sum.y + sum.z * sum.z);
+    // Centres spread over more than a hemisphere (only at level 0-2): the
+    // whole sphere is the group's cap.
+    if (!(norm > 1e-9)) {
+      g.centre = units[g.begin];
+      g.radius_rad = std::numbers::pi;
+      continue;
+    }
+    g.centre = {sum.x / norm, sum.y / norm, sum.z / norm};
+    for (std::size_t ci = g.begin; ci < g.end; ++ci)
+      g.radius_rad = std::max(g.radius_rad, std::acos(std::clamp(dot(g.centre, units[ci]), -1.0, 1.0)));
+  }
+  return groups;
+}
 
 // A region's layer of the layer being derived, with that region's weight at
 // the cells it reaches.
@@ -187,15 +238,17 @@ void keepWeight(TileCache::Weights& out, std::size_t cell, double w) {
   out.weights.push_back(w);
 }
 
-// One layer's tiles over `cells`: the global value blended towards the
-// weighted mean of the contributing regions' values; none when the layer
+// One layer's tiles over `shared` cells: the global value blended towards
+// the weighted mean of the contributing regions' values; none when the layer
 // comes out the same everywhere. Only the cells a region reaches are
-// blended (a storm cell reaches a few hundred of an area's thousands).
-LayerTiles layerTiles(std::span<const std::uint64_t> cells, const weather::CloudLayer& layer,
-                      std::span<const Contribution> contributions,
+// blended (a storm cell reaches a few hundred of an area's thousands), and
+// without a field only their tiles are kept (LayerTiles' sparse form).
+LayerTiles layerTiles(const std::shared_ptr<const std::vector<std::uint64_t>>& shared,
+                      const weather::CloudLayer& layer, std::span<const Contribution> contributions,
                       std::span<const weather::CoverageTile> field = {}) {
   LayerTiles out;
   if (contributions.empty() && field.empty()) return out;
+  const std::span<const std::uint64_t> cells(*shared);
   // Per reached cell, the sums over the contributions in their order.
   struct Sum {
     std::uint32_t cell;
@@ -239,6 +292,9 @@ LayerTiles layerTiles(std::span<const std::uint64_t> cells, const weather::Cloud
     }
     return t;
   };
+  auto differs = [&](const weather::CoverageTile& t) {
+    return t.coverage != coverage || t.density != density || t.blendType != weather::CloudType::None;
+  };
   std::vector<std::pair<std::uint32_t, weather::CoverageTile>> blended;
   bool varies = false;
   for (const Sum& s : sums) {
@@ -251,28 +307,38 @@ LayerTiles layerTiles(std::span<const std::uint64_t> cells, const weather::Cloud
       t.blendType = s.heaviestType;
       t.blend = static_cast<float>(w);
     }
-    varies = varies || t.coverage != coverage || t.density != density || t.blendType != weather::CloudType::None;
+    varies = varies || differs(t);
     blended.emplace_back(s.cell, t);
   }
+  // (Several contributions list their cells in the order each first reached them.)
+  std::sort(blended.begin(), blended.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  out.cells = shared;
+  out.layerId = layer.id;
+  out.reached.reserve(blended.size());
+  for (const auto& b : blended) out.reached.push_back(b.first);
+  if (field.empty()) {
+    // Every cell no region reaches has the layer's own value.
+    if (!varies) return LayerTiles{};
+    out.coverage = coverage;
+    out.density = density;
+    out.tiles.reserve(blended.size());
+    for (const auto& b : blended) out.tiles.push_back(b.second);
+    return out;
+  }
+  out.dense = true;
   out.tiles.reserve(cells.size());
   for (std::size_t ci = 0; ci < cells.size(); ++ci) {
     out.tiles.push_back(baseAt(ci));
-    const auto& t = out.tiles.back();
-    varies = varies || t.coverage != coverage || t.density != density || t.blendType != weather::CloudType::None;
+    varies = varies || differs(out.tiles.back());
   }
   // A layer the same everywhere in the area needs no tiles: a renderer takes
   // a layer without tiles as uniform (its own coverage and density).
   if (!varies) return LayerTiles{};
   // With a field every tile may differ from the layer's own value, and a
   // diff compares them all (NaN never equals the next snapshot's).
-  out.coverage = field.empty() ? coverage : std::numeric_limits<float>::quiet_NaN();
+  out.coverage = std::numeric_limits<float>::quiet_NaN();
   out.density = density;
-  out.reached.reserve(blended.size());
-  for (const auto& [ci, t] : blended) {
-    out.tiles[ci] = t;
-    out.reached.push_back(ci);
-  }
-  std::sort(out.reached.begin(), out.reached.end());
+  for (const auto& [ci, t] : blended) out.tiles[ci] = t;
   return out;
 }
 
@@ -300,7 +366,7 @@ const weather::CloudLayer* regionLayer(const weather::Region& r, std::uint32_t i
 
 // Every layer's tiles from every region's weight per cell (weights[k] for
 // region k; null where it reaches no cell).
-std::vector<weather::CoverageTile> tilesFromWeights(std::span<const std::uint64_t> cells,
+std::vector<weather::CoverageTile> tilesFromWeights(const std::shared_ptr<const std::vector<std::uint64_t>>& cells,
                                                     std::span<const weather::CloudLayer> layers,
                                                     std::span<const weather::Region> regions,
                                                     std::span<const TileCache::Weights* const> weights,
@@ -316,11 +382,10 @@ std::vector<weather::CoverageTile> tilesFromWeights(std::span<const std::uint64_
         contributions.push_back({weights[k], rl});
     base.clear();
     if (field && field->gives(layer.id)) {
-      base.resize(cells.size());
+      base.resize(cells->size());
       field->sample(layer.id, centres, base);
     }
-    const auto t = layerTiles(cells, layer, contributions, base).tiles;
-    tiles.insert(tiles.end(), t.begin(), t.end());
+    layerTiles(cells, layer, contributions, base).appendTo(tiles);
   }
   return tiles;
 }
@@ -335,17 +400,19 @@ UnitVector unitVector(double lat_deg, double lon_deg) {
 TileCache::Entry& TileCache::covering(const weather::SphericalCap& cap, int wantedLevel, std::size_t maxCells) {
   const auto key = std::tuple{cap.centerLat_deg, cap.centerLon_deg, cap.radius_m, wantedLevel, maxCells};
   if (auto it = coverings_.find(key); it != coverings_.end()) return it->second;
-  if (coverings_.size() >= kMaxCachedCoverings) coverings_.clear();
+  if (coverings_.size() >= std::max<std::size_t>(maxCoverings_, 1)) coverings_.clear();
   Entry e;
   e.serial = ++coveringSerials_;
   e.cap = cap;
   e.covering = coverArea(cap, wantedLevel, maxCells);
+  e.cells = std::make_shared<const std::vector<std::uint64_t>>(e.covering.cells);
   e.centres.reserve(e.covering.cells.size());
   e.units.reserve(e.covering.cells.size());
   for (std::uint64_t c : e.covering.cells) {
     e.centres.push_back(weather::cellCentre(c));
     e.units.push_back(unitVector(e.centres.back().lat_deg, e.centres.back().lon_deg));
   }
+  e.groups = cellGroups(e.covering.cells, e.covering.level, e.units);
   return coverings_.emplace(key, std::move(e)).first->second;
 }
 
@@ -388,9 +455,15 @@ const TileCache::Weights& TileCache::weights(Entry& entry, const weather::Region
   if (auto it = entry.shapeWeights.find(shape); it != entry.shapeWeights.end()) return it->second;
   Weights w;
   const ReachBound reach = reachBound(region);
-  for (std::size_t ci = 0; ci < entry.covering.cells.size(); ++ci)
-    if (dot(entry.units[ci], reach.centre) >= reach.minDot)
-      keepWeight(w, ci, cellWeight(shape, region, entry.covering.cells[ci], entry.centres[ci]));
+  for (const Entry::CellGroup& g : entry.groups) {
+    // (A bound past the antipode takes every group.)
+    if (reach.minDot > -1 &&
+        std::acos(std::clamp(dot(g.centre, reach.centre), -1.0, 1.0)) > reach.angle_rad + g.radius_rad + kGroupSlack_rad)
+      continue;
+    for (std::size_t ci = g.begin; ci < g.end; ++ci)
+      if (dot(entry.units[ci], reach.centre) >= reach.minDot)
+        keepWeight(w, ci, cellWeight(shape, region, entry.covering.cells[ci], entry.centres[ci]));
+  }
   return entry.shapeWeights.emplace(shape, std::move(w)).first->second;
 }
 
@@ -421,7 +494,8 @@ std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> ce
     }
     if (!weights[k].cells.empty()) byRegion[k] = &weights[k];
   }
-  return tilesFromWeights(cells, layers, regions, byRegion, field, centres);
+  return tilesFromWeights(std::make_shared<const std::vector<std::uint64_t>>(cells.begin(), cells.end()), layers,
+                          regions, byRegion, field, centres);
 }
 
 std::vector<LayerRun> deriveRuns(TileCache& cache, TileCache::Entry& entry,
@@ -472,11 +546,11 @@ std::vector<LayerRun> deriveRuns(TileCache& cache, TileCache::Entry& entry,
         base.resize(entry.covering.cells.size());
         field->sample(layer.id, entry.centres, base);
       }
-      auto tiles = layerTiles(entry.covering.cells, layer, contributions, base);
+      auto tiles = layerTiles(entry.cells, layer, contributions, base);
       tiles.covering = entry.serial;
       // New tiles, not the old ones overwritten: snapshots sent before still
       // hold the old.
-      memo.tiles = tiles.tiles.empty() ? nullptr : std::make_shared<const LayerTiles>(std::move(tiles));
+      memo.tiles = tiles.cells ? std::make_shared<const LayerTiles>(std::move(tiles)) : nullptr;
       memo.inputs = inputs;
       memo.generation = cache.nextGeneration();
       memo.valid = true;
@@ -491,12 +565,35 @@ std::vector<LayerRun> deriveRuns(TileCache& cache, TileCache::Entry& entry,
   return runs;
 }
 
+weather::CoverageTile LayerTiles::at(std::size_t k) const {
+  SKY_ASSERT(k < size());
+  if (dense) return tiles[k];
+  const auto it = std::lower_bound(reached.begin(), reached.end(), static_cast<std::uint32_t>(k));
+  if (it != reached.end() && *it == k) return tiles[static_cast<std::size_t>(it - reached.begin())];
+  return {(*cells)[k], layerId, coverage, density};
+}
+
+void LayerTiles::appendTo(std::vector<weather::CoverageTile>& out) const {
+  if (dense) {
+    out.insert(out.end(), tiles.begin(), tiles.end());
+    return;
+  }
+  out.reserve(out.size() + size());
+  std::size_t next = 0;  // into reached / tiles
+  for (std::size_t k = 0; k < size(); ++k) {
+    if (next < reached.size() && reached[next] == k)
+      out.push_back(tiles[next++]);
+    else
+      out.push_back({(*cells)[k], layerId, coverage, density});
+  }
+}
+
 weather::WeatherSnapshot wholeSnapshot(const BuiltSnapshot& built) {
   weather::WeatherSnapshot whole = built.snapshot;
   if (built.runs.empty()) return whole;
   whole.tiles.reserve(tileCount(built));
   for (const LayerRun& run : built.runs)
-    if (run.tiles) whole.tiles.insert(whole.tiles.end(), run.tiles->tiles.begin(), run.tiles->tiles.end());
+    if (run.tiles) run.tiles->appendTo(whole.tiles);
   return whole;
 }
 

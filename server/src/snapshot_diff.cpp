@@ -32,12 +32,9 @@ const LayerRun* runOf(const BuiltSnapshot& s, std::uint32_t layerId) {
 // Whether two runs hold tiles for the same cells in the same order (known
 // without reading them when both are over one covering).
 bool sameCells(const LayerTiles& was, const LayerTiles& now) {
-  const auto& a = was.tiles;
-  const auto& b = now.tiles;
-  if (a.size() != b.size()) return false;
-  if (was.covering != 0 && was.covering == now.covering) return true;
-  return std::equal(a.begin(), a.end(), b.begin(),
-                    [](const auto& x, const auto& y) { return x.cellId == y.cellId && x.layerId == y.layerId; });
+  if (was.size() != now.size() || was.layerId != now.layerId) return false;
+  if ((was.covering != 0 && was.covering == now.covering) || was.cells == now.cells) return true;
+  return *was.cells == *now.cells;
 }
 
 // Appends to `out` the tiles of `now` that differ from `was` (same cells, in
@@ -45,24 +42,36 @@ bool sameCells(const LayerTiles& was, const LayerTiles& now) {
 // only the reached cells of either can differ: a storm cell moving over an
 // area compares its few hundred cells, not the area's thousands.
 void changedTiles(const LayerTiles& was, const LayerTiles& now, std::vector<weather::CoverageTile>& out) {
-  const auto& a = was.tiles;
-  const auto& b = now.tiles;
   if (was.coverage != now.coverage || was.density != now.density) {
+    std::vector<weather::CoverageTile> a, b;
+    was.appendTo(a);
+    now.appendTo(b);
     for (std::size_t k = 0; k < b.size(); ++k)
       if (!(a[k] == b[k])) out.push_back(b[k]);
     return;
   }
-  // The union of both reached sets, ascending (so `out` keeps `now`'s order).
-  auto i = was.reached.begin(), j = now.reached.begin();
-  while (i != was.reached.end() || j != now.reached.end()) {
-    std::uint32_t k;
-    if (j == now.reached.end() || (i != was.reached.end() && *i < *j))
-      k = *i++;
-    else if (i == was.reached.end() || *j < *i)
-      k = *j++;
-    else
-      k = (++i, *j++);
-    if (!(a[k] == b[k])) out.push_back(b[k]);
+  // The union of both reached sets, ascending (so `out` keeps `now`'s order);
+  // a cell only one side reaches has the other's own value there.
+  const auto tileOf = [](const LayerTiles& t, std::size_t pos) {
+    return t.dense ? t.tiles[t.reached[pos]] : t.tiles[pos];
+  };
+  const auto unreached = [](const LayerTiles& t, std::uint32_t k) {
+    return t.dense ? t.tiles[k] : weather::CoverageTile{(*t.cells)[k], t.layerId, t.coverage, t.density};
+  };
+  std::size_t i = 0, j = 0;
+  while (i < was.reached.size() || j < now.reached.size()) {
+    weather::CoverageTile a, b;
+    if (j == now.reached.size() || (i < was.reached.size() && was.reached[i] < now.reached[j])) {
+      a = tileOf(was, i);
+      b = unreached(now, was.reached[i++]);
+    } else if (i == was.reached.size() || now.reached[j] < was.reached[i]) {
+      a = unreached(was, now.reached[j]);
+      b = tileOf(now, j++);
+    } else {
+      a = tileOf(was, i++);
+      b = tileOf(now, j++);
+    }
+    if (!(a == b)) out.push_back(b);
   }
 }
 
@@ -108,7 +117,7 @@ std::optional<weather::WeatherDelta> diffBuilt(const BuiltSnapshot& before, cons
     const LayerRun& now = after.runs[i];
     const LayerRun* was = runOf(before, after.snapshot.layers[i].id);
     if (!was) {  // a new layer: all its tiles
-      if (now.tiles) delta->tiles.insert(delta->tiles.end(), now.tiles->tiles.begin(), now.tiles->tiles.end());
+      if (now.tiles) now.tiles->appendTo(delta->tiles);
       continue;
     }
     if (now.generation != 0 && now.generation == was->generation && beforeLevel == afterLevel) continue;
@@ -117,7 +126,7 @@ std::optional<weather::WeatherDelta> diffBuilt(const BuiltSnapshot& before, cons
       return whole();  // the layer lost its tiles: no delta says that
     }
     if (!was->tiles) {  // the layer gained tiles (a region came): all of them
-      delta->tiles.insert(delta->tiles.end(), now.tiles->tiles.begin(), now.tiles->tiles.end());
+      now.tiles->appendTo(delta->tiles);
       continue;
     }
     if (!sameCells(*was->tiles, *now.tiles)) return whole();

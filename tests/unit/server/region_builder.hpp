@@ -1,5 +1,6 @@
-// Test builder shared by the server's region and tile-cache tests: a square
-// region (CIGI Environmental Region Control shape, no rotation or rounding).
+// Test builders shared by the server's region, tile-cache and area-frame
+// tests: a square region (CIGI Environmental Region Control shape, no
+// rotation or rounding), and a cloud layer stacked by its id.
 #pragma once
 
 #include <cstdint>
@@ -21,6 +22,20 @@ inline weather::Region squareRegion(std::uint32_t id, double lat, double lon, do
   r.transition_m = transition_m;
   r.layers = std::move(layers);
   return r;
+}
+
+// Layer `id` 1000 m deep with its base at 1500 + 2000 * id m, density 0.8,
+// a 10 m/s west wind.
+inline weather::CloudLayer stackedLayer(std::uint32_t id, weather::CloudType type, double coverage) {
+  weather::CloudLayer l;
+  l.id = id;
+  l.type = type;
+  l.base_m = 1500.0 + 2000.0 * id;
+  l.thickness_m = 1000;
+  l.coverage = coverage;
+  l.density = 0.8;
+  l.wind = {10, 270, 0};
+  return l;
 }
 
 }  // namespace sky::server::test

@@ -4,6 +4,7 @@
 // cache equals one built from scratch without it (the plain deriveTiles path,
 // which keeps nothing between calls); and the memo is really used (layers no
 // change touched come back as hits), so these comparisons test it.
+#include <algorithm>
 #include <functional>
 
 #include <gtest/gtest.h>
@@ -15,17 +16,7 @@
 namespace sky::server {
 namespace {
 
-weather::CloudLayer layer(std::uint32_t id, weather::CloudType type, double coverage) {
-  weather::CloudLayer l;
-  l.id = id;
-  l.type = type;
-  l.base_m = 1500.0 + 2000.0 * id;
-  l.thickness_m = 1000;
-  l.coverage = coverage;
-  l.density = 0.8;
-  l.wind = {10, 270, 0};
-  return l;
-}
+constexpr auto layer = test::stackedLayer;
 
 constexpr auto region = test::squareRegion;
 
@@ -262,6 +253,45 @@ TEST_F(TileCacheTest, SnapshotsShareTheCachesTilesAndKeepTheirOwnAcrossAChange) 
   EXPECT_FALSE(wholeSnapshot(after).tiles == held.tiles);
   // And the new one is what deriving from scratch gives.
   EXPECT_TRUE(wholeSnapshot(after).tiles == buildSnapshot(area, global, 0.0, kDefaultMaxCells, regions).tiles);
+}
+
+// Issue 27: a layer only a small region reaches keeps the tiles of the
+// cells it reaches, not one per cell of the area (writing every cell's tile
+// for every subscriber at every change was the regional storm's largest
+// cost); every other cell still reads as the layer's own value, and the
+// whole snapshot still has one tile per cell, in the covering's order.
+TEST_F(TileCacheTest, ALayerOnlyAStormReachesKeepsOnlyTheReachedTiles) {
+  const BuiltSnapshot built = buildSnapshotWithGenerations(area, global, 0.0, kDefaultMaxCells, regions, &cache);
+  const auto& layers = built.snapshot.layers;
+  const auto storm = std::find_if(layers.begin(), layers.end(), [](const auto& l) { return l.id == 6; });
+  ASSERT_NE(storm, layers.end());
+  const LayerRun& run = built.runs[static_cast<std::size_t>(storm - layers.begin())];
+  ASSERT_TRUE(run.tiles);
+  const LayerTiles& t = *run.tiles;
+  const std::vector<std::uint64_t> cells = coverArea(area.area, area.tileLevel, kDefaultMaxCells).cells;
+  ASSERT_EQ(t.size(), cells.size());
+  EXPECT_FALSE(t.dense);
+  // The storm is 8 km square with a 4 km perimeter in a 60 km area.
+  EXPECT_GT(t.tiles.size(), 0u);
+  EXPECT_LT(t.tiles.size() * 10, cells.size()) << "a tile per reached cell only";
+  EXPECT_EQ(t.tiles.size(), t.reached.size());
+  std::vector<weather::CoverageTile> whole;
+  t.appendTo(whole);
+  ASSERT_EQ(whole.size(), cells.size());
+  std::size_t covered = 0;
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    EXPECT_EQ(whole[k].cellId, cells[k]);
+    EXPECT_EQ(whole[k].layerId, 6u);
+    EXPECT_EQ(t.at(k), whole[k]);
+    // Beyond the storm's reach: the region-only layer's own value, none.
+    if (!std::binary_search(t.reached.begin(), t.reached.end(), static_cast<std::uint32_t>(k))) {
+      EXPECT_EQ(whole[k].coverage, 0.0f);
+      EXPECT_EQ(whole[k].density, 0.8f);
+    } else if (whole[k].coverage == 1.0f) {
+      ++covered;
+    }
+  }
+  EXPECT_GT(covered, 0u) << "inside the storm its full cover";
 }
 
 }  // namespace

@@ -19,6 +19,7 @@
 namespace sky::server {
 
 class LiveWeather;
+class TileCache;
 
 // Tiles of this level answer by default: the level skyshell-render's
 // 120 km subscription gets (cells about 4.9 km across).
@@ -39,9 +40,10 @@ Result<ConditionsQuery> parseConditionsQuery(std::string_view query);
 
 // The snapshot a renderer subscribed to `cap` at tile level `level` holds at
 // weather clock clock_s (its tiles' fractions quantised as the stream
-// carries them): what the point answers are computed from.
+// carries them): what the point answers are computed from. cache: as for
+// buildSnapshot (the same tiles, fewer derived).
 weather::WeatherSnapshot subscriberSnapshot(const LiveWeather& weather, double clock_s, const weather::SphericalCap& cap,
-                                           int level);
+                                           int level, TileCache* cache = nullptr);
 
 // The answer at the server's weather clock now (see API.md).
 nlohmann::json conditionsJson(const LiveWeather& weather, const ConditionsQuery& q);

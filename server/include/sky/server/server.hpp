@@ -20,6 +20,7 @@
 #include <boost/asio/steady_timer.hpp>
 
 #include "sky/core/result.hpp"
+#include "sky/server/area_frames.hpp"
 #include "sky/server/session.hpp"
 #include "sky/server/session_registry.hpp"
 #include "sky/server/snapshot_builder.hpp"
@@ -139,7 +140,9 @@ class Server final : private SessionHandler {
   void shutdown();
   double clockNow() const;
 
-  BuiltSnapshot snapshotFor(const stream::Subscribe& request) override;
+  std::shared_ptr<const AreaSnapshot> snapshotFor(const stream::Subscribe& request) override;
+  std::shared_ptr<const Frame> frameFor(const std::shared_ptr<const AreaSnapshot>& held,
+                                        const std::shared_ptr<const AreaSnapshot>& now) override;
   void sessionClosed(Session& session) override;
   void frameSent(std::size_t bytes) override;
   void sessionStalled(Session& session) override;
@@ -175,6 +178,7 @@ class Server final : private SessionHandler {
   Rejections rejections_;
   std::vector<std::function<void()>> onRenderersChanged_;
   TileCache tileCache_;
+  AreaFrames areaFrames_;  // cleared at every change (weatherChanged)
   LightningService lightning_;
   HostClocks hostClocks_;
   // When a host clock change was last logged at info: a peer that sends

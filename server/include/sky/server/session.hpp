@@ -17,6 +17,7 @@
 #include <boost/asio/steady_timer.hpp>
 
 #include "sky/core/result.hpp"
+#include "sky/server/area_frames.hpp"
 #include "sky/server/outbox.hpp"
 #include "sky/server/renderer_info.hpp"
 #include "sky/server/snapshot_builder.hpp"
@@ -34,8 +35,13 @@ class Session;
 // What a session needs from its owner. Called on the io_context's thread.
 class SessionHandler {
  public:
-  // The snapshot answering `request`, at the weather clock of now.
-  virtual BuiltSnapshot snapshotFor(const stream::Subscribe& request) = 0;
+  // The snapshot answering `request`, at the weather clock of now (or of
+  // moments ago, shared with other subscribers of the area: AreaFrames).
+  virtual std::shared_ptr<const AreaSnapshot> snapshotFor(const stream::Subscribe& request) = 0;
+  // The frame taking a peer that holds `held` (null: nothing) to `now`
+  // (encodeWeatherFrame; shared with the peers holding the same).
+  virtual std::shared_ptr<const Frame> frameFor(const std::shared_ptr<const AreaSnapshot>& held,
+                                                const std::shared_ptr<const AreaSnapshot>& now) = 0;
   // The session has closed its socket and will do no more work.
   virtual void sessionClosed(Session& session) = 0;
   // A frame of `bytes` bytes went out completely.
@@ -154,13 +160,12 @@ class Session : public std::enable_shared_from_this<Session> {
   stream::FrameDecoder decoder_{stream::kMaxSubscriberFrameBytes};
   // Per area index (Subscribe::areaIndex), each on its own: the latest
   // subscription asked for; what the peer holds, the last snapshot sent (or
-  // reached by deltas), and the subscription it answered. A new snapshot of
+  // reached by deltas) with the subscription it answered. A new snapshot of
   // the same subscription goes out as the Delta from it when a delta can say
   // it and is smaller.
   struct Area {
     std::optional<stream::Subscribe> subscription;
-    std::optional<BuiltSnapshot> peerHolds;
-    std::optional<stream::Subscribe> peerHoldsFor;
+    std::shared_ptr<const AreaSnapshot> peerHolds;
   };
   std::array<Area, stream::kMaxAreas> areas_;
   // The newest CameraReport and when it arrived (reports replace each other).

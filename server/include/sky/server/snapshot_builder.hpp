@@ -72,12 +72,29 @@ std::vector<weather::CloudLayer> snapshotLayers(std::span<const weather::CloudLa
 // with what lets two of them be compared without reading them all: the value
 // every tile has that no region reaches (the layer's own coverage and
 // density), and the indices, ascending, of the tiles regions reach (only
-// those can differ from it).
+// those can differ from it). Kept sparse where it can be: a storm cell
+// reaches a few hundred of an area's thousands of cells, and writing every
+// cell's tile for each subscriber at every change was the largest cost of a
+// regional storm (a quarter of the server thread's samples at 256
+// subscribers).
 struct LayerTiles {
-  std::vector<weather::CoverageTile> tiles;
+  // The covering's cells, shared by every layer and run over it.
+  std::shared_ptr<const std::vector<std::uint64_t>> cells;
+  std::uint32_t layerId = 0;
   float coverage = 0, density = 0;
   std::vector<std::uint32_t> reached;
+  // dense: one tile per cell, in the covering's order (a forecast's field
+  // gives every cell its own value). Sparse: the tiles of the `reached`
+  // cells, in that order; every other cell's tile is the layer's own value.
+  bool dense = false;
+  std::vector<weather::CoverageTile> tiles;
   std::uint64_t covering = 0;  // TileCache::Entry::serial of the cells (0: not known)
+
+  std::size_t size() const { return cells ? cells->size() : 0; }
+  // The tile of cell index k (< size()).
+  weather::CoverageTile at(std::size_t k) const;
+  // Appends every tile, in the covering's order.
+  void appendTo(std::vector<weather::CoverageTile>& out) const;
 };
 
 // A unit vector on the mean sphere (x towards 0 N 0 E, z towards the north
@@ -98,6 +115,14 @@ UnitVector unitVector(double lat_deg, double lon_deg);
 // grows past its limit starts again. Used on the server's io thread only.
 class TileCache {
  public:
+  // Coverings kept (renderers re-subscribe as they move) unless told more.
+  static constexpr std::size_t kDefaultMaxCoverings = 256;
+  // maxCoverings: areas kept before the table starts again. Below the number
+  // of areas subscribed, every change would derive every area's tiles anew
+  // (at 512 subscribers with 256, the server saturated): a server keeps one
+  // per area it may serve.
+  explicit TileCache(std::size_t maxCoverings = kDefaultMaxCoverings) : maxCoverings_(maxCoverings) {}
+
   // A region's shape (centre, sizes, corner radius, rotation, transition) as
   // the bit patterns of its values: equal keys are equal shapes, exactly.
   using ShapeKey = std::array<std::uint64_t, 7>;
@@ -123,9 +148,20 @@ class TileCache {
   struct Entry {
     weather::SphericalCap cap;
     Covering covering;
+    std::shared_ptr<const std::vector<std::uint64_t>> cells;  // covering.cells, for the LayerTiles over it
     std::uint64_t serial = 0;  // no other covering this cache made has it
     std::vector<weather::CellCentre> centres;  // of covering.cells
     std::vector<UnitVector> units;             // of centres
+    // Runs of cells with one parent kGroupLevels coarser (S2 orders a
+    // covering's cells so that a parent's children are consecutive), each
+    // with a cap holding their centres: a region's reach is tested against
+    // the groups first, then only the cells of those it may reach.
+    struct CellGroup {
+      std::uint32_t begin = 0, end = 0;  // indices into covering.cells
+      UnitVector centre;
+      double radius_rad = 0;  // from centre to the farthest cell centre
+    };
+    std::vector<CellGroup> groups;
     std::unordered_map<ShapeKey, Weights, ShapeKeyHash> shapeWeights;
     std::map<std::uint32_t, LayerMemo> layers;  // by layer id
     // Per layer id, its wind tiles over this covering (wind_tiles.cpp) and
@@ -170,6 +206,7 @@ class TileCache {
   double cellWeight(const ShapeKey& shape, const weather::Region& region, std::uint64_t cell,
                     const weather::CellCentre& centre);
 
+  std::size_t maxCoverings_;
   std::map<std::tuple<double, double, double, int, std::size_t>, Entry> coverings_;
   // Shape -> cell -> weight, shared by coverings; cellWeightCount_ entries in all.
   std::unordered_map<ShapeKey, std::unordered_map<std::uint64_t, double>, ShapeKeyHash> cellWeights_;
@@ -239,7 +276,7 @@ std::vector<weather::CoverageTile> deriveTiles(std::span<const std::uint64_t> ce
 struct LayerRun {
   std::uint64_t generation = 0;
   std::shared_ptr<const LayerTiles> tiles;  // null: none
-  std::size_t size() const { return tiles ? tiles->tiles.size() : 0; }
+  std::size_t size() const { return tiles ? tiles->size() : 0; }
 };
 
 // Each layer's run of tiles (by index of `layers`) for the cells of a cached
