@@ -70,6 +70,8 @@ int main(int argc, char** argv) {
   sbs.weatherFile = SKY_BENCH_DEFAULT_WEATHER;
   std::string sun = "-0.5,0.5,1", config = sky::bench::kReferenceName, weatherFile = sbs.weatherFile.string();
   unsigned width = 0, height = 0;
+  std::string truthKind;
+  unsigned truthSpp = 64, truthEvents = 0, truthThreads = 0;
 
   app.add_option("--suite", suite, "scene suite file (TOML)")->capture_default_str();
   app.add_option("--scenes", scenes, "comma-separated scene names (default: every scene of the suite)");
@@ -91,6 +93,16 @@ int main(int argc, char** argv) {
   app.add_option("--out", outDir, "output folder (default bench-output/<UTC date-time>)");
   app.add_flag("--quick", quick, "48x27, two scenes (a still and a path), 1 warm-up (no history fill), 1 repeat: checks the bench works");
   app.add_flag("--no-plots", noPlots, "skip the gnuplot plots");
+  app.add_option("--truth", truthKind,
+                 "path: also measure each still against its path-traced frame (slow; resumes from OUT/truth/)")
+      ->check(CLI::IsMember({"path"}));
+  app.add_option("--truth-spp", truthSpp, "--truth path: samples per pixel (passes of 1, 4, 16, ...)")
+      ->capture_default_str()
+      ->check(CLI::Range(1u, 65536u));
+  app.add_option("--truth-events", truthEvents,
+                 "--truth path: scattering events a path may have (0: any; 1: single scattering)")
+      ->capture_default_str();
+  app.add_option("--truth-threads", truthThreads, "--truth path: threads (0: every CPU)")->capture_default_str();
   app.add_flag("--list", list, "list the suite's scenes and the configurations, then exit");
   app.add_flag("--side-by-side", sideBySide, "time one view: one CLOUDPASS line per frame on stdout");
   app.add_option("--height-above-ground", sbs.heightAboveGround_m, "side-by-side: camera height, m")
@@ -192,6 +204,11 @@ int main(int argc, char** argv) {
   }
 
   options.outDir = outDir.empty() ? defaultOutDir() : outDir;
+  if (truthKind == "path") {
+    options.truth.samplesPerPixel = truthSpp;
+    options.truth.maxEvents = truthEvents;
+    options.truth.threads = truthThreads;
+  }
   std::error_code ec;
   std::filesystem::create_directories(options.outDir, ec);
   if (ec) {

@@ -60,7 +60,20 @@ SKY_CORE_CONST real kIceAsymmetry = 0.75;
 // per sample, a real4 does not).
 SKY_CORE_CONST int kScatterOctaves = 4;
 SKY_CORE_CONST real kOctaveExtinction = 0.5;
-SKY_CORE_CONST real kOctaveContribution = 0.5;
+// The parts of the light model a measurement may switch off, one at a
+// time, to see what each brings against the path-traced truth
+// (skyshell-bench --truth path): constants everywhere but in the CPU
+// core, which defines SKY_MODEL_CONST as a data member's type
+// (cpu_core.hpp, CpuReference::setModel). kOctaveContribution 0 leaves
+// single scattering of the sun; kAmbientGain 0 drops the sky's and the
+// scattered sun's diffuse light; kMiePhase false takes one HG lobe of
+// kDiffuseAsymmetry for the droplets' Mie fit.
+#ifndef SKY_MODEL_CONST
+#define SKY_MODEL_CONST SKY_CORE_CONST
+#endif
+SKY_MODEL_CONST real kOctaveContribution = 0.5;
+SKY_MODEL_CONST real kAmbientGain = 1.0;
+SKY_MODEL_CONST bool kMiePhase = true;
 SKY_CORE_CONST real kOctaveEccentricity = 0.5;
 // The march's cost knobs are run-time numbers of the frame (CoreFrame.march,
 // RenderSettings::march, the presets); these are their defaults, the
@@ -341,6 +354,7 @@ real phaseMie(real cosTheta, MieFit m, real gScale) {
 // Mie fit for its droplet diameter, or HG for ice.
 real phaseCloud(real cosTheta, CloudType t, real gScale) {
   if (t.dropletDiameter_um <= 0.0) return phaseHG(cosTheta, kIceAsymmetry * gScale);
+  if (!kMiePhase) return phaseHG(cosTheta, kDiffuseAsymmetry * gScale);
   return phaseMie(cosTheta, mieFit(t.dropletDiameter_um), gScale);
 }
 
@@ -698,7 +712,7 @@ LayerResult marchLayer(CoreFrame f, int li, real3 dir, Span s, real jitter, real
     // The map and the column hold the other layers' shadow in tauSun.
     shade.x = above >= 0.0 ? 1.0 : shade.x;
     real3 scattered = sun * (shade.x * octaveSum(mix(phases1, phases2, cs.blend), tauSun)) +
-                      diffuseLight(L, ct, ph, cs.coverage, cs.densityScale) * shade.y;
+                      diffuseLight(L, ct, ph, cs.coverage, cs.densityScale) * (shade.y * kAmbientGain);
     if (kLightning) scattered += flashInscatter(f.flashCount, p);
     // Hillaire 2016 energy-conserving step: integral over the step of
     // sigma_s L e^{-sigma_t s} = albedo L (1 - e^{-sigma_t len}); its limit
@@ -848,3 +862,5 @@ PixelResult shadePixel(CoreFrame f, real3 dir, real jitter) {
   real depth = transmittance < 1.0 ? depthSum / (1.0 - transmittance) : 0.0;
   return PixelResult(radiance, transmittance, depth);
 }
+
+#undef SKY_MODEL_CONST

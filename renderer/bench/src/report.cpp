@@ -92,6 +92,15 @@ Result<void> runGnuplot(const std::filesystem::path& script, const std::filesyst
 
 std::string reportJson(const BenchReport& report) {
   const auto refs = referenceTimes(report);
+  json variants = json::array();
+  for (const ModelVariantResult& v : report.modelVariants)
+    variants.push_back({{"scene", v.scene},
+                        {"variant", v.variant},
+                        {"width", v.width},
+                        {"height", v.height},
+                        {"error", errorJson(v.error)},
+                        {"mean_ratio", number(v.meanRatio)},
+                        {"rmse_denoised", number(v.rmse)}});
   json cases = json::array();
   for (const CaseResult& c : report.cases) {
     json frames = json::array();
@@ -113,7 +122,15 @@ std::string reportJson(const BenchReport& report) {
                   {"flicker", c.temporal->flicker},
                   {"ghosting", ghosting}};
     }
-    cases.push_back({{"scene", c.scene},
+    json truth = nullptr;
+    if (c.truthError)
+      truth = {{"error", errorJson(*c.truthError)},
+               {"samples_per_pixel", c.truthSamples},
+               {"rmse_denoised", number(c.truthRmse)},
+               {"mean_ratio", number(c.truthMeanRatio)},
+               {"mean_relative_standard_error", c.truthRelativeError}};
+    cases.push_back({{"truth", truth},
+                     {"scene", c.scene},
                      {"configuration", c.configuration},
                      {"path", c.path},
                      {"width", c.width},
@@ -151,7 +168,8 @@ std::string reportJson(const BenchReport& report) {
               {"warmup", report.warmup},
               {"repeats", report.repeats},
               {"path_repeats", report.pathRepeats},
-              {"cases", cases}};
+              {"cases", cases},
+              {"model_variants", variants}};
   return out.dump(2) + "\n";
 }
 
@@ -191,6 +209,36 @@ std::string reportMarkdown(const BenchReport& report) {
       if (!c.repeatable) md << " **repeats differ**";
       md << "\n";
     }
+    md << "\n";
+  }
+  bool anyTruth = false;
+  for (const CaseResult& c : report.cases) anyTruth = anyTruth || c.truthError.has_value();
+  if (anyTruth) {
+    md << "## Against the path-traced truth (`--truth path`)\n\n"
+       << "Each still against its frame path-traced with every order of scattering (renderer/core/src/path_tracer.cpp); "
+          "the truth's own noise is its mean relative standard error per pixel. `reference` here is the model's "
+          "own error; the other rows add what each preset loses. RMSE of the rgb mean: with the truth's noise taken "
+          "out (sqrt(max(0, mean squared difference - mean squared standard error))); the RMSE, PSNR and SSIM after "
+          "it include the truth's noise.\n\n"
+       << "| scene | size | configuration | RMSE of the rgb mean | mean / truth's | RMSE linear | PSNR dB | SSIM | vs reference: RMSE | truth spp | truth noise | sheet |\n"
+       << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const CaseResult& c : report.cases) {
+      if (!c.truthError) continue;
+      md << "| " << c.scene << " | " << c.width << "x" << c.height << " | " << c.configuration << " | "
+         << fixed(c.truthRmse, 4) << " | " << fixed(c.truthMeanRatio, 3) << " | " << fixed(c.truthError->rmseLinear, 4) << " | " << fixed(c.truthError->psnr_dB, 2) << " | "
+         << fixed(c.truthError->ssim, 4) << " | " << fixed(c.error.rmseLinear, 4) << " | " << c.truthSamples << " | "
+         << fixed(100.0 * c.truthRelativeError, 2) << " % | [sheet](contact/" << c.scene << "-" << c.width << "x"
+         << c.height << "-truth.png) |\n";
+    }
+    md << "\n";
+    md << "### What each part of the model brings\n\n"
+       << "The CPU reference (the model in double, the `reference` settings) with one part switched off at a time "
+          "(render::ModelSwitches), against the same truth; mean: the image's mean over the truth's.\n\n"
+       << "| scene | size | model | RMSE of the rgb mean | mean / truth's | RMSE linear | PSNR dB | SSIM |\n|---|---|---|---|---|---|---|---|\n";
+    for (const ModelVariantResult& v : report.modelVariants)
+      md << "| " << v.scene << " | " << v.width << "x" << v.height << " | " << v.variant << " | " << fixed(v.rmse, 4)
+         << " | " << fixed(v.meanRatio, 3) << " | " << fixed(v.error.rmseLinear, 4) << " | "
+         << fixed(v.error.psnr_dB, 2) << " | " << fixed(v.error.ssim, 4) << " |\n";
     md << "\n";
   }
   md << "Flicker: RMS change of the error between consecutive frames (8-bit levels); ghosting: share of the previous "

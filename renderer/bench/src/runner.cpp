@@ -18,6 +18,7 @@
 #include "sky/bench/display.hpp"
 #include "sky/bench/driver_pin.hpp"
 #include "sky/bench/renderer_probe.hpp"
+#include "sky/render/cpu_reference.hpp"
 
 namespace sky::bench {
 
@@ -58,6 +59,9 @@ struct ReferenceFrames {
   std::vector<std::vector<float>> linear;
   std::vector<Srgb8Image> srgb;
   double medianWall_ms = 0;
+  // A still's path-traced truth (--truth path), when asked.
+  std::optional<TruthImage> truth;
+  Srgb8Image truthSrgb;
 };
 
 // What a case keeps for the temporal error and the contact sheet.
@@ -143,6 +147,19 @@ Result<CaseResult> runCase(const LoadedScene& ls, const Configuration& config, c
       auto p = psnr(srgb, reference.srgb[f]);
       auto s = ssim(srgb, reference.srgb[f]);
       if (!rmse || !r8 || !p || !s) return fail(ErrorCode::InvalidArgument, scene.name + ": cannot compare images");
+      if (reference.truth && !cr.path) {
+        const std::vector<float>& truth = reference.truth->image.rgba;
+        auto tr = rmseLinear({res.width, res.height, linear}, {res.width, res.height, truth});
+        auto tp = psnr(srgb, reference.truthSrgb);
+        auto ts = ssim(srgb, reference.truthSrgb);
+        if (!tr || !tp || !ts) return fail(ErrorCode::InvalidArgument, scene.name + ": cannot compare with the truth");
+        cr.truthError = ErrorSummary{*tr, *tp, *ts};
+        cr.truthSamples = reference.truth->samples;
+        cr.truthRelativeError = reference.truth->meanRelativeError;
+        const TruthDistance d = truthDistance(linear, *reference.truth);
+        cr.truthRmse = d.rmse;
+        cr.truthMeanRatio = d.meanRatio;
+      }
       rmseSum += *rmse;
       mseSum += *r8 * *r8;
       ssimSum += *s;
@@ -210,7 +227,8 @@ Result<CaseResult> runCase(const LoadedScene& ls, const Configuration& config, c
 // the reference's same frame: a path's errors come and go, and its last
 // frame may be one of its best.
 Result<std::string> writeSceneImages(const std::string& stem, const std::vector<CaseResult>& cases,
-                                     const std::vector<KeptFrames>& kept, const RunOptions& options) {
+                                     const std::vector<KeptFrames>& kept, const RunOptions& options,
+                                     const ReferenceFrames* truthOf) {
   const std::filesystem::path dir = options.outDir / "contact";
   std::error_code ec;
   std::filesystem::create_directories(dir / "frames", ec);
@@ -239,12 +257,78 @@ Result<std::string> writeSceneImages(const std::string& stem, const std::vector<
                     {&ref, "REFERENCE"},
                     {&heat[i], "SSIM " + fixed(*shownSsim, 3) + " PSNR " + fixed(*shownPsnr, 1)}});
   }
+  if (const ReferenceFrames* r = truthOf; r != nullptr && r->truth) {
+    if (auto ok = writePng(r->truthSrgb, (dir / "frames" / (stem + "-truth.png")).string()); !ok)
+      return tl::unexpected(ok.error());
+    std::vector<Srgb8Image> truthHeat(cases.size());
+    std::vector<std::vector<SheetCell>> truthRows;
+    const std::string truthLabel = "PATH-TRACED " + std::to_string(r->truth->samples) + " SPP";
+    for (std::size_t i = 0; i < cases.size(); ++i) {
+      const Srgb8Image& img = kept[i].srgb[0];
+      auto map = errorHeatMap(img, r->truthSrgb);
+      auto s = ssim(img, r->truthSrgb);
+      auto p = psnr(img, r->truthSrgb);
+      if (!map || !s || !p) return fail(ErrorCode::InvalidArgument, stem + ": cannot compare with the truth");
+      truthHeat[i] = std::move(*map);
+      truthRows.push_back({{&img, cases[i].configuration},
+                           {&r->truthSrgb, truthLabel},
+                           {&truthHeat[i], "SSIM " + fixed(*s, 3) + " PSNR " + fixed(*p, 1)}});
+    }
+    const std::string truthTitle = stem + " AGAINST THE PATH-TRACED TRUTH - ERROR 0 TO " +
+                                   fixed(kHeatMapFullScale, 0) + " LEVELS, BLACK TO WHITE";
+    if (auto ok = writePng(contactSheet(truthTitle, truthRows), (dir / (stem + "-truth.png")).string()); !ok)
+      return tl::unexpected(ok.error());
+  }
   const std::string title = stem + (cases.front().path ? " (EACH ROW AT ITS WORST FRAME)" : "") + " - ERROR 0 TO " +
                             fixed(kHeatMapFullScale, 0) + " LEVELS, BLACK TO WHITE";
   const std::string file = "contact/" + stem + ".png";
   if (auto ok = writePng(contactSheet(title, rows), (options.outDir / file).string()); !ok)
     return tl::unexpected(ok.error());
   return file;
+}
+
+// The CPU reference with each part of the light model switched off in
+// turn, against the truth: what each part brings.
+Result<std::vector<ModelVariantResult>> modelVariants(const LoadedScene& ls, const Configuration& reference,
+                                                      const Resolution& res, const TruthImage& truth,
+                                                      const Srgb8Image& truthSrgb,
+                                                      const std::function<void(const std::string&)>& log) {
+  const render::RenderSettings settings = settingsFor(reference, res.width, res.height, ls.scene.verticalFov_deg);
+  auto cpu = render::CpuReference::create(settings);
+  if (!cpu) return tl::unexpected(cpu.error());
+  struct Variant {
+    const char* name;
+    render::ModelSwitches model;
+  };
+  std::vector<Variant> variants{{"model", {}}, {"no octaves", {}}, {"no ambient", {}}, {"HG phase", {}}};
+  variants[1].model.octaves = false;
+  variants[2].model.ambient = false;
+  variants[3].model.miePhase = false;
+  std::vector<ModelVariantResult> out;
+  for (const Variant& v : variants) {
+    cpu->setModel(v.model);
+    auto image = cpu->render(frameInputs(ls, 0));
+    if (!image) return tl::unexpected(image.error());
+    const Srgb8Image srgb = toSrgb8({res.width, res.height, image->rgba});
+    auto r = rmseLinear({res.width, res.height, image->rgba}, {res.width, res.height, truth.image.rgba});
+    auto p = psnr(srgb, truthSrgb);
+    auto s = ssim(srgb, truthSrgb);
+    if (!r || !p || !s) return fail(ErrorCode::InvalidArgument, "cannot compare with the truth");
+    ModelVariantResult m;
+    m.scene = ls.scene.name;
+    m.variant = v.name;
+    m.width = res.width;
+    m.height = res.height;
+    m.error = ErrorSummary{*r, *p, *s};
+    const TruthDistance d = truthDistance(image->rgba, truth);
+    m.meanRatio = d.meanRatio;
+    m.rmse = d.rmse;
+    if (log)
+      log(ls.scene.name + "-" + sizeName(res.width, res.height) + " CPU " + v.name + " against the truth: RMSE " +
+          fixed(m.rmse, 4) + " (the truth's noise taken out), SSIM " + fixed(*s, 4) + ", mean " + fixed(m.meanRatio, 3) + "x the truth's");
+    out.push_back(std::move(m));
+  }
+  return out;
 }
 
 std::string readFirstLine(const char* path) {
@@ -313,6 +397,17 @@ Result<BenchReport> runBench(const std::vector<LoadedScene>& scenes, const RunOp
     for (const LoadedScene& ls : scenes) {
       const std::string stem = ls.scene.name + "-" + sizeName(res.width, res.height);
       ReferenceFrames reference;
+      if (options.truth.samplesPerPixel > 0 && !ls.scene.isPath()) {
+        TruthOptions truthOptions = options.truth;
+        if (truthOptions.stateDir.empty()) truthOptions.stateDir = (options.outDir / "truth").string();
+        auto truth = pathTruth(ls, options.configurations.front(), res.width, res.height, truthOptions, log);
+        if (!truth) return fail(truth.error().code, stem + " truth: " + truth.error().detail);
+        reference.truthSrgb = toSrgb8({res.width, res.height, truth->image.rgba});
+        auto variants = modelVariants(ls, options.configurations.front(), res, *truth, reference.truthSrgb, log);
+        if (!variants) return fail(variants.error().code, stem + " model variants: " + variants.error().detail);
+        for (ModelVariantResult& v : *variants) report.modelVariants.push_back(std::move(v));
+        reference.truth = std::move(*truth);
+      }
       std::vector<CaseResult> cases;
       std::vector<KeptFrames> kept;
       for (const Configuration& config : options.configurations) {
@@ -326,7 +421,7 @@ Result<BenchReport> runBench(const std::vector<LoadedScene>& scenes, const RunOp
         cases.push_back(std::move(*cr));
         kept.push_back(std::move(frames));
       }
-      auto sheet = writeSceneImages(stem, cases, kept, options);
+      auto sheet = writeSceneImages(stem, cases, kept, options, &reference);
       if (!sheet) return tl::unexpected(sheet.error());
       for (CaseResult& c : cases) {
         c.contactSheet = *sheet;

@@ -4,6 +4,15 @@
 
 namespace sky::render::cpu_core {
 
+std::shared_ptr<const CoreTables> makeCoreTables(std::uint32_t noiseSeed) {
+  auto tables = std::make_shared<CoreTables>();
+  tables->shape = makeShapeNoise(kShapeNoiseSize, noiseSeed);
+  tables->detail = makeDetailNoise(kDetailNoiseSize, noiseSeed);
+  tables->atmosphere = sharedAtmosphereTables();
+  tables->blueNoise = blueNoiseTile(noiseSeed);
+  return tables;
+}
+
 CpuCore::CoreLayer CpuCore::layerAt(int li) { return layers_[li]; }
 CpuCore::real4 CpuCore::flashAt(int k) { return setup_.flashes.lights[std::size_t(k)]; }
 CpuCore::real4 CpuCore::boltStartAt(int k) { return setup_.flashes.boltStart[std::size_t(k)]; }

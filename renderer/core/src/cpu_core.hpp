@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -20,6 +21,7 @@
 #include "sky_shared.h"
 #include "sun_map_texels.hpp"
 #include "weather_field.hpp"
+#include "sky/render/cpu_reference.hpp"
 
 namespace sky::render::cpu_core {
 
@@ -30,13 +32,23 @@ using gpu::kMaxLayers;
 using gpu::kWindMapLayers;
 using gpu::kWindMapScale_mps;
 
+// What the CPU core reads besides the frame: the shape and detail noise,
+// the atmosphere's tables and the cloud pass's blue-noise tile, built as
+// the GPU's are from the settings' noise seed.
+struct CoreTables {
+  NoiseVolume shape;
+  NoiseVolume detail;
+  AtmosphereTables atmosphere;
+  std::vector<float> blueNoise;
+};
+std::shared_ptr<const CoreTables> makeCoreTables(std::uint32_t noiseSeed);
+
 class CpuCore : public GlslDouble {
  public:
 
-  CpuCore(const FrameSetup& setup, const NoiseVolume& shape, const NoiseVolume& detail,
-          const AtmosphereTables& atmosphere, const WeatherField& weather, const std::vector<float>& blueNoise)
-      : setup_(setup), shape_(shape), detail_(detail), atmosphere_(atmosphere), weather_(weather),
-        blueNoise_(blueNoise), coverageMip_(buildCoverageMip(weather)) {}
+  CpuCore(const FrameSetup& setup, const CoreTables& tables, const WeatherField& weather)
+      : setup_(setup), shape_(tables.shape), detail_(tables.detail), atmosphere_(tables.atmosphere), weather_(weather),
+        blueNoise_(tables.blueNoise), coverageMip_(buildCoverageMip(weather)) {}
 
   real3 sampleTransmittanceLut(real2 uv) const { return atmosphere_.sampleTransmittance(uv); }
   real3 sampleMultipleScatteringLut(real2 uv) const { return atmosphere_.sampleMultipleScattering(uv); }
@@ -45,12 +57,23 @@ class CpuCore : public GlslDouble {
   static constexpr bool kLightning = true;  // (lightning.glsl: the frame's counts decide)
   static constexpr bool kShowers = true;    // (cloud_core.glsl: each layer's carrier decides)
   static constexpr bool kWindField = true;  // (cloud_core.glsl's flow: the layer's flow.w decides)
+// The model's switches (cloud_core.glsl, SKY_MODEL_CONST) as data members
+// with their defaults: setModel() changes them for a measurement.
+#define SKY_MODEL_CONST
 #define SKY_AIR_TABLE_BUILDER
 #define SKY_SUN_MAP_BUILDER
 #include "cloud_core.glsl"
 #undef SKY_SUN_MAP_BUILDER
 #undef SKY_AIR_TABLE_BUILDER
+#undef SKY_MODEL_CONST
 #undef SKY_CORE_CONST
+
+  // Switches parts of the model off (from the defaults a new core has).
+  void setModel(const ModelSwitches& m) {
+    if (!m.octaves) kOctaveContribution = 0.0;
+    if (!m.ambient) kAmbientGain = 0.0;
+    if (!m.miePhase) kMiePhase = false;
+  }
 
   static CloudType coreType(const CloudTypeParams& p) { return coreCloudType<CloudType>(p); }
 

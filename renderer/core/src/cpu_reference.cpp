@@ -9,25 +9,14 @@
 
 namespace sky::render {
 
-struct CpuReference::Tables {
-  NoiseVolume shape;
-  NoiseVolume detail;
-  AtmosphereTables atmosphere;
-  std::vector<float> blueNoise;  // the cloud pass's tile (blue_noise.hpp)
-};
-
 using cpu_core::CpuCore;
 
-CpuReference::CpuReference(RenderSettings settings, std::shared_ptr<const Tables> tables)
+CpuReference::CpuReference(RenderSettings settings, std::shared_ptr<const cpu_core::CoreTables> tables)
     : settings_(settings), tables_(std::move(tables)) {}
 
 Result<CpuReference> CpuReference::create(const RenderSettings& settings) {
   if (auto ok = validateSettings(settings); !ok) return tl::unexpected(ok.error());
-  auto tables = std::make_shared<Tables>();
-  tables->shape = makeShapeNoise(kShapeNoiseSize, settings.noiseSeed);
-  tables->detail = makeDetailNoise(kDetailNoiseSize, settings.noiseSeed);
-  tables->atmosphere = sharedAtmosphereTables();
-  tables->blueNoise = blueNoiseTile(settings.noiseSeed);
+  auto tables = cpu_core::makeCoreTables(settings.noiseSeed);
   // The reference draws every pixel at full size: no resolution divisor.
   RenderSettings full = settings;
   full.resolution = {};
@@ -44,7 +33,8 @@ Result<std::vector<std::array<float, 4>>> CpuReference::renderPixels(const Frame
   const WeatherField field =
       buildWeatherField(inputs.weather, inputs.coarseWeather, weatherAnchorFor(inputs.camera.position));
   const FrameSetup setup = prepareFrame(settings_, inputs, field, tables_->atmosphere);
-  CpuCore core(setup, tables_->shape, tables_->detail, tables_->atmosphere, field, tables_->blueNoise);
+  CpuCore core(setup, *tables_, field);
+  core.setModel(model_);
   const auto frame = core.coreFrame();
   core.buildSunMap(frame);
   core.buildAirTable(frame);
@@ -62,7 +52,8 @@ Result<Image> CpuReference::render(const FrameInputs& inputs, std::uint64_t* den
   const WeatherField field =
       buildWeatherField(inputs.weather, inputs.coarseWeather, weatherAnchorFor(inputs.camera.position));
   const FrameSetup setup = prepareFrame(settings_, inputs, field, tables_->atmosphere);
-  CpuCore core(setup, tables_->shape, tables_->detail, tables_->atmosphere, field, tables_->blueNoise);
+  CpuCore core(setup, *tables_, field);
+  core.setModel(model_);
   const auto frame = core.coreFrame();
   core.buildSunMap(frame);
   core.buildAirTable(frame);

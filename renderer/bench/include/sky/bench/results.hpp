@@ -52,6 +52,14 @@ struct CaseResult {
   ErrorSummary worst;  // a path: the worst frame (largest RMSE, lowest PSNR, lowest SSIM); a still: = error
   std::size_t worstFrame = 0;  // a path: the frame of the lowest SSIM (the contact sheet shows it); a still: 0
   std::optional<TemporalError> temporal;  // paths only
+  // A still with --truth path: its image against the path-traced truth
+  // (truth.hpp), and the truth's own noise: its samples per pixel and mean
+  // relative standard error.
+  std::optional<ErrorSummary> truthError;
+  double truthRmse = 0;       // of the rgb mean, the truth's noise taken out (truth.hpp, truthDistance)
+  double truthMeanRatio = 0;  // the image's mean over the truth's
+  std::uint64_t truthSamples = 0;
+  double truthRelativeError = 0;
   std::size_t nonFinitePixels = 0;        // over every kept frame
   bool repeatable = true;                 // every repeat of a still gave the same image, bit for bit
   std::string contactSheet;               // file of the scene's contact sheet, relative to the output folder
@@ -66,11 +74,22 @@ struct MachineInfo {
   std::string started;      // UTC, ISO 8601
 };
 
+// A still's model with one part switched off (render::ModelSwitches),
+// drawn by the CPU reference and measured against the path-traced truth.
+struct ModelVariantResult {
+  std::string scene, variant;  // variant: "model", "no octaves", "no ambient", "HG phase"
+  std::uint32_t width = 0, height = 0;
+  ErrorSummary error;
+  double meanRatio = 0;  // the variant's mean luminance over the truth's
+  double rmse = 0;       // of the rgb mean, the truth's noise taken out (truthDistance)
+};
+
 struct BenchReport {
   MachineInfo machine;
   std::string timingSource;  // where wall/GPU times come from (renderer_probe.hpp)
   std::uint32_t warmup = 0, repeats = 0, pathRepeats = 0;
   std::vector<CaseResult> cases;
+  std::vector<ModelVariantResult> modelVariants;  // --truth path only
 };
 
 }  // namespace sky::bench

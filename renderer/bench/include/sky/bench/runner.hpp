@@ -12,6 +12,7 @@
 #include "sky/bench/configurations.hpp"
 #include "sky/bench/results.hpp"
 #include "sky/bench/suite_loader.hpp"
+#include "sky/bench/truth.hpp"
 #include "sky/core/result.hpp"
 
 namespace sky::bench {
@@ -33,6 +34,9 @@ struct RunOptions {
   std::uint32_t repeats = 5;      // timed renders of each still
   std::uint32_t pathRepeats = 1;  // timed runs of each whole camera path
   std::filesystem::path outDir;   // contact sheets go to outDir/contact/
+  // --truth path: each still also measured against its path-traced frame
+  // (samplesPerPixel 0: not); the sums resume from outDir/truth/.
+  TruthOptions truth;
   std::function<void(const std::string&)> log;  // progress lines; may be empty
 };
 

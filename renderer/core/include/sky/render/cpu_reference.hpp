@@ -14,8 +14,21 @@
 
 namespace sky::render {
 
+namespace cpu_core {
+struct CoreTables;  // the noise and atmosphere tables the CPU core reads (cpu_core.hpp)
+}
+
 struct PixelCoord {
   std::uint32_t x = 0, y = 0;  // column, row (top row 0)
+};
+
+// Parts of the light model (cloud_core.glsl's SKY_MODEL_CONST switches),
+// each on by default: off, the reference shows what that part brings
+// (measured against the path-traced truth, skyshell-bench --truth path).
+struct ModelSwitches {
+  bool octaves = true;   // Wrenninge's multiple-scattering octaves beyond the first
+  bool ambient = true;   // the sky's and the scattered sun's diffuse light
+  bool miePhase = true;  // the droplets' Mie fit; false: one HG lobe (g 0.85)
 };
 
 class CpuReference {
@@ -37,12 +50,14 @@ class CpuReference {
                                                          std::span<const PixelCoord> pixels) const;
 
   const RenderSettings& settings() const { return settings_; }
+  // The model the next renders draw (all of it by default).
+  void setModel(const ModelSwitches& model) { model_ = model; }
 
  private:
-  struct Tables;
-  CpuReference(RenderSettings settings, std::shared_ptr<const Tables> tables);
+  CpuReference(RenderSettings settings, std::shared_ptr<const cpu_core::CoreTables> tables);
   RenderSettings settings_;
-  std::shared_ptr<const Tables> tables_;
+  ModelSwitches model_;
+  std::shared_ptr<const cpu_core::CoreTables> tables_;
 };
 
 // One-shot convenience: create() then render() (rebuilds the tables each call).
