@@ -5,8 +5,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstring>
-#include <fstream>
 #include <mutex>
 #include <thread>
 
@@ -339,99 +337,7 @@ std::uint64_t splitMix(std::uint64_t x) {
   return x ^ (x >> 31u);
 }
 
-constexpr char kStateMagic[8] = {'S', 'K', 'Y', 'P', 'T', 'S', '1', '\n'};
-
 }  // namespace
-
-Image PathTraceState::mean() const {
-  Image image;
-  image.width = width;
-  image.height = height;
-  const std::size_t n = std::size_t(width) * height;
-  image.rgba.assign(n * 4, 0.0f);
-  image.cloudDepth_m.assign(n, 0.0f);
-  if (samples == 0) return image;
-  for (std::size_t i = 0; i < n; ++i) {
-    for (int c = 0; c < 4; ++c) image.rgba[i * 4 + c] = float(sum[i * 4 + c] / double(samples));
-    if (depthCount[i] > 0) image.cloudDepth_m[i] = float(depthSum[i] / depthCount[i]);
-  }
-  return image;
-}
-
-std::vector<float> PathTraceState::standardError() const {
-  const std::size_t n = std::size_t(width) * height;
-  std::vector<float> error(n, 0.0f);
-  if (samples < 2) return error;
-  const double k = double(samples);
-  for (std::size_t i = 0; i < n; ++i) {
-    double variance = 0.0;
-    for (int c = 0; c < 3; ++c) {
-      const double m = sum[i * 4 + c] / k;
-      variance += std::max(0.0, sumSquares[i * 3 + c] / k - m * m);
-    }
-    // The rgb mean's variance, from the channels' (taken as independent:
-    // they are strongly correlated, so this understates it by up to 3x).
-    error[i] = float(std::sqrt(variance / 9.0 / (k - 1.0)) * std::sqrt(3.0));
-  }
-  return error;
-}
-
-Result<void> PathTraceState::save(const std::string& path) const {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) return fail(ErrorCode::Io, "PathTraceState::save: cannot write " + tmp);
-    const auto put = [&](const void* p, std::size_t n) { out.write(static_cast<const char*>(p), std::streamsize(n)); };
-    const std::uint64_t keyLength = key.size();
-    put(kStateMagic, sizeof kStateMagic);
-    put(&width, sizeof width);
-    put(&height, sizeof height);
-    put(&samples, sizeof samples);
-    put(&violations, sizeof violations);
-    put(&lookups, sizeof lookups);
-    put(&keyLength, sizeof keyLength);
-    put(key.data(), key.size());
-    put(sum.data(), sum.size() * sizeof(double));
-    put(sumSquares.data(), sumSquares.size() * sizeof(double));
-    put(depthSum.data(), depthSum.size() * sizeof(double));
-    put(depthCount.data(), depthCount.size() * sizeof(std::uint32_t));
-    if (!out) return fail(ErrorCode::Io, "PathTraceState::save: writing " + tmp + " failed");
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0)
-    return fail(ErrorCode::Io, "PathTraceState::save: cannot rename " + tmp + " to " + path);
-  return {};
-}
-
-Result<PathTraceState> PathTraceState::load(const std::string& path, const std::string& key) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return fail(ErrorCode::Io, "PathTraceState::load: cannot read " + path);
-  const auto get = [&](void* p, std::size_t n) { return bool(in.read(static_cast<char*>(p), std::streamsize(n))); };
-  char magic[sizeof kStateMagic];
-  PathTraceState s;
-  std::uint64_t keyLength = 0;
-  if (!get(magic, sizeof magic) || std::memcmp(magic, kStateMagic, sizeof magic) != 0)
-    return fail(ErrorCode::InvalidArgument, "PathTraceState::load: " + path + " is not a path tracer's state");
-  if (!get(&s.width, sizeof s.width) || !get(&s.height, sizeof s.height) || !get(&s.samples, sizeof s.samples) ||
-      !get(&s.violations, sizeof s.violations) || !get(&s.lookups, sizeof s.lookups) ||
-      !get(&keyLength, sizeof keyLength))
-    return fail(ErrorCode::InvalidArgument, "PathTraceState::load: " + path + ": truncated header");
-  if (s.width == 0 || s.height == 0 || s.width > 8192 || s.height > 8192 || keyLength > 4096)
-    return fail(ErrorCode::InvalidArgument, "PathTraceState::load: " + path + ": bad size in header");
-  s.key.resize(keyLength);
-  if (!get(s.key.data(), keyLength)) return fail(ErrorCode::InvalidArgument, "PathTraceState::load: " + path + ": truncated key");
-  if (s.key != key)
-    return fail(ErrorCode::InvalidArgument, "PathTraceState::load: " + path + " holds samples of '" + s.key +
-                                                "', not of '" + key + "'");
-  const std::size_t n = std::size_t(s.width) * s.height;
-  s.sum.resize(n * 4);
-  s.sumSquares.resize(n * 3);
-  s.depthSum.resize(n);
-  s.depthCount.resize(n);
-  if (!get(s.sum.data(), n * 4 * sizeof(double)) || !get(s.sumSquares.data(), n * 3 * sizeof(double)) ||
-      !get(s.depthSum.data(), n * sizeof(double)) || !get(s.depthCount.data(), n * sizeof(std::uint32_t)))
-    return fail(ErrorCode::InvalidArgument, "PathTraceState::load: " + path + ": truncated sums");
-  return s;
-}
 
 PathTracer::PathTracer(RenderSettings settings, std::shared_ptr<const cpu_core::CoreTables> tables)
     : settings_(std::move(settings)), tables_(std::move(tables)) {}

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -55,18 +56,23 @@ struct PathTraceState {
   std::string key;                // what the sums are of (the caller's; checked on resume)
   std::vector<double> sum;        // rgb, then cloud transmittance: 4 per pixel
   std::vector<double> sumSquares; // rgb: 3 per pixel
+  std::vector<double> depthSum;   // per pixel: the distances where samples met cloud, m
+  std::vector<std::uint32_t> depthCount;
 
   // The mean radiance (alpha: the mean cloud transmittance) and the cloud
   // depth where a sample met cloud (0 elsewhere).
   Image mean() const;
-  // Per pixel, the standard error of the mean of the rgb's mean (one
-  // number, in the radiance's units).
+  // Per pixel, the standard error of the mean of the rgb's mean, in the
+  // radiance's units.
   std::vector<float> standardError() const;
-  std::vector<double> depthSum;  // per pixel: the sum of the distances where samples met cloud
-  std::vector<std::uint32_t> depthCount;
 
-  // A binary file; load checks the key and the size. Errors: Io,
-  // InvalidArgument for a file that is not a state or of another key.
+  // The state as bytes (host byte order: a run resumes on the machine that
+  // wrote it), and back: decode refuses bytes that are not a state, of
+  // another key, or whose sums do not fill exactly the rest (InvalidArgument).
+  std::vector<std::uint8_t> encode() const;
+  static Result<PathTraceState> decode(std::span<const std::uint8_t> bytes, const std::string& key);
+  // The same through a file (written to a temporary name, then renamed).
+  // Errors: Io, and decode's.
   Result<void> save(const std::string& path) const;
   static Result<PathTraceState> load(const std::string& path, const std::string& key);
 };
