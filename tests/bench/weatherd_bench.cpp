@@ -1,5 +1,6 @@
 // Weather server benchmark (issue 4): many subscribers on loopback, each with
-// its own area, under a storm of changes; not a timed test (ctest only runs
+// its own area (or --channels N to an area, as the channels of one
+// simulator), under a storm of changes; not a timed test (ctest only runs
 // it briefly, label bench), the numbers come from running it by hand:
 //   build/release/tests/bench/sky_weatherd_bench --subscribers 64 --rate 50 --seconds 10
 // It measures
@@ -53,6 +54,9 @@ namespace {
 
 struct Options {
   int subscribers = 64;
+  // Subscribers per area: the channels of one simulator subscribe the same
+  // area round one camera (1: every subscriber its own area).
+  int channels = 1;
   double rate = 50;           // changes per second
   double seconds = 10;        // storm length
   double idleSeconds = 5;     // idle measurement
@@ -178,7 +182,7 @@ class Subscriber : public std::enable_shared_from_this<Subscriber> {
 int main(int argc, char** argv) {
   Options o;
   const char* usage = "usage: sky_weatherd_bench [--subscribers N] [--rate HZ] [--seconds S] [--idle-seconds S] "
-                      "[--radius-m M] [--regional 0|1] [--storms 0|1] [--json FILE]\n";
+                      "[--radius-m M] [--regional 0|1] [--storms 0|1] [--channels N] [--json FILE]\n";
   if (argc == 2 && std::string(argv[1]) == "--help") {
     std::printf("%s", usage);
     return 0;
@@ -193,12 +197,13 @@ int main(int argc, char** argv) {
     else if (k == "--json") o.json = v;
     else if (k == "--regional") o.regional = v == "1";
     else if (k == "--storms") o.storms = v == "1";
+    else if (k == "--channels") o.channels = std::stoi(v);
     else {
       std::fprintf(stderr, "unknown option %s\n", k.c_str());
       return 2;
     }
   }
-  if (argc % 2 == 0 || o.subscribers < 1) {
+  if (argc % 2 == 0 || o.subscribers < 1 || o.channels < 1) {
     std::fprintf(stderr, "%s", usage);
     return 2;
   }
@@ -285,11 +290,13 @@ int main(int argc, char** argv) {
   std::vector<std::shared_ptr<Subscriber>> subs;
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> jitter(-2.0, 2.0);
+  sky::stream::Subscribe area = renderer;
   for (int i = 0; i < o.subscribers; ++i) {
     auto s = std::make_shared<Subscriber>(clientIo, shared);
-    sky::stream::Subscribe area = renderer;
-    area.area.centerLat_deg = 46.0 + jitter(rng);
-    area.area.centerLon_deg = 13.0 + jitter(rng);
+    if (i % o.channels == 0) {
+      area.area.centerLat_deg = 46.0 + jitter(rng);
+      area.area.centerLon_deg = 13.0 + jitter(rng);
+    }
     s->start(server->port(), area);
     subs.push_back(s);
   }
@@ -365,9 +372,9 @@ int main(int argc, char** argv) {
   std::lock_guard lock(shared.mutex);
   const double p50 = percentile(shared.latencies_ms, 50), p99 = percentile(shared.latencies_ms, 99);
   const double expected = double(changes) * o.subscribers;
-  std::printf("weatherd bench: %d subscribers (%lld served a snapshot; radius %.0f km, level %d), %zu changes at "
-              "%.0f/s, %s weather\n",
-              o.subscribers, static_cast<long long>(served), o.radius_m / 1000, renderer.tileLevel, changes, o.rate,
+  std::printf("weatherd bench: %d subscribers (%lld served a snapshot; %d per area; radius %.0f km, level %d), %zu "
+              "changes at %.0f/s, %s weather\n",
+              o.subscribers, static_cast<long long>(served), o.channels, o.radius_m / 1000, renderer.tileLevel, changes, o.rate,
               o.regional ? "regional (tiles in every snapshot; a storm cell moves)" : "uniform (layer tables only)");
   if (o.storms)
     std::printf("  lightning                   flashes drawn %llu (layer 1 cumulonimbus over every area)\n",
@@ -386,7 +393,7 @@ int main(int argc, char** argv) {
               changeBytes, regionalChangeBytes, regionalDeltaTiles, regionalSnapshotBytes, regionalSnapshot.tileLevel,
               regionalSnapshot.tiles.size());
   if (!o.json.empty()) {
-    const nlohmann::json j = {{"subscribers", o.subscribers}, {"served", served}, {"rate_hz", o.rate}, {"regional", o.regional},
+    const nlohmann::json j = {{"subscribers", o.subscribers}, {"served", served}, {"channels", o.channels}, {"rate_hz", o.rate}, {"regional", o.regional},
                               {"storms", o.storms}, {"changes", changes},
                               {"latency_p50_ms", p50}, {"latency_p99_ms", p99}, {"deliveries", shared.deliveries},
                               {"coalesced", shared.coalesced}, {"cpu_idle_pct", idlePct}, {"cpu_storm_pct", stormPct},
