@@ -317,14 +317,14 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
   });
 }
 
-Result<bool> CloudRenderer::present(const Image& image) {
+Result<bool> CloudRenderer::present(const Image& image, double exposure) {
   SKY_ASSERT(impl_ != nullptr);
   if (!impl_->presenter) return fail(ErrorCode::InvalidArgument, "present: this renderer has no window");
   if (image.width != impl_->settings.width || image.height != impl_->settings.height ||
       image.rgba.size() != std::size_t(image.width) * image.height * 4)
     return fail(ErrorCode::InvalidArgument, "present: the image is not a frame of this renderer");
   return atVulkanEdge("CloudRenderer::present", [&]() -> Result<bool> {
-    auto shown = impl_->presenter->present(*impl_->ctx, image);
+    auto shown = impl_->presenter->present(*impl_->ctx, image, exposure);
     if (shown && *shown)
       for (auto& t : impl_->presenter->lastTimes()) impl_->passTimes.push_back(std::move(t));
     return shown;

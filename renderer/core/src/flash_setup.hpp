@@ -10,13 +10,14 @@
 #include <glm/vec4.hpp>
 
 #include "sky/geo/geodetic.hpp"
+#include "sky/render/exposure.hpp"
 #include "sky/weather/lightning.hpp"
 
 namespace sky::render {
 
 // The renderer's linear unit of irradiance in W/m^2: the sun's 20 units
-// (frame_setup.cpp's kSunIrradiance) stand for the solar constant, 1361 W/m^2.
-inline constexpr double kLinearUnitIrradiance_Wpm2 = 1361.0 / 20.0;
+// stand for the solar constant, 1361 W/m^2 (sky/render/exposure.hpp).
+inline constexpr double kLinearUnitIrradiance_Wpm2 = kSolarConstant_Wpm2 / kSunIrradiance_units;
 // Flashes farther than this from the camera light nothing drawn (below the
 // horizon from any height a simulator flies at, or lost in the haze).
 inline constexpr double kMaxFlashDistance_m = 300e3;

@@ -9,6 +9,7 @@
 
 #include "sky/core/assert.hpp"
 #include "sky/render/ephemeris.hpp"
+#include "sky/render/exposure.hpp"
 #include "sky/render/haze.hpp"
 #include "sky/weather/advection.hpp"
 #include "sky/weather/precipitation.hpp"
@@ -40,11 +41,9 @@ double maxCoverage(const WeatherField& field, std::uint32_t slice) {
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 // Largest image edge, pixels: keeps buffers and the tile permutation in range.
 constexpr std::uint32_t kMaxImageEdge = 8192;
-// Sun irradiance at the top of the atmosphere, linear units (white: the
-// atmosphere colours it). The units are the PNG's (exposure 1): this puts a
-// clear noon zenith near 0.3-0.5 and a sunlit cloud top near 1-2, the tones
-// the tonemap maps to mid and upper grey.
-constexpr double kSunIrradiance = 20.0;
+// Sun irradiance at the top of the atmosphere, linear units: the unit's
+// definition and its physical value are in sky/render/exposure.hpp.
+constexpr double kSunIrradiance = kSunIrradiance_units;
 // Secondary march towards the sun: half the layer's thickness (Haggstrom 2018
 // sec. 4.2, "half the layer thickness"), at least 100 m (a thin layer's light
 // still crosses a few cells' edges) and at most 2 km (4 steps of 500 m keep

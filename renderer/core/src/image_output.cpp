@@ -1,6 +1,6 @@
-// Image statistics, the display transform (exposure, ACES filmic tonemap,
-// Narkowicz 2015 fit, sRGB transfer, 8 bits) shared by the PNG and the
-// window, and PNG output through stb_image_write.
+// Image statistics, the display transform (the camera's exposure, ACES
+// filmic tonemap, Narkowicz 2015 fit, sRGB transfer, 8 bits) shared by the
+// PNG and the window, and PNG output through stb_image_write.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -18,12 +18,15 @@ namespace sky::render {
 
 namespace {
 
-// Exposure applied before the tonemap: the skeleton's radiance units put a
-// clear zenith near 0.4 and a sunlit cloud near 1, which this maps to mid and
-// upper tones.
-constexpr double kPngExposure = 1.0;
-
-// Narkowicz 2015, "ACES Filmic Tone Mapping Curve".
+// Narkowicz 2015, "ACES Filmic Tone Mapping Curve": a rational fit of the
+// ACES reference rendering and sRGB output transforms' tone scale, per
+// channel, f(x) = x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14), clamped to
+// [0, 1]. f(0) = 0; toe below x ~ 0.05; f(0.104) = 0.133, where a metered
+// mean lands (1 / 9.6: exposure.hpp), encoded 102 of 255; f(1) = 0.80, the
+// exposure's L_max; the white point, f(x) = 1, is x = 7.24 (the root of
+// 0.08 x^2 - 0.56 x - 0.14): 2.86 EV above L_max, 6.1 EV above the metered
+// mean. Brighter values clip to white. (Narkowicz scales his input by 0.6
+// first; we do not: our exposure is the camera's, documented in exposure.hpp.)
 double acesFilmic(double x) {
   constexpr double a = 2.51, b = 0.03, c = 2.43, d = 0.59, e = 0.14;
   return std::clamp((x * (a * x + b)) / (x * (c * x + d) + e), 0.0, 1.0);
@@ -55,22 +58,22 @@ ImageStats computeStats(const Image& image) {
   return stats;
 }
 
-std::vector<std::uint8_t> tonemapToSrgb8(const Image& image) {
+std::vector<std::uint8_t> tonemapToSrgb8(const Image& image, double exposure) {
   SKY_ASSERT(consistent(image));
   std::vector<std::uint8_t> rgb(std::size_t(image.width) * image.height * 3);
   for (std::size_t px = 0; px < std::size_t(image.width) * image.height; ++px)
     for (int c = 0; c < 3; ++c) {
       const double v = image.rgba[px * 4 + std::size_t(c)];
-      const double mapped = std::isfinite(v) ? srgbEncode(acesFilmic(std::max(0.0, v * kPngExposure))) : 0.0;
+      const double mapped = std::isfinite(v) ? srgbEncode(acesFilmic(std::max(0.0, v * exposure))) : 0.0;
       rgb[px * 3 + std::size_t(c)] = static_cast<std::uint8_t>(std::lround(mapped * 255.0));
     }
   return rgb;
 }
 
-Result<void> writePng(const Image& image, const std::string& path) {
+Result<void> writePng(const Image& image, const std::string& path, double exposure) {
   if (!consistent(image))
     return fail(ErrorCode::InvalidArgument, "writePng " + path + ": image size does not match its pixels");
-  const std::vector<std::uint8_t> rgb = tonemapToSrgb8(image);
+  const std::vector<std::uint8_t> rgb = tonemapToSrgb8(image, exposure);
   const int ok = stbi_write_png(path.c_str(), int(image.width), int(image.height), 3, rgb.data(), int(image.width) * 3);
   if (ok == 0) return fail(ErrorCode::Io, "writePng " + path + ": cannot write file");
   return {};

@@ -110,7 +110,7 @@ Result<void> Presenter::rebuild(const GpuContext& ctx) {
   return {};
 }
 
-Result<bool> Presenter::present(const GpuContext& ctx, const Image& image) {
+Result<bool> Presenter::present(const GpuContext& ctx, const Image& image, double exposure) {
   SKY_ASSERT(image.width > 0 && image.height > 0 && image.rgba.size() == std::size_t(image.width) * image.height * 4);
   if (stale_) {
     if (auto ok = rebuild(ctx); !ok) return tl::unexpected(ok.error());
@@ -132,7 +132,7 @@ Result<bool> Presenter::present(const GpuContext& ctx, const Image& image) {
   }
 
   // The PNG's bytes, in the swapchain's byte order, scaled by nearest pixel.
-  const std::vector<std::uint8_t> rgb = tonemapToSrgb8(image);
+  const std::vector<std::uint8_t> rgb = tonemapToSrgb8(image, exposure);
   auto* out = static_cast<std::uint8_t*>(staging_.mapped);
   for (std::uint32_t y = 0; y < extent_.height; ++y) {
     const std::uint32_t sy = std::uint32_t(std::uint64_t(y) * image.height / extent_.height);

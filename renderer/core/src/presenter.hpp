@@ -25,9 +25,11 @@ class Presenter {
   // no transfer-destination use; Vulkan failures throw.
   static Result<Presenter> create(const GpuContext& ctx, const WindowSurface& window);
 
-  // Shows the image. Returns false when nothing could be shown this time (a
-  // minimised window, a swapchain being rebuilt). Errors: Timeout, Device.
-  Result<bool> present(const GpuContext& ctx, const Image& image);
+  // Shows the image through the PNG's display transform at `exposure` (the
+  // multiplier of the radiance units, tonemapToSrgb8). Returns false when
+  // nothing could be shown this time (a minimised window, a swapchain being
+  // rebuilt). Errors: Timeout, Device.
+  Result<bool> present(const GpuContext& ctx, const Image& image, double exposure);
 
   // GPU time of the last presented frame's copy ("present").
   std::vector<PassTime> lastTimes() const { return timer_.results(); }

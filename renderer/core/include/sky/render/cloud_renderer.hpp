@@ -449,11 +449,11 @@ class CloudRenderer {
   std::size_t variantsBuilt() const;
 
   // Shows a rendered image in the window (created with GpuOptions::window),
-  // with the PNG's display transform. Returns false when the window could
-  // not take a frame this time (minimised, being resized). Errors:
-  // InvalidArgument without a window or for an image of another size,
-  // Device/Timeout from the GPU.
-  Result<bool> present(const Image& image);
+  // with the PNG's display transform at `exposure` (writePng). Returns false
+  // when the window could not take a frame this time (minimised, being
+  // resized). Errors: InvalidArgument without a window or for an image of
+  // another size, Device/Timeout from the GPU.
+  Result<bool> present(const Image& image, double exposure = 1.0);
 
   // The passes the GPU ran for the last render() (and a present() after it),
   // in submission order; empty when the device's queue has no timestamps.
@@ -500,10 +500,14 @@ class CloudRenderer {
 
 ImageStats computeStats(const Image& image);
 
-// Writes an 8-bit sRGB PNG (rgb only): fixed exposure, ACES filmic tonemap
-// (Narkowicz 2015 fit), sRGB transfer. Errors: InvalidArgument for an empty or
-// inconsistent image, Io when the file cannot be written.
-Result<void> writePng(const Image& image, const std::string& path);
+// Writes an 8-bit sRGB PNG (rgb only): the radiance times `exposure` (the
+// multiplier of the renderer's radiance units, > 0: displayExposure of an
+// EV100, sky/render/exposure.hpp; the default, 1, is the fixed exposure the
+// PNGs had before the camera's, kFixedDisplayExposure), ACES filmic tonemap
+// (Narkowicz 2015 fit; curve and white point in image_output.cpp), sRGB
+// transfer. Errors: InvalidArgument for an empty or inconsistent image, Io
+// when the file cannot be written.
+Result<void> writePng(const Image& image, const std::string& path, double exposure = 1.0);
 // Writes 8-bit RGB pixels as they are (rows top to bottom, width x height x
 // 3 bytes): pictures that are not radiance (a radar's false colours).
 Result<void> writeRgbPng(const std::vector<std::uint8_t>& rgb, std::uint32_t width, std::uint32_t height,
