@@ -39,8 +39,8 @@ bool sameArea(const stream::Subscribe& a, const stream::Subscribe& b);
 Frame encodeWeatherFrame(const AreaSnapshot* held, const AreaSnapshot& now);
 
 // How long what AreaFrames keeps answers when the weather does not change
-// (it is all dropped then). A fan-out to 512 subscribers takes ~15 ms
-// (sky_weatherd_bench), so it is served from one build per area; a
+// (it is all dropped then). A fan-out to 512 subscribers takes ~14 ms of
+// the io thread (sky_weatherd_bench), so it is served from one build per area; a
 // subscriber asking later gets a snapshot no older than this (its clock is
 // when it was built: the weather standing still, a renderer advects from
 // it).
