@@ -72,6 +72,7 @@ int main(int argc, char** argv) {
   unsigned width = 0, height = 0;
   std::string truthKind;
   unsigned truthSpp = 64, truthEvents = 0, truthThreads = 0;
+  std::vector<double> truthOctaves;
 
   app.add_option("--suite", suite, "scene suite file (TOML)")->capture_default_str();
   app.add_option("--scenes", scenes, "comma-separated scene names (default: every scene of the suite)");
@@ -103,6 +104,10 @@ int main(int argc, char** argv) {
                  "--truth path: scattering events a path may have (0: any; 1: single scattering)")
       ->capture_default_str();
   app.add_option("--truth-threads", truthThreads, "--truth path: threads (0: every CPU)")->capture_default_str();
+  app.add_option("--truth-octaves", truthOctaves,
+                 "--truth path: octave weights b to measure besides the model's, comma-separated (e.g. 0.25,0.35)")
+      ->delimiter(',')
+      ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--list", list, "list the suite's scenes and the configurations, then exit");
   app.add_flag("--side-by-side", sideBySide, "time one view: one CLOUDPASS line per frame on stdout");
   app.add_option("--height-above-ground", sbs.heightAboveGround_m, "side-by-side: camera height, m")
@@ -208,6 +213,7 @@ int main(int argc, char** argv) {
     options.truth.samplesPerPixel = truthSpp;
     options.truth.maxEvents = truthEvents;
     options.truth.threads = truthThreads;
+    options.truth.octaveWeights = truthOctaves;
   }
   std::error_code ec;
   std::filesystem::create_directories(options.outDir, ec);

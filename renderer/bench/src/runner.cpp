@@ -291,19 +291,26 @@ Result<std::string> writeSceneImages(const std::string& stem, const std::vector<
 // turn, against the truth: what each part brings.
 Result<std::vector<ModelVariantResult>> modelVariants(const LoadedScene& ls, const Configuration& reference,
                                                       const Resolution& res, const TruthImage& truth,
-                                                      const Srgb8Image& truthSrgb,
+                                                      const Srgb8Image& truthSrgb, const std::vector<double>& octaveWeights,
                                                       const std::function<void(const std::string&)>& log) {
   const render::RenderSettings settings = settingsFor(reference, res.width, res.height, ls.scene.verticalFov_deg);
   auto cpu = render::CpuReference::create(settings);
   if (!cpu) return tl::unexpected(cpu.error());
   struct Variant {
-    const char* name;
+    std::string name;
     render::ModelSwitches model;
   };
   std::vector<Variant> variants{{"model", {}}, {"no octaves", {}}, {"no ambient", {}}, {"HG phase", {}}};
   variants[1].model.octaves = false;
   variants[2].model.ambient = false;
   variants[3].model.miePhase = false;
+  for (const double b : octaveWeights) {
+    std::ostringstream name;
+    name << "octaves b=" << b;
+    Variant v{name.str(), {}};
+    v.model.octaveContribution = b;
+    variants.push_back(v);
+  }
   std::vector<ModelVariantResult> out;
   for (const Variant& v : variants) {
     cpu->setModel(v.model);
@@ -403,7 +410,8 @@ Result<BenchReport> runBench(const std::vector<LoadedScene>& scenes, const RunOp
         auto truth = pathTruth(ls, options.configurations.front(), res.width, res.height, truthOptions, log);
         if (!truth) return fail(truth.error().code, stem + " truth: " + truth.error().detail);
         reference.truthSrgb = toSrgb8({res.width, res.height, truth->image.rgba});
-        auto variants = modelVariants(ls, options.configurations.front(), res, *truth, reference.truthSrgb, log);
+        auto variants = modelVariants(ls, options.configurations.front(), res, *truth, reference.truthSrgb,
+                                      options.truth.octaveWeights, log);
         if (!variants) return fail(variants.error().code, stem + " model variants: " + variants.error().detail);
         for (ModelVariantResult& v : *variants) report.modelVariants.push_back(std::move(v));
         reference.truth = std::move(*truth);

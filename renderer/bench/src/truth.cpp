@@ -74,6 +74,7 @@ Result<TruthImage> pathTruth(const LoadedScene& scene, const Configuration& refe
       if (log) log(stem + " truth: resumed at " + std::to_string(state.samples) + " samples per pixel");
     }
   }
+  state.key = key;  // a fresh state is of this frame; a loaded one was checked to be
   const render::FrameInputs inputs = frameInputs(scene, 0);
   const auto start = Clock::now();
   TruthImage out;

@@ -23,6 +23,8 @@ struct TruthOptions {
   std::uint32_t threads = 0;          // 0: every hardware thread
   std::uint32_t maxEvents = 0;        // 0: every order of scattering
   std::string stateDir;               // where the resumable sums go; empty: not saved
+  // Octave weights b to measure besides the model's (a variant "octaves b=X" each).
+  std::vector<double> octaveWeights;
 };
 
 struct TruthImage {

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -27,6 +28,9 @@ struct PixelCoord {
 // (measured against the path-traced truth, skyshell-bench --truth path).
 struct ModelSwitches {
   bool octaves = true;   // Wrenninge's multiple-scattering octaves beyond the first
+  // When set, the octaves' contribution b (kOctaveContribution) instead of
+  // the model's: a measurement of what another weight would do.
+  std::optional<double> octaveContribution;
   bool ambient = true;   // the sky's and the scattered sun's diffuse light
   bool miePhase = true;  // the droplets' Mie fit; false: one HG lobe (g 0.85)
 };
