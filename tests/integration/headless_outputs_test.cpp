@@ -96,8 +96,10 @@ std::map<std::string, std::vector<float>> readExr(const fs::path& path) {
 
 // The PNG's tonemap as the README states it: exposure 1, the ACES filmic fit
 // of Narkowicz 2015, the sRGB transfer (IEC 61966-2-1), 8 bits.
-int tonemapped(float linear) {
-  const double x = std::max(0.0, double(linear));
+// The PNG's display transform written out here: the frame's recorded camera
+// exposure (frames.jsonl "camera_exposure"), ACES (Narkowicz 2015), sRGB.
+int tonemapped(float linear, double exposure) {
+  const double x = std::max(0.0, double(linear) * exposure);
   const double aces = std::clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
   const double srgb = aces <= 0.0031308 ? 12.92 * aces : 1.055 * std::pow(aces, 1 / 2.4) - 0.055;
   return int(std::lround(srgb * 255));
@@ -156,6 +158,7 @@ TEST(HeadlessOutputs, ExrChannelsEqualTheLinearValuesAndThePng) {
     ASSERT_EQ(w, kWidth);
     ASSERT_EQ(h, kHeight);
     int worstLsb = 0;
+    const double exposure = f["camera_exposure"]["exposure"].get<double>();
     for (std::size_t i = 0; i < std::size_t(kWidth * kHeight); ++i) {
       ASSERT_EQ(R[i], radiance[i * 3 + 0]) << "pixel " << i;
       ASSERT_EQ(G[i], radiance[i * 3 + 1]) << "pixel " << i;
@@ -163,7 +166,7 @@ TEST(HeadlessOutputs, ExrChannelsEqualTheLinearValuesAndThePng) {
       ASSERT_EQ(T[i], transmittance[i]) << "pixel " << i;
       const float linear[3] = {R[i], G[i], B[i]};
       for (std::size_t c = 0; c < 3; ++c)
-        worstLsb = std::max(worstLsb, std::abs(int(rgb[i * 3 + c]) - tonemapped(linear[c])));
+        worstLsb = std::max(worstLsb, std::abs(int(rgb[i * 3 + c]) - tonemapped(linear[c], exposure)));
       // Physics: transmittance in [0, 1]; depth exactly where light was taken,
       // and within the march's reach (600 km plus one 60 km span).
       ASSERT_GE(T[i], 0.0f);
@@ -222,6 +225,23 @@ TEST(HeadlessOutputs, MetadataDescribesEachFrameAndTheReportSumsGpuTimes) {
     EXPECT_LE(clouds, f["render_ms"].get<double>()) << "the GPU part of a frame cannot outlast the frame";
     EXPECT_EQ(f["gpu_ms"].contains("weather_upload"), i == 0);
     EXPECT_GT(f["cpu_ms"].get<double>(), 0.0);
+    // The EXR's units: the sun's 20 units stand for 1361 W/m^2 and 128 klx.
+    EXPECT_NEAR(f["units"]["radiance_W_m2_sr"].get<double>(), 1361.0 / 20, 1e-9);
+    EXPECT_NEAR(f["units"]["luminance_cd_m2"].get<double>(), 128000.0 / 20, 1e-9);
+    // Auto exposure by default: frames 2 s apart each meter (every 0.25 s),
+    // the first takes its metering at once; the exposure is Lagarde 2014's
+    // 1 / (1.2 x 2^EV100) per cd/m^2, in the 6400 cd/m^2 units.
+    const auto& e = f["camera_exposure"];
+    EXPECT_EQ(e["mode"], "auto");
+    EXPECT_EQ(e["metered"], true);
+    const double ev100 = e["ev100"].get<double>(), metered = e["metered_ev100"].get<double>();
+    EXPECT_GE(metered, 5.32);
+    EXPECT_LE(metered, 18.0);
+    if (i == 0) {
+      EXPECT_EQ(ev100, metered);
+    }
+    EXPECT_NEAR(e["exposure"].get<double>() * 1.2 * std::exp2(ev100) / 6400.0, 1.0, 1e-9);
+    EXPECT_GT(e["meter_ms"].get<double>(), 0.0);
   }
   const auto& gpu = run.report["gpu_ms"];
   ASSERT_TRUE(gpu.contains("clouds")) << run.report.dump(2);
@@ -230,6 +250,39 @@ TEST(HeadlessOutputs, MetadataDescribesEachFrameAndTheReportSumsGpuTimes) {
   EXPECT_LE(gpu["clouds"]["p50"].get<double>(), gpu["clouds"]["p90"].get<double>());
   EXPECT_EQ(gpu["weather_upload"]["frames"], 1);
   EXPECT_EQ(run.report["preset"], "high");
+  EXPECT_EQ(run.report["camera_exposure"]["mode"], "auto");
+  EXPECT_EQ(run.report["camera_exposure"]["adaptation_tau_s"], 0.5);
+}
+
+// --ev100 14 --ev-compensation 1: every frame exposed at EV100 14, one EV
+// brighter, none metered; the PNG is its EXR at that exposure (checked on
+// the first frame, as ExrChannelsEqualTheLinearValuesAndThePng does).
+TEST(HeadlessOutputs, FixedEv100IsRecordedAndUsed) {
+  const ReplayResult run = replay("fixed-ev", SKY_SCENARIO_CLOUDY, {"--ev100", "14", "--ev-compensation", "1"});
+  ASSERT_EQ(run.frames.size(), kFrames);
+  for (const auto& f : run.frames) {
+    SCOPED_TRACE(f.dump());
+    const auto& e = f["camera_exposure"];
+    EXPECT_EQ(e["mode"], "fixed");
+    EXPECT_EQ(e["ev100"], 14.0);
+    EXPECT_EQ(e["compensation_ev"], 1.0);
+    EXPECT_EQ(e["metered"], false);
+    EXPECT_TRUE(e["metered_ev100"].is_null());
+    EXPECT_NEAR(e["exposure"].get<double>(), 6400.0 / (1.2 * std::exp2(13.0)), 1e-12);
+  }
+  const auto& f = run.frames[0];
+  const fs::path png = run.dir / "frames" / f["file"].get<std::string>();
+  const auto radiance = readPfm(fs::path(png).replace_extension(".pfm"), 3);
+  const std::string bytes = readAll(png);
+  int w = 0, h = 0, n = 0;
+  unsigned char* rgb =
+      stbi_load_from_memory(reinterpret_cast<const unsigned char*>(bytes.data()), int(bytes.size()), &w, &h, &n, 3);
+  ASSERT_NE(rgb, nullptr) << png;
+  int worstLsb = 0;
+  for (std::size_t i = 0; i < std::size_t(w) * std::size_t(h) * 3; ++i)
+    worstLsb = std::max(worstLsb, std::abs(int(rgb[i]) - tonemapped(radiance[i], 6400.0 / (1.2 * std::exp2(13.0)))));
+  stbi_image_free(rgb);
+  EXPECT_LE(worstLsb, 1);
 }
 
 // --frame-budget-ms: a budget no level can meet (0.1 ms) takes the frames

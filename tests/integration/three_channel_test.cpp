@@ -5,7 +5,8 @@
 // with each channel's View Definition (60 deg wide) and View Control (yaw
 // -60, 0, +60). Checks the seams from the frames' own metadata (the rays of
 // the pixels either side of a seam) and pixels (their colours), and that
-// the three frames of a host frame share the weather clock and version.
+// the three frames of a host frame share the weather clock and version and
+// the camera's exposure (metered on the host's boresight, not each view).
 // Writes a contact sheet of the three channels side by side, at noon and at
 // dawn (the sun set with --sun-azimuth/--sun-elevation).
 #include <algorithm>
@@ -219,6 +220,8 @@ void checkDisplay(const std::string& name, double sunAzimuth_deg, double sunElev
   // how much later than its own time line the host's datagrams arrived (a
   // loaded machine delays the host process), which the lock cannot see.
   double lagMin_s = 1e300, lagMax_s = -1e300;
+  double evSpread = 0;  // the largest EV100 difference between the channels of a settled host frame
+  double evOwnViews = 0;  // how far apart the channels' own views meter (their frames' mean log luminance)
   for (const auto& [host, trio] : run.frames) {
     SCOPED_TRACE("host frame " + std::to_string(host));
     bool settled = true;
@@ -256,6 +259,13 @@ void checkDisplay(const std::string& name, double sunAzimuth_deg, double sunElev
       // One shared picture: the same clock (host_locked_clock.hpp), bit for bit.
       EXPECT_EQ(trio[i]["weather_clock_s"], trio[0]["weather_clock_s"]);
       EXPECT_EQ(trio[i]["weather_version"], trio[0]["weather_version"]);
+      EXPECT_EQ(trio[i]["camera_exposure"]["mode"], "auto");
+      evSpread = std::max(evSpread, std::abs(trio[i]["camera_exposure"]["ev100"].get<double>() -
+                                             trio[0]["camera_exposure"]["ev100"].get<double>()));
+      // A channel's own picture as a meter would read it (mean luminance:
+      // the log mean is not in the metadata), in EV against the centre's.
+      evOwnViews = std::max(evOwnViews, std::abs(std::log2(trio[i]["mean_luminance"].get<double>() /
+                                                           trio[1]["mean_luminance"].get<double>())));
     }
     for (int i = 0; i + 1 < kChannels; ++i) {
       const auto &left = trio[i], &right = trio[i + 1];
@@ -289,6 +299,13 @@ void checkDisplay(const std::string& name, double sunAzimuth_deg, double sunElev
     ++checked;
   }
   EXPECT_GE(checked, 3u) << startUp << " host frames of start-up";
+  // Channels that drew the same host frames compute the same exposure bit
+  // for bit (exposure_test.cpp); a channel that missed a different host frame
+  // metered a pose a frame apart, and the start-up's differences decay with
+  // the adaptation (tau 0.5 s): 0.05 EV is a twentieth of a stop.
+  std::printf("[ exposure ] %s: the channels' EV100 at most %.2e apart; their own views' mean luminances %.2f EV apart\n",
+              name.c_str(), evSpread, evOwnViews);
+  EXPECT_LE(evSpread, 0.05);
   const double lagSwing_s = lagMax_s - lagMin_s;
   std::printf("[ clock    ] %s: the server's clock at the channels' arrivals of a host frame %.2f ms apart at most; "
               "the host's datagrams late by a varying %.3f s; the locked clock within %.3f s of it\n",

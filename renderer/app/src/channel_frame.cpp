@@ -60,6 +60,12 @@ tl::expected<DrawnFrame, FrameFailure> ChannelFrames::draw(const FrameRequest& r
     budget_->update(record.render_ms);
   }
   out.image = std::move(*image);
+  // The camera meters the host's boresight, not this channel's view.
+  if (cameraExposure_) {
+    auto exposed = cameraExposure_->expose(in, r.host.pose, r.hostTime_s);
+    if (!exposed) return tl::unexpected(FrameFailure{3, frameName + "exposure: " + describe(exposed.error())});
+    record.cameraExposure = *exposed;
+  }
   const auto delay_ms = [&] {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r.host.receivedAt).count();
   };
@@ -84,7 +90,7 @@ tl::expected<DrawnFrame, FrameFailure> ChannelFrames::draw(const FrameRequest& r
   record.weatherAreas = {{view.snapshot.tileLevel, view.snapshot.tiles.size()}};
   if (view.coarse) record.weatherAreas.push_back({view.coarse->tileLevel, view.coarse->tiles.size()});
   if (display_) {
-    auto shown = display_->show(out.image);
+    auto shown = display_->show(out.image, record.cameraExposure.exposure);
     if (!shown) return tl::unexpected(FrameFailure{3, frameName + describe(shown.error())});
     record.presented = *shown;
     if (r.live) record.presentDelay_ms = delay_ms();

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "sky/render/exposure.hpp"
 #include "sky/render/exr_output.hpp"
 
 namespace sky::app {
@@ -105,7 +106,7 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
   std::snprintf(name, sizeof name, "frame_%06llu", static_cast<unsigned long long>(r.frame));
   const std::string base = directory_ + "/" + name;
   if (outputs_.png)
-    if (auto ok = render::writePng(image, base + ".png"); !ok) return ok;
+    if (auto ok = render::writePng(image, base + ".png", r.cameraExposure.exposure); !ok) return ok;
   if (outputs_.exr)
     if (auto ok = render::writeExr(image, base + ".exr"); !ok) return ok;
   if (outputs_.pfm) {
@@ -206,6 +207,19 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
                                   {"drop_area_px2", r.nearPrecip.dropArea_px2},
                                   {"camera_speed_mps", r.nearPrecip.cameraSpeed_mps}};
   line["exposure_s"] = r.exposure_s;
+  // The EXR's (and PFM's) linear rgb in physical units: one unit is this
+  // radiance per channel, and this luminance (Rec. 709 Y of the rgb).
+  line["units"] = {{"radiance_W_m2_sr", render::kRadianceUnit_Wpm2sr}, {"luminance_cd_m2", render::kLuminanceUnit_cdm2}};
+  // The PNG's (and window's) camera: its EV100, the compensation, and the
+  // multiplier of the linear rgb into the tonemap (exposure.hpp).
+  const render::FrameExposure& e = r.cameraExposure;
+  line["camera_exposure"] = {{"mode", e.automatic ? "auto" : "fixed"},
+                             {"ev100", e.ev100},
+                             {"compensation_ev", e.compensation_ev},
+                             {"exposure", e.exposure},
+                             {"metered_ev100", e.meteredEv100 ? nlohmann::json(*e.meteredEv100) : nlohmann::json()},
+                             {"metered", e.meteredNow},
+                             {"meter_ms", e.meter_ms}};
   if (!r.flashesLit.empty()) {
     nlohmann::json lit = nlohmann::json::array();
     for (const weather::LightningFlash& f : r.flashesLit)

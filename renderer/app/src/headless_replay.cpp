@@ -247,6 +247,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   ChannelFrames frames(renderer, *writer, o.display);
   frames.setBudget(o.budget);
   frames.setExposure(o.exposure_s);
+  frames.setCameraExposure(o.cameraExposure);
   std::map<std::string, std::size_t> framesPerLevel;
   for (std::size_t i = 0; i < frameCount; ++i) {
     if (stop && *stop) {
@@ -306,6 +307,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     request.utc_s = host.utc_s;
     request.utcSource = host.timeSource;
     request.frameIndex = i;
+    request.hostTime_s = t;
     auto drawn = frames.draw(request);
     if (!drawn) {
       std::fprintf(stderr, "skyshell-render: %s\n", drawn.error().message.c_str());
@@ -330,7 +332,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     versionsSeen.insert(view.version);
     nonFinite += record.stats.nonFinite;
     if (nextPick < picks.size() && picks[nextPick] == i) {
-      sheet.add(drawn->image);
+      sheet.add(drawn->image, record.cameraExposure.exposure);
       ++nextPick;
     }
     done = i + 1;
@@ -375,6 +377,15 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   report["vertical_fov_deg"] = s.verticalFov_deg;
   report["noise_seed"] = s.noiseSeed;
   report["preset"] = o.preset;
+  // The camera's exposure of the PNGs and the contact sheet (each frame's in frames.jsonl).
+  if (o.cameraExposure) {
+    const render::ExposureSettings& e = o.cameraExposure->settings();
+    report["camera_exposure"] = {{"mode", e.automatic ? "auto" : "fixed"},
+                                 {"ev100", e.automatic ? nlohmann::json() : nlohmann::json(e.fixedEv100)},
+                                 {"compensation_ev", e.compensation_ev},
+                                 {"adaptation_tau_s", e.adaptationTau_s},
+                                 {"meter_period_s", e.meterPeriod_s}};
+  }
   if (o.budget) {
     report["budget"] = {{"target_ms", o.budget->target_ms()}, {"frames_per_level", framesPerLevel}};
   }

@@ -41,6 +41,7 @@
 #include "sky/flight/clean.hpp"
 #include "sky/flight/utf8_text.hpp"
 #include "sky/geo/geodetic.hpp"
+#include "sky/render/auto_exposure.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky/render/noise_cache.hpp"
 
@@ -91,6 +92,9 @@ struct Options {
   double replayWeatherClock_s = std::numeric_limits<double>::quiet_NaN();
   sky::flight::ReadOptions replayRead;  // --icao24, --altitude-unit (ADS-B files), --track (KML/KMZ)
   double exposure_ms = 1000.0 * sky::render::kDefaultExposure_s;
+  std::string ev100 = "auto";  // --ev100: auto or a fixed EV100
+  double evCompensation = 0;
+  double evAdaptation_s = sky::render::kDefaultAdaptationTau_s;
   std::string replayAltitudeUnit;
   bool noClean = false;                   // --no-clean
   std::string maxSpeed;                   // --max-speed
@@ -111,6 +115,21 @@ extern "C" void onReplaySignal(int) { gReplayStop = true; }
 // A command-line value as an error message may quote it (ill-formed UTF-8
 // and control characters replaced, cut at 200 bytes).
 std::string shown(const std::string& value) { return sky::flight::messageText(value); }
+
+// The camera's exposure from --ev100 (auto or a number), --ev-compensation
+// and --ev-adaptation-s; none for an --ev100 that is neither.
+std::optional<sky::render::ExposureSettings> exposureSettings(const Options& o) {
+  sky::render::ExposureSettings s;
+  s.compensation_ev = o.evCompensation;
+  s.adaptationTau_s = o.evAdaptation_s;
+  if (o.ev100 == "auto") return s;
+  double ev = 0;
+  const auto [end, ec] = std::from_chars(o.ev100.data(), o.ev100.data() + o.ev100.size(), ev);
+  if (ec != std::errc() || end != o.ev100.data() + o.ev100.size() || !(ev >= -10 && ev <= 30)) return std::nullopt;
+  s.automatic = false;
+  s.fixedEv100 = ev;
+  return s;
+}
 
 bool writePortFile(const std::string& path, unsigned port) {
   const std::string tmp = path + ".tmp";
@@ -224,6 +243,17 @@ int main(int argc, char** argv) {
                  "each frame's exposure, ms: what a lightning flash lights in it and how long the drops near the "
                  "camera streak (shorter: shorter, brighter streaks)")
       ->check(CLI::Range(0.1, 1000.0));
+  app.add_option("--ev100", o.ev100,
+                 "the camera's exposure of the PNGs and the window (the EXR stays linear radiance): auto, metered "
+                 "on the host's boresight (the same on every channel) and adapting, or a fixed EV100 in [-10, 30] "
+                 "for every channel started with it (12.38 is the fixed exposure of before; sunny daylight ~15)")
+      ->capture_default_str();
+  app.add_option("--ev-compensation", o.evCompensation, "exposure compensation, EV (+1: twice as bright)")
+      ->check(CLI::Range(-10.0, 10.0));
+  app.add_option("--ev-adaptation-s", o.evAdaptation_s,
+                 "with --ev100 auto: the adaptation's time constant, s (63 % of a change of the scene after it)")
+      ->check(CLI::Range(0.01, 60.0))
+      ->capture_default_str();
   app.add_option("--icao24", o.replayRead.icao24,
                  "with --replay of an ADS-B .csv holding several aircraft: this one (ICAO 24-bit address, hex)");
   app.add_option("--track", o.replayRead.track,
@@ -305,6 +335,12 @@ int main(int argc, char** argv) {
     }
     o.cleanOptions.maxGroundSpeed_mps = *v;
   }
+  const auto cameraSettings = exposureSettings(o);
+  if (!cameraSettings) {
+    std::fprintf(stderr, "skyshell-render: --ev100 '%s' is neither auto nor an EV100 in [-10, 30]\n",
+                 shown(o.ev100).c_str());
+    return 2;
+  }
   std::optional<double> startUtc_s;
   if (!o.utc.empty()) {
     startUtc_s = sky::app::parseUtc(o.utc.c_str());
@@ -367,6 +403,11 @@ int main(int argc, char** argv) {
   if (o.validation) spdlog::info("vulkan validation on ({})", "VK_LAYER_KHRONOS_validation");
   std::optional<sky::app::WindowDisplay> display;
   if (window) display.emplace(**renderer, *window);
+  auto cameraExposure = sky::render::AutoExposure::create(*cameraSettings, settings.noiseSeed);
+  if (!cameraExposure) {
+    std::fprintf(stderr, "skyshell-render: exposure: %s\n", sky::describe(cameraExposure.error()).c_str());
+    return 2;
+  }
   // Said at every exit, so a run under --vulkan-validation can be checked.
   struct ValidationSummary {
     sky::render::CloudRenderer& renderer;
@@ -384,6 +425,7 @@ int main(int argc, char** argv) {
     r.flightPath = o.replayFlight;
     r.read = o.replayRead;
     r.exposure_s = o.exposure_ms / 1000.0;
+    r.cameraExposure = &*cameraExposure;
     if (!o.replayAltitudeUnit.empty())
       r.read.altitudeUnit = o.replayAltitudeUnit == "ft" ? sky::flight::AltitudeUnit::Feet : sky::flight::AltitudeUnit::Metres;
     r.step_s = o.replayStep_s;
@@ -549,6 +591,7 @@ int main(int argc, char** argv) {
   sky::app::ChannelFrames channelFrames(**renderer, *writer, display ? &*display : nullptr);
   channelFrames.setBudget(budget ? &*budget : nullptr);
   channelFrames.setExposure(o.exposure_ms / 1000.0);
+  channelFrames.setCameraExposure(&*cameraExposure);
 
   std::uint64_t frames = 0, lastSequence = 0, resetsSeen = 0;
   sky::app::LatencyHistogram transportDelay, presentDelay;
@@ -631,6 +674,11 @@ int main(int argc, char** argv) {
     request.utcSource = pose->timeSource;
     request.atmosphere = source->atmosphere();
     request.frameIndex = frames;
+    // The host's own time where it sends one (the same on every channel);
+    // else this channel's time since start.
+    request.hostTime_s = !smoothed && pose->hostTimeValid
+                             ? pose->hostTime_s
+                             : std::chrono::duration<double>((smoothed ? now : pose->receivedAt) - start).count();
     request.live = true;
     auto drawn = channelFrames.draw(request);
     if (!drawn) {

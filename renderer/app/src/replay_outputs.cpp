@@ -44,7 +44,7 @@ std::vector<std::size_t> ContactSheet::pick(std::size_t frameCount, std::size_t 
   return out;
 }
 
-void ContactSheet::add(const render::Image& frame) {
+void ContactSheet::add(const render::Image& frame, double exposure) {
   if (added_ >= columns_ * rows_ || frame.width == 0 || frame.height == 0) return;
   const std::uint32_t x0 = kGap_px + static_cast<std::uint32_t>(added_ % columns_) * (cellW_ + kGap_px);
   const std::uint32_t y0 = kGap_px + static_cast<std::uint32_t>(added_ / columns_) * (cellH_ + kGap_px);
@@ -66,7 +66,7 @@ void ContactSheet::add(const render::Image& frame) {
           ++n;
         }
       float* q = &sheet_.rgba[(std::size_t(y0 + y) * sheet_.width + (x0 + x)) * 4];
-      for (int c = 0; c < 4; ++c) q[c] = n ? static_cast<float>(sum[c] / double(n)) : 0.0f;
+      for (int c = 0; c < 4; ++c) q[c] = n ? static_cast<float>(sum[c] / double(n) * (c < 3 ? exposure : 1.0)) : 0.0f;
     }
   }
 }

@@ -13,6 +13,7 @@
 #include "sky/app/shared_state.hpp"
 #include "sky/app/view_state.hpp"
 #include "sky/app/window_display.hpp"
+#include "sky/render/auto_exposure.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky/render/frame_budget.hpp"
 
@@ -37,6 +38,10 @@ struct FrameRequest {
   TimeSource utcSource = TimeSource::Fixed;
   HostAtmosphere atmosphere;
   std::uint64_t frameIndex = 0;
+  // The host's time of the frame, s (the CIGI timestamp when the host sends
+  // one, the flight's time in a replay): what the auto exposure adapts over
+  // and meters on the grid of, the same on every channel of the host.
+  double hostTime_s = 0;
   MirrorMode mirror = MirrorMode::None;
   bool live = false;  // record the transport delay from host.receivedAt
 };
@@ -70,12 +75,17 @@ class ChannelFrames {
   // The exposure each frame stands for (s, > 0): what a flash lights in it,
   // and how long the drops near the camera streak.
   void setExposure(double exposure_s) { exposure_s_ = exposure_s; }
+  // The camera's exposure of the PNG and the window, metered on the host's
+  // pose (FrameRequest::host) at FrameRequest::hostTime_s. Not owned; null:
+  // the fixed exposure 1 (kFixedDisplayExposure).
+  void setCameraExposure(render::AutoExposure* exposure) { cameraExposure_ = exposure; }
 
  private:
   render::CloudRenderer& renderer_;
   FrameWriter& writer_;
   WindowDisplay* display_;
   render::FrameBudget* budget_ = nullptr;
+  render::AutoExposure* cameraExposure_ = nullptr;
   double exposure_s_ = render::kDefaultExposure_s;
   std::size_t appliedLevel_ = 0;
   std::uint64_t droppedWarnedAt_ = 0;

@@ -1,9 +1,11 @@
-// Writes a channel's per-frame output: a PNG (tonemapped sRGB) and an EXR
-// (linear radiance, cloud transmittance, cloud depth) per frame, optionally
+// Writes a channel's per-frame output: a PNG (the camera's exposure, then
+// tonemapped sRGB) and an EXR (linear radiance in the renderer's units,
+// cloud transmittance, cloud depth) per frame, optionally
 // PFMs, and one JSON line of metadata per frame in frames.jsonl, the frames'
 // sidecar: camera pose and its source, host frame, weather clock and version,
 // the time of day and its source, the sun and the moon, the atmosphere, the settings in use (preset, resolution, field of view, noise
-// seeds), GPU time per pass, image statistics, and the files written.
+// seeds), GPU time per pass, image statistics, the renderer's units in W
+// m^-2 sr^-1 and cd/m^2 and the PNG's EV100 and exposure, and the files written.
 #pragma once
 
 #include <cstdint>
@@ -17,6 +19,7 @@
 #include "sky/app/host_locked_clock.hpp"
 #include "sky/app/shared_state.hpp"
 #include "sky/core/result.hpp"
+#include "sky/render/auto_exposure.hpp"
 #include "sky/render/cloud_renderer.hpp"
 
 namespace sky::app {
@@ -77,6 +80,9 @@ struct FrameRecord {
   render::SunMapReport sunMap;        // the sun map rebuilt or reused (map methods)
   render::NearPrecipReport nearPrecip;  // the drops drawn near the camera (in precipitation)
   double exposure_s = 0;                            // the exposure the frame stands for
+  // The camera's exposure its PNG and window show it with (auto or fixed
+  // EV100, auto_exposure.hpp); the EXR stays linear radiance.
+  render::FrameExposure cameraExposure;
   std::vector<weather::LightningFlash> flashesLit;  // the flashes giving light over the frame's exposure
   render::WeatherMapReport weatherMap;  // what this frame changed in the weather map (per tile, or rebuilt and why)
   std::optional<bool> presented;      // windowed: whether the frame reached the window

@@ -60,6 +60,9 @@ struct ReplayOptions {
   // replay (exit code 0, report written). Not owned.
   WindowDisplay* display = nullptr;
   double exposure_s = render::kDefaultExposure_s;  // --exposure-ms: each frame's exposure
+  // The camera's exposure of the PNGs, the window and the contact sheet
+  // (--ev100), adapting over the flight's time. Not owned; null: fixed 1.
+  render::AutoExposure* cameraExposure = nullptr;
   // Holds the frames to a time budget (--frame-budget-ms); the report
   // counts the frames per level. Not owned; null: none.
   render::FrameBudget* budget = nullptr;

@@ -20,7 +20,10 @@ class ContactSheet {
                std::uint32_t sourceHeight);
   // The frame indices (of `frameCount`) to pick: evenly spaced, first and last included.
   static std::vector<std::size_t> pick(std::size_t frameCount, std::size_t cells);
-  void add(const render::Image& frame);
+  // The frame's radiance is scaled by `exposure` (its PNG's display
+  // exposure: writePng), so a sheet written at exposure 1 shows each
+  // thumbnail as its frame's PNG does.
+  void add(const render::Image& frame, double exposure = 1.0);
   const render::Image& image() const { return sheet_; }
 
  private:

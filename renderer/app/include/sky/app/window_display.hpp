@@ -14,10 +14,11 @@ class WindowDisplay {
   // Both must outlive the display; the renderer was created on window's surface.
   WindowDisplay(render::CloudRenderer& renderer, GlfwWindow& window) : renderer_(renderer), window_(window) {}
 
-  // Presents the frame (true if it reached the window) and handles window
-  // events. Errors from CloudRenderer::present.
-  Result<bool> show(const render::Image& image) {
-    auto shown = renderer_.present(image);
+  // Presents the frame at `exposure` (the PNG's display exposure, writePng)
+  // (true if it reached the window) and handles window events. Errors from
+  // CloudRenderer::present.
+  Result<bool> show(const render::Image& image, double exposure) {
+    auto shown = renderer_.present(image, exposure);
     if (shown && *shown) ++presented_;
     closed_ = closed_ || window_.pollClosed();
     return shown;
