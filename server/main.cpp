@@ -84,6 +84,11 @@ int main(int argc, char** argv) {
   app.add_option("--listen", options.listenAddress, "Address to listen on")->capture_default_str();
   app.add_option("--port", options.port, "TCP port; 0 picks a free one")->capture_default_str();
   app.add_option("--port-file", portFile, "Write the port number here once listening");
+  app.add_option("--max-subscribers", options.maxSubscribers,
+                 "stream subscribers served at once; past it a connection is told \"server full\" and closed "
+                 "(each costs the server its tile cache areas: docs/weather-server-scaling.md has the cost to 512)")
+      ->capture_default_str()
+      ->check(CLI::Range(std::size_t{1}, sky::server::kMaxSubscribersOption));
   app.add_option("--heartbeat-ms", heartbeatMs, "Heartbeat period, ms")
       ->check(CLI::Range(1, 3'600'000))
       ->capture_default_str();

@@ -232,5 +232,20 @@ TEST_F(HostileWeatherd, EveryProbeIsRefusedAndTheServerStaysUp) {
   EXPECT_EQ(rejected("handler_failed"), 0u) << "a probe reached the last boundary";
 }
 
+// skyshell-weatherd --max-subscribers sets the cap: with 3, the fourth
+// subscriber is told the server is full and closed, and the three are served.
+TEST(WeatherdSubscriberCap, TheCommandLineSetsHowManySubscribersAreServed) {
+  Weatherd weatherd("subscriber-cap", SKY_SCENARIO_CLOUDY, false, {"--max-subscribers", "3"});
+  std::vector<std::unique_ptr<StreamPeer>> admitted;
+  for (int i = 0; i < 3; ++i) {
+    admitted.push_back(std::make_unique<StreamPeer>(weatherd.streamPort));
+    auto hello = admitted.back()->read();
+    ASSERT_TRUE(hello && std::holds_alternative<stream::Hello>(*hello)) << "subscriber " << i;
+  }
+  StreamPeer extra(weatherd.streamPort);
+  extra.expectRefused("server full: 3 subscribers, at most 3");
+  ASSERT_FALSE(weatherd.process->wait(0ms)) << weatherd.process->log();
+}
+
 }  // namespace
 }  // namespace sky::test

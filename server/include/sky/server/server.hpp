@@ -41,6 +41,10 @@ namespace sky::server {
 // and bounds what a flood of connections costs (each holds a socket, a read
 // buffer of 64 KiB and its areas' snapshots).
 inline constexpr std::size_t kDefaultMaxSubscribers = 64;
+// The most --max-subscribers may ask for: the tile cache holds areas for
+// each, and 4096 renderers is past what one process serves (512 takes 70 %
+// of a core in a regional storm: docs/weather-server-scaling.md).
+inline constexpr std::size_t kMaxSubscribersOption = 4096;
 
 struct ServerOptions {
   std::string listenAddress = "127.0.0.1";  // loopback unless a deployment opens it
