@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 
@@ -148,6 +149,15 @@ Result<void> PathTraceState::save(const std::string& path) const {
 }
 
 Result<PathTraceState> PathTraceState::load(const std::string& path, const std::string& key) {
+  // The largest state a decoder accepts: refuse a bigger file before reading it.
+  constexpr std::uintmax_t kMaxStateBytes = 4096 + kMaxKeyLength + std::uintmax_t(kMaxStateEdge) * kMaxStateEdge *
+                                                                       (8 * sizeof(double) + sizeof(std::uint32_t));
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) return fail(ErrorCode::Io, "PathTraceState::load: cannot read " + path + ": " + ec.message());
+  if (size > kMaxStateBytes)
+    return fail(ErrorCode::InvalidArgument, "PathTraceState::load: " + path + ": " + std::to_string(size) +
+                                                " bytes, more than any state");
   std::ifstream in(path, std::ios::binary);
   if (!in) return fail(ErrorCode::Io, "PathTraceState::load: cannot read " + path);
   const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

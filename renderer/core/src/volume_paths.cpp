@@ -101,8 +101,14 @@ void Scene::surfaceSegment(const Ray&, double, dvec3& inscatter, dvec3& transmit
   transmittance = dvec3(1.0);
 }
 
-double freeFlight(const Scene& scene, const Ray& ray, double tMax, Rng& rng, MediumPoint& point, TraceStats& stats,
-                  std::vector<MajorantSegment>& scratch) {
+namespace {
+
+// Tentative collisions along the ray before tMax, against the scene's
+// majorants: visit(medium there, majorant) returns false to stop. Delta
+// and ratio tracking differ only in what they do at each.
+template <class Visit>
+void trackCandidates(const Scene& scene, const Ray& ray, double tMax, Rng& rng, TraceStats& stats,
+                     std::vector<MajorantSegment>& scratch, Visit&& visit, double& tStop) {
   scene.majorants(ray, tMax, scratch);
   for (const MajorantSegment& seg : scratch) {
     if (seg.sigma <= 0.0) continue;
@@ -113,35 +119,45 @@ double freeFlight(const Scene& scene, const Ray& ray, double tMax, Rng& rng, Med
       const MediumPoint m = scene.medium(ray.origin + ray.dir * t, rng.uniform());
       ++stats.densityLookups;
       if (m.sigmaT > seg.sigma) ++stats.majorantViolations;
-      if (rng.uniform() * seg.sigma < m.sigmaT) {
-        point = m;
-        return t;
+      if (!visit(m, seg.sigma)) {
+        tStop = t;
+        return;
       }
     }
   }
-  return kInfinity;
+}
+
+}  // namespace
+
+double freeFlight(const Scene& scene, const Ray& ray, double tMax, Rng& rng, MediumPoint& point, TraceStats& stats,
+                  std::vector<MajorantSegment>& scratch) {
+  double t = kInfinity;
+  trackCandidates(scene, ray, tMax, rng, stats, scratch,
+                  [&](const MediumPoint& m, double sigma) {
+                    if (rng.uniform() * sigma >= m.sigmaT) return true;
+                    point = m;
+                    return false;
+                  },
+                  t);
+  return t;
 }
 
 double ratioTransmittance(const Scene& scene, const Ray& ray, double tMax, Rng& rng, TraceStats& stats,
                           std::vector<MajorantSegment>& scratch) {
-  scene.majorants(ray, tMax, scratch);
-  double transmittance = 1.0;
-  for (const MajorantSegment& seg : scratch) {
-    if (seg.sigma <= 0.0) continue;
-    double t = seg.t0;
-    for (;;) {
-      t -= std::log1p(-rng.uniform()) / seg.sigma;
-      if (t >= seg.t1) break;
-      const MediumPoint m = scene.medium(ray.origin + ray.dir * t, rng.uniform());
-      ++stats.densityLookups;
-      if (m.sigmaT > seg.sigma) ++stats.majorantViolations;
-      transmittance *= std::max(0.0, 1.0 - m.sigmaT / seg.sigma);
-      if (transmittance < kRatioRoulette) {
-        if (rng.uniform() < 0.5) return 0.0;
-        transmittance *= 2.0;
-      }
-    }
-  }
+  double transmittance = 1.0, stopped = kInfinity;
+  trackCandidates(scene, ray, tMax, rng, stats, scratch,
+                  [&](const MediumPoint& m, double sigma) {
+                    transmittance *= std::max(0.0, 1.0 - m.sigmaT / sigma);
+                    if (transmittance < kRatioRoulette) {
+                      if (rng.uniform() < 0.5) {
+                        transmittance = 0.0;
+                        return false;
+                      }
+                      transmittance *= 2.0;
+                    }
+                    return true;
+                  },
+                  stopped);
   return transmittance;
 }
 
