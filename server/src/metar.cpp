@@ -35,10 +35,15 @@ bool allSlashes(std::string_view s) {
   return true;
 }
 
-// Value of an all-digits string of at most 9 digits (callers check the length).
+// Value of an all-digits string; saturates at 999,999,999 so that a run of
+// digits longer than any real group cannot overflow.
 int toInt(std::string_view s) {
+  constexpr int kMax = 999'999'999;
   int v = 0;
-  for (char c : s) v = v * 10 + (c - '0');
+  for (char c : s) {
+    if (v > (kMax - 9) / 10) return kMax;
+    v = v * 10 + (c - '0');
+  }
   return v;
 }
 
@@ -192,6 +197,13 @@ bool isCompass(std::string_view s) {
   return false;
 }
 
+// "3/4", "15/16": the finest fraction reported is sixteenths, so each side
+// has one or two digits.
+bool isMilesFraction(std::string_view v, std::size_t slash) {
+  const std::string_view num = v.substr(0, slash), den = v.substr(slash + 1);
+  return num.size() <= 2 && den.size() <= 2 && allDigits(num) && allDigits(den);
+}
+
 // 9999, 0800, 4000N, 0000E, 9999NDV, //// (metres); 10SM, P6SM, M1/4SM, 3/4SM.
 bool isVisibility(std::string_view g) {
   if (g == "////") return true;
@@ -204,7 +216,7 @@ bool isVisibility(std::string_view g) {
   if (!v.empty() && (v[0] == 'P' || v[0] == 'M')) v.remove_prefix(1);
   std::size_t slash = v.find('/');
   if (slash == std::string_view::npos) return allDigits(v) && v.size() <= 2;
-  return allDigits(v.substr(0, slash)) && allDigits(v.substr(slash + 1));
+  return isMilesFraction(v, slash);
 }
 
 // The whole-miles part of "1 1/2SM": one or two digits followed by a fraction.
@@ -420,7 +432,7 @@ bool isMilesBeforeUnit(std::string_view g, std::string_view next) {
   if (!v.empty() && (v[0] == 'P' || v[0] == 'M')) v.remove_prefix(1);
   const std::size_t slash = v.find('/');
   if (slash == std::string_view::npos) return v.size() <= 2 && allDigits(v);
-  return allDigits(v.substr(0, slash)) && allDigits(v.substr(slash + 1));
+  return isMilesFraction(v, slash);
 }
 
 constexpr double kMetresPerStatuteMile = 1609.344;

@@ -814,6 +814,13 @@ TEST(MetarOddities, EachMapsToWhatItSays) {
       {"metar lszh 221150z 24005kt 9999 few040 xyz 12/06 q1018", "FEW040", "xyz"},  // quoted as written
       {"SPECI KXYZ 221210Z 27010KT 3SM -TSRA BR SCT008 BKN020CB OVC050 20/18 A2992 RMK", "FOG6282 SCT008 BKN020CB OVC050 RAIN1.0"},
       {"METAR CYSY NIL=", "refused: CYSY: NIL report (no observation)"},
+      // Runs of digits longer than any real group (found by fuzz_metar: they
+      // overflowed the integer read): not a visibility, skipped.
+      {"METAR KNKT 061200Z 13030G40KT 1/88888888888888882SM FEW003 OVC005 24/24 A2967", "FEW003 OVC005",
+       "1/88888888888888882SM"},
+      {"METAR KNKT 061200Z 13030G40KT 2 1/88888888888888882SM FEW003 OVC005 24/24 A2967", "FEW003 OVC005",
+       "2 1/88888888888888882SM"},
+      {"METAR KNKT 061200Z 13030G40KT 1 15/16SM FEW003 OVC005 24/24 A2967", "FEW003 OVC005"},
   };
   int read = 0;
   for (const Case& c : cases) {
@@ -826,6 +833,11 @@ TEST(MetarOddities, EachMapsToWhatItSays) {
     const std::string sky = c.sky;
     read += sky != "not observed" && sky.rfind("refused", 0) != 0;
   }
+  // Sixteenths, the finest fraction reported, still read after the limit on
+  // a fraction's digits.
+  auto sixteenths = parseMetar("METAR KNKT 061200Z 13030G40KT 1 15/16SM FEW003 OVC005 24/24 A2967");
+  ASSERT_TRUE(sixteenths && sixteenths->visibility_m);
+  EXPECT_NEAR(*sixteenths->visibility_m, (1 + 15.0 / 16) * 1609.344, 1e-6);
   const int n = static_cast<int>(std::size(cases));
   std::printf("[ METAR    ] oddities: %d reports, sky read on %d (%.1f %%)\n", n, read, 100.0 * read / n);
 }
