@@ -47,11 +47,11 @@ tl::expected<DrawnFrame, FrameFailure> ChannelFrames::draw(const FrameRequest& r
   FrameRecord& record = out.record;
   const std::string frameName = "frame " + std::to_string(r.frameIndex) + ": ";
   if (budget_ && budget_->level() != appliedLevel_) {
-    if (auto ok = renderer_.setMarch(budget_->current().march); !ok)
+    if (auto ok = renderer_->setMarch(budget_->current().march); !ok)
       return tl::unexpected(FrameFailure{3, frameName + "frame budget: " + describe(ok.error())});
     appliedLevel_ = budget_->level();
   }
-  auto image = timedRender(renderer_, in, record);
+  auto image = truth_ ? truth_->render(in, record) : timedRender(*renderer_, in, record);
   if (!image) return tl::unexpected(FrameFailure{3, frameName + describe(image.error())});
   if (budget_) {
     const render::BudgetLevel& level = budget_->current();
@@ -94,10 +94,10 @@ tl::expected<DrawnFrame, FrameFailure> ChannelFrames::draw(const FrameRequest& r
     if (!shown) return tl::unexpected(FrameFailure{3, frameName + describe(shown.error())});
     record.presented = *shown;
     if (r.live) record.presentDelay_ms = delay_ms();
-    for (const auto& pass : renderer_.lastPassTimes())
+    for (const auto& pass : renderer_->lastPassTimes())
       if (pass.pass == "present") record.gpu.push_back(pass);
   }
-  logValidationMessages(renderer_);
+  if (renderer_) logValidationMessages(*renderer_);
   if (auto ok = writer_.write(out.image, record); !ok) return tl::unexpected(FrameFailure{2, describe(ok.error())});
   return out;
 }

@@ -107,8 +107,11 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
   const std::string base = directory_ + "/" + name;
   if (outputs_.png)
     if (auto ok = render::writePng(image, base + ".png", r.cameraExposure.exposure); !ok) return ok;
-  if (outputs_.exr)
-    if (auto ok = render::writeExr(image, base + ".exr"); !ok) return ok;
+  if (outputs_.exr) {
+    std::vector<render::ExrChannel> extra;
+    if (r.truth) extra.push_back({kExrTruthStandardError, r.truth->standardError});
+    if (auto ok = render::writeExr(image, base + ".exr", extra); !ok) return ok;
+  }
   if (outputs_.pfm) {
     if (auto ok = writePfm(image, base + ".pfm", PfmChannels::Radiance); !ok) return ok;
     if (auto ok = writePfm(image, base + ".transmittance.pfm", PfmChannels::Transmittance); !ok) return ok;
@@ -220,6 +223,22 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
                              {"metered_ev100", e.meteredEv100 ? nlohmann::json(*e.meteredEv100) : nlohmann::json()},
                              {"metered", e.meteredNow},
                              {"meter_ms", e.meter_ms}};
+  if (r.truth) {
+    const FrameRecord::Truth& t = *r.truth;
+    line["truth"] = {{"mode", "path"},
+                     {"samples_per_pixel", t.samplesPerPixel},
+                     {"seed", t.seed},
+                     {"threads", t.threads},
+                     {"majorant_violations", t.majorantViolations},
+                     {"density_lookups", t.densityLookups},
+                     {"standard_error",
+                      {{"of", "a pixel's rgb mean, radiance units"},
+                       {"mean", t.meanStandardError},
+                       {"max", t.maxStandardError},
+                       {"image_mean", t.imageMeanStandardError},
+                       {"mean_relative", t.meanRelativeStandardError}}},
+                     {"exr_channel", outputs_.exr ? nlohmann::json(kExrTruthStandardError) : nlohmann::json()}};
+  }
   if (!r.flashesLit.empty()) {
     nlohmann::json lit = nlohmann::json::array();
     for (const weather::LightningFlash& f : r.flashesLit)

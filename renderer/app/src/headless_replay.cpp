@@ -23,11 +23,13 @@
 #include "sky/app/radar_image.hpp"
 #include "sky/app/replay_outputs.hpp"
 #include "sky/app/shared_state.hpp"
+#include "sky/app/truth_frames.hpp"
 #include "sky/app/weather_client.hpp"
 #include "sky/flight/clean.hpp"
 #include "sky/flight/file_limits.hpp"
 #include "sky/flight/flight.hpp"
 #include "sky/flight/info.hpp"
+#include "sky/core/assert.hpp"
 #include "sky/flight/utf8_text.hpp"
 #include "sky/weather/lightning.hpp"
 #include "sky/weather/scenario.hpp"
@@ -48,6 +50,9 @@ constexpr double kMinVideoFps = 1, kMaxVideoFps = 60;
 constexpr auto kWeatherPoll = std::chrono::milliseconds(5);
 // How often a window's events are handled while the replay waits for a frame's time.
 constexpr auto kWindowPoll = std::chrono::milliseconds(20);
+// Least time between a path-traced frame's progress lines: a line every few
+// seconds shows it is alive without flooding a log over a frame of minutes.
+constexpr auto kTruthProgressPeriod = std::chrono::seconds(5);
 
 std::string duration(double s) {
   char buf[32];
@@ -112,9 +117,31 @@ nlohmann::json cleaningJson(const flight::CleanReport* r, const flight::CleanOpt
           {"summary", r->lines(options)}};
 }
 
+// What draws a replay's frames: the GPU renderer or the path-traced truth
+// (exactly one), and what the report says of it.
+struct ReplayDrawer {
+  render::CloudRenderer* gpu = nullptr;
+  TruthFrames* truth = nullptr;
+  const render::RenderSettings& settings;
+  std::string device;
+};
+
+int runReplay(const ReplayOptions& o, const ReplayDrawer& drawer, const std::atomic<bool>* stop);
+
 }  // namespace
 
 int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, const std::atomic<bool>* stop) {
+  return runReplay(o, ReplayDrawer{&renderer, nullptr, renderer.settings(), renderer.deviceName()}, stop);
+}
+
+int runTruthReplay(const ReplayOptions& o, TruthFrames& truth, const std::atomic<bool>* stop) {
+  SKY_ASSERT(o.display == nullptr && o.budget == nullptr);
+  return runReplay(o, ReplayDrawer{nullptr, &truth, truth.settings(), truth.deviceName()}, stop);
+}
+
+namespace {
+
+int runReplay(const ReplayOptions& o, const ReplayDrawer& drawer, const std::atomic<bool>* stop) {
   // Flight files are read here and parsed by protocol/ (the renderer does
   // not link sim_clients/).
   auto text = readFile(o.flightPath, flight::kMaxFlightFileBytes);
@@ -151,7 +178,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   const auto frameCount = std::min(static_cast<std::size_t>(std::floor((t1 - t0) / o.step_s + 1e-9)) + 1,
                                    o.maxFrames > 0 ? o.maxFrames : std::numeric_limits<std::size_t>::max());
 
-  auto writer = FrameWriter::open(o.outDir + "/frames", o.outputs, RunSettings{o.preset, renderer.settings()});
+  auto writer = FrameWriter::open(o.outDir + "/frames", o.outputs, RunSettings{o.preset, drawer.settings});
   if (!writer) {
     std::fprintf(stderr, "skyshell-render: %s\n", describe(writer.error()).c_str());
     return 2;
@@ -193,11 +220,15 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     }
   } stopper{weather, guard, ioThread};
 
-  const auto& s = renderer.settings();
+  const auto& s = drawer.settings;
   std::printf("skyshell-render: replaying %s %s: %zu frames of %.3f s (flight %.1f-%.1f s) at %ux%u, "
               "weather from %s, output to %s\n",
               o.flightPath.c_str(), o.display ? "in a window" : "headless", frameCount, o.step_s, t0 - first_s, t1 - first_s, s.width, s.height,
               weatherSource.c_str(), o.outDir.c_str());
+  if (drawer.truth)
+    std::printf("skyshell-render: path-traced truth: %u samples per pixel on %u threads (slow: the first frame's "
+                "rows say how slow)\n",
+                drawer.truth->truth().samplesPerPixel, drawer.truth->threads());
   std::fflush(stdout);
 
   // The camera and the time of day come from the flight, as a live
@@ -244,12 +275,33 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   auto lastReport = start;
   int exitCode = 0;
   std::size_t done = 0;
-  ChannelFrames frames(renderer, *writer, o.display);
+  ChannelFrames frames = drawer.truth ? ChannelFrames(*drawer.truth, *writer) : ChannelFrames(*drawer.gpu, *writer, o.display);
   frames.setBudget(o.budget);
   frames.setExposure(o.exposure_s);
   frames.setCameraExposure(o.cameraExposure);
   std::map<std::string, std::size_t> framesPerLevel;
+  std::size_t drawing = 0;  // the frame being drawn
+  std::uint64_t violations = 0;
+  auto lastRows = start;
+  if (drawer.truth) {
+    // A path-traced frame takes seconds to minutes: its rows say how far it
+    // is, and the time left counts the rows of the frames still to draw.
+    drawer.truth->setProgress([&](std::uint32_t rows, std::uint32_t all) {
+      const auto now = Clock::now();
+      // The first row of all says at once how slow the frames will be.
+      if (now - lastRows < kTruthProgressPeriod && !(drawing == 0 && rows == 1)) return;
+      lastRows = now;
+      const double elapsed = std::chrono::duration<double>(now - start).count();
+      const double rowsDone = double(drawing) * all + rows, rowsAll = double(frameCount) * all;
+      const double rate = elapsed > 0 ? rowsDone / elapsed : 0;
+      std::printf("truth: frame %zu/%zu, rows %u/%u, %.2f rows/s, %s elapsed, %s left\n", drawing + 1, frameCount,
+                  rows, all, rate, duration(elapsed).c_str(),
+                  duration(rate > 0 ? (rowsAll - rowsDone) / rate : 0).c_str());
+      std::fflush(stdout);
+    });
+  }
   for (std::size_t i = 0; i < frameCount; ++i) {
+    drawing = i;
     if (stop && *stop) {
       exitCode = 1;
       break;
@@ -331,6 +383,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
     for (const auto& pass : record.gpu) gpuMs[pass.pass].push_back(pass.gpu_ms);
     versionsSeen.insert(view.version);
     nonFinite += record.stats.nonFinite;
+    if (record.truth) violations += record.truth->majorantViolations;
     if (nextPick < picks.size() && picks[nextPick] == i) {
       sheet.add(drawn->image, record.cameraExposure.exposure);
       ++nextPick;
@@ -395,7 +448,18 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   } else {
     report["sun"] = {{"azimuth_deg", o.sunAzimuth_deg}, {"elevation_deg", o.sunElevation_deg}};
   }
-  report["device"] = renderer.deviceName();
+  report["device"] = drawer.device;
+  // What drew the frames: the GPU, or the path tracer (each frame's samples
+  // and standard error in frames.jsonl "truth").
+  if (drawer.truth)
+    report["truth"] = {{"mode", "path"},
+                       {"samples_per_pixel", drawer.truth->truth().samplesPerPixel},
+                       {"threads", drawer.truth->threads()},
+                       {"seed", "frame index + 1"},
+                       {"majorant_violations", violations},
+                       {"exr_channel", o.outputs.exr ? nlohmann::json(kExrTruthStandardError) : nlohmann::json()}};
+  else
+    report["truth"] = {{"mode", "none"}};
   report["render_ms"] = {{"p50", ms.p50}, {"p90", ms.p90}, {"p99", ms.p99}, {"mean", ms.mean}, {"max", ms.max}};
   nlohmann::json gpu = nlohmann::json::object();
   for (const auto& [pass, samples] : gpuMs) {
@@ -432,5 +496,7 @@ int runHeadlessReplay(const ReplayOptions& o, render::CloudRenderer& renderer, c
   std::fflush(stdout);
   return exitCode;
 }
+
+}  // namespace
 
 }  // namespace sky::app

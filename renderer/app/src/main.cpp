@@ -36,6 +36,7 @@
 #include "sky/app/view_state.hpp"
 #include "sky/render/presets.hpp"
 #include "sky/app/timed_render.hpp"
+#include "sky/app/truth_frames.hpp"
 #include "sky/app/weather_client.hpp"
 #include "sky/app/window_display.hpp"
 #include "sky/flight/clean.hpp"
@@ -105,6 +106,9 @@ struct Options {
   std::string utc;  // --utc: the time of day at the host's first datagram
   std::string weatherFile;
   std::string channel;  // name in the operator console; empty: render@<host>
+  std::string truth;    // --truth: "path", or empty (the GPU draws)
+  std::string spp;      // --spp, as given (parsed by parseTruthSettings)
+  unsigned truthThreads = 0;
 };
 
 // Set by SIGINT/SIGTERM during a --replay (which runs no io_context of its own
@@ -129,6 +133,53 @@ std::optional<sky::render::ExposureSettings> exposureSettings(const Options& o) 
   s.automatic = false;
   s.fixedEv100 = ev;
   return s;
+}
+
+// The replay of --replay as the options say (its camera exposure, window
+// and budget are the caller's).
+sky::app::ReplayOptions replayOptions(const Options& o, const sky::app::FrameOutputs& outputs,
+                                      const std::string& serverHost, unsigned serverPort) {
+  sky::app::ReplayOptions r;
+  r.flightPath = o.replayFlight;
+  r.read = o.replayRead;
+  r.exposure_s = o.exposure_ms / 1000.0;
+  if (!o.replayAltitudeUnit.empty())
+    r.read.altitudeUnit = o.replayAltitudeUnit == "ft" ? sky::flight::AltitudeUnit::Feet : sky::flight::AltitudeUnit::Metres;
+  r.step_s = o.replayStep_s;
+  r.pace = o.replayPace;
+  r.start_s = o.replayStart_s;
+  if (o.replayEnd_s >= 0) r.end_s = o.replayEnd_s;
+  r.maxFrames = o.maxFrames;
+  if (std::isfinite(o.replayWeatherClock_s)) r.weatherClock_s = o.replayWeatherClock_s;
+  r.serverHost = serverHost;
+  r.serverPort = static_cast<unsigned short>(serverPort);
+  r.weatherTimeout_s = o.weatherTimeout_s;
+  r.outDir = o.outDir;
+  r.outputs = outputs;
+  r.video = !o.noVideo;
+  r.clean = !o.noClean;
+  r.cleanOptions = o.cleanOptions;
+  r.cleanOptions.longGap = o.longGap == "end" ? sky::flight::LongGap::End : sky::flight::LongGap::Hold;
+  r.sunAzimuth_deg = o.sunAzimuth_deg;
+  r.sunElevation_deg = o.sunElevation_deg;
+  r.fixedSun = o.fixedSun;
+  r.preset = o.preset;
+  r.weatherFile = o.weatherFile;
+  if (o.radarRange_km > 0) r.radarRange_m = o.radarRange_km * 1000.0;
+  return r;
+}
+
+// Why --truth cannot go with the other options given (empty: it can). The
+// truth is drawn offline, seconds to minutes a frame, by the path tracer,
+// which takes the light itself and the view ray's air from the reference
+// preset's march.
+std::string truthConflict(const Options& o, const CLI::App& app) {
+  if (o.replayFlight.empty()) return "--truth path draws the frames of a --replay flight, not a live channel's";
+  if (o.window) return "--truth path cannot show its frames in a --window (they take seconds to minutes each); use --headless";
+  if (app.count("--frame-budget-ms") > 0) return "--frame-budget-ms does not apply to --truth path (a frame takes as long as its samples)";
+  if (app.count("--preset") > 0) return "--preset does not apply to --truth path (the path tracer takes the light itself; its view-ray air is the reference preset's march)";
+  if (app.count("--sun-shadow") > 0) return "--sun-shadow does not apply to --truth path (the path tracer finds the sun's shadow by ratio tracking)";
+  return {};
 }
 
 bool writePortFile(const std::string& path, unsigned port) {
@@ -289,6 +340,15 @@ int main(int argc, char** argv) {
   app.add_option("--weather-file", o.weatherFile,
                  "a scenario file (deploy/scenarios/*.toml): with --replay, the weather rendered instead of asking "
                  "--server; live, the weather drawn until the server's comes (default: clear sky)");
+  app.add_option("--truth", o.truth,
+                 "with --replay --headless: path (the only mode): path-trace every frame on the CPU (the physical "
+                 "ground truth, docs/ground-truth.md) instead of drawing it on the GPU; slow: seconds a frame at "
+                 "32x18, minutes at 160x90");
+  app.add_option("--spp", o.spp,
+                 "with --truth path: samples per pixel, 2-65536 (default 16); each frame records its per-pixel "
+                 "standard error (frames.jsonl truth, the EXR's truth.standard_error)");
+  app.add_option("--truth-threads", o.truthThreads, "with --truth path: threads (0 = every hardware thread)")
+      ->capture_default_str();
   app.add_flag("--fixed-sun", o.fixedSun,
                "with --replay: light from --sun-azimuth/--sun-elevation even when the flight has a date");
   app.set_config("--config", "", "config file (TOML keys named like the long options)");
@@ -341,6 +401,24 @@ int main(int argc, char** argv) {
                  shown(o.ev100).c_str());
     return 2;
   }
+  std::optional<sky::app::TruthSettings> truth;
+  if (!o.truth.empty()) {
+    if (const std::string conflict = truthConflict(o, app); !conflict.empty()) {
+      std::fprintf(stderr, "skyshell-render: %s\n", shown(conflict).c_str());
+      return 2;
+    }
+    auto parsed = sky::app::parseTruthSettings(
+        o.truth, app.count("--spp") > 0 ? std::optional(o.spp) : std::nullopt, o.truthThreads);
+    if (!parsed) {
+      std::fprintf(stderr, "skyshell-render: %s\n", shown(parsed.error().detail).c_str());
+      return 2;
+    }
+    truth = *parsed;
+    o.preset = "reference";
+  } else if (app.count("--spp") > 0 || app.count("--truth-threads") > 0) {
+    std::fprintf(stderr, "skyshell-render: --spp and --truth-threads go with --truth path\n");
+    return 2;
+  }
   std::optional<double> startUtc_s;
   if (!o.utc.empty()) {
     startUtc_s = sky::app::parseUtc(o.utc.c_str());
@@ -381,6 +459,23 @@ int main(int argc, char** argv) {
   };
   sky::render::RenderSettings settings{o.width, o.height, o.fov_deg, 1, o.noNoiseCache ? std::string() : o.cacheDir,
                                        withSunShadow(preset->march), preset->temporal, preset->resolution};
+  if (truth) {
+    auto frames = sky::app::TruthFrames::create(settings, *truth);
+    if (!frames) {
+      std::fprintf(stderr, "skyshell-render: --truth: %s\n", sky::describe(frames.error()).c_str());
+      return 2;
+    }
+    auto exposure = sky::render::AutoExposure::create(*cameraSettings, settings.noiseSeed);
+    if (!exposure) {
+      std::fprintf(stderr, "skyshell-render: exposure: %s\n", sky::describe(exposure.error()).c_str());
+      return 2;
+    }
+    sky::app::ReplayOptions r = replayOptions(o, outputs, serverHost, serverPort);
+    r.cameraExposure = &*exposure;
+    std::signal(SIGINT, onReplaySignal);
+    std::signal(SIGTERM, onReplaySignal);
+    return sky::app::runTruthReplay(r, *frames, &gReplayStop);
+  }
   std::optional<sky::render::FrameBudget> budget;
   if (o.frameBudget_ms > 0) {
     auto ladder = sky::render::budgetLadder(*preset);
@@ -421,36 +516,10 @@ int main(int argc, char** argv) {
     }
   } validationSummary{**renderer, o.validation};
   if (!o.replayFlight.empty()) {
-    sky::app::ReplayOptions r;
-    r.flightPath = o.replayFlight;
-    r.read = o.replayRead;
-    r.exposure_s = o.exposure_ms / 1000.0;
+    sky::app::ReplayOptions r = replayOptions(o, outputs, serverHost, serverPort);
     r.cameraExposure = &*cameraExposure;
-    if (!o.replayAltitudeUnit.empty())
-      r.read.altitudeUnit = o.replayAltitudeUnit == "ft" ? sky::flight::AltitudeUnit::Feet : sky::flight::AltitudeUnit::Metres;
-    r.step_s = o.replayStep_s;
-    r.pace = o.replayPace;
-    r.start_s = o.replayStart_s;
-    if (o.replayEnd_s >= 0) r.end_s = o.replayEnd_s;
-    r.maxFrames = o.maxFrames;
-    if (std::isfinite(o.replayWeatherClock_s)) r.weatherClock_s = o.replayWeatherClock_s;
-    r.serverHost = serverHost;
-    r.serverPort = static_cast<unsigned short>(serverPort);
-    r.weatherTimeout_s = o.weatherTimeout_s;
-    r.outDir = o.outDir;
-    r.outputs = outputs;
-    r.video = !o.noVideo;
-    r.clean = !o.noClean;
-    r.cleanOptions = o.cleanOptions;
-    r.cleanOptions.longGap = o.longGap == "end" ? sky::flight::LongGap::End : sky::flight::LongGap::Hold;
-    r.sunAzimuth_deg = o.sunAzimuth_deg;
-    r.sunElevation_deg = o.sunElevation_deg;
-    r.fixedSun = o.fixedSun;
-    r.preset = o.preset;
-    r.weatherFile = o.weatherFile;
     r.display = display ? &*display : nullptr;
     r.budget = budget ? &*budget : nullptr;
-    if (o.radarRange_km > 0) r.radarRange_m = o.radarRange_km * 1000.0;
     std::signal(SIGINT, onReplaySignal);
     std::signal(SIGTERM, onReplaySignal);
     return sky::app::runHeadlessReplay(r, **renderer, &gReplayStop);

@@ -31,6 +31,11 @@ Result<render::Image> timedRender(render::CloudRenderer& renderer, const render:
   record.nearPrecip = renderer.lastNearPrecip();
   record.weatherMap = renderer.lastWeatherMap();
   record.stats = render::computeStats(*image);
+  recordLighting(in, record);
+  return image;
+}
+
+void recordLighting(const render::FrameInputs& in, FrameRecord& record) {
   // The same choice as the renderer's frame setup: the ephemeris when the
   // frame has a date, else the given angles.
   if (in.utc_s) {
@@ -48,7 +53,6 @@ Result<render::Image> timedRender(render::CloudRenderer& renderer, const render:
     record.moonElevation_deg = in.moonElevation_deg;
   }
   record.visibility_m = in.visibility_m;
-  return image;
 }
 
 void logValidationMessages(render::CloudRenderer& renderer) {

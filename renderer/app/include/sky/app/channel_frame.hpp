@@ -1,7 +1,7 @@
 // One frame of a channel, from a pose and the weather to draw to a finished
 // image and its record in frames.jsonl: the work every loop of a channel
 // shares (the live loop of skyshell-render, whatever its pose source, and
-// the headless replay of a flight file). The loops differ only in where the
+// the headless replay of a flight file, drawn by the GPU or path-traced). The loops differ only in where the
 // pose, the time and the weather clock come from and when a frame is due.
 #pragma once
 
@@ -11,8 +11,10 @@
 
 #include "sky/app/frame_writer.hpp"
 #include "sky/app/shared_state.hpp"
+#include "sky/app/truth_frames.hpp"
 #include "sky/app/view_state.hpp"
 #include "sky/app/window_display.hpp"
+#include "sky/core/assert.hpp"
 #include "sky/render/auto_exposure.hpp"
 #include "sky/render/cloud_renderer.hpp"
 #include "sky/render/frame_budget.hpp"
@@ -60,18 +62,25 @@ struct DrawnFrame {
 
 class ChannelFrames {
  public:
-  // display: the window, or none (headless). All must outlive this.
+  // Frames of the GPU renderer. display: the window, or none (headless).
+  // All must outlive this.
   ChannelFrames(render::CloudRenderer& renderer, FrameWriter& writer, WindowDisplay* display)
-      : renderer_(renderer), writer_(writer), display_(display) {}
+      : renderer_(&renderer), writer_(writer), display_(display) {}
+  // Frames of the path-traced truth (headless, no budget: each frame takes
+  // as long as its samples do). Both must outlive this.
+  ChannelFrames(const TruthFrames& truth, FrameWriter& writer) : truth_(&truth), writer_(writer), display_(nullptr) {}
 
   // Draws the frame: the layers this channel can draw (warning once per
   // weather version about those left out), the frame inputs, the render,
   // the window, the record, the files.
   tl::expected<DrawnFrame, FrameFailure> draw(const FrameRequest& request);
 
-  // Holds the frames to a time budget: each frame is drawn at the budget's
-  // level, and its time moves the budget on. Not owned; null: none.
-  void setBudget(render::FrameBudget* budget) { budget_ = budget; }
+  // Holds the GPU's frames to a time budget: each frame is drawn at the
+  // budget's level, and its time moves the budget on. Not owned; null: none.
+  void setBudget(render::FrameBudget* budget) {
+    SKY_ASSERT(budget == nullptr || renderer_ != nullptr);
+    budget_ = budget;
+  }
   // The exposure each frame stands for (s, > 0): what a flash lights in it,
   // and how long the drops near the camera streak.
   void setExposure(double exposure_s) { exposure_s_ = exposure_s; }
@@ -81,7 +90,9 @@ class ChannelFrames {
   void setCameraExposure(render::AutoExposure* exposure) { cameraExposure_ = exposure; }
 
  private:
-  render::CloudRenderer& renderer_;
+  // One of the two draws the frames.
+  render::CloudRenderer* renderer_ = nullptr;
+  const TruthFrames* truth_ = nullptr;
   FrameWriter& writer_;
   WindowDisplay* display_;
   render::FrameBudget* budget_ = nullptr;

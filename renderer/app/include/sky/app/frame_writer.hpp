@@ -5,7 +5,8 @@
 // sidecar: camera pose and its source, host frame, weather clock and version,
 // the time of day and its source, the sun and the moon, the atmosphere, the settings in use (preset, resolution, field of view, noise
 // seeds), GPU time per pass, image statistics, the renderer's units in W
-// m^-2 sr^-1 and cd/m^2 and the PNG's EV100 and exposure, and the files written.
+// m^-2 sr^-1 and cd/m^2 and the PNG's EV100 and exposure, a path-traced
+// frame's samples and standard error, and the files written.
 #pragma once
 
 #include <cstdint>
@@ -109,7 +110,25 @@ struct FrameRecord {
     geo::GeodeticPose camera;
   };
   std::optional<View> view;
+  // A path-traced frame (--truth path, truth_frames.hpp): its samples and
+  // their noise. The standard errors are of a pixel's rgb mean (R+G+B)/3, in
+  // the radiance's units.
+  struct Truth {
+    std::uint32_t samplesPerPixel = 0;
+    std::uint64_t seed = 0;
+    std::uint32_t threads = 0;
+    std::uint64_t majorantViolations = 0;  // density reads above the majorant (0: unbiased)
+    std::uint64_t densityLookups = 0;
+    double meanStandardError = 0, maxStandardError = 0;  // over the pixels
+    double imageMeanStandardError = 0;     // of the image's mean
+    double meanRelativeStandardError = 0;  // a pixel's over its mean (floor 1e-3 units), averaged
+    std::vector<float> standardError;      // per pixel, top row first: the EXR's kExrTruthStandardError
+  };
+  std::optional<Truth> truth;
 };
+
+// The EXR channel of a path-traced frame's per-pixel standard error.
+inline constexpr const char* kExrTruthStandardError = "truth.standard_error";
 
 class FrameWriter {
  public:

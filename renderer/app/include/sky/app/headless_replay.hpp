@@ -1,7 +1,8 @@
 // skyshell-render --replay: renders a recorded flight headless (or shows it
 // in a window), one frame per fixed step of flight time, with the weather the
 // server streams, then writes an MP4 (ffmpeg), a contact sheet and a JSON
-// report next to the frames.
+// report next to the frames. With --truth path the frames are path-traced on
+// the CPU instead (runTruthReplay, truth_frames.hpp).
 //
 // Deterministic: frame i shows the flight at t0 + i × step and the weather at
 // clock base + i × step × rate (base: --weather-clock, else the server's clock
@@ -20,6 +21,7 @@
 #include <string>
 
 #include "sky/app/frame_writer.hpp"
+#include "sky/app/truth_frames.hpp"
 #include "sky/app/window_display.hpp"
 #include "sky/flight/clean.hpp"
 #include "sky/flight/flight.hpp"
@@ -75,5 +77,11 @@ struct ReplayOptions {
 // closed). Returns the process exit code: 0 done (or window closed), 2 bad
 // input (flight file, output folder), 3 render failure, 4 no weather in time.
 int runHeadlessReplay(const ReplayOptions& options, render::CloudRenderer& renderer, const std::atomic<bool>* stop);
+
+// The same replay with every frame path-traced by `truth` instead of drawn
+// by the GPU (--truth path): the same poses, sun, weather and exposure;
+// no window and no frame budget (options.display and options.budget null).
+// A progress line every few seconds gives the frame's rows and the time left.
+int runTruthReplay(const ReplayOptions& options, TruthFrames& truth, const std::atomic<bool>* stop);
 
 }  // namespace sky::app

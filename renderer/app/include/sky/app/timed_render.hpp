@@ -13,6 +13,10 @@ namespace sky::app {
 // and sun, moon and haze fields.
 Result<render::Image> timedRender(render::CloudRenderer& renderer, const render::FrameInputs& in, FrameRecord& record);
 
+// Fills record's sun, moon and haze fields with what the frame `in` is lit
+// by (the renderer's choice: the ephemeris when it has a date, else its angles).
+void recordLighting(const render::FrameInputs& in, FrameRecord& record);
+
 // CPU time of the whole process (every thread), ms.
 double processCpu_ms();
 
