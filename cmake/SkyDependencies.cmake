@@ -70,6 +70,13 @@ add_library(sky::eccodes INTERFACE IMPORTED)
 target_link_libraries(sky::eccodes INTERFACE ${ECCODES_LIBRARY})
 target_include_directories(sky::eccodes SYSTEM INTERFACE ${ECCODES_INCLUDE_DIR})
 
+# The weather on a NATS cluster (server/, skyshell-weatherd --nats): the C
+# client nats.c, Debian's libnats-dev, found by its pkg-config file. Linked by
+# the server library only; the renderer never sees it.
+pkg_check_modules(LIBNATS REQUIRED IMPORTED_TARGET libnats)
+add_library(sky::nats INTERFACE IMPORTED)
+target_link_libraries(sky::nats INTERFACE PkgConfig::LIBNATS)
+
 find_package(Vulkan REQUIRED)
 find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)
 find_package(glm CONFIG REQUIRED)
