@@ -126,7 +126,8 @@ HostFrame hostFrame() {
   vc.pitch_deg = -5;
   vc.yaw_deg = 45;
   EnvironmentalConditionsRequest ecr{kRequestWeather | kRequestAerosol, 42, 47.4647, 8.5492, 3000};
-  f.packets = {ig, e, cel, atm, reg, w, vd, vc, ecr};
+  CameraExposureControl exposure{2, ExposureMode::Fixed, 14.5f, -1.25f};
+  f.packets = {ig, e, cel, atm, reg, w, vd, vc, ecr, exposure};
   f.fields = {
       {"cigi.ig_control.db_number", 5}, {"cigi.ig_control.ig_mode", 1},
       {"cigi.ig_control.timestamp_valid", 1}, {"cigi.ig_control.extrapolation_enable", 1},
@@ -183,6 +184,10 @@ HostFrame hostFrame() {
       {"cigi.env_cond_request.type", 12}, {"cigi.env_cond_request.id", 42},
       {"cigi.env_cond_request.lat", 47.4647}, {"cigi.env_cond_request.lon", 8.5492},
       {"cigi.env_cond_request.alt", 3000},
+      // Skyshell's camera exposure component (its data words are bytes to
+      // tshark, shown unswapped: checked by cigi_test.cpp's offsets).
+      {"cigi.component_control.component_id", 100}, {"cigi.component_control.instance_id", 2},
+      {"cigi.component_control.component_class", 1}, {"cigi.component_control.component_state", 1},
   };
   return f;
 }

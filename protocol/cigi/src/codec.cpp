@@ -22,6 +22,9 @@ struct PacketKind {
   Direction direction;
   const char* name;
   Result<Packet> (*read)(PacketReader&);
+  // For an id several packets share (Component Control): whether this
+  // packet is the one we decode. Null: every packet of the id is.
+  bool (*claims)(const std::uint8_t* packet, std::size_t size, ByteOrder order) = nullptr;
 };
 
 template <class T>
@@ -34,6 +37,11 @@ Result<Packet> readAs(PacketReader& r) {
 template <class T>
 constexpr PacketKind kind(Direction d) {
   return {T::kId, T::kSize, d, Codec<T>::kName, &readAs<T>};
+}
+
+template <class T>
+constexpr PacketKind claimedKind(Direction d, bool (*claims)(const std::uint8_t*, std::size_t, ByteOrder)) {
+  return {T::kId, T::kSize, d, Codec<T>::kName, &readAs<T>, claims};
 }
 
 constexpr std::array kKinds = {
@@ -49,11 +57,14 @@ constexpr std::array kKinds = {
     kind<StartOfFrame>(Direction::IgToHost),
     kind<WeatherConditionsResponse>(Direction::IgToHost),
     kind<AerosolConcentrationResponse>(Direction::IgToHost),
+    claimedKind<CameraExposureControl>(Direction::HostToIg, &detail::claimsCameraExposure),
 };
 
-const PacketKind* findKind(std::uint8_t id) {
+// The kind that decodes the packet at `packet` (its id and size byte
+// checked), or null for one we skip.
+const PacketKind* findKind(const std::uint8_t* packet, std::size_t size, ByteOrder order) {
   for (const auto& k : kKinds)
-    if (k.id == id) return &k;
+    if (k.id == packet[0] && (!k.claims || k.claims(packet, size, order))) return &k;
   return nullptr;
 }
 
@@ -156,7 +167,7 @@ Result<Datagram> decodeDatagram(std::span<const std::uint8_t> bytes) {
       return fail(ErrorCode::Malformed, at(index, offset) + "id " + std::to_string(id) + " size " +
                                             std::to_string(size) + " runs past the " +
                                             std::to_string(bytes.size()) + "-byte datagram");
-    const PacketKind* k = findKind(id);
+    const PacketKind* k = findKind(bytes.data() + offset, size, out.order);
     if (index > 0 && (id == IgControl::kId || id == StartOfFrame::kId))
       return fail(ErrorCode::Malformed,
                   at(index, offset) + "only the first packet may be IG Control / Start of Frame");

@@ -454,4 +454,43 @@ Result<AerosolConcentrationResponse> Codec<AerosolConcentrationResponse>::read(P
   return r.result(p);
 }
 
+// --- Component Control (4): the camera exposure component --------------------
+// The walker hands over only packets of our class and component id
+// (claimsCameraExposure); the rest of the packet is checked here.
+void Codec<CameraExposureControl>::write(PacketBuilder& b, const CameraExposureControl& p) {
+  b.u16(2, CameraExposureControl::kComponentId);
+  b.u16(4, p.viewId);
+  b.u8(6, CameraExposureControl::kComponentClass);
+  b.u8(7, static_cast<std::uint8_t>(p.mode));
+  b.f32(8, p.ev100);
+  b.f32(12, p.compensation_ev);
+}
+
+Result<CameraExposureControl> Codec<CameraExposureControl>::read(PacketReader& r) {
+  CameraExposureControl p;
+  p.viewId = r.u16(4);
+  if ((r.u8(6) & 0xC0) != 0) r.invalid(6, "reserved bits 6-7 of the component class byte are set");
+  const std::uint8_t state = r.u8(7);
+  if (state > static_cast<std::uint8_t>(ExposureMode::Fixed))
+    r.invalid(7, "camera exposure state " + std::to_string(state) + " is neither 0 (auto) nor 1 (fixed)");
+  p.mode = static_cast<ExposureMode>(state);
+  p.ev100 = r.f32(8);
+  p.compensation_ev = r.f32(12);
+  if (p.mode == ExposureMode::Fixed)
+    r.range(8, "EV100", p.ev100, -10, 30);
+  else
+    r.finite(8, "EV100", p.ev100);
+  r.range(12, "exposure compensation", p.compensation_ev, -10, 10);
+  for (std::size_t off = 16; off < CameraExposureControl::kSize; off += 4)
+    if (r.u32(off) != 0) r.invalid(off, "reserved data word is not 0");
+  return r.result(p);
+}
+
+bool claimsCameraExposure(const std::uint8_t* packet, std::size_t size, ByteOrder order) {
+  if (size < 8) return false;
+  const PacketReader r(packet, order, 0, 0, "");
+  return (r.u8(6) & 0x3F) == CameraExposureControl::kComponentClass &&
+         r.u16(2) == CameraExposureControl::kComponentId;
+}
+
 }  // namespace sky::cigi::detail

@@ -29,7 +29,14 @@ SKY_CIGI_CODEC(EnvironmentalConditionsRequest, "Environmental Conditions Request
 SKY_CIGI_CODEC(StartOfFrame, "Start of Frame")
 SKY_CIGI_CODEC(WeatherConditionsResponse, "Weather Conditions Response")
 SKY_CIGI_CODEC(AerosolConcentrationResponse, "Aerosol Concentration Response")
+SKY_CIGI_CODEC(CameraExposureControl, "Component Control (camera exposure)")
 
 #undef SKY_CIGI_CODEC
+
+// Whether a Component Control (id 4) of `size` bytes at `packet` is of our
+// camera exposure component (its class and component id; size >= 8 to hold
+// them). Component Control carries many components in one id: only ours is
+// decoded, the others are skipped like any packet a channel does not use.
+bool claimsCameraExposure(const std::uint8_t* packet, std::size_t size, ByteOrder order);
 
 }  // namespace sky::cigi::detail

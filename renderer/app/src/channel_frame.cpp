@@ -9,6 +9,7 @@
 
 #include "sky/app/drawable_weather.hpp"
 #include "sky/app/timed_render.hpp"
+#include "sky/render/exposure.hpp"
 
 namespace sky::app {
 
@@ -60,11 +61,27 @@ tl::expected<DrawnFrame, FrameFailure> ChannelFrames::draw(const FrameRequest& r
     budget_->update(record.render_ms);
   }
   out.image = std::move(*image);
-  // The camera meters the host's boresight, not this channel's view.
-  if (cameraExposure_) {
-    auto exposed = cameraExposure_->expose(in, r.host.pose, r.hostTime_s);
+  // The camera meters the host's boresight, not this channel's view. The
+  // host's setting, when it sent one, replaces the channel's own: a fixed
+  // EV100, or the meter with the host's compensation.
+  const cigi::CameraExposureControl* host = r.hostExposure ? &*r.hostExposure : nullptr;
+  if (host && host->mode == cigi::ExposureMode::Fixed) {
+    render::FrameExposure& e = record.cameraExposure;
+    e = render::FrameExposure{};
+    e.automatic = false;
+    e.ev100 = host->ev100;
+    e.compensation_ev = host->compensation_ev;
+    e.exposure = render::displayExposure(host->ev100, host->compensation_ev);
+    record.exposureSource = "host";
+  } else if (render::AutoExposure* meter = host && hostMeter_ ? hostMeter_ : cameraExposure_) {
+    auto exposed = meter->expose(in, r.host.pose, r.hostTime_s);
     if (!exposed) return tl::unexpected(FrameFailure{3, frameName + "exposure: " + describe(exposed.error())});
     record.cameraExposure = *exposed;
+    if (host && hostMeter_) {
+      record.cameraExposure.compensation_ev = host->compensation_ev;
+      record.cameraExposure.exposure = render::displayExposure(exposed->ev100, host->compensation_ev);
+      record.exposureSource = "host";
+    }
   }
   const auto delay_ms = [&] {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - r.host.receivedAt).count();

@@ -176,6 +176,8 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
       takeView(*definition, "View Definition");
     } else if (const auto* control = std::get_if<cigi::ViewControl>(&packet)) {
       takeView(*control, "View Control");
+    } else if (const auto* exposure = std::get_if<cigi::CameraExposureControl>(&packet)) {
+      takeExposure(*exposure);
     }
   }
   for (std::size_t i = 1; i < datagram->packets.size(); ++i) {
@@ -185,6 +187,7 @@ std::vector<std::uint8_t> CigiListener::handleDatagram(std::span<const std::uint
       if (!std::holds_alternative<cigi::CelestialSphereControl>(packet) &&
           !std::holds_alternative<cigi::AtmosphereControl>(packet) &&
           !std::holds_alternative<cigi::ViewDefinition>(packet) && !std::holds_alternative<cigi::ViewControl>(packet) &&
+          !std::holds_alternative<cigi::CameraExposureControl>(packet) &&
           !std::holds_alternative<cigi::EnvironmentalConditionsRequest>(packet))
         ignore(cigi::packetId(packet));
       continue;
@@ -265,6 +268,26 @@ void CigiListener::takeView(const ViewPacket& packet, const char* name) {
           spdlog::warn("CIGI: {} for this channel's view asks for {}: not supported, counted", name, part);
       }
       return;
+  }
+}
+
+void CigiListener::takeExposure(const cigi::CameraExposureControl& e) {
+  // The decoder checked every field; what is left is whose view it is.
+  if (e.viewId != cigi::CameraExposureControl::kAllViews && e.viewId != state_.view().viewId) {
+    otherViewPackets_.fetch_add(1, std::memory_order_relaxed);
+    otherViewExposures_.fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
+  state_.setHostExposure(e);
+  hostExposures_.fetch_add(1, std::memory_order_relaxed);
+  // A host may send its setting with every frame: said when it changes.
+  if (loggedExposure_ != e) {
+    loggedExposure_ = e;
+    if (e.mode == cigi::ExposureMode::Fixed)
+      spdlog::info("CIGI: the host fixed the camera exposure at EV100 {:.2f}, compensation {:+.2f} EV", e.ev100,
+                   e.compensation_ev);
+    else
+      spdlog::info("CIGI: the host gave the camera exposure to the meter, compensation {:+.2f} EV", e.compensation_ev);
   }
 }
 

@@ -214,9 +214,11 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
   // radiance per channel, and this luminance (Rec. 709 Y of the rgb).
   line["units"] = {{"radiance_W_m2_sr", render::kRadianceUnit_Wpm2sr}, {"luminance_cd_m2", render::kLuminanceUnit_cdm2}};
   // The PNG's (and window's) camera: its EV100, the compensation, and the
-  // multiplier of the linear rgb into the tonemap (exposure.hpp).
+  // multiplier of the linear rgb into the tonemap (exposure.hpp), and whose
+  // setting it is.
   const render::FrameExposure& e = r.cameraExposure;
-  line["camera_exposure"] = {{"mode", e.automatic ? "auto" : "fixed"},
+  line["camera_exposure"] = {{"source", r.exposureSource},
+                             {"mode", e.automatic ? "auto" : "fixed"},
                              {"ev100", e.ev100},
                              {"compensation_ev", e.compensation_ev},
                              {"exposure", e.exposure},

@@ -661,6 +661,22 @@ int main(int argc, char** argv) {
   channelFrames.setBudget(budget ? &*budget : nullptr);
   channelFrames.setExposure(o.exposure_ms / 1000.0);
   channelFrames.setCameraExposure(&*cameraExposure);
+  // A host's "auto" (CIGI camera exposure component) is the meter: the
+  // channel's own when it meters, else one built now, so that a channel
+  // started with a fixed --ev100 meters at once when its host asks.
+  std::optional<sky::render::AutoExposure> hostMeter;
+  if (!cameraExposure->settings().automatic) {
+    sky::render::ExposureSettings metered = cameraExposure->settings();
+    metered.automatic = true;
+    auto built = sky::render::AutoExposure::create(metered, settings.noiseSeed);
+    if (!built) {
+      std::fprintf(stderr, "skyshell-render: exposure: %s\n", sky::describe(built.error()).c_str());
+      shutdown();
+      return 2;
+    }
+    hostMeter = std::move(*built);
+  }
+  channelFrames.setHostMeter(hostMeter ? &*hostMeter : &*cameraExposure);
 
   std::uint64_t frames = 0, lastSequence = 0, resetsSeen = 0;
   sky::app::LatencyHistogram transportDelay, presentDelay;
@@ -742,6 +758,7 @@ int main(int argc, char** argv) {
     request.utc_s = pose->utc_s;
     request.utcSource = pose->timeSource;
     request.atmosphere = source->atmosphere();
+    request.hostExposure = state.hostExposure();
     request.frameIndex = frames;
     // The host's own time where it sends one (the same on every channel);
     // else this channel's time since start.
@@ -795,6 +812,9 @@ int main(int argc, char** argv) {
               static_cast<unsigned long long>(state.view().controls),
               static_cast<unsigned long long>(cigi->otherViewPackets()),
               static_cast<unsigned long long>(cigi->unsupportedViewParts()));
+  std::printf("render: camera exposure: %llu host settings applied, %llu for other views ignored\n",
+              static_cast<unsigned long long>(cigi->hostExposures()),
+              static_cast<unsigned long long>(cigi->otherViewExposures()));
   if (const auto line = source->summary(); !line.empty()) std::printf("%s\n", line.c_str());
   std::fflush(stdout);
   shutdown();

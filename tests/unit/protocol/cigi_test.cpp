@@ -1,6 +1,7 @@
 // CIGI 3.3 codec against the golden hex vectors of the reference
 // (../shared/reference/cigi.md §9.2, verified there with tshark), in both byte
 // orders, and the malformed datagrams a receiver must reject.
+#include <cmath>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -290,6 +291,107 @@ TEST(Cigi, SkipsUndecodedHostPacketsByIdInBothOrders) {
   EXPECT_STREQ(packetIdName(8), "Rate Control");
   EXPECT_STREQ(packetIdName(117), "Image Generator Message");
   EXPECT_EQ(packetId(Packet(AtmosphereControl{})), 10);
+}
+
+// Skyshell's camera exposure component (Component Control, class View,
+// component id 100): round trip in both byte orders at the offsets CIGI 3.3
+// gives Component Control (2 component id, 4 instance id, 6 class, 7 state,
+// 8.. data words), every field checked, and other components skipped.
+std::vector<std::uint8_t> withExposure(ByteOrder order, const CameraExposureControl& c) {
+  return DatagramWriter(order).add(IgControl{}).add(c).bytes();
+}
+
+TEST(CigiCameraExposure, RoundTripsAtComponentControlOffsetsInBothOrders) {
+  CameraExposureControl c;
+  c.viewId = 2;
+  c.mode = ExposureMode::Fixed;
+  c.ev100 = 14.5f;
+  c.compensation_ev = -1.25f;
+  for (const ByteOrder order : {ByteOrder::Big, ByteOrder::Little}) {
+    const auto bytes = withExposure(order, c);
+    ASSERT_EQ(bytes.size(), 24u + 32u);
+    const std::uint8_t* p = bytes.data() + 24;
+    EXPECT_EQ(p[0], 4);
+    EXPECT_EQ(p[1], 32);
+    const bool big = order == ByteOrder::Big;
+    EXPECT_EQ(big ? (p[2] << 8 | p[3]) : (p[3] << 8 | p[2]), 100) << "component id";
+    EXPECT_EQ(big ? (p[4] << 8 | p[5]) : (p[5] << 8 | p[4]), 2) << "instance id: the view";
+    EXPECT_EQ(p[6], 1) << "component class View";
+    EXPECT_EQ(p[7], 1) << "component state: fixed";
+    for (std::size_t i = 16; i < 32; ++i) EXPECT_EQ(p[i], 0) << "reserved data byte " << i;
+    const auto r = decodeDatagram(bytes);
+    ASSERT_TRUE(r) << r.error().detail;
+    ASSERT_EQ(r->packets.size(), 2u);
+    ASSERT_TRUE(std::holds_alternative<CameraExposureControl>(r->packets[1]));
+    EXPECT_EQ(std::get<CameraExposureControl>(r->packets[1]), c);
+    EXPECT_TRUE(r->skippedIds.empty());
+  }
+  // The EV100 at byte 8 as the big-endian float it is: 14.5 = 0x41680000.
+  const auto be = withExposure(ByteOrder::Big, c);
+  EXPECT_EQ(std::vector<std::uint8_t>(be.begin() + 32, be.begin() + 36), (std::vector<std::uint8_t>{0x41, 0x68, 0, 0}));
+}
+
+TEST(CigiCameraExposure, EveryFieldOutOfItsRangeDropsTheDatagramSayingWhich) {
+  const auto rejects = [](std::vector<std::uint8_t> bytes, const std::string& says) {
+    const auto r = decodeDatagram(bytes);
+    ASSERT_FALSE(r) << says;
+    EXPECT_NE(r.error().detail.find(says), std::string::npos) << r.error().detail;
+  };
+  CameraExposureControl fixed;
+  fixed.mode = ExposureMode::Fixed;
+  fixed.ev100 = 14;
+  const auto good = withExposure(ByteOrder::Big, fixed);
+  ASSERT_TRUE(decodeDatagram(good));
+  auto b = good;
+  b[24 + 7] = 2;
+  rejects(b, "packet 1 (Component Control (camera exposure)) at byte 31: camera exposure state 2 is neither 0 (auto) nor 1 (fixed)");
+  b = good;
+  b[24 + 6] = 0x41;  // class View with a reserved bit
+  rejects(b, "at byte 30: reserved bits 6-7");
+  for (const float ev : {31.0f, -10.5f, std::nanf(""), INFINITY}) {
+    CameraExposureControl bad = fixed;
+    bad.ev100 = ev;
+    rejects(withExposure(ByteOrder::Little, bad), "at byte 32: EV100");
+  }
+  CameraExposureControl autoNan;
+  autoNan.ev100 = std::nanf("");
+  rejects(withExposure(ByteOrder::Big, autoNan), "at byte 32: EV100 is not finite");
+  CameraExposureControl autoAny;
+  autoAny.ev100 = 99;  // auto: the EV100 is not used, only finite
+  EXPECT_TRUE(decodeDatagram(withExposure(ByteOrder::Big, autoAny)));
+  for (const float comp : {10.5f, -11.0f, std::nanf("")}) {
+    CameraExposureControl bad = fixed;
+    bad.compensation_ev = comp;
+    rejects(withExposure(ByteOrder::Big, bad), "at byte 36: exposure compensation");
+  }
+  for (const std::size_t word : {16u, 20u, 24u, 28u}) {
+    b = good;
+    b[24 + word + 3] = 1;
+    rejects(b, "at byte " + std::to_string(24 + word) + ": reserved data word is not 0");
+  }
+  // Our class and component id in a packet that is not 32 bytes.
+  b = good;
+  b[24 + 1] = 24;
+  b.resize(24 + 24);
+  rejects(b, "size 24, must be 32");
+}
+
+TEST(CigiCameraExposure, OtherComponentsAreSkippedAndCounted) {
+  // Component id 100 of the Entity class, and component 101 of the View
+  // class: not ours, skipped by their size whatever their data.
+  CameraExposureControl c;
+  auto bytes = withExposure(ByteOrder::Big, c);
+  bytes[24 + 6] = 0;  // class Entity
+  bytes[24 + 7] = 200;
+  auto other = withExposure(ByteOrder::Little, c);
+  other[24 + 2] = 101;  // little-endian component id 101
+  other[24 + 8] = 0xff;
+  for (const auto& d : {bytes, other}) {
+    const auto r = decodeDatagram(d);
+    ASSERT_TRUE(r) << r.error().detail;
+    EXPECT_EQ(r->packets.size(), 1u);
+    EXPECT_EQ(r->skippedIds, (std::vector<std::uint8_t>{4}));
+  }
 }
 
 }  // namespace

@@ -276,6 +276,32 @@ TEST(CigiIgnored, UnusedPacketsAreCountedById) {
             "Entity Control (2) 1, Component Control (4) 1, Rate Control (8) 1, Weather Control (12) 1");
 }
 
+// The host's camera exposure component: one for this channel's view (0)
+// or every view (65535) is held in the shared state until the next, one
+// for another view is counted and changes nothing, in both byte orders.
+TEST(CigiExposure, TheHostsSettingForThisViewOrEveryViewIsHeld) {
+  for (const cigi::ByteOrder order : {cigi::ByteOrder::Big, cigi::ByteOrder::Little}) {
+    asio::io_context io;
+    SharedState state;
+    CigiListener cigi(io, state, "127.0.0.1", 0);
+    cigi::CameraExposureControl fixed{cigi::CameraExposureControl::kAllViews, cigi::ExposureMode::Fixed, 13.0f, 0.5f};
+    EXPECT_FALSE(cigi.handleDatagram(datagram(order, 1.0, {fixed}), kHost).empty());
+    ASSERT_TRUE(state.hostExposure());
+    EXPECT_EQ(*state.hostExposure(), fixed);
+    cigi::CameraExposureControl other{7, cigi::ExposureMode::Fixed, 3.0f, 0.0f};
+    EXPECT_FALSE(cigi.handleDatagram(datagram(order, 1.1, {other}), kHost).empty());
+    EXPECT_EQ(*state.hostExposure(), fixed) << "another view's setting changed this channel's";
+    cigi::CameraExposureControl metered{0, cigi::ExposureMode::Auto, 0.0f, -1.0f};
+    EXPECT_FALSE(cigi.handleDatagram(datagram(order, 1.2, {metered}), kHost).empty());
+    EXPECT_EQ(*state.hostExposure(), metered);
+    EXPECT_EQ(cigi.hostExposures(), 2u);
+    EXPECT_EQ(cigi.otherViewExposures(), 1u);
+    EXPECT_EQ(cigi.otherViewPackets(), 1u);
+    EXPECT_EQ(cigi.ignored().total(), 0u) << cigi.ignoredSummary();
+    EXPECT_EQ(cigi.datagramsDropped(), 0u);
+  }
+}
+
 // --- FlightGear ------------------------------------------------------------------
 
 // cur_time is FlightGear's simulated time, the warp already added in

@@ -17,7 +17,7 @@ namespace sky::cigi {
 using Packet = std::variant<IgControl, EntityControl, CelestialSphereControl, AtmosphereControl,
                             EnvironmentalRegionControl, WeatherControl, ViewControl, ViewDefinition,
                             EnvironmentalConditionsRequest, StartOfFrame, WeatherConditionsResponse,
-                            AerosolConcentrationResponse>;
+                            AerosolConcentrationResponse, CameraExposureControl>;
 
 // Appends packets to a datagram under construction, in one byte order. The
 // caller puts IG Control (or Start of Frame) first.
@@ -38,9 +38,9 @@ struct Datagram {
   ByteOrder order = ByteOrder::Big;
   Direction direction = Direction::HostToIg;
   std::vector<Packet> packets;     // the packets we decode, in datagram order
-  // Ids of the well-sized packets we do not decode (Component Control, Rate
-  // Control, user-defined 201-255, ...), in datagram order: skipped by their
-  // size byte.
+  // Ids of the well-sized packets we do not decode (Component Control of
+  // components other than ours, Rate Control, user-defined 201-255, ...), in
+  // datagram order: skipped by their size byte.
   std::vector<std::uint8_t> skippedIds;
 };
 

@@ -167,6 +167,26 @@ struct ViewDefinition {
   bool operator==(const ViewDefinition&) const = default;
 };
 
+// Component Control, id 4, 32 bytes (CIGI 3.3: 2 component id, 4 instance
+// id, 6 bits 0-5 component class, 7 component state, 8-31 six 32-bit data
+// words), of Skyshell's camera exposure component: class View, component
+// id kComponentId. The host fixes the EV100 of the channels' cameras, or
+// gives it back to their meter (docs/cigi-conformance.md). Any other
+// Component Control is not decoded (skipped by its size, counted).
+enum class ExposureMode : std::uint8_t { Auto = 0, Fixed = 1 };
+struct CameraExposureControl {
+  static constexpr std::uint8_t kId = 4, kSize = 32;
+  static constexpr std::uint8_t kComponentClass = 1;    // View: the instance id is a view id
+  static constexpr std::uint16_t kComponentId = 100;    // IG-defined; Skyshell's camera exposure
+  static constexpr std::uint16_t kAllViews = 0xFFFF;    // instance id: every view (every channel)
+  std::uint16_t viewId = kAllViews;         // the instance id
+  ExposureMode mode = ExposureMode::Auto;   // the component state: 0 auto (the meter), 1 fixed
+  float ev100 = 0;            // data word 1 (8-11): fixed: [-10, 30]; auto: finite, not used
+  float compensation_ev = 0;  // data word 2 (12-15): [-10, 10], added in both modes
+  // Data words 3-6 (16-31) are reserved: 0.
+  bool operator==(const CameraExposureControl&) const = default;
+};
+
 // Environmental Conditions Request, id 28, 32 bytes.
 struct EnvironmentalConditionsRequest {
   static constexpr std::uint8_t kId = 28, kSize = 32;

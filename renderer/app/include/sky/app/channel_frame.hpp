@@ -44,6 +44,9 @@ struct FrameRequest {
   // one, the flight's time in a replay): what the auto exposure adapts over
   // and meters on the grid of, the same on every channel of the host.
   double hostTime_s = 0;
+  // The host's camera exposure (CIGI camera exposure component), when it
+  // set one: it replaces the channel's own.
+  std::optional<cigi::CameraExposureControl> hostExposure;
   MirrorMode mirror = MirrorMode::None;
   bool live = false;  // record the transport delay from host.receivedAt
 };
@@ -88,6 +91,10 @@ class ChannelFrames {
   // pose (FrameRequest::host) at FrameRequest::hostTime_s. Not owned; null:
   // the fixed exposure 1 (kFixedDisplayExposure).
   void setCameraExposure(render::AutoExposure* exposure) { cameraExposure_ = exposure; }
+  // The meter a host's "auto" exposes with (FrameRequest::hostExposure):
+  // the channel's own when it is automatic. Not owned; null: a host's auto
+  // falls back to the channel's own exposure.
+  void setHostMeter(render::AutoExposure* meter) { hostMeter_ = meter; }
 
  private:
   // One of the two draws the frames.
@@ -97,6 +104,7 @@ class ChannelFrames {
   WindowDisplay* display_;
   render::FrameBudget* budget_ = nullptr;
   render::AutoExposure* cameraExposure_ = nullptr;
+  render::AutoExposure* hostMeter_ = nullptr;
   double exposure_s_ = render::kDefaultExposure_s;
   std::size_t appliedLevel_ = 0;
   std::uint64_t droppedWarnedAt_ = 0;

@@ -5,7 +5,8 @@
 // (Reset/Standby forgets the pose), and the View Definition and View Control
 // of this channel's view (other views' are ignored and counted; one that
 // would give no valid view is dropped and counted as out of range, the rest
-// of its datagram kept) into SharedState and answers with Start of Frame
+// of its datagram kept), and the host's camera exposure (Skyshell's Component
+// Control, for this view or every view) into SharedState and answers with Start of Frame
 // (reporting the IG mode), plus a Weather Conditions Response and
 // Aerosol Concentration Responses for each Environmental Conditions Request.
 // It answers one host only: the one it is told (--cigi-host) or else the
@@ -138,6 +139,10 @@ class CigiListener {
   // View Definitions not drawn (orthographic, pixel replication). Thread-safe.
   std::uint64_t otherViewPackets() const { return otherViewPackets_.load(); }
   std::uint64_t unsupportedViewParts() const { return unsupportedViewParts_.load(); }
+  // Camera exposure components applied to this channel, and those for other
+  // views (ignored; also counted in otherViewPackets). Thread-safe.
+  std::uint64_t hostExposures() const { return hostExposures_.load(); }
+  std::uint64_t otherViewExposures() const { return otherViewExposures_.load(); }
   // The host this port answers, once known. Thread-safe.
   std::optional<CigiHost> host() const;
 
@@ -149,6 +154,7 @@ class CigiListener {
                                          const std::vector<cigi::Packet>& replies);
   template <class ViewPacket>
   void takeView(const ViewPacket& packet, const char* name);
+  void takeExposure(const cigi::CameraExposureControl& exposure);
 
   boost::asio::ip::udp::socket socket_;
   boost::asio::ip::udp::endpoint from_;
@@ -158,6 +164,8 @@ class CigiListener {
   std::uint32_t igFrame_ = 0;  // io thread only
   std::atomic<std::uint64_t> accepted_{0};
   std::atomic<std::uint64_t> otherViewPackets_{0}, unsupportedViewParts_{0};
+  std::atomic<std::uint64_t> hostExposures_{0}, otherViewExposures_{0};
+  std::optional<cigi::CameraExposureControl> loggedExposure_;  // io thread only
   DropCounts drops_;
   std::set<std::string> loggedReasons_;  // io thread only
   IgnoredPackets ignored_;

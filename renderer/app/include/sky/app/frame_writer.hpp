@@ -84,6 +84,9 @@ struct FrameRecord {
   // The camera's exposure its PNG and window show it with (auto or fixed
   // EV100, auto_exposure.hpp); the EXR stays linear radiance.
   render::FrameExposure cameraExposure;
+  // Whose exposure it is: "channel" (its --ev100) or "host" (the CIGI camera
+  // exposure component in force).
+  std::string exposureSource = "channel";
   std::vector<weather::LightningFlash> flashesLit;  // the flashes giving light over the frame's exposure
   render::WeatherMapReport weatherMap;  // what this frame changed in the weather map (per tile, or rebuilt and why)
   std::optional<bool> presented;      // windowed: whether the frame reached the window

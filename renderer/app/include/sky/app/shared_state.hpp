@@ -1,7 +1,7 @@
 // What the network side of a renderer channel hands to its render loop: the
 // latest ownship pose from the host (with its time of day), the host's
 // atmosphere, the latest state of the channel's view (View Definition, View
-// Control) and the latest weather from the server.
+// Control), the host's camera exposure and the latest weather from the server.
 // Written by the io thread, read by the render loop; guarded by one mutex.
 #pragma once
 
@@ -15,6 +15,7 @@
 #include "sky/app/host_atmosphere.hpp"
 #include "sky/app/host_clock.hpp"
 #include "sky/app/view_state.hpp"
+#include "sky/cigi/packets.hpp"
 #include "sky/geo/geodetic.hpp"
 #include "sky/stream/messages.hpp"
 #include "sky/weather/clock.hpp"
@@ -92,6 +93,16 @@ class SharedState {
   void setAtmosphere(const HostAtmosphere& a) {
     std::lock_guard lock(mutex_);
     atmosphere_ = a;
+  }
+  // The host's camera exposure for this channel (CIGI camera exposure
+  // component): held until the host sends another.
+  void setHostExposure(const cigi::CameraExposureControl& e) {
+    std::lock_guard lock(mutex_);
+    hostExposure_ = e;
+  }
+  std::optional<cigi::CameraExposureControl> hostExposure() const {
+    std::lock_guard lock(mutex_);
+    return hostExposure_;
   }
   HostAtmosphere atmosphere() const {
     std::lock_guard lock(mutex_);
@@ -210,6 +221,7 @@ class SharedState {
 
  private:
   mutable std::mutex mutex_;
+  std::optional<cigi::CameraExposureControl> hostExposure_;
   std::optional<HostPose> pose_;
   std::uint64_t lastSequence_ = 0;  // of the pose a reset forgot: sequences never repeat
   std::uint64_t resets_ = 0;
