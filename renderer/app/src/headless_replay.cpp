@@ -401,6 +401,8 @@ int runReplay(const ReplayOptions& o, const ReplayDrawer& drawer, const std::ato
     }
   }
   const double wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+  // The progress reads this loop's locals: it ends with them.
+  if (drawer.truth) drawer.truth->setProgress({});
 
   nlohmann::json report;
   if (done > 0) {
