@@ -4,10 +4,12 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -21,6 +23,7 @@
 #include "sky/server/forecast_files.hpp"
 #include "sky/server/http_api.hpp"
 #include "sky/server/metar_changes.hpp"
+#include "sky/server/nats_weather.hpp"
 #include "sky/server/scenario.hpp"
 #include "sky/server/server.hpp"
 #include "sky/server/weather_store.hpp"
@@ -141,6 +144,17 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--lightning-seed", options.lightning.seed, "Seed of the lightning process (same seed, same flashes)")
       ->capture_default_str();
+  std::string natsUrls;
+  int natsLeaseMs = 3000;
+  app.add_option("--nats", natsUrls,
+                 "NATS servers (nats://host:port, comma-separated) whose JetStream holds the weather: every accepted "
+                 "change is stored on a stream replicated on three servers before it is acknowledged, and servers "
+                 "started with the same --nats share one weather, one leading (default: none, one server alone)");
+  app.add_option("--nats-lease-ms", natsLeaseMs,
+                 "With --nats: the leader's lease lasts this long unless renewed (a follower takes over this long "
+                 "after the leader is lost)")
+      ->check(CLI::Range(500, 60000))
+      ->capture_default_str();
   app.add_option("--log-level", logLevel, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
@@ -199,6 +213,32 @@ int main(int argc, char** argv) {
   if (!scenario->timeline.empty())
     log->info("event=timeline_scheduled scenario={:?} entries={} first_at_s={:.0f}", scenarioPath, scenario->timeline.size(),
               scenario->timeline.front().at_s);
+
+  // With --nats the weather is the NATS log's: it replaces the scenario's
+  // (when the log holds one) and no SQLite file is used.
+  std::unique_ptr<sky::server::NatsWeather> nats;
+  if (!natsUrls.empty()) {
+    if (!dbPath.empty() || !gribPath.empty()) {
+      log->error("--nats with {}: with --nats the weather lives in the NATS stream, which holds no SQLite file "
+                 "and no forecast", !dbPath.empty() ? "--db" : "--grib");
+      return kExitBadInput;
+    }
+    sky::server::NatsWeatherOptions natsOptions;
+    std::stringstream list(natsUrls);
+    for (std::string url; std::getline(list, url, ',');)
+      if (!url.empty()) natsOptions.log.urls.push_back(url);
+    natsOptions.log.leaseTtl = std::chrono::milliseconds(natsLeaseMs);
+    // Unique among the servers of one host: the lease names its holder.
+    natsOptions.serverId = options.serverId + ":" + std::to_string(::getpid());
+    natsOptions.logger = log;
+    auto started = sky::server::NatsWeather::start(**server, std::move(natsOptions));
+    if (!started) {
+      log->error("event=nats_unusable nats={:?} detail={:?}", natsUrls, sky::describe(started.error()));
+      return kExitRuntime;
+    }
+    nats = std::move(*started);
+    (*server)->onShutdown([&nats] { nats->close(); });
+  }
 
   sky::server::GribDecoder decoder;
   decoder.executable = gribDecoder.empty() ? sky::server::defaultGribDecoder() : std::filesystem::path(gribDecoder);
@@ -296,10 +336,11 @@ int main(int argc, char** argv) {
     http.port = static_cast<std::uint16_t>(httpPort);
     http.serverId = options.serverId;
     http.log = log;
-    auto moreMetrics = [&cigi, &s]() -> std::string {
+    auto moreMetrics = [&cigi, &s, &nats]() -> std::string {
       std::string m = s.streamMetrics();
+      if (nats) m += nats->metrics();
       const auto& commits = s.weather().commitStats();
-      m += "# HELP skyshell_commit_seconds time to commit an accepted change to SQLite before acknowledging it\n"
+      m += "# HELP skyshell_commit_seconds time to commit an accepted change (to SQLite, or JetStream with --nats) before acknowledging it\n"
            "# TYPE skyshell_commit_seconds summary\n"
            "skyshell_commit_seconds_sum " + std::to_string(commits.total_s) + "\n"
            "skyshell_commit_seconds_count " + std::to_string(commits.count) + "\n"
@@ -370,6 +411,11 @@ int main(int argc, char** argv) {
     }
   }
 
+  if (nats) {
+    const std::string apiHost = http.listenAddress.find(':') != std::string::npos ? "[" + http.listenAddress + "]"
+                                                                                  : http.listenAddress;
+    nats->elect(api ? "http://" + apiHost + ":" + std::to_string(api->port()) : std::string());
+  }
   (*server)->run();
   return EXIT_SUCCESS;
 }

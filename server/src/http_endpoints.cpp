@@ -143,7 +143,14 @@ HttpReply HttpApi::changes(const ApiRequest& r) {
     if (options_.log)
       options_.log->info("event=change_refused source=api author={:?} detail={:?}", request->author,
                          applied.error().detail);
-    return error(applied.error().code == ErrorCode::Unsupported ? 501 : 400, applied.error().detail);
+    // Io and Timeout: the change was fine but could not be stored now (a
+    // follower of a NATS cluster, a store that failed): worth a retry, there
+    // or at the leader the detail names.
+    const ErrorCode code = applied.error().code;
+    return error(code == ErrorCode::Unsupported                        ? 501
+                 : code == ErrorCode::Io || code == ErrorCode::Timeout ? 503
+                                                                       : 400,
+                 applied.error().detail);
   }
   ++counters_.applied;
   if (options_.log)

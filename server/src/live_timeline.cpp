@@ -117,13 +117,13 @@ Result<AppliedChange> LiveWeather::loadScenario(const Scenario& scenario, const 
 }
 
 std::optional<double> LiveWeather::nextTimelineAt() const {
-  if (timeline_.empty()) return std::nullopt;
+  if (timeline_.empty() || timelineHeld_) return std::nullopt;
   return timeline_.front().at_s;
 }
 
 std::vector<LiveWeather::TimelineOutcome> LiveWeather::runTimeline() {
   std::vector<TimelineOutcome> out;
-  while (!timeline_.empty()) {
+  while (!timeline_.empty() && !timelineHeld_) {
     const double now_s = clockNow();
     const double at_s = timeline_.front().at_s;
     if (at_s > now_s) break;

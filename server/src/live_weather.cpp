@@ -226,7 +226,15 @@ Result<AppliedChange> LiveWeather::commit(State next, std::vector<TimelineItem> 
                                           const std::string& source, const std::string& summary, double now_s,
                                           bool durableNow) {
   ChangeEvent e{sequence_ + 1, now_s, unixNowMs_(), author, source, summary};
-  if (store_ && durableNow) {
+  if (committer_) {
+    const auto started = std::chrono::steady_clock::now();
+    auto ok = committer_(stateJson(next, timeline, sequence_ + 1, version_ + 1), e);
+    const double took_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    ++commitStats_.count;
+    commitStats_.total_s += took_s;
+    commitStats_.max_s = std::max(commitStats_.max_s, took_s);
+    if (!ok) return tl::unexpected(ok.error());
+  } else if (store_ && durableNow) {
     // Commit first: only a change on disk is acknowledged and applied. The
     // state saved holds every batched change applied before it, so their
     // events go in the same transaction.
@@ -267,6 +275,11 @@ std::size_t LiveWeather::addListener(Listener listener) {
 }
 
 void LiveWeather::removeListener(std::size_t id) { listeners_.erase(id); }
+
+void LiveWeather::announce(const ChangeEvent& event) {
+  const auto listeners = listeners_;
+  for (const auto& [id, f] : listeners) f(event);
+}
 
 bool LiveWeather::rampRunning(double c) const {
   for (const Ramp& r : ramps_)

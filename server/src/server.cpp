@@ -309,6 +309,11 @@ void Server::weatherChanged() {
   registry_.forEach([](Session& s) { s.weatherChanged(); });
 }
 
+void Server::weatherReplaced() {
+  weatherChanged();
+  armTimeline();
+}
+
 std::shared_ptr<const AreaSnapshot> Server::snapshotFor(const stream::Subscribe& request) {
   return areaFrames_.snapshot(request, std::chrono::steady_clock::now(), [&] {
     const double clock_s = clockNow();

@@ -151,6 +151,9 @@ class LiveWeather final : public WeatherService {
   using Listener = std::function<void(const ChangeEvent&)>;
   std::size_t addListener(Listener listener);  // returns an id for removeListener
   void removeListener(std::size_t id);
+  // Tells the listeners of a change accepted elsewhere and restored here (a
+  // follower folding its leader's log), as if accepted here.
+  void announce(const ChangeEvent& event);
   // Commits to the store: how many, and their total and longest duration.
   struct CommitStats {
     std::uint64_t count = 0;
@@ -163,6 +166,17 @@ class LiveWeather final : public WeatherService {
   // commit refuses the change (Io) and leaves the state as it was.
   void attachStore(class WeatherStore* store) { store_ = store; }
   class WeatherStore* store() const { return store_; }
+  // Replication (nats_weather.hpp): with a committer attached, every accepted
+  // change (batched ones too: a replicated log has no later flush) is handed
+  // to it, the whole state it makes and its event, before it is applied; an
+  // error from it refuses the change and leaves the state as it was. Used
+  // instead of a store.
+  using Committer = std::function<Result<void>(const nlohmann::json& state, const ChangeEvent& event)>;
+  void attachCommitter(Committer committer) { committer_ = std::move(committer); }
+  // While held, no timeline entry is ever due: a follower keeps its leader's
+  // timeline in its state but only the leader runs it.
+  void holdTimeline(bool held) { timelineHeld_ = held; }
+  bool timelineHeld() const { return timelineHeld_; }
   // The whole state as JSON: layers, ramps in progress, sequence, version,
   // and the clock as (clock_s, rate) at unix_ms.
   nlohmann::json toJson() const;
@@ -252,6 +266,8 @@ class LiveWeather final : public WeatherService {
   std::size_t nextListenerId_ = 1;
   CommitStats commitStats_;
   class WeatherStore* store_ = nullptr;
+  Committer committer_;
+  bool timelineHeld_ = false;
 };
 
 }  // namespace sky::server

@@ -79,6 +79,10 @@ class Server final : private SessionHandler {
   // Every subscriber gets fresh weather for its area (call on the io
   // thread). Every change the LiveWeather accepts does this already.
   void weatherChanged();
+  // The weather was replaced from outside its inputs (a follower folding its
+  // leader's log, a server taking the lead): every subscriber gets fresh
+  // weather and the timeline timer is set anew. Call on the io thread.
+  void weatherReplaced();
   // Call on the io thread (the registry is its own).
   std::size_t subscribers() const { return registry_.size(); }
   // Every subscriber as the console sees it (area, last camera report), by

@@ -1,0 +1,48 @@
+// One entry of the weather's change log on JetStream (nats_weather.hpp): the
+// whole state a leader made, with the change's event, or with no event when a
+// server takes the lead. Entries are read back from the stream by every
+// server, so decodeLogEntry treats them as hostile bytes.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+#include "sky/core/result.hpp"
+#include "sky/server/change.hpp"
+
+namespace sky::server {
+
+// The largest entry written or read: NATS's default max_payload (1 MiB),
+// which a state stays far below (a cockpit's weather is a few KiB; the
+// kMaxPendingRamps bound keeps the largest state under it).
+inline constexpr std::size_t kMaxLogEntry_bytes = 1024 * 1024;
+// Longest leader id, API address, author, source or summary in an entry:
+// the HTTP API bounds what it takes far below this.
+inline constexpr std::size_t kMaxLogEntryText = 4096;
+
+struct LogEntry {
+  enum class Kind { Change, Term };
+  Kind kind = Kind::Change;
+  // The lease's revision when the writer took the lead: grows with every
+  // new leader, so an entry names the term it was written in.
+  std::uint64_t term = 0;
+  std::string leaderId;   // the writer's server id
+  std::string leaderApi;  // the writer's HTTP API ("http://host:port"), or empty
+  nlohmann::json state;   // LiveWeather::toJson() after the change: an object
+  std::optional<ChangeEvent> event;  // present for Kind::Change only
+};
+
+// The entry as bytes (JSON, one object).
+std::string encodeLogEntry(const LogEntry& entry);
+// Malformed (not JSON, a field missing or of the wrong type, an unknown
+// kind or format), TooLarge (over kMaxLogEntry_bytes or a text over
+// kMaxLogEntryText). The state is only checked to be an object here; its
+// contents are LiveWeather::restore's to check.
+Result<LogEntry> decodeLogEntry(std::string_view bytes);
+
+}  // namespace sky::server

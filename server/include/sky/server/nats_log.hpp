@@ -1,0 +1,100 @@
+// The weather's change log and leader lease on a NATS cluster (JetStream):
+// one stream with one subject, replicated on three servers when the cluster
+// has them, appended to only at an expected last sequence (so a writer that
+// missed an entry is refused), read back by sequence or followed in order;
+// and one key in a KV bucket whose values expire, the lease of the leading
+// server. A thin owner of the nats.c handles (src/nats_handles.hpp): no
+// policy here, that is nats_weather.hpp's.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "sky/core/result.hpp"
+
+namespace sky::server {
+
+struct NatsLogOptions {
+  std::vector<std::string> urls;  // nats://host:port, one or more servers of the cluster
+  std::string stream = "SKY_WEATHER";
+  std::string subject = "sky.weather.log";
+  std::string leaseBucket = "sky_weather_leader";
+  std::string leaseKey = "leader";
+  std::chrono::milliseconds leaseTtl{3000};  // a lease not renewed for this long is gone
+  int replicas = 3;                           // the stream's and the bucket's; 1 on a single server
+  std::uint64_t maxEntries = 10000;           // the stream keeps the newest this many
+  // How long a publish, a read or a lease operation waits for its answer.
+  std::chrono::milliseconds requestWait{5000};
+  // How long connect() retries while JetStream is not ready (a cluster that
+  // has just started elects its meta leader first).
+  std::chrono::milliseconds readyWait{30000};
+};
+
+class NatsLog {
+ public:
+  // Connects (reconnecting for ever afterwards), and makes the stream and the
+  // lease bucket when they are missing. With replicas 3 on a server that is
+  // not clustered the stream is made with 1 (`replicas()` says which).
+  // Errors: Io (no server answers), Timeout (JetStream not ready in readyWait).
+  static Result<std::unique_ptr<NatsLog>> connect(const NatsLogOptions& options);
+  ~NatsLog();
+  NatsLog(const NatsLog&) = delete;
+  NatsLog& operator=(const NatsLog&) = delete;
+
+  int replicas() const;
+  const NatsLogOptions& options() const;
+
+  struct Appended {
+    bool stored = false;        // false: the stream's last sequence was not expectedLast (fenced)
+    std::uint64_t sequence = 0;  // the entry's stream sequence when stored
+  };
+  // Appends once JetStream has stored it on a majority of the stream's
+  // replicas, if the stream's last sequence is expectedLast (0: empty).
+  // Errors: Timeout (no acknowledgement in requestWait: it may or may not
+  // be stored), Io.
+  Result<Appended> append(std::string_view bytes, std::uint64_t expectedLast);
+  // The stream's first and last sequence (0 and 0 when empty).
+  struct Range {
+    std::uint64_t first = 0, last = 0;
+  };
+  Result<Range> range();
+  // The name of the NATS server that leads a stream's replicas ("" when none
+  // does, e.g. during an election): this log's stream, or the lease's
+  // bucket with `lease` true.
+  Result<std::string> leaderOf(bool lease = false);
+  // The entry at a sequence (nullopt: none there, e.g. discarded).
+  Result<std::optional<std::string>> read(std::uint64_t sequence);
+
+  // Calls `onEntry(sequence, bytes)` for every entry from `fromSequence` on,
+  // in order, on a thread of the NATS client (an ordered consumer: gaps and
+  // lost servers are recovered by the client). Replaces an earlier follow.
+  using EntryHandler = std::function<void(std::uint64_t sequence, std::string_view bytes)>;
+  Result<void> follow(std::uint64_t fromSequence, EntryHandler onEntry);
+  void stopFollowing();
+
+  // The lease: create-if-absent (nullopt when held by another), renew at the
+  // revision this holder last wrote (nullopt when that is no longer the
+  // key's revision: the lease was lost), read, and release (only the
+  // revision this holder wrote: a lease another took since is left alone).
+  Result<std::optional<std::uint64_t>> takeLease(std::string_view value);
+  Result<std::optional<std::uint64_t>> renewLease(std::string_view value, std::uint64_t revision);
+  struct Lease {
+    std::string value;
+    std::uint64_t revision = 0;
+  };
+  Result<std::optional<Lease>> readLease();
+  Result<void> releaseLease(std::uint64_t revision);
+
+ private:
+  struct Handles;
+  explicit NatsLog(std::unique_ptr<Handles> handles);
+  std::unique_ptr<Handles> h_;
+};
+
+}  // namespace sky::server

@@ -1,0 +1,117 @@
+// The weather on a NATS cluster (skyshell-weatherd --nats): several servers
+// share one weather. The change log is a JetStream stream (nats_log.hpp)
+// whose entries are whole states (nats_entry.hpp), so the weather is the
+// fold of the log: the last entry's state, with the events of the entries
+// before it. One server leads: it holds the lease (a KV key that expires
+// unless renewed), takes changes, runs the clock's timeline, and appends each
+// accepted change before acknowledging it. The others follow the log and
+// refuse changes, naming the leader. A leader's appends are fenced twice:
+// it refuses changes once its lease may have lapsed, and each append expects
+// the stream's last sequence to be the one it applied last, so a leader that
+// was paused while another took over cannot append after it, and steps down.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include <boost/asio/steady_timer.hpp>
+
+#include "sky/core/result.hpp"
+#include "sky/server/nats_entry.hpp"
+#include "sky/server/nats_log.hpp"
+
+namespace spdlog {
+class logger;
+}
+
+namespace sky::server {
+
+class Server;
+
+// Entries a starting server reads back for its event log; the last of them
+// is its state. The console shows the recent history, a few hundred lines.
+inline constexpr std::uint64_t kReplayEntries = 256;
+
+struct NatsWeatherOptions {
+  NatsLogOptions log;
+  std::string serverId;  // names this server in the lease and its entries
+  std::shared_ptr<spdlog::logger> logger;  // null: log nothing
+};
+
+class NatsWeather {
+ public:
+  // Connects, folds the stream's newest entries into the server's weather
+  // (the scenario's weather stays when the stream is empty), follows the
+  // log from there and attaches itself as the weather's committer; every
+  // change is refused until this server leads. Call before the server runs
+  // (it blocks while it reads). Errors: those of NatsLog::connect, Malformed
+  // when the stream's last entry cannot be restored.
+  static Result<std::unique_ptr<NatsWeather>> start(Server& server, NatsWeatherOptions options);
+  ~NatsWeather();
+  NatsWeather(const NatsWeather&) = delete;
+  NatsWeather& operator=(const NatsWeather&) = delete;
+
+  // Begins taking part in the election, with this server's HTTP API address
+  // ("http://host:port", or empty) for the followers' refusals.
+  void elect(std::string apiUrl);
+  // Leaves the election, releasing the lease when held (a follower takes
+  // over at its next poll instead of after the lease's time to live), and
+  // stops following. Call on the server's io thread, at shutdown.
+  void close();
+
+  bool leading() const { return leading_.load(); }
+  // Prometheus text: the role, the term, the applied sequence, entries
+  // dropped as malformed, fenced appends.
+  std::string metrics() const;
+
+ private:
+  NatsWeather(Server& server, NatsWeatherOptions options, std::unique_ptr<NatsLog> log);
+  Result<void> replay();
+  // Follows the log from the entry after the last one folded; replaces the
+  // subscription (the election thread's, once started).
+  Result<void> follow();
+  // On the io thread: one entry of the log, as the follower sees it.
+  void onEntry(std::uint64_t sequence, const std::string& bytes);
+  Result<void> commit(const nlohmann::json& state, const ChangeEvent& event);
+  // On the io thread, after the lease was taken at `term`: catches up with
+  // the log, then appends the term entry that makes this server the leader.
+  void claim(std::uint64_t term, int attempt);
+  void stepDown(const std::string& why);
+  void electionLoop();
+  std::string refusal() const;
+  std::string leaseValue() const;
+
+  Server& server_;
+  NatsWeatherOptions options_;
+  std::shared_ptr<spdlog::logger> log_;
+  std::unique_ptr<NatsLog> natsLog_;
+  boost::asio::steady_timer claimRetry_;
+
+  // The io thread's: the last stream sequence folded into the weather (by
+  // following or by this server's own append).
+  // Atomic only so that metrics() may read them from another thread.
+  std::atomic<std::uint64_t> applied_{0};
+  std::atomic<std::uint64_t> term_{0};  // the term this server leads in, while leading
+  std::atomic<bool> leading_{false};
+  bool closed_ = false;
+  std::chrono::steady_clock::time_point claimStarted_{};
+
+  // Shared between the io thread and the election thread.
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stopping_ = false;
+  bool leaseLost_ = false;  // set by stepDown: the election thread stops renewing
+  std::string apiUrl_;
+  std::string leaderId_, leaderApi_;  // who leads, as last seen
+  std::atomic<std::int64_t> leaseRenewedAt_ns_{0};  // steady clock of the last renewal
+  std::atomic<std::uint64_t> dropped_{0}, fenced_{0}, appended_{0}, followed_{0};
+  std::thread election_;
+};
+
+}  // namespace sky::server

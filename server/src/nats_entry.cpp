@@ -1,0 +1,102 @@
+// The change log's entries as bytes (see nats_entry.hpp).
+#include "sky/server/nats_entry.hpp"
+
+#include <cmath>
+#include <utility>
+
+namespace sky::server {
+
+namespace {
+
+// Bumped when an entry's fields change meaning; a reader refuses others.
+constexpr int kLogEntryFormat = 1;
+
+Result<std::string> text(const nlohmann::json& j, const char* key) {
+  const auto it = j.find(key);
+  if (it == j.end() || !it->is_string()) return fail(ErrorCode::Malformed, std::string("log entry: ") + key + ": not a string");
+  const auto& s = it->get_ref<const std::string&>();
+  if (s.size() > kMaxLogEntryText)
+    return fail(ErrorCode::TooLarge, std::string("log entry: ") + key + ": " + std::to_string(s.size()) + " bytes");
+  return s;
+}
+
+Result<std::uint64_t> count(const nlohmann::json& j, const char* key) {
+  const auto it = j.find(key);
+  if (it == j.end() || !it->is_number_unsigned())
+    return fail(ErrorCode::Malformed, std::string("log entry: ") + key + ": not an unsigned integer");
+  return it->get<std::uint64_t>();
+}
+
+}  // namespace
+
+std::string encodeLogEntry(const LogEntry& entry) {
+  nlohmann::json j{{"format", kLogEntryFormat},
+                   {"kind", entry.kind == LogEntry::Kind::Change ? "change" : "term"},
+                   {"term", entry.term},
+                   {"leader", entry.leaderId},
+                   {"leader_api", entry.leaderApi},
+                   {"state", entry.state}};
+  if (entry.event) {
+    const ChangeEvent& e = *entry.event;
+    j["event"] = {{"sequence", e.sequence}, {"clock_s", e.clock_s}, {"wall_ms", e.wallTime_ms},
+                  {"author", e.author},     {"source", e.source},   {"summary", e.summary}};
+  }
+  return j.dump();
+}
+
+Result<LogEntry> decodeLogEntry(std::string_view bytes) {
+  if (bytes.size() > kMaxLogEntry_bytes)
+    return fail(ErrorCode::TooLarge, "log entry: " + std::to_string(bytes.size()) + " bytes, at most " +
+                                         std::to_string(kMaxLogEntry_bytes));
+  nlohmann::json j = nlohmann::json::parse(bytes, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return fail(ErrorCode::Malformed, "log entry: not a JSON object");
+  const auto format = j.find("format");
+  if (format == j.end() || !format->is_number_integer() || format->get<std::int64_t>() != kLogEntryFormat)
+    return fail(ErrorCode::Unsupported, "log entry: format: not " + std::to_string(kLogEntryFormat));
+  LogEntry e;
+  auto kind = text(j, "kind");
+  if (!kind) return tl::unexpected(kind.error());
+  if (*kind == "change") e.kind = LogEntry::Kind::Change;
+  else if (*kind == "term") e.kind = LogEntry::Kind::Term;
+  else return fail(ErrorCode::Malformed, "log entry: kind: neither change nor term");
+  auto term = count(j, "term");
+  if (!term) return tl::unexpected(term.error());
+  if (*term == 0) return fail(ErrorCode::Malformed, "log entry: term: 0");
+  e.term = *term;
+  auto leader = text(j, "leader");
+  if (!leader) return tl::unexpected(leader.error());
+  e.leaderId = std::move(*leader);
+  auto api = text(j, "leader_api");
+  if (!api) return tl::unexpected(api.error());
+  e.leaderApi = std::move(*api);
+  const auto state = j.find("state");
+  if (state == j.end() || !state->is_object()) return fail(ErrorCode::Malformed, "log entry: state: not an object");
+  e.state = std::move(*state);
+  const auto event = j.find("event");
+  if (e.kind == LogEntry::Kind::Term) {
+    if (event != j.end()) return fail(ErrorCode::Malformed, "log entry: a term entry with an event");
+    return e;
+  }
+  if (event == j.end() || !event->is_object()) return fail(ErrorCode::Malformed, "log entry: event: not an object");
+  ChangeEvent ce;
+  auto sequence = count(*event, "sequence");
+  if (!sequence) return tl::unexpected(sequence.error());
+  ce.sequence = *sequence;
+  const auto clock = event->find("clock_s");
+  if (clock == event->end() || !clock->is_number() || !std::isfinite(clock->get<double>()))
+    return fail(ErrorCode::Malformed, "log entry: event.clock_s: not a finite number");
+  ce.clock_s = clock->get<double>();
+  const auto wall = event->find("wall_ms");
+  if (wall == event->end() || !wall->is_number_integer())
+    return fail(ErrorCode::Malformed, "log entry: event.wall_ms: not an integer");
+  ce.wallTime_ms = wall->get<std::int64_t>();
+  for (auto [key, out] : {std::pair{"author", &ce.author}, {"source", &ce.source}, {"summary", &ce.summary}}) {
+    auto t = text(*event, key);
+    if (!t) return tl::unexpected(t.error());
+    *out = std::move(*t);
+  }
+  e.event = std::move(ce);
+  return e;
+}
+
+}  // namespace sky::server

@@ -1,0 +1,397 @@
+// The weather on a NATS cluster: the fold of the log, the lease, the
+// leader's fenced appends (see nats_weather.hpp).
+#include "sky/server/nats_weather.hpp"
+
+#include <algorithm>
+#include <utility>
+#include <vector>
+
+#include <boost/asio/post.hpp>
+#include <spdlog/spdlog.h>
+
+#include "sky/server/server.hpp"
+
+namespace sky::server {
+
+namespace {
+
+// How often a follower tries to take the lease, and a leader renews it, as
+// fractions of its time to live: a follower notices an expired lease within
+// a sixth of it; a leader renews four times per lifetime, so one or two lost
+// renewals do not cost the lead.
+constexpr int kPollsPerTtl = 6;
+constexpr int kRenewalsPerTtl = 4;
+// A leader takes changes only while its last renewal (counted from before
+// it was sent) is younger than this fraction of the time to live: the key
+// expires a whole time to live after the renewal was stored, so the leader
+// stops well before another server can take the lead, even with the
+// renewal's own latency and clocks running at slightly different rates.
+constexpr double kLeaseTrustFraction = 0.5;
+// While taking the lead: how often, and how many times, it checks that it
+// has folded the whole log before appending its term entry (5 s in all, far
+// above the time a follower lags its leader on a loopback or LAN link).
+constexpr std::chrono::milliseconds kClaimRetry{20};
+constexpr int kClaimAttempts = 250;
+// A follower whose log subscription has folded nothing for this long while
+// the stream holds newer entries follows anew from its last entry. The
+// client's ordered consumer lives on one NATS server; when that server is
+// lost, the client notices only after missed heartbeats (seconds), and a
+// follower that lags serves old weather. Healthy, it folds an entry within
+// milliseconds of its append.
+constexpr std::chrono::seconds kFollowStall{1};
+// The longest leader id or API address read from another server's lease.
+constexpr std::size_t kMaxLeaseText = 512;
+
+std::int64_t steadyNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace
+
+Result<std::unique_ptr<NatsWeather>> NatsWeather::start(Server& server, NatsWeatherOptions options) {
+  auto connected = NatsLog::connect(options.log);
+  if (!connected) return tl::unexpected(connected.error());
+  std::unique_ptr<NatsWeather> w(new NatsWeather(server, std::move(options), std::move(*connected)));
+  if (auto r = w->replay(); !r) return tl::unexpected(r.error());
+  LiveWeather& weather = server.weather();
+  weather.holdTimeline(true);
+  weather.attachCommitter(
+      [self = w.get()](const nlohmann::json& state, const ChangeEvent& event) { return self->commit(state, event); });
+  auto followed = w->follow();
+  if (!followed) return tl::unexpected(followed.error());
+  return w;
+}
+
+Result<void> NatsWeather::follow() {
+  return natsLog_->follow(applied_ + 1, [this](std::uint64_t sequence, std::string_view bytes) {
+    boost::asio::post(server_.io(), [this, sequence, b = std::string(bytes)] { onEntry(sequence, b); });
+  });
+}
+
+NatsWeather::NatsWeather(Server& server, NatsWeatherOptions options, std::unique_ptr<NatsLog> log)
+    : server_(server),
+      options_(std::move(options)),
+      log_(options_.logger ? options_.logger : std::make_shared<spdlog::logger>("sky_nats")),
+      natsLog_(std::move(log)),
+      claimRetry_(server.io()) {}
+
+NatsWeather::~NatsWeather() { close(); }
+
+Result<void> NatsWeather::replay() {
+  auto range = natsLog_->range();
+  if (!range) return tl::unexpected(range.error());
+  LiveWeather& weather = server_.weather();
+  if (range->last == 0) {
+    log_->info("event=nats_log_empty stream={} replicas={}: the scenario's weather stands until a leader writes it",
+               options_.log.stream, natsLog_->replicas());
+    return {};
+  }
+  const std::uint64_t from = std::max(range->first, range->last >= kReplayEntries ? range->last - kReplayEntries + 1 : 1);
+  std::vector<ChangeEvent> events;
+  std::optional<LogEntry> newest;
+  std::uint64_t bad = 0;
+  for (std::uint64_t seq = from; seq <= range->last; ++seq) {
+    auto bytes = natsLog_->read(seq);
+    if (!bytes) return tl::unexpected(bytes.error());
+    if (!*bytes) continue;  // discarded by the stream's limit meanwhile
+    auto entry = decodeLogEntry(**bytes);
+    if (!entry) {
+      ++bad;
+      log_->warn("event=nats_entry_dropped sequence={} detail={:?}", seq, describe(entry.error()));
+      continue;
+    }
+    if (entry->event) events.push_back(*entry->event);
+    newest = std::move(*entry);
+  }
+  dropped_ += bad;
+  if (!newest) return fail(ErrorCode::Malformed, "NATS stream " + options_.log.stream + ": no readable entry in " +
+                                                     std::to_string(from) + ".." + std::to_string(range->last));
+  if (auto r = weather.restore(newest->state, std::move(events)); !r)
+    return fail(r.error().code, "NATS stream " + options_.log.stream + ": " + r.error().detail);
+  applied_ = range->last;
+  {
+    std::lock_guard lock(mutex_);
+    leaderId_ = newest->leaderId;
+    leaderApi_ = newest->leaderApi;
+  }
+  log_->info("event=nats_replayed stream={} replicas={} entries={}..{} dropped={} sequence={} state_hash={:016x}",
+             options_.log.stream, natsLog_->replicas(), from, range->last, bad, weather.view().lastSequence,
+             weather.stateHash());
+  return {};
+}
+
+void NatsWeather::onEntry(std::uint64_t sequence, const std::string& bytes) {
+  if (sequence <= applied_) return;  // this server's own append, or one folded already
+  ++followed_;
+  if (leading_) stepDown("the log moved to sequence " + std::to_string(sequence) + " past this leader's " +
+                         std::to_string(applied_.load()));
+  auto entry = decodeLogEntry(bytes);
+  LiveWeather& weather = server_.weather();
+  if (entry) {
+    std::vector<ChangeEvent> events = weather.events(kReplayEntries);
+    if (entry->event) events.push_back(*entry->event);
+    if (auto r = weather.restore(entry->state, std::move(events)); !r) entry = tl::unexpected(r.error());
+  }
+  applied_ = sequence;
+  if (!entry) {
+    ++dropped_;
+    log_->warn("event=nats_entry_dropped sequence={} detail={:?}", sequence, describe(entry.error()));
+    return;
+  }
+  {
+    std::lock_guard lock(mutex_);
+    leaderId_ = entry->leaderId;
+    leaderApi_ = entry->leaderApi;
+  }
+  log_->debug("event=nats_entry_applied sequence={} term={} leader={:?}", sequence, entry->term, entry->leaderId);
+  // A change reaches this server's subscribers and consoles as one made
+  // here would; a term entry changes nothing they see but the version.
+  if (entry->event) weather.announce(*entry->event);
+  else server_.weatherReplaced();
+}
+
+Result<void> NatsWeather::commit(const nlohmann::json& state, const ChangeEvent& event) {
+  if (!leading_) return fail(ErrorCode::Io, refusal());
+  const double age_s = double(steadyNs() - leaseRenewedAt_ns_.load()) * 1e-9;
+  const double trust_s = kLeaseTrustFraction * std::chrono::duration<double>(options_.log.leaseTtl).count();
+  if (age_s >= trust_s) {
+    stepDown("lease last renewed " + std::to_string(static_cast<int>(age_s * 1000)) + " ms ago");
+    return fail(ErrorCode::Io, refusal());
+  }
+  if (state.contains("forecast") && !state.at("forecast").is_null())
+    return fail(ErrorCode::Unsupported,
+                "forecasts are not replicated over NATS (their GRIB files live in a server's SQLite store): "
+                "run this server without --nats to load one");
+  LogEntry entry;
+  entry.kind = LogEntry::Kind::Change;
+  entry.term = term_;
+  entry.leaderId = options_.serverId;
+  {
+    std::lock_guard lock(mutex_);
+    entry.leaderApi = apiUrl_;
+  }
+  entry.state = state;
+  entry.event = event;
+  const std::string bytes = encodeLogEntry(entry);
+  if (bytes.size() > kMaxLogEntry_bytes)
+    return fail(ErrorCode::TooLarge, "the weather's state is " + std::to_string(bytes.size()) +
+                                         " bytes, more than a NATS log entry holds (" +
+                                         std::to_string(kMaxLogEntry_bytes) + ")");
+  auto appended = natsLog_->append(bytes, applied_);
+  if (!appended)
+    return fail(appended.error().code, "change not acknowledged by JetStream (it may still be stored; the "
+                                       "weather shows it if so): " + appended.error().detail);
+  if (!appended->stored) {
+    ++fenced_;
+    stepDown("fenced: the stream moved past sequence " + std::to_string(applied_.load()) +
+             " (another server appended)");
+    return fail(ErrorCode::Io, refusal());
+  }
+  applied_ = appended->sequence;
+  ++appended_;
+  return {};
+}
+
+void NatsWeather::elect(std::string apiUrl) {
+  {
+    std::lock_guard lock(mutex_);
+    apiUrl_ = std::move(apiUrl);
+  }
+  election_ = std::thread([this] { electionLoop(); });
+}
+
+void NatsWeather::electionLoop() {
+  const auto ttl = options_.log.leaseTtl;
+  const auto poll = ttl / kPollsPerTtl, renewEvery = ttl / kRenewalsPerTtl;
+  std::uint64_t held = 0;  // the lease's revision this server wrote last (0: none; revisions start at 1)
+  std::int64_t renewedAt_ns = 0;
+  // A follower lagging the stream: since when, at which applied sequence.
+  std::optional<std::pair<std::chrono::steady_clock::time_point, std::uint64_t>> lagging;
+  for (;;) {
+    bool lost = false;
+    {
+      std::unique_lock lock(mutex_);
+      // A holder wakes when its renewal is due; a follower every poll.
+      const auto wait = held != 0 ? std::chrono::duration_cast<std::chrono::nanoseconds>(renewEvery) -
+                                   std::chrono::nanoseconds(steadyNs() - renewedAt_ns)
+                             : std::chrono::duration_cast<std::chrono::nanoseconds>(poll);
+      wake_.wait_for(lock, std::max(wait, std::chrono::nanoseconds{0}), [this] { return stopping_ || leaseLost_; });
+      if (stopping_) break;
+      lost = std::exchange(leaseLost_, false);
+    }
+    if (lost && held != 0) {
+      // Stepped down while the lease is still this server's: free it for
+      // the others now rather than when it expires.
+      (void)natsLog_->releaseLease(held);
+      held = 0;
+      continue;
+    }
+    if (held == 0) {
+      const std::int64_t sentAt_ns = steadyNs();
+      auto taken = natsLog_->takeLease(leaseValue());
+      if (taken && *taken) {
+        held = **taken;
+        renewedAt_ns = sentAt_ns;
+        leaseRenewedAt_ns_ = sentAt_ns;
+        const std::uint64_t term = **taken;
+        boost::asio::post(server_.io(), [this, term] {
+          claimStarted_ = std::chrono::steady_clock::now();
+          claim(term, 0);
+        });
+        continue;
+      }
+      if (auto range = natsLog_->range(); range) {
+        const std::uint64_t applied = applied_.load();
+        const auto now = std::chrono::steady_clock::now();
+        if (range->last <= applied || (lagging && lagging->second != applied)) {
+          lagging.reset();
+        } else if (!lagging) {
+          lagging.emplace(now, applied);
+        } else if (now - lagging->first >= kFollowStall) {
+          log_->warn("event=nats_follow_again applied={} stream_last={} (no entry folded for {} ms)", applied,
+                     range->last, std::chrono::duration_cast<std::chrono::milliseconds>(now - lagging->first).count());
+          if (auto r = follow(); !r) log_->warn("event=nats_follow_failed detail={:?}", describe(r.error()));
+          lagging.reset();
+        }
+      }
+      auto lease = natsLog_->readLease();
+      if (lease && *lease) {
+        const auto j = nlohmann::json::parse((*lease)->value, nullptr, false);
+        if (j.is_object() && j.contains("id") && j["id"].is_string() && j.contains("api") && j["api"].is_string() &&
+            j["id"].get_ref<const std::string&>().size() <= kMaxLeaseText &&
+            j["api"].get_ref<const std::string&>().size() <= kMaxLeaseText) {
+          std::lock_guard lock(mutex_);
+          leaderId_ = j["id"].get<std::string>();
+          leaderApi_ = j["api"].get<std::string>();
+        }
+      }
+      continue;
+    }
+    if (std::chrono::nanoseconds(steadyNs() - renewedAt_ns) < renewEvery) continue;
+    const std::int64_t sentAt_ns = steadyNs();
+    auto renewed = natsLog_->renewLease(leaseValue(), held);
+    if (renewed && *renewed) {
+      held = **renewed;
+      renewedAt_ns = sentAt_ns;
+      leaseRenewedAt_ns_ = sentAt_ns;
+    } else if (renewed) {
+      held = 0;
+      boost::asio::post(server_.io(), [this] { stepDown("lease lost: another server holds it"); });
+    }
+    // A failed request (a server of the cluster gone, a timeout) is tried
+    // again; meanwhile the leader refuses changes once the lease may lapse.
+  }
+  if (held != 0) (void)natsLog_->releaseLease(held);
+}
+
+void NatsWeather::claim(std::uint64_t term, int attempt) {
+  if (leading_ || closed_) return;
+  {
+    std::lock_guard lock(mutex_);
+    if (leaseLost_) return;
+  }
+  auto retry = [this, term, attempt](const std::string& why) {
+    if (attempt + 1 >= kClaimAttempts) {
+      stepDown("could not take the lead: " + why);
+      return;
+    }
+    claimRetry_.expires_after(kClaimRetry);
+    claimRetry_.async_wait([this, term, attempt](const boost::system::error_code& ec) {
+      if (!ec) claim(term, attempt + 1);
+    });
+  };
+  auto range = natsLog_->range();
+  if (!range) return retry(describe(range.error()));
+  if (applied_ < range->last)
+    return retry("the log is at " + std::to_string(range->last) + ", folded to " + std::to_string(applied_.load()));
+  LogEntry entry;
+  entry.kind = LogEntry::Kind::Term;
+  entry.term = term;
+  entry.leaderId = options_.serverId;
+  {
+    std::lock_guard lock(mutex_);
+    entry.leaderApi = apiUrl_;
+  }
+  entry.state = server_.weather().toJson();
+  auto appended = natsLog_->append(encodeLogEntry(entry), applied_);
+  if (!appended) return retry(describe(appended.error()));
+  if (!appended->stored) return retry("another server appended meanwhile");
+  applied_ = appended->sequence;
+  term_ = term;
+  leading_ = true;
+  {
+    std::lock_guard lock(mutex_);
+    leaderId_ = entry.leaderId;
+    leaderApi_ = entry.leaderApi;
+  }
+  server_.weather().holdTimeline(false);
+  server_.weatherReplaced();
+  const auto took_ms =
+      std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - claimStarted_).count();
+  log_->info("event=nats_leading term={} sequence={} claim_ms={} state_hash={:016x}", term, applied_.load(), took_ms,
+             server_.weather().stateHash());
+}
+
+void NatsWeather::stepDown(const std::string& why) {
+  claimRetry_.cancel();
+  if (leading_) log_->warn("event=nats_step_down term={} why={:?}", term_.load(), why);
+  else log_->info("event=nats_not_leading why={:?}", why);
+  leading_ = false;
+  term_ = 0;
+  {
+    std::lock_guard lock(mutex_);
+    leaseLost_ = true;
+  }
+  wake_.notify_all();
+  server_.weather().holdTimeline(true);
+  server_.weatherReplaced();
+}
+
+void NatsWeather::close() {
+  if (closed_) return;
+  closed_ = true;
+  claimRetry_.cancel();
+  leading_ = false;
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  if (election_.joinable()) election_.join();
+  natsLog_->stopFollowing();
+}
+
+std::string NatsWeather::refusal() const {
+  std::lock_guard lock(mutex_);
+  if (leaderId_.empty() || leaderId_ == options_.serverId)
+    return "not the leader: this server follows the NATS log and no other server leads yet (an election "
+           "takes up to the lease's time to live); try again";
+  return "not the leader: " + leaderId_ + " leads" + (leaderApi_.empty() ? "" : " (" + leaderApi_ + ")") +
+         "; send changes there";
+}
+
+std::string NatsWeather::leaseValue() const {
+  std::lock_guard lock(mutex_);
+  return nlohmann::json{{"id", options_.serverId}, {"api", apiUrl_}}.dump();
+}
+
+std::string NatsWeather::metrics() const {
+  std::string m;
+  auto line = [&m](const char* name, const char* type, const char* help, std::uint64_t v) {
+    m += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " " + type + "\n" + name + " " +
+         std::to_string(v) + "\n";
+  };
+  line("skyshell_nats_leader", "gauge", "1 while this server leads the weather on NATS", leading_ ? 1 : 0);
+  line("skyshell_nats_term", "gauge", "the lease revision this server leads in (0: following)", term_.load());
+  line("skyshell_nats_applied_sequence", "gauge", "the last NATS log sequence folded into the weather",
+       applied_.load());
+  line("skyshell_nats_appended_total", "counter", "changes this server appended to the NATS log", appended_.load());
+  line("skyshell_nats_followed_total", "counter", "log entries of other servers folded in", followed_.load());
+  line("skyshell_nats_entries_dropped_total", "counter", "log entries dropped as malformed", dropped_.load());
+  line("skyshell_nats_fenced_total", "counter", "appends refused by JetStream for a stale last sequence",
+       fenced_.load());
+  return m;
+}
+
+}  // namespace sky::server

@@ -1,0 +1,414 @@
+// skyshell-weatherd --nats (issue 27): the weather on a real three-node NATS
+// cluster with JetStream on loopback, shared by two weather servers, as it
+// fails: the leader killed (SIGKILL), the leader paused (SIGSTOP) while
+// another takes over, one NATS node killed. Real processes, real sockets; the
+// stream is read back with the server library's own NATS client.
+#include <signal.h>
+
+#include <algorithm>
+#include <chrono>
+#include <vector>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "child_process.hpp"
+#include "nats_cluster.hpp"
+#include "sky/server/nats_entry.hpp"
+#include "sky/server/nats_log.hpp"
+#include "sky/sim/http_client.hpp"
+
+namespace sky::test {
+namespace {
+
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+constexpr const char* kToken = "s3cret-nats-token";
+// The servers' lease: short, so that a failover fits a test; the default
+// (3 s) is what docs/weather-server-scaling.md measures.
+constexpr const char* kLeaseMs = "2000";
+// Time allowed for a three-node cluster to start and elect JetStream's meta
+// leader, and for a first server to take the lead (measured: 2-4 s).
+constexpr auto kFirstLeaderWait = 25s;
+
+std::string layerChange(int id, double coverage) {
+  return R"({"author": "nats-test", "changes": [{"op": "set_layer", "ramp_s": 0, "layer": {"id": )" +
+         std::to_string(id) + R"(, "type": "stratus", "base_m": 400, "thickness_m": 300, "transition_band_m": 50,
+         "coverage": )" + std::to_string(coverage) +
+         R"(, "density": 0.7, "wind": {"speed_mps": 5, "from_deg": 200, "vertical_mps": 0}}}]})";
+}
+
+// One skyshell-weatherd with --nats, on ephemeral ports.
+struct NatsWeatherd {
+  std::filesystem::path dir;
+  std::optional<PausableProcess> process;
+  unsigned httpPort = 0;
+
+  // natsArgs: --nats URLS and its options, or other options of a server
+  // without NATS (e.g. --db FILE).
+  NatsWeatherd(const std::filesystem::path& root, const std::string& name, const std::string& natsUrls,
+               std::vector<std::string> more = {"--nats-lease-ms", kLeaseMs}) {
+    dir = root / name;
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "token") << kToken << "\n";
+    std::vector<std::string> args{SKY_WEATHERD, "--scenario", SKY_SCENARIO_CLOUDY, "--port", "0", "--http-port", "0",
+                                  "--http-port-file", (dir / "http.port").string(), "--token-file",
+                                  (dir / "token").string(), "--heartbeat-ms", "200"};
+    if (!natsUrls.empty()) args.insert(args.end(), {"--nats", natsUrls});
+    args.insert(args.end(), more.begin(), more.end());
+    process.emplace(args, (dir / "weatherd.log").string());
+    httpPort = waitForPortFile((dir / "http.port").string(), 40s);
+  }
+
+  std::optional<sim::HttpResponse> request(const std::string& method, const std::string& target,
+                                           const std::string& body = "") const {
+    sim::HttpRequest r;
+    r.method = method;
+    r.port = static_cast<unsigned short>(httpPort);
+    r.target = target;
+    r.body = body;
+    r.bearerToken = kToken;
+    r.timeout = 10s;
+    auto response = sim::httpRequest(r);
+    if (!response) return std::nullopt;
+    return *response;
+  }
+  // A gauge or counter of /metrics, or -1 when unreadable.
+  double metric(const std::string& name) const {
+    auto r = request("GET", "/metrics");
+    if (!r || r->status != 200) return -1;
+    std::istringstream in(r->body);
+    for (std::string line; std::getline(in, line);)
+      if (line.rfind(name + " ", 0) == 0) return std::stod(line.substr(name.size() + 1));
+    return -1;
+  }
+  bool leads() const { return metric("skyshell_nats_leader") == 1; }
+  bool hasLayer(int id) const {
+    auto r = request("GET", "/api/state");
+    if (!r || r->status != 200) return false;
+    const auto j = nlohmann::json::parse(r->body, nullptr, false);
+    if (!j.is_object() || !j.contains("layers")) return false;
+    for (const auto& l : j["layers"])
+      if (l.value("id", -1) == id) return true;
+    return false;
+  }
+  std::string log() const { return process->log(); }
+};
+
+template <class F>
+bool waitUntil(std::chrono::milliseconds timeout, F&& f) {
+  const auto deadline = Clock::now() + timeout;
+  while (Clock::now() < deadline) {
+    if (f()) return true;
+    std::this_thread::sleep_for(50ms);
+  }
+  return f();
+}
+
+double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+class WeatherdNats : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    SKY_REQUIRE_NATS_SERVER();
+    root_ = std::filesystem::path(SKY_TEST_OUTPUT_DIR) /
+            ("nats-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    // A port file left by an earlier run would name a dead server.
+    std::filesystem::remove_all(root_);
+    cluster_.emplace(root_ / "cluster");
+    ASSERT_TRUE(cluster_->waitReady(10s)) << "nats-server did not listen (logs in " << root_ << ")";
+  }
+  // Two servers, the first leading and the second following its log.
+  // Callers check HasFatalFailure() after it (its ASSERTs return from it only).
+  void startTwo() {
+    a_.emplace(root_, "a", cluster_->urls(0));
+    ASSERT_NE(a_->httpPort, 0u) << a_->log();
+    const auto t0 = Clock::now();
+    ASSERT_TRUE(waitUntil(kFirstLeaderWait, [&] { return a_->leads(); })) << a_->log();
+    std::printf("first leader after %.2f s (cluster cold)\n", secondsSince(t0));
+    b_.emplace(root_, "b", cluster_->urls(1));
+    ASSERT_NE(b_->httpPort, 0u) << b_->log();
+    ASSERT_TRUE(waitUntil(10s, [&] {
+      return b_->metric("skyshell_nats_applied_sequence") >= a_->metric("skyshell_nats_applied_sequence") &&
+             b_->metric("skyshell_nats_applied_sequence") > 0;
+    })) << b_->log();
+    EXPECT_FALSE(b_->leads());
+  }
+  // The stream's newest entry, read with the server library's client.
+  std::optional<server::LogEntry> lastEntry() {
+    server::NatsLogOptions o;
+    o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+    auto log = server::NatsLog::connect(o);
+    if (!log) {
+      ADD_FAILURE() << describe(log.error());
+      return std::nullopt;
+    }
+    auto range = (*log)->range();
+    if (!range || range->last == 0) return std::nullopt;
+    auto bytes = (*log)->read(range->last);
+    if (!bytes || !*bytes) return std::nullopt;
+    auto entry = server::decodeLogEntry(**bytes);
+    if (!entry) return std::nullopt;
+    return *entry;
+  }
+
+  std::filesystem::path root_;
+  std::optional<NatsCluster> cluster_;
+  std::optional<NatsWeatherd> a_, b_;
+};
+
+TEST_F(WeatherdNats, AChangeAcknowledgedByTheLeaderIsInTheStreamAndOnTheFollower) {
+  startTwo();
+  if (HasFatalFailure()) return;
+  const auto t0 = Clock::now();
+  const auto ack = a_->request("POST", "/api/changes", layerChange(7, 0.4));
+  ASSERT_TRUE(ack);
+  ASSERT_EQ(ack->status, 200) << ack->body;
+  std::printf("change acknowledged by the leader in %.1f ms\n", secondsSince(t0) * 1000);
+  const auto sequence = nlohmann::json::parse(ack->body)["sequence"].get<std::uint64_t>();
+
+  const auto entry = lastEntry();
+  ASSERT_TRUE(entry);
+  EXPECT_EQ(entry->kind, server::LogEntry::Kind::Change);
+  ASSERT_TRUE(entry->event);
+  EXPECT_EQ(entry->event->sequence, sequence);
+  EXPECT_NE(entry->event->summary.find("layer 7"), std::string::npos) << entry->event->summary;
+
+  EXPECT_TRUE(waitUntil(5s, [&] { return b_->hasLayer(7); })) << b_->log();
+  std::printf("visible on the follower %.1f ms after the change was sent\n", secondsSince(t0) * 1000);
+
+  // A follower refuses changes, naming the leader and its API.
+  const auto refused = b_->request("POST", "/api/changes", layerChange(8, 0.5));
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 503);
+  EXPECT_NE(refused->body.find("not the leader"), std::string::npos) << refused->body;
+  EXPECT_NE(refused->body.find("127.0.0.1:" + std::to_string(a_->httpPort)), std::string::npos) << refused->body;
+  EXPECT_FALSE(a_->hasLayer(8));
+}
+
+TEST_F(WeatherdNats, KillingTheLeaderMakesTheFollowerLeadAndTakeChanges) {
+  startTwo();
+  if (HasFatalFailure()) return;
+  ASSERT_EQ(a_->request("POST", "/api/changes", layerChange(7, 0.4))->status, 200);
+  ASSERT_TRUE(waitUntil(5s, [&] { return b_->hasLayer(7); }));
+
+  a_->process->killNow();
+  const auto killed = Clock::now();
+  // Failover: the leader killed -> the first change accepted by the new one.
+  std::optional<double> led_s, accepted_s;
+  int refusals = 0;
+  while (secondsSince(killed) < 20 && !accepted_s) {
+    if (!led_s && b_->leads()) led_s = secondsSince(killed);
+    const auto r = b_->request("POST", "/api/changes", layerChange(9, 0.6));
+    if (r && r->status == 200) {
+      accepted_s = secondsSince(killed);
+      break;
+    }
+    ++refusals;
+    std::this_thread::sleep_for(100ms);
+  }
+  ASSERT_TRUE(accepted_s) << b_->log();
+  std::printf("failover (lease %s ms): leading after %.2f s, first change accepted after %.2f s (%d refused "
+              "before)\n", kLeaseMs, led_s.value_or(*accepted_s), *accepted_s, refusals);
+  EXPECT_LT(*accepted_s, 15.0);
+  EXPECT_TRUE(b_->hasLayer(7));  // what the old leader acknowledged is still there
+  EXPECT_TRUE(b_->hasLayer(9));
+  const auto entry = lastEntry();
+  ASSERT_TRUE(entry && entry->event);
+  EXPECT_NE(entry->event->summary.find("layer 9"), std::string::npos);
+}
+
+TEST_F(WeatherdNats, APausedLeaderResumedAfterATakeoverCannotAppendAndStepsDown) {
+  startTwo();
+  if (HasFatalFailure()) return;
+  a_->process->pause();
+  const auto paused = Clock::now();
+  ASSERT_TRUE(waitUntil(15s, [&] { return b_->leads(); })) << b_->log();
+  std::printf("the follower leads %.2f s after the leader was paused\n", secondsSince(paused));
+  ASSERT_EQ(b_->request("POST", "/api/changes", layerChange(10, 0.3))->status, 200);
+
+  // Resumed, the old leader is asked for a change at once: refused, never
+  // in the log, and it steps down and follows the new leader.
+  a_->process->resume();
+  const auto stale = a_->request("POST", "/api/changes", layerChange(11, 0.9));
+  ASSERT_TRUE(stale);
+  EXPECT_EQ(stale->status, 503) << stale->body;
+  EXPECT_NE(stale->body.find("not the leader"), std::string::npos) << stale->body;
+  EXPECT_TRUE(waitUntil(5s, [&] { return !a_->leads(); })) << a_->log();
+  const auto entry = lastEntry();
+  ASSERT_TRUE(entry && entry->event);
+  EXPECT_NE(entry->event->summary.find("layer 10"), std::string::npos) << entry->event->summary;
+  EXPECT_FALSE(b_->hasLayer(11));
+  EXPECT_TRUE(waitUntil(5s, [&] { return a_->hasLayer(10); })) << a_->log();
+  EXPECT_FALSE(a_->hasLayer(11));
+  const std::string aLog = a_->log();
+  EXPECT_NE(aLog.find("event=nats_step_down"), std::string::npos) << aLog;
+}
+
+// The fence itself, without the lease's own check in front of it: JetStream
+// refuses an append whose expected last sequence the stream has moved past,
+// and a lease taken by one holder can be neither taken nor renewed by a
+// stale revision.
+TEST_F(WeatherdNats, JetStreamRefusesAStaleAppendAndAStaleLease) {
+  server::NatsLogOptions o;
+  o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+  o.stream = "SKY_FENCE_TEST";
+  o.subject = "sky.fence.test";
+  o.leaseBucket = "sky_fence_test";
+  o.leaseTtl = 2s;
+  auto connected = server::NatsLog::connect(o);
+  ASSERT_TRUE(connected) << describe(connected.error());
+  server::NatsLog& log = **connected;
+  EXPECT_EQ(log.replicas(), 3);
+  auto first = log.append("one", 0);
+  ASSERT_TRUE(first && first->stored);
+  auto second = log.append("two", first->sequence);
+  ASSERT_TRUE(second && second->stored);
+  auto stale = log.append("three", first->sequence);  // a writer that missed "two"
+  ASSERT_TRUE(stale) << describe(stale.error());
+  EXPECT_FALSE(stale->stored);
+  auto range = log.range();
+  ASSERT_TRUE(range);
+  EXPECT_EQ(range->last, second->sequence);
+
+  auto taken = log.takeLease(R"({"id": "x", "api": ""})");
+  ASSERT_TRUE(taken && *taken);
+  auto again = log.takeLease(R"({"id": "y", "api": ""})");
+  ASSERT_TRUE(again);
+  EXPECT_FALSE(*again);
+  auto renewed = log.renewLease(R"({"id": "x", "api": ""})", **taken);
+  ASSERT_TRUE(renewed && *renewed);
+  auto staleRenewal = log.renewLease(R"({"id": "x", "api": ""})", **taken);
+  ASSERT_TRUE(staleRenewal);
+  EXPECT_FALSE(*staleRenewal);
+  // Unrenewed, the lease expires after its time to live and is free again.
+  const auto t0 = Clock::now();
+  ASSERT_TRUE(waitUntil(10s, [&] {
+    auto t = log.takeLease(R"({"id": "y", "api": ""})");
+    return t && *t;
+  }));
+  std::printf("an unrenewed lease (ttl 2 s) was free again %.2f s after its last renewal\n", secondsSince(t0));
+}
+
+// The NATS node that leads the change log's stream is killed, the hardest
+// node to lose: the stream's replicas elect a new leader (JetStream's Raft
+// election takes 2-5 s), and the lease's bucket may lose its leader too, so
+// changes may be refused (503) for a few seconds. Every change is
+// acknowledged once retried within a bound, and every acknowledged one is
+// on the follower.
+TEST_F(WeatherdNats, KillingOneNatsNodeOfThreeKeepsChangesAcknowledged) {
+  startTwo();
+  if (HasFatalFailure()) return;
+  std::string streamLeader, leaseLeader;
+  {
+    server::NatsLogOptions o;
+    o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+    auto log = server::NatsLog::connect(o);
+    ASSERT_TRUE(log) << describe(log.error());
+    auto l = (*log)->leaderOf();
+    auto k = (*log)->leaderOf(true);
+    ASSERT_TRUE(l && k);
+    streamLeader = *l;
+    leaseLeader = *k;
+  }
+  ASSERT_EQ(streamLeader.size(), 2u) << streamLeader;  // "n0".."n2"
+  const int victim = streamLeader[1] - '0';
+  cluster_->kill(victim);
+  const auto killed = Clock::now();
+  double longest_s = 0;
+  int refused = 0;
+  for (int i = 0; i < 5; ++i) {
+    const auto t0 = Clock::now();
+    int status = 0;
+    while (secondsSince(t0) < 15) {
+      const auto r = a_->request("POST", "/api/changes", layerChange(20 + i, 0.5));
+      status = r ? r->status : 0;
+      if (status == 200) break;
+      ++refused;
+      std::this_thread::sleep_for(100ms);
+    }
+    ASSERT_EQ(status, 200) << a_->log();
+    longest_s = std::max(longest_s, secondsSince(t0));
+  }
+  std::printf("killed n%d (leading the stream; the lease's bucket was led by %s): 5 changes acknowledged %.2f s "
+              "after, the longest took %.2f s with %d refusals before\n",
+              victim, leaseLeader.c_str(), secondsSince(killed), longest_s, refused);
+  EXPECT_LT(longest_s, 15.0);
+  for (int i = 0; i < 5; ++i) EXPECT_TRUE(waitUntil(10s, [&] { return b_->hasLayer(20 + i); })) << i << b_->log();
+}
+
+
+// Measurements for docs/weather-server-scaling.md, not a check of a bound
+// (ctest label long): the time from sending POST /api/changes to its 200,
+// 500 changes one after another on fresh connections, for a server alone
+// (memory only, and with --db), and for the leader of two on the
+// three-node cluster; then the failover with the default lease (3 s).
+class WeatherdNatsMeasure : public WeatherdNats {};
+
+struct Percentiles {
+  double p50_ms = 0, p99_ms = 0, max_ms = 0;
+};
+Percentiles ackLatency(const NatsWeatherd& w, int changes) {
+  std::vector<double> ms;
+  for (int i = 0; i < changes; ++i) {
+    const auto t0 = Clock::now();
+    const auto r = w.request("POST", "/api/changes", layerChange(5, 0.2 + 0.6 * (i % 2)));
+    if (!r || r->status != 200) {
+      ADD_FAILURE() << "change " << i << ": " << (r ? r->body : "no answer");
+      return {};
+    }
+    ms.push_back(secondsSince(t0) * 1000);
+  }
+  std::sort(ms.begin(), ms.end());
+  return {ms[ms.size() / 2], ms[ms.size() * 99 / 100], ms.back()};
+}
+
+TEST_F(WeatherdNatsMeasure, ChangeAcknowledgementAndFailover) {
+  constexpr int kChanges = 500;
+  {
+    NatsWeatherd alone(root_, "alone", "", {});
+    const auto p = ackLatency(alone, kChanges);
+    std::printf("ack latency, one server, memory only: p50 %.2f ms, p99 %.2f ms, max %.2f ms (%d changes)\n",
+                p.p50_ms, p.p99_ms, p.max_ms, kChanges);
+  }
+  {
+    NatsWeatherd sqlite(root_, "sqlite", "", {"--db", (root_ / "weather.db").string()});
+    const auto p = ackLatency(sqlite, kChanges);
+    std::printf("ack latency, one server, --db (SQLite, synchronous FULL): p50 %.2f ms, p99 %.2f ms, max %.2f ms\n",
+                p.p50_ms, p.p99_ms, p.max_ms);
+  }
+  a_.emplace(root_, "a", cluster_->urls(0), std::vector<std::string>{});
+  ASSERT_NE(a_->httpPort, 0u);
+  ASSERT_TRUE(waitUntil(kFirstLeaderWait, [&] { return a_->leads(); })) << a_->log();
+  b_.emplace(root_, "b", cluster_->urls(1), std::vector<std::string>{});
+  ASSERT_NE(b_->httpPort, 0u);
+  ASSERT_TRUE(waitUntil(10s, [&] { return b_->metric("skyshell_nats_applied_sequence") > 0; }));
+  const auto p = ackLatency(*a_, kChanges);
+  std::printf("ack latency, --nats leader (stream R3 on 3 local nodes, one follower): p50 %.2f ms, p99 %.2f ms, "
+              "max %.2f ms\n", p.p50_ms, p.p99_ms, p.max_ms);
+
+  a_->process->killNow();
+  const auto killed = Clock::now();
+  std::optional<double> accepted_s;
+  while (secondsSince(killed) < 20) {
+    const auto r = b_->request("POST", "/api/changes", layerChange(6, 0.5));
+    if (r && r->status == 200) {
+      accepted_s = secondsSince(killed);
+      break;
+    }
+    std::this_thread::sleep_for(20ms);
+  }
+  ASSERT_TRUE(accepted_s) << b_->log();
+  std::printf("failover, default lease 3000 ms: leader SIGKILLed -> first change accepted by the follower %.2f s\n",
+              *accepted_s);
+}
+
+}  // namespace
+}  // namespace sky::test
