@@ -193,6 +193,8 @@ TEST_F(WeatherdNats, AChangeAcknowledgedByTheLeaderIsInTheStreamAndOnTheFollower
   EXPECT_FALSE(a_->hasLayer(8));
 }
 
+// And the killed server, started again, rejoins as a follower with the
+// same weather.
 TEST_F(WeatherdNats, KillingTheLeaderMakesTheFollowerLeadAndTakeChanges) {
   startTwo();
   if (HasFatalFailure()) return;
@@ -223,6 +225,22 @@ TEST_F(WeatherdNats, KillingTheLeaderMakesTheFollowerLeadAndTakeChanges) {
   const auto entry = lastEntry();
   ASSERT_TRUE(entry && entry->event);
   EXPECT_NE(entry->event->summary.find("layer 9"), std::string::npos);
+
+  // The killed server, started again, replays the log (its state, and its
+  // events for the console) and follows the new leader.
+  NatsWeatherd again(root_, "a-again", cluster_->urls(0));
+  ASSERT_NE(again.httpPort, 0u) << again.log();
+  EXPECT_TRUE(waitUntil(5s, [&] { return again.hasLayer(7) && again.hasLayer(9); })) << again.log();
+  EXPECT_FALSE(again.leads());
+  const auto sequenceOf = [](const NatsWeatherd& w) {
+    const auto r = w.request("GET", "/api/state");
+    return r ? nlohmann::json::parse(r->body, nullptr, false).value("sequence", std::uint64_t{0}) : 0;
+  };
+  EXPECT_EQ(sequenceOf(again), sequenceOf(*b_));
+  const auto events = again.request("GET", "/api/events?limit=10");
+  ASSERT_TRUE(events);
+  EXPECT_NE(events->body.find("layer 7"), std::string::npos) << events->body;
+  EXPECT_NE(events->body.find("layer 9"), std::string::npos) << events->body;
 }
 
 TEST_F(WeatherdNats, APausedLeaderResumedAfterATakeoverCannotAppendAndStepsDown) {
