@@ -164,6 +164,7 @@ class WeatherdNats : public ::testing::Test {
   std::optional<NatsWeatherd> a_, b_;
 };
 
+// Then the leader shuts down cleanly and hands over at once.
 TEST_F(WeatherdNats, AChangeAcknowledgedByTheLeaderIsInTheStreamAndOnTheFollower) {
   startTwo();
   if (HasFatalFailure()) return;
@@ -191,6 +192,15 @@ TEST_F(WeatherdNats, AChangeAcknowledgedByTheLeaderIsInTheStreamAndOnTheFollower
   EXPECT_NE(refused->body.find("not the leader"), std::string::npos) << refused->body;
   EXPECT_NE(refused->body.find("127.0.0.1:" + std::to_string(a_->httpPort)), std::string::npos) << refused->body;
   EXPECT_FALSE(a_->hasLayer(8));
+
+  // A leader shut down cleanly (SIGTERM) releases its lease: the follower
+  // leads at its next poll, well before the lease (2 s) would have expired.
+  a_.reset();
+  const auto stopped = Clock::now();
+  ASSERT_TRUE(waitUntil(10s, [&] { return b_->leads(); })) << b_->log();
+  std::printf("after a clean shutdown of the leader the follower leads in %.2f s\n", secondsSince(stopped));
+  EXPECT_LT(secondsSince(stopped), 1.5);
+  EXPECT_TRUE(b_->hasLayer(7));
 }
 
 // And the killed server, started again, rejoins as a follower with the
