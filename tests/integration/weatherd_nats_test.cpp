@@ -280,6 +280,44 @@ TEST_F(WeatherdNats, APausedLeaderResumedAfterATakeoverCannotAppendAndStepsDown)
   EXPECT_NE(aLog.find("event=nats_step_down"), std::string::npos) << aLog;
 }
 
+// Bytes in the stream that no leader wrote (another program on the cluster,
+// a corrupted entry): every server drops and counts them and keeps its
+// weather; the leader, seeing the log move past it, steps down and frees
+// the lease, one of the two takes the lead, and changes are acknowledged
+// there afterwards.
+TEST_F(WeatherdNats, AForeignEntryInTheLogIsDroppedAndCountedEverywhere) {
+  startTwo();
+  if (HasFatalFailure()) return;
+  ASSERT_EQ(a_->request("POST", "/api/changes", layerChange(7, 0.4))->status, 200);
+  {
+    server::NatsLogOptions o;
+    o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+    auto log = server::NatsLog::connect(o);
+    ASSERT_TRUE(log) << describe(log.error());
+    auto range = (*log)->range();
+    ASSERT_TRUE(range);
+    auto garbage = (*log)->append(R"({"format": 1, "kind": "change", "term": 99, "leader": "x", "leader_api": "", "state": []})", range->last);
+    ASSERT_TRUE(garbage && garbage->stored);
+  }
+  EXPECT_TRUE(waitUntil(5s, [&] { return b_->metric("skyshell_nats_entries_dropped_total") == 1; })) << b_->log();
+  EXPECT_TRUE(waitUntil(5s, [&] { return a_->metric("skyshell_nats_entries_dropped_total") == 1; })) << a_->log();
+  EXPECT_TRUE(b_->hasLayer(7));
+  const auto t0 = Clock::now();
+  bool accepted = false;
+  while (!accepted && secondsSince(t0) < 10) {
+    for (const NatsWeatherd* w : {&*a_, &*b_}) {
+      const auto r = w->request("POST", "/api/changes", layerChange(8, 0.6));
+      if ((accepted = r && r->status == 200)) break;
+    }
+    if (!accepted) std::this_thread::sleep_for(100ms);
+  }
+  ASSERT_TRUE(accepted) << a_->log();
+  std::printf("changes acknowledged again %.2f s after a foreign entry\n", secondsSince(t0));
+  EXPECT_TRUE(waitUntil(5s, [&] { return b_->hasLayer(8) && b_->hasLayer(7); })) << b_->log();
+  EXPECT_TRUE(waitUntil(5s, [&] { return a_->hasLayer(8) && a_->hasLayer(7); })) << a_->log();
+  EXPECT_EQ(a_->metric("skyshell_nats_leader") + b_->metric("skyshell_nats_leader"), 1);
+}
+
 // The fence itself, without the lease's own check in front of it: JetStream
 // refuses an append whose expected last sequence the stream has moved past,
 // and a lease taken by one holder can be neither taken nor renewed by a
