@@ -181,6 +181,8 @@ TEST_F(WeatherdNats, AChangeAcknowledgedByTheLeaderIsInTheStreamAndOnTheFollower
   ASSERT_TRUE(entry->event);
   EXPECT_EQ(entry->event->sequence, sequence);
   EXPECT_NE(entry->event->summary.find("layer 7"), std::string::npos) << entry->event->summary;
+  std::printf("the entry (whole state of two layers, and the event): %zu bytes\n",
+              server::encodeLogEntry(*entry).size());
 
   EXPECT_TRUE(waitUntil(5s, [&] { return b_->hasLayer(7); })) << b_->log();
   std::printf("visible on the follower %.1f ms after the change was sent\n", secondsSince(t0) * 1000);
