@@ -73,6 +73,8 @@ int main(int argc, char** argv) {
   std::string truthKind;
   unsigned truthSpp = 64, truthEvents = 0, truthThreads = 0;
   std::vector<double> truthOctaves;
+  std::vector<std::string> truthModels;
+  bool truthNoParts = false;
 
   app.add_option("--suite", suite, "scene suite file (TOML)")->capture_default_str();
   app.add_option("--scenes", scenes, "comma-separated scene names (default: every scene of the suite)");
@@ -108,6 +110,13 @@ int main(int argc, char** argv) {
                  "--truth path: octave weights b to measure besides the model's, comma-separated (e.g. 0.25,0.35)")
       ->delimiter(',')
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--truth-model", truthModels,
+                 "--truth path: another model to measure, b=<octave weight 0-1>:a=<octave extinction (0,1]>:"
+                 "c=<octave eccentricity 0-1>:sd=<scattered sun's diffuse gain 0-2> (any of them; repeat the "
+                 "option for more)");
+  app.add_flag("--truth-no-parts", truthNoParts,
+               "--truth path: skip the model's parts switched off one at a time (measure the model and the "
+               "--truth-model/--truth-octaves variants only)");
   app.add_flag("--list", list, "list the suite's scenes and the configurations, then exit");
   app.add_flag("--side-by-side", sideBySide, "time one view: one CLOUDPASS line per frame on stdout");
   app.add_option("--height-above-ground", sbs.heightAboveGround_m, "side-by-side: camera height, m")
@@ -214,6 +223,15 @@ int main(int argc, char** argv) {
     options.truth.maxEvents = truthEvents;
     options.truth.threads = truthThreads;
     options.truth.octaveWeights = truthOctaves;
+    options.truth.parts = !truthNoParts;
+    for (const std::string& spec : truthModels) {
+      auto model = sky::bench::parseModelSpec(spec);
+      if (!model) {
+        std::fprintf(stderr, "skyshell-bench: --truth-model: %s\n", model.error().detail.c_str());
+        return 2;
+      }
+      options.truth.models.emplace_back(spec, *model);
+    }
   }
   std::error_code ec;
   std::filesystem::create_directories(options.outDir, ec);

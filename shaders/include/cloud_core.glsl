@@ -54,27 +54,35 @@ SKY_CORE_CONST real kAlbedo = 0.999;
 SKY_CORE_CONST real kIceAsymmetry = 0.75;
 // Wrenninge 2015 multiple-scattering octaves: octave i scales the extinction
 // towards the sun by a^i, its contribution by b^i and the phase eccentricity
-// by c^i; a <= b keeps the sum energy-conserving. a = b = c = 0.5 as in
-// formulas.md; 4 octaves, one per lane of a real4 (Ford uses 8; the 5th adds
+// by c^i; a <= b keeps the sum energy-conserving. a = b = 0.5 as in
+// formulas.md. c is the droplets' asymmetry g (kDiffuseAsymmetry), not
+// formulas.md's example 0.5: light scattered n times has the asymmetry g^n
+// (the phase functions' Legendre moments multiply under convolution), so
+// octave i, standing for order i + 1, has eccentricity g c^i = g^(i+1).
+// Against the path-traced truth (docs/bench/truth-160x90.md) c = g moves
+// every still towards it: front-lit 1.12-1.20x the truth's mean to
+// 1.04-1.10x, looking into a low sun 0.45x to 0.58x. 4 octaves, one per lane of a real4 (Ford uses 8; the 5th adds
 // under 3 %; arrays of per-octave values cost lavapipe a memory round trip
 // per sample, a real4 does not).
 SKY_CORE_CONST int kScatterOctaves = 4;
-SKY_CORE_CONST real kOctaveExtinction = 0.5;
 // The parts of the light model a measurement may switch off, one at a
 // time, to see what each brings against the path-traced truth
 // (skyshell-bench --truth path): constants everywhere but in the CPU
 // core, which defines SKY_MODEL_CONST as a data member's type
 // (cpu_core.hpp, CpuReference::setModel). kOctaveContribution 0 leaves
 // single scattering of the sun; kAmbientGain 0 drops the sky's and the
-// scattered sun's diffuse light; kMiePhase false takes one HG lobe of
-// kDiffuseAsymmetry for the droplets' Mie fit.
+// scattered sun's diffuse light, kSunDiffuseGain 0 only the scattered
+// sun's; kMiePhase false takes one HG lobe of kDiffuseAsymmetry for the
+// droplets' Mie fit.
 #ifndef SKY_MODEL_CONST
 #define SKY_MODEL_CONST SKY_CORE_CONST
 #endif
 SKY_MODEL_CONST real kOctaveContribution = 0.5;
+SKY_MODEL_CONST real kOctaveExtinction = 0.5;
 SKY_MODEL_CONST real kAmbientGain = 1.0;
+SKY_MODEL_CONST real kSunDiffuseGain = 1.0;
 SKY_MODEL_CONST bool kMiePhase = true;
-SKY_CORE_CONST real kOctaveEccentricity = 0.5;
+SKY_MODEL_CONST real kOctaveEccentricity = 0.85;
 // The march's cost knobs are run-time numbers of the frame (CoreFrame.march,
 // RenderSettings::march, the presets); these are their defaults, the
 // `high` preset. Primary samples per layer span, spread evenly over it, so
@@ -414,7 +422,7 @@ real3 diffuseLight(CoreLayer L, CloudType t, real ph, real c, real densityScale)
   real tauAbove = t.extinction_perm * densityScale * c * t.columnFill * layerPresenceAbove(ph, L.band) * L.thickness;
   real transmitted = 1.0 / (1.0 + 0.75 * (1.0 - kDiffuseAsymmetry) * tauAbove);
   real scatteredOut = 1.0 - exp(-tauAbove / max(L.sunCosine, kMinSunCosine));
-  return (L.skyTop + L.sunDiffuseTop * scatteredOut) * transmitted;
+  return (L.skyTop + L.sunDiffuseTop * (scatteredOut * kSunDiffuseGain)) * transmitted;
 }
 
 // The density at p (height fraction ph) of layer L and what the light march

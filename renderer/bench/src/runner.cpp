@@ -292,6 +292,8 @@ Result<std::string> writeSceneImages(const std::string& stem, const std::vector<
 Result<std::vector<ModelVariantResult>> modelVariants(const LoadedScene& ls, const Configuration& reference,
                                                       const Resolution& res, const TruthImage& truth,
                                                       const Srgb8Image& truthSrgb, const std::vector<double>& octaveWeights,
+                                                      const std::vector<std::pair<std::string, render::ModelSwitches>>& models,
+                                                      bool parts,
                                                       const std::function<void(const std::string&)>& log) {
   const render::RenderSettings settings = settingsFor(reference, res.width, res.height, ls.scene.verticalFov_deg);
   auto cpu = render::CpuReference::create(settings);
@@ -300,10 +302,13 @@ Result<std::vector<ModelVariantResult>> modelVariants(const LoadedScene& ls, con
     std::string name;
     render::ModelSwitches model;
   };
-  std::vector<Variant> variants{{"model", {}}, {"no octaves", {}}, {"no ambient", {}}, {"HG phase", {}}};
+  std::vector<Variant> variants{
+      {"model", {}}, {"no octaves", {}}, {"no ambient", {}}, {"no scattered sun", {}}, {"HG phase", {}}};
   variants[1].model.octaves = false;
   variants[2].model.ambient = false;
-  variants[3].model.miePhase = false;
+  variants[3].model.scatteredSun = false;
+  variants[4].model.miePhase = false;
+  if (!parts) variants.resize(1);
   for (const double b : octaveWeights) {
     std::ostringstream name;
     name << "octaves b=" << b;
@@ -311,6 +316,7 @@ Result<std::vector<ModelVariantResult>> modelVariants(const LoadedScene& ls, con
     v.model.octaveContribution = b;
     variants.push_back(v);
   }
+  for (const auto& [name, model] : models) variants.push_back({name, model});
   std::vector<ModelVariantResult> out;
   for (const Variant& v : variants) {
     cpu->setModel(v.model);
@@ -411,7 +417,7 @@ Result<BenchReport> runBench(const std::vector<LoadedScene>& scenes, const RunOp
         if (!truth) return fail(truth.error().code, stem + " truth: " + truth.error().detail);
         reference.truthSrgb = toSrgb8({res.width, res.height, truth->image.rgba});
         auto variants = modelVariants(ls, options.configurations.front(), res, *truth, reference.truthSrgb,
-                                      options.truth.octaveWeights, log);
+                                      options.truth.octaveWeights, options.truth.models, options.truth.parts, log);
         if (!variants) return fail(variants.error().code, stem + " model variants: " + variants.error().detail);
         for (ModelVariantResult& v : *variants) report.modelVariants.push_back(std::move(v));
         reference.truth = std::move(*truth);

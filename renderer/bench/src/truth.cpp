@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <cstdlib>
 #include <sstream>
+#include <string_view>
 
 #include "sky/render/path_tracer.hpp"
 
@@ -33,6 +35,41 @@ std::string stateKey(const LoadedScene& scene, std::uint32_t w, std::uint32_t h,
 }
 
 }  // namespace
+
+Result<render::ModelSwitches> parseModelSpec(std::string_view spec) {
+  render::ModelSwitches m;
+  if (spec.empty()) return fail(ErrorCode::InvalidArgument, "empty model spec (e.g. b=0.35:sd=0.5)");
+  std::size_t start = 0;
+  while (start <= spec.size()) {
+    const std::size_t end = std::min(spec.find(':', start), spec.size());
+    const std::string_view part = spec.substr(start, end - start);
+    const std::size_t eq = part.find('=');
+    const std::string_view key = part.substr(0, eq);
+    const std::string value(eq == std::string_view::npos ? std::string_view{} : part.substr(eq + 1));
+    char* stop = nullptr;
+    const double v = value.empty() ? -1.0 : std::strtod(value.c_str(), &stop);
+    const bool number = !value.empty() && stop == value.c_str() + value.size() && std::isfinite(v);
+    if (key == "b" && number && v >= 0 && v <= 1) {
+      if (m.octaveContribution) return fail(ErrorCode::InvalidArgument, "model spec '" + std::string(spec) + "': b twice");
+      m.octaveContribution = v;
+    } else if (key == "sd" && number && v >= 0 && v <= 2) {
+      if (m.sunDiffuseGain) return fail(ErrorCode::InvalidArgument, "model spec '" + std::string(spec) + "': sd twice");
+      m.sunDiffuseGain = v;
+    } else if (key == "a" && number && v > 0 && v <= 1) {
+      if (m.octaveExtinction) return fail(ErrorCode::InvalidArgument, "model spec '" + std::string(spec) + "': a twice");
+      m.octaveExtinction = v;
+    } else if (key == "c" && number && v >= 0 && v <= 1) {
+      if (m.octaveEccentricity)
+        return fail(ErrorCode::InvalidArgument, "model spec '" + std::string(spec) + "': c twice");
+      m.octaveEccentricity = v;
+    } else {
+      return fail(ErrorCode::InvalidArgument, "model spec '" + std::string(spec) + "': '" + std::string(part) +
+                                                  "' is not b=<0-1>, a=<(0,1]>, c=<0-1> or sd=<0-2>");
+    }
+    start = end + 1;
+  }
+  return m;
+}
 
 TruthDistance truthDistance(const std::vector<float>& rgba, const TruthImage& truth) {
   const std::size_t n = std::min(rgba.size(), truth.image.rgba.size()) / 4;

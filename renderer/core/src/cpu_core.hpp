@@ -71,8 +71,12 @@ class CpuCore : public GlslDouble {
   // Switches parts of the model off (from the defaults a new core has).
   void setModel(const ModelSwitches& m) {
     if (m.octaveContribution) kOctaveContribution = *m.octaveContribution;
+    if (m.octaveExtinction) kOctaveExtinction = *m.octaveExtinction;
+    if (m.octaveEccentricity) kOctaveEccentricity = *m.octaveEccentricity;
     if (!m.octaves) kOctaveContribution = 0.0;
     if (!m.ambient) kAmbientGain = 0.0;
+    if (m.sunDiffuseGain) kSunDiffuseGain = *m.sunDiffuseGain;
+    if (!m.scatteredSun) kSunDiffuseGain = 0.0;
     if (!m.miePhase) kMiePhase = false;
   }
 

@@ -16,6 +16,7 @@
 #include "sky/bench/side_by_side.hpp"
 #include "sky/bench/suite.hpp"
 #include "sky/bench/suite_loader.hpp"
+#include "sky/bench/truth.hpp"
 
 namespace sky::bench {
 namespace {
@@ -383,6 +384,29 @@ TEST(Configurations, ReferenceCanBeReplacedForASweep) {
   EXPECT_NE(interleaved.error().detail.find("every pixel"), std::string::npos) << interleaved.error().detail;
   EXPECT_FALSE(referenceConfiguration("base=reference,scale=0.5"));
   EXPECT_FALSE(referenceConfiguration("base=reference,light=x"));
+}
+
+// --truth-model's spec: each part read, and each bad one named.
+TEST(TruthModelSpec, ReadsItsPartsAndNamesTheBadOne) {
+  auto both = parseModelSpec("b=0.35:sd=0.5");
+  ASSERT_TRUE(both) << both.error().detail;
+  EXPECT_EQ(both->octaveContribution, 0.35);
+  EXPECT_EQ(both->sunDiffuseGain, 0.5);
+  auto octaves = parseModelSpec("c=0.8:a=0.6");
+  ASSERT_TRUE(octaves) << octaves.error().detail;
+  EXPECT_EQ(octaves->octaveEccentricity, 0.8);
+  EXPECT_EQ(octaves->octaveExtinction, 0.6);
+  auto one = parseModelSpec("sd=0");
+  ASSERT_TRUE(one) << one.error().detail;
+  EXPECT_FALSE(one->octaveContribution);
+  EXPECT_EQ(one->sunDiffuseGain, 0.0);
+  for (const char* bad : {"", "b", "b=", "b=1.5", "sd=-1", "sd=3", "b=0.2:b=0.3", "x=1", "b=0.2:", "b=nan",
+                          "b=0.2x", "sd=inf", "a=0", "c=1.1", "c=0.5:c=0.6"}) {
+    auto r = parseModelSpec(bad);
+    ASSERT_FALSE(r) << bad;
+    EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument) << bad;
+    EXPECT_NE(r.error().detail.find("model spec"), std::string::npos) << r.error().detail;
+  }
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "sky/bench/suite_loader.hpp"
 #include "sky/core/result.hpp"
 #include "sky/render/cloud_renderer.hpp"
+#include "sky/render/cpu_reference.hpp"
 
 namespace sky::bench {
 
@@ -25,7 +26,17 @@ struct TruthOptions {
   std::string stateDir;               // where the resumable sums go; empty: not saved
   // Octave weights b to measure besides the model's (a variant "octaves b=X" each).
   std::vector<double> octaveWeights;
+  // The model with each of its parts off (octaves, ambient, scattered sun,
+  // Mie phase): false measures the model and the variants asked for only.
+  bool parts = true;
+  // Other models to measure, each a variant named by its spec (parseModelSpec).
+  std::vector<std::pair<std::string, render::ModelSwitches>> models;
 };
+
+// A model to measure from its spec "b=0.35:c=0.8:sd=0.5": the octaves'
+// weight b (0-1), extinction a (0-1] and eccentricity c (0-1), and the gain
+// on the scattered sun's diffuse light sd (0-2), any of them in any order. Errors: InvalidArgument naming the bad part.
+Result<render::ModelSwitches> parseModelSpec(std::string_view spec);
 
 struct TruthImage {
   render::Image image;             // the mean (rgba linear)

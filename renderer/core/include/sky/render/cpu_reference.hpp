@@ -31,7 +31,16 @@ struct ModelSwitches {
   // When set, the octaves' contribution b (kOctaveContribution) instead of
   // the model's: a measurement of what another weight would do.
   std::optional<double> octaveContribution;
+  // When set, the octaves' extinction a (kOctaveExtinction) and eccentricity
+  // c (kOctaveEccentricity) instead of the model's.
+  std::optional<double> octaveExtinction;
+  std::optional<double> octaveEccentricity;
   bool ambient = true;   // the sky's and the scattered sun's diffuse light
+  // The scattered sun's part of the diffuse light alone (the octaves stand
+  // for the sun's multiple scattering too).
+  bool scatteredSun = true;
+  // When set, the scattered sun's diffuse light times this (kSunDiffuseGain).
+  std::optional<double> sunDiffuseGain;
   bool miePhase = true;  // the droplets' Mie fit; false: one HG lobe (g 0.85)
 };
 
