@@ -2,6 +2,8 @@
 // the decoder enforces (../shared/reference/cigi.md §3-§7).
 #include "packet_codec.hpp"
 
+#include <cstring>
+
 #include "sky/cigi/celestial_time.hpp"
 
 namespace sky::cigi::detail {
@@ -488,9 +490,13 @@ Result<CameraExposureControl> Codec<CameraExposureControl>::read(PacketReader& r
 
 bool claimsCameraExposure(const std::uint8_t* packet, std::size_t size, ByteOrder order) {
   if (size < 8) return false;
-  const PacketReader r(packet, order, 0, 0, "");
-  return (r.u8(6) & 0x3F) == CameraExposureControl::kComponentClass &&
-         r.u16(2) == CameraExposureControl::kComponentId;
+  // Two fields read directly: a PacketReader here (with its optional error
+  // string never set) trips GCC 12's -Wmaybe-uninitialized in the sanitizer
+  // build, which treats warnings as errors.
+  std::uint16_t id = 0;
+  std::memcpy(&id, packet + 2, sizeof id);
+  if (needsSwap(order)) id = static_cast<std::uint16_t>((id >> 8) | (id << 8));
+  return (packet[6] & 0x3F) == CameraExposureControl::kComponentClass && id == CameraExposureControl::kComponentId;
 }
 
 }  // namespace sky::cigi::detail
