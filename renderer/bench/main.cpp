@@ -2,7 +2,7 @@
 // its image is from `reference` over a suite of scenes (deploy/bench/suite.toml),
 // and writes results.json, results.md, plots and contact sheets; or, with
 // --side-by-side, times one view frame by frame for comparison with another
-// renderer on the same machine. README, "Measuring speed against accuracy".
+// renderer on the same machine. docs/performance.md, "Speed against accuracy".
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>

@@ -1,6 +1,6 @@
 // The Skyshell operator console: wires the live feed (api.js) to the map and
 // the panels, keeps the token for the tab's session, and turns the page
-// read-only without it. Served by skyshell-weatherd at / (README, "The
+// read-only without it. Served by skyshell-weatherd at / (docs/operating.md, "The
 // operator console").
 import { LiveLink, postChanges, request, session } from "./api.js";
 import { ClockPanel } from "./clock.js";

@@ -17,7 +17,7 @@ export const REGION_KEYS = {
 const STORM = { size_m: 10000, transition_m: 4000 };
 const CLEARING = { size_m: 30000, transition_m: 10000 };
 // A storm cell's cloud: cumulonimbus from 900 m to 9900 m, nearly overcast,
-// in a 12 m/s south-westerly (the README's example cell).
+// in a 12 m/s south-westerly (docs/operating.md's example storm cell).
 const STORM_LAYER = { type: "cumulonimbus", base_m: 900, thickness_m: 9000, transition_band_m: 200, coverage: 0.9,
   density: 1, wind: { speed_mps: 12, from_deg: 250, vertical_mps: 0 } };
 

@@ -33,8 +33,8 @@ using namespace std::chrono_literals;
 namespace sky::test {
 namespace {
 
-// The renderer's documented mapping of cloud to the CIGI response (README,
-// "CIGI answers"): humidity 100 % in cloud, 50 % in clear air; visibility
+// The renderer's documented mapping of cloud to the CIGI response
+// (docs/integrating.md, "Conditions answers"): humidity 100 % in cloud, 50 % in clear air; visibility
 // 3.912 / (0.05 /m x density), at most 50 km; cloud water 0.5 g/m^3 x density.
 constexpr double kExtinctionPerDensity = 0.05, kClearVisibility_m = 50000, kLiquidWater_gpm3 = 0.5;
 

@@ -94,10 +94,10 @@ std::map<std::string, std::vector<float>> readExr(const fs::path& path) {
   return out;
 }
 
-// The PNG's tonemap as the README states it: exposure 1, the ACES filmic fit
-// of Narkowicz 2015, the sRGB transfer (IEC 61966-2-1), 8 bits.
-// The PNG's display transform written out here: the frame's recorded camera
-// exposure (frames.jsonl "camera_exposure"), ACES (Narkowicz 2015), sRGB.
+// The PNG's display transform as docs/ground-truth.md ("The camera's
+// exposure") states it, written out here: the frame's recorded camera
+// exposure (frames.jsonl "camera_exposure"), the ACES filmic fit of
+// Narkowicz 2015, the sRGB transfer (IEC 61966-2-1), 8 bits.
 int tonemapped(float linear, double exposure) {
   const double x = std::max(0.0, double(linear) * exposure);
   const double aces = std::clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);

@@ -254,7 +254,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 65535))
       ->capture_default_str();
   app.add_option("--preset", o.preset,
-                 "quality preset: reference, high, medium, low, realtime (README.md, \"Quality presets\")")
+                 "quality preset: reference, high, medium, low, realtime (docs/rendering.md, \"Quality presets\")")
       ->capture_default_str();
   app.add_option("--frame-budget-ms", o.frameBudget_ms,
                  "hold frames to this many ms: each frame drawn at the most accurate of the preset's cheaper "

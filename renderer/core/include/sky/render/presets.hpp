@@ -1,7 +1,7 @@
 // Named quality presets: each a set of the cloud march's cost knobs
 // (MarchSettings). `reference` is the ground truth the bench compares the
 // others with; `high` is the default (RenderSettings' defaults). The table
-// of values is in README.md ("Quality presets").
+// of values is in docs/rendering.md ("Quality presets").
 #pragma once
 
 #include <string>
