@@ -15,13 +15,13 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
-#include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include "sky/server/cigi_weather_input.hpp"
 #include "sky/server/console_files.hpp"
 #include "sky/server/forecast_files.hpp"
 #include "sky/server/http_api.hpp"
+#include "sky/server/main_support.hpp"
 #include "sky/server/metar_changes.hpp"
 #include "sky/server/nats_weather.hpp"
 #include "sky/server/scenario.hpp"
@@ -40,32 +40,6 @@ namespace {
 constexpr int kExitRuntime = 1;
 constexpr int kExitBadInput = 2;
 constexpr int kExitStorage = 3;
-
-// Writes `port` to `path` via a temporary file and a rename, so a reader
-// polling for the file never sees it half written.
-sky::Result<void> writePortFile(const std::filesystem::path& path, std::uint16_t port) {
-  std::filesystem::path tmp = path;
-  tmp += ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    out << port << '\n';
-    out.close();
-    if (!out) return sky::fail(sky::ErrorCode::Io, tmp.string() + ": cannot write");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    return sky::fail(sky::ErrorCode::Io, path.string() + ": cannot rename into place");
-  }
-  return {};
-}
-
-std::string hostName() {
-  char name[256] = {};
-  if (::gethostname(name, sizeof name - 1) != 0) return "unknown-host";
-  return name;
-}
 
 }  // namespace
 
@@ -165,15 +139,9 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : kExitBadInput;
   }
 
-  // Logs go to stderr (journald under systemd); stdout carries only the
-  // "listening on" line that scripts wait for.
-  auto log = std::make_shared<spdlog::logger>(
-      "weatherd", std::make_shared<spdlog::sinks::stderr_sink_mt>());
-  log->set_level(spdlog::level::from_str(logLevel));
-  log->flush_on(spdlog::level::info);
-  // Structured lines: a timestamp, the level, then "event=... key=value"
-  // fields (strings that may hold spaces are quoted), for grep and log shippers.
-  log->set_pattern("%Y-%m-%dT%H:%M:%S.%e%z level=%l %v");
+  // Logs go to stderr; stdout carries only the "listening on" lines that
+  // scripts wait for.
+  auto log = sky::server::stderrLogger("weatherd", logLevel);
 
   auto scenario = sky::server::loadScenario(scenarioPath);
   if (!scenario) {
@@ -182,7 +150,7 @@ int main(int argc, char** argv) {
   }
 
   options.heartbeatInterval = std::chrono::milliseconds(heartbeatMs);
-  options.serverId = "skyshell-weatherd@" + hostName();
+  options.serverId = "skyshell-weatherd@" + sky::server::hostName();
   options.log = log;
   sky::server::WeatherState state(*scenario, sky::server::WallClock::now());
   auto server = sky::server::Server::create(options, std::move(state));
@@ -195,7 +163,7 @@ int main(int argc, char** argv) {
   const std::string host = v6 ? "[" + options.listenAddress + "]" : options.listenAddress;
   std::cout << "skyshell-weatherd listening on " << host << ":" << (*server)->port() << std::endl;
   if (!portFile.empty()) {
-    if (auto r = writePortFile(portFile, (*server)->port()); !r) {
+    if (auto r = sky::server::writePortFile(portFile, (*server)->port()); !r) {
       log->error("{}", sky::describe(r.error()));
       return kExitRuntime;
     }
@@ -386,7 +354,7 @@ int main(int argc, char** argv) {
                                                                       : http.listenAddress)
                 << ":" << api->port() << "/" << std::endl;
     if (!httpPortFile.empty()) {
-      if (auto r = writePortFile(httpPortFile, api->port()); !r) {
+      if (auto r = sky::server::writePortFile(httpPortFile, api->port()); !r) {
         log->error("{}", sky::describe(r.error()));
         return kExitRuntime;
       }
@@ -404,7 +372,7 @@ int main(int argc, char** argv) {
     s.onShutdown([&cigi] { cigi->close(); });
     std::cout << "skyshell-weatherd CIGI weather input on udp " << cigiListen << ":" << cigi->port() << std::endl;
     if (!cigiPortFile.empty()) {
-      if (auto r = writePortFile(cigiPortFile, cigi->port()); !r) {
+      if (auto r = sky::server::writePortFile(cigiPortFile, cigi->port()); !r) {
         log->error("{}", sky::describe(r.error()));
         return kExitRuntime;
       }

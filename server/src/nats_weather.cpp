@@ -228,44 +228,12 @@ void NatsWeather::electionLoop() {
       continue;
     }
     if (held == 0) {
-      const std::int64_t sentAt_ns = steadyNs();
-      auto taken = natsLog_->takeLease(leaseValue());
-      if (taken && *taken) {
-        held = **taken;
-        renewedAt_ns = sentAt_ns;
-        leaseRenewedAt_ns_ = sentAt_ns;
-        const std::uint64_t term = **taken;
-        boost::asio::post(server_.io(), [this, term] {
-          claimStarted_ = std::chrono::steady_clock::now();
-          claim(term, 0);
-        });
+      // A relay never asks for the lease: it only watches the log.
+      if (!options_.relay && (held = tryTakeLease()) != 0) {
+        renewedAt_ns = leaseRenewedAt_ns_.load();
         continue;
       }
-      if (auto range = natsLog_->range(); range) {
-        const std::uint64_t applied = applied_.load();
-        const auto now = std::chrono::steady_clock::now();
-        if (range->last <= applied || (lagging && lagging->second != applied)) {
-          lagging.reset();
-        } else if (!lagging) {
-          lagging.emplace(now, applied);
-        } else if (now - lagging->first >= kFollowStall) {
-          log_->warn("event=nats_follow_again applied={} stream_last={} (no entry folded for {} ms)", applied,
-                     range->last, std::chrono::duration_cast<std::chrono::milliseconds>(now - lagging->first).count());
-          if (auto r = follow(); !r) log_->warn("event=nats_follow_failed detail={:?}", describe(r.error()));
-          lagging.reset();
-        }
-      }
-      auto lease = natsLog_->readLease();
-      if (lease && *lease) {
-        const auto j = nlohmann::json::parse((*lease)->value, nullptr, false);
-        if (j.is_object() && j.contains("id") && j["id"].is_string() && j.contains("api") && j["api"].is_string() &&
-            j["id"].get_ref<const std::string&>().size() <= kMaxLeaseText &&
-            j["api"].get_ref<const std::string&>().size() <= kMaxLeaseText) {
-          std::lock_guard lock(mutex_);
-          leaderId_ = j["id"].get<std::string>();
-          leaderApi_ = j["api"].get<std::string>();
-        }
-      }
+      watchLog(lagging);
       continue;
     }
     if (std::chrono::nanoseconds(steadyNs() - renewedAt_ns) < renewEvery) continue;
@@ -283,6 +251,47 @@ void NatsWeather::electionLoop() {
     // again; meanwhile the leader refuses changes once the lease may lapse.
   }
   if (held != 0) (void)natsLog_->releaseLease(held);
+}
+
+std::uint64_t NatsWeather::tryTakeLease() {
+  const std::int64_t sentAt_ns = steadyNs();
+  auto taken = natsLog_->takeLease(leaseValue());
+  if (!taken || !*taken) return 0;
+  leaseRenewedAt_ns_ = sentAt_ns;
+  const std::uint64_t term = **taken;
+  boost::asio::post(server_.io(), [this, term] {
+    claimStarted_ = std::chrono::steady_clock::now();
+    claim(term, 0);
+  });
+  return term;
+}
+
+void NatsWeather::watchLog(std::optional<std::pair<std::chrono::steady_clock::time_point, std::uint64_t>>& lagging) {
+  if (auto range = natsLog_->range(); range) {
+    const std::uint64_t applied = applied_.load();
+    const auto now = std::chrono::steady_clock::now();
+    if (range->last <= applied || (lagging && lagging->second != applied)) {
+      lagging.reset();
+    } else if (!lagging) {
+      lagging.emplace(now, applied);
+    } else if (now - lagging->first >= kFollowStall) {
+      log_->warn("event=nats_follow_again applied={} stream_last={} (no entry folded for {} ms)", applied,
+                 range->last, std::chrono::duration_cast<std::chrono::milliseconds>(now - lagging->first).count());
+      if (auto r = follow(); !r) log_->warn("event=nats_follow_failed detail={:?}", describe(r.error()));
+      lagging.reset();
+    }
+  }
+  auto lease = natsLog_->readLease();
+  if (lease && *lease) {
+    const auto j = nlohmann::json::parse((*lease)->value, nullptr, false);
+    if (j.is_object() && j.contains("id") && j["id"].is_string() && j.contains("api") && j["api"].is_string() &&
+        j["id"].get_ref<const std::string&>().size() <= kMaxLeaseText &&
+        j["api"].get_ref<const std::string&>().size() <= kMaxLeaseText) {
+      std::lock_guard lock(mutex_);
+      leaderId_ = j["id"].get<std::string>();
+      leaderApi_ = j["api"].get<std::string>();
+    }
+  }
 }
 
 void NatsWeather::claim(std::uint64_t term, int attempt) {
@@ -364,6 +373,11 @@ void NatsWeather::close() {
 
 std::string NatsWeather::refusal() const {
   std::lock_guard lock(mutex_);
+  if (options_.relay)
+    return "a relay serves the weather read-only" +
+           (leaderId_.empty() ? std::string("; no server leads yet") :
+                                "; " + leaderId_ + " leads" + (leaderApi_.empty() ? "" : " (" + leaderApi_ + ")") +
+                                    ", send changes there");
   if (leaderId_.empty() || leaderId_ == options_.serverId)
     return "not the leader: this server follows the NATS log and no other server leads yet (an election "
            "takes up to the lease's time to live); try again";
@@ -383,6 +397,7 @@ std::string NatsWeather::metrics() const {
          std::to_string(v) + "\n";
   };
   line("skyshell_nats_leader", "gauge", "1 while this server leads the weather on NATS", leading_ ? 1 : 0);
+  line("skyshell_nats_relay", "gauge", "1 for a relay (follows the log, never leads)", options_.relay ? 1 : 0);
   line("skyshell_nats_term", "gauge", "the lease revision this server leads in (0: following)", term_.load());
   line("skyshell_nats_applied_sequence", "gauge", "the last NATS log sequence folded into the weather",
        applied_.load());
@@ -391,6 +406,11 @@ std::string NatsWeather::metrics() const {
   line("skyshell_nats_entries_dropped_total", "counter", "log entries dropped as malformed", dropped_.load());
   line("skyshell_nats_fenced_total", "counter", "appends refused by JetStream for a stale last sequence",
        fenced_.load());
+  // A 64-bit hash does not fit a Prometheus value (a double): it is the
+  // label of an info metric, compared as text.
+  m += fmt::format("# HELP skyshell_state_hash_info the weather's state hash (FNV-1a of the canonical state "
+                   "without the clock's position)\n# TYPE skyshell_state_hash_info gauge\nskyshell_state_hash_info{{hash=\"{:016x}\"}} 1\n",
+                   server_.weather().stateHash());
   return m;
 }
 

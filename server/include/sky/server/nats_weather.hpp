@@ -17,8 +17,10 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 
 #include <boost/asio/steady_timer.hpp>
 
@@ -41,6 +43,10 @@ inline constexpr std::uint64_t kReplayEntries = 256;
 struct NatsWeatherOptions {
   NatsLogOptions log;
   std::string serverId;  // names this server in the lease and its entries
+  // A relay (skyshell-relay): follows the log and serves its weather but
+  // never takes part in the election, so it never leads and refuses every
+  // change. A standby server is the same without this.
+  bool relay = false;
   std::shared_ptr<spdlog::logger> logger;  // null: log nothing
 };
 
@@ -58,7 +64,9 @@ class NatsWeather {
   NatsWeather& operator=(const NatsWeather&) = delete;
 
   // Begins taking part in the election, with this server's HTTP API address
-  // ("http://host:port", or empty) for the followers' refusals.
+  // ("http://host:port", or empty) for the followers' refusals. A relay
+  // only starts watching the log (a stalled subscription is followed anew)
+  // and who leads (named in its refusals).
   void elect(std::string apiUrl);
   // Leaves the election, releasing the lease when held (a follower takes
   // over at its next poll instead of after the lease's time to live), and
@@ -67,7 +75,9 @@ class NatsWeather {
 
   bool leading() const { return leading_.load(); }
   // Prometheus text: the role, the term, the applied sequence, entries
-  // dropped as malformed, fenced appends.
+  // dropped as malformed, fenced appends, and the weather's state hash
+  // (LiveWeather::stateHash, equal on every server and relay that folded
+  // the same entry). Call on the io thread.
   std::string metrics() const;
 
  private:
@@ -84,6 +94,13 @@ class NatsWeather {
   void claim(std::uint64_t term, int attempt);
   void stepDown(const std::string& why);
   void electionLoop();
+  // The election thread's: takes the lease when free and starts the claim
+  // on the io thread; the lease's revision, or 0 when another holds it.
+  std::uint64_t tryTakeLease();
+  // The election thread's, while not holding the lease: follows the log
+  // anew when its subscription stalled (`lagging`: since when, at which
+  // applied sequence), and reads who leads.
+  void watchLog(std::optional<std::pair<std::chrono::steady_clock::time_point, std::uint64_t>>& lagging);
   std::string refusal() const;
   std::string leaseValue() const;
 
