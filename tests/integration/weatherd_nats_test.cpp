@@ -20,99 +20,13 @@
 
 #include "child_process.hpp"
 #include "nats_cluster.hpp"
+#include "nats_weatherd.hpp"
 #include "sky/server/nats_entry.hpp"
 #include "sky/server/nats_log.hpp"
 #include "sky/sim/http_client.hpp"
 
 namespace sky::test {
 namespace {
-
-using namespace std::chrono_literals;
-using Clock = std::chrono::steady_clock;
-
-constexpr const char* kToken = "s3cret-nats-token";
-// The servers' lease: short, so that a failover fits a test; the default
-// (3 s) is what docs/weather-server-scaling.md measures.
-constexpr const char* kLeaseMs = "2000";
-// Time allowed for a three-node cluster to start and elect JetStream's meta
-// leader, and for a first server to take the lead (measured: 2-4 s).
-constexpr auto kFirstLeaderWait = 25s;
-
-std::string layerChange(int id, double coverage) {
-  return R"({"author": "nats-test", "changes": [{"op": "set_layer", "ramp_s": 0, "layer": {"id": )" +
-         std::to_string(id) + R"(, "type": "stratus", "base_m": 400, "thickness_m": 300, "transition_band_m": 50,
-         "coverage": )" + std::to_string(coverage) +
-         R"(, "density": 0.7, "wind": {"speed_mps": 5, "from_deg": 200, "vertical_mps": 0}}}]})";
-}
-
-// One skyshell-weatherd with --nats, on ephemeral ports.
-struct NatsWeatherd {
-  std::filesystem::path dir;
-  std::optional<PausableProcess> process;
-  unsigned httpPort = 0;
-
-  // natsArgs: --nats URLS and its options, or other options of a server
-  // without NATS (e.g. --db FILE).
-  NatsWeatherd(const std::filesystem::path& root, const std::string& name, const std::string& natsUrls,
-               std::vector<std::string> more = {"--nats-lease-ms", kLeaseMs}) {
-    dir = root / name;
-    std::filesystem::create_directories(dir);
-    std::ofstream(dir / "token") << kToken << "\n";
-    std::vector<std::string> args{SKY_WEATHERD, "--scenario", SKY_SCENARIO_CLOUDY, "--port", "0", "--http-port", "0",
-                                  "--http-port-file", (dir / "http.port").string(), "--token-file",
-                                  (dir / "token").string(), "--heartbeat-ms", "200"};
-    if (!natsUrls.empty()) args.insert(args.end(), {"--nats", natsUrls});
-    args.insert(args.end(), more.begin(), more.end());
-    process.emplace(args, (dir / "weatherd.log").string());
-    httpPort = waitForPortFile((dir / "http.port").string(), 40s);
-  }
-
-  std::optional<sim::HttpResponse> request(const std::string& method, const std::string& target,
-                                           const std::string& body = "") const {
-    sim::HttpRequest r;
-    r.method = method;
-    r.port = static_cast<unsigned short>(httpPort);
-    r.target = target;
-    r.body = body;
-    r.bearerToken = kToken;
-    r.timeout = 10s;
-    auto response = sim::httpRequest(r);
-    if (!response) return std::nullopt;
-    return *response;
-  }
-  // A gauge or counter of /metrics, or -1 when unreadable.
-  double metric(const std::string& name) const {
-    auto r = request("GET", "/metrics");
-    if (!r || r->status != 200) return -1;
-    std::istringstream in(r->body);
-    for (std::string line; std::getline(in, line);)
-      if (line.rfind(name + " ", 0) == 0) return std::stod(line.substr(name.size() + 1));
-    return -1;
-  }
-  bool leads() const { return metric("skyshell_nats_leader") == 1; }
-  bool hasLayer(int id) const {
-    auto r = request("GET", "/api/state");
-    if (!r || r->status != 200) return false;
-    const auto j = nlohmann::json::parse(r->body, nullptr, false);
-    if (!j.is_object() || !j.contains("layers")) return false;
-    for (const auto& l : j["layers"])
-      if (l.value("id", -1) == id) return true;
-    return false;
-  }
-  std::string log() const { return process->log(); }
-};
-
-template <class F>
-bool waitUntil(std::chrono::milliseconds timeout, F&& f) {
-  const auto deadline = Clock::now() + timeout;
-  while (Clock::now() < deadline) {
-    if (f()) return true;
-    std::this_thread::sleep_for(50ms);
-  }
-  return f();
-}
-
-double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 class WeatherdNats : public ::testing::Test {
  protected:
