@@ -336,6 +336,7 @@ int main(int argc, char** argv) {
     hooks.rejections = &s.rejections();
     hooks.triggerLightning = [&s](const sky::server::FlashRequest& r) { return s.triggerLightning(r); };
     hooks.flashes = [&s](std::size_t limit) { return s.recentFlashes(limit); };
+    if (nats) hooks.cluster = [&nats] { return nats->cluster(); };
     http.gribDecoder = decoder;
     http.gribDir = gribDir;
     auto created = sky::server::HttpApi::create(s.io(), http, s.weather(), std::move(hooks));
@@ -382,7 +383,8 @@ int main(int argc, char** argv) {
   if (nats) {
     const std::string apiHost = http.listenAddress.find(':') != std::string::npos ? "[" + http.listenAddress + "]"
                                                                                   : http.listenAddress;
-    nats->elect(api ? "http://" + apiHost + ":" + std::to_string(api->port()) : std::string());
+    nats->elect(api ? "http://" + apiHost + ":" + std::to_string(api->port()) : std::string(),
+                host + ":" + std::to_string(s.port()));
   }
   (*server)->run();
   return EXIT_SUCCESS;

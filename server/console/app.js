@@ -4,6 +4,7 @@
 // operator console").
 import { LiveLink, postChanges, request, session } from "./api.js";
 import { ClockPanel } from "./clock.js";
+import { ClusterPanel } from "./cluster.js";
 import { layerIds } from "./coverage.js";
 import { $, $$, note, showErrors } from "./dom.js";
 import { LayerPanel } from "./layers.js";
@@ -380,3 +381,4 @@ updateEditable();
 renderRenderers($("#renderers"), []);
 log.render();
 link.start();
+new ClusterPanel($("#cluster"), request).start();

@@ -56,7 +56,8 @@ void addOptions(CLI::App& app, RelayOptions& o) {
       ->capture_default_str();
   app.add_option("--http-listen", o.httpListen, "Address of the read-only HTTP endpoint")->capture_default_str();
   app.add_option("--http-port", o.httpPort,
-                 "Port of the read-only HTTP endpoint (/healthz, /metrics, GET /api/state, /api/renderers; "
+                 "Port of the read-only HTTP endpoint (/healthz, /metrics, GET /api/state, /api/renderers, "
+                 "/api/cluster; "
                  "0 picks a free one; default: none)")
       ->check(CLI::Range(0, 65535));
   app.add_option("--http-port-file", o.httpPortFile, "Write the HTTP port here once listening");
@@ -92,6 +93,7 @@ sky::Result<std::unique_ptr<sky::server::HttpApi>> startHttp(sky::server::Server
   hooks.extraMetrics = [&s, &nats] { return s.streamMetrics() + nats.metrics(); };
   hooks.renderers = [&s] { return sky::server::renderersJson(s.renderers()); };
   hooks.rejections = &s.rejections();
+  hooks.cluster = [&nats] { return nats.cluster(); };
   return sky::server::HttpApi::create(s.io(), std::move(http), s.weather(), std::move(hooks));
 }
 
@@ -166,7 +168,8 @@ int main(int argc, char** argv) {
       }
     }
   }
-  nats->elect(api ? "http://" + hostForUrl(o.httpListen) + ":" + std::to_string(api->port()) : std::string());
+  nats->elect(api ? "http://" + hostForUrl(o.httpListen) + ":" + std::to_string(api->port()) : std::string(),
+              host + ":" + std::to_string(s.port()));
   s.run();
   return EXIT_SUCCESS;
 }

@@ -54,6 +54,11 @@ std::optional<HttpReply> HttpApi::serve(Endpoint endpoint, const ApiRequest& r) 
       if (!q) return error(400, q.error().detail);
       return json(windJson(weather_, *q));
     }
+    case Endpoint::Cluster:
+      // 200 either way: the console asks every server, and a 404 would be
+      // an error in every page's log on a server alone.
+      if (!hooks_.cluster) return json({{"nats", false}, {"members", nlohmann::json::array()}});
+      return json(hooks_.cluster());
     case Endpoint::Radar: {
       auto q = parseRadarQuery(r.query);
       if (!q) return error(400, q.error().detail);

@@ -26,6 +26,7 @@ constexpr std::array kRoutes = {
     Route{"/api/conformance", Endpoint::Conformance, kGet, 0, TokenRule::None},
     Route{"/api/wind", Endpoint::Wind, kGet, 0, TokenRule::None},
     Route{"/api/radar", Endpoint::Radar, kGet, 0, TokenRule::None},
+    Route{"/api/cluster", Endpoint::Cluster, kGet, 0, TokenRule::None},
     // GET: the change log and recent flashes; POST: ask for a flash (token).
     Route{"/api/events", Endpoint::Events, kGet | kPost, kMaxBody_bytes, TokenRule::WhenPosting},
     Route{"/api/changes", Endpoint::Changes, kPost, kMaxBody_bytes, TokenRule::Always},

@@ -84,6 +84,7 @@ struct NatsLog::Handles {
   // context, then the connection.
   ConnectionPtr connection;
   JsPtr js;
+  KvPtr registry;  // the cluster's registry bucket
   std::shared_ptr<FollowState> follow;
   SubscriptionPtr subscription;
 
@@ -147,23 +148,25 @@ Result<int> ensureStream(jsCtx* js, jsStreamConfig& config) {
   return static_cast<int>(info->Config->Replicas);
 }
 
-Result<int> ensureBucket(jsCtx* js, const NatsLogOptions& o, int replicas) {
+// Opens a KV bucket, making it when missing: one value per key (no
+// history), each expiring `ttl` after it was put.
+Result<KvPtr> ensureBucket(jsCtx* js, const std::string& bucket, std::chrono::milliseconds ttl, int replicas) {
   kvStore* raw = nullptr;
-  natsStatus s = js_KeyValue(&raw, js, o.leaseBucket.c_str());
+  natsStatus s = js_KeyValue(&raw, js, bucket.c_str());
   KvPtr kv(raw);
-  if (s == NATS_OK) return replicas;
+  if (s == NATS_OK) return kv;
   kvConfig config;
   kvConfig_Init(&config);
-  config.Bucket = o.leaseBucket.c_str();
+  config.Bucket = bucket.c_str();
   config.History = 1;
-  config.TTL = std::chrono::nanoseconds(o.leaseTtl).count();  // nats.c takes it in ns, as JetStream does
+  config.TTL = std::chrono::nanoseconds(ttl).count();  // nats.c takes it in ns, as JetStream does
   config.StorageType = js_FileStorage;
   config.Replicas = replicas;
   raw = nullptr;
   s = js_CreateKeyValue(&raw, js, &config);
   kv.reset(raw);
-  if (s != NATS_OK) return tl::unexpected(natsError("lease bucket " + o.leaseBucket + " create", s));
-  return replicas;
+  if (s != NATS_OK) return tl::unexpected(natsError("KV bucket " + bucket + " create", s));
+  return kv;
 }
 
 }  // namespace
@@ -210,14 +213,20 @@ Result<std::unique_ptr<NatsLog>> NatsLog::connect(const NatsLogOptions& options)
   for (;;) {
     jsStreamConfig attempt = config;
     auto replicas = ensureStream(h->js.get(), attempt);
-    if (replicas) replicas = ensureBucket(h->js.get(), options, *replicas);
+    Result<KvPtr> registry = tl::unexpected(replicas ? Error{} : replicas.error());
     if (replicas) {
+      auto lease = ensureBucket(h->js.get(), options.leaseBucket, options.leaseTtl, *replicas);
+      registry = lease ? ensureBucket(h->js.get(), options.registryBucket, options.registryTtl, *replicas)
+                       : Result<KvPtr>(tl::unexpected(lease.error()));
+    }
+    if (registry) {
       h->replicas = *replicas;
+      h->registry = std::move(*registry);
       break;
     }
     if (std::chrono::steady_clock::now() >= deadline)
       return fail(ErrorCode::Timeout, "JetStream not ready in " + std::to_string(options.readyWait.count()) +
-                                          " ms: " + replicas.error().detail);
+                                          " ms: " + registry.error().detail);
     std::this_thread::sleep_for(kReadyRetry);
   }
   return std::unique_ptr<NatsLog>(new NatsLog(std::move(h)));
@@ -407,6 +416,48 @@ Result<void> NatsLog::releaseLease(std::uint64_t revision) {
                               h_->options.requestWait, "DEL");
   if (!del) return tl::unexpected(del.error());
   return {};
+}
+
+namespace {
+
+// A KV key holds only [-/_=.a-zA-Z0-9] and neither starts nor ends with a
+// dot; ids hold '@' and ':' (skyshell-weatherd@host:pid).
+std::string memberKey(std::string_view id) {
+  std::string key;
+  for (char c : id) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' ||
+                    c == '_' || c == '=' || c == '/';
+    key += ok ? c : '_';
+  }
+  return key.empty() ? "_" : key;
+}
+
+}  // namespace
+
+Result<void> NatsLog::putMember(std::string_view id, std::string_view value) {
+  std::uint64_t revision = 0;
+  const std::string key = memberKey(id);
+  if (natsStatus s = kvStore_Put(&revision, h_->registry.get(), key.c_str(), value.data(), static_cast<int>(value.size()));
+      s != NATS_OK)
+    return tl::unexpected(natsError("registry put " + key, s));
+  return {};
+}
+
+Result<std::vector<std::string>> NatsLog::members(std::size_t max) {
+  kvKeysList keys{};
+  natsStatus s = kvStore_Keys(&keys, h_->registry.get(), nullptr);
+  if (s == NATS_NOT_FOUND) return std::vector<std::string>{};  // no key yet
+  if (s != NATS_OK) return tl::unexpected(natsError("registry keys", s));
+  std::vector<std::string> values;
+  for (int i = 0; i < keys.Count && values.size() < max; ++i) {
+    kvEntry* raw = nullptr;
+    if (kvStore_Get(&raw, h_->registry.get(), keys.Keys[i]) != NATS_OK) continue;  // expired meanwhile
+    const Owned<kvEntry, kvEntry_Destroy> entry(raw);
+    const auto* data = static_cast<const char*>(kvEntry_Value(entry.get()));
+    if (data) values.emplace_back(data, static_cast<std::size_t>(kvEntry_ValueLen(entry.get())));
+  }
+  kvKeysList_Destroy(&keys);
+  return values;
 }
 
 }  // namespace sky::server

@@ -193,12 +193,15 @@ Result<void> NatsWeather::commit(const nlohmann::json& state, const ChangeEvent&
   return {};
 }
 
-void NatsWeather::elect(std::string apiUrl) {
+void NatsWeather::elect(std::string apiUrl, std::string streamAddress) {
   {
     std::lock_guard lock(mutex_);
     apiUrl_ = std::move(apiUrl);
+    streamAddress_ = std::move(streamAddress);
   }
   election_ = std::thread([this] { electionLoop(); });
+  registry_ = std::make_unique<ClusterRegistry>(*natsLog_, server_.io(), [this] { return describeSelf(); }, log_);
+  registry_->start();
 }
 
 void NatsWeather::electionLoop() {
@@ -368,6 +371,7 @@ void NatsWeather::close() {
   }
   wake_.notify_all();
   if (election_.joinable()) election_.join();
+  if (registry_) registry_->stop();
   natsLog_->stopFollowing();
 }
 
@@ -388,6 +392,35 @@ std::string NatsWeather::refusal() const {
 std::string NatsWeather::leaseValue() const {
   std::lock_guard lock(mutex_);
   return nlohmann::json{{"id", options_.serverId}, {"api", apiUrl_}}.dump();
+}
+
+ClusterMember NatsWeather::describeSelf() const {
+  ClusterMember m;
+  m.id = options_.serverId;
+  m.role = options_.relay ? ClusterMember::Role::Relay
+           : leading_     ? ClusterMember::Role::Leader
+                          : ClusterMember::Role::Follower;
+  {
+    std::lock_guard lock(mutex_);
+    m.stream = streamAddress_;
+    m.api = apiUrl_;
+  }
+  m.subscribers = server_.subscribers();
+  m.appliedSequence = applied_;
+  m.term = term_;
+  m.stateHash = fmt::format("{:016x}", server_.weather().stateHash());
+  m.updated_unixMs =
+      std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  return m;
+}
+
+nlohmann::json NatsWeather::cluster() const {
+  nlohmann::json j = registry_ ? registry_->view()
+                               : nlohmann::json{{"members", nlohmann::json::array()}, {"read_age_ms", nullptr},
+                                                {"malformed_records", 0}};
+  j["nats"] = true;
+  j["self"] = options_.serverId;
+  return j;
 }
 
 std::string NatsWeather::metrics() const {

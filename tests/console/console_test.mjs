@@ -432,9 +432,27 @@ const cases = {
       // What the page made of the click (a refusal, still applying, nothing).
       throw new Error(`${e.message}; the clock card's note: "${await a.page.textContent("#clock .note")}"`);
     }
-    // Another tab session (a new context) starts without it.
-    const b = await openConsole(browser, w, { allowed, name: "B" });
+    // A server alone has no cluster panel.
+    assert(await a.page.isHidden("#cluster"), "no cluster panel without --nats");
+    // Another tab session (a new context) starts without it. Its GET
+    // /api/cluster answers a fixture: a leader, a follower and two relays,
+    // one of them behind (another state hash).
+    const now = Date.now();
+    const member = (id, role, subscribers, hash) => ({ id, role, stream: `10.0.0.${subscribers}:7700`, api: "",
+      subscribers, applied_sequence: 42, term: role === "leader" ? 7 : 0, state_hash: hash, updated_unix_ms: now });
+    const cluster = { nats: true, self: "weatherd-a", read_age_ms: 300, malformed_records: 0, members: [
+      member("weatherd-a", "leader", 0, "00000000000000aa"), member("weatherd-b", "follower", 0, "00000000000000aa"),
+      member("relay-site-1", "relay", 12, "00000000000000aa"), member("relay-site-2", "relay", 3, "00000000000000bb")] };
+    const b = await openConsole(browser, w, { allowed, name: "B", routes: { "/api/cluster": cluster } });
     assert(await b.page.isDisabled("#layer-apply"), "a new session is read-only");
+    await until("the cluster panel", async () => await b.page.isVisible("#cluster"));
+    const rows = await b.page.$$eval("#cluster tbody tr", (trs) => trs.map((tr) =>
+      [...tr.querySelectorAll("td")].map((td) => td.textContent)));
+    assert(rows.length === 4, `4 members, got ${JSON.stringify(rows)}`);
+    assert(rows[0][0] === "leader (this)" && rows[2][3] === "12" && rows[2][5] === "as leader" && rows[3][5] === "differs",
+      `the cluster rows: ${JSON.stringify(rows)}`);
+    const note = await b.page.textContent("#cluster .note");
+    assert(/2 server\(s\), 2 relay\(s\) with 15 renderer\(s\)/.test(note), `the cluster note: ${note}`);
     noProblems(a.problems, b.problems);
   },
 

@@ -204,9 +204,14 @@ export function watch(page, name, allowed = []) {
   return problems;
 }
 
+// routes: { "/api/path": body } answered by the browser with that JSON (a
+// fixture, for what this server cannot show, e.g. a NATS cluster).
 export async function openConsole(browser, weatherd, { token = null, hash = "", allowed = [], name = "page",
-  viewport = { width: 1600, height: 1000 } } = {}) {
+  viewport = { width: 1600, height: 1000 }, routes = {} } = {}) {
   const context = await browser.newContext({ viewport });
+  for (const [route, body] of Object.entries(routes))
+    await context.route(`**${route}`, (r) => r.fulfill({ status: 200, contentType: "application/json",
+      body: JSON.stringify(body) }));
   const page = await context.newPage();
   const problems = watch(page, name, allowed);
   await page.goto(`${weatherd.base}/${hash}`);

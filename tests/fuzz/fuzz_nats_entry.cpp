@@ -1,19 +1,39 @@
-// libFuzzer target: entries of the weather's NATS change log as a follower
-// reads them back from JetStream (server/src/nats_entry.cpp), then their state
-// folded into a live weather (LiveWeather::restore), as nats_weather.cpp does.
-// The decoder may refuse (with a reason), never crash, hang or read out of
-// bounds; what it accepts re-encodes to an entry that decodes the same; a
-// state it passes on is restored or refused, never thrown.
+// libFuzzer target: what a server or relay reads from NATS. Entries of the
+// weather's change log as a follower reads them back from JetStream
+// (server/src/nats_entry.cpp), then their state folded into a live weather
+// (LiveWeather::restore), as nats_weather.cpp does; and the same bytes as a
+// record of the cluster's registry bucket (cluster_member.cpp), which any
+// publisher could have put there. One target for both (not one each): the
+// inputs are JSON of the same origin, and each target costs deploy/test its
+// fuzzing time. The decoders may refuse (with a reason), never crash, hang
+// or read out of bounds; what they accept re-encodes to the same; a state
+// passed on is restored or refused, never thrown.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <string_view>
 
+#include "sky/server/cluster_member.hpp"
 #include "sky/server/live_weather.hpp"
 #include "sky/server/nats_entry.hpp"
 
+namespace {
+
+void checkClusterMember(std::string_view bytes) {
+  auto member = sky::server::decodeClusterMember(bytes);
+  if (!member) {
+    if (member.error().detail.empty()) std::abort();
+    return;
+  }
+  auto again = sky::server::decodeClusterMember(sky::server::clusterMemberJson(*member).dump());
+  if (!again || sky::server::clusterMemberJson(*again) != sky::server::clusterMemberJson(*member)) std::abort();
+}
+
+}  // namespace
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);
+  checkClusterMember(bytes);
   auto entry = sky::server::decodeLogEntry(bytes);
   if (!entry) {
     if (entry.error().detail.empty()) std::abort();

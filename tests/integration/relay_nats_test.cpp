@@ -1,6 +1,7 @@
 // skyshell-relay (issue 27) on a real three-node NATS cluster on loopback:
 // a real headless skyshell-render pointed at a relay draws the weather the
-// leading skyshell-weatherd accepts; the relay keeps serving while the
+// leading skyshell-weatherd accepts, and GET /api/cluster lists both with
+// the relay's renderer; the relay keeps serving while the
 // leader is killed (SIGKILL) and the standby takes over, and catches up
 // after it was paused (SIGSTOP) while changes were made, to the same state
 // hash as every server.
@@ -147,6 +148,43 @@ TEST_F(RelayNats, ARendererOnARelayDrawsTheChangesTheLeaderAccepts) {
   EXPECT_TRUE(relay_->hasLayer(7));
   EXPECT_EQ(relay_->stateHash(), a_->stateHash());
   EXPECT_FALSE(relay_->hasLayer(8));
+
+  // GET /api/cluster, on the server and on the relay: the leader and the
+  // relay with its renderer, from the registry (puts every second).
+  const auto listed = Clock::now();
+  auto clusterOf = [](const HttpPeer& p) {
+    const auto r = p.request("GET", "/api/cluster");
+    return r && r->status == 200 ? nlohmann::json::parse(r->body, nullptr, false) : nlohmann::json();
+  };
+  auto member = [](const nlohmann::json& cluster, const std::string& role) {
+    if (cluster.is_object() && cluster.contains("members") && cluster["members"].is_array())
+      for (const auto& m : cluster["members"])
+        if (m.value("role", "") == role) return m;
+    return nlohmann::json();
+  };
+  const std::string relayStream = "127.0.0.1:" + std::to_string(relay_->streamPort);
+  ASSERT_TRUE(waitUntil(10s, [&] {
+    const auto c = clusterOf(*a_);
+    return member(c, "leader").value("api", "") == "http://127.0.0.1:" + std::to_string(a_->httpPort) &&
+           member(c, "relay").value("stream", "") == relayStream &&
+           member(c, "relay").value("subscribers", 0) == 1 && c["members"].size() == 2;
+  })) << clusterOf(*a_).dump(2);
+  std::printf("GET /api/cluster lists the leader and the relay with its renderer %.2f s after asked\n",
+              secondsSince(listed));
+  const auto onRelay = clusterOf(*relay_);
+  EXPECT_EQ(member(onRelay, "relay").value("stream", ""), relayStream) << onRelay.dump(2);
+  EXPECT_EQ(member(onRelay, "relay").value("state_hash", ""), relay_->stateHash()) << onRelay.dump(2);
+  EXPECT_EQ(onRelay.value("self", ""), member(onRelay, "relay").value("id", "-"));
+
+  // A record another publisher put in the registry is left out and counted.
+  server::NatsLogOptions o;
+  o.urls = {cluster_->url(0)};
+  auto log = server::NatsLog::connect(o);
+  ASSERT_TRUE(log) << describe(log.error());
+  ASSERT_TRUE((*log)->putMember("intruder", "{\"id\": \"x\", \"role\": \"king\"}"));
+  EXPECT_TRUE(waitUntil(5s, [&] { return clusterOf(*a_).value("malformed_records", 0) == 1; }))
+      << clusterOf(*a_).dump(2);
+  EXPECT_EQ(clusterOf(*a_)["members"].size(), 2u);
 }
 
 TEST_F(RelayNats, TheRelayServesThroughAFailoverAndCatchesUpAfterAPause) {

@@ -110,6 +110,9 @@ struct HttpApiHooks {
   // flashes for GET /api/events. Without them the API has no lightning.
   std::function<weather::LightningFlash(const FlashRequest&)> triggerLightning;
   std::function<std::vector<weather::LightningFlash>(std::size_t)> flashes;
+  // GET /api/cluster: the NATS cluster's members (NatsWeather::cluster).
+  // Without it (no --nats) the route answers {"nats": false, "members": []}.
+  std::function<nlohmann::json()> cluster;
 };
 
 class HttpApi {

@@ -23,6 +23,7 @@ enum class Endpoint {
   Conformance,
   Wind,  // GET /api/wind (wind_api.hpp)
   Radar,  // GET /api/radar (radar_api.hpp)
+  Cluster,  // GET /api/cluster: the NATS cluster's registry (cluster_registry.hpp)
   Events,
   Changes,
   Scenario,

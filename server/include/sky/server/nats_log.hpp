@@ -2,8 +2,8 @@
 // one stream with one subject, replicated on three servers when the cluster
 // has them, appended to only at an expected last sequence (so a writer that
 // missed an entry is refused), read back by sequence or followed in order;
-// and one key in a KV bucket whose values expire, the lease of the leading
-// server. A thin owner of the nats.c handles (src/nats_handles.hpp): no
+// one key in a KV bucket whose values expire, the lease of the leading
+// server; and a second such bucket, the registry of the cluster's members. A thin owner of the nats.c handles (src/nats_handles.hpp): no
 // policy here, that is nats_weather.hpp's.
 #pragma once
 
@@ -27,6 +27,10 @@ struct NatsLogOptions {
   std::string leaseBucket = "sky_weather_leader";
   std::string leaseKey = "leader";
   std::chrono::milliseconds leaseTtl{3000};  // a lease not renewed for this long is gone
+  // The cluster's registry (cluster_registry.hpp): a member not put again
+  // for this long is gone from it. Set by the process that makes the bucket.
+  std::string registryBucket = "sky_weather_members";
+  std::chrono::milliseconds registryTtl{5000};
   int replicas = 3;                           // the stream's and the bucket's; 1 on a single server
   std::uint64_t maxEntries = 10000;           // the stream keeps the newest this many
   // How long a publish, a read or a lease operation waits for its answer.
@@ -90,6 +94,13 @@ class NatsLog {
   };
   Result<std::optional<Lease>> readLease();
   Result<void> releaseLease(std::uint64_t revision);
+
+  // The registry: puts a member's record under a key made from its id
+  // (characters a KV key does not allow become '_'), and reads every
+  // record there (at most `max`; keys that expire meanwhile are left out).
+  // Errors: Io, Timeout.
+  Result<void> putMember(std::string_view id, std::string_view value);
+  Result<std::vector<std::string>> members(std::size_t max);
 
  private:
   struct Handles;

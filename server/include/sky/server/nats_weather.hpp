@@ -25,6 +25,7 @@
 #include <boost/asio/steady_timer.hpp>
 
 #include "sky/core/result.hpp"
+#include "sky/server/cluster_registry.hpp"
 #include "sky/server/nats_entry.hpp"
 #include "sky/server/nats_log.hpp"
 
@@ -66,14 +67,20 @@ class NatsWeather {
   // Begins taking part in the election, with this server's HTTP API address
   // ("http://host:port", or empty) for the followers' refusals. A relay
   // only starts watching the log (a stalled subscription is followed anew)
-  // and who leads (named in its refusals).
-  void elect(std::string apiUrl);
+  // and who leads (named in its refusals). Either joins the cluster's
+  // registry with both addresses (streamAddress: "host:port" renderers
+  // connect to). Call before the server runs.
+  void elect(std::string apiUrl, std::string streamAddress);
   // Leaves the election, releasing the lease when held (a follower takes
   // over at its next poll instead of after the lease's time to live), and
   // stops following. Call on the server's io thread, at shutdown.
   void close();
 
   bool leading() const { return leading_.load(); }
+  // GET /api/cluster: every member of the registry as last read
+  // (ClusterRegistry::view), this member's id as "self", "nats": true.
+  // Any thread.
+  nlohmann::json cluster() const;
   // Prometheus text: the role, the term, the applied sequence, entries
   // dropped as malformed, fenced appends, and the weather's state hash
   // (LiveWeather::stateHash, equal on every server and relay that folded
@@ -103,11 +110,14 @@ class NatsWeather {
   void watchLog(std::optional<std::pair<std::chrono::steady_clock::time_point, std::uint64_t>>& lagging);
   std::string refusal() const;
   std::string leaseValue() const;
+  // This server's record for the registry; on the io thread.
+  ClusterMember describeSelf() const;
 
   Server& server_;
   NatsWeatherOptions options_;
   std::shared_ptr<spdlog::logger> log_;
   std::unique_ptr<NatsLog> natsLog_;
+  std::unique_ptr<ClusterRegistry> registry_;  // after natsLog_, which it uses; made by elect()
   boost::asio::steady_timer claimRetry_;
 
   // The io thread's: the last stream sequence folded into the weather (by
@@ -124,7 +134,7 @@ class NatsWeather {
   std::condition_variable wake_;
   bool stopping_ = false;
   bool leaseLost_ = false;  // set by stepDown: the election thread stops renewing
-  std::string apiUrl_;
+  std::string apiUrl_, streamAddress_;
   std::string leaderId_, leaderApi_;  // who leads, as last seen
   std::atomic<std::int64_t> leaseRenewedAt_ns_{0};  // steady clock of the last renewal
   std::atomic<std::uint64_t> dropped_{0}, fenced_{0}, appended_{0}, followed_{0};
