@@ -57,6 +57,9 @@ class ChildProcess {
   ChildProcess& operator=(const ChildProcess&) = delete;
   ~ChildProcess() { stop(); }
 
+  // The process id (for /proc: sky_weatherd_relay_bench reads its CPU time).
+  pid_t pid() const { return pid_; }
+
   // Waits for the process to exit by itself; nullopt on timeout.
   std::optional<int> wait(std::chrono::milliseconds timeout) {
     if (exitCode_) return exitCode_;
