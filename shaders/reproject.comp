@@ -78,6 +78,9 @@ vec3 gForward, gRight, gDown;              // this camera
 vec3 gPrevForward, gPrevRight, gPrevDown;  // the previous camera
 vec3 gPrevPosition;
 float gRadius;
+float gGroundC;      // the ground sphere's constant c (core_common.glsl's rayMeetsSphere)
+bool gHorizonSides;  // TemporalSettings::horizonSides: take and blend only pixels on the pixel's side of the horizon
+bool gPixelGround;   // whether this invocation's pixel looks at the ground (set in resolvePixel)
 vec4 gFrustum, gPrevFrustum;  // this frame's and the previous frame's view frusta
 float gRelTolerance, gAbsTolerance, gBandMargin;
 float gAccumulation;  // the history's share of a redrawn pixel
@@ -110,6 +113,26 @@ float freshDepthAt(ivec2 texel) { return imageLoad(freshDepthImage, texel).x; }
 vec4 historyAtPixel(ivec2 c) { return imageLoad(historyImage, c); }
 float historyDepthAtPixel(ivec2 c) { return imageLoad(historyDepthImage, c).x; }
 
+// Ground and sky both have no cloud depth (0), so the depth test alone lets
+// a pixel take history or blend drawn pixels from across the horizon, and
+// each frame's resampling then smears the one into the other along it (the
+// band of streaks on a banked horizon, docs/motion.md). With
+// gHorizonSides a pixel takes only what lies on its own side: a history
+// pixel's side from the previous camera's ray through it, a drawn pixel's
+// from this camera's; the upscale pass sorts its taps the same way.
+bool historySideAgrees(ivec2 c) {
+  if (!gHorizonSides) return true;
+  vec2 s = frustumPoint(gPrevFrustum, float(c.x) + 0.5, float(c.y) + 0.5, gRaster.x, gRaster.y);
+  return rayFromMeetsSphere(gPrevPosition, gPrevForward + gPrevRight * s.x - gPrevDown * s.y, gRadius, gGroundC) ==
+         gPixelGround;
+}
+
+bool drawnSideAgrees(ivec2 px) {
+  if (!gHorizonSides) return true;
+  vec2 s = frustumPoint(gFrustum, float(px.x) + 0.5, float(px.y) + 0.5, gRaster.x, gRaster.y);
+  return rayMeetsSphere(gForward + gRight * s.x - gDown * s.y, gRadius, gGroundC) == gPixelGround;
+}
+
 // This frame's drawn pixels interpolated at pixel px (bilinear over the grid
 // of drawn pixels, each block's drawn pixel at b * n + phase); depth from the
 // nearest of them.
@@ -125,6 +148,9 @@ void upscale(ivec2 px, out vec4 colour, out float depth) {
     ivec2 i;
     if (!drawnPixel(b0 + o, i)) continue;
     float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
+    // A drawn pixel across the horizon weighs (almost) nothing: where all
+    // four are across it (a sliver of the horizon), they blend as before.
+    w *= drawnSideAgrees(((b0 + o) << gShift) + ivec2(gPhase)) ? 1.0 : 1e-6;
     colour += w * freshAt(i);
     wsum += w;
     if (w > best) best = w, depth = freshDepthAt(i);
@@ -174,6 +200,7 @@ bool previousPixel(vec3 dir, float d, out vec2 p, out float expected) {
 
 bool insideImage(ivec2 q) { return q.x >= 0 && q.y >= 0 && q.x < int(gSize.x) && q.y < int(gSize.y); }
 
+
 // Catmull-Rom weights of the taps at -1, 0, 1 and 2 for a position t in
 // [0, 1) past tap 0: they sum to 1 and keep a linear ramp, and resampling
 // with them every frame blurs far less than bilinear weights do.
@@ -193,12 +220,17 @@ bool sharpHistoryAt(ivec2 i0, vec2 f, float expected, out vec4 colour, out float
   seenDepth = 0.0;
   vec4 lo = vec4(3.0e38), hi = vec4(-3.0e38);
   float wsum = 0.0, inner = 0.0;
+  // The horizon is a gentle curve at the scale of the 4 x 4 taps: when the
+  // four corner taps lie on the pixel's side, all sixteen do, and only the
+  // taps of a footprint the horizon crosses are tested one by one.
+  bool oneSide = historySideAgrees(i0 - 1) && historySideAgrees(i0 + ivec2(2, -1)) &&
+                 historySideAgrees(i0 + ivec2(-1, 2)) && historySideAgrees(i0 + 2);
   for (int k = 0; k < 16; ++k) {
     ivec2 o = ivec2(k & 3, k >> 2) - 1;
     ivec2 c = i0 + o;
     if (!insideImage(c)) continue;
     float hd = historyDepthAtPixel(c);
-    if (!agree(hd, expected)) continue;
+    if (!agree(hd, expected) || !(oneSide || historySideAgrees(c))) continue;
     vec4 v = historyAtPixel(c);
     float w = wx[o.x + 1] * wy[o.y + 1];
     colour += w * v;
@@ -238,7 +270,7 @@ bool historyAt(vec2 p, float expected, out vec4 colour, out float seenDepth) {
     ivec2 c = i0 + ivec2(round(f));
     if (!insideImage(c)) return false;
     float hd = historyDepthAtPixel(c);
-    if (!agree(hd, expected)) return false;
+    if (!agree(hd, expected) || !historySideAgrees(c)) return false;
     colour = historyAtPixel(c);
     seenDepth = hd;
     return true;
@@ -250,7 +282,7 @@ bool historyAt(vec2 p, float expected, out vec4 colour, out float seenDepth) {
     ivec2 c = i0 + o;
     if (!insideImage(c)) continue;
     float hd = historyDepthAtPixel(c);
-    if (!agree(hd, expected)) continue;
+    if (!agree(hd, expected) || !historySideAgrees(c)) continue;
     float w = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
     colour += w * historyAtPixel(c);
     seenDepth += w * hd;
@@ -365,6 +397,10 @@ bool droppedHere(ivec2 px) {
 // pixels share one history lookup, one clip and one upscale, each taken
 // once for the lanes that need it, where a branch per case ran each twice.
 uint resolvePixel(ivec2 px, out vec4 colour, out float depth) {
+  if (gHorizonSides) {
+    vec2 s = frustumPoint(gFrustum, float(px.x) + 0.5, float(px.y) + 0.5, gRaster.x, gRaster.y);
+    gPixelGround = rayMeetsSphere(gForward + gRight * s.x - gDown * s.y, gRadius, gGroundC);
+  }
   ivec2 drawnTexel;
   bool drawn = drawnHere(px, drawnTexel);
   vec4 fresh = freshAt(drawnTexel);
@@ -425,6 +461,9 @@ void main() {
   gPrevDown = params.prevDown.xyz;
   gPrevPosition = params.prevPosition.xyz;
   gRadius = params.prevPosition.w;
+  gGroundC = params.camForward.w;
+  gHorizonSides = params.camRight.w != 0.0;
+  gPixelGround = false;
   gRelTolerance = params.tolerance.x;
   gAbsTolerance = params.tolerance.y;
   gBandMargin = params.tolerance.z;

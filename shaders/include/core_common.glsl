@@ -105,6 +105,19 @@ bool rayMeetsSphere(real3 v, real r, real c) {
   return v.z < real(0.0) && v.z * v.z * (r * r) >= c * dot(v, v);
 }
 
+// rayMeetsSphere for a ray from o (camera-local, m) instead of the camera:
+// the previous frame's camera, whose rays the reprojection's history was
+// drawn along. The ray's origin from the centre is m = o + (0, 0, r), and
+// it meets the sphere ahead where c' = |m|^2 - R^2 < 0 (inside), or where
+// b = m.v < 0 and b^2 >= c' |v|^2. c' is c + (2 r + o.z) o.z + |o.xy|^2,
+// kept apart from r^2 as c is; with o = 0 this is rayMeetsSphere.
+bool rayFromMeetsSphere(real3 o, real3 v, real r, real c) {
+  real cFrom = c + (real(2.0) * r + o.z) * o.z + o.x * o.x + o.y * o.y;
+  if (cFrom < real(0.0)) return true;
+  real b = dot(o, v) + r * v.z;
+  return b < real(0.0) && b * b >= cFrom * dot(v, v);
+}
+
 // Height of p above the sphere through the camera, m, without forming
 // |p - centre| - r from two Earth-sized numbers: (|q|^2 - r^2) / (|q| + r).
 real heightAboveCameraSphere(real3 p, real r) {

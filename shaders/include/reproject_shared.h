@@ -47,8 +47,10 @@ SKY_REPROJECT_CONST kReprojectLocalSizeY = 2u;
 SKY_REPROJECT_CONST kReprojectMaxLayers = 4u;  // = kMaxLayers of sky_shared.h
 
 struct SkyReproject {
-  vec4 camForward;   // xyz: this frame's camera axes in its local frame (x east, y north, z up)
-  vec4 camRight;     // w: unused
+  vec4 camForward;   // xyz: this frame's camera axes in its local frame (x east, y north, z up);
+                     // w: the ground sphere's c = hGround (2r - hGround) (m^2, SkyFrame::earth.z)
+  vec4 camRight;     // w: 1 when a pixel takes only history and drawn pixels on its side of the
+                     // horizon (TemporalSettings::horizonSides), else 0
   vec4 camDown;      // w: unused
   vec4 prevForward;  // xyz: the previous frame's camera axes, in this frame's local frame
   vec4 prevRight;

@@ -150,6 +150,7 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
       {"history_clip", s.temporal.interleave > 1 ? s.temporal.historyClip : 0.0},
       {"fresh_edges", s.temporal.interleave > 1 && s.temporal.freshEdges},
       {"sharp_history", s.temporal.interleave > 1 && s.temporal.sharpHistory},
+      {"horizon_sides", s.temporal.interleave > 1 && s.temporal.horizonSides},
       {"resolution_divisor", s.resolution.divisor},
       {"resolution", {s.width, s.height}},
       {"vertical_fov_deg", s.verticalFov_deg},

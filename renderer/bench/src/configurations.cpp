@@ -147,6 +147,7 @@ Result<Configuration> customConfiguration(const std::string& spec) {
     else if (key == "acc-motion" && v >= 0 && v <= 1000) c.settings.temporal.accumulationMotion_px = v;
     else if (key == "edges" && (v == 0 || v == 1)) c.settings.temporal.freshEdges = v == 1;
     else if (key == "sharp" && (v == 0 || v == 1)) c.settings.temporal.sharpHistory = v == 1;
+    else if (key == "horizon" && (v == 0 || v == 1)) c.settings.temporal.horizonSides = v == 1;
     else if (key == "region-drop" && (v == 0 || v == 1)) c.settings.temporal.regionDrop = v == 1;
     else
       return fail(ErrorCode::InvalidArgument,
@@ -155,7 +156,7 @@ Result<Configuration> customConfiguration(const std::string& spec) {
                       "interleave 1|2|4, divisor 1|2|4, depth-aware 0|1, blue 0|1, cloud-shadows 0|1, near-precip 0|1, shower-cells 0|1, "
                       "air-table 0|1, "
                       "air-azimuths, air-zeniths, air-slices, budget 0..4 (after base), accumulate 0..0.95, "
-                      "pixel-jitter 0|1, clip 0..4, dense-turn (px, 0 never), acc-motion (px, 0 off), edges 0|1, sharp 0|1, region-drop 0|1, shadow 0..5 (march, column, esm, bsm, fom, deep), shadow-size, "
+                      "pixel-jitter 0|1, clip 0..4, dense-turn (px, 0 never), acc-motion (px, 0 off), edges 0|1, sharp 0|1, horizon 0|1, region-drop 0|1, shadow 0..5 (march, column, esm, bsm, fom, deep), shadow-size, "
                       "shadow-cascades, shadow-extent (m), shadow-steps, shadow-frames)");
   }
   // Accumulation blends redraws with the history: without interleaving

@@ -226,8 +226,8 @@ TemporalPlan TemporalPlanner::plan(const FrameSetup& setup, const FrameInputs& i
   ++frames_;
 
   gpu::SkyReproject& p = plan.params;
-  p.camForward = v4(setup.camForward);
-  p.camRight = v4(setup.camRight);
+  p.camForward = v4(setup.camForward, setup.cGround_m2);
+  p.camRight = v4(setup.camRight, settings_.horizonSides ? 1.0 : 0.0);
   p.camDown = v4(setup.camDown);
   p.frustum = gpu::vec4(setup.frustum);
   p.prevFrustum = p.frustum;

@@ -526,6 +526,51 @@ TEST(CloudCore, TheRootlessGroundTestIsTheSpheresHitAhead) {
   EXPECT_GT(missed, 30000u);
 }
 
+// The same test from another point than the camera (rayFromMeetsSphere: the
+// previous frame's camera, for the reprojection's ground/sky sides) against
+// the quadratic |o + (0, 0, r) + t v|^2 = R^2 solved in double from the
+// sphere's centre: the far root ahead. Origins up to 2 km away in every
+// direction (a frame's motion is metres), from below the ground to 400 km,
+// directions crowded round the origin's own horizon; and from o = 0 it is
+// rayMeetsSphere exactly.
+TEST(CloudCore, TheGroundTestFromAnotherPointIsTheSpheresHitAhead) {
+  Core c;
+  const double Rs = 6371000;
+  std::uint32_t seed = 777u, met = 0, missed = 0;
+  auto uniform = [&seed] {
+    seed = seed * 1664525u + 1013904223u;
+    return double(seed >> 8) / double(1u << 24);
+  };
+  for (const double h : {-50.0, 0.0, 1.0, 800.0, 12000.0, 400000.0}) {
+    const double r = Rs + std::max(h, 0.0), cc = h * (2 * r - h), R = r - h;
+    for (int k = 0; k < 20000; ++k) {
+      const dvec3 o = k % 4 == 0 ? dvec3(0) : dvec3(4000 * uniform() - 2000, 4000 * uniform() - 2000, 200 * uniform() - 100);
+      const dvec3 m = o + dvec3(0, 0, r);
+      const double mLength = glm::length(m);
+      const double horizonMu = mLength > R ? -std::sqrt(mLength * mLength - R * R) / mLength : 0.0;
+      // Directions about the origin's own up, half within 0.01 of its horizon.
+      const dvec3 up = m / mLength;
+      const dvec3 east = glm::normalize(glm::cross(dvec3(0, 1, 0), up)), north = glm::cross(up, east);
+      const double mu = k % 2 == 0 ? 2 * uniform() - 1 : std::clamp(horizonMu + 0.02 * (uniform() - 0.5), -1.0, 1.0);
+      if (std::abs(mu - horizonMu) < 1e-9) continue;
+      const double phi = 6.283185307179586 * uniform(), s = std::sqrt(1 - mu * mu), length = 0.1 + 10 * uniform();
+      const dvec3 v = length * (s * std::cos(phi) * east + s * std::sin(phi) * north + mu * up);
+      // t^2 |v|^2 + 2 t (m.v) + |m|^2 - R^2 = 0: a hit ahead when the larger root is positive.
+      const double a = glm::dot(v, v), b = glm::dot(m, v), q = glm::dot(m, m) - R * R;
+      const double disc = b * b - a * q;
+      const bool expected = disc >= 0 && (-b + std::sqrt(disc)) / a > 0;
+      ASSERT_EQ(c.rayFromMeetsSphere(o, v, r, cc), expected) << "h " << h << " o " << o.x << "," << o.y << "," << o.z
+                                                              << " mu " << mu;
+      if (o == dvec3(0)) {
+        ASSERT_EQ(c.rayFromMeetsSphere(o, v, r, cc), c.rayMeetsSphere(v, r, cc));
+      }
+      (expected ? met : missed) += 1;
+    }
+  }
+  EXPECT_GT(met, 30000u);
+  EXPECT_GT(missed, 30000u);
+}
+
 // The weather map's projection (anchorPlane, shared by the GPU passes and
 // the CPU reference): the gnomonic projection of the anchor sphere onto its
 // tangent plane at the anchor, x = R tan(angle east), whichever way the

@@ -216,6 +216,13 @@ struct TemporalSettings {
   // turn each frame resamples what the last one resampled, and bilinear
   // weights blur it a little more every time.
   bool sharpHistory = false;
+  // Ground and sky have the same cloud depth (none), so the depth test alone
+  // lets a pixel near the horizon take history or blend drawn pixels from
+  // the other side of it, and a banked turn smears the one into the other
+  // (streaks along the horizon). On: a pixel takes only what lies on its own
+  // side, judged by the ground sphere along each pixel's ray (the previous
+  // camera's for the history), as the upscale pass already does.
+  bool horizonSides = true;
   // A change of only the weather's tiles (a region's or a station's
   // coverage ramping) keeps the history; in the cells of the image the
   // changed tiles' volume and shadow may show in (history_drop.hpp) a
