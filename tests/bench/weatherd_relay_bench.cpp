@@ -60,6 +60,7 @@ struct Options {
   std::size_t maxTiles = 4096;
   std::string out = "/tmp/sky_weatherd_relay_bench";
   std::string json;
+  bool regional = false;  // a region over every area (tiles in every snapshot), the storm a moving cell
 };
 
 // One of our processes or nats-server, its CPU read from /proc.
@@ -139,6 +140,27 @@ std::string markerChange(std::size_t i) {
       "wind": {"speed_mps": 10, "from_deg": 250, "vertical_mps": 0}}}]})";
 }
 
+// A region over every subscriber's area, so every snapshot carries tiles
+// (the regional storm of weatherd_bench.cpp).
+std::string everywhereRegion() {
+  return R"({"author": "relay-bench", "changes": [{"op": "set_region", "region": {"id": 1, "center_lat_deg": 46.0,
+      "center_lon_deg": 13.0, "size_x_m": 800000, "size_y_m": 800000, "corner_radius_m": 0, "transition_m": 20000,
+      "drifts_with_wind": false, "layers": [{"id": 1, "type": "cumulus", "base_m": 600, "thickness_m": 800,
+      "transition_band_m": 50, "coverage": 0.9, "density": 0.8,
+      "wind": {"speed_mps": 10, "from_deg": 250, "vertical_mps": 0}}]}}]})";
+}
+
+// The regional change of index i: a storm cell 60 km across moving east
+// 300 m per change, its layer 9 the marker (as weatherd_bench.cpp's).
+std::string stormCellChange(std::size_t i) {
+  return R"({"author": "relay-bench", "changes": [{"op": "set_region", "region": {"id": 9, "center_lat_deg": 46.0,
+      "center_lon_deg": )" + std::to_string(12.0 + 0.004 * double(i)) + R"(, "size_x_m": 60000, "size_y_m": 60000,
+      "corner_radius_m": 30000, "transition_m": 5000, "drifts_with_wind": false, "layers": [{"id": 9,
+      "type": "cumulonimbus", "base_m": )" + std::to_string(kMarkerBase + double(i)) + R"(, "thickness_m": 8000,
+      "transition_band_m": 100, "coverage": 0.9, "density": 0.8,
+      "wind": {"speed_mps": 10, "from_deg": 250, "vertical_mps": 0}}]}}]})";
+}
+
 bool parse(int argc, char** argv, Options& o) {
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
@@ -150,6 +172,7 @@ bool parse(int argc, char** argv, Options& o) {
     else if (k == "--radius-m") o.radius_m = std::stod(v);
     else if (k == "--out") o.out = v;
     else if (k == "--json") o.json = v;
+    else if (k == "--regional") o.regional = v == "1";
     else return false;
   }
   return argc % 2 == 1 && o.relays >= 1 && o.subscribers >= 1 && o.rate > 0;
@@ -189,7 +212,7 @@ Process startOurs(const std::string& name, std::vector<std::string> args, const 
 int main(int argc, char** argv) {
   Options o;
   const char* usage = "usage: sky_weatherd_relay_bench [--relays N] [--subscribers N] [--rate HZ] [--seconds S] "
-                      "[--idle-seconds S] [--radius-m M] [--out DIR] [--json FILE]\n";
+                      "[--idle-seconds S] [--radius-m M] [--regional 0|1] [--out DIR] [--json FILE]\n";
   if (argc == 2 && std::string(argv[1]) == "--help") {
     std::printf("%s", usage);
     return 0;
@@ -239,6 +262,19 @@ int main(int argc, char** argv) {
       }) || leader.child->wait(0ms)) {
     std::fprintf(stderr, "the server did not lead (logs in %s)\n", dir.c_str());
     return 1;
+  }
+  if (o.regional) {
+    sky::sim::HttpRequest post;
+    post.method = "POST";
+    post.port = static_cast<unsigned short>(leaderHttp);
+    post.target = "/api/changes";
+    post.body = everywhereRegion();
+    post.bearerToken = kToken;
+    const auto answer = sky::sim::httpRequest(post);
+    if (!answer || answer->status != 200) {
+      std::fprintf(stderr, "region refused: %s\n", answer ? answer->body.c_str() : "no answer");
+      return 1;
+    }
   }
   for (int r = 0; r < o.relays; ++r)
     procs.push_back(startOurs("relay" + std::to_string(r), {SKY_RELAY, "--nats", url}, dir));
@@ -299,7 +335,7 @@ int main(int argc, char** argv) {
     post.method = "POST";
     post.port = static_cast<unsigned short>(leaderHttp);
     post.target = "/api/changes";
-    post.body = markerChange(i);
+    post.body = o.regional ? stormCellChange(i) : markerChange(i);
     post.bearerToken = kToken;
     const auto sent = Clock::now();
     {
@@ -331,9 +367,9 @@ int main(int argc, char** argv) {
   std::lock_guard lock(shared.mutex);
   const double p50 = percentile(shared.latencies_ms, 50), p99 = percentile(shared.latencies_ms, 99);
   std::printf("relay bench: %d subscribers (%lld served a snapshot) over %d relays, radius %.0f km (level %d), "
-              "%zu changes at %.0f/s to the leader (%zu refused), one-node nats-server with JetStream\n",
+              "%zu changes at %.0f/s to the leader (%zu refused), %s weather, one-node nats-server with JetStream\n",
               o.subscribers, static_cast<long long>(served), o.relays, o.radius_m / 1000, area.tileLevel, changes,
-              o.rate, refused);
+              o.rate, refused, o.regional ? "regional (tiles in every snapshot; a storm cell moves)" : "uniform");
   std::printf("  change-to-delivery latency  p50 %.2f ms  p99 %.2f ms  from sending the change (%llu deliveries, "
               "%llu coalesced of %.0f)\n",
               p50, p99, static_cast<unsigned long long>(shared.deliveries),
@@ -357,7 +393,7 @@ int main(int argc, char** argv) {
       cpu[names[p]] = {{"idle_pct", idlePct[p]}, {"storm_pct", stormPct[p]}};
     cpu["subscribers"] = {{"idle_pct", selfIdlePct}, {"storm_pct", selfStormPct}};
     const nlohmann::json j = {{"relays", o.relays}, {"subscribers", o.subscribers}, {"served", served},
-                              {"rate_hz", o.rate}, {"changes", changes}, {"refused", refused},
+                              {"rate_hz", o.rate}, {"regional", o.regional}, {"changes", changes}, {"refused", refused},
                               {"latency_p50_ms", p50}, {"latency_p99_ms", p99}, {"deliveries", shared.deliveries},
                               {"coalesced", shared.coalesced}, {"ack_p50_ms", percentile(ack_ms, 50)},
                               {"ack_p99_ms", percentile(ack_ms, 99)}, {"cpu", cpu},
