@@ -1,6 +1,13 @@
 // SQLite persistence of the live weather (see weather_store.hpp).
 #include "sky/server/weather_store.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
 #include <sqlite3.h>
 
 namespace sky::server {
@@ -33,8 +40,25 @@ std::string text(sqlite3_stmt* s, int col) {
 
 void WeatherStore::Closer::operator()(sqlite3* db) const { sqlite3_close_v2(db); }
 
-WeatherStore::WeatherStore(std::filesystem::path path, std::unique_ptr<sqlite3, Closer> db)
-    : path_(std::move(path)), db_(std::move(db)) {}
+// An open descriptor of <file>.lock holding an exclusive flock. A separate
+// file, not the database: closing any descriptor of the database file would
+// drop the POSIX locks SQLite holds on it.
+class WeatherStore::OwnerLock {
+ public:
+  explicit OwnerLock(int fd) : fd_(fd) {}
+  ~OwnerLock() { ::close(fd_); }
+  OwnerLock(const OwnerLock&) = delete;
+  OwnerLock& operator=(const OwnerLock&) = delete;
+
+ private:
+  int fd_;
+};
+
+void WeatherStore::OwnerLockDeleter::operator()(OwnerLock* lock) const { delete lock; }
+
+WeatherStore::WeatherStore(std::filesystem::path path, std::unique_ptr<OwnerLock, OwnerLockDeleter> owner,
+                           std::unique_ptr<sqlite3, Closer> db)
+    : path_(std::move(path)), owner_(std::move(owner)), db_(std::move(db)) {}
 WeatherStore::WeatherStore(WeatherStore&&) noexcept = default;
 WeatherStore& WeatherStore::operator=(WeatherStore&&) noexcept = default;
 WeatherStore::~WeatherStore() = default;
@@ -50,6 +74,18 @@ Result<void> WeatherStore::exec(const char* sql) const {
 }
 
 Result<WeatherStore> WeatherStore::open(const std::filesystem::path& path, std::chrono::milliseconds lockWait) {
+  const std::string lockPath = path.string() + ".lock";
+  const int fd = ::open(lockPath.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0600);
+  if (fd < 0) return fail(ErrorCode::Io, lockPath + ": cannot open: " + std::strerror(errno));
+  std::unique_ptr<OwnerLock, OwnerLockDeleter> owner(new OwnerLock(fd));
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    return fail(ErrorCode::Io, path.string() + ": " +
+                                   (err == EWOULDBLOCK ? "another process holds " + lockPath +
+                                                             " (is a second server using this database? one server "
+                                                             "per file)"
+                                                       : lockPath + ": cannot lock: " + std::strerror(err)));
+  }
   sqlite3* raw = nullptr;
   const int rc = sqlite3_open_v2(path.c_str(), &raw, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
   std::unique_ptr<sqlite3, Closer> db(raw);
@@ -59,7 +95,7 @@ Result<WeatherStore> WeatherStore::open(const std::filesystem::path& path, std::
   // for this long, then reported: better a clear error at start than a
   // server that fails every commit later.
   sqlite3_busy_timeout(raw, static_cast<int>(lockWait.count()));
-  WeatherStore store(path, std::move(db));
+  WeatherStore store(path, std::move(owner), std::move(db));
   // Says what went wrong in words an operator acts on: garbage bytes are
   // "not a database" (Malformed), a lock is "locked" (Io).
   auto explain = [&store](const Error& e) {

@@ -73,6 +73,15 @@ TEST(WeatherdLifecycle, ALockedDatabaseExitsWithThreeNamingTheFile) {
   {  // A real database first, made by the server itself.
     ChildProcess first(weatherdArgs(dir, "0"), (dir / "weatherd.0.log").string());
     ASSERT_GT(waitForPortFile((dir / "http.0.port").string(), 20s), 0u) << first.log();
+    // A second server on the same file while the first runs: SQLite would
+    // let both write it (it locks only during a commit); the store's owner
+    // lock refuses the second, which exits 3 saying so.
+    ChildProcess twin(weatherdArgs(dir, "twin"), (dir / "weatherd.twin.log").string());
+    const auto twinCode = twin.wait(15s);
+    ASSERT_TRUE(twinCode) << "a second server on the same database still running:\n" << twin.log();
+    EXPECT_EQ(*twinCode, kExitStorage) << twin.log();
+    EXPECT_NE(twin.log().find((dir / "weather.db").string()), std::string::npos) << twin.log();
+    EXPECT_NE(twin.log().find("second server"), std::string::npos) << twin.log();
     ASSERT_EQ(first.stop(), 0) << first.log();
   }
   sqlite3* other = nullptr;

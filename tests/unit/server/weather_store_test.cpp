@@ -86,5 +86,28 @@ TEST(WeatherStore, NotADatabaseIsAnErrorNamingTheFile) {
   EXPECT_NE(store.error().detail.find(file.string()), std::string::npos) << store.error().detail;
 }
 
+// One store per file: SQLite locks the file only while it commits, so a
+// second server on the same file would open it and both would write it.
+// The second open fails naming the file and the lock, and succeeds once the
+// first store is gone (the kernel's flock goes with the descriptor, as it
+// does when a server dies).
+TEST(WeatherStore, ASecondStoreOnTheSameFileIsRefusedUntilTheFirstCloses) {
+  const fs::path file = freshFile("owned.db");
+  {
+    auto first = WeatherStore::open(file);
+    ASSERT_TRUE(first) << describe(first.error());
+    auto second = WeatherStore::open(file, std::chrono::milliseconds{0});
+    ASSERT_FALSE(second);
+    EXPECT_EQ(second.error().code, ErrorCode::Io);
+    EXPECT_NE(second.error().detail.find(file.string()), std::string::npos) << second.error().detail;
+    EXPECT_NE(second.error().detail.find("second server"), std::string::npos) << second.error().detail;
+    // Another file beside it is another weather.
+    auto other = WeatherStore::open(freshFile("other.db"));
+    EXPECT_TRUE(other) << describe(other.error());
+  }
+  auto again = WeatherStore::open(file);
+  EXPECT_TRUE(again) << describe(again.error());
+}
+
 }  // namespace
 }  // namespace sky::server

@@ -34,10 +34,14 @@ inline constexpr std::size_t kMaxStoredEvents = 10000;
 class WeatherStore {
  public:
   // Opens or creates the file and checks that this process can write it.
-  // Io (cannot open), Malformed (not a database: garbage bytes, a truncated
-  // file), Busy-like Io when another connection holds a lock on it (another
-  // server) for longer than lockWait; Unsupported (a schema version we do not
-  // know). Every error names the file.
+  // One store per file: it holds an exclusive flock on `<file>.lock` for its
+  // life (SQLite locks the file only while a commit runs, so it alone would
+  // let a second server open the file and both write it; the kernel drops
+  // the flock when the process dies, so a crash leaves nothing to clean up).
+  // Io (cannot open; another store holds the lock file), Malformed (not a
+  // database: garbage bytes, a truncated file), Busy-like Io when another
+  // connection holds a lock on it for longer than lockWait; Unsupported (a
+  // schema version we do not know). Every error names the file.
   static Result<WeatherStore> open(const std::filesystem::path& path,
                                    std::chrono::milliseconds lockWait = std::chrono::milliseconds{2000});
   WeatherStore(WeatherStore&&) noexcept;
@@ -72,10 +76,16 @@ class WeatherStore {
   struct Closer {
     void operator()(sqlite3* db) const;
   };
-  WeatherStore(std::filesystem::path path, std::unique_ptr<sqlite3, Closer> db);
+  class OwnerLock;  // the flock on <file>.lock (weather_store.cpp)
+  struct OwnerLockDeleter {
+    void operator()(OwnerLock* lock) const;
+  };
+  WeatherStore(std::filesystem::path path, std::unique_ptr<OwnerLock, OwnerLockDeleter> owner,
+               std::unique_ptr<sqlite3, Closer> db);
   Result<void> exec(const char* sql) const;
 
   std::filesystem::path path_;
+  std::unique_ptr<OwnerLock, OwnerLockDeleter> owner_;  // released after the database is closed
   std::unique_ptr<sqlite3, Closer> db_;
 };
 
