@@ -1,0 +1,53 @@
+# Compile-time savings for the trees deploy/test builds cold (the ASan+UBSan
+# tree with GCC, the clang fuzz tree), applied after every folder has defined
+# its targets, so the folders' CMakeLists.txt stay as they are. Measured with
+# /usr/bin/time on cold builds (user+sys CPU, the commit that added this file
+# has the numbers).
+#
+# Boost.Asio and Boost.Beast separate compilation: header-only, each
+# translation unit that includes them compiles their non-template parts
+# (scheduler, reactor, socket operations, error categories, the HTTP parser,
+# websocket framing) again; here they are compiled once, in sky_asio_beast
+# (third_party/asio_beast/asio_beast.cpp), and every target linking sky::asio
+# gets the two macros. They must be the same for every translation unit of a
+# program that includes Asio or Beast, so they go on sky::asio (the only way
+# our targets get Boost) and nowhere else.
+add_library(sky_asio_beast STATIC ${PROJECT_SOURCE_DIR}/third_party/asio_beast/asio_beast.cpp)
+# sky_settings: the tree's sanitizer and TSan options (BOOST_ASIO_DISABLE_FENCED_BLOCK)
+# must be the same as for the code that calls it.
+target_link_libraries(sky_asio_beast PUBLIC sky_settings Boost::headers Threads::Threads)
+target_compile_definitions(sky_asio_beast PUBLIC
+  BOOST_ASIO_NO_DEPRECATED BOOST_ASIO_SEPARATE_COMPILATION BOOST_BEAST_SEPARATE_COMPILATION)
+target_link_libraries(sky::asio INTERFACE sky_asio_beast)
+
+# Precompiled headers, clang only (the fuzz tree): the standard library and,
+# for the server library, Asio, Beast, nlohmann/json and spdlog, parsed once
+# per target instead of once per file. Third-party and standard headers only:
+# none of them depends on a macro our sources define before an include (those
+# are stb's, GLFW's and our own SKY_* switches, none of them in these lists).
+# With GCC 12 (the ASan and release trees) precompiled headers of these sets
+# did not pay: loading the 100-350 MB .gch costs about what parsing saves.
+set(SKY_PCH_STD <algorithm> <array> <charconv> <chrono> <cmath> <cstddef> <cstdint> <cstdio>
+  <cstring> <functional> <limits> <map> <memory> <optional> <set> <span> <string>
+  <string_view> <utility> <variant> <vector>)
+set(SKY_PCH_SERVER ${SKY_PCH_STD} <atomic> <deque> <filesystem> <fstream> <mutex> <sstream>
+  <thread> <unordered_map> <boost/asio.hpp> <boost/beast/core.hpp> <boost/beast/http.hpp>
+  <boost/beast/websocket.hpp> <nlohmann/json.hpp> <spdlog/spdlog.h>)
+option(SKY_PCH "Precompiled headers for the heavy targets (clang builds)" ON)
+if(SKY_PCH AND CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+  if(TARGET sky_server)
+    target_precompile_headers(sky_server PRIVATE ${SKY_PCH_SERVER})
+  endif()
+  if(TARGET sky_protocol)
+    target_precompile_headers(sky_protocol PRIVATE ${SKY_PCH_STD})
+  endif()
+endif()
+
+# GCC's garbage collector: by default it collects whenever its heap grew by
+# 100 % past 128 MB, which the Asio/Beast units (1-2 GB of allocations each)
+# pay for with several collections (7 % of http_api.cpp's time). Collecting
+# only past 1 GB trades memory for CPU: at most ~2 GB a compiler process,
+# two at a time on the CI machine. Output and diagnostics are unchanged.
+if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+  target_compile_options(sky_settings INTERFACE --param=ggc-min-expand=400 --param=ggc-min-heapsize=1048576)
+endif()
