@@ -13,7 +13,6 @@ namespace sky::server {
 ClusterRegistry::ClusterRegistry(NatsLog& log, boost::asio::io_context& io, std::function<ClusterMember()> describe,
                                  std::shared_ptr<spdlog::logger> logger)
     : log_(log),
-      io_(io),
       describe_(std::move(describe)),
       logger_(logger ? std::move(logger) : std::make_shared<spdlog::logger>("sky_registry")),
       describeTimer_(io) {}

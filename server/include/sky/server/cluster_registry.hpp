@@ -69,7 +69,6 @@ class ClusterRegistry {
   void round();
 
   NatsLog& log_;
-  boost::asio::io_context& io_;
   std::function<ClusterMember()> describe_;
   std::shared_ptr<spdlog::logger> logger_;
   boost::asio::steady_timer describeTimer_;  // the io thread's
