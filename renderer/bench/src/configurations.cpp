@@ -60,16 +60,24 @@ std::vector<Configuration> builtInConfigurations() {
   // The renderer's own resolution scale (realtime has it): high's march
   // with the clouds drawn at 1/2 the width and height, brought to full size
   // by the depth-aware upscale, next to the bench-side bilinear half-res.
-  {
-    Configuration c{"high-half",
-                    "preset high with the clouds drawn at 1/2 the width and height (the renderer's depth-aware upscale)",
-                    1.0,
-                    {}};
-    c.settings.resolution.divisor = 2;
-    all.push_back(c);
+  // Each carries high's settings whole (its sun map included), so it
+  // differs from high only in size.
+  if (const auto high = render::findPreset("high")) {
+    auto sized = [&high](std::string name, std::string description, double scale) {
+      Configuration c{std::move(name), std::move(description), scale, {}};
+      c.settings.march = high->march;
+      c.settings.temporal = high->temporal;
+      c.settings.resolution = high->resolution;
+      return c;
+    };
+    Configuration half = sized(
+        "high-half", "preset high with the clouds drawn at 1/2 the width and height (the renderer's depth-aware upscale)",
+        1.0);
+    half.settings.resolution.divisor = 2;
+    all.push_back(half);
+    all.push_back(sized("half-res", "preset high at 1/2 the width and height, bilinear upscale (bench-side)", 0.5));
+    all.push_back(sized("quarter-res", "preset high at 1/4 the width and height, bilinear upscale (bench-side)", 0.25));
   }
-  all.push_back({"half-res", "preset high at 1/2 the width and height, bilinear upscale (bench-side)", 0.5, {}});
-  all.push_back({"quarter-res", "preset high at 1/4 the width and height, bilinear upscale (bench-side)", 0.25, {}});
   return all;
 }
 

@@ -223,6 +223,30 @@ TEST(Configurations, ReferenceFirstAndUnknownNamesRefused) {
   EXPECT_DOUBLE_EQ(s.verticalFov_deg, 45);
 }
 
+// high at other sizes is high's march (its sun map included), so the bench
+// measures what the size alone costs; these once took the default
+// MarchSettings, which march to the sun instead of reading high's map.
+TEST(Configurations, HighAtOtherSizesKeepsHighsSettings) {
+  auto chosen = selectConfigurations("high,high-half,half-res,quarter-res");
+  ASSERT_TRUE(chosen) << chosen.error().detail;
+  ASSERT_EQ(chosen->size(), 5u);
+  const render::MarchSettings& high = (*chosen)[1].settings.march;
+  ASSERT_EQ(high.sunShadow.method, render::SunShadow::Deep);
+  for (std::size_t i = 2; i < chosen->size(); ++i) {
+    const Configuration& c = (*chosen)[i];
+    SCOPED_TRACE(c.name);
+    EXPECT_EQ(c.settings.march.sunShadow.method, high.sunShadow.method);
+    EXPECT_EQ(c.settings.march.sunShadow.size, high.sunShadow.size);
+    EXPECT_EQ(c.settings.march.sunShadow.buildFrames, high.sunShadow.buildFrames);
+    EXPECT_EQ(c.settings.march.primarySteps, high.primarySteps);
+    EXPECT_DOUBLE_EQ(c.settings.march.minTransmittance, high.minTransmittance);
+    EXPECT_EQ(c.settings.temporal.interleave, (*chosen)[1].settings.temporal.interleave);
+  }
+  EXPECT_EQ((*chosen)[2].settings.resolution.divisor, 2u);
+  EXPECT_DOUBLE_EQ((*chosen)[3].renderScale, 0.5);
+  EXPECT_DOUBLE_EQ((*chosen)[4].renderScale, 0.25);
+}
+
 // The seeds' final settings, with the figures their papers give
 // (Haggstrom 2018 eq. 20 and sec. 3.2.1.3, 4.2.1; Ford 2024 sec. 4.6.2, 5.4).
 TEST(Configurations, TheSeedsFinalSettingsAreBuiltIn) {
