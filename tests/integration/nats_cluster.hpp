@@ -155,6 +155,13 @@ class NatsCluster {
     for (int k = 0; k < kNodes; ++k) s += (k ? "," : "") + url((first + k) % kNodes);
     return s;
   }
+  // Every node's URL, one an element (NatsLogOptions::urls).
+  std::vector<std::string> urlList() const {
+    std::vector<std::string> v;
+    for (int k = 0; k < kNodes; ++k) v.push_back(url(k));
+    return v;
+  }
+  bool accepts(int i) const { return acceptsConnections(clientPorts_[i]); }
   void kill(int i) { nodes_[i]->killNow(); }
   void start(int i) {
     nodes_[i].emplace(std::vector<std::string>{SKY_NATS_SERVER, "-c", (dir_ / ("n" + std::to_string(i) + ".conf")).string()},

@@ -1,12 +1,15 @@
-// skyshell-weatherd --nats and skyshell-relay as child processes for the NATS
-// integration tests (weatherd_nats_test.cpp, relay_nats_test.cpp): started
-// on ephemeral ports, and what the tests read from their HTTP endpoints
-// (/metrics gauges, the state, the state hash).
+// skyshell-weatherd --nats, skyshell-relay and a headless skyshell-render as
+// child processes for the NATS integration tests (weatherd_nats_test.cpp,
+// relay_nats_test.cpp, cluster_fault_test.cpp): started on ephemeral ports,
+// and what the tests read from their HTTP endpoints (/metrics gauges, the
+// state, the state hash) and from a renderer's frames.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -17,6 +20,7 @@
 
 #include "child_process.hpp"
 #include "nats_cluster.hpp"
+#include "sky/core/result.hpp"
 #include "sky/sim/http_client.hpp"
 
 namespace sky::test {
@@ -39,6 +43,20 @@ inline std::string layerChange(int id, double coverage) {
          R"(, "density": 0.7, "wind": {"speed_mps": 5, "from_deg": 200, "vertical_mps": 0}}}]})";
 }
 
+// One request to a weather server's (or relay's) HTTP API on loopback, with
+// the tests' token; 10 s for the answer, twice a JetStream append's wait
+// (NatsLogOptions::requestWait), so a leader's answer is not given up on.
+inline Result<sim::HttpResponse> natsApiRequest(unsigned port, const std::string& method, const std::string& target,
+                                                const std::string& body = "") {
+  return sim::httpRequest(sim::HttpRequest{.method = method,
+                                           .host = "127.0.0.1",
+                                           .port = static_cast<unsigned short>(port),
+                                           .target = target,
+                                           .body = body,
+                                           .bearerToken = kNatsToken,
+                                           .timeout = 10s});
+}
+
 // A weather process with an HTTP endpoint: what the tests ask it.
 struct HttpPeer {
   std::filesystem::path dir;
@@ -47,14 +65,7 @@ struct HttpPeer {
 
   std::optional<sim::HttpResponse> request(const std::string& method, const std::string& target,
                                            const std::string& body = "") const {
-    sim::HttpRequest r;
-    r.method = method;
-    r.port = static_cast<unsigned short>(httpPort);
-    r.target = target;
-    r.body = body;
-    r.bearerToken = kNatsToken;
-    r.timeout = 10s;
-    auto response = sim::httpRequest(r);
+    auto response = natsApiRequest(httpPort, method, target, body);
     if (!response) return std::nullopt;
     return *response;
   }
@@ -127,6 +138,71 @@ struct NatsRelay : HttpPeer {
                     (dir / "relay.log").string());
     streamPort = waitForPortFile((dir / "stream.port").string(), 40s);
     httpPort = waitForPortFile((dir / "http.port").string(), 40s);
+  }
+};
+#endif
+
+#ifdef SKY_RENDER
+// Frames of the tests' renderers: tiny, paced at flight speed, a hover long
+// enough to outlast a test (the renderer is stopped with it).
+inline constexpr const char* kRenderWidth = "64";
+inline constexpr const char* kRenderHeight = "36";
+inline constexpr double kRenderStep_s = 0.25;
+inline constexpr int kRenderHover_s = 600;
+
+// The frames of a frames.jsonl, in order.
+inline std::vector<nlohmann::json> framesOf(const std::filesystem::path& jsonl) {
+  std::vector<nlohmann::json> v;
+  std::ifstream f(jsonl);
+  for (std::string line; std::getline(f, line);) {
+    auto j = nlohmann::json::parse(line, nullptr, false);
+    if (j.is_object()) v.push_back(std::move(j));  // the last line may be half written
+  }
+  return v;
+}
+
+// A headless skyshell-render hovering near 46.2N 12.8E, its weather from a
+// server's or a relay's stream `port`; extra: more renderer arguments.
+struct Renderer {
+  std::filesystem::path out;
+  std::optional<ChildProcess> process;
+  Renderer(const std::filesystem::path& dir, unsigned port, const std::vector<std::string>& extra = {}) {
+    std::filesystem::create_directories(dir);
+    {
+      std::ofstream csv(dir / "hover.csv");
+      csv << "time_s,lat_deg,lon_deg,alt_m,yaw_deg,pitch_deg,roll_deg\n";
+      for (int t = 0; t <= kRenderHover_s; t += 10) csv << t << ",46.2,12.8,900,90,20,0\n";
+    }
+    out = dir / "out";
+    std::vector<std::string> args{SKY_RENDER, "--headless", "--server", "127.0.0.1:" + std::to_string(port),
+                                  "--replay", (dir / "hover.csv").string(), "--step", std::to_string(kRenderStep_s),
+                                  "--replay-pace", "1", "--no-exr", "--no-video", "--out", out.string(), "--width",
+                                  kRenderWidth, "--height", kRenderHeight};
+    args.insert(args.end(), extra.begin(), extra.end());
+    process.emplace(args, (dir / "render.log").string(),
+                    std::vector<std::string>{"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
+  }
+  std::filesystem::path framesFile() const { return out / "frames" / "frames.jsonl"; }
+  std::vector<nlohmann::json> written() const { return framesOf(framesFile()); }
+  std::uint64_t lastVersion() const {
+    const auto f = written();
+    return f.empty() ? 0 : f.back().value("weather_version", std::uint64_t{0});
+  }
+  // The newest whole frame, read from the file's tail (cheap enough to poll);
+  // null before the first.
+  nlohmann::json lastFrame() const {
+    constexpr std::streamoff kTail_bytes = 16384;  // several frames' lines
+    std::ifstream f(framesFile(), std::ios::binary | std::ios::ate);
+    if (!f) return nullptr;
+    const std::streamoff size = f.tellg();
+    f.seekg(std::max<std::streamoff>(0, size - kTail_bytes));
+    std::string tail((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    const auto end = tail.rfind('\n');
+    if (end == std::string::npos || end == 0) return nullptr;
+    const auto previous = tail.rfind('\n', end - 1);
+    const std::size_t begin = previous == std::string::npos ? 0 : previous + 1;
+    auto j = nlohmann::json::parse(tail.substr(begin, end - begin), nullptr, false);
+    return j.is_object() ? j : nlohmann::json(nullptr);
   }
 };
 #endif

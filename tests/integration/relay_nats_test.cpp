@@ -10,7 +10,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,47 +38,6 @@ constexpr double kChangeToFrameBound_s = 5.0;
 // within this (the relay catches up at once; then the renderer's next frame
 // and its weather upload, as above).
 constexpr double kRendererConvergeBound_s = 10.0;
-// Frames of the renderer: tiny, paced at flight speed, a hover long enough
-// to outlast the test (it is stopped with the test).
-constexpr const char* kWidth = "64";
-constexpr const char* kHeight = "36";
-constexpr double kStep_s = 0.25;
-constexpr int kHover_s = 300;
-
-std::vector<nlohmann::json> frames(const fs::path& jsonl) {
-  std::vector<nlohmann::json> v;
-  std::ifstream f(jsonl);
-  for (std::string line; std::getline(f, line);) {
-    auto j = nlohmann::json::parse(line, nullptr, false);
-    if (j.is_object()) v.push_back(std::move(j));  // the last line may be half written
-  }
-  return v;
-}
-
-// A headless renderer hovering near 46.2N 12.8E, its weather from `port`.
-struct Renderer {
-  fs::path out;
-  std::optional<ChildProcess> process;
-  Renderer(const fs::path& dir, unsigned port) {
-    fs::create_directories(dir);
-    {
-      std::ofstream csv(dir / "hover.csv");
-      csv << "time_s,lat_deg,lon_deg,alt_m,yaw_deg,pitch_deg,roll_deg\n";
-      for (int t = 0; t <= kHover_s; t += 10) csv << t << ",46.2,12.8,900,90,20,0\n";
-    }
-    out = dir / "out";
-    process.emplace(std::vector<std::string>{SKY_RENDER, "--headless", "--server", "127.0.0.1:" + std::to_string(port),
-                                             "--replay", (dir / "hover.csv").string(), "--step", std::to_string(kStep_s),
-                                             "--replay-pace", "1", "--no-exr", "--no-video", "--out", out.string(),
-                                             "--width", kWidth, "--height", kHeight},
-                    (dir / "render.log").string(), std::vector<std::string>{"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
-  }
-  std::vector<nlohmann::json> written() const { return frames(out / "frames" / "frames.jsonl"); }
-  std::uint64_t lastVersion() const {
-    const auto f = written();
-    return f.empty() ? 0 : f.back().value("weather_version", std::uint64_t{0});
-  }
-};
 
 class RelayNats : public ::testing::Test {
  protected:
