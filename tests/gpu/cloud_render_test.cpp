@@ -182,6 +182,41 @@ TEST(CloudRender, CreateRenderDestroy) {
   moved.reset();
 }
 
+// Work slower than GpuOptions::frameTimeout fails with Timeout naming the
+// limit, and only after the work has finished (ASan would see its buffers
+// freed under it otherwise); a limit that is not positive is refused.
+TEST(CloudRender, WorkPastTheFrameTimeoutFailsWithTimeout) {
+  SKY_RENDERER(shared, 16, 16);  // keeps the driver loaded across the teardowns
+  (void)shared;
+  render::RenderSettings settings;
+  settings.width = 160;
+  settings.height = 90;
+  render::GpuOptions gpu;
+  gpu.frameTimeout = std::chrono::milliseconds(0);
+  const auto refused = render::CloudRenderer::create(settings, gpu);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().code, ErrorCode::InvalidArgument);
+
+  gpu.frameTimeout = std::chrono::milliseconds(1);
+  auto created = render::CloudRenderer::create(settings, gpu);
+  Error error{ErrorCode::Io, ""};
+  if (!created) {
+    error = created.error();  // its set-up work (the noise volumes) already took longer
+  } else {
+    weather::WeatherSnapshot deck;
+    deck.layers.push_back(layer(0, 1000.0, 800, 1.0, 1));
+    FrameInputs in;
+    in.camera = pose(47.0, 8.0, 500.0, 0.0, 20.0);
+    in.weather = &deck;
+    const auto frame = (*created)->render(in);
+    ASSERT_FALSE(frame) << "a 160x90 frame under a deck finished within 1 ms";
+    error = frame.error();
+    created->reset();
+  }
+  EXPECT_EQ(error.code, ErrorCode::Timeout) << error.detail;
+  EXPECT_NE(error.detail.find("within 1 ms"), std::string::npos) << error.detail;
+}
+
 TEST(CloudRender, RejectsBadInputs) {
   SKY_RENDERER(r, 160, 90);
   FrameInputs in;

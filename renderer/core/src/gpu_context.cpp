@@ -14,7 +14,6 @@ namespace {
 
 // A frame that takes longer than this is treated as a lost device, ns. A
 // 4K frame on lavapipe takes seconds; 60 s leaves room for sanitizer builds.
-constexpr std::uint64_t kFenceTimeout_ns = 60'000'000'000ull;
 
 int typeRank(vk::PhysicalDeviceType type) {
   switch (type) {
@@ -60,7 +59,11 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(VkDebugUtilsMessageSeverityFl
 }  // namespace
 
 Result<std::unique_ptr<GpuContext>> GpuContext::create(const GpuOptions& options) {
+  if (options.frameTimeout <= std::chrono::milliseconds::zero())
+    return fail(ErrorCode::InvalidArgument,
+                "GPU frame timeout must be positive, not " + std::to_string(options.frameTimeout.count()) + " ms");
   std::unique_ptr<GpuContext> ctx(new GpuContext());
+  ctx->frameTimeout_ = options.frameTimeout;
 
   bool haveDebugUtils = false;
   for (const auto& ext : ctx->context_.enumerateInstanceExtensionProperties())
@@ -192,24 +195,24 @@ Result<void> GpuContext::submitAndWait(const vk::raii::CommandBuffer& commands, 
   device_.resetFences(*fence);
   const vk::CommandBuffer raw = *commands;
   queue_.submit(vk::SubmitInfo({}, {}, raw), *fence);
-  const vk::Result waited = device_.waitForFences(*fence, VK_TRUE, kFenceTimeout_ns);
+  const vk::Result waited = device_.waitForFences(*fence, VK_TRUE, fenceTimeout_ns());
   if (waited == vk::Result::eTimeout) {
     // The work is still running and owns the command buffer and the
     // resources it reads: the caller may free them once it has the error
-    // (a frame slower than 60 s freed them under lavapipe's running threads
-    // and crashed the bench). lavapipe finishes what it started.
+    // (a frame slower than the timeout freed them under lavapipe's running
+    // threads and crashed the bench). lavapipe finishes what it started.
     device_.waitIdle();
-    return fail(ErrorCode::Timeout, "GPU frame did not finish within 60 s");
+    return fail(ErrorCode::Timeout, "GPU frame did not finish within " + timeoutText());
   }
   if (waited != vk::Result::eSuccess) return fail(ErrorCode::Device, "waitForFences: " + vk::to_string(waited));
   return {};
 }
 
 Result<void> GpuContext::wait(const vk::raii::Fence& fence) const {
-  const vk::Result waited = device_.waitForFences(*fence, VK_TRUE, kFenceTimeout_ns);
+  const vk::Result waited = device_.waitForFences(*fence, VK_TRUE, fenceTimeout_ns());
   if (waited == vk::Result::eTimeout) {
     device_.waitIdle();  // as in submitAndWait
-    return fail(ErrorCode::Timeout, "GPU work did not finish within 60 s");
+    return fail(ErrorCode::Timeout, "GPU work did not finish within " + timeoutText());
   }
   if (waited != vk::Result::eSuccess) return fail(ErrorCode::Device, "waitForFences: " + vk::to_string(waited));
   return {};

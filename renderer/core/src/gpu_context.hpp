@@ -6,6 +6,7 @@
 // and outlives them.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -78,6 +79,13 @@ class GpuContext {
 
  private:
   GpuContext() = default;
+  std::uint64_t fenceTimeout_ns() const {
+    return std::uint64_t(std::chrono::duration_cast<std::chrono::nanoseconds>(frameTimeout_).count());
+  }
+  std::string timeoutText() const {  // "60 s", "1500 ms"
+    const auto ms = frameTimeout_.count();
+    return ms % 1000 == 0 ? std::to_string(ms / 1000) + " s" : std::to_string(ms) + " ms";
+  }
 
   // Members are destroyed in reverse order: the pool before the device, the
   // device before the surface and the messenger, those before the instance,
@@ -97,6 +105,7 @@ class GpuContext {
   double timestampPeriod_ns_ = 0;
   std::string deviceName_;
   bool debugUtils_ = false;
+  std::chrono::milliseconds frameTimeout_{60'000};  // GpuOptions::frameTimeout
 };
 
 }  // namespace sky::render

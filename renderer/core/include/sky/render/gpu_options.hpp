@@ -4,6 +4,7 @@
 // Khronos validation with its messages collected for the front end to log.
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -31,6 +32,11 @@ struct GpuOptions {
   // Enable VK_LAYER_KHRONOS_validation (Unsupported when it is not installed)
   // and collect its messages (CloudRenderer::takeValidationMessages).
   bool validation = false;
+  // How long one submitted frame may run before it is given up as hung and
+  // fails with Timeout (the work is let finish before its resources are
+  // freed). A minute is far past any preset's frame; `reference` at 640x360
+  // takes longer on lavapipe, so the bench raises it. Must be positive.
+  std::chrono::milliseconds frameTimeout{60'000};
 };
 
 struct ValidationCounts {
