@@ -68,13 +68,11 @@ constexpr std::size_t kSteadyAcks = 20;
 // How long the relay is cut off ("a few seconds"): longer than
 // kFrameGapBound_s, so a renderer that waits out the cut fails the test.
 constexpr auto kCut = 6s;
-// The renderers' --weather-timeout. A headless replay waits for its
-// server's lightning answer before each frame, for at most this long. A
-// relay cut off (stopped, its socket open) sends nothing and the renderer's
-// weather client does not notice silence, so with the default (30 s) the
-// renderer drew no frame for the whole cut (4.0 s without a frame over a 4 s
-// cut, measured); with 1 s it draws a frame a second and more meanwhile.
-constexpr const char* kRenderWeatherTimeout_s = "1";
+// The renderers run with the default --weather-timeout (30 s): a paced
+// replay waits for its server's lightning answer until its next frame is
+// due at most (kRenderStep_s), so a relay cut off (stopped, its socket
+// open, sending nothing) must not stop its frames. Before the replay
+// bounded that wait it drew no frame for a whole 4 s cut (measured).
 // The first frames of two renderers starting together (the shaders' JIT on
 // lavapipe; under ASan beside the servers it has taken half a minute).
 constexpr auto kFirstFrames = 120s;
@@ -94,7 +92,7 @@ constexpr double kNodeLossBound_s = 15.0;
 constexpr double kConvergeBound_s = 10.0;
 // The longest a renderer may go without writing a frame: a frame with a
 // weather upload (longest gap 1.3 s in Release on the relay not cut off,
-// measured) or a frame after a lightning wait given up (kRenderWeatherTimeout_s),
+// measured) or a frame after a lightning wait given up (kRenderStep_s),
 // while every process of the test shares the two cores.
 constexpr double kFrameGapBound_s = 5.0;
 // After the storm: every server and relay on one state hash within this.
@@ -315,8 +313,7 @@ class ClusterFault : public ::testing::Test {
     })) << b_->log() << relays_[0]->log() << relays_[1]->log();
     EXPECT_FALSE(b_->leads());
     for (int i = 0; i < 2; ++i)
-      renderers_[i].emplace(root_ / ("render" + std::to_string(i + 1)), relays_[i]->streamPort,
-                            std::vector<std::string>{"--weather-timeout", kRenderWeatherTimeout_s});
+      renderers_[i].emplace(root_ / ("render" + std::to_string(i + 1)), relays_[i]->streamPort);
     for (const auto& r : renderers_)
       ASSERT_TRUE(waitUntil(kFirstFrames, [&] { return r->written().size() >= 2; })) << r->process->log();
     watch_.emplace(std::vector<const Renderer*>{&*renderers_[0], &*renderers_[1]});

@@ -1,6 +1,7 @@
 // Headless replay of a recorded flight (see headless_replay.hpp).
 #include "sky/app/headless_replay.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -300,6 +301,13 @@ int runReplay(const ReplayOptions& o, const ReplayDrawer& drawer, const std::ato
       std::fflush(stdout);
     });
   }
+  // A paced replay keeps its pace as a live channel does: it waits for the
+  // server's answers (a new area's weather, the lightning at a frame's clock)
+  // until the next frame is due at most, then draws the weather it holds. A
+  // server that falls silent (a relay cut off, its socket still open) would
+  // otherwise hold every frame for the whole --weather-timeout. Unpaced, a
+  // replay waits the full timeout: its frames are what it is run for.
+  const double answerWait_s = o.pace > 0 ? std::min(o.weatherTimeout_s, o.step_s / o.pace) : o.weatherTimeout_s;
   for (std::size_t i = 0; i < frameCount; ++i) {
     drawing = i;
     if (stop && *stop) {
@@ -325,9 +333,9 @@ int runReplay(const ReplayOptions& o, const ReplayDrawer& drawer, const std::ato
     if (const auto asked = weather ? areas.update(pose) : std::vector<stream::Subscribe>{}; !asked.empty()) {
       const std::uint64_t before = state.weatherVersion();
       for (const auto& area : asked) weather->subscribe(area);
-      if (!waitForWeather(state, before, o.weatherTimeout_s, stop))
-        std::fprintf(stderr, "skyshell-render: warning: frame %zu: no weather for the new area within %.0f s; "
-                             "drawing the old area's\n", i, o.weatherTimeout_s);
+      if (!waitForWeather(state, before, answerWait_s, stop))
+        std::fprintf(stderr, "skyshell-render: warning: frame %zu: no weather for the new area within %.3g s; "
+                             "drawing the old area's\n", i, answerWait_s);
     }
     const double frameClock_s = clockBase_s + (t - t0) * clockRate;
     // The lightning at this frame's clock: the server's stream sends flashes
@@ -341,9 +349,9 @@ int runReplay(const ReplayOptions& o, const ReplayDrawer& drawer, const std::ato
         const auto to = state.lightningAnsweredTo();
         return (to && *to >= frameClock_s) || !weather->serverTakesLightningRequests();
       };
-      if (!waitUntil(answered, o.weatherTimeout_s, stop))
-        std::fprintf(stderr, "skyshell-render: warning: frame %zu: no lightning answer from the server within %.0f s\n",
-                     i, o.weatherTimeout_s);
+      if (!waitUntil(answered, answerWait_s, stop))
+        std::fprintf(stderr, "skyshell-render: warning: frame %zu: no lightning answer from the server within %.3g s\n",
+                     i, answerWait_s);
     }
     const WeatherView view = state.weather();
     FrameRequest request;
