@@ -162,11 +162,11 @@ inline std::vector<nlohmann::json> framesOf(const std::filesystem::path& jsonl) 
 }
 
 // A headless skyshell-render hovering near 46.2N 12.8E, its weather from a
-// server's or a relay's stream `port`; extra: more renderer arguments.
+// server's or a relay's stream `port`.
 struct Renderer {
   std::filesystem::path out;
   std::optional<ChildProcess> process;
-  Renderer(const std::filesystem::path& dir, unsigned port, const std::vector<std::string>& extra = {}) {
+  Renderer(const std::filesystem::path& dir, unsigned port) {
     std::filesystem::create_directories(dir);
     {
       std::ofstream csv(dir / "hover.csv");
@@ -174,11 +174,10 @@ struct Renderer {
       for (int t = 0; t <= kRenderHover_s; t += 10) csv << t << ",46.2,12.8,900,90,20,0\n";
     }
     out = dir / "out";
-    std::vector<std::string> args{SKY_RENDER, "--headless", "--server", "127.0.0.1:" + std::to_string(port),
+    const std::vector<std::string> args{SKY_RENDER, "--headless", "--server", "127.0.0.1:" + std::to_string(port),
                                   "--replay", (dir / "hover.csv").string(), "--step", std::to_string(kRenderStep_s),
                                   "--replay-pace", "1", "--no-exr", "--no-video", "--out", out.string(), "--width",
                                   kRenderWidth, "--height", kRenderHeight};
-    args.insert(args.end(), extra.begin(), extra.end());
     process.emplace(args, (dir / "render.log").string(),
                     std::vector<std::string>{"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"});
   }

@@ -12,9 +12,6 @@ namespace sky::render {
 
 namespace {
 
-// A frame that takes longer than this is treated as a lost device, ns. A
-// 4K frame on lavapipe takes seconds; 60 s leaves room for sanitizer builds.
-
 int typeRank(vk::PhysicalDeviceType type) {
   switch (type) {
     case vk::PhysicalDeviceType::eDiscreteGpu: return 4;
@@ -59,6 +56,8 @@ VKAPI_ATTR VkBool32 VKAPI_CALL onValidationMessage(VkDebugUtilsMessageSeverityFl
 }  // namespace
 
 Result<std::unique_ptr<GpuContext>> GpuContext::create(const GpuOptions& options) {
+  // A frame past GpuOptions::frameTimeout is treated as hung: a 4K frame on
+  // lavapipe takes seconds, the default minute leaves room for sanitizer builds.
   if (options.frameTimeout <= std::chrono::milliseconds::zero())
     return fail(ErrorCode::InvalidArgument,
                 "GPU frame timeout must be positive, not " + std::to_string(options.frameTimeout.count()) + " ms");
