@@ -352,20 +352,32 @@ uint reuseHistory(ivec2 px, out vec4 colour, inout float depth, out vec2 from) {
 }
 
 // The box of the pixels drawn this frame around px (history_clip.glsl): the
-// drawn pixels of the 3 x 3 blocks centred on the one nearest px.
+// four drawn pixels whose grid cell holds px (the upscale's). The 3 x 3
+// blocks round it spanned 6 to 12 pixels, wide enough to hold sky and
+// cloud at every edge, so nothing at an edge was ever outside the box.
 HistoryBox drawnBox(ivec2 px) {
-  ivec2 c = ivec2(floor((vec2(px) - vec2(gPhase)) / float(gN) + 0.5));
+  ivec2 c = ivec2(floor((vec2(px) - vec2(gPhase)) / float(gN)));
   HistoryBox box = historyBoxEmpty();
-  for (int k = 0; k < 9; ++k) {
+  for (int k = 0; k < 4; ++k) {
     ivec2 t;
-    if (drawnPixel(c + ivec2(k % 3 - 1, k / 3 - 1), t)) box = historyBoxAdd(box, historyClipSpace(freshAt(t)));
+    if (drawnPixel(c + ivec2(k & 1, k >> 1), t)) box = historyBoxAdd(box, historyClipSpace(freshAt(t)));
   }
   return box;
 }
 
 vec4 clippedHistory(ivec2 px, vec4 history) {
   if (!kHistoryClip) return history;
-  return gClip ? clipHistory(drawnBox(px), history, gClipGamma) : history;
+  if (!gClip) return history;
+  // Only a history whose transmittance none of the four drawn pixels has
+  // is clipped: cloud (or a blend of cloud and sky) where all of them show
+  // sky, or the reverse. Each frame's resampling blends the rows it falls
+  // between, so at a cloud's edge a pixel left to the history took a
+  // blend of sky and cloud, and the next frames carried it on: streaks
+  // along the rows not drawn that frame, into the sky of a banked turn
+  // (docs/motion.md). Within the cloud the history's finer detail stays.
+  HistoryBox box = drawnBox(px);
+  bool outside = box.count > 0.5 && (history.w < box.lo.w - 1e-3 || history.w > box.hi.w + 1e-3);
+  return outside ? clipHistory(box, history, gClipGamma) : history;
 }
 
 // Whether pixel px was drawn this frame, and where its sample is: its

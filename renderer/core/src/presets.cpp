@@ -91,6 +91,7 @@ TemporalSettings interleaved(std::uint32_t n, double accumulation, double denseT
   t.accumulation = accumulation;
   t.denseTurn_px = denseTurn_px;
   t.sharpHistory = true;
+  t.historyClip = 4;
   return t;
 }
 
@@ -123,21 +124,23 @@ const std::vector<Preset>& presets() {
        "steps of 40 m in cloud, 80 m in clear air, +0.5 % of the distance; exit at 0.2 %; the sun from a deep shadow "
        "map (128 x 128 x 4, rebuilt over 8 frames); "
        "1 pixel of 16 per frame (1 of 4 in a turn of over 2 pixels a frame), the rest reprojected, redraws accumulated "
-       "(history 0.75 at rest, 0.375 from 1 pixel of motion a frame, resampled Catmull-Rom)",
+       "(history 0.75 at rest, 0.375 from 1 pixel of motion a frame, resampled Catmull-Rom, clipped in motion where "
+       "it shows cloud or sky the drawn pixels round it do not)",
        deepMap(metres(256, 4, 0.002, 40, 80, 0.005, 12), 128, 8), interleaved(4, 0.75)},
       {"low",
        "steps of 40 m in cloud, 80 m in clear air, +1 % of the distance; exit at 3 %; the sun from a deep shadow map "
        "(128 x 128 x 4, rebuilt over 16 frames); "
        "the air from a 48 x 48 x 24 table; 1 pixel of 16 per frame (1 of 4 in a turn of over 2 pixels a frame), the "
        "rest reprojected, redraws accumulated (history 0.75 at rest, 0.375 from 1 pixel of motion a frame, "
-       "resampled Catmull-Rom)",
+       "resampled Catmull-Rom, clipped in motion where it shows cloud or sky the drawn pixels round it do not)",
        deepMap(withAirTable(metres(256, 3, 0.03, 40, 80, 0.01, 8), 48, 48, 24), 128, 16), interleaved(4, 0.75)},
       {"realtime",
        "steps of 40 m in cloud, 80 m in clear air, +2 % of the distance; exit at 5 %; the sun from a deep shadow map "
        "(64 x 64 x 4, rebuilt over 16 frames); "
        "the air from a 32 x 32 x 16 table; the clouds drawn at 1/2 the width and height (depth-aware upscale); 1 "
        "pixel of 16 per frame (1 of 4 in a turn of over 1 pixel of the half size a frame), the rest reprojected, "
-       "redraws accumulated (history 0.75 at rest, 0.375 from 1 pixel of motion a frame, resampled Catmull-Rom)",
+       "redraws accumulated (history 0.75 at rest, 0.375 from 1 pixel of motion a frame, resampled Catmull-Rom, "
+       "clipped in motion where it shows cloud or sky the drawn pixels round it do not)",
        // The dense turn's threshold is in the cloud pass's pixels: 1 at half
        // the size is the other presets' 2 of the image. The bundled glider's
        // circle turns 1.1-1.7 of these pixels a frame; drawn densely there,

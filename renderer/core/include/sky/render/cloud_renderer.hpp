@@ -175,16 +175,19 @@ struct TemporalSettings {
   // R2 sequence, so the redraws average over the pixel's area (anti-aliased
   // edges) instead of sampling its centre. Ignored without accumulation.
   bool pixelJitter = false;
-  // Variance clipping of the history in motion (shaders/include/history_clip.glsl):
+  // Clipping of the history in motion (shaders/include/history_clip.glsl):
   // a pixel taken from the history, and the history a redraw is blended
-  // with, are first clipped to the box of the pixels drawn this frame around
-  // it (the drawn pixels of its own and the eight neighbouring n x n
-  // blocks): their mean +- this many standard deviations, within their
-  // range, in a compressed YCoCg space with the transmittance. What the
-  // history holds that nothing drawn nearby now shows (a cloud that moved
-  // or changed, a stale horizon) is pulled back to what is drawn. Not
-  // applied to a still view (the camera and every layer's air unmoved),
-  // which keeps converging to the image drawn whole. 0: off. [0, 4].
+  // with, are clipped to the box of the four pixels drawn this frame round
+  // it (the corners of its cell of the interleave's grid) when the
+  // history's transmittance lies outside theirs: cloud where all four show
+  // sky, sky inside cloud, or the blend of both that each frame's
+  // resampling makes at an edge (which, left alone, streaked along the rows
+  // not drawn that frame in a banked turn; docs/motion.md). The box is their
+  // mean +- this many standard deviations, within their range, in a
+  // compressed YCoCg space with the transmittance; with four samples 4 is
+  // their range. Not applied to a still view (the camera and every layer's
+  // air unmoved), which keeps converging to the image drawn whole. 0: off.
+  // [0, 4].
   double historyClip = 0;
   // A fast turn with interleave 4: when the view turned since the previous
   // frame by more than this many of the cloud pass's pixels (at the image's
