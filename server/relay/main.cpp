@@ -102,6 +102,11 @@ sky::Result<std::unique_ptr<sky::server::HttpApi>> startHttp(sky::server::Server
 int main(int argc, char** argv) {
   CLI::App app{"skyshell-relay: serves the Skyshell weather stream to nearby renderers from the weather servers' "
                "NATS log (read-only)"};
+  app.set_config("--config", "",
+                 "TOML file whose keys are these options without the dashes "
+                 "(see deploy/relay.example.toml); the command line wins");
+  // A misspelt key in the config must be an error, not silently ignored.
+  app.allow_config_extras(CLI::config_extras_mode::error);
   RelayOptions o;
   addOptions(app, o);
   try {

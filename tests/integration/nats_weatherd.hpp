@@ -126,15 +126,19 @@ struct NatsWeatherd : HttpPeer {
 };
 
 #ifdef SKY_RELAY
-// One skyshell-relay following the cluster's log, on ephemeral ports.
+// One skyshell-relay following the cluster's log, on ephemeral ports, its
+// options in a config file as the systemd unit gives them
+// (deploy/skyshell-relay.service; the port file on the command line).
 struct NatsRelay : HttpPeer {
   unsigned streamPort = 0;
   NatsRelay(const std::filesystem::path& root, const std::string& name, const std::string& natsUrls) {
     dir = root / name;
     std::filesystem::create_directories(dir);
-    process.emplace(std::vector<std::string>{SKY_RELAY, "--nats", natsUrls, "--port", "0", "--port-file",
-                                             (dir / "stream.port").string(), "--http-port", "0", "--http-port-file",
-                                             (dir / "http.port").string(), "--heartbeat-ms", "200"},
+    const std::filesystem::path config = dir / "relay.toml";
+    std::ofstream(config) << "nats = \"" << natsUrls << "\"\nport = 0\nhttp-port = 0\nhttp-port-file = \""
+                          << (dir / "http.port").string() << "\"\nheartbeat-ms = 200\n";
+    process.emplace(std::vector<std::string>{SKY_RELAY, "--config", config.string(), "--port-file",
+                                             (dir / "stream.port").string()},
                     (dir / "relay.log").string());
     streamPort = waitForPortFile((dir / "stream.port").string(), 40s);
     httpPort = waitForPortFile((dir / "http.port").string(), 40s);

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -242,6 +243,39 @@ TEST_F(RelayNats, ARendererOnARelayDrawsThroughChangesAFailoverAndAPause) {
   servesThroughAFailover(render);
   if (HasFatalFailure()) return;
   catchesUpAfterAPause(render);
+}
+
+// The config file's keys are checked before the relay reaches NATS: a
+// misspelt one (heartbeat_ms for heartbeat-ms) stops it with exit code 2,
+// the code its systemd unit does not restart on, and names the key. No
+// NATS server is needed: the relay never gets that far.
+TEST(RelayConfig, AMisspeltKeyIsRefusedWithItsName) {
+  const fs::path dir = fs::path(SKY_TEST_OUTPUT_DIR) / "relay-config-misspelt";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "relay.toml") << "nats = \"nats://127.0.0.1:1\"\nheartbeat_ms = 200\n";
+  ChildProcess relay({SKY_RELAY, "--config", (dir / "relay.toml").string()}, (dir / "relay.log").string());
+  const auto code = relay.wait(30s);
+  ASSERT_TRUE(code.has_value()) << "the relay did not exit: " << relay.log();
+  EXPECT_EQ(*code, 2) << relay.log();
+  EXPECT_NE(relay.log().find("heartbeat_ms"), std::string::npos) << relay.log();
+}
+
+// Every key of deploy/relay.example.toml is one the relay knows: with it
+// (its NATS pointed at a closed port, its stream at a free loopback one:
+// the command line wins) the relay gets past its options and stops at
+// NATS, exit code 1.
+TEST(RelayConfig, TheExampleConfigIsAccepted) {
+  const fs::path dir = fs::path(SKY_TEST_OUTPUT_DIR) / "relay-config-example";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  ChildProcess relay({SKY_RELAY, "--config", SKY_RELAY_EXAMPLE_CONFIG, "--nats", "nats://127.0.0.1:1", "--listen",
+                      "127.0.0.1", "--port", "0"},
+                     (dir / "relay.log").string());
+  const auto code = relay.wait(60s);
+  ASSERT_TRUE(code.has_value()) << "the relay did not exit: " << relay.log();
+  EXPECT_EQ(*code, 1) << relay.log();
+  EXPECT_NE(relay.log().find("nats_unusable"), std::string::npos) << relay.log();
 }
 
 }  // namespace
