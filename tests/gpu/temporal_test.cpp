@@ -136,6 +136,17 @@ void converge(render::CloudRenderer& r, const render::FrameInputs& in, std::uint
   for (std::uint32_t i = 0; i <= n * n; ++i) renderOk(r, in);
 }
 
+// Two renderers of `s`: as it is, and with `change` made to its temporal
+// settings (the tests that weigh one setting against its absence).
+struct Variants {
+  Result<std::unique_ptr<render::CloudRenderer>> as, changed;
+};
+Variants variants(render::RenderSettings s, const std::function<void(render::TemporalSettings&)>& change) {
+  auto as = render::CloudRenderer::create(s);
+  change(s.temporal);
+  return {std::move(as), render::CloudRenderer::create(s)};
+}
+
 TEST(Temporal, StillViewConvergesToTheWholeImage) {
   for (std::uint32_t n : {2u, 4u}) {
     SCOPED_TRACE("interleave " + std::to_string(n));
@@ -387,9 +398,7 @@ TEST(Temporal, HorizonSidesKeepGroundAndSkyApartInARoll) {
   render::RenderSettings s = interleaved->settings();
   s.temporal.sharpHistory = true;
   s.temporal.horizonSides = true;
-  auto sides = render::CloudRenderer::create(s);
-  s.temporal.horizonSides = false;
-  auto across = render::CloudRenderer::create(s);
+  auto [sides, across] = variants(s, [](render::TemporalSettings& t) { t.horizonSides = false; });
   ASSERT_TRUE(sides && across);
   const weather::WeatherSnapshot snap = cumulus();
   render::FrameInputs in = cumulusInputs(snap);
@@ -443,9 +452,7 @@ TEST(Temporal, HistoryClipKeepsTheSkyClearAtCloudEdgesInABankedTurn) {
   render::RenderSettings s = interleaved->settings();
   s.temporal = render::findPreset("medium")->temporal;
   s.temporal.historyClip = 4;
-  auto clipped = render::CloudRenderer::create(s);
-  s.temporal.historyClip = 0;
-  auto unclipped = render::CloudRenderer::create(s);
+  auto [clipped, unclipped] = variants(s, [](render::TemporalSettings& t) { t.historyClip = 0; });
   ASSERT_TRUE(clipped && unclipped);
   const weather::WeatherSnapshot snap = cumulus();
   render::FrameInputs in = cumulusInputs(snap);
@@ -488,9 +495,7 @@ TEST(Temporal, AccumulationYieldsToMotion) {
   render::RenderSettings s = whole->settings();
   s.temporal.interleave = 4;
   s.temporal.accumulation = 0.75;
-  auto yielding = render::CloudRenderer::create(s);
-  s.temporal.accumulationMotion_px = 0;
-  auto holding = render::CloudRenderer::create(s);
+  auto [yielding, holding] = variants(s, [](render::TemporalSettings& t) { t.accumulationMotion_px = 0; });
   ASSERT_TRUE(yielding && holding);
   const weather::WeatherSnapshot snap = cumulus();
   render::FrameInputs in = cumulusInputs(snap);
