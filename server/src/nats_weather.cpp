@@ -246,6 +246,14 @@ void NatsWeather::electionLoop() {
       held = **renewed;
       renewedAt_ns = sentAt_ns;
       leaseRenewedAt_ns_ = sentAt_ns;
+    } else if (renewed && adoptOwnRenewal(held)) {
+      // The key's revision is past ours and the value there is ours: a
+      // renewal whose answer timed out had landed. The lease is still this
+      // server's; the next turn renews it at the revision adopted. Not
+      // counted as renewed (leaseRenewedAt_ns_ stays): when it landed is
+      // not known, so commit() goes on trusting the lease only from the
+      // renewal this server saw.
+      continue;
     } else if (renewed) {
       held = 0;
       boost::asio::post(server_.io(), [this] { stepDown("lease lost: another server holds it"); });
@@ -254,6 +262,15 @@ void NatsWeather::electionLoop() {
     // again; meanwhile the leader refuses changes once the lease may lapse.
   }
   if (held != 0) (void)natsLog_->releaseLease(held);
+}
+
+bool NatsWeather::adoptOwnRenewal(std::uint64_t& held) {
+  auto lease = natsLog_->readLease();
+  if (!lease || !*lease || (*lease)->revision <= held || (*lease)->value != leaseValue()) return false;
+  log_->info("event=nats_lease_adopted revision={} was={} (a renewal whose answer was lost had landed)",
+             (*lease)->revision, held);
+  held = (*lease)->revision;
+  return true;
 }
 
 std::uint64_t NatsWeather::tryTakeLease() {

@@ -279,6 +279,43 @@ TEST_F(WeatherdNats, JetStreamRefusesAStaleAppendAndAStaleLease) {
   std::printf("an unrenewed lease (ttl 2 s) was free again %.2f s after its last renewal\n", secondsSince(t0));
 }
 
+// A leader's renewal of its lease that JetStream stored but whose answer
+// the leader never got (a timeout) leaves the key a revision past the one
+// the leader knows, and its next renewal is refused. That is not a lost
+// lease: the value there is its own. The test writes that renewal itself,
+// with the leader's value at the leader's revision; the leader adopts the
+// revision and goes on leading, where before it stepped down ("lease lost:
+// another server holds it") and the standby took over after the lease's
+// time to live.
+TEST_F(WeatherdNats, ARenewalWhoseAnswerWasLostIsNotALostLease) {
+  startTwo();
+  if (HasFatalFailure()) return;
+  server::NatsLogOptions o;
+  o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+  auto connected = server::NatsLog::connect(o);
+  ASSERT_TRUE(connected) << describe(connected.error());
+  // Read and renew until the leader's own renewal does not slip in between.
+  bool landed = false;
+  for (int attempt = 0; attempt < 5 && !landed; ++attempt) {
+    auto lease = (*connected)->readLease();
+    ASSERT_TRUE(lease && *lease) << "no lease while a server leads";
+    auto renewed = (*connected)->renewLease((*lease)->value, (*lease)->revision);
+    ASSERT_TRUE(renewed) << describe(renewed.error());
+    landed = renewed->has_value();
+  }
+  ASSERT_TRUE(landed) << "the leader renewed between every read and renewal of the test's";
+  // Three lease lifetimes (kLeaseMs each): the leader's next renewal comes
+  // within a third of one.
+  const auto until = Clock::now() + 3 * std::chrono::milliseconds(std::stoi(kLeaseMs));
+  while (Clock::now() < until) {
+    ASSERT_TRUE(a_->leads()) << a_->log();
+    ASSERT_FALSE(b_->leads()) << b_->log();
+    std::this_thread::sleep_for(100ms);
+  }
+  EXPECT_NE(a_->log().find("event=nats_lease_adopted"), std::string::npos) << a_->log();
+  EXPECT_EQ(a_->log().find("event=nats_step_down"), std::string::npos) << a_->log();
+}
+
 // The NATS node that leads the change log's stream is killed, the hardest
 // node to lose: the stream's replicas elect a new leader (JetStream's Raft
 // election takes 2-5 s), and the lease's bucket may lose its leader too, so

@@ -104,6 +104,11 @@ class NatsWeather {
   // The election thread's: takes the lease when free and starts the claim
   // on the io thread; the lease's revision, or 0 when another holds it.
   std::uint64_t tryTakeLease();
+  // The election thread's, after a renewal was refused at revision `held`:
+  // true (and `held` moved on) when the key's newer revision holds this
+  // server's own value, i.e. a renewal of ours whose answer was lost
+  // landed; false when another server holds the lease or it is gone.
+  bool adoptOwnRenewal(std::uint64_t& held);
   // The election thread's, while not holding the lease: follows the log
   // anew when its subscription stalled (`lagging`: since when, at which
   // applied sequence), and reads who leads.
