@@ -149,7 +149,9 @@ DisplayRun runDisplay(const std::string& name, double sunAzimuth_deg, double sun
         ch + ".log", std::vector<std::string>{"ASAN_OPTIONS=detect_leaks=0:abort_on_error=1"}));
   }
   for (int i = 0; i < kChannels; ++i) {
-    const unsigned port = waitForPortFile(d + "/channel" + std::to_string(i) + ".port", 60s);
+    // A channel writes its port once its pipelines are built: three ASan
+    // renderers building theirs on two busy cores took over a minute.
+    const unsigned port = waitForPortFile(d + "/channel" + std::to_string(i) + ".port", 180s);
     EXPECT_GT(port, 0u) << channels[i]->log();
     if (port == 0) return run;
     igs.push_back("127.0.0.1:" + std::to_string(port));
