@@ -366,8 +366,7 @@ HistoryBox drawnBox(ivec2 px) {
 }
 
 vec4 clippedHistory(ivec2 px, vec4 history) {
-  if (!kHistoryClip) return history;
-  if (!gClip) return history;
+  if (!kHistoryClip || !gClip) return history;
   // Only a history whose transmittance none of the four drawn pixels has
   // is clipped: cloud (or a blend of cloud and sky) where all of them show
   // sky, or the reverse. Each frame's resampling blends the rows it falls
