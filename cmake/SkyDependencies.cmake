@@ -79,6 +79,7 @@ target_link_libraries(sky::nats INTERFACE PkgConfig::LIBNATS)
 
 find_package(Vulkan REQUIRED)
 find_program(GLSLANG_VALIDATOR glslangValidator REQUIRED)
+find_program(SPIRV_OPT spirv-opt REQUIRED)
 find_package(glm CONFIG REQUIRED)
 
 find_path(STB_INCLUDE_DIR stb_image_write.h PATH_SUFFIXES stb REQUIRED)

@@ -465,7 +465,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "skyshell-render: --truth: %s\n", sky::describe(frames.error()).c_str());
       return 2;
     }
-    auto exposure = sky::render::AutoExposure::create(*cameraSettings, settings.noiseSeed);
+    auto exposure = sky::render::AutoExposure::create(*cameraSettings, settings.noiseSeed, settings.noiseCacheDir);
     if (!exposure) {
       std::fprintf(stderr, "skyshell-render: exposure: %s\n", sky::describe(exposure.error()).c_str());
       return 2;
@@ -498,7 +498,7 @@ int main(int argc, char** argv) {
   if (o.validation) spdlog::info("vulkan validation on ({})", "VK_LAYER_KHRONOS_validation");
   std::optional<sky::app::WindowDisplay> display;
   if (window) display.emplace(**renderer, *window);
-  auto cameraExposure = sky::render::AutoExposure::create(*cameraSettings, settings.noiseSeed);
+  auto cameraExposure = sky::render::AutoExposure::create(*cameraSettings, settings.noiseSeed, settings.noiseCacheDir);
   if (!cameraExposure) {
     std::fprintf(stderr, "skyshell-render: exposure: %s\n", sky::describe(cameraExposure.error()).c_str());
     return 2;
@@ -668,7 +668,7 @@ int main(int argc, char** argv) {
   if (!cameraExposure->settings().automatic) {
     sky::render::ExposureSettings metered = cameraExposure->settings();
     metered.automatic = true;
-    auto built = sky::render::AutoExposure::create(metered, settings.noiseSeed);
+    auto built = sky::render::AutoExposure::create(metered, settings.noiseSeed, settings.noiseCacheDir);
     if (!built) {
       std::fprintf(stderr, "skyshell-render: exposure: %s\n", sky::describe(built.error()).c_str());
       shutdown();

@@ -19,8 +19,9 @@ namespace {
 // log luminance of 576 rays does not need more), with the sun's light marched
 // per sample and the air per pixel: a shadow map or an air table built for
 // 576 rays would cost more than the rays.
-RenderSettings meterSettings(std::uint32_t noiseSeed) {
+RenderSettings meterSettings(std::uint32_t noiseSeed, const std::string& noiseCacheDir) {
   RenderSettings s;
+  s.noiseCacheDir = noiseCacheDir;
   s.width = kMeterWidth;
   s.height = kMeterHeight;
   s.verticalFov_deg = kMeterVerticalFov_deg;
@@ -41,12 +42,13 @@ double turn_deg(const geo::GeodeticPose& a, const geo::GeodeticPose& b) {
 AutoExposure::AutoExposure(const ExposureSettings& settings, std::optional<CpuReference> meter)
     : settings_(settings), meter_(std::move(meter)), adaptation_(settings.adaptationTau_s) {}
 
-Result<AutoExposure> AutoExposure::create(const ExposureSettings& settings, std::uint32_t noiseSeed) {
+Result<AutoExposure> AutoExposure::create(const ExposureSettings& settings, std::uint32_t noiseSeed,
+                                          const std::string& noiseCacheDir) {
   if (!(settings.adaptationTau_s > 0) || !(settings.meterPeriod_s > 0) || !std::isfinite(settings.fixedEv100) ||
       !std::isfinite(settings.compensation_ev))
     return fail(ErrorCode::InvalidArgument, "exposure: tau and meter period must be > 0, EV100 and compensation finite");
   if (!settings.automatic) return AutoExposure(settings, std::nullopt);
-  auto meter = CpuReference::create(meterSettings(noiseSeed));
+  auto meter = CpuReference::create(meterSettings(noiseSeed, noiseCacheDir));
   if (!meter) return tl::unexpected(meter.error());
   return AutoExposure(settings, std::move(*meter));
 }

@@ -5,13 +5,9 @@
 
 #include <algorithm>
 #include <exception>
-#include <map>
-#include <mutex>
-#include <tuple>
 #include <optional>
 
 #include "sky/core/assert.hpp"
-#include "sky/render/noise_cache.hpp"
 
 #include "atmosphere_tables.hpp"
 #include "blue_noise.hpp"
@@ -85,49 +81,6 @@ auto atVulkanEdge(const char* what, F&& body) -> decltype(body()) {
   }
 }
 
-// A noise texture for these settings from the cache when it holds it, else
-// from generate(size, seed); *report says which. The fingerprint is the
-// generator's output at fingerprintSize; its bytes per texel give the
-// channel count.
-NoiseVolume cachedNoise(const RenderSettings& settings, const char* kind, std::uint32_t generatorVersion,
-                        std::uint32_t size, std::uint32_t fingerprintSize,
-                        NoiseVolume (*generate)(std::uint32_t, std::uint32_t), std::string* report) {
-  // Without a disk cache the texture is generated: once per process for each
-  // (kind, version, seed, size), so a process creating many renderers (the
-  // bench: one per case) does not regenerate it (~1 s each in Release).
-  if (settings.noiseCacheDir.empty()) {
-    static std::mutex mutex;
-    static std::map<std::tuple<std::string, std::uint32_t, std::uint32_t, std::uint32_t>, NoiseVolume> generated;
-    const std::lock_guard lock(mutex);
-    const auto key = std::make_tuple(std::string(kind), generatorVersion, settings.noiseSeed, size);
-    auto it = generated.find(key);
-    if (it == generated.end()) it = generated.emplace(key, generate(size, settings.noiseSeed)).first;
-    *report += std::string(report->empty() ? "" : "; ") + kind + " noise " + std::to_string(size) + "^3 seed " +
-               std::to_string(settings.noiseSeed) + ": generated (no cache)";
-    return it->second;
-  }
-  const NoiseVolume tiny = generate(fingerprintSize, settings.noiseSeed);
-  const std::size_t tinyTexels = std::size_t(fingerprintSize) * fingerprintSize * fingerprintSize;
-  SKY_ASSERT(tinyTexels > 0 && tiny.texels.size() % tinyTexels == 0);
-  const NoiseKey key{kind, generatorVersion, settings.noiseSeed, size,
-                     static_cast<std::uint32_t>(tiny.texels.size() / tinyTexels), fnv1a64(tiny.texels)};
-  CachedNoise cached = loadOrGenerateNoise(settings.noiseCacheDir, key, [&] {
-    return generate(size, settings.noiseSeed).texels;
-  });
-  const char* how = cached.source == NoiseSource::Loaded        ? "loaded from "
-                    : cached.source == NoiseSource::Regenerated ? "regenerated into "
-                    : cached.path.empty()                       ? "generated (no cache)"
-                                                                : "generated into ";
-  *report += std::string(report->empty() ? "" : "; ") + kind + " noise " + std::to_string(size) + "^3 seed " +
-             std::to_string(settings.noiseSeed) + ": " + how + cached.path.string() +
-             (cached.note.empty() ? "" : " (" + cached.note + ")");
-  NoiseVolume volume;
-  volume.size = size;
-  volume.channels = key.channels;
-  volume.texels = std::move(cached.texels);
-  return volume;
-}
-
 // llvmpipe's shader compiler (lavapipe's) gives an invocation 65535 loop
 // iterations in all, shared by every loop (gallivm's
 // LP_MAX_TGSI_LOOP_ITERATIONS); past them every loop exits and the pixel is
@@ -165,10 +118,8 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
     auto weather = WeatherTexture::create(**ctx);
     if (!weather) return tl::unexpected(weather.error());
     std::string noiseReport;
-    const NoiseVolume shape = cachedNoise(settings, "shape", kShapeNoiseGeneratorVersion, kShapeNoiseSize,
-                                          kShapeNoiseFingerprintSize, makeShapeNoise, &noiseReport);
-    const NoiseVolume detail = cachedNoise(settings, "detail", kDetailNoiseGeneratorVersion, kDetailNoiseSize,
-                                           kDetailNoiseFingerprintSize, makeDetailNoise, &noiseReport);
+    const NoiseVolume shape = shapeNoiseFor(settings.noiseCacheDir, settings.noiseSeed, &noiseReport);
+    const NoiseVolume detail = detailNoiseFor(settings.noiseCacheDir, settings.noiseSeed, &noiseReport);
     AtmosphereTables atmosphere = sharedAtmosphereTables();
     // The size the cloud pass draws (FrameSetup::width).
     const std::uint32_t divisor = settings.resolution.divisor;

@@ -4,10 +4,10 @@
 
 namespace sky::render::cpu_core {
 
-std::shared_ptr<const CoreTables> makeCoreTables(std::uint32_t noiseSeed) {
+std::shared_ptr<const CoreTables> makeCoreTables(std::uint32_t noiseSeed, const std::string& noiseCacheDir) {
   auto tables = std::make_shared<CoreTables>();
-  tables->shape = makeShapeNoise(kShapeNoiseSize, noiseSeed);
-  tables->detail = makeDetailNoise(kDetailNoiseSize, noiseSeed);
+  tables->shape = shapeNoiseFor(noiseCacheDir, noiseSeed);
+  tables->detail = detailNoiseFor(noiseCacheDir, noiseSeed);
   tables->atmosphere = sharedAtmosphereTables();
   tables->blueNoise = blueNoiseTile(noiseSeed);
   return tables;

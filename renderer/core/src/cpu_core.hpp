@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -34,14 +35,15 @@ using gpu::kWindMapScale_mps;
 
 // What the CPU core reads besides the frame: the shape and detail noise,
 // the atmosphere's tables and the cloud pass's blue-noise tile, built as
-// the GPU's are from the settings' noise seed.
+// the GPU's are from the settings' noise seed (the noise from the disk
+// cache in noiseCacheDir when it holds it, as the GPU renderer's).
 struct CoreTables {
   NoiseVolume shape;
   NoiseVolume detail;
   AtmosphereTables atmosphere;
   std::vector<float> blueNoise;
 };
-std::shared_ptr<const CoreTables> makeCoreTables(std::uint32_t noiseSeed);
+std::shared_ptr<const CoreTables> makeCoreTables(std::uint32_t noiseSeed, const std::string& noiseCacheDir);
 
 class CpuCore : public GlslDouble {
  public:

@@ -16,7 +16,7 @@ CpuReference::CpuReference(RenderSettings settings, std::shared_ptr<const cpu_co
 
 Result<CpuReference> CpuReference::create(const RenderSettings& settings) {
   if (auto ok = validateSettings(settings); !ok) return tl::unexpected(ok.error());
-  auto tables = cpu_core::makeCoreTables(settings.noiseSeed);
+  auto tables = cpu_core::makeCoreTables(settings.noiseSeed, settings.noiseCacheDir);
   // The reference draws every pixel at full size: no resolution divisor.
   RenderSettings full = settings;
   full.resolution = {};

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -56,5 +57,13 @@ NoiseVolume makeShapeNoise(std::uint32_t size, std::uint32_t seed);
 // Detail noise, R: inverted Worley fBm of three octaves weighted 0.625, 0.25,
 // 0.125 (Haggstrom 2018 eq. 13), histogram-equalised.
 NoiseVolume makeDetailNoise(std::uint32_t size, std::uint32_t seed);
+
+// The shape and detail textures at their sizes for a seed, as every renderer
+// and CPU core uses them (cached_noise.cpp): loaded from the disk cache in
+// cacheDir when it holds them, else generated and written there; with no
+// cacheDir, generated once per process. *report, when given, gets what was
+// done (appended, "; "-separated).
+NoiseVolume shapeNoiseFor(const std::string& cacheDir, std::uint32_t seed, std::string* report = nullptr);
+NoiseVolume detailNoiseFor(const std::string& cacheDir, std::uint32_t seed, std::string* report = nullptr);
 
 }  // namespace sky::render

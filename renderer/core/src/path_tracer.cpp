@@ -344,7 +344,7 @@ PathTracer::PathTracer(RenderSettings settings, std::shared_ptr<const cpu_core::
 
 Result<PathTracer> PathTracer::create(const RenderSettings& settings) {
   if (auto ok = validateSettings(settings); !ok) return tl::unexpected(ok.error());
-  auto tables = cpu_core::makeCoreTables(settings.noiseSeed);
+  auto tables = cpu_core::makeCoreTables(settings.noiseSeed, settings.noiseCacheDir);
   RenderSettings full = settings;
   full.resolution = {};
   return PathTracer(full, std::move(tables));

@@ -54,9 +54,12 @@ struct FrameExposure {
 class AutoExposure {
  public:
   // Builds the meter's CPU reference (its noise and atmosphere tables, from
-  // noiseSeed: the channel's, the same on every channel) when automatic.
+  // noiseSeed: the channel's, the same on every channel) when automatic;
+  // the noise from the disk cache in noiseCacheDir when it holds it (the
+  // renderer's RenderSettings::noiseCacheDir; empty: generated).
   // Errors: InvalidArgument for a tau or period <= 0 or a non-finite EV.
-  static Result<AutoExposure> create(const ExposureSettings& settings, std::uint32_t noiseSeed);
+  static Result<AutoExposure> create(const ExposureSettings& settings, std::uint32_t noiseSeed,
+                                     const std::string& noiseCacheDir = {});
 
   // The exposure of the frame drawn from `frame` (its weather, clock, sun,
   // flashes and haze are metered; its camera and frustum are not) with the
