@@ -16,29 +16,16 @@ namespace sky::render {
 namespace {
 
 // A noise texture from the cache in cacheDir when it holds it, else from
-// generate(size, seed); *report says which. The fingerprint is the
-// generator's output at fingerprintSize; its bytes per texel give the
-// channel count.
-NoiseVolume cachedNoise(const std::string& cacheDir, std::uint32_t seed, const char* kind,
-                        std::uint32_t generatorVersion, std::uint32_t size, std::uint32_t fingerprintSize,
-                        NoiseVolume (*generate)(std::uint32_t, std::uint32_t), std::string* report) {
-  const auto say = [&](const std::string& what) {
-    if (report) *report += std::string(report->empty() ? "" : "; ") + what;
-  };
-  // Without a disk cache the texture is generated: once per process for each
-  // (kind, version, seed, size), so a process creating many renderers (the
-  // bench: one per case) or CPU references does not regenerate it (~1 s each
-  // in Release).
+// generate(size, seed) (and written to the cache); *report says which. The
+// fingerprint is the generator's output at fingerprintSize; its bytes per
+// texel give the channel count.
+NoiseVolume loadOrGenerate(const std::string& cacheDir, std::uint32_t seed, const char* kind,
+                           std::uint32_t generatorVersion, std::uint32_t size, std::uint32_t fingerprintSize,
+                           NoiseVolume (*generate)(std::uint32_t, std::uint32_t), std::string& report) {
+  const std::string what = std::string(kind) + " noise " + std::to_string(size) + "^3 seed " + std::to_string(seed);
   if (cacheDir.empty()) {
-    static std::mutex mutex;
-    static std::map<std::tuple<std::string, std::uint32_t, std::uint32_t, std::uint32_t>, NoiseVolume> generated;
-    const std::lock_guard lock(mutex);
-    const auto key = std::make_tuple(std::string(kind), generatorVersion, seed, size);
-    auto it = generated.find(key);
-    if (it == generated.end()) it = generated.emplace(key, generate(size, seed)).first;
-    say(std::string(kind) + " noise " + std::to_string(size) + "^3 seed " + std::to_string(seed) +
-        ": generated (no cache)");
-    return it->second;
+    report = what + ": generated (no cache)";
+    return generate(size, seed);
   }
   const NoiseVolume tiny = generate(fingerprintSize, seed);
   const std::size_t tinyTexels = std::size_t(fingerprintSize) * fingerprintSize * fingerprintSize;
@@ -50,13 +37,38 @@ NoiseVolume cachedNoise(const std::string& cacheDir, std::uint32_t seed, const c
                     : cached.source == NoiseSource::Regenerated ? "regenerated into "
                     : cached.path.empty()                       ? "generated (no cache)"
                                                                 : "generated into ";
-  say(std::string(kind) + " noise " + std::to_string(size) + "^3 seed " + std::to_string(seed) + ": " + how +
-      cached.path.string() + (cached.note.empty() ? "" : " (" + cached.note + ")"));
+  report = what + ": " + how + cached.path.string() + (cached.note.empty() ? "" : " (" + cached.note + ")");
   NoiseVolume volume;
   volume.size = size;
   volume.channels = key.channels;
   volume.texels = std::move(cached.texels);
   return volume;
+}
+
+// The texture once per process for each (cache folder, kind, version,
+// seed, size): a process creating many renderers (the bench: one per case)
+// or a renderer and its exposure meters' CPU references neither regenerates
+// it (~1 s in Release) nor reads and fingerprints the cache file again.
+// *report gets what was done the first time.
+NoiseVolume cachedNoise(const std::string& cacheDir, std::uint32_t seed, const char* kind,
+                        std::uint32_t generatorVersion, std::uint32_t size, std::uint32_t fingerprintSize,
+                        NoiseVolume (*generate)(std::uint32_t, std::uint32_t), std::string* report) {
+  struct Made {
+    NoiseVolume volume;
+    std::string report;
+  };
+  static std::mutex mutex;
+  static std::map<std::tuple<std::string, std::string, std::uint32_t, std::uint32_t, std::uint32_t>, Made> made;
+  const std::lock_guard lock(mutex);
+  const auto key = std::make_tuple(cacheDir, std::string(kind), generatorVersion, seed, size);
+  auto it = made.find(key);
+  if (it == made.end()) {
+    Made m;
+    m.volume = loadOrGenerate(cacheDir, seed, kind, generatorVersion, size, fingerprintSize, generate, m.report);
+    it = made.emplace(key, std::move(m)).first;
+  }
+  if (report) *report += std::string(report->empty() ? "" : "; ") + it->second.report;
+  return it->second.volume;
 }
 
 }  // namespace

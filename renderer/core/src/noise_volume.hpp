@@ -60,9 +60,9 @@ NoiseVolume makeDetailNoise(std::uint32_t size, std::uint32_t seed);
 
 // The shape and detail textures at their sizes for a seed, as every renderer
 // and CPU core uses them (cached_noise.cpp): loaded from the disk cache in
-// cacheDir when it holds them, else generated and written there; with no
-// cacheDir, generated once per process. *report, when given, gets what was
-// done (appended, "; "-separated).
+// cacheDir when it holds them, else generated (and written there when
+// cacheDir is not empty); once per process for each folder and seed.
+// *report, when given, gets what was done (appended, "; "-separated).
 NoiseVolume shapeNoiseFor(const std::string& cacheDir, std::uint32_t seed, std::string* report = nullptr);
 NoiseVolume detailNoiseFor(const std::string& cacheDir, std::uint32_t seed, std::string* report = nullptr);
 
