@@ -12,13 +12,7 @@ endif()
 # SKY_ASSERT stays active in every build of ours (tests and the demo run the
 # RelWithDebInfo build, and a broken invariant must stop there, not render junk).
 target_compile_definitions(sky_settings INTERFACE SKY_ENABLE_ASSERTS=1)
-if(SKY_FUZZ)
-  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
-    message(FATAL_ERROR "SKY_FUZZ needs clang: -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++")
-  endif()
-  target_compile_options(sky_settings INTERFACE -fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer)
-  target_link_options(sky_settings INTERFACE -fsanitize=address,undefined)
-elseif(SKY_TSAN)
+if(SKY_TSAN)
   # ThreadSanitizer (deploy/test --long): the processes of the integration
   # tests, built apart from the ASan tree since the two cannot be combined.
   # Asio's fenced blocks use std::atomic_thread_fence, which TSan does not
@@ -27,17 +21,31 @@ elseif(SKY_TSAN)
   target_compile_options(sky_settings INTERFACE -fsanitize=thread -fno-omit-frame-pointer)
   target_compile_definitions(sky_settings INTERFACE BOOST_ASIO_DISABLE_FENCED_BLOCK)
   target_link_options(sky_settings INTERFACE -fsanitize=thread)
+elseif(SKY_SANITIZE AND CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+  # deploy/test's tree (clang): every UBSan check, AddressSanitizer.
+  target_compile_options(sky_settings INTERFACE
+    -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
+  target_link_options(sky_settings INTERFACE -fsanitize=address,undefined)
 elseif(SKY_SANITIZE)
-  # Four of UBSan's checks are left to the clang fuzz tree (which keeps them
-  # all, on every parser of outside input): vptr, alignment, null and
+  # With GCC, four of UBSan's checks are left out: vptr, alignment, null and
   # pointer-overflow instrument nearly every member call, load and pointer
-  # step, and in GCC they were 40 % of this tree's compile time (http_api.cpp:
+  # step, and in GCC they were 40 % of the tree's compile time (http_api.cpp:
   # 56 s with them, 32 s without; without UBSan 28 s). AddressSanitizer still
   # stops a null or out-of-bounds access.
   target_compile_options(sky_settings INTERFACE
     -fsanitize=address,undefined -fno-sanitize=vptr,alignment,null,pointer-overflow
     -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
   target_link_options(sky_settings INTERFACE -fsanitize=address,undefined)
+endif()
+# SKY_FUZZ (clang, with SKY_SANITIZE): libFuzzer's coverage instrumentation on
+# every target, so the fuzz targets (tests/fuzz) link the same libraries as the
+# other tests of the tree; outside a fuzz target the coverage hooks are the
+# sanitizer runtime's empty defaults.
+if(SKY_FUZZ)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang" OR NOT SKY_SANITIZE)
+    message(FATAL_ERROR "SKY_FUZZ needs clang and SKY_SANITIZE: -DCMAKE_CXX_COMPILER=clang++-16 -DSKY_SANITIZE=ON")
+  endif()
+  target_compile_options(sky_settings INTERFACE -fsanitize=fuzzer-no-link)
 endif()
 
 # sky_add_library(name SOURCES ... DEPS ...): a library with a public include/

@@ -1,5 +1,5 @@
-# Compile-time savings for the trees deploy/test builds cold (the ASan+UBSan
-# tree with GCC, the clang fuzz tree), applied after every folder has defined
+# Compile-time savings for the tree deploy/test builds cold (clang: ASan,
+# UBSan and the fuzz targets), applied after every folder has defined
 # its targets, so the folders' CMakeLists.txt stay as they are. Measured with
 # /usr/bin/time on cold builds (user+sys CPU, the commit that added this file
 # has the numbers).
@@ -20,7 +20,7 @@ target_compile_definitions(sky_asio_beast PUBLIC
   BOOST_ASIO_NO_DEPRECATED BOOST_ASIO_SEPARATE_COMPILATION BOOST_BEAST_SEPARATE_COMPILATION)
 target_link_libraries(sky::asio INTERFACE sky_asio_beast)
 
-# Precompiled headers, clang only (the fuzz tree): the standard library and,
+# Precompiled headers, clang only (the test tree): the standard library and,
 # for the server library, Asio, Beast, nlohmann/json and spdlog, parsed once
 # per target instead of once per file. Third-party and standard headers only:
 # none of them depends on a macro our sources define before an include (those

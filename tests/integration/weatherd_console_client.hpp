@@ -15,11 +15,15 @@
 #include <boost/asio/write.hpp>
 // GCC 12 at -O2 reports a boost::optional inside Beast's HTTP response parser
 // (the client's handshake) as maybe uninitialized: a false positive.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <boost/beast/core.hpp>
 #include <boost/beast/websocket.hpp>
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 #include <nlohmann/json.hpp>
 
 #include "sky/stream/framing.hpp"

@@ -11,12 +11,16 @@
 #include <utility>  // before asio: Boost 1.74 asio uses std::exchange without including it
 // GCC 12 at -O2 reports a boost::optional inside Beast's HTTP response parser
 // (the client's handshake) as maybe uninitialized: a false positive.
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <boost/asio/executor_work_guard.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/websocket.hpp>
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
+#endif
 #include <nlohmann/json.hpp>
 
 #include "sky/server/http_api.hpp"
