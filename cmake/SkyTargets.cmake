@@ -21,17 +21,16 @@ if(SKY_TSAN)
   target_compile_options(sky_settings INTERFACE -fsanitize=thread -fno-omit-frame-pointer)
   target_compile_definitions(sky_settings INTERFACE BOOST_ASIO_DISABLE_FENCED_BLOCK)
   target_link_options(sky_settings INTERFACE -fsanitize=thread)
-elseif(SKY_SANITIZE AND CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
-  # deploy/test's tree (clang): every UBSan check, AddressSanitizer.
-  target_compile_options(sky_settings INTERFACE
-    -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
-  target_link_options(sky_settings INTERFACE -fsanitize=address,undefined)
 elseif(SKY_SANITIZE)
-  # With GCC, four of UBSan's checks are left out: vptr, alignment, null and
+  # Four of UBSan's checks are left out: vptr, alignment, null and
   # pointer-overflow instrument nearly every member call, load and pointer
-  # step, and in GCC they were 40 % of the tree's compile time (http_api.cpp:
-  # 56 s with them, 32 s without; without UBSan 28 s). AddressSanitizer still
-  # stops a null or out-of-bounds access.
+  # step. In GCC they were 40 % of the tree's compile time (http_api.cpp: 56 s
+  # with them, 32 s without; without UBSan 28 s). In deploy/test's clang tree
+  # with them, its cold run took 2537 s (over the 40 minutes), and the vptr
+  # check reported a false error in a process at its descriptor limit (it
+  # reads the object through a pipe), which a hostile test makes on purpose.
+  # AddressSanitizer still stops a null or out-of-bounds access, in the fuzz
+  # targets too.
   target_compile_options(sky_settings INTERFACE
     -fsanitize=address,undefined -fno-sanitize=vptr,alignment,null,pointer-overflow
     -fno-sanitize-recover=undefined -fno-omit-frame-pointer)

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <memory>
 #include <sstream>
@@ -159,7 +160,15 @@ TEST(HostileStream, AHandlerThatThrowsDoesNotEndTheServer) {
 int acceptBackoffChild() {
   auto server = makeServer();
   if (!server) return 10;
-  std::thread thread([&] { server->run(); });
+  // The thread is running before the limit is lowered: UBSan's vptr check
+  // of its first (virtual) call reads the object through a pipe, and with no
+  // descriptor left it would report the thread's own state as invalid.
+  std::atomic<bool> running{false};
+  std::thread thread([&] {
+    running = true;
+    server->run();
+  });
+  while (!running) std::this_thread::yield();
   int code = 0;
   {
     // Connected before the limit: the kernel completes the handshake into the
