@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Runs one libFuzzer binary for a bounded time on a scratch copy of its
-# committed seed corpus. Exit 77 (ctest: skipped) when the binary is absent;
-# non-zero with the crashing input's path when libFuzzer finds a crash.
+# committed seed corpus. Non-zero when the binary is absent (the test tree
+# builds it, so that is a failed build), and with the crashing input's path
+# when libFuzzer finds a crash.
 set -u
 bin=$1 corpus=$2 seconds=$3
 if [ ! -x "$bin" ]; then
-  echo "skipped: $bin not built (deploy/test builds it in build/test with clang, -DSKY_FUZZ=ON)"
-  exit 77
+  echo "FAIL: $bin not built (deploy/test builds it in build/test with clang, -DSKY_FUZZ=ON)"
+  exit 1
 fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
