@@ -38,10 +38,11 @@ struct Options {
 
 // The frames' claim: each within this fraction of the budget (above or below).
 constexpr double kHoldFraction = 0.2;
-// The level a probe frame is drawn at after each budgeted frame: its times
-// say how fast the machine ran while the budget did (it is shared, and its
-// speed drifts by a third within a minute).
-constexpr std::size_t kProbeLevel = 2;
+// After each budgeted frame a probe frame is drawn by a second renderer
+// with high's march at every pixel (no history, so its cost does not depend
+// on the budget's frames): its times against its times during the
+// calibration say how fast the machine ran while the budget did (it is
+// shared, and its speed drifts by a third within a minute).
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
@@ -72,6 +73,10 @@ double timedFrame(sky::render::CloudRenderer& r, const sky::render::FrameInputs&
     return -1;
   }
   return ms;
+}
+
+sky::Result<void> setLevel(sky::render::CloudRenderer& r, const sky::render::BudgetLevel& level) {
+  return r.setLevel(level.march, level.temporal, level.resolution);
 }
 
 // The most accurate level whose time fits the budget, else the cheapest.
@@ -115,12 +120,23 @@ int main(int argc, char** argv) {
   settings.width = o.width;
   settings.height = o.height;
   settings.march = preset->march;
+  settings.temporal = preset->temporal;
+  settings.resolution = preset->resolution;
   auto renderer = sky::render::CloudRenderer::create(settings);
   if (!renderer) {
     std::fprintf(stderr, "sky_frame_budget_bench: %s\n", sky::describe(renderer.error()).c_str());
     return renderer.error().code == sky::ErrorCode::NoDevice ? 77 : 1;
   }
   sky::render::CloudRenderer& r = **renderer;
+  sky::render::RenderSettings probeSettings;
+  probeSettings.width = o.width;
+  probeSettings.height = o.height;
+  auto probeRenderer = sky::render::CloudRenderer::create(probeSettings);
+  if (!probeRenderer) {
+    std::fprintf(stderr, "sky_frame_budget_bench: %s\n", sky::describe(probeRenderer.error()).c_str());
+    return 1;
+  }
+  sky::render::CloudRenderer& probeR = **probeRenderer;
   sky::weather::WeatherSnapshot snap;
   sky::weather::CloudLayer layer;
   layer.id = 1;
@@ -138,19 +154,27 @@ int main(int argc, char** argv) {
   // also builds what each level needs and is not counted), so the machine's
   // drift falls on all levels alike: the median per level, and the fastest
   // (the machine's other load only adds time, so the fastest frames give the
-  // levels' own relative costs best).
+  // levels' own relative costs best). After each change of level a frame is
+  // drawn untimed: a level drawn at another size than the last starts
+  // without a history, drawn whole.
   const std::size_t levels = ladder->size();
   std::vector<std::vector<double>> calibration(levels);
-  for (int round = 0; round < o.rounds; ++round)
+  std::vector<double> probesCalibrated;
+  for (int round = 0; round < o.rounds; ++round) {
+    const double probe = timedFrame(probeR, pathFrame(snap, std::uint64_t(2 * round)));
+    if (probe < 0) return 1;
+    if (round > 0) probesCalibrated.push_back(probe);
     for (std::size_t level = 0; level < levels; ++level) {
-      if (auto set = r.setMarch((*ladder)[level].march); !set) {
+      if (auto set = setLevel(r, (*ladder)[level]); !set) {
         std::fprintf(stderr, "sky_frame_budget_bench: %s\n", sky::describe(set.error()).c_str());
         return 1;
       }
-      const double ms = timedFrame(r, pathFrame(snap, std::uint64_t(round)));
+      if (timedFrame(r, pathFrame(snap, std::uint64_t(2 * round))) < 0) return 1;
+      const double ms = timedFrame(r, pathFrame(snap, std::uint64_t(2 * round + 1)));
       if (ms < 0) return 1;
       if (round > 0) calibration[level].push_back(ms);
     }
+  }
   std::vector<double> levelMs, fastestMs;
   for (const auto& ms : calibration) {
     levelMs.push_back(median(ms));
@@ -165,7 +189,6 @@ int main(int argc, char** argv) {
   // the first and the last), so one level in between fits.
   const std::size_t below = levels > 3 ? 1 : 0, above = levels > 3 ? 3 : levels - 1;
   const double budgetMs = 0.5 * (levelMs[below] + levelMs[above]);
-  const std::size_t probeLevel = std::min(kProbeLevel, levels - 1);
   std::printf("budget %.2f ms (halfway between levels %zu and %zu), level %zu fits at the calibration's speed\n",
               budgetMs, below, above, bestFitting(levelMs, budgetMs));
 
@@ -176,15 +199,14 @@ int main(int argc, char** argv) {
   std::printf("%5s %5s %9s %9s %7s %9s\n", "frame", "level", "ms", "budget", "ratio", "probe ms");
   for (int i = 0; i < o.frames; ++i) {
     const std::size_t drawnAt = budget.level();
-    if (auto set = r.setMarch(budget.current().march); !set) {
+    if (auto set = setLevel(r, budget.current()); !set) {
       std::fprintf(stderr, "sky_frame_budget_bench: %s\n", sky::describe(set.error()).c_str());
       return 1;
     }
     const double ms = timedFrame(r, pathFrame(snap, std::uint64_t(i)));
     if (ms < 0) return 1;
-    budget.update(ms);
-    if (auto set = r.setMarch((*ladder)[probeLevel].march); !set) return 1;
-    const double probe = timedFrame(r, pathFrame(snap, std::uint64_t(i)));
+    budget.update(ms, sky::render::timesLevel(budget.current(), r.lastTemporal()));
+    const double probe = timedFrame(probeR, pathFrame(snap, std::uint64_t(i)));
     if (probe < 0) return 1;
     std::printf("%5d %5zu %9.2f %9.2f %7.3f %9.2f%s\n", i, drawnAt, ms, budgetMs, ms / budgetMs, probe,
                 i < o.settle ? "  (settling)" : "");
@@ -195,14 +217,9 @@ int main(int argc, char** argv) {
     ++framesPerLevel[drawnAt];
   }
 
-  // The machine's speed while the budget ran: the probes' median over the
-  // probe level's calibrated time, taken from every level's through the
-  // ladder's relative costs (one level's reading can be off by a burst of
-  // the machine's other load).
-  std::vector<double> perUnitCost;
-  for (std::size_t level = 0; level < levels; ++level)
-    perUnitCost.push_back(levelMs[level] / (*ladder)[level].relativeCost);
-  const double speed = median(probes) / (median(perUnitCost) * (*ladder)[probeLevel].relativeCost);
+  // The machine's speed while the budget ran: the probes' median over
+  // their median during the calibration.
+  const double speed = median(probes) / median(probesCalibrated);
   std::vector<double> duringMs;
   for (double ms : levelMs) duringMs.push_back(ms * speed);
   const std::size_t fits = bestFitting(duringMs, budgetMs);

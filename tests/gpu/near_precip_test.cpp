@@ -212,5 +212,36 @@ TEST(NearPrecipGpu, ADryFrameRunsNoPassAndIsUnchanged) {
   EXPECT_EQ(wet->rgba, dry->rgba);
 }
 
+// A frame budget's change of level (CloudRenderer::setLevel) carries the
+// last image over as the new level's history, except after a frame that drew
+// drops near the camera over it: the history would keep them. Then the next
+// frame is drawn whole.
+TEST(NearPrecipGpu, AChangeOfLevelAfterDropsDrawsWhole) {
+  auto high = render::findPreset("high");
+  auto medium = render::findPreset("medium");
+  ASSERT_TRUE(high && medium);
+  render::RenderSettings settings;
+  settings.width = 160;
+  settings.height = 90;
+  settings.march = high->march;
+  auto r = render::CloudRenderer::create(settings);
+  if (!r && r.error().code == ErrorCode::NoDevice) GTEST_SKIP() << describe(r.error());
+  ASSERT_TRUE(r) << describe(r.error());
+  const weather::WeatherSnapshot snap = rainUnderADeck();
+  render::MarchSettings mediumMarch = medium->march;
+  mediumMarch.sunShadow = high->march.sunShadow;  // the renderer's map
+  ASSERT_TRUE((*r)->setLevel(high->march, high->temporal, high->resolution));
+  ASSERT_TRUE((*r)->render(frameAt(&snap, 0)));
+  ASSERT_GT((*r)->lastNearPrecip().streaks, 0u) << "the frame drew drops near the camera";
+  ASSERT_TRUE((*r)->setLevel(mediumMarch, medium->temporal, medium->resolution));
+  ASSERT_TRUE((*r)->render(frameAt(&snap, 1)));
+  EXPECT_TRUE((*r)->lastTemporal().drawnWhole);
+  EXPECT_EQ((*r)->lastTemporal().reason, "drawn another way, after drops near the camera");
+  // Within one level the history never holds the drops (the copy is taken
+  // before they are drawn): the next frame reuses it.
+  ASSERT_TRUE((*r)->render(frameAt(&snap, 2)));
+  EXPECT_FALSE((*r)->lastTemporal().drawnWhole) << (*r)->lastTemporal().reason;
+}
+
 }  // namespace
 }  // namespace sky::test

@@ -298,15 +298,29 @@ TEST(HeadlessOutputs, FrameBudgetIsRecordedPerFrame) {
     SCOPED_TRACE(f.dump());
     ASSERT_TRUE(f.contains("budget"));
     EXPECT_EQ(f["budget"]["target_ms"], 0.1);
-    EXPECT_EQ(f["budget"]["level"], i == 0 ? 0 : 4) << "the first frame at the preset, then the cheapest";
-    EXPECT_EQ(f["budget"]["name"], i == 0 ? "high" : "high/4");
-    EXPECT_EQ(f["budget"]["march"]["primary_steps"], i == 0 ? 48 : 12);
+    EXPECT_EQ(f["budget"]["level"], i == 0 ? 0 : 5) << "the first frame at the preset, then the cheapest";
+    EXPECT_EQ(f["budget"]["name"], i == 0 ? "high" : "realtime/1.5");
+    // high marches 48 samples evenly; realtime's way in steps of 60 m in
+    // cloud (40 m over 1.5), 1 pixel of 16 at half size.
+    EXPECT_EQ(f["budget"]["march"]["primary_steps"], i == 0 ? 48 : 256);
+    EXPECT_EQ(f["budget"]["march"]["cloud_step_m"], i == 0 ? 0.0 : 60.0);
+    EXPECT_EQ(f["budget"]["interleave"], i == 0 ? 1 : 4);
+    EXPECT_EQ(f["budget"]["resolution_divisor"], i == 0 ? 1 : 2);
     EXPECT_GT(f["budget"]["expected_psnr_db"].get<double>(), 0.0);
     EXPECT_EQ(f["budget"]["predicted_ms"].get<double>() > 0, i > 0) << "no prediction before the first frame";
+    // From the second frame on the frames are interleaved: the first of
+    // them at half size has no history of that size.
+    ASSERT_EQ(f.contains("temporal"), i > 0);
+    if (i == 1) {
+      EXPECT_EQ(f["temporal"]["reason"], "drawn at another size");
+    }
+    if (i > 1) {
+      EXPECT_EQ(f["temporal"]["drawn_whole"], false);
+    }
   }
   EXPECT_EQ(run.report["budget"]["target_ms"], 0.1);
   EXPECT_EQ(run.report["budget"]["frames_per_level"]["high"], 1);
-  EXPECT_EQ(run.report["budget"]["frames_per_level"]["high/4"], kFrames - 1);
+  EXPECT_EQ(run.report["budget"]["frames_per_level"]["realtime/1.5"], kFrames - 1);
   // reference has no cheaper level: refused, naming the option.
   ChildProcess refused({SKY_RENDER, "--headless", "--replay", SKY_TEST_FLIGHT, "--weather-file", SKY_SCENARIO_CLOUDY,
                         "--out", (fs::path(SKY_TEST_OUTPUT_DIR) / "outputs-budget-refused").string(), "--preset",

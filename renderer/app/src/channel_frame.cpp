@@ -48,7 +48,8 @@ tl::expected<DrawnFrame, FrameFailure> ChannelFrames::draw(const FrameRequest& r
   FrameRecord& record = out.record;
   const std::string frameName = "frame " + std::to_string(r.frameIndex) + ": ";
   if (budget_ && budget_->level() != appliedLevel_) {
-    if (auto ok = renderer_->setMarch(budget_->current().march); !ok)
+    const render::BudgetLevel& level = budget_->current();
+    if (auto ok = renderer_->setLevel(level.march, level.temporal, level.resolution); !ok)
       return tl::unexpected(FrameFailure{3, frameName + "frame budget: " + describe(ok.error())});
     appliedLevel_ = budget_->level();
   }
@@ -57,8 +58,9 @@ tl::expected<DrawnFrame, FrameFailure> ChannelFrames::draw(const FrameRequest& r
   if (budget_) {
     const render::BudgetLevel& level = budget_->current();
     record.budget = FrameRecord::Budget{budget_->target_ms(), budget_->level(), level.name,
-                                        budget_->predicted_ms(budget_->level()), level.expectedPsnr_db, level.march};
-    budget_->update(record.render_ms);
+                                        budget_->predicted_ms(budget_->level()), level.expectedPsnr_db, level.march,
+                                        level.temporal.interleave, level.resolution.divisor};
+    budget_->update(record.render_ms, render::timesLevel(level, record.temporal));
   }
   out.image = std::move(*image);
   // The camera meters the host's boresight, not this channel's view. The

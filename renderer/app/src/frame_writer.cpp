@@ -187,9 +187,11 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
                       {"name", r.budget->name},
                       {"predicted_ms", r.budget->predicted_ms},
                       {"expected_psnr_db", r.budget->expectedPsnr_db},
-                      {"march", marchJson(r.budget->march)}};
+                      {"march", marchJson(r.budget->march)},
+                      {"interleave", r.budget->interleave},
+                      {"resolution_divisor", r.budget->divisor}};
   if (r.presentDelay_ms) line["present_delay_ms"] = *r.presentDelay_ms;
-  if (s.temporal.interleave > 1) {
+  if (s.temporal.interleave > 1 || (r.budget && r.budget->interleave > 1)) {
     const render::TemporalReport& t = r.temporal;
     line["temporal"] = {{"drawn_whole", t.drawnWhole}, {"reason", t.reason}, {"interleave", t.interleave},
                         {"drawn", t.drawn},           {"fresh_edge_pixels", t.freshEdgePixels},

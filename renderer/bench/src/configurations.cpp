@@ -136,7 +136,10 @@ Result<Configuration> customConfiguration(const std::string& spec) {
       if (std::size_t(v) >= ladder->size())
         return fail(ErrorCode::InvalidArgument, "custom configuration '" + spec + "': " + base->name + "'s ladder has " +
                                                     std::to_string(ladder->size()) + " levels");
-      m = (*ladder)[std::size_t(v)].march;
+      const render::BudgetLevel& level = (*ladder)[std::size_t(v)];
+      m = level.march;
+      c.settings.temporal = level.temporal;
+      c.settings.resolution = level.resolution;
     }
     else if (key == "air-table" && (v == 0 || v == 1)) m.airTable.enabled = v == 1;
     else if (key == "air-azimuths") m.airTable.azimuths = std::uint32_t(v);

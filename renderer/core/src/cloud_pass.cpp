@@ -235,6 +235,25 @@ std::size_t CloudPass::variantsBuilt() const {
   return n;
 }
 
+void CloudPass::resizeAirTable(const GpuContext& ctx, const AirTableSettings& airTable) {
+  SKY_ASSERT(airTableSize_.enabled && airTable.enabled);
+  if (airTable.azimuths == airTableSize_.azimuths && airTable.zeniths == airTableSize_.zeniths &&
+      airTable.slices == airTableSize_.slices)
+    return;
+  // The old image is unused once the last run's fence was waited for.
+  airTableSize_ = airTable;
+  airTable_ = createStorageVolume(ctx, vk::Format::eR32G32B32A32Sfloat,
+                                  vk::Extent3D(airTable.azimuths, airTable.zeniths, 3 * airTable.slices),
+                                  "sky.airTable");
+  const vk::DescriptorImageInfo outInfo({}, *airTable_.view, vk::ImageLayout::eGeneral);
+  const vk::DescriptorImageInfo inInfo(*airTableSampler_, *airTable_.view, vk::ImageLayout::eGeneral);
+  const std::array writes{
+      vk::WriteDescriptorSet(*descriptorSet_, gpu::kBindingAirTableOut, 0, vk::DescriptorType::eStorageImage, outInfo),
+      vk::WriteDescriptorSet(*descriptorSet_, gpu::kBindingAirTable, 0, vk::DescriptorType::eCombinedImageSampler,
+                             inInfo)};
+  ctx.device().updateDescriptorSets(writes, {});
+}
+
 void CloudPass::setCoverageMip(const std::vector<float>& mip) {
   SKY_ASSERT(mip.size() * sizeof(float) == coverageMip_.size);
   std::memcpy(coverageMip_.mapped, mip.data(), coverageMip_.size);
@@ -291,6 +310,10 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
   commands_.reset();
   commands_.begin(vk::CommandBufferBeginInfo(vk::CommandBufferUsageFlagBits::eOneTimeSubmit));
   timer_.begin(commands_);
+  if (next.seedHistory.first) {
+    SKY_ASSERT(next.reproject != nullptr && next.seedHistory.second);
+    next.reproject->seedHistory(commands_, next.seedHistory.first, next.seedHistory.second);
+  }
   // The tables' old contents are never read again: from eUndefined each frame.
   const vk::ImageSubresourceRange whole(vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1);
   const vk::ImageSubresourceRange allLayers(vk::ImageAspectFlagBits::eColor, 0, 1, 0, sunMap_.layers);
@@ -370,7 +393,8 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
 
   if (next.upscale != nullptr) return next.upscale->readBack();
   if (next.reproject != nullptr) return next.reproject->readBack();
-  return readImage(output_, depth_, width_, height_);
+  SKY_ASSERT(frame.image.x <= width_ && frame.image.y <= height_);
+  return readImage(output_, depth_, frame.image.x, frame.image.y);
 }
 
 }  // namespace sky::render

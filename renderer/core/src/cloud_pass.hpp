@@ -51,6 +51,10 @@ class CloudPass {
   struct Followers {
     ReprojectPass* reproject = nullptr;
     const gpu::SkyReproject* reprojectParams = nullptr;
+    // A history for the reprojection from another pass's last image of the
+    // same size (its radiance + transmittance and cloud depth buffers),
+    // copied in first, before this frame's clouds overwrite either.
+    std::pair<vk::Buffer, vk::Buffer> seedHistory{};
     std::span<const std::uint32_t> dropCells;  // the history-drop mask, when reprojectParams->drop.w is set
     UpscalePass* upscale = nullptr;
     const gpu::SkyUpscale* upscaleParams = nullptr;
@@ -71,6 +75,10 @@ class CloudPass {
     return {*weatherSampler_, weatherView_, vk::ImageLayout::eShaderReadOnlyOptimal};
   }
   const GpuBuffer& depth() const { return depth_; }
+  // Gives the air table this size (both it and the table the pass was
+  // built with enabled): a new image, its old contents are not kept (each
+  // frame builds its table). Call between runs. Vulkan failures throw.
+  void resizeAirTable(const GpuContext& ctx, const AirTableSettings& airTable);
   // Replaces the max-coverage mip the march reads (coverage_mip.hpp; size
   // kMaxLayers x kCoverageMipSize^2). Call between runs.
   void setCoverageMip(const std::vector<float>& mip);

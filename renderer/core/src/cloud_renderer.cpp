@@ -27,21 +27,102 @@
 
 namespace sky::render {
 
+// The passes after the clouds for one way of drawing the image (the
+// interleave's history, the resolution divisor), and the drops near the
+// camera over the image they end with.
+struct FollowerChain {
+  std::uint32_t divisor = 1;
+  bool interleaved = false;
+  // What the reprojection's shader was built with (TemporalSettings).
+  bool historyClip = false, sharpHistory = false, freshEdges = false;
+  std::optional<ReprojectPass> reproject;  // with interleaving
+  std::optional<UpscalePass> upscale;      // with a divisor
+  // Built at the first frame with drops to draw (or by buildAllVariants):
+  // a renderer that never meets precipitation never compiles its shaders.
+  std::optional<NearPrecipPass> nearPass;
+
+  bool drawsLike(const RenderSettings& s) const {
+    const TemporalSettings& t = s.temporal;
+    return divisor == s.resolution.divisor && interleaved == (t.interleave > 1) &&
+           (!interleaved || (historyClip == (t.historyClip > 0) && sharpHistory == t.sharpHistory &&
+                             freshEdges == t.freshEdges));
+  }
+  // The last frame's image (radiance + transmittance, cloud depth) at the
+  // size another chain's history has: the reprojection's or the clouds'
+  // own at this chain's divisor, the upscale's at full size (divisor 1);
+  // none at another size.
+  std::optional<std::pair<vk::Buffer, vk::Buffer>> imageFor(std::uint32_t historyDivisor,
+                                                            const CloudPass& pass) const {
+    if (historyDivisor == divisor)
+      return reproject ? std::pair{*reproject->output().buffer, *reproject->depth().buffer}
+                       : std::pair{*pass.output().buffer, *pass.depth().buffer};
+    if (historyDivisor == 1 && upscale) return std::pair{*upscale->output().buffer, *upscale->depth().buffer};
+    return std::nullopt;
+  }
+  // The buffer of the image the frame ends with, which the host reads back.
+  const GpuBuffer& finalImage(const CloudPass& pass) const {
+    return upscale ? upscale->output() : reproject ? reproject->output() : pass.output();
+  }
+};
+
+namespace {
+
+// The chain for drawing with `settings`, its passes reading `pass`'s output.
+Result<std::unique_ptr<FollowerChain>> buildChain(const GpuContext& ctx, const CloudPass& pass,
+                                                  const RenderSettings& settings) {
+  auto chain = std::make_unique<FollowerChain>();
+  const TemporalSettings& t = settings.temporal;
+  chain->divisor = settings.resolution.divisor;
+  chain->interleaved = t.interleave > 1;
+  chain->historyClip = chain->interleaved && t.historyClip > 0;
+  chain->sharpHistory = chain->interleaved && t.sharpHistory;
+  chain->freshEdges = chain->interleaved && t.freshEdges;
+  // The size the cloud pass draws (FrameSetup::width).
+  const std::uint32_t smallW = drawnExtent(settings.width, chain->divisor);
+  const std::uint32_t smallH = drawnExtent(settings.height, chain->divisor);
+  if (chain->interleaved) {
+    auto created = ReprojectPass::create(ctx, smallW, smallH, pass.output(), pass.depth(), chain->historyClip,
+                                         chain->sharpHistory, chain->freshEdges, pass.weatherDescriptor());
+    if (!created) return tl::unexpected(created.error());
+    chain->reproject.emplace(std::move(*created));
+  }
+  if (chain->divisor > 1) {
+    UpscalePass::Input input;
+    if (chain->reproject)
+      input.images = &chain->reproject->image();
+    else
+      input.buffers = {&pass.output(), &pass.depth()};
+    auto created = UpscalePass::create(ctx, smallW, smallH, settings.width, settings.height, input);
+    if (!created) return tl::unexpected(created.error());
+    chain->upscale.emplace(std::move(*created));
+  }
+  return chain;
+}
+
+}  // namespace
+
 struct CloudRenderer::Impl {
-  // Destroyed in reverse order: the presenter, the reprojection pass (which
-  // binds the cloud pass's output), the pass (which binds the weather image)
-  // before the weather texture, all before the context that owns the device.
+  // Destroyed in reverse order: the presenter, the chains (whose
+  // reprojection and upscale bind the cloud pass's output), the pass (which
+  // binds the weather image) before the weather texture, all before the
+  // context that owns the device.
   std::unique_ptr<GpuContext> ctx;
   WeatherTexture weather;
   CloudPass pass;
-  std::optional<ReprojectPass> reproject;  // with interleaving (settings.temporal.interleave > 1)
-  std::optional<UpscalePass> upscale;      // with a resolution divisor (settings.resolution.divisor > 1)
+  // The ways of drawing built so far (setLevel), the current one first.
+  std::vector<std::unique_ptr<FollowerChain>> chains;
+  // The chain the last frame ended with (null before the first): a change
+  // of chain carries its history over, or draws the frame whole.
+  const FollowerChain* lastChain = nullptr;
+  bool lastStreaks = false;  // the last frame drew drops near the camera over its image
   TemporalPlanner planner;
   std::optional<Presenter> presenter;
   RenderSettings settings;
+  // The cloud pass's size as built: no level draws more.
+  std::uint32_t builtDivisor = 1;
   AtmosphereTables atmosphere;  // CPU copy: the frame setup's sky light reads it
-  std::vector<PassTime> passTimes;
-  std::string noiseReport;
+  std::vector<PassTime> passTimes{};
+  std::string noiseReport{};
   std::uint64_t coverageMipUploads = ~std::uint64_t(0);  // weather uploads the pass's coverage mip is of
   std::vector<float> coverageMip{};                       // its CPU copy (updated per tile as the map is)
   TemporalReport temporal{};  // what the reprojection did with the last frame
@@ -50,21 +131,18 @@ struct CloudRenderer::Impl {
   NearPrecipSource nearSource{};
   NearPrecipFrame nearFrame{};  // the last frame's streaks (kept for its buffers)
   NearPrecipReport nearReport{};
-  // Built at the first frame with drops to draw (or by buildAllVariants):
-  // a renderer that never meets precipitation never compiles its shaders.
-  std::optional<NearPrecipPass> nearPass{};
+  // The planner follows every frame, with a history or not (setLevel).
+  bool plansAlways = false;
 
-  // The buffer of the image the frame ends with, which the host reads back.
-  const GpuBuffer& finalImage() const {
-    return upscale ? upscale->output() : reproject ? reproject->output() : pass.output();
-  }
+  FollowerChain& chain() { return *chains.front(); }
   Result<NearPrecipPass*> nearPrecipPass() {
-    if (!nearPass) {
-      auto created = NearPrecipPass::create(*ctx, settings.width, settings.height, finalImage());
+    FollowerChain& c = chain();
+    if (!c.nearPass) {
+      auto created = NearPrecipPass::create(*ctx, settings.width, settings.height, c.finalImage(pass));
       if (!created) return tl::unexpected(created.error());
-      nearPass.emplace(std::move(*created));
+      c.nearPass.emplace(std::move(*created));
     }
-    return &*nearPass;
+    return &*c.nearPass;
   }
 };
 
@@ -121,43 +199,25 @@ Result<std::unique_ptr<CloudRenderer>> CloudRenderer::create(const RenderSetting
     const NoiseVolume shape = shapeNoiseFor(settings.noiseCacheDir, settings.noiseSeed, &noiseReport);
     const NoiseVolume detail = detailNoiseFor(settings.noiseCacheDir, settings.noiseSeed, &noiseReport);
     AtmosphereTables atmosphere = sharedAtmosphereTables();
-    // The size the cloud pass draws (FrameSetup::width).
-    const std::uint32_t divisor = settings.resolution.divisor;
-    const std::uint32_t smallW = drawnExtent(settings.width, divisor);
-    const std::uint32_t smallH = drawnExtent(settings.height, divisor);
-    auto pass = CloudPass::create(**ctx, smallW, smallH, shape, detail, atmosphere, *weather,
-                                  blueNoiseTile(settings.noiseSeed), settings.march.airTable,
+    auto pass = CloudPass::create(**ctx, drawnExtent(settings.width, settings.resolution.divisor),
+                                  drawnExtent(settings.height, settings.resolution.divisor), shape, detail,
+                                  atmosphere, *weather, blueNoiseTile(settings.noiseSeed), settings.march.airTable,
                                   settings.march.sunShadow);
     if (!pass) return tl::unexpected(pass.error());
-    std::optional<ReprojectPass> reproject;
-    if (settings.temporal.interleave > 1) {
-      auto created = ReprojectPass::create(**ctx, smallW, smallH, pass->output(), pass->depth(),
-                                           settings.temporal.historyClip > 0, settings.temporal.sharpHistory,
-                                           settings.temporal.freshEdges, pass->weatherDescriptor());
-      if (!created) return tl::unexpected(created.error());
-      reproject.emplace(std::move(*created));
-    }
-    std::optional<UpscalePass> upscale;
-    if (divisor > 1) {
-      UpscalePass::Input input;
-      if (reproject)
-        input.images = &reproject->image();
-      else
-        input.buffers = {&pass->output(), &pass->depth()};
-      auto created = UpscalePass::create(**ctx, smallW, smallH, settings.width, settings.height, input);
-      if (!created) return tl::unexpected(created.error());
-      upscale.emplace(std::move(*created));
-    }
+    auto chain = buildChain(**ctx, *pass, settings);
+    if (!chain) return tl::unexpected(chain.error());
     std::optional<Presenter> presenter;
     if (gpu.window) {
       auto created = Presenter::create(**ctx, *gpu.window);
       if (!created) return tl::unexpected(created.error());
       presenter.emplace(std::move(*created));
     }
-    auto impl = std::make_unique<Impl>(Impl{std::move(*ctx), std::move(*weather), std::move(*pass),
-                                            std::move(reproject), std::move(upscale),
-                                            TemporalPlanner(settings.temporal), std::move(presenter), settings,
-                                            std::move(atmosphere), {}, std::move(noiseReport)});
+    std::vector<std::unique_ptr<FollowerChain>> chains;
+    chains.push_back(std::move(*chain));
+    auto impl = std::make_unique<Impl>(Impl{std::move(*ctx), std::move(*weather), std::move(*pass), std::move(chains),
+                                            nullptr, false, TemporalPlanner(settings.temporal), std::move(presenter),
+                                            settings, settings.resolution.divisor, std::move(atmosphere)});
+    impl->noiseReport = std::move(noiseReport);
     return std::unique_ptr<CloudRenderer>(new CloudRenderer(std::move(impl)));
   });
 }
@@ -208,23 +268,45 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
     // reprojection's block; with a divisor the upscale follows.
     CloudPass::Followers next;
     std::optional<TemporalPlan> plan;
-    if (impl_->reproject) {
-      plan = impl_->planner.plan(setup, inputs, edit);
+    FollowerChain& chain = impl_->chain();
+    // A change of the way of drawing (setLevel): the history carries over
+    // from the last frame's image at the new way's size (copied before the
+    // clouds overwrite it), the upscaled one when the new way draws every
+    // pixel's size. There is none from a larger image to a smaller (it
+    // would need a resampling pass), nor when the drops near the camera
+    // were drawn over the last image (the history would keep them).
+    if (chain.reproject && impl_->lastChain != nullptr && impl_->lastChain != &chain) {
+      const auto last = impl_->lastChain->imageFor(chain.divisor, impl_->pass);
+      if (impl_->lastStreaks)
+        impl_->planner.forget("drawn another way, after drops near the camera");
+      else if (!last)
+        impl_->planner.forget("drawn at another size");
+      else
+        next.seedHistory = *last;
+    }
+    // Without interleaving the planner runs only once the way of drawing
+    // may change: it then knows the previous frame when a level with a
+    // history follows.
+    if (chain.reproject || impl_->plansAlways) {
+      const TemporalPlan planned = impl_->planner.plan(setup, inputs, edit);
+      if (chain.reproject) plan = planned;
+    }
+    if (chain.reproject) {
       setup.interleave = plan->interleave;
       setup.phase = plan->phase;
       setup.freshEdges = plan->freshEdges;
       setup.jitterShift = plan->jitterShift;
       setup.pixelShift = plan->pixelShift;
       setup.pixelJitter = plan->pixelJitter;
-      next.reproject = &*impl_->reproject;
+      next.reproject = &*chain.reproject;
       next.reprojectParams = &plan->params;
       next.dropCells = plan->drop.cells;
     }
     const gpu::SkyFrame frame = packFrame(setup);
     gpu::SkyUpscale upscaleBlock{};
-    if (impl_->upscale) {
+    if (chain.upscale) {
       upscaleBlock = upscaleParams(frame, impl_->settings.resolution, impl_->settings.width, impl_->settings.height);
-      next.upscale = &*impl_->upscale;
+      next.upscale = &*chain.upscale;
       next.upscaleParams = &upscaleBlock;
     }
     // The drops near the camera, when it is in precipitation.
@@ -250,13 +332,16 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
     }
     auto image = impl_->pass.run(*impl_->ctx, frame, next);
     if (!image) {
-      if (plan) impl_->planner.forget();
+      impl_->planner.forget();
+      impl_->lastChain = nullptr;
       if (sunMap) impl_->sunMaps.forget();
       return image;
     }
+    impl_->lastChain = &chain;
+    impl_->lastStreaks = next.nearPrecip != nullptr;
     for (auto& t : impl_->pass.lastTimes()) impl_->passTimes.push_back(std::move(t));
     if (plan) {
-      impl_->temporal = impl_->reproject->counts();
+      impl_->temporal = chain.reproject->counts();
       impl_->temporal.drawnWhole = plan->drawWhole;
       impl_->temporal.reason = plan->reason;
       impl_->temporal.interleave = plan->interleave;
@@ -286,13 +371,13 @@ Result<std::size_t> CloudRenderer::buildAllVariants() {
   return atVulkanEdge("building the pass's variants", [&]() -> Result<std::size_t> {
     auto built = impl_->pass.buildAllVariants(*impl_->ctx);
     if (!built) return built;
-    const bool had = impl_->nearPass.has_value();
+    const bool had = impl_->chain().nearPass.has_value();
     if (auto near = impl_->nearPrecipPass(); !near) return tl::unexpected(near.error());
     return *built + (had ? 0 : 2);
   });
 }
 
-std::size_t CloudRenderer::variantsBuilt() const { return impl_->pass.variantsBuilt() + (impl_->nearPass ? 2 : 0); }
+std::size_t CloudRenderer::variantsBuilt() const { return impl_->pass.variantsBuilt() + (impl_->chains.front()->nearPass ? 2 : 0); }
 
 const std::string& CloudRenderer::noiseReport() const { return impl_->noiseReport; }
 
@@ -317,20 +402,47 @@ std::string CloudRenderer::deviceName() const { return impl_->ctx->deviceName();
 const RenderSettings& CloudRenderer::settings() const { return impl_->settings; }
 
 Result<void> CloudRenderer::setMarch(const MarchSettings& march) {
+  return setLevel(march, impl_->settings.temporal, impl_->settings.resolution);
+}
+
+Result<void> CloudRenderer::setLevel(const MarchSettings& march, const TemporalSettings& temporal,
+                                     const ResolutionSettings& resolution) {
   RenderSettings next = impl_->settings;
   next.march = march;
+  next.temporal = temporal;
+  next.resolution = resolution;
   if (auto ok = validateSettings(next); !ok) return ok;
-  const AirTableSettings &was = impl_->settings.march.airTable, &now = march.airTable;
-  if (was.enabled != now.enabled ||
-      (now.enabled && (was.azimuths != now.azimuths || was.zeniths != now.zeniths || was.slices != now.slices)))
-    return fail(ErrorCode::InvalidArgument, "CloudRenderer::setMarch: the air table is fixed when the renderer is built");
+  if (impl_->settings.march.airTable.enabled != march.airTable.enabled)
+    return fail(ErrorCode::InvalidArgument,
+                "CloudRenderer::setLevel: whether the air table is on is fixed when the renderer is built");
   if (auto ok = checkLoopBudget(march, impl_->ctx->deviceName()); !ok) return ok;
   const SunMapSettings &sunWas = impl_->settings.march.sunShadow, &sunNow = march.sunShadow;
   if (sunWas.method != sunNow.method || sunWas.size != sunNow.size || sunWas.cascades != sunNow.cascades)
     return fail(ErrorCode::InvalidArgument,
-                "CloudRenderer::setMarch: the sun shadow's method and map size are fixed when the renderer is built");
-  impl_->settings = next;
-  return {};
+                "CloudRenderer::setLevel: the sun shadow's method and map size are fixed when the renderer is built");
+  // The cloud pass's buffers hold the image at the divisor it was built
+  // with; a multiple of it draws fewer pixels into them.
+  if (resolution.divisor % impl_->builtDivisor != 0)
+    return fail(ErrorCode::InvalidArgument, "CloudRenderer::setLevel: resolution divisor " +
+                                                std::to_string(resolution.divisor) + " draws more pixels than the " +
+                                                std::to_string(impl_->builtDivisor) + " the renderer was built with");
+  return atVulkanEdge("CloudRenderer::setLevel", [&]() -> Result<void> {
+    auto& chains = impl_->chains;
+    auto found = std::find_if(chains.begin(), chains.end(),
+                              [&](const std::unique_ptr<FollowerChain>& c) { return c->drawsLike(next); });
+    if (found == chains.end()) {
+      auto built = buildChain(*impl_->ctx, impl_->pass, next);
+      if (!built) return tl::unexpected(built.error());
+      chains.push_back(std::move(*built));
+      found = chains.end() - 1;
+    }
+    std::rotate(chains.begin(), found, found + 1);
+    if (march.airTable.enabled) impl_->pass.resizeAirTable(*impl_->ctx, march.airTable);
+    impl_->settings = next;
+    impl_->planner.setSettings(temporal);
+    impl_->plansAlways = true;
+    return {};
+  });
 }
 
 }  // namespace sky::render

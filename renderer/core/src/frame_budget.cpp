@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 #include "sky/core/assert.hpp"
 
@@ -17,37 +18,58 @@ namespace {
 constexpr std::array<double, 5> kStepFactors = {1.0, 1.5, 2.0, 3.0, 4.0};
 
 // Each preset's ladder measured with skyshell-bench on this machine (2-core
-// AMD EPYC VM, lavapipe, Release; 2026-12-04): frame time over the first
-// level's (the sums over the scenes) and the mean PSNR against reference
-// (the sun's column marched), 320x180, the still scenes cumulus-midday,
-// sunset-backlit, cumulonimbus, godrays and overcast-below:
-//   skyshell-bench --scenes cumulus-midday,sunset-backlit,cumulonimbus,godrays,overcast-below
-//     --configs "P-0:base=P,budget=0;...;P-4:base=P,budget=4" --resolution 320x180 --warmup 1 --repeats 3
-// A ladder ends where the next level saved less than 2 % of the time (or
-// cost more: medium's third level measured 0.955 after its second's 0.918,
-// low's third 0.924 after 0.941). With the sun from a map the samples are
-// a smaller part of a frame than they were with the light march: the map's
-// reads by the air table and the ground, the reprojection and the upscale
-// do not scale with them, so only high has a ladder of any range. The
-// controller learns the absolute scale while it runs; these give the shape.
+// AMD EPYC VM, lavapipe, LP_NUM_THREADS=2, Release; 2026-12-06): a level's
+// frame time over the first level's (the sums of the scenes' median frame
+// times) and its mean PSNR against reference (the sun's column marched),
+// 320x180, over the still scenes cumulus-midday, sunset-backlit,
+// cumulonimbus, godrays and overcast-below and the camera paths fast-turn
+// and glider-thermal (each path's mean over its frames: the interleaved
+// ways are judged in motion too, where their history lags):
+//   skyshell-bench --scenes cumulus-midday,sunset-backlit,cumulonimbus,godrays,overcast-below,fast-turn,glider-thermal
+//     --configs "P-0:base=P,budget=0;...;P-K:base=P,budget=K" --resolution 320x180 --warmup 1 --repeats 3
+// run with every candidate in the ladder: the preset's march over 1, 1.5,
+// 2, 3 and 4 (high), or 1 and 1.5 (the others), then each cheaper preset's
+// way at its marches over 1 and 1.5 (and realtime's at 1/4 size). A
+// ladder keeps the preset's own way first and, of the rest, those no other
+// candidate beats on both time and error (the Pareto front), less
+// accurate than the first. Dropped that way: high's cheaper marches (medium's
+// way is more accurate at under half their time: 40.72 dB at 0.457
+// against 38.48 dB at 0.895 for high/1.5); realtime's own march as a level
+// of the others (high's: 0.086, 33.74 dB) behind realtime/1.5 (0.076,
+// 33.86 dB: its longer steps cost nothing in error on these scenes); and in
+// realtime's own ladder realtime/1.5 (0.806, 33.54 dB), which is not less
+// accurate than realtime (33.43 dB).
+struct Step {
+  const char* preset;      // whose way of drawing (march, interleave, divisor, air table)
+  std::size_t marchLevel;  // its march over kStepFactors[marchLevel]
+  double relativeCost;
+  double psnr_db;
+  std::uint32_t divisor = 0;  // the resolution divisor; 0: the preset's
+};
 struct Measured {
   const char* preset;
-  std::size_t levels;
-  std::array<double, kStepFactors.size()> relativeCost;
-  std::array<double, kStepFactors.size()> psnr_db;
+  std::vector<Step> steps;
 };
-constexpr std::array<Measured, 4> kMeasured = {{
-    // high measured again on all five scenes after the wind field's code
-    // went into a pipeline variant of its own (a frame without a wind field
-    // holds none of it): sums 371.3, 321.9, 288.2, 266.3, 251.8 ms, the
-    // noisy cumulus-midday's levels 3 and 4 the mean of two runs (50.9 and
-    // 65.6, 62.7 and 48.2 ms). FrameBudget's uniform deck gave 0.83, 0.74,
-    // 0.66, 0.62 the same day.
-    {"high", 5, {1.0, 0.867, 0.776, 0.717, 0.678}, {39.8, 37.7, 35.7, 32.7, 30.3}},
-    {"medium", 2, {1.0, 0.918, 0, 0, 0}, {42.0, 41.4, 0, 0, 0}},
-    {"low", 2, {1.0, 0.941, 0, 0, 0}, {40.2, 40.4, 0, 0, 0}},
-    {"realtime", 2, {1.0, 0.957, 0, 0, 0}, {36.1, 36.3, 0, 0, 0}},
-}};
+const std::vector<Measured>& measuredLadders() {
+  static const std::vector<Measured> all = {
+      {"high",
+       {{"high", 0, 1.000, 40.82},
+        {"medium", 0, 0.457, 40.72},
+        {"medium", 1, 0.397, 37.70},
+        {"low", 0, 0.276, 37.29},
+        {"low", 1, 0.260, 37.28},
+        {"realtime", 1, 0.076, 33.86}}},
+      {"medium",
+       {{"medium", 0, 1.000, 40.72},
+        {"medium", 1, 0.870, 37.70},
+        {"low", 0, 0.591, 37.29},
+        {"low", 1, 0.562, 37.28},
+        {"realtime", 1, 0.161, 33.86}}},
+      {"low", {{"low", 0, 1.000, 37.29}, {"low", 1, 0.921, 37.28}, {"realtime", 1, 0.275, 33.86}}},
+      {"realtime", {{"realtime", 0, 1.000, 33.43}, {"realtime", 1, 0.507, 31.29, 4}}},
+  };
+  return all;
+}
 
 MarchSettings cheaper(const MarchSettings& m0, std::size_t k) {
   const double f = kStepFactors[k];
@@ -67,19 +89,31 @@ MarchSettings cheaper(const MarchSettings& m0, std::size_t k) {
 }  // namespace
 
 Result<std::vector<BudgetLevel>> budgetLadder(const Preset& p) {
-  const auto measured = std::find_if(kMeasured.begin(), kMeasured.end(),
-                                     [&](const Measured& m) { return p.name == m.preset; });
-  if (measured == kMeasured.end())
+  const auto& ladders = measuredLadders();
+  const auto measured =
+      std::find_if(ladders.begin(), ladders.end(), [&](const Measured& m) { return p.name == m.preset; });
+  if (measured == ladders.end())
     return fail(ErrorCode::InvalidArgument, "frame budget: preset '" + p.name +
                                                 "' has no measured ladder (high, medium, low or realtime)");
   std::vector<BudgetLevel> ladder;
-  for (std::size_t k = 0; k < measured->levels; ++k) {
+  for (const Step& step : measured->steps) {
+    auto way = findPreset(step.preset);
+    SKY_ASSERT(way);
+    // The renderer keeps the preset's sun map (a new size would build a new
+    // map whole at the change); the rest, the air table's size too, is the
+    // cheaper preset's.
+    MarchSettings m = way->march;
+    m.sunShadow = p.march.sunShadow;
+    ResolutionSettings resolution = way->resolution;
+    if (step.divisor != 0) resolution.divisor = step.divisor;
     char name[64];
-    if (k == 0)
-      std::snprintf(name, sizeof name, "%s", p.name.c_str());
-    else
-      std::snprintf(name, sizeof name, "%s/%g", p.name.c_str(), kStepFactors[k]);
-    ladder.push_back({name, cheaper(p.march, k), measured->relativeCost[k], measured->psnr_db[k]});
+    std::snprintf(name, sizeof name, "%s", step.preset);
+    if (step.marchLevel != 0)
+      std::snprintf(name + std::strlen(name), sizeof name - std::strlen(name), "/%g", kStepFactors[step.marchLevel]);
+    if (step.divisor != 0)
+      std::snprintf(name + std::strlen(name), sizeof name - std::strlen(name), " at 1/%u size", step.divisor);
+    ladder.push_back({name, cheaper(m, step.marchLevel), way->temporal, resolution, step.relativeCost,
+                      step.psnr_db});
   }
   return ladder;
 }
@@ -90,8 +124,8 @@ FrameBudget::FrameBudget(double target_ms, std::vector<BudgetLevel> ladder)
   for (std::size_t i = 1; i < ladder_.size(); ++i) SKY_ASSERT(ladder_[i].relativeCost < ladder_[i - 1].relativeCost);
 }
 
-std::size_t FrameBudget::update(double frame_ms) {
-  if (!(frame_ms > 0) || !std::isfinite(frame_ms)) return level_;
+std::size_t FrameBudget::update(double frame_ms, bool representative) {
+  if (!representative || !(frame_ms > 0) || !std::isfinite(frame_ms)) return level_;
   // A frame's time over its level's cost is this machine's speed on this
   // scene; a mean over the last few frames (weight 1/4 for the newest) rides
   // out single slow frames but follows a change of scene within a second.

@@ -43,6 +43,14 @@ class ReprojectPass {
   // params.drop.w is set: params.drop.x * params.drop.y of them) are copied now.
   void record(const vk::raii::CommandBuffer& commands, GpuTimer& timer, const gpu::SkyReproject& params,
               std::span<const std::uint32_t> dropCells = {});
+  // Records the copy of another pass's image of this size (radiance +
+  // transmittance and cloud depth buffers, width x height each) into the
+  // history, as if the last record() had written it: the next record()
+  // reprojects it. A frame budget's change of the way of drawing
+  // (CloudRenderer::setLevel) keeps its history this way.
+  void seedHistory(const vk::raii::CommandBuffer& commands, vk::Buffer colour, vk::Buffer depth) {
+    history_->record(commands, colour, depth, width_, height_);
+  }
   // After the submission completed: the image the last record() wrote, and
   // what became of its pixels.
   Image readBack() const;
@@ -52,6 +60,7 @@ class ReprojectPass {
   const PixelMirror& image() const { return *history_; }
   // The image it writes for the host (copied into image() as it is recorded).
   const GpuBuffer& output() const { return colour_; }
+  const GpuBuffer& depth() const { return depth_; }
 
  private:
   ReprojectPass() = default;

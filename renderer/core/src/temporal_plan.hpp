@@ -82,6 +82,9 @@ class TemporalPlanner {
   // as the previous frame for the next call. Without an edit a change of
   // the weather's tiles redraws the frame whole.
   TemporalPlan plan(const FrameSetup& setup, const FrameInputs& inputs, const WeatherEdit& edit = {});
+  // The settings of the frames from the next on (a frame budget's level):
+  // the previous frame is kept, as a history of any interleave is a whole image.
+  void setSettings(const TemporalSettings& settings) { settings_ = settings; }
   // Forgets the previous frame (after a frame that failed on the GPU, or on
   // a host's reset): the next frame is drawn whole, for `reason`.
   void forget(std::string reason = "first frame") {

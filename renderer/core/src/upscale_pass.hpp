@@ -44,6 +44,7 @@ class UpscalePass {
   Image readBack() const;
   // The full-size image's buffer.
   const GpuBuffer& output() const { return colour_; }
+  const GpuBuffer& depth() const { return depth_; }
 
  private:
   UpscalePass() = default;

@@ -326,7 +326,18 @@ TEST(Configurations, BudgetLevelsOfAPresetsLadder) {
   EXPECT_EQ(c->settings.march.primarySteps, (*ladder)[2].march.primarySteps);
   EXPECT_EQ(c->settings.march.lightSteps, (*ladder)[2].march.lightSteps);
   EXPECT_EQ(c->settings.march.minTransmittance, (*ladder)[2].march.minTransmittance);
-  EXPECT_LT(c->settings.march.primarySteps, high->march.primarySteps);
+  EXPECT_EQ(c->settings.march.cloudStep_m, (*ladder)[2].march.cloudStep_m);
+  EXPECT_EQ(c->settings.temporal.interleave, (*ladder)[2].temporal.interleave);
+  // A level that is a cheaper preset's way of drawing brings its interleave,
+  // history and resolution divisor too.
+  const render::BudgetLevel& last = ladder->back();
+  auto cheapest = customConfiguration("hn:base=high,budget=" + std::to_string(ladder->size() - 1));
+  ASSERT_TRUE(cheapest) << cheapest.error().detail;
+  EXPECT_EQ(cheapest->settings.temporal.interleave, last.temporal.interleave);
+  EXPECT_EQ(cheapest->settings.temporal.accumulation, last.temporal.accumulation);
+  EXPECT_EQ(cheapest->settings.resolution.divisor, last.resolution.divisor);
+  EXPECT_EQ(cheapest->settings.march.airTable.azimuths, last.march.airTable.azimuths);
+  EXPECT_GT(last.temporal.interleave, high->temporal.interleave);
   for (const char* bad : {"x:budget=1", "x:base=realtime,budget=2", "x:base=high,budget=1.5", "x:base=reference,budget=1"}) {
     auto r = customConfiguration(bad);
     ASSERT_FALSE(r) << bad;

@@ -3,6 +3,7 @@
 // the machine's speed, which changes when the scene does.
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -17,30 +18,56 @@ render::Preset preset(const char* name) {
   return *p;
 }
 
-// Every preset but reference has a ladder (high five levels, medium, low and
-// realtime two), its own march first, each cheaper than the one
-// before (fewer samples or longer steps, never more light steps, an exit no
-// later) and measured to cost less.
+// The preset's name a level's name starts with ("medium/1.5" -> "medium").
+std::string wayOf(const std::string& level) { return level.substr(0, level.find_first_of("/ ")); }
+
+// Every preset but reference has a ladder: its own way of drawing first,
+// then cheaper marches of it, then the cheaper presets' ways (their march,
+// interleave and resolution divisor); each level measured to cost less and
+// to be less accurate than the one before (so the first that fits is the
+// most accurate that fits). Within one way, each march is cheaper than the
+// one before (fewer samples or longer steps, never more light steps, an
+// exit no later). Every level keeps the preset's air table and sun map
+// (the renderer is built with them) and draws no more pixels than it.
 TEST(FrameBudget, LaddersGoFromThePresetDown) {
-  const std::pair<const char*, std::size_t> expected[] = {{"high", 5}, {"medium", 2}, {"low", 2}, {"realtime", 2}};
+  const std::pair<const char*, std::size_t> expected[] = {{"high", 6}, {"medium", 5}, {"low", 3}, {"realtime", 2}};
   for (const auto& [name, levels] : expected) {
     const render::Preset p = preset(name);
     auto ladder = render::budgetLadder(p);
     ASSERT_TRUE(ladder) << name;
     ASSERT_EQ(ladder->size(), levels) << name;
-    EXPECT_EQ((*ladder)[0].name, name);
-    EXPECT_EQ((*ladder)[0].march.primarySteps, p.march.primarySteps);
-    EXPECT_EQ((*ladder)[0].march.cloudStep_m, p.march.cloudStep_m);
-    EXPECT_EQ((*ladder)[0].relativeCost, 1.0);
+    const render::BudgetLevel& first = (*ladder)[0];
+    EXPECT_EQ(first.name, name);
+    EXPECT_EQ(first.march.primarySteps, p.march.primarySteps);
+    EXPECT_EQ(first.march.cloudStep_m, p.march.cloudStep_m);
+    EXPECT_EQ(first.temporal.interleave, p.temporal.interleave);
+    EXPECT_EQ(first.temporal.accumulation, p.temporal.accumulation);
+    EXPECT_EQ(first.resolution.divisor, p.resolution.divisor);
+    EXPECT_EQ(first.relativeCost, 1.0);
     for (std::size_t i = 1; i < ladder->size(); ++i) {
-      const render::MarchSettings &m = (*ladder)[i].march, &before = (*ladder)[i - 1].march;
-      SCOPED_TRACE(std::string(name) + " level " + std::to_string(i));
-      EXPECT_TRUE(m.primarySteps < before.primarySteps || m.cloudStep_m > before.cloudStep_m);
-      EXPECT_LE(m.lightSteps, before.lightSteps);
-      EXPECT_GE(m.minTransmittance, before.minTransmittance);
-      EXPECT_LT((*ladder)[i].relativeCost, (*ladder)[i - 1].relativeCost);
-      EXPECT_GT((*ladder)[i].expectedPsnr_db, 0.0);
-      EXPECT_EQ(m.airTable.azimuths, p.march.airTable.azimuths) << "the renderer's air table stays";
+      const render::BudgetLevel &level = (*ladder)[i], &before = (*ladder)[i - 1];
+      const render::MarchSettings &m = level.march, &mb = before.march;
+      SCOPED_TRACE(std::string(name) + " level " + std::to_string(i) + " (" + level.name + ")");
+      EXPECT_LT(level.relativeCost, before.relativeCost);
+      EXPECT_LT(level.expectedPsnr_db, before.expectedPsnr_db);
+      EXPECT_GT(level.expectedPsnr_db, 0.0);
+      EXPECT_EQ(m.airTable.enabled, p.march.airTable.enabled) << "the renderer has an air table or not";
+      EXPECT_EQ(m.sunShadow.method, p.march.sunShadow.method) << "the renderer's sun map stays";
+      EXPECT_EQ(m.sunShadow.size, p.march.sunShadow.size);
+      EXPECT_EQ(level.resolution.divisor % p.resolution.divisor, 0u) << "no more pixels than the preset's";
+      EXPECT_GE(level.resolution.divisor, before.resolution.divisor);
+      EXPECT_GE(level.temporal.interleave, before.temporal.interleave);
+      auto way = render::findPreset(wayOf(level.name));
+      ASSERT_TRUE(way) << "a level is a preset's way of drawing";
+      EXPECT_EQ(level.temporal.interleave, way->temporal.interleave);
+      EXPECT_EQ(level.temporal.accumulation, way->temporal.accumulation);
+      EXPECT_EQ(m.airTable.azimuths, way->march.airTable.azimuths) << "the way's air table";
+      EXPECT_EQ(m.airTable.slices, way->march.airTable.slices);
+      if (wayOf(level.name) == wayOf(before.name) && level.resolution.divisor == before.resolution.divisor) {
+        EXPECT_TRUE(m.primarySteps < mb.primarySteps || m.cloudStep_m > mb.cloudStep_m);
+        EXPECT_LE(m.lightSteps, mb.lightSteps);
+        EXPECT_GE(m.minTransmittance, mb.minTransmittance);
+      }
     }
   }
   auto reference = render::budgetLadder(preset("reference"));
@@ -50,7 +77,7 @@ TEST(FrameBudget, LaddersGoFromThePresetDown) {
 
 // Frames at k ms per unit of cost, +-4 % of noise: the controller settles
 // on the most accurate level whose cost fits (the budget halfway between
-// levels 2 and 3), goes cheaper as soon as the scene gets dearer, and dearer
+// levels 1 and 2), goes cheaper as soon as the scene gets dearer, and dearer
 // again when it gets cheaper, once that level fits with 5 % to spare.
 TEST(FrameBudget, SettlesOnTheMostAccurateLevelThatFits) {
   auto ladder = render::budgetLadder(preset("high"));
@@ -61,7 +88,7 @@ TEST(FrameBudget, SettlesOnTheMostAccurateLevelThatFits) {
     return ladder->size() - 1;
   };
   const double k0 = 100;
-  const double target = k0 * 0.5 * ((*ladder)[2].relativeCost + (*ladder)[3].relativeCost);
+  const double target = k0 * 0.5 * ((*ladder)[1].relativeCost + (*ladder)[2].relativeCost);
   render::FrameBudget budget(target, *ladder);
   double k = k0;
   std::size_t changes = 0, last = budget.level();
@@ -74,7 +101,7 @@ TEST(FrameBudget, SettlesOnTheMostAccurateLevelThatFits) {
     last = next;
     SCOPED_TRACE("frame " + std::to_string(frame));
     if (frame == 19) {
-      EXPECT_EQ(budget.level(), 3u);
+      EXPECT_EQ(budget.level(), 2u);
     }
     if (frame == 39) {
       EXPECT_EQ(budget.level(), fitting(k, target));
@@ -102,6 +129,24 @@ TEST(FrameBudget, IgnoresFrameTimesThatAreNotTimes) {
   render::FrameBudget budget(30, *ladder);
   for (double ms : {0.0, -5.0, std::nan(""), double(INFINITY)}) EXPECT_EQ(budget.update(ms), 0u);
   EXPECT_EQ(budget.predicted_ms(0), 0.0);
+  // Nor does a frame that is not its level's cost (timesLevel: an
+  // interleaved level's frame drawn whole, several times its cost).
+  EXPECT_EQ(budget.update(10), 0u);
+  EXPECT_EQ(budget.update(1000, false), 0u);
+  EXPECT_DOUBLE_EQ(budget.predicted_ms(0), 10.0);
+}
+
+// An interleaved level's frame drawn whole does not time the level; every
+// other frame does.
+TEST(FrameBudget, AFrameDrawnWholeDoesNotTimeAnInterleavedLevel) {
+  auto ladder = render::budgetLadder(preset("high"));
+  ASSERT_TRUE(ladder);
+  render::TemporalReport whole, interleaved;
+  whole.drawnWhole = true;
+  for (const render::BudgetLevel& level : *ladder) {
+    EXPECT_TRUE(render::timesLevel(level, interleaved)) << level.name;
+    EXPECT_EQ(render::timesLevel(level, whole), level.temporal.interleave == 1) << level.name;
+  }
 }
 
 }  // namespace

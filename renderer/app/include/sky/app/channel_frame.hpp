@@ -83,6 +83,7 @@ class ChannelFrames {
   void setBudget(render::FrameBudget* budget) {
     SKY_ASSERT(budget == nullptr || renderer_ != nullptr);
     budget_ = budget;
+    appliedLevel_ = kNoLevel;
   }
   // The exposure each frame stands for (s, > 0): what a flash lights in it,
   // and how long the drops near the camera streak.
@@ -106,7 +107,11 @@ class ChannelFrames {
   render::AutoExposure* cameraExposure_ = nullptr;
   render::AutoExposure* hostMeter_ = nullptr;
   double exposure_s_ = render::kDefaultExposure_s;
-  std::size_t appliedLevel_ = 0;
+  // The budget level the renderer was last set to; none yet, so the first
+  // frame sets it too (the renderer then follows every frame for a later
+  // level's history: CloudRenderer::setLevel).
+  static constexpr std::size_t kNoLevel = ~std::size_t(0);
+  std::size_t appliedLevel_ = kNoLevel;
   std::uint64_t droppedWarnedAt_ = 0;
   // The renderer's weather version (FrameInputs::weatherVersion): a new one
   // whenever the source ("server", "file", "clear") or its version changes,

@@ -99,6 +99,8 @@ struct FrameRecord {
     double predicted_ms = 0;       // the model's time for it before the frame (0 for the first frame)
     double expectedPsnr_db = 0;    // its error against reference on the bench
     render::MarchSettings march;   // the march it drew with
+    std::uint32_t interleave = 1;  // and the interleave and resolution divisor
+    std::uint32_t divisor = 1;
   };
   std::optional<Budget> budget;
   // Transport delay: from the arrival of the host datagram whose pose the

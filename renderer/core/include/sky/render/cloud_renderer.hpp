@@ -491,12 +491,26 @@ class CloudRenderer {
 
   std::string deviceName() const;
   const RenderSettings& settings() const;
-  // Changes the march for the frames from the next on (a frame budget's
-  // levels, frame_budget.hpp). What the renderer was built with stays: the
-  // air table's size and whether it is on. Errors: InvalidArgument for
-  // settings validateSettings refuses or a different air table; the
-  // settings are then as they were.
+  // Changes the march for the frames from the next on, keeping how the
+  // image is drawn (setLevel with the current temporal and resolution).
   Result<void> setMarch(const MarchSettings& march);
+  // Changes how the frames from the next on are drawn (a frame budget's
+  // levels, frame_budget.hpp): the march (the air table's size with it),
+  // the interleave and its history, the resolution divisor. What the
+  // renderer was built with stays: whether there is an air table, the sun
+  // map's method and size, and the most pixels the cloud pass draws (a
+  // level may divide the image further than the renderer's settings, not
+  // less). The passes after the clouds for each way of drawing are built at
+  // its first frame and kept. At a change of the way of drawing the history
+  // carries over, copied from the last frame's image at the new way's size
+  // (the upscaled image for a way at full size). From a larger image to a
+  // smaller one, or after a frame that drew drops near the camera over its
+  // image, the next frame is drawn whole (TemporalReport::reason "drawn at
+  // another size", "drawn another way, after drops near the camera").
+  // Errors: InvalidArgument for settings validateSettings refuses or any of
+  // those fixed ones changed; the settings are then as they were.
+  Result<void> setLevel(const MarchSettings& march, const TemporalSettings& temporal,
+                        const ResolutionSettings& resolution);
 
   CloudRenderer(CloudRenderer&&) noexcept;
   CloudRenderer& operator=(CloudRenderer&&) noexcept;

@@ -1,12 +1,12 @@
-// Holding a frame time: a ladder of march settings from a preset's own down
-// to cheaper ones, each with its cost relative to the first and its expected
+// Holding a frame time: a ladder of settings from a preset's own down to
+// cheaper ones, each with its cost relative to the first and its expected
 // error (both measured with skyshell-bench), and a controller that picks,
 // frame by frame, the most accurate level whose predicted time fits the
 // budget. The prediction is the ladder's relative cost times this machine's
 // and this scene's milliseconds per unit of cost, learnt from the frames
-// drawn so far. What the ladder changes is the march only (steps, light
-// steps, early exit): the settings a renderer is built with (interleave,
-// resolution, the air table) stay the preset's.
+// drawn so far. A level changes the march (steps, light steps, early exit),
+// the interleave and its history, and the resolution divisor; the air
+// table and the sun map stay the preset's (the renderer is built with them).
 #pragma once
 
 #include <cstddef>
@@ -19,19 +19,32 @@
 namespace sky::render {
 
 struct BudgetLevel {
-  std::string name;           // "medium", "medium/1.5", ...: the preset and the march's step factor
+  // "high", "high/1.5": the preset and the march's step factor; a cheaper
+  // preset's way of drawing as a level of this one: "medium", "realtime/1.5".
+  std::string name;
   MarchSettings march;
-  double relativeCost = 1;    // the level's frame time over the first level's (skyshell-bench)
-  double expectedPsnr_db = 0; // against reference, mean over the bench's still scenes (skyshell-bench)
+  TemporalSettings temporal;
+  ResolutionSettings resolution;
+  double relativeCost = 1;     // the level's frame time over the first level's (skyshell-bench)
+  double expectedPsnr_db = 0;  // against reference, mean over the bench's scenes and camera paths (skyshell-bench)
 };
 
-// The ladder for preset p (not reference): its own march, then marches with
-// fewer samples (even placement: primarySteps over 1.5, 2, 3, 4; in metres:
-// the steps and their growth times those), fewer light steps and an earlier
-// exit, as far as each level saves time on the bench (high 5
-// levels, medium, low and realtime 2). Errors: InvalidArgument for reference (the
-// ground truth has no cheaper level).
+// The ladder for preset p (not reference): its own march, then marches
+// with fewer samples (even placement: primarySteps over 1.5, 2, 3, 4; in
+// metres: the steps and their growth times those), fewer light steps and an
+// earlier exit, then the cheaper presets' ways of drawing (their march,
+// interleave and history, resolution divisor) with p's air table and sun
+// map, each as far as it was measured to save time on the bench for less
+// accuracy. Errors: InvalidArgument for reference (the ground truth has no
+// cheaper level) and for a preset with no measured ladder.
 Result<std::vector<BudgetLevel>> budgetLadder(const Preset& p);
+
+// Whether a frame's time is what its level costs, for FrameBudget::update:
+// not for a frame of an interleaved level drawn whole (the first, one after
+// a change to another size, a teleport), which costs several of its frames.
+inline bool timesLevel(const BudgetLevel& level, const TemporalReport& drawn) {
+  return level.temporal.interleave <= 1 || !drawn.drawnWhole;
+}
 
 class FrameBudget {
  public:
@@ -51,8 +64,9 @@ class FrameBudget {
   // when the current one does not fit (at once when it is 10 % over, else
   // after two frames over in a row), to a dearer one only when that fits
   // with 5 % to spare (so two levels next to the budget do not alternate).
-  // Returns the level for the next frame.
-  std::size_t update(double frame_ms);
+  // Returns the level for the next frame. representative false (timesLevel):
+  // the frame's time is not learnt from, and the level stays.
+  std::size_t update(double frame_ms, bool representative = true);
 
  private:
   double target_ms_;
