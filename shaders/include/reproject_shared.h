@@ -85,7 +85,24 @@ struct SkyReproject {
                                         // previous frame; w: unused
 };
 
+// The history from a larger image (shaders/history_downsample.comp): a
+// frame budget's change of level to a smaller image (CloudRenderer::setLevel)
+// boxes the last frame's full image down into the history images. Bindings
+// of its own set; workgroup 8x8 history pixels.
+SKY_REPROJECT_CONST kDownsampleBindingParams = 0u;      // read-only: one SkyHistoryDownsample
+SKY_REPROJECT_CONST kDownsampleBindingSource = 1u;      // read-only vec4: the full image, radiance + transmittance
+SKY_REPROJECT_CONST kDownsampleBindingSourceDepth = 2u; // read-only float: its cloud depth
+SKY_REPROJECT_CONST kDownsampleBindingHistory = 3u;     // rgba32f storage image, written: the history
+SKY_REPROJECT_CONST kDownsampleBindingHistoryDepth = 4u; // r32f storage image, written: its cloud depth
+SKY_REPROJECT_CONST kDownsampleLocalSize = 8u;
+
+struct SkyHistoryDownsample {
+  uvec4 size;  // x, y: the history's width and height; z, w: the full image's
+  uvec4 mode;  // x: the box's side (full pixels per history pixel each way); yzw: unused
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(SkyHistoryDownsample) == 32);
 static_assert(sizeof(SkyReproject) == 16 * (9 + 2 * kReprojectMaxLayers + 6 + 5 + kReprojectMaxLayers));
 static_assert(offsetof(SkyReproject, image) == 112);
 static_assert(offsetof(SkyReproject, layerBand) == 144);

@@ -155,8 +155,9 @@ int main(int argc, char** argv) {
   // drift falls on all levels alike: the median per level, and the fastest
   // (the machine's other load only adds time, so the fastest frames give the
   // levels' own relative costs best). After each change of level a frame is
-  // drawn untimed: a level drawn at another size than the last starts
-  // without a history, drawn whole.
+  // drawn untimed: the first frame of a level carries the last one's
+  // history over (a copy, or a box filter to a smaller size) and builds
+  // what the level had not built yet.
   const std::size_t levels = ladder->size();
   std::vector<std::vector<double>> calibration(levels);
   std::vector<double> probesCalibrated;

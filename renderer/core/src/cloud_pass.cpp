@@ -314,6 +314,10 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
     SKY_ASSERT(next.reproject != nullptr && next.seedHistory.second);
     next.reproject->seedHistory(commands_, next.seedHistory.first, next.seedHistory.second);
   }
+  if (next.downsampleHistory) {
+    SKY_ASSERT(next.reproject != nullptr && !next.seedHistory.first);
+    next.reproject->recordDownsample(commands_);
+  }
   // The tables' old contents are never read again: from eUndefined each frame.
   const vk::ImageSubresourceRange whole(vk::ImageAspectFlagBits::eColor, 0, 1, 0, 1);
   const vk::ImageSubresourceRange allLayers(vk::ImageAspectFlagBits::eColor, 0, 1, 0, sunMap_.layers);

@@ -55,6 +55,9 @@ class CloudPass {
     // same size (its radiance + transmittance and cloud depth buffers),
     // copied in first, before this frame's clouds overwrite either.
     std::pair<vk::Buffer, vk::Buffer> seedHistory{};
+    // Or the history boxed down from a larger image
+    // (ReprojectPass::prepareDownsample, called before the run).
+    bool downsampleHistory = false;
     std::span<const std::uint32_t> dropCells;  // the history-drop mask, when reprojectParams->drop.w is set
     UpscalePass* upscale = nullptr;
     const gpu::SkyUpscale* upscaleParams = nullptr;

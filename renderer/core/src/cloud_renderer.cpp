@@ -50,7 +50,7 @@ struct FollowerChain {
   // The last frame's image (radiance + transmittance, cloud depth) at the
   // size another chain's history has: the reprojection's or the clouds'
   // own at this chain's divisor, the upscale's at full size (divisor 1);
-  // none at another size.
+  // none for a smaller image (it is boxed down from finalImage).
   std::optional<std::pair<vk::Buffer, vk::Buffer>> imageFor(std::uint32_t historyDivisor,
                                                             const CloudPass& pass) const {
     if (historyDivisor == divisor)
@@ -59,9 +59,12 @@ struct FollowerChain {
     if (historyDivisor == 1 && upscale) return std::pair{*upscale->output().buffer, *upscale->depth().buffer};
     return std::nullopt;
   }
-  // The buffer of the image the frame ends with, which the host reads back.
-  const GpuBuffer& finalImage(const CloudPass& pass) const {
-    return upscale ? upscale->output() : reproject ? reproject->output() : pass.output();
+  // The buffers of the image the frame ends with (radiance + transmittance,
+  // cloud depth; full size), which the host reads back.
+  std::pair<const GpuBuffer*, const GpuBuffer*> finalImage(const CloudPass& pass) const {
+    if (upscale) return {&upscale->output(), &upscale->depth()};
+    if (reproject) return {&reproject->output(), &reproject->depth()};
+    return {&pass.output(), &pass.depth()};
   }
 };
 
@@ -138,7 +141,7 @@ struct CloudRenderer::Impl {
   Result<NearPrecipPass*> nearPrecipPass() {
     FollowerChain& c = chain();
     if (!c.nearPass) {
-      auto created = NearPrecipPass::create(*ctx, settings.width, settings.height, c.finalImage(pass));
+      auto created = NearPrecipPass::create(*ctx, settings.width, settings.height, *c.finalImage(pass).first);
       if (!created) return tl::unexpected(created.error());
       c.nearPass.emplace(std::move(*created));
     }
@@ -271,18 +274,24 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
     FollowerChain& chain = impl_->chain();
     // A change of the way of drawing (setLevel): the history carries over
     // from the last frame's image at the new way's size (copied before the
-    // clouds overwrite it), the upscaled one when the new way draws every
-    // pixel's size. There is none from a larger image to a smaller (it
-    // would need a resampling pass), nor when the drops near the camera
-    // were drawn over the last image (the history would keep them).
+    // clouds overwrite it; the upscaled one when the new way draws at full
+    // size), or boxed down from its full image for a smaller one. None when
+    // the drops near the camera were drawn over the last image (the
+    // history would keep them).
     if (chain.reproject && impl_->lastChain != nullptr && impl_->lastChain != &chain) {
-      const auto last = impl_->lastChain->imageFor(chain.divisor, impl_->pass);
-      if (impl_->lastStreaks)
+      const FollowerChain& lastChain = *impl_->lastChain;
+      if (impl_->lastStreaks) {
         impl_->planner.forget("drawn another way, after drops near the camera");
-      else if (!last)
-        impl_->planner.forget("drawn at another size");
-      else
+      } else if (const auto last = lastChain.imageFor(chain.divisor, impl_->pass)) {
         next.seedHistory = *last;
+      } else {
+        const auto [colour, depth] = lastChain.finalImage(impl_->pass);
+        if (auto ok = chain.reproject->prepareDownsample(*impl_->ctx, *colour, *depth, impl_->settings.width,
+                                                         impl_->settings.height, chain.divisor);
+            !ok)
+          return tl::unexpected(ok.error());
+        next.downsampleHistory = true;
+      }
     }
     // Without interleaving the planner runs only once the way of drawing
     // may change: it then knows the previous frame when a level with a

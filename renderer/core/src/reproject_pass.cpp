@@ -106,6 +106,57 @@ void ReprojectPass::record(const vk::raii::CommandBuffer& commands, GpuTimer& ti
                            {});
 }
 
+Result<void> ReprojectPass::prepareDownsample(const GpuContext& ctx, const GpuBuffer& colour, const GpuBuffer& depth,
+                                              std::uint32_t fullWidth, std::uint32_t fullHeight, std::uint32_t box) {
+  SKY_ASSERT(box >= 1 && (fullWidth + box - 1) / box == width_ && (fullHeight + box - 1) / box == height_);
+  SKY_ASSERT(colour.size >= vk::DeviceSize(fullWidth) * fullHeight * 4 * sizeof(float));
+  SKY_ASSERT(depth.size >= vk::DeviceSize(fullWidth) * fullHeight * sizeof(float));
+  if (!downsample_) {
+    ComputePipelineBuilder builder("sky.history_downsample");
+    for (std::uint32_t b : {gpu::kDownsampleBindingParams, gpu::kDownsampleBindingSource,
+                            gpu::kDownsampleBindingSourceDepth})
+      builder.binding(b, vk::DescriptorType::eStorageBuffer);
+    for (std::uint32_t b : {gpu::kDownsampleBindingHistory, gpu::kDownsampleBindingHistoryDepth})
+      builder.binding(b, vk::DescriptorType::eStorageImage);
+    builder.shader("history_downsample.comp.spv");
+    auto pipeline = builder.build(ctx);
+    if (!pipeline) return tl::unexpected(pipeline.error());
+    downsample_.emplace(Downsample{std::move(*pipeline),
+                                   createHostBuffer(ctx, sizeof(gpu::SkyHistoryDownsample),
+                                                    vk::BufferUsageFlagBits::eStorageBuffer,
+                                                    "sky.history_downsample.params"),
+                                   {}});
+  }
+  gpu::SkyHistoryDownsample p{};
+  p.size = gpu::uvec4(width_, height_, fullWidth, fullHeight);
+  p.mode = gpu::uvec4(box, 0u, 0u, 0u);
+  std::memcpy(downsample_->params.mapped, &p, sizeof p);
+  auto info = [](const GpuBuffer& b) { return vk::DescriptorBufferInfo(*b.buffer, 0, b.size); };
+  // A new set for this source (a change of level is rare; the old set is
+  // unused once the last run's fence was waited for).
+  downsample_->set = {};
+  downsample_->set = createStorageSet(ctx, downsample_->pipeline, "sky.history_downsample",
+                                      {std::pair{gpu::kDownsampleBindingParams, info(downsample_->params)},
+                                       std::pair{gpu::kDownsampleBindingSource, info(colour)},
+                                       std::pair{gpu::kDownsampleBindingSourceDepth, info(depth)}},
+                                      {std::pair{gpu::kDownsampleBindingHistory, history_->colourInfo()},
+                                       std::pair{gpu::kDownsampleBindingHistoryDepth, history_->depthInfo()}});
+  return {};
+}
+
+void ReprojectPass::recordDownsample(const vk::raii::CommandBuffer& commands) {
+  SKY_ASSERT(downsample_.has_value());
+  commands.bindPipeline(vk::PipelineBindPoint::eCompute, *downsample_->pipeline.pipeline);
+  commands.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *downsample_->pipeline.layout, 0,
+                              *downsample_->set.set, {});
+  const std::uint32_t g = gpu::kDownsampleLocalSize;
+  commands.dispatch((width_ + g - 1) / g, (height_ + g - 1) / g, 1);
+  // The history images are read by this frame's reprojection.
+  const vk::MemoryBarrier written(vk::AccessFlagBits::eShaderWrite, vk::AccessFlagBits::eShaderRead);
+  commands.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {},
+                           written, {}, {});
+}
+
 Image ReprojectPass::readBack() const { return readImage(colour_, depth_, width_, height_); }
 
 TemporalReport ReprojectPass::counts() const {

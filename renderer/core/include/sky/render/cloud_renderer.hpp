@@ -502,11 +502,11 @@ class CloudRenderer {
   // level may divide the image further than the renderer's settings, not
   // less). The passes after the clouds for each way of drawing are built at
   // its first frame and kept. At a change of the way of drawing the history
-  // carries over, copied from the last frame's image at the new way's size
-  // (the upscaled image for a way at full size). From a larger image to a
-  // smaller one, or after a frame that drew drops near the camera over its
-  // image, the next frame is drawn whole (TemporalReport::reason "drawn at
-  // another size", "drawn another way, after drops near the camera").
+  // carries over: copied from the last frame's image at the new way's size
+  // (the upscaled image for a way at full size), or boxed down from its
+  // full image for a way that draws a smaller one. After a frame that drew
+  // drops near the camera over its image the next frame is drawn whole
+  // (TemporalReport::reason "drawn another way, after drops near the camera").
   // Errors: InvalidArgument for settings validateSettings refuses or any of
   // those fixed ones changed; the settings are then as they were.
   Result<void> setLevel(const MarchSettings& march, const TemporalSettings& temporal,
