@@ -1,7 +1,7 @@
-// The history of a smaller image from the last frame's full image: a frame
-// budget's change of level to a larger resolution divisor
+// The history of an image of another size from the last frame's full image:
+// a frame budget's change of level to another resolution divisor
 // (CloudRenderer::setLevel) keeps its history this way instead of drawing
-// the next frame whole. History pixel (i, j) is centred where the full
+// the next frame whole (divisor 1: a box of 1, the full image as it is). History pixel (i, j) is centred where the full
 // image's continuous coordinate is ((i + 0.5) d, (j + 0.5) d) (frame_setup.hpp,
 // FrameSetup::width): the d x d box of full pixels around it, as far as the
 // image reaches. Radiance and transmittance are the box's mean; the cloud

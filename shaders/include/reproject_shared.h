@@ -85,9 +85,10 @@ struct SkyReproject {
                                         // previous frame; w: unused
 };
 
-// The history from a larger image (shaders/history_downsample.comp): a
-// frame budget's change of level to a smaller image (CloudRenderer::setLevel)
-// boxes the last frame's full image down into the history images. Bindings
+// The history from an image of another size (shaders/history_downsample.comp):
+// a frame budget's change of level to another resolution divisor
+// (CloudRenderer::setLevel) boxes the last frame's full image into the
+// history images (a box of 1 at full size). Bindings
 // of its own set; workgroup 8x8 history pixels.
 SKY_REPROJECT_CONST kDownsampleBindingParams = 0u;      // read-only: one SkyHistoryDownsample
 SKY_REPROJECT_CONST kDownsampleBindingSource = 1u;      // read-only vec4: the full image, radiance + transmittance

@@ -44,6 +44,13 @@ constexpr std::size_t kSettleFrames = 10;
 // two levels alternate, so 3 %.
 constexpr double kNoise = 0.03;
 
+// The path's weather: half-covered cumulus, base 1500 m, 1000 m thick.
+weather::WeatherSnapshot halfCumulus() {
+  weather::WeatherSnapshot snap;
+  snap.layers.push_back(layer(1, 1500, 1000, 0.5, 1.0));
+  return snap;
+}
+
 // The replayed path: east at 800 m under half-covered cumulus, turning 3
 // degrees a frame, looking 12 degrees up (the bench's path).
 render::FrameInputs pathFrame(const weather::WeatherSnapshot& snap, std::uint64_t i) {
@@ -94,8 +101,7 @@ TEST(FrameBudget, HoldsABudgetBetweenTwoLevelsOverAReplay) {
   settings.march = preset->march;
   auto r = render::CloudRenderer::create(settings);
   ASSERT_TRUE(r) << describe(r.error());
-  weather::WeatherSnapshot snap;
-  snap.layers.push_back(layer(1, 1500, 1000, 0.5, 1.0));
+  const weather::WeatherSnapshot snap = halfCumulus();
 
   const double budgetMs = 0.5 * (kRecordedLevel_ms[1] + kRecordedLevel_ms[2]);
   const std::size_t cheapest = ladder->size() - 1;
@@ -208,8 +214,7 @@ TEST(FrameBudget, ALevelWithAHistoryCarriesTheLastImageOver) {
   interleaved.temporal = medium.temporal;
   auto own = render::CloudRenderer::create(interleaved);
   ASSERT_TRUE(own) << describe(own.error());
-  weather::WeatherSnapshot snap;
-  snap.layers.push_back(layer(1, 1500, 1000, 0.5, 1.0));
+  const weather::WeatherSnapshot snap = halfCumulus();
   const render::FrameInputs still = pathFrame(snap, 0);
 
   ASSERT_TRUE(r->setLevel(high.march, high.temporal, high.resolution));
@@ -264,8 +269,7 @@ TEST(FrameBudget, ALevelAtAnotherSizeTakesTheLastImageResized) {
   ASSERT_LT(realtime.march.airTable.azimuths, high.march.airTable.azimuths);
   auto r = highRenderer(high);
   ASSERT_TRUE(r);
-  weather::WeatherSnapshot snap;
-  snap.layers.push_back(layer(1, 1500, 1000, 0.5, 1.0));
+  const weather::WeatherSnapshot snap = halfCumulus();
   const render::FrameInputs still = pathFrame(snap, 0);
   ASSERT_TRUE(r->setLevel(high.march, high.temporal, high.resolution));
   ASSERT_TRUE(r->render(still));

@@ -55,7 +55,7 @@ class CloudPass {
     // same size (its radiance + transmittance and cloud depth buffers),
     // copied in first, before this frame's clouds overwrite either.
     std::pair<vk::Buffer, vk::Buffer> seedHistory{};
-    // Or the history boxed down from a larger image
+    // Or the history boxed down from the last full image
     // (ReprojectPass::prepareDownsample, called before the run).
     bool downsampleHistory = false;
     std::span<const std::uint32_t> dropCells;  // the history-drop mask, when reprojectParams->drop.w is set

@@ -48,16 +48,10 @@ struct FollowerChain {
                              freshEdges == t.freshEdges));
   }
   // The last frame's image (radiance + transmittance, cloud depth) at the
-  // size another chain's history has: the reprojection's or the clouds'
-  // own at this chain's divisor, the upscale's at full size (divisor 1);
-  // none for a smaller image (it is boxed down from finalImage).
-  std::optional<std::pair<vk::Buffer, vk::Buffer>> imageFor(std::uint32_t historyDivisor,
-                                                            const CloudPass& pass) const {
-    if (historyDivisor == divisor)
-      return reproject ? std::pair{*reproject->output().buffer, *reproject->depth().buffer}
-                       : std::pair{*pass.output().buffer, *pass.depth().buffer};
-    if (historyDivisor == 1 && upscale) return std::pair{*upscale->output().buffer, *upscale->depth().buffer};
-    return std::nullopt;
+  // size the clouds draw: the reprojection's, or the clouds' own.
+  std::pair<vk::Buffer, vk::Buffer> smallImage(const CloudPass& pass) const {
+    return reproject ? std::pair{*reproject->output().buffer, *reproject->depth().buffer}
+                     : std::pair{*pass.output().buffer, *pass.depth().buffer};
   }
   // The buffers of the image the frame ends with (radiance + transmittance,
   // cloud depth; full size), which the host reads back.
@@ -273,17 +267,17 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
     std::optional<TemporalPlan> plan;
     FollowerChain& chain = impl_->chain();
     // A change of the way of drawing (setLevel): the history carries over
-    // from the last frame's image at the new way's size (copied before the
-    // clouds overwrite it; the upscaled one when the new way draws at full
-    // size), or boxed down from its full image for a smaller one. None when
-    // the drops near the camera were drawn over the last image (the
-    // history would keep them).
+    // from the last frame's image, copied at the same size (before the
+    // clouds overwrite it), else its full image boxed to the new way's size
+    // (box 1 at full size: the upscaled image as it is). None when the
+    // drops near the camera were drawn over the last image (the history
+    // would keep them).
     if (chain.reproject && impl_->lastChain != nullptr && impl_->lastChain != &chain) {
       const FollowerChain& lastChain = *impl_->lastChain;
       if (impl_->lastStreaks) {
         impl_->planner.forget("drawn another way, after drops near the camera");
-      } else if (const auto last = lastChain.imageFor(chain.divisor, impl_->pass)) {
-        next.seedHistory = *last;
+      } else if (lastChain.divisor == chain.divisor) {
+        next.seedHistory = lastChain.smallImage(impl_->pass);
       } else {
         const auto [colour, depth] = lastChain.finalImage(impl_->pass);
         if (auto ok = chain.reproject->prepareDownsample(*impl_->ctx, *colour, *depth, impl_->settings.width,
@@ -386,7 +380,9 @@ Result<std::size_t> CloudRenderer::buildAllVariants() {
   });
 }
 
-std::size_t CloudRenderer::variantsBuilt() const { return impl_->pass.variantsBuilt() + (impl_->chains.front()->nearPass ? 2 : 0); }
+std::size_t CloudRenderer::variantsBuilt() const {
+  return impl_->pass.variantsBuilt() + (impl_->chains.front()->nearPass ? 2 : 0);
+}
 
 const std::string& CloudRenderer::noiseReport() const { return impl_->noiseReport; }
 

@@ -49,6 +49,18 @@ struct StorageSet {
   // Destroyed in reverse order: the set before its pool.
   vk::raii::DescriptorPool pool{nullptr};
   vk::raii::DescriptorSet set{nullptr};
+
+  StorageSet() = default;
+  StorageSet(StorageSet&&) noexcept = default;
+  // Assigned over an older set (a pass rebinding its sources): that set is
+  // freed before its pool, which member-wise assignment would free first
+  // (lavapipe then crashes freeing the set).
+  StorageSet& operator=(StorageSet&& other) noexcept {
+    set = nullptr;
+    pool = std::move(other.pool);
+    set = std::move(other.set);
+    return *this;
+  }
 };
 
 // The set for a pass that binds storage buffers and storage images only

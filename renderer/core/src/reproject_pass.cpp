@@ -133,10 +133,7 @@ Result<void> ReprojectPass::prepareDownsample(const GpuContext& ctx, const GpuBu
   std::memcpy(downsample_->params.mapped, &p, sizeof p);
   auto info = [](const GpuBuffer& b) { return vk::DescriptorBufferInfo(*b.buffer, 0, b.size); };
   // A new set for this source (a change of level is rare; the old set is
-  // unused once the last run's fence was waited for). The old set goes
-  // before its pool: assigning the pair would free the pool first.
-  downsample_->set.set = nullptr;
-  downsample_->set.pool = nullptr;
+  // unused once the last run's fence was waited for).
   downsample_->set = createStorageSet(ctx, downsample_->pipeline, "sky.history_downsample",
                                       {std::pair{gpu::kDownsampleBindingParams, info(downsample_->params)},
                                        std::pair{gpu::kDownsampleBindingSource, info(colour)},

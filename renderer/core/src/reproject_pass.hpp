@@ -51,11 +51,11 @@ class ReprojectPass {
   void seedHistory(const vk::raii::CommandBuffer& commands, vk::Buffer colour, vk::Buffer depth) {
     history_->record(commands, colour, depth, width_, height_);
   }
-  // Prepares the history from a larger image for the next run: the last
+  // Prepares the history from another size for the next run: the last
   // frame's full image (radiance + transmittance and cloud depth buffers,
   // fullWidth x fullHeight, which must hold it until then) boxed down by
-  // `box` each way (shaders/history_downsample.comp), as if the last
-  // record() had written it. Builds its pipeline at the first call. Errors:
+  // `box` each way, 1 a copy (shaders/history_downsample.comp), as if the
+  // last record() had written it. Builds its pipeline at the first call. Errors:
   // Io/Malformed for the SPIR-V; other Vulkan failures throw.
   Result<void> prepareDownsample(const GpuContext& ctx, const GpuBuffer& colour, const GpuBuffer& depth,
                                  std::uint32_t fullWidth, std::uint32_t fullHeight, std::uint32_t box);
@@ -85,7 +85,7 @@ class ReprojectPass {
   GpuBuffer outcomes_;  // uint per pixel: what became of it (kStat*)
   GpuBuffer drop_;      // uint per cell of the history-drop mask (history_drop.hpp)
   StorageSet set_;
-  // The history from a larger image (prepareDownsample).
+  // The history from an image of another size (prepareDownsample).
   struct Downsample {
     ComputePipeline pipeline;
     GpuBuffer params;
