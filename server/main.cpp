@@ -184,11 +184,14 @@ int main(int argc, char** argv) {
 
   // With --nats the weather is the NATS log's: it replaces the scenario's
   // (when the log holds one) and no SQLite file is used.
+  sky::server::GribDecoder decoder;
+  decoder.executable = gribDecoder.empty() ? sky::server::defaultGribDecoder() : std::filesystem::path(gribDecoder);
   std::unique_ptr<sky::server::NatsWeather> nats;
   if (!natsUrls.empty()) {
     if (!dbPath.empty() || !gribPath.empty()) {
-      log->error("--nats with {}: with --nats the weather lives in the NATS stream, which holds no SQLite file "
-                 "and no forecast", !dbPath.empty() ? "--db" : "--grib");
+      log->error("--nats with {}: with --nats the weather lives in the NATS stream, which holds no SQLite file; "
+                 "a forecast is loaded on the leader with POST /api/grib once it leads",
+                 !dbPath.empty() ? "--db" : "--grib");
       return kExitBadInput;
     }
     sky::server::NatsWeatherOptions natsOptions;
@@ -199,6 +202,7 @@ int main(int argc, char** argv) {
     // Unique among the servers of one host: the lease names its holder.
     natsOptions.serverId = options.serverId + ":" + std::to_string(::getpid());
     natsOptions.logger = log;
+    natsOptions.gribDecoder = decoder;
     auto started = sky::server::NatsWeather::start(**server, std::move(natsOptions));
     if (!started) {
       log->error("event=nats_unusable nats={:?} detail={:?}", natsUrls, sky::describe(started.error()));
@@ -208,8 +212,6 @@ int main(int argc, char** argv) {
     (*server)->onShutdown([&nats] { nats->close(); });
   }
 
-  sky::server::GribDecoder decoder;
-  decoder.executable = gribDecoder.empty() ? sky::server::defaultGribDecoder() : std::filesystem::path(gribDecoder);
   std::optional<sky::server::WeatherStore> store;
   if (!dbPath.empty()) {
     auto storageFailed = [&](const sky::Error& e) {

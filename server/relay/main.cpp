@@ -15,6 +15,7 @@
 #include <spdlog/spdlog.h>
 
 #include "sky/server/console_feed.hpp"
+#include "sky/server/grib_isolated.hpp"
 #include "sky/server/http_api.hpp"
 #include "sky/server/main_support.hpp"
 #include "sky/server/nats_weather.hpp"
@@ -136,6 +137,7 @@ int main(int argc, char** argv) {
   natsOptions.serverId = o.stream.serverId;
   natsOptions.relay = true;
   natsOptions.logger = log;
+  natsOptions.gribDecoder.executable = sky::server::defaultGribDecoder();
   auto started = sky::server::NatsWeather::start(s, std::move(natsOptions));
   if (!started) {
     log->error("event=nats_unusable nats={:?} detail={:?}", o.natsUrls, sky::describe(started.error()));

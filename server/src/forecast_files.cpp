@@ -11,10 +11,7 @@
 
 namespace sky::server {
 
-namespace {
-
-// The store's key of a file: FNV-1a (64 bits) of its bytes and its size, in
-// hex. Equal files share one copy; it names, it does not protect.
+// Equal files share one copy; the key names, it does not protect.
 std::string fileKey(std::span<const std::byte> bytes) {
   std::uint64_t h = 1469598103934665603ull;
   for (std::byte b : bytes) {
@@ -25,6 +22,8 @@ std::string fileKey(std::span<const std::byte> bytes) {
   std::snprintf(buf, sizeof buf, "%016llx-%zu", static_cast<unsigned long long>(h), bytes.size());
   return buf;
 }
+
+namespace {
 
 Result<std::vector<std::byte>> readAll(const std::filesystem::path& p, std::size_t maxBytes) {
   std::error_code ec;
@@ -149,19 +148,24 @@ Result<AppliedChange> applyForecast(LiveWeather& weather, DecodedForecast decode
     for (std::size_t k = 0; k < decoded.bytes.size(); ++k)
       if (auto ok = store->putFile(decoded.loaded.files[k].key, decoded.loaded.files[k].name, decoded.bytes[k]); !ok)
         return tl::unexpected(ok.error());
+  if (const LiveWeather::FileKeeper& keep = weather.fileKeeper())
+    for (std::size_t k = 0; k < decoded.bytes.size(); ++k)
+      if (auto ok = keep(decoded.loaded.files[k].key, decoded.bytes[k]); !ok) return tl::unexpected(ok.error());
   return weather.loadForecast(std::move(decoded.loaded), author, source);
 }
 
-LiveWeather::ForecastLoader storeForecastLoader(const WeatherStore& store, GribDecoder decoder) {
-  return [&store, decoder](const nlohmann::json& saved) -> Result<LoadedForecast> {
+LiveWeather::ForecastLoader forecastLoader(FileFetch fetch, GribDecoder decoder) {
+  return [fetch = std::move(fetch), decoder](const nlohmann::json& saved) -> Result<LoadedForecast> {
     auto files = forecastFilesFromJson(saved);
     if (!files) return tl::unexpected(files.error());
     auto placement = forecastPlacementFromJson(saved);
     if (!placement) return tl::unexpected(placement.error());
     std::vector<GribFile> decoded;
     for (const auto& f : *files) {
-      auto bytes = store.getFile(f.key);
+      auto bytes = fetch(f.key);
       if (!bytes) return tl::unexpected(bytes.error());
+      if (fileKey(*bytes) != f.key)
+        return fail(ErrorCode::Malformed, "file " + f.name + ": its bytes do not have its key " + f.key);
       auto tmp = TempFile::write(*bytes);
       if (!tmp) return tl::unexpected(tmp.error());
       auto file = readGribIsolated(tmp->path(), f.name, GribSelection::Forecast, decoder);
@@ -178,6 +182,10 @@ LiveWeather::ForecastLoader storeForecastLoader(const WeatherStore& store, GribD
     loaded.forecast = std::make_shared<const Forecast>(std::move(*forecast));
     return loaded;
   };
+}
+
+LiveWeather::ForecastLoader storeForecastLoader(const WeatherStore& store, GribDecoder decoder) {
+  return forecastLoader([&store](const std::string& key) { return store.getFile(key); }, std::move(decoder));
 }
 
 }  // namespace sky::server

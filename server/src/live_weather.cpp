@@ -361,6 +361,25 @@ nlohmann::json LiveWeather::stateJson(const State& s, const std::vector<Timeline
 
 nlohmann::json LiveWeather::toJson() const { return stateJson(state(), timeline_, sequence_, version_); }
 
+namespace {
+
+// Whether a saved forecast is the one held: the same files at the same
+// place on the clock (what restore decodes it from).
+bool sameForecast(const LoadedForecast* held, const nlohmann::json& saved) {
+  if (!held || !held->forecast) return false;
+  auto files = forecastFilesFromJson(saved);
+  auto placement = forecastPlacementFromJson(saved);
+  if (!files || !placement || files->size() != held->files.size() ||
+      saved.value("name", std::string()) != held->forecast->name())
+    return false;
+  for (std::size_t k = 0; k < files->size(); ++k)
+    if ((*files)[k].key != held->files[k].key || (*files)[k].name != held->files[k].name) return false;
+  return placement->anchorClock_s == held->placement.anchorClock_s &&
+         placement->anchorValid_unix == held->placement.anchorValid_unix;
+}
+
+}  // namespace
+
 Result<void> LiveWeather::restore(const nlohmann::json& j, std::vector<ChangeEvent> events,
                                   const ForecastLoader& loader) {
   auto bad = [](const std::string& what) { return fail(ErrorCode::Malformed, "saved state: " + what); };
@@ -424,7 +443,11 @@ Result<void> LiveWeather::restore(const nlohmann::json& j, std::vector<ChangeEve
     }
     // The forecast came with format 4 of the saved state.
     std::shared_ptr<const LoadedForecast> forecast;
-    if (j.contains("forecast") && !j.at("forecast").is_null()) {
+    if (j.contains("forecast") && !j.at("forecast").is_null() && sameForecast(forecast_.get(), j.at("forecast"))) {
+      // The forecast held already (a follower folding the next change of
+      // the same weather): not decoded again, and its tiles stay cached.
+      forecast = forecast_;
+    } else if (j.contains("forecast") && !j.at("forecast").is_null()) {
       if (!loader) return bad("a forecast, and no way to decode it");
       auto f = loader(j.at("forecast"));
       if (!f) return fail(f.error().code, "saved state: forecast: " + f.error().detail);

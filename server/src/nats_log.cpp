@@ -17,28 +17,11 @@
 
 #include <nats/nats.h>
 
+#include "nats_handles.hpp"
+
 namespace sky::server {
 
 namespace {
-
-template <class T, void (*Destroy)(T*)>
-struct Deleter {
-  void operator()(T* p) const {
-    if (p) Destroy(p);
-  }
-};
-template <class T, void (*Destroy)(T*)>
-using Owned = std::unique_ptr<T, Deleter<T, Destroy>>;
-
-using OptionsPtr = Owned<natsOptions, natsOptions_Destroy>;
-using ConnectionPtr = Owned<natsConnection, natsConnection_Destroy>;
-using JsPtr = Owned<jsCtx, jsCtx_Destroy>;
-using StreamInfoPtr = Owned<jsStreamInfo, jsStreamInfo_Destroy>;
-using MsgPtr = Owned<natsMsg, natsMsg_Destroy>;
-using PubAckPtr = Owned<jsPubAck, jsPubAck_Destroy>;
-using MetaPtr = Owned<jsMsgMetaData, jsMsgMetaData_Destroy>;
-using KvPtr = Owned<kvStore, kvStore_Destroy>;
-using SubscriptionPtr = Owned<natsSubscription, natsSubscription_Destroy>;
 
 // How long connect() waits between tries while JetStream is not ready.
 constexpr std::chrono::milliseconds kReadyRetry{250};
@@ -52,58 +35,19 @@ constexpr std::int64_t kReconnectWait_ms = 100;
 constexpr std::chrono::milliseconds kPublishAttemptWait{1000};
 constexpr std::chrono::milliseconds kPublishRetryPause{100};
 constexpr std::chrono::seconds kFollowHeartbeat{1};
-// How long stopFollowing waits for a message callback under way to finish.
-constexpr std::chrono::seconds kFollowStopWait{5};
 
 const char* const kExpectedLastSeq = "Nats-Expected-Last-Sequence";
 const char* const kExpectedLastSubjectSeq = "Nats-Expected-Last-Subject-Sequence";
 
-Error natsError(const std::string& what, natsStatus s, jsErrCode jerr = static_cast<jsErrCode>(0)) {
+}  // namespace
+
+Error natsError(const std::string& what, natsStatus s, jsErrCode jerr) {
   const char* last = nats_GetLastError(nullptr);
   std::string detail = what + ": " + natsStatus_GetText(s);
   if (jerr != 0) detail += " (JetStream error " + std::to_string(static_cast<int>(jerr)) + ")";
   if (last && *last) detail += ": " + std::string(last);
   return Error{s == NATS_TIMEOUT ? ErrorCode::Timeout : ErrorCode::Io, detail};
 }
-
-}  // namespace
-
-// The message handler's state: outlives the subscription until nats.c says
-// no callback of it runs any more (natsSubscription_SetOnCompleteCB).
-struct FollowState {
-  std::mutex mutex;
-  std::condition_variable done;
-  bool complete = false;
-  NatsLog::EntryHandler onEntry;
-};
-
-struct NatsLog::Handles {
-  NatsLogOptions options;
-  int replicas = 1;
-  // Destruction order is the reverse: the subscription, then the JetStream
-  // context, then the connection.
-  ConnectionPtr connection;
-  JsPtr js;
-  KvPtr registry;  // the cluster's registry bucket
-  std::shared_ptr<FollowState> follow;
-  SubscriptionPtr subscription;
-
-  ~Handles() { stop(); }
-
-  void stop() {
-    if (!subscription) return;
-    natsSubscription_Unsubscribe(subscription.get());
-    std::unique_lock lock(follow->mutex);
-    const bool complete = follow->done.wait_for(lock, kFollowStopWait, [this] { return follow->complete; });
-    follow->onEntry = nullptr;
-    lock.unlock();
-    subscription.reset();
-    // Not told that its callbacks are over (a client cut off from every
-    // server): the state stays allocated for them, a few bytes per such stop.
-    if (!complete) new std::shared_ptr<FollowState>(follow);
-    follow.reset();
-  }
-};
 
 namespace {
 
@@ -125,8 +69,8 @@ void onFollowComplete(void* closure) {
   state->done.notify_all();
 }
 
-// Makes a stream unless it exists; on a server that is not clustered asks
-// again with one replica. Returns the replicas it has.
+}  // namespace
+
 Result<int> ensureStream(jsCtx* js, jsStreamConfig& config) {
   jsStreamInfo* raw = nullptr;
   jsErrCode jerr = static_cast<jsErrCode>(0);
@@ -147,6 +91,8 @@ Result<int> ensureStream(jsCtx* js, jsStreamConfig& config) {
   if (s != NATS_OK) return tl::unexpected(natsError(std::string("stream ") + config.Name + " create", s, jerr));
   return static_cast<int>(info->Config->Replicas);
 }
+
+namespace {
 
 // Opens a KV bucket, making it when missing: one value per key (no
 // history), each expiring `ttl` after it was put.
@@ -218,6 +164,9 @@ Result<std::unique_ptr<NatsLog>> NatsLog::connect(const NatsLogOptions& options)
       auto lease = ensureBucket(h->js.get(), options.leaseBucket, options.leaseTtl, *replicas);
       registry = lease ? ensureBucket(h->js.get(), options.registryBucket, options.registryTtl, *replicas)
                        : Result<KvPtr>(tl::unexpected(lease.error()));
+      if (registry)
+        if (auto files = ensureFilesStream(h->js.get(), options, *replicas); !files)
+          registry = tl::unexpected(files.error());
     }
     if (registry) {
       h->replicas = *replicas;

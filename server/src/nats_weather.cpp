@@ -9,6 +9,7 @@
 #include <boost/asio/post.hpp>
 #include <spdlog/spdlog.h>
 
+#include "sky/server/forecast_files.hpp"
 #include "sky/server/server.hpp"
 
 namespace sky::server {
@@ -58,6 +59,12 @@ Result<std::unique_ptr<NatsWeather>> NatsWeather::start(Server& server, NatsWeat
   weather.holdTimeline(true);
   weather.attachCommitter(
       [self = w.get()](const nlohmann::json& state, const ChangeEvent& event) { return self->commit(state, event); });
+  // A forecast's files go to the files stream before its change is
+  // appended, so a follower that folds the change finds them there.
+  weather.attachFileKeeper([self = w.get()](const std::string& key, std::span<const std::byte> bytes) -> Result<void> {
+    if (!self->leading_) return fail(ErrorCode::Io, self->refusal());
+    return self->natsLog_->putFile(key, bytes);
+  });
   auto followed = w->follow();
   if (!followed) return tl::unexpected(followed.error());
   return w;
@@ -107,7 +114,7 @@ Result<void> NatsWeather::replay() {
   dropped_ += bad;
   if (!newest) return fail(ErrorCode::Malformed, "NATS stream " + options_.log.stream + ": no readable entry in " +
                                                      std::to_string(from) + ".." + std::to_string(range->last));
-  if (auto r = weather.restore(newest->state, std::move(events)); !r)
+  if (auto r = weather.restore(newest->state, std::move(events), forecastLoader()); !r)
     return fail(r.error().code, "NATS stream " + options_.log.stream + ": " + r.error().detail);
   applied_ = range->last;
   {
@@ -131,7 +138,8 @@ void NatsWeather::onEntry(std::uint64_t sequence, const std::string& bytes) {
   if (entry) {
     std::vector<ChangeEvent> events = weather.events(kReplayEntries);
     if (entry->event) events.push_back(*entry->event);
-    if (auto r = weather.restore(entry->state, std::move(events)); !r) entry = tl::unexpected(r.error());
+    if (auto r = weather.restore(entry->state, std::move(events), forecastLoader()); !r)
+      entry = tl::unexpected(r.error());
   }
   applied_ = sequence;
   if (!entry) {
@@ -159,10 +167,6 @@ Result<void> NatsWeather::commit(const nlohmann::json& state, const ChangeEvent&
     stepDown("lease last renewed " + std::to_string(static_cast<int>(age_s * 1000)) + " ms ago");
     return fail(ErrorCode::Io, refusal());
   }
-  if (state.contains("forecast") && !state.at("forecast").is_null())
-    return fail(ErrorCode::Unsupported,
-                "forecasts are not replicated over NATS (their GRIB files live in a server's SQLite store): "
-                "run this server without --nats to load one");
   LogEntry entry;
   entry.kind = LogEntry::Kind::Change;
   entry.term = term_;
@@ -190,7 +194,44 @@ Result<void> NatsWeather::commit(const nlohmann::json& state, const ChangeEvent&
   }
   applied_ = appended->sequence;
   ++appended_;
+  dropUnusedFiles(state);
   return {};
+}
+
+LiveWeather::ForecastLoader NatsWeather::forecastLoader() const {
+  const std::size_t maxBytes = options_.gribDecoder.maxFileBytes;
+  auto load = sky::server::forecastLoader(
+      [nats = natsLog_.get(), maxBytes](const std::string& key) { return nats->getFile(key, maxBytes); },
+      options_.gribDecoder);
+  // Decoding runs on the io thread, like the rest of an entry's fold: once
+  // per forecast loaded (restore keeps a forecast it holds already).
+  return [load = std::move(load), log = log_](const nlohmann::json& saved) -> Result<LoadedForecast> {
+    const std::int64_t t0 = steadyNs();
+    auto loaded = load(saved);
+    if (loaded)
+      log->info("event=nats_forecast_decoded name={:?} files={} ms={:.0f}", saved.value("name", std::string()),
+                loaded->files.size(), double(steadyNs() - t0) * 1e-6);
+    return loaded;
+  };
+}
+
+void NatsWeather::dropUnusedFiles(const nlohmann::json& state) {
+  // The weather still holds the state before this change.
+  const auto held = server_.weather().forecast();
+  if (!held) return;
+  std::vector<std::string> kept;
+  if (state.contains("forecast") && !state.at("forecast").is_null())
+    if (auto files = forecastFilesFromJson(state.at("forecast")))
+      for (const auto& f : *files) kept.push_back(f.key);
+  for (const auto& f : held->files) {
+    if (std::find(kept.begin(), kept.end(), f.key) != kept.end()) continue;
+    // A follower still folding an older entry that names the file fails to
+    // decode it and folds the next entry, which holds the whole state.
+    if (auto dropped = natsLog_->dropFile(f.key); !dropped)
+      log_->warn("event=nats_file_kept key={} detail={:?}", f.key, describe(dropped.error()));
+    else
+      log_->info("event=nats_file_dropped key={} name={:?}", f.key, f.name);
+  }
 }
 
 void NatsWeather::elect(std::string apiUrl, std::string streamAddress) {

@@ -3,8 +3,9 @@
 // (server/src/nats_entry.cpp), then their state folded into a live weather
 // (LiveWeather::restore), as nats_weather.cpp does; and the same bytes as a
 // record of the cluster's registry bucket (cluster_member.cpp), which any
-// publisher could have put there. One target for both (not one each): the
-// inputs are JSON of the same origin, and each target costs deploy/test its
+// publisher could have put there; and as the manifest of a forecast file on
+// the files stream (nats_files.cpp: "<bytes> <chunk bytes>"). One target for
+// all three (not one each): the inputs are text of the same origin, and each target costs deploy/test its
 // fuzzing time. The decoders may refuse (with a reason), never crash, hang
 // or read out of bounds; what they accept re-encodes to the same; a state
 // passed on is restored or refused, never thrown.
@@ -16,6 +17,7 @@
 #include "sky/server/cluster_member.hpp"
 #include "sky/server/live_weather.hpp"
 #include "sky/server/nats_entry.hpp"
+#include "sky/server/nats_log.hpp"
 
 namespace {
 
@@ -29,11 +31,25 @@ void checkClusterMember(std::string_view bytes) {
   if (!again || sky::server::clusterMemberJson(*again) != sky::server::clusterMemberJson(*member)) std::abort();
 }
 
+// A manifest is accepted only within its bounds, and re-encodes to the
+// same text.
+void checkFileManifest(std::string_view bytes) {
+  constexpr std::uint64_t kMax = std::uint64_t{1} << 30;
+  auto m = sky::server::parseFileManifest(bytes, kMax);
+  if (!m) {
+    if (m.error().detail.empty()) std::abort();
+    return;
+  }
+  if (m->bytes > kMax || m->chunkBytes == 0 || m->chunkBytes > sky::server::kMaxNatsFileChunk_bytes) std::abort();
+  if (sky::server::encodeFileManifest(*m) != bytes) std::abort();
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);
   checkClusterMember(bytes);
+  checkFileManifest(bytes);
   auto entry = sky::server::decodeLogEntry(bytes);
   if (!entry) {
     if (entry.error().detail.empty()) std::abort();

@@ -9,6 +9,8 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstring>
+#include <iterator>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -243,6 +245,76 @@ TEST_F(RelayNats, ARendererOnARelayDrawsThroughChangesAFailoverAndAPause) {
   servesThroughAFailover(render);
   if (HasFatalFailure()) return;
   catchesUpAfterAPause(render);
+}
+
+// Forecasts on the cluster: a GRIB file loaded on the leader goes to the
+// files stream before its change is appended; the standby and the relay
+// read it back by its key, decode it themselves and reach the leader's
+// state hash; the next change does not decode it again; removed, its file
+// leaves the stream. A follower refuses the load, naming the leader.
+TEST_F(RelayNats, AForecastLoadedOnTheLeaderIsDecodedOnTheStandbyAndTheRelay) {
+  startStandby();
+  if (HasFatalFailure()) return;
+  std::ifstream in(SKY_GRIB_SAMPLE, std::ios::binary);
+  const std::string gfs((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(gfs.size(), 1000u) << SKY_GRIB_SAMPLE;
+
+  const auto refused = b_->request("POST", "/api/grib?name=gfs.grib2", gfs);
+  ASSERT_TRUE(refused);
+  EXPECT_NE(refused->status, 200) << refused->body;
+  EXPECT_TRUE(b_->state()["forecast"].is_null());
+
+  const auto t0 = Clock::now();
+  const auto loaded = a_->request("POST", "/api/grib?name=gfs.grib2", gfs);
+  ASSERT_TRUE(loaded);
+  ASSERT_EQ(loaded->status, 200) << loaded->body << a_->log();
+  const auto forecast = nlohmann::json::parse(loaded->body)["forecast"];
+  ASSERT_TRUE(forecast.is_object()) << loaded->body;
+  const std::string key = forecast["files"][0]["key"];
+  ASSERT_TRUE(waitUntil(60s, [&] {
+    return relay_->stateHash() == a_->stateHash() && b_->stateHash() == a_->stateHash();
+  })) << relay_->log() << b_->log();
+  std::printf("a %zu-byte GRIB file loaded on the leader: the standby and the relay hold its forecast %.2f s after "
+              "it was sent\n", gfs.size(), secondsSince(t0));
+  for (const HttpPeer* peer : {static_cast<const HttpPeer*>(&*b_), static_cast<const HttpPeer*>(&*relay_)}) {
+    const auto state = peer->state();
+    ASSERT_TRUE(state.is_object() && state["forecast"].is_object()) << state.dump();
+    EXPECT_EQ(state["forecast"]["first_valid"], "2011-01-15T12:00Z");
+    EXPECT_EQ(state["forecast"]["files"][0]["key"], key);
+    EXPECT_EQ(state["forecast"]["layers"].size(), 5u) << state["forecast"].dump();
+  }
+
+  const auto ack = a_->request("POST", "/api/changes", layerChange(7, 0.4));
+  ASSERT_TRUE(ack);
+  ASSERT_EQ(ack->status, 200) << ack->body;
+  ASSERT_TRUE(waitUntil(10s, [&] { return relay_->hasLayer(7) && b_->hasLayer(7); }));
+  EXPECT_EQ(relay_->stateHash(), a_->stateHash());
+  const auto decodes = [](const std::string& log) {
+    std::size_t n = 0;
+    for (auto at = log.find("event=nats_forecast_decoded"); at != std::string::npos;
+         at = log.find("event=nats_forecast_decoded", at + 1))
+      ++n;
+    return n;
+  };
+  EXPECT_EQ(decodes(relay_->log()), 1u) << relay_->log();
+  EXPECT_EQ(decodes(b_->log()), 1u) << b_->log();
+
+  server::NatsLogOptions o;
+  o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+  auto nats = server::NatsLog::connect(o);
+  ASSERT_TRUE(nats) << describe(nats.error());
+  auto stored = (*nats)->getFile(key, gfs.size());
+  ASSERT_TRUE(stored) << describe(stored.error());
+  EXPECT_TRUE(stored->size() == gfs.size() && std::memcmp(stored->data(), gfs.data(), gfs.size()) == 0);
+
+  const auto removed = a_->request("POST", "/api/grib", R"({"remove": true})");
+  ASSERT_TRUE(removed);
+  ASSERT_EQ(removed->status, 200) << removed->body;
+  ASSERT_TRUE(waitUntil(10s, [&] { return relay_->stateHash() == a_->stateHash(); })) << relay_->log();
+  EXPECT_TRUE(relay_->state()["forecast"].is_null());
+  const auto gone = (*nats)->getFile(key, gfs.size());
+  ASSERT_FALSE(gone);
+  EXPECT_NE(gone.error().detail.find("not in stream"), std::string::npos) << gone.error().detail;
 }
 
 // The config file's keys are checked before the relay reaches NATS: a

@@ -16,6 +16,7 @@
 #include <thread>
 
 #include <gtest/gtest.h>
+#include <nats/nats.h>
 #include <nlohmann/json.hpp>
 
 #include "child_process.hpp"
@@ -238,6 +239,60 @@ TEST_F(WeatherdNats, AForeignEntryInTheLogIsDroppedAndCountedEverywhere) {
 // refuses an append whose expected last sequence the stream has moved past,
 // and a lease taken by one holder can be neither taken nor renewed by a
 // stale revision.
+// The forecast files' stream (NatsLog::putFile/getFile) read back as a
+// follower reads it: a file of several chunks comes back byte for byte, one
+// over the reader's bound is refused before its chunks are read, and what
+// another publisher put on the subjects (a manifest whose chunks do not add
+// up, one that is not a manifest) is refused, never read past.
+TEST_F(WeatherdNats, AForecastFileComesBackAsPutAndAForgedOneIsRefused) {
+  server::NatsLogOptions o;
+  o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+  auto log = server::NatsLog::connect(o);
+  ASSERT_TRUE(log) << describe(log.error());
+  std::vector<std::byte> bytes(600000);
+  for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<std::byte>((i * 7919) >> 3);
+  ASSERT_TRUE((*log)->putFile("0123abcd-600000", bytes));
+  auto back = (*log)->getFile("0123abcd-600000", bytes.size());
+  ASSERT_TRUE(back) << describe(back.error());
+  EXPECT_TRUE(*back == bytes);
+  auto bound = (*log)->getFile("0123abcd-600000", bytes.size() - 1);
+  ASSERT_FALSE(bound);
+  EXPECT_EQ(bound.error().code, ErrorCode::TooLarge) << bound.error().detail;
+  EXPECT_EQ((*log)->putFile("a.b", bytes).error().code, ErrorCode::InvalidArgument);
+  EXPECT_EQ((*log)->getFile("*", 10).error().code, ErrorCode::InvalidArgument);
+
+  // Another publisher on the files' subjects (plain NATS publishes, which
+  // the stream stores as any other).
+  natsConnection* raw = nullptr;
+  ASSERT_EQ(natsConnection_ConnectTo(&raw, cluster_->url(0).c_str()), NATS_OK);
+  const auto publish = [&](const std::string& subject, const std::string& data) {
+    ASSERT_EQ(natsConnection_Publish(raw, subject.c_str(), data.data(), static_cast<int>(data.size())), NATS_OK);
+    ASSERT_EQ(natsConnection_Flush(raw), NATS_OK);
+  };
+  // Chunk 1 of "forged-1" is 5 bytes where its manifest needs 262144.
+  publish("sky.weather.file.forged-1.0", std::string(262144, 'x'));
+  publish("sky.weather.file.forged-1.1", "short");
+  publish("sky.weather.file.forged-1.manifest", "524288 262144");
+  publish("sky.weather.file.forged-2.manifest", "12 bytes, honest");
+  publish("sky.weather.file.forged-3.manifest", "1000 0");
+  natsConnection_Destroy(raw);
+  ASSERT_TRUE(waitUntil(5s, [&] {
+    auto f = (*log)->getFile("forged-3", 1 << 20);
+    return !f && f.error().code == ErrorCode::Malformed;
+  }));
+  auto forged = (*log)->getFile("forged-1", 1 << 20);
+  ASSERT_FALSE(forged);
+  EXPECT_EQ(forged.error().code, ErrorCode::Malformed);
+  EXPECT_NE(forged.error().detail.find("chunk 1 is 5 bytes"), std::string::npos) << forged.error().detail;
+  EXPECT_EQ((*log)->getFile("forged-2", 1 << 20).error().code, ErrorCode::Malformed);
+
+  // Dropped: gone from the stream.
+  ASSERT_TRUE((*log)->dropFile("0123abcd-600000"));
+  auto gone = (*log)->getFile("0123abcd-600000", bytes.size());
+  ASSERT_FALSE(gone);
+  EXPECT_EQ(gone.error().code, ErrorCode::Io);
+}
+
 TEST_F(WeatherdNats, JetStreamRefusesAStaleAppendAndAStaleLease) {
   server::NatsLogOptions o;
   o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};

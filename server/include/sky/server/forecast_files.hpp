@@ -6,6 +6,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -47,13 +48,22 @@ Result<DecodedForecast> decodeForecast(const std::vector<GribInput>& files, cons
 Result<DecodedForecast> decodeUploadedForecast(std::span<const std::byte> bytes, const std::string& name,
                                                double anchorClock_s, const GribDecoder& decoder);
 
-// Keeps the files' bytes in the weather's store (if it has one), then loads
+// Keeps the files' bytes in the weather's store (if it has one) and hands
+// them to its file keeper (if it has one: the NATS cluster's), then loads
 // the forecast as one change.
 Result<AppliedChange> applyForecast(LiveWeather& weather, DecodedForecast decoded, const std::string& author,
                                     const std::string& source);
 
-// For LiveWeather::restore: a saved forecast decoded again from the files
-// the store keeps.
+// For LiveWeather::restore: a saved forecast decoded again from its files'
+// bytes, each read by `fetch` under its key (the SQLite store's, or the
+// NATS cluster's files stream). A file whose bytes do not have the key
+// they were read under (fileKey) is refused: Malformed.
+using FileFetch = std::function<Result<std::vector<std::byte>>(const std::string& key)>;
+LiveWeather::ForecastLoader forecastLoader(FileFetch fetch, GribDecoder decoder);
+// The same from the files the store keeps.
 LiveWeather::ForecastLoader storeForecastLoader(const WeatherStore& store, GribDecoder decoder);
+
+// The key a file's bytes are kept under: a 64-bit FNV-1a hash and the size.
+std::string fileKey(std::span<const std::byte> bytes);
 
 }  // namespace sky::server

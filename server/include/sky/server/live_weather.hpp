@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -173,6 +174,12 @@ class LiveWeather final : public WeatherService {
   // instead of a store.
   using Committer = std::function<Result<void>(const nlohmann::json& state, const ChangeEvent& event)>;
   void attachCommitter(Committer committer) { committer_ = std::move(committer); }
+  // A loaded forecast's files go to the keeper, when one is attached,
+  // before the change that loads it is committed (applyForecast): the NATS
+  // cluster's files stream, from which the followers decode it again.
+  using FileKeeper = std::function<Result<void>(const std::string& key, std::span<const std::byte> bytes)>;
+  void attachFileKeeper(FileKeeper keeper) { fileKeeper_ = std::move(keeper); }
+  const FileKeeper& fileKeeper() const { return fileKeeper_; }
   // While held, no timeline entry is ever due: a follower keeps its leader's
   // timeline in its state but only the leader runs it.
   void holdTimeline(bool held) { timelineHeld_ = held; }
@@ -267,6 +274,7 @@ class LiveWeather final : public WeatherService {
   CommitStats commitStats_;
   class WeatherStore* store_ = nullptr;
   Committer committer_;
+  FileKeeper fileKeeper_;
   bool timelineHeld_ = false;
 };
 

@@ -12,6 +12,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -31,6 +32,10 @@ struct NatsLogOptions {
   // for this long is gone from it. Set by the process that makes the bucket.
   std::string registryBucket = "sky_weather_members";
   std::chrono::milliseconds registryTtl{5000};
+  // A loaded forecast's GRIB files (nats_files.cpp), by the key the state
+  // names each by: chunks of a stream of their own, one message per subject.
+  std::string filesStream = "SKY_WEATHER_FILES";
+  std::string filesSubject = "sky.weather.file";
   int replicas = 3;                           // the stream's and the bucket's; 1 on a single server
   std::uint64_t maxEntries = 10000;           // the stream keeps the newest this many
   // How long a publish, a read or a lease operation waits for its answer.
@@ -39,6 +44,19 @@ struct NatsLogOptions {
   // has just started elects its meta leader first).
   std::chrono::milliseconds readyWait{30000};
 };
+
+// A file's manifest on the files stream, written after its chunks: the
+// file's size and the size of every chunk but the last.
+struct NatsFileManifest {
+  std::uint64_t bytes = 0;
+  std::uint64_t chunkBytes = 0;
+  std::uint64_t chunks() const { return bytes == 0 ? 0 : (bytes + chunkBytes - 1) / chunkBytes; }
+};
+inline constexpr std::uint64_t kMaxNatsFileChunk_bytes = std::uint64_t{1} << 20;  // NATS's default max payload
+std::string encodeFileManifest(const NatsFileManifest& m);
+// "<bytes> <chunk bytes>" in decimal; Malformed for anything else or a
+// chunk size outside [1, kMaxNatsFileChunk_bytes], TooLarge past maxBytes.
+Result<NatsFileManifest> parseFileManifest(std::string_view text, std::uint64_t maxBytes);
 
 class NatsLog {
  public:
@@ -101,6 +119,18 @@ class NatsLog {
   // Errors: Io, Timeout.
   Result<void> putMember(std::string_view id, std::string_view value);
   Result<std::vector<std::string>> members(std::size_t max);
+
+  // A forecast's files (nats_files.cpp), each under its key (a key holds
+  // only [0-9a-z-], at most 64 of them: InvalidArgument otherwise).
+  // putFile stores the bytes in chunks, then their manifest, so a reader
+  // that finds the manifest finds every chunk; putting a key again
+  // replaces it. getFile reads a file back: Io when its manifest is not
+  // there, TooLarge past maxBytes, Malformed when the manifest or a chunk
+  // does not add up. dropFile purges a key's messages (a file no state
+  // names any more). Errors: Io, Timeout.
+  Result<void> putFile(std::string_view key, std::span<const std::byte> bytes);
+  Result<std::vector<std::byte>> getFile(std::string_view key, std::size_t maxBytes);
+  Result<void> dropFile(std::string_view key);
 
  private:
   struct Handles;

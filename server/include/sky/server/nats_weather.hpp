@@ -9,6 +9,9 @@
 // it refuses changes once its lease may have lapsed, and each append expects
 // the stream's last sequence to be the one it applied last, so a leader that
 // was paused while another took over cannot append after it, and steps down.
+// A forecast's GRIB files go to a stream of their own (NatsLog::putFile)
+// before the change that loads it; a follower folding that change reads
+// them back and decodes the forecast itself.
 #pragma once
 
 #include <atomic>
@@ -26,6 +29,8 @@
 
 #include "sky/core/result.hpp"
 #include "sky/server/cluster_registry.hpp"
+#include "sky/server/grib_isolated.hpp"
+#include "sky/server/live_weather.hpp"
 #include "sky/server/nats_entry.hpp"
 #include "sky/server/nats_log.hpp"
 
@@ -49,6 +54,9 @@ struct NatsWeatherOptions {
   // change. A standby server is the same without this.
   bool relay = false;
   std::shared_ptr<spdlog::logger> logger;  // null: log nothing
+  // Decodes a forecast the leader loaded (its files read back from the
+  // files stream) when this server or relay folds it.
+  GribDecoder gribDecoder;
 };
 
 class NatsWeather {
@@ -96,6 +104,11 @@ class NatsWeather {
   // On the io thread: one entry of the log, as the follower sees it.
   void onEntry(std::uint64_t sequence, const std::string& bytes);
   Result<void> commit(const nlohmann::json& state, const ChangeEvent& event);
+  // Decodes a forecast an entry names from the files stream.
+  LiveWeather::ForecastLoader forecastLoader() const;
+  // After an append: purges the files of the forecast held before it that
+  // the appended state no longer names.
+  void dropUnusedFiles(const nlohmann::json& state);
   // On the io thread, after the lease was taken at `term`: catches up with
   // the log, then appends the term entry that makes this server the leader.
   void claim(std::uint64_t term, int attempt);
