@@ -89,6 +89,10 @@ Result<void> ensureFilesStream(jsCtx* js, const NatsLogOptions& options, int rep
   config.Storage = js_FileStorage;
   config.Replicas = replicas;
   config.MaxMsgsPerSubject = 1;  // a key put again replaces its chunks
+  // No byte limit: JetStream reserves a clustered stream's MaxBytes on
+  // every replica's disk at creation. A file whose change was then refused
+  // (fenced, or not acknowledged) stays unnamed until a purge
+  // (docs/weather-server-scaling.md).
   auto made = ensureStream(js, config);
   if (!made) return tl::unexpected(made.error());
   return {};
@@ -113,8 +117,9 @@ Result<std::vector<std::byte>> NatsLog::getFile(std::string_view key, std::size_
   if (!*text) return fail(ErrorCode::Io, "file " + std::string(key) + ": not in stream " + h_->options.filesStream);
   auto m = parseFileManifest(**text, maxBytes);
   if (!m) return fail(m.error().code, "file " + std::string(key) + ": " + m.error().detail);
+  // Grown chunk by chunk, not reserved from the manifest: a forged manifest
+  // of 13 bytes must not cost its claimed size in memory.
   std::vector<std::byte> bytes;
-  bytes.reserve(m->bytes);
   for (std::uint64_t k = 0; k < m->chunks(); ++k) {
     auto chunk = lastOn(h_->js.get(), h_->options, chunkSubject(h_->options, key, k));
     if (!chunk) return tl::unexpected(chunk.error());
