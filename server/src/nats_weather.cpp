@@ -114,8 +114,15 @@ Result<void> NatsWeather::replay() {
   dropped_ += bad;
   if (!newest) return fail(ErrorCode::Malformed, "NATS stream " + options_.log.stream + ": no readable entry in " +
                                                      std::to_string(from) + ".." + std::to_string(range->last));
-  if (auto r = weather.restore(newest->state, std::move(events), forecastLoader()); !r)
-    return fail(r.error().code, "NATS stream " + options_.log.stream + ": " + r.error().detail);
+  // An entry this server cannot fold (its forecast's files unreadable or
+  // undecodable here) does not stop it: it keeps the scenario's weather,
+  // as a follower keeps its last after such an entry (onEntry), and
+  // follows from there.
+  if (auto r = weather.restore(newest->state, std::move(events), forecastLoader()); !r) {
+    ++dropped_;
+    log_->error("event=nats_entry_dropped sequence={} detail={:?}: the scenario's weather stands until an entry "
+                "this server can fold", range->last, describe(r.error()));
+  }
   applied_ = range->last;
   {
     std::lock_guard lock(mutex_);
@@ -494,7 +501,7 @@ std::string NatsWeather::metrics() const {
        applied_.load());
   line("skyshell_nats_appended_total", "counter", "changes this server appended to the NATS log", appended_.load());
   line("skyshell_nats_followed_total", "counter", "log entries of other servers folded in", followed_.load());
-  line("skyshell_nats_entries_dropped_total", "counter", "log entries dropped as malformed", dropped_.load());
+  line("skyshell_nats_entries_dropped_total", "counter", "log entries dropped: malformed, or not foldable here (a forecast whose files cannot be read or decoded)", dropped_.load());
   line("skyshell_nats_fenced_total", "counter", "appends refused by JetStream for a stale last sequence",
        fenced_.load());
   // A 64-bit hash does not fit a Prometheus value (a double): it is the

@@ -307,11 +307,21 @@ TEST_F(RelayNats, AForecastLoadedOnTheLeaderIsDecodedOnTheStandbyAndTheRelay) {
   ASSERT_TRUE(stored) << describe(stored.error());
   EXPECT_TRUE(stored->size() == gfs.size() && std::memcmp(stored->data(), gfs.data(), gfs.size()) == 0);
 
+  // A relay that starts while the forecast's file is gone from the stream
+  // (purged by hand) starts all the same, counts the entry it cannot fold,
+  // and folds the next one.
+  ASSERT_TRUE((*nats)->dropFile(key));
+  NatsRelay late(root_, "late-relay", cluster_->urls(1));
+  ASSERT_NE(late.httpPort, 0u) << late.log();
+  EXPECT_GE(late.metric("skyshell_nats_entries_dropped_total"), 1) << late.log();
+  EXPECT_TRUE(late.state()["forecast"].is_null());
+
   const auto removed = a_->request("POST", "/api/grib", R"({"remove": true})");
   ASSERT_TRUE(removed);
   ASSERT_EQ(removed->status, 200) << removed->body;
   ASSERT_TRUE(waitUntil(10s, [&] { return relay_->stateHash() == a_->stateHash(); })) << relay_->log();
   EXPECT_TRUE(relay_->state()["forecast"].is_null());
+  EXPECT_TRUE(waitUntil(10s, [&] { return late.stateHash() == a_->stateHash(); })) << late.log();
   const auto gone = (*nats)->getFile(key, gfs.size());
   ASSERT_FALSE(gone);
   EXPECT_NE(gone.error().detail.find("not in stream"), std::string::npos) << gone.error().detail;
