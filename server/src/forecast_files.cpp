@@ -158,6 +158,11 @@ LiveWeather::ForecastLoader forecastLoader(FileFetch fetch, GribDecoder decoder)
   return [fetch = std::move(fetch), decoder](const nlohmann::json& saved) -> Result<LoadedForecast> {
     auto files = forecastFilesFromJson(saved);
     if (!files) return tl::unexpected(files.error());
+    // As many as a load takes: a state from elsewhere (a NATS entry) naming
+    // more would fetch and decode each, however often it names one file.
+    if (files->size() > kMaxGribFiles)
+      return fail(ErrorCode::TooLarge, "forecast: " + std::to_string(files->size()) + " files, more than the " +
+                                           std::to_string(kMaxGribFiles) + " a forecast is loaded from");
     auto placement = forecastPlacementFromJson(saved);
     if (!placement) return tl::unexpected(placement.error());
     std::vector<GribFile> decoded;

@@ -11,6 +11,7 @@
 
 #include "grib_tools.hpp"
 #include "sky/server/forecast.hpp"
+#include "sky/server/forecast_files.hpp"
 #include "sky/server/grib_isolated.hpp"
 #include "sky/weather/precipitation.hpp"
 
@@ -337,3 +338,31 @@ TEST(Forecast, PrecipitationRateIsALayerOfItsRate) {
 
 }  // namespace
 }  // namespace sky::server
+
+namespace sky::test {
+namespace {
+
+// A saved forecast naming more files than a load takes (a NATS entry from
+// elsewhere) is refused before any file is fetched.
+TEST(ForecastLoader, MoreFilesThanALoadTakesAreRefusedUnread) {
+  std::size_t fetched = 0;
+  const auto load = server::forecastLoader(
+      [&](const std::string&) -> Result<std::vector<std::byte>> {
+        ++fetched;
+        return fail(ErrorCode::Io, "not here");
+      },
+      server::GribDecoder{});
+  nlohmann::json saved = {{"name", "many"}, {"anchor_clock_s", 0.0}, {"anchor_valid_unix", 0}};
+  for (std::size_t k = 0; k <= server::kMaxGribFiles; ++k)
+    saved["files"].push_back({{"key", "0123abcd-1"}, {"name", "f.grib2"}});
+  const auto refused = load(saved);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().code, ErrorCode::TooLarge) << refused.error().detail;
+  EXPECT_EQ(fetched, 0u);
+  saved["files"].erase(saved["files"].begin());  // kMaxGribFiles: fetched, and refused at the first
+  EXPECT_EQ(load(saved).error().code, ErrorCode::Io);
+  EXPECT_EQ(fetched, 1u);
+}
+
+}  // namespace
+}  // namespace sky::test
