@@ -181,9 +181,9 @@ int main(int argc, char** argv) {
     levelMs.push_back(median(ms));
     fastestMs.push_back(*std::min_element(ms.begin(), ms.end()));
   }
-  std::printf("%-12s %9s %9s %14s %14s\n", "level", "p50 ms", "min ms", "cost (min)", "cost (ladder)");
+  std::printf("%-26s %9s %9s %14s %14s\n", "level", "p50 ms", "min ms", "cost (min)", "cost (ladder)");
   for (std::size_t level = 0; level < levels; ++level)
-    std::printf("%-12s %9.2f %9.2f %14.3f %14.3f\n", (*ladder)[level].name.c_str(), levelMs[level], fastestMs[level],
+    std::printf("%-26s %9.2f %9.2f %14.3f %14.3f\n", (*ladder)[level].name.c_str(), levelMs[level], fastestMs[level],
                 fastestMs[level] / fastestMs[0], (*ladder)[level].relativeCost);
 
   // The budget halfway between levels 1 and 3 (on a short ladder: between

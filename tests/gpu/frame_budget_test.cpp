@@ -25,10 +25,13 @@ namespace {
 // Each level of high's ladder on the path below at 320x180, ms: the medians
 // of 8 round-robin frames recorded with
 //   LP_NUM_THREADS=1 sky_frame_budget_bench --width 320 --height 180
-// (Release, 2-core AMD EPYC VM, lavapipe, 2026-12-06). Their shape is this
-// path's, not the ladder's (measured on the bench's scenes): the controller
-// learns the machine's speed from frames, through the ladder.
-constexpr std::array<double, 7> kRecordedLevel_ms = {172.56, 76.70, 66.88, 53.38, 47.40, 22.76, 13.16};
+// (Release, 2-core AMD EPYC VM, lavapipe, 2026-12-06); level 5
+// (realtime/1.5 at full size, added since) as 0.93 of low/1.5's, its ratio
+// in a run of the same command on 2026-12-07 (158.9 against 170.7 ms, with
+// a test suite running beside it). Their shape is this path's, not the
+// ladder's (measured on the bench's scenes): the controller learns the
+// machine's speed from frames, through the ladder.
+constexpr std::array<double, 8> kRecordedLevel_ms = {172.56, 76.70, 66.88, 53.38, 47.40, 44.08, 22.76, 13.16};
 
 // The machine's speed over the replay, a phase of kPhaseFrames frames each:
 // as recorded, then 1.3x slower (CI has run at up to 1.46x a calibration's

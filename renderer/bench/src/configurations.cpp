@@ -166,7 +166,7 @@ Result<Configuration> customConfiguration(const std::string& spec) {
                       "' (base, primary, light, exit, stride, cloud, empty, growth, air, multmin, divmin, scale, "
                       "interleave 1|2|4, divisor 1|2|4, depth-aware 0|1, blue 0|1, cloud-shadows 0|1, near-precip 0|1, shower-cells 0|1, "
                       "air-table 0|1, "
-                      "air-azimuths, air-zeniths, air-slices, budget 0..4 (after base), accumulate 0..0.95, "
+                      "air-azimuths, air-zeniths, air-slices, budget (a level of the base preset's ladder, after base), accumulate 0..0.95, "
                       "pixel-jitter 0|1, clip 0..4, dense-turn (px, 0 never), acc-motion (px, 0 off), edges 0|1, sharp 0|1, horizon 0|1, region-drop 0|1, shadow 0..5 (march, column, esm, bsm, fom, deep), shadow-size, "
                       "shadow-cascades, shadow-extent (m), shadow-steps, shadow-frames)");
   }

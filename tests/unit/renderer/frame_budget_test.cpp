@@ -30,7 +30,7 @@ std::string wayOf(const std::string& level) { return level.substr(0, level.find_
 // exit no later). Every level keeps the preset's air table and sun map
 // (the renderer is built with them) and draws no more pixels than it.
 TEST(FrameBudget, LaddersGoFromThePresetDown) {
-  const std::pair<const char*, std::size_t> expected[] = {{"high", 7}, {"medium", 6}, {"low", 4}, {"realtime", 2}};
+  const std::pair<const char*, std::size_t> expected[] = {{"high", 8}, {"medium", 7}, {"low", 5}, {"realtime", 2}};
   for (const auto& [name, levels] : expected) {
     const render::Preset p = preset(name);
     auto ladder = render::budgetLadder(p);
@@ -63,6 +63,12 @@ TEST(FrameBudget, LaddersGoFromThePresetDown) {
       EXPECT_EQ(level.temporal.accumulation, way->temporal.accumulation);
       EXPECT_EQ(m.airTable.azimuths, way->march.airTable.azimuths) << "the way's air table";
       EXPECT_EQ(m.airTable.slices, way->march.airTable.slices);
+      // A level drawn at another size than its way's says which.
+      const std::uint32_t d = level.resolution.divisor;
+      if (d != way->resolution.divisor)
+        EXPECT_NE(level.name.find(d == 1 ? " at full size" : " at 1/" + std::to_string(d) + " size"), std::string::npos);
+      else
+        EXPECT_EQ(level.name.find(" at "), std::string::npos);
       if (wayOf(level.name) == wayOf(before.name) && level.resolution.divisor == before.resolution.divisor) {
         EXPECT_TRUE(m.primarySteps < mb.primarySteps || m.cloudStep_m > mb.cloudStep_m);
         EXPECT_LE(m.lightSteps, mb.lightSteps);
