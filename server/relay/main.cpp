@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -38,6 +39,7 @@ struct RelayOptions {
   std::string httpPortFile;
   std::string natsUrls;
   std::string logLevel = "info";
+  std::string gribDecoder;
 };
 
 void addOptions(CLI::App& app, RelayOptions& o) {
@@ -62,6 +64,9 @@ void addOptions(CLI::App& app, RelayOptions& o) {
                  "0 picks a free one; default: none)")
       ->check(CLI::Range(0, 65535));
   app.add_option("--http-port-file", o.httpPortFile, "Write the HTTP port here once listening");
+  app.add_option("--grib-decoder", o.gribDecoder,
+                 "The GRIB decoder executable for the forecasts the log names (default: skyshell-grib-decode "
+                 "beside this executable)");
   app.add_option("--log-level", o.logLevel, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
@@ -137,7 +142,8 @@ int main(int argc, char** argv) {
   natsOptions.serverId = o.stream.serverId;
   natsOptions.relay = true;
   natsOptions.logger = log;
-  natsOptions.gribDecoder.executable = sky::server::defaultGribDecoder();
+  natsOptions.gribDecoder.executable =
+      o.gribDecoder.empty() ? sky::server::defaultGribDecoder() : std::filesystem::path(o.gribDecoder);
   auto started = sky::server::NatsWeather::start(s, std::move(natsOptions));
   if (!started) {
     log->error("event=nats_unusable nats={:?} detail={:?}", o.natsUrls, sky::describe(started.error()));

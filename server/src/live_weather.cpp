@@ -380,6 +380,8 @@ bool sameForecast(const LoadedForecast* held, const nlohmann::json& saved) {
 
 }  // namespace
 
+bool LiveWeather::holdsForecast(const nlohmann::json& saved) const { return sameForecast(forecast_.get(), saved); }
+
 Result<void> LiveWeather::restore(const nlohmann::json& j, std::vector<ChangeEvent> events,
                                   const ForecastLoader& loader) {
   auto bad = [](const std::string& what) { return fail(ErrorCode::Malformed, "saved state: " + what); };

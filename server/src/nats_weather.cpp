@@ -137,16 +137,59 @@ Result<void> NatsWeather::replay() {
 
 void NatsWeather::onEntry(std::uint64_t sequence, const std::string& bytes) {
   if (sequence <= applied_) return;  // this server's own append, or one folded already
+  if (decoding_) {
+    waitingBytes_ += bytes.size();
+    waiting_.emplace_back(sequence, bytes);
+    while (waitingBytes_ > kMaxWaitingBytes && waiting_.size() > 1) {
+      ++dropped_;
+      log_->warn("event=nats_entry_dropped sequence={} detail=\"{} bytes of entries waited for a forecast's "
+                 "decode; a later entry holds the whole state\"",
+                 waiting_.front().first, waitingBytes_);
+      waitingBytes_ -= waiting_.front().second.size();
+      waiting_.pop_front();
+    }
+    return;
+  }
   ++followed_;
   if (leading_) stepDown("the log moved to sequence " + std::to_string(sequence) + " past this leader's " +
                          std::to_string(applied_.load()));
   auto entry = decodeLogEntry(bytes);
+  if (entry && entry->state.is_object() && entry->state.contains("forecast") &&
+      !entry->state["forecast"].is_null() && !server_.weather().holdsForecast(entry->state["forecast"])) {
+    decodeThenFold(sequence, std::move(*entry));
+    return;
+  }
+  fold(sequence, std::move(entry), {});
+}
+
+void NatsWeather::decodeThenFold(std::uint64_t sequence, LogEntry entry) {
+  decoding_ = true;
+  if (decodeThread_.joinable()) decodeThread_.join();  // the last decode, which posted its fold already
+  nlohmann::json saved = entry.state["forecast"];
+  decodeThread_ = std::thread([this, load = forecastLoader(), saved = std::move(saved), sequence,
+                               entry = std::move(entry), alive = alive_]() mutable {
+    auto decoded = std::make_shared<Result<LoadedForecast>>(load(saved));
+    if (!*alive) return;
+    boost::asio::post(server_.io(), [this, sequence, entry = std::move(entry), decoded, alive]() mutable {
+      if (!*alive) return;
+      decoding_ = false;
+      fold(sequence, std::move(entry),
+           [decoded](const nlohmann::json&) -> Result<LoadedForecast> { return std::move(*decoded); });
+      // The entries that arrived meanwhile, in order; one of them may start
+      // a decode again, and the rest then wait for it.
+      auto waiting = std::exchange(waiting_, {});
+      waitingBytes_ = 0;
+      for (auto& [next, bytes] : waiting) onEntry(next, bytes);
+    });
+  });
+}
+
+void NatsWeather::fold(std::uint64_t sequence, Result<LogEntry> entry, const LiveWeather::ForecastLoader& loader) {
   LiveWeather& weather = server_.weather();
   if (entry) {
     std::vector<ChangeEvent> events = weather.events(kReplayEntries);
     if (entry->event) events.push_back(*entry->event);
-    if (auto r = weather.restore(entry->state, std::move(events), forecastLoader()); !r)
-      entry = tl::unexpected(r.error());
+    if (auto r = weather.restore(entry->state, std::move(events), loader); !r) entry = tl::unexpected(r.error());
   }
   applied_ = sequence;
   if (!entry) {
@@ -210,8 +253,9 @@ LiveWeather::ForecastLoader NatsWeather::forecastLoader() const {
   auto load = sky::server::forecastLoader(
       [nats = natsLog_.get(), maxBytes](const std::string& key) { return nats->getFile(key, maxBytes); },
       options_.gribDecoder);
-  // Decoding runs on the io thread, like the rest of an entry's fold: once
-  // per forecast loaded (restore keeps a forecast it holds already).
+  // Once per forecast loaded (restore keeps a forecast it holds already):
+  // at start on the io thread, before the server serves; while following,
+  // on decodeThenFold's thread.
   return [load = std::move(load), log = log_](const nlohmann::json& saved) -> Result<LoadedForecast> {
     const std::int64_t t0 = steadyNs();
     auto loaded = load(saved);
@@ -338,7 +382,8 @@ void NatsWeather::watchLog(std::optional<std::pair<std::chrono::steady_clock::ti
   if (auto range = natsLog_->range(); range) {
     const std::uint64_t applied = applied_.load();
     const auto now = std::chrono::steady_clock::now();
-    if (range->last <= applied || (lagging && lagging->second != applied)) {
+    // A forecast decoding holds the fold, not the subscription.
+    if (range->last <= applied || decoding_ || (lagging && lagging->second != applied)) {
       lagging.reset();
     } else if (!lagging) {
       lagging.emplace(now, applied);
@@ -428,6 +473,8 @@ void NatsWeather::stepDown(const std::string& why) {
 void NatsWeather::close() {
   if (closed_) return;
   closed_ = true;
+  *alive_ = false;
+  if (decodeThread_.joinable()) decodeThread_.join();
   claimRetry_.cancel();
   leading_ = false;
   {
@@ -501,6 +548,9 @@ std::string NatsWeather::metrics() const {
        applied_.load());
   line("skyshell_nats_appended_total", "counter", "changes this server appended to the NATS log", appended_.load());
   line("skyshell_nats_followed_total", "counter", "log entries of other servers folded in", followed_.load());
+  line("skyshell_nats_decoding", "gauge",
+       "1 while a forecast an entry names is decoded (the entries after it wait)", decoding_ ? 1 : 0);
+  line("skyshell_nats_waiting_entries", "gauge", "log entries waiting for a forecast's decode", waiting_.size());
   line("skyshell_nats_entries_dropped_total", "counter", "log entries dropped: malformed, or not foldable here (a forecast whose files cannot be read or decoded)", dropped_.load());
   line("skyshell_nats_fenced_total", "counter", "appends refused by JetStream for a stale last sequence",
        fenced_.load());

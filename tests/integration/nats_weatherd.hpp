@@ -131,12 +131,14 @@ struct NatsWeatherd : HttpPeer {
 // (deploy/skyshell-relay.service; the port file on the command line).
 struct NatsRelay : HttpPeer {
   unsigned streamPort = 0;
-  NatsRelay(const std::filesystem::path& root, const std::string& name, const std::string& natsUrls) {
+  // moreConfig: more lines of its config file.
+  NatsRelay(const std::filesystem::path& root, const std::string& name, const std::string& natsUrls,
+            const std::string& moreConfig = "") {
     dir = root / name;
     std::filesystem::create_directories(dir);
     const std::filesystem::path config = dir / "relay.toml";
     std::ofstream(config) << "nats = \"" << natsUrls << "\"\nport = 0\nhttp-port = 0\nhttp-port-file = \""
-                          << (dir / "http.port").string() << "\"\nheartbeat-ms = 200\n";
+                          << (dir / "http.port").string() << "\"\nheartbeat-ms = 200\n" << moreConfig;
     process.emplace(std::vector<std::string>{SKY_RELAY, "--config", config.string(), "--port-file",
                                              (dir / "stream.port").string()},
                     (dir / "relay.log").string());

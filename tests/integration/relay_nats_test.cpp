@@ -252,9 +252,20 @@ TEST_F(RelayNats, ARendererOnARelayDrawsThroughChangesAFailoverAndAPause) {
 // read it back by its key, decode it themselves and reach the leader's
 // state hash; the next change does not decode it again; removed, its file
 // leaves the stream. A follower refuses the load, naming the leader.
+// A relay whose decoder is slow (kSlowDecode_s before it runs) decodes off
+// its io thread: it answers HTTP (served on the io thread, as its weather
+// stream is) within a second while it decodes, holds the change appended
+// meanwhile until the forecast is in, then folds both in order.
 TEST_F(RelayNats, AForecastLoadedOnTheLeaderIsDecodedOnTheStandbyAndTheRelay) {
   startStandby();
   if (HasFatalFailure()) return;
+  constexpr int kSlowDecode_s = 4;
+  const fs::path slowDecoder = root_ / "slow-grib-decode";
+  std::ofstream(slowDecoder) << "#!/bin/sh\nsleep " << kSlowDecode_s << "\nexec '" << SKY_GRIB_DECODE << "' \"$@\"\n";
+  fs::permissions(slowDecoder, fs::perms::owner_all);
+  NatsRelay slow(root_, "slow-relay", cluster_->urls(2), "grib-decoder = \"" + slowDecoder.string() + "\"\n");
+  ASSERT_NE(slow.httpPort, 0u) << slow.log();
+  ASSERT_TRUE(waitUntil(10s, [&] { return slow.stateHash() == a_->stateHash(); })) << slow.log();
   std::ifstream in(SKY_GRIB_SAMPLE, std::ios::binary);
   const std::string gfs((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_GT(gfs.size(), 1000u) << SKY_GRIB_SAMPLE;
@@ -276,6 +287,18 @@ TEST_F(RelayNats, AForecastLoadedOnTheLeaderIsDecodedOnTheStandbyAndTheRelay) {
   })) << relay_->log() << b_->log();
   std::printf("a %zu-byte GRIB file loaded on the leader: the standby and the relay hold its forecast %.2f s after "
               "it was sent\n", gfs.size(), secondsSince(t0));
+  // The slow relay is still decoding (kSlowDecode_s after the others
+  // started): its HTTP answers meanwhile.
+  double slowestAnswer_s = 0;
+  bool sawDecoding = false;
+  for (int i = 0; i < 5; ++i) {
+    const auto asked = Clock::now();
+    const double decoding = slow.metric("skyshell_nats_decoding");
+    slowestAnswer_s = std::max(slowestAnswer_s, secondsSince(asked));
+    sawDecoding = sawDecoding || decoding == 1;
+  }
+  EXPECT_TRUE(sawDecoding) << slow.log();
+  EXPECT_LT(slowestAnswer_s, 1.0) << "the relay's io thread waited for the decode";
   for (const HttpPeer* peer : {static_cast<const HttpPeer*>(&*b_), static_cast<const HttpPeer*>(&*relay_)}) {
     const auto state = peer->state();
     ASSERT_TRUE(state.is_object() && state["forecast"].is_object()) << state.dump();
@@ -289,6 +312,17 @@ TEST_F(RelayNats, AForecastLoadedOnTheLeaderIsDecodedOnTheStandbyAndTheRelay) {
   ASSERT_EQ(ack->status, 200) << ack->body;
   ASSERT_TRUE(waitUntil(10s, [&] { return relay_->hasLayer(7) && b_->hasLayer(7); }));
   EXPECT_EQ(relay_->stateHash(), a_->stateHash());
+  // The change waits on the slow relay for the forecast's decode, then both
+  // are folded: the leader's state, decoded once.
+  bool sawWaiting = false;
+  ASSERT_TRUE(waitUntil(30s, [&] {
+    sawWaiting = sawWaiting || slow.metric("skyshell_nats_waiting_entries") >= 1;
+    return slow.stateHash() == a_->stateHash();
+  })) << slow.log();
+  EXPECT_TRUE(sawWaiting) << "the change arrived after the slow decode had finished; " << slow.log();
+  EXPECT_TRUE(slow.hasLayer(7));
+  EXPECT_EQ(slow.state()["forecast"]["files"][0]["key"], key);
+  EXPECT_EQ(slow.metric("skyshell_nats_entries_dropped_total"), 0) << slow.log();
   const auto decodes = [](const std::string& log) {
     std::size_t n = 0;
     for (auto at = log.find("event=nats_forecast_decoded"); at != std::string::npos;
@@ -298,6 +332,7 @@ TEST_F(RelayNats, AForecastLoadedOnTheLeaderIsDecodedOnTheStandbyAndTheRelay) {
   };
   EXPECT_EQ(decodes(relay_->log()), 1u) << relay_->log();
   EXPECT_EQ(decodes(b_->log()), 1u) << b_->log();
+  EXPECT_EQ(decodes(slow.log()), 1u) << slow.log();
 
   server::NatsLogOptions o;
   o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};

@@ -194,6 +194,9 @@ class LiveWeather final : public WeatherService {
   // have no forecast).
   Result<void> restore(const nlohmann::json& state, std::vector<ChangeEvent> events,
                        const ForecastLoader& loader = {});
+  // Whether restore would keep the forecast held for this saved one (the
+  // same files at the same place on the clock) rather than decode it.
+  bool holdsForecast(const nlohmann::json& saved) const;
   // FNV-1a of the canonical state without the clock's position (layers,
   // ramps, sequence, clock rate): equal before a shutdown and after restore.
   std::uint64_t stateHash() const;

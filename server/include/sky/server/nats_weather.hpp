@@ -18,6 +18,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -45,6 +46,8 @@ class Server;
 // Entries a starting server reads back for its event log; the last of them
 // is its state. The console shows the recent history, a few hundred lines.
 inline constexpr std::uint64_t kReplayEntries = 256;
+// The most bytes of log entries a follower holds while a forecast decodes.
+inline constexpr std::size_t kMaxWaitingBytes = 64u << 20;
 
 struct NatsWeatherOptions {
   NatsLogOptions log;
@@ -101,8 +104,15 @@ class NatsWeather {
   // Follows the log from the entry after the last one folded; replaces the
   // subscription (the election thread's, once started).
   Result<void> follow();
-  // On the io thread: one entry of the log, as the follower sees it.
+  // On the io thread: one entry of the log, as the follower sees it. An
+  // entry naming a forecast not held is decoded off the io thread
+  // (decodeThenFold); the entries after it wait for it.
   void onEntry(std::uint64_t sequence, const std::string& bytes);
+  // Folds one entry (or counts it dropped) with `loader` for its forecast.
+  void fold(std::uint64_t sequence, Result<LogEntry> entry, const LiveWeather::ForecastLoader& loader);
+  // Reads and decodes the forecast `entry` names on decodeThread_, then
+  // folds the entry and the ones that waited for it on the io thread.
+  void decodeThenFold(std::uint64_t sequence, LogEntry entry);
   Result<void> commit(const nlohmann::json& state, const ChangeEvent& event);
   // Decodes a forecast an entry names from the files stream.
   LiveWeather::ForecastLoader forecastLoader() const;
@@ -146,6 +156,19 @@ class NatsWeather {
   std::atomic<bool> leading_{false};
   bool closed_ = false;
   std::chrono::steady_clock::time_point claimStarted_{};
+  // A forecast being decoded for an entry (seconds for a large GRIB file),
+  // off the io thread so that the weather stream and the HTTP API go on
+  // serving the weather folded so far; the entries that arrive meanwhile
+  // wait, in order, up to kMaxWaitingBytes (each holds the whole state: one
+  // dropped loses only its event from the history). decoding_ is atomic for
+  // the election thread, which does not count a decode as a stalled
+  // subscription. alive_ is false once closed: a decode that finishes after
+  // close() leaves this object alone.
+  std::atomic<bool> decoding_{false};
+  std::deque<std::pair<std::uint64_t, std::string>> waiting_;
+  std::size_t waitingBytes_ = 0;
+  std::thread decodeThread_;
+  std::shared_ptr<std::atomic<bool>> alive_ = std::make_shared<std::atomic<bool>>(true);
 
   // Shared between the io thread and the election thread.
   mutable std::mutex mutex_;
