@@ -1,6 +1,7 @@
 // The server's live weather (see live_weather.hpp).
 #include "sky/server/live_weather.hpp"
 
+#include "sky/core/utf8.hpp"
 #include "sky/server/api_json.hpp"
 #include "sky/server/weather_store.hpp"
 #include "ramp_math.hpp"
@@ -223,8 +224,13 @@ Result<AppliedChange> LiveWeather::submitImpl(const ChangeRequest& request, bool
 }
 
 Result<AppliedChange> LiveWeather::commit(State next, std::vector<TimelineItem> timeline, const std::string& author,
-                                          const std::string& source, const std::string& summary, double now_s,
+                                          const std::string& source, const std::string& fullSummary, double now_s,
                                           bool durableNow) {
+  std::string summary = fullSummary;
+  if (summary.size() > kMaxEventSummary_bytes) {
+    const std::string tail = " ... (" + std::to_string(fullSummary.size()) + " bytes in all)";
+    summary = std::string(utf8::cut(fullSummary, kMaxEventSummary_bytes - tail.size())) + tail;
+  }
   ChangeEvent e{sequence_ + 1, now_s, unixNowMs_(), author, source, summary};
   if (committer_) {
     const auto started = std::chrono::steady_clock::now();

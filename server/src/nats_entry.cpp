@@ -2,7 +2,10 @@
 #include "sky/server/nats_entry.hpp"
 
 #include <cmath>
+#include <span>
 #include <utility>
+
+#include "sky/server/forecast_files.hpp"
 
 namespace sky::server {
 
@@ -29,13 +32,18 @@ Result<std::uint64_t> count(const nlohmann::json& j, const char* key) {
 
 }  // namespace
 
+std::string stateFileKey(std::string_view json) {
+  return "state-" + fileKey(std::as_bytes(std::span(json.data(), json.size())));
+}
+
 std::string encodeLogEntry(const LogEntry& entry) {
   nlohmann::json j{{"format", kLogEntryFormat},
                    {"kind", entry.kind == LogEntry::Kind::Change ? "change" : "term"},
                    {"term", entry.term},
                    {"leader", entry.leaderId},
-                   {"leader_api", entry.leaderApi},
-                   {"state", entry.state}};
+                   {"leader_api", entry.leaderApi}};
+  if (entry.stateFile) j["state_file"] = {{"key", entry.stateFile->key}, {"bytes", entry.stateFile->bytes}};
+  else j["state"] = entry.state;
   if (entry.event) {
     const ChangeEvent& e = *entry.event;
     j["event"] = {{"sequence", e.sequence}, {"clock_s", e.clock_s}, {"wall_ms", e.wallTime_ms},
@@ -70,8 +78,24 @@ Result<LogEntry> decodeLogEntry(std::string_view bytes) {
   if (!api) return tl::unexpected(api.error());
   e.leaderApi = std::move(*api);
   const auto state = j.find("state");
-  if (state == j.end() || !state->is_object()) return fail(ErrorCode::Malformed, "log entry: state: not an object");
-  e.state = std::move(*state);
+  const auto file = j.find("state_file");
+  if (file != j.end() && state == j.end()) {
+    if (!file->is_object()) return fail(ErrorCode::Malformed, "log entry: state_file: not an object");
+    auto key = text(*file, "key");
+    if (!key) return tl::unexpected(key.error());
+    if (key->rfind("state-", 0) != 0 || key->find_first_of(". *>\t\r\n") != std::string::npos)
+      return fail(ErrorCode::Malformed, "log entry: state_file.key: not a state file's key");
+    auto bytes = count(*file, "bytes");
+    if (!bytes) return tl::unexpected(bytes.error());
+    if (*bytes > kMaxStateFile_bytes)
+      return fail(ErrorCode::TooLarge, "log entry: state_file.bytes: " + std::to_string(*bytes) + ", at most " +
+                                           std::to_string(kMaxStateFile_bytes));
+    e.stateFile = LogEntry::StateFile{std::move(*key), *bytes};
+  } else {
+    if (state == j.end() || !state->is_object()) return fail(ErrorCode::Malformed, "log entry: state: not an object");
+    if (file != j.end()) return fail(ErrorCode::Malformed, "log entry: both a state and a state_file");
+    e.state = std::move(*state);
+  }
   const auto event = j.find("event");
   if (e.kind == LogEntry::Kind::Term) {
     if (event != j.end()) return fail(ErrorCode::Malformed, "log entry: a term entry with an event");

@@ -3,6 +3,7 @@
 #include "sky/server/nats_weather.hpp"
 
 #include <algorithm>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -42,6 +43,21 @@ constexpr int kClaimAttempts = 250;
 constexpr std::chrono::seconds kFollowStall{1};
 // The longest leader id or API address read from another server's lease.
 constexpr std::size_t kMaxLeaseText = 512;
+
+// The state an entry names in the files stream: its bytes must have the
+// entry's key and size, and be a JSON object.
+Result<nlohmann::json> readStateFile(NatsLog& nats, const LogEntry::StateFile& file) {
+  auto bytes = nats.getFile(file.key, kMaxStateFile_bytes);
+  if (!bytes) return fail(bytes.error().code, "state file " + file.key + ": " + bytes.error().detail);
+  const std::string_view json(reinterpret_cast<const char*>(bytes->data()), bytes->size());
+  if (json.size() != file.bytes || stateFileKey(json) != file.key)
+    return fail(ErrorCode::Malformed, "state file " + file.key + ": " + std::to_string(json.size()) +
+                                          " bytes that do not have its key");
+  nlohmann::json state = nlohmann::json::parse(json, nullptr, false);
+  if (state.is_discarded() || !state.is_object())
+    return fail(ErrorCode::Malformed, "state file " + file.key + ": not a JSON object");
+  return state;
+}
 
 std::int64_t steadyNs() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
@@ -117,8 +133,16 @@ Result<void> NatsWeather::replay() {
   // An entry this server cannot fold (its forecast's files unreadable or
   // undecodable here) does not stop it: it keeps the scenario's weather,
   // as a follower keeps its last after such an entry (onEntry), and
-  // follows from there.
-  if (auto r = weather.restore(newest->state, std::move(events), forecastLoader()); !r) {
+  // follows from there. So does a state file it cannot read.
+  Result<void> r;
+  if (newest->stateFile) {
+    auto state = readStateFile(*natsLog_, *newest->stateFile);
+    if (state) newest->state = std::move(*state);
+    else r = tl::unexpected(state.error());
+    stateFile_ = newest->stateFile->key;
+  }
+  if (r) r = weather.restore(newest->state, std::move(events), forecastLoader());
+  if (!r) {
     ++dropped_;
     log_->error("event=nats_entry_dropped sequence={} detail={:?}: the scenario's weather stands until an entry "
                 "this server can fold", range->last, describe(r.error()));
@@ -154,34 +178,88 @@ void NatsWeather::onEntry(std::uint64_t sequence, const std::string& bytes) {
   if (leading_) stepDown("the log moved to sequence " + std::to_string(sequence) + " past this leader's " +
                          std::to_string(applied_.load()));
   auto entry = decodeLogEntry(bytes);
-  if (entry && entry->state.is_object() && entry->state.contains("forecast") &&
-      !entry->state["forecast"].is_null() && !server_.weather().holdsForecast(entry->state["forecast"])) {
-    decodeThenFold(sequence, std::move(*entry));
-    return;
-  }
+  if (!entry) return fold(sequence, std::move(entry), {});
+  if (entry->stateFile) return readStateThenFold(sequence, std::move(*entry));
+  foldOrDecode(sequence, std::move(*entry));
+}
+
+void NatsWeather::foldOrDecode(std::uint64_t sequence, LogEntry entry) {
+  if (entry.state.is_object() && entry.state.contains("forecast") && !entry.state["forecast"].is_null() &&
+      !server_.weather().holdsForecast(entry.state["forecast"]))
+    return decodeThenFold(sequence, std::move(entry));
   fold(sequence, std::move(entry), {});
 }
 
-void NatsWeather::decodeThenFold(std::uint64_t sequence, LogEntry entry) {
+void NatsWeather::offIoThread(std::function<std::function<void()>()> work) {
   decoding_ = true;
-  if (decodeThread_.joinable()) decodeThread_.join();  // the last decode, which posted its fold already
-  nlohmann::json saved = entry.state["forecast"];
-  decodeThread_ = std::thread([this, load = forecastLoader(), saved = std::move(saved), sequence,
-                               entry = std::move(entry), alive = alive_]() mutable {
-    auto decoded = std::make_shared<Result<LoadedForecast>>(load(saved));
+  if (decodeThread_.joinable()) decodeThread_.join();  // the last one, which posted its result already
+  decodeThread_ = std::thread([this, work = std::move(work), alive = alive_] {
+    std::function<void()> then = work();
     if (!*alive) return;
-    boost::asio::post(server_.io(), [this, sequence, entry = std::move(entry), decoded, alive]() mutable {
+    boost::asio::post(server_.io(), [this, then = std::move(then), alive] {
       if (!*alive) return;
       decoding_ = false;
-      fold(sequence, std::move(entry),
-           [decoded](const nlohmann::json&) -> Result<LoadedForecast> { return std::move(*decoded); });
-      // The entries that arrived meanwhile, in order; one of them may start
-      // a decode again, and the rest then wait for it.
+      then();
+      // The entries that arrived meanwhile, in order; `then` or one of them
+      // may go off the io thread again, and the rest then wait for it.
       auto waiting = std::exchange(waiting_, {});
       waitingBytes_ = 0;
       for (auto& [next, bytes] : waiting) onEntry(next, bytes);
     });
   });
+}
+
+void NatsWeather::decodeThenFold(std::uint64_t sequence, LogEntry entry) {
+  nlohmann::json saved = entry.state["forecast"];
+  offIoThread([this, load = forecastLoader(), saved = std::move(saved), sequence,
+               entry = std::move(entry)]() -> std::function<void()> {
+    auto decoded = std::make_shared<Result<LoadedForecast>>(load(saved));
+    return [this, sequence, entry, decoded] {
+      fold(sequence, entry,
+           [decoded](const nlohmann::json&) -> Result<LoadedForecast> { return std::move(*decoded); });
+    };
+  });
+}
+
+
+void NatsWeather::readStateThenFold(std::uint64_t sequence, LogEntry entry) {
+  offIoThread([this, sequence, entry = std::move(entry)]() -> std::function<void()> {
+    auto state = std::make_shared<Result<nlohmann::json>>(readStateFile(*natsLog_, *entry.stateFile));
+    return [this, sequence, entry, state]() mutable {
+      if (!*state) return fold(sequence, tl::unexpected(state->error()), {});
+      entry.state = std::move(**state);
+      stateFileStands(entry.stateFile);
+      entry.stateFile.reset();
+      foldOrDecode(sequence, std::move(entry));
+    };
+  });
+}
+
+Result<std::string> NatsWeather::entryBytes(LogEntry& entry) {
+  std::string bytes = encodeLogEntry(entry);
+  if (bytes.size() <= kMaxLogEntry_bytes) return bytes;
+  const std::string json = entry.state.dump();
+  if (json.size() > kMaxStateFile_bytes)
+    return fail(ErrorCode::TooLarge, "the weather's state is " + std::to_string(json.size()) +
+                                         " bytes, more than the NATS log holds (" +
+                                         std::to_string(kMaxStateFile_bytes) + ")");
+  LogEntry::StateFile file{stateFileKey(json), json.size()};
+  if (auto put = natsLog_->putFile(file.key, std::as_bytes(std::span(json.data(), json.size()))); !put)
+    return fail(put.error().code, "the weather's state (" + std::to_string(json.size()) +
+                                      " bytes) not stored in the files stream: " + put.error().detail);
+  entry.stateFile = std::move(file);
+  return encodeLogEntry(entry);
+}
+
+void NatsWeather::stateFileStands(const std::optional<LogEntry::StateFile>& file) {
+  const std::optional<std::string> key = file ? std::optional(file->key) : std::nullopt;
+  if (stateFile_ && stateFile_ != key && leading_) {
+    // A follower still folding the entry before fails to read it and folds
+    // this one, which holds the whole state.
+    if (auto dropped = natsLog_->dropFile(*stateFile_); !dropped)
+      log_->warn("event=nats_file_kept key={} detail={:?}", *stateFile_, describe(dropped.error()));
+  }
+  stateFile_ = key;
 }
 
 void NatsWeather::fold(std::uint64_t sequence, Result<LogEntry> entry, const LiveWeather::ForecastLoader& loader) {
@@ -227,12 +305,9 @@ Result<void> NatsWeather::commit(const nlohmann::json& state, const ChangeEvent&
   }
   entry.state = state;
   entry.event = event;
-  const std::string bytes = encodeLogEntry(entry);
-  if (bytes.size() > kMaxLogEntry_bytes)
-    return fail(ErrorCode::TooLarge, "the weather's state is " + std::to_string(bytes.size()) +
-                                         " bytes, more than a NATS log entry holds (" +
-                                         std::to_string(kMaxLogEntry_bytes) + ")");
-  auto appended = natsLog_->append(bytes, applied_);
+  auto bytes = entryBytes(entry);
+  if (!bytes) return tl::unexpected(bytes.error());
+  auto appended = natsLog_->append(*bytes, applied_);
   if (!appended)
     return fail(appended.error().code, "change not acknowledged by JetStream (it may still be stored; the "
                                        "weather shows it if so): " + appended.error().detail);
@@ -245,6 +320,7 @@ Result<void> NatsWeather::commit(const nlohmann::json& state, const ChangeEvent&
   applied_ = appended->sequence;
   ++appended_;
   dropUnusedFiles(state);
+  stateFileStands(entry.stateFile);
   return {};
 }
 
@@ -436,12 +512,15 @@ void NatsWeather::claim(std::uint64_t term, int attempt) {
     entry.leaderApi = apiUrl_;
   }
   entry.state = server_.weather().toJson();
-  auto appended = natsLog_->append(encodeLogEntry(entry), applied_);
+  auto bytes = entryBytes(entry);
+  if (!bytes) return retry(describe(bytes.error()));
+  auto appended = natsLog_->append(*bytes, applied_);
   if (!appended) return retry(describe(appended.error()));
   if (!appended->stored) return retry("another server appended meanwhile");
   applied_ = appended->sequence;
   term_ = term;
   leading_ = true;
+  stateFileStands(entry.stateFile);
   {
     std::lock_guard lock(mutex_);
     leaderId_ = entry.leaderId;

@@ -1,7 +1,8 @@
 // libFuzzer target: what a server or relay reads from NATS. Entries of the
 // weather's change log as a follower reads them back from JetStream
 // (server/src/nats_entry.cpp), then their state folded into a live weather
-// (LiveWeather::restore), as nats_weather.cpp does; and the same bytes as a
+// (LiveWeather::restore), as nats_weather.cpp does (or, for a state too
+// large for an entry, the name of its file on the files stream); and the same bytes as a
 // record of the cluster's registry bucket (cluster_member.cpp), which any
 // publisher could have put there; and as the manifest of a forecast file on
 // the files stream (nats_files.cpp: "<bytes> <chunk bytes>"). One target for
@@ -57,8 +58,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   auto again = sky::server::decodeLogEntry(sky::server::encodeLogEntry(*entry));
   if (!again || again->term != entry->term || again->kind != entry->kind || again->state != entry->state ||
-      again->event.has_value() != entry->event.has_value())
+      again->event.has_value() != entry->event.has_value() ||
+      again->stateFile.has_value() != entry->stateFile.has_value() ||
+      (entry->stateFile && (again->stateFile->key != entry->stateFile->key ||
+                            again->stateFile->bytes != entry->stateFile->bytes)))
     std::abort();
+  // A state in the files stream: only its name and size are in the entry.
+  if (entry->stateFile) {
+    if (entry->stateFile->bytes > sky::server::kMaxStateFile_bytes || !entry->state.is_null()) std::abort();
+    return 0;
+  }
   const sky::server::WallClock::time_point t0{std::chrono::hours(1000)};
   sky::server::LiveWeather weather(sky::server::Scenario{}, t0, [t0] { return t0; },
                                    [] { return std::int64_t{1700000000000}; });

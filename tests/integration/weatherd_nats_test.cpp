@@ -70,7 +70,10 @@ class WeatherdNats : public ::testing::Test {
     auto bytes = (*log)->read(range->last);
     if (!bytes || !*bytes) return std::nullopt;
     auto entry = server::decodeLogEntry(**bytes);
-    if (!entry) return std::nullopt;
+    if (!entry) {
+      ADD_FAILURE() << describe(entry.error());
+      return std::nullopt;
+    }
     return *entry;
   }
 
@@ -291,6 +294,85 @@ TEST_F(WeatherdNats, AForecastFileComesBackAsPutAndAForgedOneIsRefused) {
   auto gone = (*log)->getFile("0123abcd-600000", bytes.size());
   ASSERT_FALSE(gone);
   EXPECT_EQ(gone.error().code, ErrorCode::Io);
+}
+
+// A state past what a log entry holds (NATS's 1 MiB payload: here some
+// thousands of regions, as a continent of METAR stations makes) goes to the files
+// stream, and the entry names it: every change is still acknowledged, the
+// follower folds it to the leader's state hash, and a server started
+// afterwards replays it. The leader purges a state file once a newer entry
+// stands. A state small again goes back into the entry.
+TEST_F(WeatherdNats, AStateLargerThanAnEntryGoesToTheFilesStream) {
+  startTwo();
+  if (HasFatalFailure()) return;
+  // Requests of 100 regions (each request's body under the API's 64 KiB)
+  // until two entries named a state file.
+  constexpr int kMaxRequests = 40, kPerRequest = 100;
+  std::vector<std::string> stateFiles;
+  int regionCount = 0;
+  for (int r = 0; r < kMaxRequests && stateFiles.size() < 2; ++r) {
+    std::string body = R"({"author": "nats-test", "changes": [)";
+    for (int k = 0; k < kPerRequest; ++k) {
+      const int id = 1 + r * kPerRequest + k;
+      body += std::string(k ? "," : "") + R"({"op": "set_region", "region": {"id": )" + std::to_string(id) +
+              R"(, "center_lat_deg": )" + std::to_string(30 + 0.5 * (id / 60)) + R"(, "center_lon_deg": )" +
+              std::to_string(-120 + 0.9 * (id % 60)) +
+              R"(, "size_x_m": 20000, "size_y_m": 20000, "transition_m": 5000, "layers": [{"id": 3, "type": "cumulus",
+              "base_m": 1200, "thickness_m": 900, "transition_band_m": 50, "coverage": 0.5, "density": 0.6,
+              "wind": {"speed_mps": 5, "from_deg": 200, "vertical_mps": 0}}]}})";
+    }
+    body += "]}";
+    const auto ack = a_->request("POST", "/api/changes", body);
+    ASSERT_TRUE(ack) << r;
+    ASSERT_EQ(ack->status, 200) << r << ": " << ack->body;
+    regionCount += kPerRequest;
+    const auto entry = lastEntry();
+    ASSERT_TRUE(entry) << r;
+    if (entry->stateFile) stateFiles.push_back(entry->stateFile->key);
+  }
+  ASSERT_GE(stateFiles.size(), 2u) << "the state never outgrew an entry";
+  const auto entry = lastEntry();
+  ASSERT_TRUE(entry && entry->stateFile);
+  std::printf("%d regions: the state is %llu bytes, in the files stream as %s\n", regionCount,
+              static_cast<unsigned long long>(entry->stateFile->bytes), entry->stateFile->key.c_str());
+  EXPECT_GT(entry->stateFile->bytes, server::kMaxLogEntry_bytes);
+  EXPECT_TRUE(entry->state.is_null());
+  ASSERT_TRUE(waitUntil(20s, [&] { return b_->stateHash() == a_->stateHash(); })) << b_->log();
+  EXPECT_EQ(b_->metric("skyshell_nats_entries_dropped_total"), 0) << b_->log();
+
+  server::NatsLogOptions o;
+  o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+  auto log = server::NatsLog::connect(o);
+  ASSERT_TRUE(log) << describe(log.error());
+  EXPECT_TRUE((*log)->getFile(stateFiles.back(), server::kMaxStateFile_bytes)) << "the newest state's file";
+  for (std::size_t k = 0; k + 1 < stateFiles.size(); ++k)
+    EXPECT_FALSE((*log)->getFile(stateFiles[k], server::kMaxStateFile_bytes)) << "purged: " << stateFiles[k];
+
+  // A server started now replays the log, the state file included.
+  NatsWeatherd c(root_, "c", cluster_->urls(2));
+  ASSERT_NE(c.httpPort, 0u) << c.log();
+  EXPECT_TRUE(waitUntil(20s, [&] { return c.stateHash() == a_->stateHash(); })) << c.log();
+  EXPECT_EQ(c.metric("skyshell_nats_entries_dropped_total"), 0) << c.log();
+
+  // The regions removed: the state fits an entry again, and the last
+  // state file is purged.
+  constexpr int kBatch = 256;  // the API's most changes a request
+  for (int first = 1; first <= regionCount; first += kBatch) {
+    std::string b = R"({"author": "nats-test", "changes": [)";
+    for (int id = first; id < first + kBatch && id <= regionCount; ++id)
+      b += std::string(id > first ? "," : "") + R"({"op": "remove_region", "id": )" + std::to_string(id) + "}";
+    b += "]}";
+    const auto ack = a_->request("POST", "/api/changes", b);
+    ASSERT_TRUE(ack);
+    ASSERT_EQ(ack->status, 200) << ack->body;
+  }
+  const auto small = lastEntry();
+  ASSERT_TRUE(small);
+  EXPECT_FALSE(small->stateFile);
+  EXPECT_TRUE(small->state.is_object());
+  EXPECT_FALSE((*log)->getFile(stateFiles.back(), server::kMaxStateFile_bytes)) << "purged: " << stateFiles.back();
+  EXPECT_TRUE(waitUntil(20s, [&] { return b_->stateHash() == a_->stateHash() && c.stateHash() == a_->stateHash(); }))
+      << b_->log() << c.log();
 }
 
 TEST_F(WeatherdNats, JetStreamRefusesAStaleAppendAndAStaleLease) {

@@ -131,6 +131,36 @@ TEST(ScheduleBounds, PendingRampsAreCapped) {
   EXPECT_NE(last.error().detail.find("at most 1024"), std::string::npos) << last.error().detail;
 }
 
+// A batch of 256 changes names each in its summary (some 25 kB); the event
+// keeps the first kMaxEventSummary_bytes, cut on a character boundary and
+// saying how long the whole was, so that the event log stays readable and
+// a NATS log entry carrying it stays within what followers read
+// (kMaxLogEntryText).
+TEST(ScheduleBounds, ALongSummaryIsCutInTheEvent) {
+  WallClock::time_point wall = kT0;
+  LiveWeather w(scenario(), kT0, [&] { return wall; }, [] { return std::int64_t{0}; });
+  ChangeRequest req{{}, "test", "api"};
+  for (int i = 0; i < 256; ++i) {
+    weather::CloudLayer l = layerWithCoverage(0.5);
+    l.id = 1 + i % 4;
+    req.changes.push_back(SetLayer{l, {}});
+  }
+  auto r = w.submit(req);
+  ASSERT_TRUE(r) << r.error().detail;
+  const auto events = w.events(1);
+  ASSERT_EQ(events.size(), 1u);
+  const std::string& s = events[0].summary;
+  EXPECT_LE(s.size(), kMaxEventSummary_bytes);
+  EXPECT_GT(s.size(), kMaxEventSummary_bytes - 100);
+  EXPECT_NE(s.find(" bytes in all)"), std::string::npos) << s;
+  EXPECT_EQ(s.rfind("layer 1 ", 0), 0u) << "the summary's start is kept: " << s.substr(0, 80);
+  EXPECT_EQ(r->summary, s);
+  // A short one is kept whole.
+  auto one = w.submit({{SetLayer{layerWithCoverage(0.4), {}}}, "test", "api"});
+  ASSERT_TRUE(one);
+  EXPECT_EQ(w.events(1)[0].summary.find("bytes in all"), std::string::npos) << w.events(1)[0].summary;
+}
+
 std::vector<std::uint8_t> weatherDatagram(double coverage_pct) {
   cigi::DatagramWriter w(cigi::ByteOrder::Big);
   w.add(cigi::IgControl{});

@@ -80,6 +80,40 @@ TEST(NatsLogEntry, RoundTrips) {
   EXPECT_FALSE(termBack->event);
 }
 
+// A state too large for an entry: the entry names its file (key and size)
+// and carries no state; the key is the state's content key.
+TEST(NatsLogEntry, AStateFileIsNamedNotCarried) {
+  Fixture f;
+  LogEntry e = sampleEntry(f.weather);
+  const std::string json = e.state.dump();
+  e.stateFile = LogEntry::StateFile{stateFileKey(json), json.size()};
+  e.state = nullptr;
+  auto back = decodeLogEntry(encodeLogEntry(e));
+  ASSERT_TRUE(back) << describe(back.error());
+  ASSERT_TRUE(back->stateFile);
+  EXPECT_EQ(back->stateFile->key, e.stateFile->key);
+  EXPECT_EQ(back->stateFile->bytes, json.size());
+  EXPECT_TRUE(back->state.is_null());
+  EXPECT_EQ(e.stateFile->key.rfind("state-", 0), 0u);
+  EXPECT_NE(stateFileKey(json + " "), e.stateFile->key);
+
+  const nlohmann::json good = nlohmann::json::parse(encodeLogEntry(e));
+  auto with = [&](auto edit) {
+    nlohmann::json j = good;
+    edit(j);
+    return decodeLogEntry(j.dump());
+  };
+  EXPECT_EQ(with([](auto& j) { j["state_file"]["key"] = "0123-45"; }).error().code, ErrorCode::Malformed);
+  EXPECT_EQ(with([](auto& j) { j["state_file"]["key"] = "state-a.b"; }).error().code, ErrorCode::Malformed);
+  EXPECT_EQ(with([](auto& j) { j["state_file"]["key"] = "state->"; }).error().code, ErrorCode::Malformed);
+  EXPECT_EQ(with([](auto& j) { j["state_file"]["bytes"] = -1; }).error().code, ErrorCode::Malformed);
+  EXPECT_EQ(with([](auto& j) { j["state_file"]["bytes"] = kMaxStateFile_bytes + 1; }).error().code,
+            ErrorCode::TooLarge);
+  EXPECT_EQ(with([](auto& j) { j["state_file"] = "state-1"; }).error().code, ErrorCode::Malformed);
+  EXPECT_EQ(with([&](auto& j) { j["state"] = f.weather.toJson(); }).error().code, ErrorCode::Malformed)
+      << "both a state and a state file";
+}
+
 TEST(NatsLogEntry, RefusesWhatALeaderNeverWrites) {
   Fixture f;
   const nlohmann::json good = nlohmann::json::parse(encodeLogEntry(sampleEntry(f.weather)));
@@ -138,7 +172,7 @@ TEST(LiveWeatherCommitter, EveryChangeBatchedOrNotIsHandedOverAndFoldsToTheSameS
   EXPECT_EQ(log[1].second.sequence, 2u);
   EXPECT_EQ(leader.weather.unsaved(), 0u);
   // The follower folds the last entry (through the bytes, as over NATS).
-  LogEntry e{LogEntry::Kind::Change, 1, "a", "", log.back().first, log.back().second};
+  LogEntry e{LogEntry::Kind::Change, 1, "a", "", log.back().first, log.back().second, std::nullopt};
   auto read = decodeLogEntry(encodeLogEntry(e));
   ASSERT_TRUE(read);
   ASSERT_TRUE(follower.weather.restore(read->state, {*read->event}));

@@ -79,6 +79,11 @@ struct PendingChange {
 };
 
 // One line of the event log.
+// The longest summary an event keeps, in bytes: a batch of 256 changes
+// names each (about 90 bytes a region), and the event log, the console and
+// a NATS log entry take the first of it (LiveWeather::commit).
+inline constexpr std::size_t kMaxEventSummary_bytes = 2048;
+
 struct ChangeEvent {
   std::uint64_t sequence = 0;
   double clock_s = 0;

@@ -17,13 +17,17 @@
 
 namespace sky::server {
 
-// The largest entry written or read: NATS's default max_payload (1 MiB),
-// which a state stays far below (a cockpit's weather is a few KiB; the
-// kMaxPendingRamps bound keeps the largest state under it).
+// The largest entry written or read: NATS's default max_payload (1 MiB).
+// A cockpit's weather is a few KiB; a state past this (a continent of
+// METAR stations' regions: 4.2 MB for 4745) goes to the files stream, and
+// the entry names it (LogEntry::stateFile).
 inline constexpr std::size_t kMaxLogEntry_bytes = 1024 * 1024;
+// The largest state an entry may name in the files stream.
+inline constexpr std::size_t kMaxStateFile_bytes = 256u << 20;
 // Longest leader id, API address, author, source or summary in an entry:
 // the HTTP API bounds what it takes far below this.
 inline constexpr std::size_t kMaxLogEntryText = 4096;
+static_assert(kMaxEventSummary_bytes <= kMaxLogEntryText, "a leader's event summary must be an entry's text");
 
 struct LogEntry {
   enum class Kind { Change, Term };
@@ -35,14 +39,27 @@ struct LogEntry {
   std::string leaderApi;  // the writer's HTTP API ("http://host:port"), or empty
   nlohmann::json state;   // LiveWeather::toJson() after the change: an object
   std::optional<ChangeEvent> event;  // present for Kind::Change only
+  // Instead of `state` (then null): the state's JSON in the files stream
+  // under `key` (NatsLog::putFile), `bytes` long; its key is
+  // stateFileKey(its bytes).
+  struct StateFile {
+    std::string key;
+    std::uint64_t bytes = 0;
+  };
+  std::optional<StateFile> stateFile;
 };
+
+// The files stream's key for a state's JSON bytes: "state-" and their
+// content key (forecast_files.hpp's fileKey).
+std::string stateFileKey(std::string_view json);
 
 // The entry as bytes (JSON, one object).
 std::string encodeLogEntry(const LogEntry& entry);
 // Malformed (not JSON, a field missing or of the wrong type, an unknown
 // kind or format), TooLarge (over kMaxLogEntry_bytes or a text over
-// kMaxLogEntryText). The state is only checked to be an object here; its
-// contents are LiveWeather::restore's to check.
+// kMaxLogEntryText, a state file's key over it or its size over
+// kMaxStateFile_bytes). The state is only checked to be an object (or a
+// state file named) here; its contents are LiveWeather::restore's to check.
 Result<LogEntry> decodeLogEntry(std::string_view bytes);
 
 }  // namespace sky::server

@@ -19,6 +19,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -108,11 +109,26 @@ class NatsWeather {
   // entry naming a forecast not held is decoded off the io thread
   // (decodeThenFold); the entries after it wait for it.
   void onEntry(std::uint64_t sequence, const std::string& bytes);
+  // An entry whose state is in hand: decodes its forecast first when it
+  // names one not held (decodeThenFold), else folds it.
+  void foldOrDecode(std::uint64_t sequence, LogEntry entry);
   // Folds one entry (or counts it dropped) with `loader` for its forecast.
   void fold(std::uint64_t sequence, Result<LogEntry> entry, const LiveWeather::ForecastLoader& loader);
   // Reads and decodes the forecast `entry` names on decodeThread_, then
   // folds the entry and the ones that waited for it on the io thread.
   void decodeThenFold(std::uint64_t sequence, LogEntry entry);
+  // Reads the state `entry` names in the files stream on decodeThread_,
+  // then goes on with it as foldOrDecode on the io thread.
+  void readStateThenFold(std::uint64_t sequence, LogEntry entry);
+  // Runs `work` on decodeThread_ while the entries after wait; then, on the
+  // io thread, what it returned, and the entries that waited, in order.
+  void offIoThread(std::function<std::function<void()>()> work);
+  // The entry's bytes for the log; a state too large for an entry is put
+  // in the files stream first, and the entry names it.
+  Result<std::string> entryBytes(LogEntry& entry);
+  // After an entry was appended or folded: the state file it named (or
+  // none). A leader purges the one before once a newer entry stands.
+  void stateFileStands(const std::optional<LogEntry::StateFile>& file);
   Result<void> commit(const nlohmann::json& state, const ChangeEvent& event);
   // Decodes a forecast an entry names from the files stream.
   LiveWeather::ForecastLoader forecastLoader() const;
@@ -168,6 +184,9 @@ class NatsWeather {
   std::deque<std::pair<std::uint64_t, std::string>> waiting_;
   std::size_t waitingBytes_ = 0;
   std::thread decodeThread_;
+  // The io thread's: the newest entry's state file, which a leader's next
+  // append makes unused.
+  std::optional<std::string> stateFile_;
   std::shared_ptr<std::atomic<bool>> alive_ = std::make_shared<std::atomic<bool>>(true);
 
   // Shared between the io thread and the election thread.
