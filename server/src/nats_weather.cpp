@@ -236,9 +236,12 @@ void NatsWeather::readStateThenFold(std::uint64_t sequence, LogEntry entry) {
 }
 
 Result<std::string> NatsWeather::entryBytes(LogEntry& entry) {
-  std::string bytes = encodeLogEntry(entry);
-  if (bytes.size() <= kMaxLogEntry_bytes) return bytes;
-  const std::string json = entry.state.dump();
+  // The state decides, dumped once: around it an entry has its kind, term,
+  // two texts and an event of three more, each text at most
+  // kMaxLogEntryText bytes.
+  constexpr std::size_t kAroundState_bytes = 6 * kMaxLogEntryText + 1024;
+  std::string json = entry.state.dump();
+  if (json.size() + kAroundState_bytes <= kMaxLogEntry_bytes) return encodeLogEntry(entry);
   if (json.size() > kMaxStateFile_bytes)
     return fail(ErrorCode::TooLarge, "the weather's state is " + std::to_string(json.size()) +
                                          " bytes, more than the NATS log holds (" +
