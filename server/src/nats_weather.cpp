@@ -254,6 +254,14 @@ Result<std::string> NatsWeather::entryBytes(LogEntry& entry) {
   return encodeLogEntry(entry);
 }
 
+void NatsWeather::dropRefusedStateFile(const LogEntry& entry) {
+  // JetStream refused the entry (not stored): no entry names its state
+  // file, unless it is the newest entry's own (the same state).
+  if (!entry.stateFile || entry.stateFile->key == stateFile_) return;
+  if (auto dropped = natsLog_->dropFile(entry.stateFile->key); !dropped)
+    log_->warn("event=nats_file_kept key={} detail={:?}", entry.stateFile->key, describe(dropped.error()));
+}
+
 void NatsWeather::stateFileStands(const std::optional<LogEntry::StateFile>& file) {
   const std::optional<std::string> key = file ? std::optional(file->key) : std::nullopt;
   if (stateFile_ && stateFile_ != key && leading_) {
@@ -316,6 +324,7 @@ Result<void> NatsWeather::commit(const nlohmann::json& state, const ChangeEvent&
                                        "weather shows it if so): " + appended.error().detail);
   if (!appended->stored) {
     ++fenced_;
+    dropRefusedStateFile(entry);
     stepDown("fenced: the stream moved past sequence " + std::to_string(applied_.load()) +
              " (another server appended)");
     return fail(ErrorCode::Io, refusal());
@@ -519,7 +528,10 @@ void NatsWeather::claim(std::uint64_t term, int attempt) {
   if (!bytes) return retry(describe(bytes.error()));
   auto appended = natsLog_->append(*bytes, applied_);
   if (!appended) return retry(describe(appended.error()));
-  if (!appended->stored) return retry("another server appended meanwhile");
+  if (!appended->stored) {
+    dropRefusedStateFile(entry);
+    return retry("another server appended meanwhile");
+  }
   applied_ = appended->sequence;
   term_ = term;
   leading_ = true;

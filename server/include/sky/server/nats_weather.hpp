@@ -129,6 +129,10 @@ class NatsWeather {
   // After an entry was appended or folded: the state file it named (or
   // none). A leader purges the one before once a newer entry stands.
   void stateFileStands(const std::optional<LogEntry::StateFile>& file);
+  // After JetStream refused an entry for a stale sequence: purges the state
+  // file put for it (an entry not acknowledged in time may still be stored,
+  // and keeps its file).
+  void dropRefusedStateFile(const LogEntry& entry);
   Result<void> commit(const nlohmann::json& state, const ChangeEvent& event);
   // Decodes a forecast an entry names from the files stream.
   LiveWeather::ForecastLoader forecastLoader() const;
