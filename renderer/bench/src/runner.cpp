@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
@@ -130,11 +131,26 @@ Result<CaseResult> runCase(const LoadedScene& ls, const Configuration& config, c
   double mseSum = 0, rmseSum = 0, ssimSum = 0;
   cr.worst.psnr_dB = std::numeric_limits<double>::infinity();
   cr.worst.rmseLinear = 0;
+  // A long case (a path's reference at a large size takes minutes, an hour
+  // on a loaded machine) says how far it is, at most every kProgressEvery_ms.
+  constexpr double kProgressEvery_ms = 30000;
+  const auto caseStart = Clock::now();
+  auto lastProgress = caseStart;
   for (std::uint32_t rep = 0; rep < repeats; ++rep)
     for (std::uint32_t f = 0; f < frames; ++f) {
       auto rendered = timedRender(**renderer, frameInputs(ls, f));
       if (!rendered) return tl::unexpected(rendered.error());
       cr.frames.push_back(rendered->timing);
+      if (const std::uint32_t done = rep * frames + f + 1, total = repeats * frames;
+          options.log && done < total && msBetween(lastProgress, Clock::now()) >= kProgressEvery_ms) {
+        lastProgress = Clock::now();
+        const double perFrame_s = msBetween(caseStart, lastProgress) / 1000.0 / done;
+        char line[160];
+        std::snprintf(line, sizeof line, "%s-%s %s: frame %u of %u, %.1f s a frame, about %.0f s left",
+                      scene.name.c_str(), sizeName(res.width, res.height).c_str(), config.name.c_str(), done, total,
+                      perFrame_s, perFrame_s * (total - done));
+        options.log(line);
+      }
       if (rep > 0) {
         const auto& px = rendered->image.rgba;
         if (!cr.path && (px.size() != firstStill.size() ||
