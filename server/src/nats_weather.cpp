@@ -167,7 +167,7 @@ void NatsWeather::onEntry(std::uint64_t sequence, const std::string& bytes) {
     while (waitingBytes_ > kMaxWaitingBytes && waiting_.size() > 1) {
       ++dropped_;
       log_->warn("event=nats_entry_dropped sequence={} detail=\"{} bytes of entries waited for a forecast's "
-                 "decode; a later entry holds the whole state\"",
+                 "decode or a state file; a later entry holds the whole state\"",
                  waiting_.front().first, waitingBytes_);
       waitingBytes_ -= waiting_.front().second.size();
       waiting_.pop_front();
@@ -221,7 +221,6 @@ void NatsWeather::decodeThenFold(std::uint64_t sequence, LogEntry entry) {
   });
 }
 
-
 void NatsWeather::readStateThenFold(std::uint64_t sequence, LogEntry entry) {
   offIoThread([this, sequence, entry = std::move(entry)]() -> std::function<void()> {
     auto state = std::make_shared<Result<nlohmann::json>>(readStateFile(*natsLog_, *entry.stateFile));
@@ -236,12 +235,15 @@ void NatsWeather::readStateThenFold(std::uint64_t sequence, LogEntry entry) {
 }
 
 Result<std::string> NatsWeather::entryBytes(LogEntry& entry) {
-  // The state decides, dumped once: around it an entry has its kind, term,
-  // two texts and an event of three more, each text at most
-  // kMaxLogEntryText bytes.
+  // The state, dumped once, says whether the entry may fit: around it an
+  // entry has its kind, term, two texts and an event of three more, each
+  // text at most kMaxLogEntryText bytes. JSON escapes can grow a text (a
+  // control character takes six bytes), so an entry that may fit is
+  // measured before it goes inline.
   constexpr std::size_t kAroundState_bytes = 6 * kMaxLogEntryText + 1024;
   std::string json = entry.state.dump();
-  if (json.size() + kAroundState_bytes <= kMaxLogEntry_bytes) return encodeLogEntry(entry);
+  if (json.size() + kAroundState_bytes <= kMaxLogEntry_bytes)
+    if (std::string bytes = encodeLogEntry(entry); bytes.size() <= kMaxLogEntry_bytes) return bytes;
   if (json.size() > kMaxStateFile_bytes)
     return fail(ErrorCode::TooLarge, "the weather's state is " + std::to_string(json.size()) +
                                          " bytes, more than the NATS log holds (" +
@@ -257,20 +259,23 @@ Result<std::string> NatsWeather::entryBytes(LogEntry& entry) {
 void NatsWeather::dropRefusedStateFile(const LogEntry& entry) {
   // JetStream refused the entry (not stored): no entry names its state
   // file, unless it is the newest entry's own (the same state).
-  if (!entry.stateFile || entry.stateFile->key == stateFile_) return;
-  if (auto dropped = natsLog_->dropFile(entry.stateFile->key); !dropped)
-    log_->warn("event=nats_file_kept key={} detail={:?}", entry.stateFile->key, describe(dropped.error()));
+  if (entry.stateFile && entry.stateFile->key != stateFile_) dropFile(entry.stateFile->key);
 }
 
 void NatsWeather::stateFileStands(const std::optional<LogEntry::StateFile>& file) {
   const std::optional<std::string> key = file ? std::optional(file->key) : std::nullopt;
-  if (stateFile_ && stateFile_ != key && leading_) {
-    // A follower still folding the entry before fails to read it and folds
-    // this one, which holds the whole state.
-    if (auto dropped = natsLog_->dropFile(*stateFile_); !dropped)
-      log_->warn("event=nats_file_kept key={} detail={:?}", *stateFile_, describe(dropped.error()));
-  }
+  // A follower still folding the entry before fails to read it and folds
+  // this one, which holds the whole state.
+  if (stateFile_ && stateFile_ != key && leading_) dropFile(*stateFile_);
   stateFile_ = key;
+}
+
+bool NatsWeather::dropFile(const std::string& key) {
+  if (auto dropped = natsLog_->dropFile(key); !dropped) {
+    log_->warn("event=nats_file_kept key={} detail={:?}", key, describe(dropped.error()));
+    return false;
+  }
+  return true;
 }
 
 void NatsWeather::fold(std::uint64_t sequence, Result<LogEntry> entry, const LiveWeather::ForecastLoader& loader) {
@@ -366,10 +371,7 @@ void NatsWeather::dropUnusedFiles(const nlohmann::json& state) {
     if (std::find(kept.begin(), kept.end(), f.key) != kept.end()) continue;
     // A follower still folding an older entry that names the file fails to
     // decode it and folds the next entry, which holds the whole state.
-    if (auto dropped = natsLog_->dropFile(f.key); !dropped)
-      log_->warn("event=nats_file_kept key={} detail={:?}", f.key, describe(dropped.error()));
-    else
-      log_->info("event=nats_file_dropped key={} name={:?}", f.key, f.name);
+    if (dropFile(f.key)) log_->info("event=nats_file_dropped key={} name={:?}", f.key, f.name);
   }
 }
 
@@ -470,7 +472,8 @@ void NatsWeather::watchLog(std::optional<std::pair<std::chrono::steady_clock::ti
   if (auto range = natsLog_->range(); range) {
     const std::uint64_t applied = applied_.load();
     const auto now = std::chrono::steady_clock::now();
-    // A forecast decoding holds the fold, not the subscription.
+    // An entry read or decoded off the io thread holds the fold, not the
+    // subscription.
     if (range->last <= applied || decoding_ || (lagging && lagging->second != applied)) {
       lagging.reset();
     } else if (!lagging) {
@@ -643,8 +646,9 @@ std::string NatsWeather::metrics() const {
   line("skyshell_nats_appended_total", "counter", "changes this server appended to the NATS log", appended_.load());
   line("skyshell_nats_followed_total", "counter", "log entries of other servers folded in", followed_.load());
   line("skyshell_nats_decoding", "gauge",
-       "1 while a forecast an entry names is decoded (the entries after it wait)", decoding_ ? 1 : 0);
-  line("skyshell_nats_waiting_entries", "gauge", "log entries waiting for a forecast's decode", waiting_.size());
+       "1 while an entry's forecast is decoded or its state file read (the entries after it wait)",
+       decoding_ ? 1 : 0);
+  line("skyshell_nats_waiting_entries", "gauge", "log entries waiting for that", waiting_.size());
   line("skyshell_nats_entries_dropped_total", "counter", "log entries dropped: malformed, or not foldable here (a forecast whose files cannot be read or decoded)", dropped_.load());
   line("skyshell_nats_fenced_total", "counter", "appends refused by JetStream for a stale last sequence",
        fenced_.load());

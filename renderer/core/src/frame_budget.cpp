@@ -42,11 +42,11 @@ constexpr std::array<double, 5> kStepFactors = {1.0, 1.5, 2.0, 3.0, 4.0};
 // paths it takes 0.90 and 0.99 of low/1.5's time (its turns are drawn
 // densely from 1 pixel a frame, realtime's threshold at half size) for
 // 0.6-0.8 dB less. The medium and low ladders take its time scaled by
-// low/1.5's there. A ladder keeps the preset's own way first and, of the rest, those no other
-// candidate beats on both time and error (the Pareto front), less
-// accurate than the first. Dropped that way: high's cheaper marches (medium's
-// way is more accurate at under half their time: 40.72 dB at 0.457
-// against 38.48 dB at 0.895 for high/1.5); realtime's own march as a level
+// low/1.5's there. A ladder keeps the preset's own way first and, of the
+// rest, those no other candidate beats on both time and error (the Pareto
+// front), less accurate than the first. Dropped that way: high's cheaper
+// marches (medium's way is more accurate at under half their time: 40.72
+// dB at 0.457 against 38.48 dB at 0.895 for high/1.5); realtime's own march as a level
 // of the others (high's: 0.086, 33.74 dB) behind realtime/1.5 (0.076,
 // 33.86 dB: its longer steps cost nothing in error on these scenes); and in
 // realtime's own ladder realtime/1.5 (0.806, 33.54 dB), which is not less

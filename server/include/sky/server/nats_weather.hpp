@@ -47,7 +47,8 @@ class Server;
 // Entries a starting server reads back for its event log; the last of them
 // is its state. The console shows the recent history, a few hundred lines.
 inline constexpr std::uint64_t kReplayEntries = 256;
-// The most bytes of log entries a follower holds while a forecast decodes.
+// The most bytes of log entries a follower holds while an entry's forecast
+// decodes or its state file is read.
 inline constexpr std::size_t kMaxWaitingBytes = 64u << 20;
 
 struct NatsWeatherOptions {
@@ -133,6 +134,8 @@ class NatsWeather {
   // file put for it (an entry not acknowledged in time may still be stored,
   // and keeps its file).
   void dropRefusedStateFile(const LogEntry& entry);
+  // Purges a file from the files stream; false (logged) when NATS refused.
+  bool dropFile(const std::string& key);
   Result<void> commit(const nlohmann::json& state, const ChangeEvent& event);
   // Decodes a forecast an entry names from the files stream.
   LiveWeather::ForecastLoader forecastLoader() const;
@@ -177,7 +180,8 @@ class NatsWeather {
   bool closed_ = false;
   std::chrono::steady_clock::time_point claimStarted_{};
   // A forecast being decoded for an entry (seconds for a large GRIB file),
-  // off the io thread so that the weather stream and the HTTP API go on
+  // or its state file read, off the io thread so that the weather stream
+  // and the HTTP API go on
   // serving the weather folded so far; the entries that arrive meanwhile
   // wait, in order, up to kMaxWaitingBytes (each holds the whole state: one
   // dropped loses only its event from the history). decoding_ is atomic for
