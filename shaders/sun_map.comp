@@ -13,15 +13,23 @@ layout(local_size_x = kLocalSize, local_size_y = kLocalSize) in;
 #define SKY_SUN_MAP_BUILDER
 #include "cloud_pass.glsl"
 
+// The cascade this invocation builds: the frame builds cascades
+// [sunMapSlots.z, sunMapSlots.w) (sun_map_plan.hpp rebuilds a cascade only
+// when what it resolves has moved).
+int builtCascade() {
+  return int(gl_GlobalInvocationID.z) + int(frame.sunMapSlots.z);
+}
+
 void storeSunMap(vec4 part0, vec4 part1) {
+  int c = builtCascade();
   ivec3 at = ivec3(gl_GlobalInvocationID.x, int(gl_GlobalInvocationID.y) + int(frame.sunBuildShells.z),
-                   int(gl_GlobalInvocationID.z) * sunMapParts(kSunMethod) + int(frame.sunMapShells.w));
+                   sunMapLayer(gSunMap, c, int(frame.sunMapSlots.y >> uint(c)) & 1));
   imageStore(sunMapOut, at, part0);
   if (sunMapParts(kSunMethod) > 1) imageStore(sunMapOut, at + ivec3(0, 0, 1), part1);
 }
 
-// This frame builds rows [sunBuildShells.z, sunBuildShells.w) of every
-// cascade of the map being built (its geometry: sunBuild*), which frames
+// This frame builds rows [sunBuildShells.z, sunBuildShells.w) of those
+// cascades of the map being built (its geometry: sunBuild*), which frames
 // read once its last row is done (renderer/core/src/sun_map_plan.hpp).
 void main() {
   ivec2 texel = ivec2(gl_GlobalInvocationID.x, int(gl_GlobalInvocationID.y) + int(frame.sunBuildShells.z));
@@ -32,5 +40,5 @@ void main() {
   gSunMap.topHeight = frame.sunBuildShells.x;
   gSunMap.baseHeight = frame.sunBuildShells.y;
   gSunMap.origin = frame.sunBuildOrigin.xyz;
-  buildSunMapTexel(frameAir(), gSunMap, frameLayerCount(), int(gl_GlobalInvocationID.z), texel.x, texel.y);
+  buildSunMapTexel(frameAir(), gSunMap, frameLayerCount(), builtCascade(), texel.x, texel.y);
 }

@@ -90,7 +90,7 @@ layout(set = 0, binding = kBindingSunMapOut, rgba32f) uniform writeonly image2DA
 layout(set = 0, binding = kBindingSunMap) uniform sampler2DArray sunMapTex;
 
 vec4 sampleSunMap(int layer, vec2 uv) {
-  return textureLod(sunMapTex, vec3(uv, float(layer) + frame.sunMapShells.z), 0.0);
+  return textureLod(sunMapTex, vec3(uv, float(layer)), 0.0);
 }
 
 #include "cloud_core.glsl"
@@ -212,7 +212,8 @@ void loadFrameGlobals() {
   gRings = frame.weatherRings;
   gSunMap = SunMap(kSunMethod, int(frame.sunMap.y), int(frame.sunMap.z), int(frame.sunMap.w), frame.sunMapU.w,
                    frame.sunMapU.xyz, frame.sunMapV.xyz, frame.sunMapShells.x, frame.sunMapShells.y,
-                   frame.sunMapOrigin.xyz);
+                   frame.sunMapOrigin.xyz, frame.sunMapOrigins[0].xyz, frame.sunMapOrigins[1].xyz,
+                   frame.sunMapOrigins[2].xyz, int(frame.sunMapSlots.x));
 }
 
 AirFrame frameAir() {

@@ -10,6 +10,10 @@ SKY_CORE_CONST real kInv2Pow24 = 5.9604644775390625e-8;
 // there (1 - e^-x) / x = 1 - x/2 + O(x^2), so the limit's relative error is
 // under 5e-5, below float's resolution of the sums it feeds.
 SKY_CORE_CONST real kSmallOpticalDepth = 1e-4;
+// Each cascade of the sun map (sun_map.glsl) covers this times the half
+// extent of the one before; here because the planner of its rebuilds
+// (renderer/core/src/sun_map_plan.cpp) scales its thresholds by it.
+SKY_CORE_CONST real kSunCascadeRatio = 4.0;
 
 struct Roots {
   bool hit;

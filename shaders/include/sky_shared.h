@@ -145,10 +145,9 @@ struct SkyFrame {
   vec4 sunMapU;         // xyz: the map's first axis, local frame; w: cascade 0's half extent (m)
   vec4 sunMapV;         // xyz: its second axis; w: unused (the rows this frame builds: sunBuildShells)
   vec4 sunMapShells;    // x: the highest drawn layer's top, y: the lowest one's base, m above the ground
-                        // sphere (as the map read was built); z: the image layer where the map read starts,
-                        // w: where the map built starts (the image holds two maps: one read while the
-                        // other is built over several frames)
-  vec4 sunMapOrigin;    // xyz: the map's centre, local frame (m; 0 when built this frame); w: unused
+                        // sphere (as the map read was built); z, w: unused
+  vec4 sunMapOrigin;    // xyz: the centre of the map's cascade 0, local frame (m; 0 when built this frame);
+                        // w: unused
   uvec4 freshEdges;     // with interleaving, the widths (px) of the bands at the left, right, top and bottom
                         // edges drawn at every pixel as well (fresh_edges.glsl); 0 none
   vec4 sunBuildU;       // the map this frame builds rows of, as sunMapU: xyz its first axis; w unused
@@ -156,6 +155,11 @@ struct SkyFrame {
   vec4 sunBuildShells;  // x, y: its top and base shells as sunMapShells; z: the first texel row built this
                         // frame, w: one past the last (of every cascade)
   vec4 sunBuildOrigin;  // xyz: its centre, local frame (m); w unused
+  vec4 sunMapOrigins[3];  // xyz: the centres of the map's cascades 1-3 as sunMapOrigin (each cascade is
+                          // rebuilt when what it resolves has moved: sun_map_plan.hpp); w unused
+  uvec4 sunMapSlots;    // the image holds two maps, one read while the other is built over several
+                        // frames: x bit c, the map cascade c is read from; y bit c, the map it is built
+                        // into; z, w: the cascades built this frame, [z, w)
   vec4 flashInfo;       // x: flashes lit this frame, y: bolt segments drawn, z: a pixel's angle (rad); w unused
   vec4 flashes[kMaxFrameFlashes];        // xyz: a flash's light centre, local frame (m); w: its intensity
                                          // (linear units x m^2: the irradiance at 1 m)
@@ -189,8 +193,8 @@ static_assert(offsetof(SkyFrame, raster) == 272 + 304 * kMaxLayers + 48);
 static_assert(offsetof(SkyFrame, frustum) == 272 + 304 * kMaxLayers + 80);
 static_assert(offsetof(SkyFrame, airTable) == 272 + 304 * kMaxLayers + 96);
 static_assert(offsetof(SkyFrame, sunMap) == 272 + 304 * kMaxLayers + 112);
-static_assert(offsetof(SkyFrame, flashInfo) == 272 + 304 * kMaxLayers + 272);
-static_assert(sizeof(SkyFrame) == 272 + 304 * kMaxLayers + 288 + 16 * (kMaxFrameFlashes + 2 * kMaxFrameBoltSegments));
+static_assert(offsetof(SkyFrame, flashInfo) == 272 + 304 * kMaxLayers + 336);
+static_assert(sizeof(SkyFrame) == 272 + 304 * kMaxLayers + 352 + 16 * (kMaxFrameFlashes + 2 * kMaxFrameBoltSegments));
 }  // namespace sky::gpu
 #endif
 #undef SKY_SHARED_CONST

@@ -60,8 +60,6 @@ SKY_CORE_CONST real kSunMaxDepth = 80.0;
 // samples across 14 km of a layer left 22 dB against the 1000-step column
 // on the sunset-backlit scene, 64 gave 26.6 (256: 26.8).
 SKY_CORE_CONST int kSunMapSlantFactor = 4;
-// Each cascade covers 4x the half extent of the one before.
-SKY_CORE_CONST real kSunCascadeRatio = 4.0;
 
 struct SunMap {
   int method;      // kSunMarch .. kSunDeep
@@ -73,7 +71,14 @@ struct SunMap {
   real3 axisV;     // unit, perpendicular to the sun and axisU
   real topHeight;  // m above the ground sphere: the highest drawn layer's top
   real baseHeight; // m: the lowest drawn layer's base
-  real3 origin;    // the map's centre, camera-local: the camera where it was built (sun_map_plan.hpp)
+  // Each cascade's centre, camera-local: the camera where that cascade was
+  // last built (sun_map_plan.hpp rebuilds a cascade when what it resolves
+  // has moved, so the coarse ones are rebuilt less often than the fine).
+  real3 origin;
+  real3 origin1;
+  real3 origin2;
+  real3 origin3;
+  int readSlots;   // bit c: which of the image's two maps cascade c is read from
 };
 
 real4 sampleSunMap(int layer, real2 uv);
@@ -248,19 +253,31 @@ struct SunMapPlace {
   real2 uv;
 };
 
+real3 sunCascadeOrigin(SunMap m, int c) {
+  return c == 0 ? m.origin : (c == 1 ? m.origin1 : (c == 2 ? m.origin2 : m.origin3));
+}
+
+// The image layer of cascade c's part 0 in the map of its slot (the image
+// holds two maps, one read while the other is built).
+int sunMapLayer(SunMap m, int c, int slot) {
+  return (slot * m.cascades + c) * sunMapParts(m.method);
+}
+
 SunMapPlace sunMapPlace(SunMap m, real3 p) {
-  real2 plane = real2(dot(p - m.origin, m.axisU), dot(p - m.origin, m.axisV));
-  real reach = max(abs(plane.x), abs(plane.y));
   real extent = m.extent;
-  int cascade = 0;
-  // The first cascade whose texel centres reach past p.
-  for (int c = 0; c < m.cascades - 1; ++c) {
-    bool outside = reach > extent * (1.0 - 1.0 / real(m.size));
-    cascade += outside ? 1 : 0;
-    extent *= outside ? kSunCascadeRatio : 1.0;
+  SunMapPlace at = SunMapPlace(-1, real2(0.0));
+  // The first cascade whose texel centres reach past p (the last: whose
+  // edge does), each around its own centre.
+  for (int c = 0; c < m.cascades; ++c) {
+    real3 d = p - sunCascadeOrigin(m, c);
+    real2 plane = real2(dot(d, m.axisU), dot(d, m.axisV));
+    real reach = max(abs(plane.x), abs(plane.y));
+    bool inside = at.layer < 0 && reach <= (c == m.cascades - 1 ? extent : extent * (1.0 - 1.0 / real(m.size)));
+    at.layer = inside ? sunMapLayer(m, c, (m.readSlots >> c) & 1) : at.layer;
+    at.uv = inside ? plane / (2.0 * extent) + 0.5 : at.uv;
+    extent *= kSunCascadeRatio;
   }
-  bool inside = reach <= extent;
-  return SunMapPlace(inside ? cascade * sunMapParts(m.method) : -1, plane / (2.0 * extent) + 0.5);
+  return at;
 }
 
 // The optical depth towards the sun at p (camera-local, sun cosine muSun

@@ -475,11 +475,12 @@ TEST(GpuVsCpu, SunMapIsReusedUntilWhatItHoldsMoves) {
 
 
 // A rebuild spread over frames (SunMapSettings::buildFrames, sun_map_plan.hpp):
-// with 4, the camera 1.5 km on starts a new map that is built a quarter of
-// the rows a frame while the frames read the old one (within the GPU-vs-CPU
-// bounds of the map built at once there: measured 2.7 % RMSE); the
-// fourth frame reads the new map, the same image as a renderer that built it
-// whole (to float rounding of the anchor's axes: measured 0.000 %). A new
+// with 4, the camera 1.5 km on starts a rebuild of the fine cascade (the
+// coarse one resolves that move) that is built a quarter of the rows a frame
+// while the frames read the old one (within the GPU-vs-CPU bounds of the map
+// built at once there: measured 2.1 % RMSE); the fourth frame reads the new
+// cascade, the same image as a renderer that built it whole (to float
+// rounding of the anchor's axes: measured 0.000 %). A new
 // weather map is built whole at once; with tiles changing every frame the
 // build is not restarted: it completes every 4 frames. A jump (the sun 2
 // degrees on) is built at once.
@@ -522,6 +523,21 @@ TEST(GpuVsCpu, SunMapRebuildIsSpreadOverFrames) {
   const render::Image movedWhole = draw(**whole);
   EXPECT_EQ((*whole)->lastSunMap().reason, "camera moved");
   EXPECT_TRUE((*whole)->lastSunMap().completed);
+  // 1.5 km is past a quarter of cascade 0's half extent (1 km), within
+  // cascade 1's (4 km): only cascade 0 is rebuilt. Against a renderer whose
+  // first frame is here (both cascades around this camera), cascade 1 read
+  // around the old one differs by its bilinear texels' placement only.
+  EXPECT_EQ((*whole)->lastSunMap().firstCascade, 0u);
+  EXPECT_EQ((*whole)->lastSunMap().endCascade, 1u);
+  {
+    settings.march.sunShadow.buildFrames = 1;
+    auto fresh = render::CloudRenderer::create(settings);
+    ASSERT_TRUE(fresh) << describe(fresh.error());
+    const Diff d = diff(draw(**fresh), movedWhole);
+    std::printf("[ sun map  ] cascade 1 kept 1.5 km away against both built here: rmse %.3f %%\n",
+                100 * d.displayedRmse / d.displayedMean);
+    EXPECT_LT(d.displayedRmse, kRelativeRmseTolerance * d.displayedMean);
+  }
   for (std::uint32_t k = 0; k < 4; ++k) {
     SCOPED_TRACE("spread frame " + std::to_string(k));
     const render::Image image = draw(**spread);
@@ -531,6 +547,7 @@ TEST(GpuVsCpu, SunMapRebuildIsSpreadOverFrames) {
     EXPECT_EQ(m.rowBegin, 16 * k);
     EXPECT_EQ(m.rowEnd, 16 * (k + 1));
     EXPECT_EQ(m.completed, k == 3);
+    EXPECT_EQ(m.endCascade, 1u) << "cascade 0 only";
     EXPECT_TRUE(hasPass(**spread, "sun-map"));
     const Diff d = diff(image, movedWhole);
     std::printf("[ sun map  ] spread over 4 frames, frame %u against the map built at once: rmse %.3f %%\n", k,
@@ -558,6 +575,7 @@ TEST(GpuVsCpu, SunMapRebuildIsSpreadOverFrames) {
     draw(**spread);
     EXPECT_TRUE((*spread)->lastSunMap().rebuilt);
     EXPECT_EQ((*spread)->lastSunMap().reason, "tiles changed");
+    EXPECT_EQ((*spread)->lastSunMap().endCascade - (*spread)->lastSunMap().firstCascade, 2u) << "every cascade";
     completed.push_back((*spread)->lastSunMap().completed);
   }
   EXPECT_EQ(completed, (std::vector<bool>{false, false, false, true, false, false, false, true}));

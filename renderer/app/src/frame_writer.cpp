@@ -202,6 +202,7 @@ Result<void> FrameWriter::write(const render::Image& image, const FrameRecord& r
     line["sun_map"] = {{"rebuilt", r.sunMap.rebuilt},
                        {"reason", r.sunMap.reason},
                        {"rows", {r.sunMap.rowBegin, r.sunMap.rowEnd}},
+                       {"cascades", {r.sunMap.firstCascade, r.sunMap.endCascade}},
                        {"completed", r.sunMap.completed}};
   if (r.nearPrecip.type != weather::CloudType::None)
     line["near_precipitation"] = {{"type", std::string(weather::toString(r.nearPrecip.type))},

@@ -299,9 +299,10 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
   const ComputePipeline* sunPipeline = nullptr;
   const std::uint32_t sunRowBegin = std::uint32_t(frame.sunBuildShells.z);
   const std::uint32_t sunRowEnd = std::uint32_t(frame.sunBuildShells.w);
-  if (sunMapParts(sunMapSize_.method) > 0 && layersDrawn > 0 && sunRowEnd > sunRowBegin) {
+  const std::uint32_t sunCascadesBuilt = frame.sunMapSlots.w - frame.sunMapSlots.z;
+  if (sunMapParts(sunMapSize_.method) > 0 && layersDrawn > 0 && sunRowEnd > sunRowBegin && sunCascadesBuilt > 0) {
     SKY_ASSERT(frame.sunMap.y == sunMapSize_.size && frame.sunMap.z == sunMapSize_.cascades);
-    SKY_ASSERT(sunRowEnd <= sunMapSize_.size);
+    SKY_ASSERT(sunRowEnd <= sunMapSize_.size && frame.sunMapSlots.w <= sunMapSize_.cascades);
     auto built = pipelineFor(ctx, Stage::SunMap, layersDrawn, windField, false, showers);
     if (!built) return tl::unexpected(built.error());
     sunPipeline = *built;
@@ -339,7 +340,7 @@ Result<Image> CloudPass::run(const GpuContext& ctx, const gpu::SkyFrame& frame, 
       commands_.bindDescriptorSets(vk::PipelineBindPoint::eCompute, *sunPipeline->layout, 0, *descriptorSet_, {});
       const std::uint32_t groups = (sunMapSize_.size + gpu::kLocalSize - 1) / gpu::kLocalSize;
       const std::uint32_t rowGroups = (sunRowEnd - sunRowBegin + gpu::kLocalSize - 1) / gpu::kLocalSize;
-      commands_.dispatch(groups, rowGroups, sunMapSize_.cascades);
+      commands_.dispatch(groups, rowGroups, sunCascadesBuilt);
     }
     commands_.pipelineBarrier(vk::PipelineStageFlagBits::eComputeShader, vk::PipelineStageFlagBits::eComputeShader, {},
                               {}, {},

@@ -259,7 +259,8 @@ Result<Image> CloudRenderer::render(const FrameInputs& inputs) {
       const SunMapPlan plan = impl_->sunMaps.plan(setup, inputs.weatherClock_s, impl_->weather.uploads(),
                                                   update.rebuilt || update.largestStep > kMaxRampStep);
       setup.sunMapPlan = plan.frame;
-      impl_->sunMap = {plan.builds(), plan.reason, plan.frame.rowBegin, plan.frame.rowEnd, plan.completes};
+      impl_->sunMap = {plan.builds(),          plan.reason,           plan.frame.rowBegin, plan.frame.rowEnd,
+                       plan.frame.firstCascade, plan.frame.endCascade, plan.completes};
     }
     // With interleaving the planner chooses this frame's pixels and the
     // reprojection's block; with a divisor the upscale follows.

@@ -115,7 +115,7 @@ class CpuCore : public GlslDouble {
     const SunMapSettings& sun = setup_.march.sunShadow;
     const SunMapGeometry g = sunMapGeometry(setup_);
     gSunMap = SunMap{int(sun.method), int(sun.size), int(sun.cascades), int(sun.buildSteps), sun.extent_m,
-                     g.axisU, g.axisV, g.top_m, g.base_m, g.origin};
+                     g.axisU, g.axisV, g.top_m, g.base_m, g.origin, g.origin, g.origin, g.origin, 0};
     const CloudType cumulus = coreType(cloudTypeParams(weather::CloudType::Cumulus));
     for (std::size_t i = 0; i < kMaxLayers; ++i) {
       CoreLayer& c = layers_[i];

@@ -597,15 +597,17 @@ gpu::SkyFrame packFrame(const FrameSetup& s) {
     plan = *s.sunMapPlan;
   } else {
     plan.read = plan.build = sunMapGeometry(s);
+    plan.endCascade = sun.cascades;
     plan.rowEnd = sun.size;
   }
   const SunMapGeometry& g = plan.read;
-  const auto slotLayer = [&](std::uint32_t slot) { return float(slot * sun.cascades * sunMapParts(sun.method)); };
   f.sunMap = gpu::uvec4(std::uint32_t(sun.method), sun.size, sun.cascades, sun.buildSteps);
   f.sunMapU = v4(g.axisU, sun.extent_m);
   f.sunMapV = v4(g.axisV, 0.0);
-  f.sunMapShells = gpu::vec4(float(g.top_m), float(g.base_m), slotLayer(plan.readSlot), slotLayer(plan.buildSlot));
+  f.sunMapShells = gpu::vec4(float(g.top_m), float(g.base_m), 0.0f, 0.0f);
   f.sunMapOrigin = v4(g.origin);
+  for (std::size_t c = 0; c < plan.readOrigins.size(); ++c) f.sunMapOrigins[c] = v4(plan.readOrigins[c]);
+  f.sunMapSlots = gpu::uvec4(plan.readSlots, plan.buildSlots, plan.firstCascade, plan.endCascade);
   const SunMapGeometry& b = plan.build;
   f.sunBuildU = v4(b.axisU, 0.0);
   f.sunBuildV = v4(b.axisV, 0.0);

@@ -5,6 +5,7 @@
 // Packed into the GPU's uniform block, or fed to the CPU reference.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -148,9 +149,11 @@ struct FrameSetup {
   // frame's camera (sunMapGeometry) into slot 0 and read, as the CPU
   // reference builds it.
   struct SunMapFrame {
-    SunMapGeometry read, build;
-    std::uint32_t readSlot = 0, buildSlot = 0;
-    std::uint32_t rowBegin = 0, rowEnd = 0;  // rows of every cascade built; none when equal
+    SunMapGeometry read, build;  // read.origin is cascade 0's centre
+    std::array<glm::dvec3, 3> readOrigins{};  // the centres of cascades 1-3 read, local frame
+    std::uint32_t readSlots = 0, buildSlots = 0;  // bit c: the image's map cascade c is read from, built into
+    std::uint32_t firstCascade = 0, endCascade = 0;  // the cascades built, [first, end)
+    std::uint32_t rowBegin = 0, rowEnd = 0;  // rows of those cascades built; none when equal
   };
   std::optional<SunMapFrame> sunMapPlan;
   // The lightning this frame draws (flash_setup.hpp).

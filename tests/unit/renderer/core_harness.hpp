@@ -66,7 +66,8 @@ class Core : public render::GlslDouble {
   sky::render::AirTableTexels airTexels;
 
   // sun_map.glsl's global: the secondary march unless a test sets a map.
-  SunMap gSunMap{kSunMarch, 16, 1, 16, 4000.0, real3(1, 0, 0), real3(0, 1, 0), 0.0, 0.0, real3(0.0)};
+  SunMap gSunMap{kSunMarch, 16, 1, 16, 4000.0, real3(1, 0, 0), real3(0, 1, 0), 0.0, 0.0,
+                 real3(0.0),       real3(0.0),     real3(0.0),     real3(0.0),     0};
   sky::render::SunMapTexels sunTexels;
 
   // Builds the sun map gSunMap describes for frame f's layers.

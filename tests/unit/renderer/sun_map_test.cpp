@@ -37,7 +37,7 @@ struct Slab {
     f.layerCount = 1;
     const Core::real3 u = normalize(cross(Core::real3(0, 0, 1), f.air.sunDir));
     c.gSunMap = Core::SunMap{method, 64, 2, 32, 8000.0, u, cross(f.air.sunDir, u), kBase + kThick, kBase,
-                             Core::real3(0.0)};
+                             Core::real3(0.0), Core::real3(0.0), Core::real3(0.0), Core::real3(0.0), 0};
     if (c.sunMapIsMap(method)) c.buildSunMap(f);
   }
   // The depth at p (camera-local) by the frame's method.
@@ -104,6 +104,36 @@ TEST(SunMap, ExponentialShadowMapDarkensPastTheFront) {
 TEST(SunMap, BeyondTheLastCascadeTheMapSaysSo) {
   Slab s(Core::kSunDeep, 40);
   EXPECT_EQ(s.depth({200000, 0, 1800 - kAlt + 3140}), -1.0);
+}
+
+// Each cascade is read around its own centre (the planner rebuilds the
+// fine ones more often, around a camera that moved on), and from the
+// image's map its slot bit names: a point is in the first cascade whose
+// texel centres reach past it from that cascade's centre.
+TEST(SunMap, EachCascadeIsReadAroundItsOwnCentre) {
+  Core c;
+  const Core::real3 u(1, 0, 0), v(0, 1, 0);
+  // 2 parts a cascade (deep), cascade 0 1 km east of the camera, cascade 1
+  // 5 km west, cascade 1 read from the second map (slot bit 1).
+  Core::SunMap m{Core::kSunDeep, 64, 3, 16, 8000.0, u, v, 3000, 1000,
+                 Core::real3(1000, 0, 0), Core::real3(-5000, 0, 0), Core::real3(0.0), Core::real3(0.0), 2};
+  const Core::SunMapPlace near = c.sunMapPlace(m, Core::real3(7000, 0, 0));
+  EXPECT_EQ(near.layer, 0);
+  EXPECT_NEAR(near.uv.x, 0.5 + 6000 / 16000.0, 1e-12);
+  // 9 km east of the camera: 8 km from cascade 0's centre, past its last
+  // texel centre; 14 km from cascade 1's, within its 32 km. Cascade 1's
+  // part 0 in the second map: (1 x 3 + 1) x 2.
+  const Core::SunMapPlace mid = c.sunMapPlace(m, Core::real3(9000, 0, 0));
+  EXPECT_EQ(mid.layer, 8);
+  EXPECT_NEAR(mid.uv.x, 0.5 + 14000 / 64000.0, 1e-12);
+  // 30 km west: 25 km from cascade 1's centre, so still cascade 1.
+  EXPECT_EQ(c.sunMapPlace(m, Core::real3(-30000, 0, 0)).layer, 8);
+  // 40 km east: 45 km from cascade 1's; cascade 2 (around the camera,
+  // 128 km, first map): (0 x 3 + 2) x 2.
+  const Core::SunMapPlace far = c.sunMapPlace(m, Core::real3(40000, 0, 0));
+  EXPECT_EQ(far.layer, 4);
+  EXPECT_NEAR(far.uv.x, 0.5 + 40000 / 256000.0, 1e-12);
+  EXPECT_EQ(c.sunMapPlace(m, Core::real3(0, 129000, 0)).layer, -1) << "past the last cascade";
 }
 
 // The line geometry on the curved shells: from a point at height h, the top
