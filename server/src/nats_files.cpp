@@ -100,10 +100,12 @@ Result<void> ensureFilesStream(jsCtx* js, const NatsLogOptions& options, int rep
 
 Result<void> NatsLog::putFile(std::string_view key, std::span<const std::byte> bytes) {
   if (!validKey(key)) return fail(ErrorCode::InvalidArgument, "file key '" + std::string(key) + "'");
-  const NatsFileManifest m{bytes.size(), kChunk_bytes};
+  // Chunks no larger than a message of the server connected to may be.
+  const std::uint64_t chunk = std::min<std::uint64_t>(kChunk_bytes, messageLimit());
+  const NatsFileManifest m{bytes.size(), chunk};
   for (std::uint64_t k = 0; k < m.chunks(); ++k) {
-    const std::size_t begin = k * kChunk_bytes;
-    const std::size_t size = std::min<std::size_t>(kChunk_bytes, bytes.size() - begin);
+    const std::size_t begin = k * chunk;
+    const std::size_t size = std::min<std::size_t>(chunk, bytes.size() - begin);
     if (auto ok = publish(h_->js.get(), chunkSubject(h_->options, key, k), bytes.data() + begin, size); !ok) return ok;
   }
   const std::string manifest = encodeFileManifest(m);

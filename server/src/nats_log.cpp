@@ -187,6 +187,17 @@ NatsLog::~NatsLog() = default;
 int NatsLog::replicas() const { return h_->replicas; }
 const NatsLogOptions& NatsLog::options() const { return h_->options; }
 
+std::size_t NatsLog::messageLimit() const {
+  // The headers a publish carries (the expected last sequence, the message
+  // id) count against max_payload too.
+  constexpr std::int64_t kHeaderRoom_bytes = 1024;
+  // Read at every call: after a reconnect another server may announce
+  // another limit. 0 or less: not connected now; the default then.
+  const std::int64_t announced = natsConnection_GetMaxPayload(h_->connection.get());
+  const std::int64_t payload = announced > 0 ? announced : std::int64_t(kMaxNatsFileChunk_bytes);
+  return std::size_t(std::clamp<std::int64_t>(payload - kHeaderRoom_bytes, 1, std::int64_t(kMaxNatsFileChunk_bytes)));
+}
+
 namespace {
 
 // Publishes with one expectation header; stored, fenced (JetStream's wrong

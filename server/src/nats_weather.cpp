@@ -240,10 +240,13 @@ Result<std::string> NatsWeather::entryBytes(LogEntry& entry) {
   // text at most kMaxLogEntryText bytes. JSON escapes can grow a text (a
   // control character takes six bytes), so an entry that may fit is
   // measured before it goes inline.
+  // An entry is at most what a message of the NATS server may be (its
+  // max_payload, 1 MiB by default) and what a follower reads.
   constexpr std::size_t kAroundState_bytes = 6 * kMaxLogEntryText + 1024;
+  const std::size_t limit = std::min(kMaxLogEntry_bytes, natsLog_->messageLimit());
   std::string json = entry.state.dump();
-  if (json.size() + kAroundState_bytes <= kMaxLogEntry_bytes)
-    if (std::string bytes = encodeLogEntry(entry); bytes.size() <= kMaxLogEntry_bytes) return bytes;
+  if (json.size() + kAroundState_bytes <= limit)
+    if (std::string bytes = encodeLogEntry(entry); bytes.size() <= limit) return bytes;
   if (json.size() > kMaxStateFile_bytes)
     return fail(ErrorCode::TooLarge, "the weather's state is " + std::to_string(json.size()) +
                                          " bytes, more than the NATS log holds (" +

@@ -125,7 +125,9 @@ class NatsCluster {
  public:
   static constexpr int kNodes = 3;
 
-  explicit NatsCluster(const std::filesystem::path& dir) : dir_(dir) {
+  // maxPayload_bytes: the nodes' max_payload (0: NATS's default, 1 MiB).
+  explicit NatsCluster(const std::filesystem::path& dir, std::size_t maxPayload_bytes = 0)
+      : dir_(dir), maxPayload_bytes_(maxPayload_bytes) {
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_);
     for (int i = 0; i < kNodes; ++i) {
@@ -172,7 +174,9 @@ class NatsCluster {
   void writeConfig(int i) const {
     std::ofstream f(dir_ / ("n" + std::to_string(i) + ".conf"));
     f << "server_name: n" << i << "\n"
-      << "listen: 127.0.0.1:" << clientPorts_[i] << "\n"
+      << "listen: 127.0.0.1:" << clientPorts_[i] << "\n";
+    if (maxPayload_bytes_ > 0) f << "max_payload: " << maxPayload_bytes_ << "\n";
+    f
       << "jetstream { store_dir: \"" << (dir_ / ("store" + std::to_string(i))).string()
       << "\", max_memory_store: 64MB, max_file_store: 256MB }\n"
       << "cluster {\n  name: skytest\n  listen: 127.0.0.1:" << routePorts_[i] << "\n  routes: [\n";
@@ -182,6 +186,7 @@ class NatsCluster {
   }
 
   std::filesystem::path dir_;
+  std::size_t maxPayload_bytes_ = 0;
   std::array<unsigned, kNodes> clientPorts_{}, routePorts_{};
   std::array<std::optional<ChildProcess>, kNodes> nodes_;
 };

@@ -17,10 +17,12 @@
 
 namespace sky::server {
 
-// The largest entry written or read: NATS's default max_payload (1 MiB).
-// A cockpit's weather is a few KiB; a state past this (a continent of
-// METAR stations' regions: 4.2 MB for 4745) goes to the files stream, and
-// the entry names it (LogEntry::stateFile).
+// The largest entry written or read: NATS's default max_payload (1 MiB);
+// a leader writes at most what the server it is connected to takes
+// (NatsLog::messageLimit: a deployment may set max_payload lower). A
+// cockpit's weather is a few KiB; a state past this (a continent of METAR
+// stations' regions: 4.2 MB for 4745) goes to the files stream, and the
+// entry names it (LogEntry::stateFile).
 inline constexpr std::size_t kMaxLogEntry_bytes = 1024 * 1024;
 // The largest state an entry may name in the files stream.
 inline constexpr std::size_t kMaxStateFile_bytes = 256u << 20;

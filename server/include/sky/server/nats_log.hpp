@@ -71,6 +71,12 @@ class NatsLog {
 
   int replicas() const;
   const NatsLogOptions& options() const;
+  // The most bytes a message this log publishes may carry: the max_payload
+  // the NATS server it is connected to announces (1 MiB by default; a
+  // deployment may set less), less room for the message's headers, and at
+  // most kMaxNatsFileChunk_bytes. Entries over it go to the files stream,
+  // and files are chunked to it.
+  std::size_t messageLimit() const;
 
   struct Appended {
     bool stored = false;        // false: the stream's last sequence was not expectedLast (fenced)
