@@ -29,6 +29,21 @@
 namespace sky::test {
 namespace {
 
+// A change request setting `count` regions of cumulus from id `first` on,
+// spread over a grid of North America (each ~450 bytes of state).
+std::string regionsRequest(int first, int count) {
+  std::string body = R"({"author": "nats-test", "changes": [)";
+  for (int id = first; id < first + count; ++id) {
+    body += std::string(id > first ? "," : "") + R"({"op": "set_region", "region": {"id": )" + std::to_string(id) +
+            R"(, "center_lat_deg": )" + std::to_string(30 + 0.5 * (id / 60)) + R"(, "center_lon_deg": )" +
+            std::to_string(-120 + 0.9 * (id % 60)) +
+            R"(, "size_x_m": 20000, "size_y_m": 20000, "transition_m": 5000, "layers": [{"id": 3, "type": "cumulus",
+            "base_m": 1200, "thickness_m": 900, "transition_band_m": 50, "coverage": 0.5, "density": 0.6,
+            "wind": {"speed_mps": 5, "from_deg": 200, "vertical_mps": 0}}]}})";
+  }
+  return body + "]}";
+}
+
 class WeatherdNats : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -320,18 +335,7 @@ TEST_F(WeatherdNats, AStateLargerThanAnEntryGoesToTheFilesStream) {
   std::vector<std::string> stateFiles;
   int regionCount = 0;
   for (int r = 0; r < kMaxRequests && stateFiles.size() < 2; ++r) {
-    std::string body = R"({"author": "nats-test", "changes": [)";
-    for (int k = 0; k < kPerRequest; ++k) {
-      const int id = 1 + r * kPerRequest + k;
-      body += std::string(k ? "," : "") + R"({"op": "set_region", "region": {"id": )" + std::to_string(id) +
-              R"(, "center_lat_deg": )" + std::to_string(30 + 0.5 * (id / 60)) + R"(, "center_lon_deg": )" +
-              std::to_string(-120 + 0.9 * (id % 60)) +
-              R"(, "size_x_m": 20000, "size_y_m": 20000, "transition_m": 5000, "layers": [{"id": 3, "type": "cumulus",
-              "base_m": 1200, "thickness_m": 900, "transition_band_m": 50, "coverage": 0.5, "density": 0.6,
-              "wind": {"speed_mps": 5, "from_deg": 200, "vertical_mps": 0}}]}})";
-    }
-    body += "]}";
-    const auto ack = a_->request("POST", "/api/changes", body);
+    const auto ack = a_->request("POST", "/api/changes", regionsRequest(1 + r * kPerRequest, kPerRequest));
     ASSERT_TRUE(ack) << r;
     ASSERT_EQ(ack->status, 200) << r << ": " << ack->body;
     regionCount += kPerRequest;
@@ -403,18 +407,7 @@ TEST_F(WeatherdNatsSmallPayload, AStateOverTheServersMaxPayloadGoesToTheFilesStr
 
   std::vector<std::string> stateFiles;
   for (int r = 0; r < 6 && stateFiles.size() < 2; ++r) {
-    std::string body = R"({"author": "nats-test", "changes": [)";
-    for (int k = 0; k < 100; ++k) {
-      const int id = 1 + r * 100 + k;
-      body += std::string(k ? "," : "") + R"({"op": "set_region", "region": {"id": )" + std::to_string(id) +
-              R"(, "center_lat_deg": )" + std::to_string(30 + 0.5 * (id / 60)) + R"(, "center_lon_deg": )" +
-              std::to_string(-120 + 0.9 * (id % 60)) +
-              R"(, "size_x_m": 20000, "size_y_m": 20000, "transition_m": 5000, "layers": [{"id": 3, "type": "cumulus",
-              "base_m": 1200, "thickness_m": 900, "transition_band_m": 50, "coverage": 0.5, "density": 0.6,
-              "wind": {"speed_mps": 5, "from_deg": 200, "vertical_mps": 0}}]}})";
-    }
-    body += "]}";
-    const auto ack = a_->request("POST", "/api/changes", body);
+    const auto ack = a_->request("POST", "/api/changes", regionsRequest(1 + r * 100, 100));
     ASSERT_TRUE(ack) << r;
     ASSERT_EQ(ack->status, 200) << r << ": " << ack->body << a_->log();
     const auto entry = lastEntry();
