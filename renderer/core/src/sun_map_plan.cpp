@@ -28,8 +28,12 @@ SunMapPlanner::Staleness SunMapPlanner::staleness(const Front& f, const FrameSet
   const SunMapSettings& settings = s.march.sunShadow;
   const double turned_deg =
       std::acos(std::clamp(glm::dot(s.localToEcef * s.sunDir, f.frame.sun), -1.0, 1.0)) * 180 / std::numbers::pi;
-  // The clouds drift with the fastest layer's wind; half a texel of a
-  // cascade is what it resolves.
+  // The clouds drift with the fastest layer's wind; half a texel of the
+  // first cascade is what the map resolves. Every cascade by the first's:
+  // a coarse cascade kept until the clouds drifted half of its own texel
+  // (4^c times more) changed the picture at once when it was rebuilt, by
+  // 3x a frame's motion (HeadlessReconnect.ServerKilledAndRestartedMidReplayCausesNoJump),
+  // where rebuilt with the first it moves on in small steps.
   double wind = 1.0;
   for (const LayerSetup& l : s.layers)
     if (!l.absent)
@@ -49,7 +53,7 @@ SunMapPlanner::Staleness SunMapPlanner::staleness(const Front& f, const FrameSet
     const Anchor& a = f.anchors[c];
     const char* why = weatherUploads != a.weatherUploads         ? "tiles changed"
                       : turned_deg > kSunMapRebuildTurn_deg      ? "sun turned"
-                      : drift(a) > halfTexel * scale             ? "clouds drifted"
+                      : drift(a) > halfTexel                     ? "clouds drifted"
                       : moved(a) > 0.25 * settings.extent_m * scale ? "camera moved"
                                                                  : nullptr;
     if (why == nullptr) continue;

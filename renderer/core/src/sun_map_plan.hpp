@@ -2,15 +2,15 @@
 // lies in the meantime. The map is Earth-fixed: each cascade is built around
 // the camera's position at the time (its anchor), on axes across the sun
 // fixed in ECEF, and read by later frames through the anchor's offset and the
-// axes in their own local frame. A cascade is rebuilt when what it read has
-// moved by more than it resolves: changed tiles of the weather map; the key
-// light turned by more than kSunMapRebuildTurn_deg (every cascade: they share
-// the axes); the clouds drifted with the wind by more than half a texel of
-// that cascade since its build; the camera moved more than a quarter of its
-// half extent from its anchor. Cascade c's texels are 4^c times cascade 0's,
-// so in a steady drift or flight the fine cascade is rebuilt often and the
-// 256 km one 64 times less often (a rebuild of every cascade at the fine
-// one's pace cost 3x the work).
+// axes in their own local frame. Every cascade is rebuilt when tiles of the
+// weather map change, when the key light turned by more than
+// kSunMapRebuildTurn_deg (they share the axes), and when the clouds drifted
+// with the wind by more than half a texel of the first cascade (a coarse
+// cascade kept until they drifted half of its own texel jumped visibly when
+// rebuilt). A cascade alone is rebuilt when the camera moved more than a
+// quarter of its half extent from its anchor: cascade c's extent is 4^c
+// times cascade 0's, so a flight through calm air rebuilds the fine cascade
+// most often and the 256 km one 64 times less often.
 //
 // A rebuild is built over SunMapSettings::buildFrames frames, a band of rows
 // of each cascade it rebuilds per frame, into the other of the image's two
