@@ -8,6 +8,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <sstream>
 #include <stdexcept>
@@ -130,9 +131,18 @@ class NatsCluster {
       : dir_(dir), maxPayload_bytes_(maxPayload_bytes) {
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_);
+    // Six distinct ports: a port freed by one call can come back from the
+    // next (two nodes given one route port: one failed to listen).
+    std::vector<unsigned> taken;
+    const auto distinctPort = [&] {
+      unsigned port = freeLoopbackPort();
+      while (std::find(taken.begin(), taken.end(), port) != taken.end()) port = freeLoopbackPort();
+      taken.push_back(port);
+      return port;
+    };
     for (int i = 0; i < kNodes; ++i) {
-      clientPorts_[i] = freeLoopbackPort();
-      routePorts_[i] = freeLoopbackPort();
+      clientPorts_[i] = distinctPort();
+      routePorts_[i] = distinctPort();
     }
     for (int i = 0; i < kNodes; ++i) writeConfig(i);
     for (int i = 0; i < kNodes; ++i) start(i);
