@@ -14,8 +14,8 @@ layout(local_size_x = kLocalSize, local_size_y = kLocalSize) in;
 #include "cloud_pass.glsl"
 
 // The cascade this invocation builds: the frame builds cascades
-// [sunMapSlots.z, sunMapSlots.w) (sun_map_plan.hpp rebuilds a cascade only
-// when what it resolves has moved).
+// [sunMapSlots.z, sunMapSlots.w) (sun_map_plan.hpp: a camera that moved
+// rebuilds a cascade by its own extent, so the coarse ones less often).
 int builtCascade() {
   return int(gl_GlobalInvocationID.z) + int(frame.sunMapSlots.z);
 }

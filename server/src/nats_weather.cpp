@@ -235,13 +235,13 @@ void NatsWeather::readStateThenFold(std::uint64_t sequence, LogEntry entry) {
 }
 
 Result<std::string> NatsWeather::entryBytes(LogEntry& entry) {
-  // The state, dumped once, says whether the entry may fit: around it an
-  // entry has its kind, term, two texts and an event of three more, each
-  // text at most kMaxLogEntryText bytes. JSON escapes can grow a text (a
-  // control character takes six bytes), so an entry that may fit is
-  // measured before it goes inline.
   // An entry is at most what a message of the NATS server may be (its
-  // max_payload, 1 MiB by default) and what a follower reads.
+  // max_payload, 1 MiB by default) and what a follower reads. The state,
+  // dumped once, says whether the entry may fit: around it an entry has its
+  // kind, term, two texts and an event of three more, each text at most
+  // kMaxLogEntryText bytes. JSON escapes can grow a text (a control
+  // character takes six bytes), so an entry that may fit is measured before
+  // it goes inline.
   constexpr std::size_t kAroundState_bytes = 6 * kMaxLogEntryText + 1024;
   const std::size_t limit = std::min(kMaxLogEntry_bytes, natsLog_->messageLimit());
   std::string json = entry.state.dump();

@@ -155,8 +155,8 @@ struct SkyFrame {
   vec4 sunBuildShells;  // x, y: its top and base shells as sunMapShells; z: the first texel row built this
                         // frame, w: one past the last (of every cascade)
   vec4 sunBuildOrigin;  // xyz: its centre, local frame (m); w unused
-  vec4 sunMapOrigins[3];  // xyz: the centres of the map's cascades 1-3 as sunMapOrigin (each cascade is
-                          // rebuilt when what it resolves has moved: sun_map_plan.hpp); w unused
+  vec4 sunMapOrigins[3];  // xyz: the centres of the map's cascades 1-3 as sunMapOrigin (a camera that
+                          // moved rebuilds a cascade by its own extent: sun_map_plan.hpp); w unused
   uvec4 sunMapSlots;    // the image holds two maps, one read while the other is built over several
                         // frames: x bit c, the map cascade c is read from; y bit c, the map it is built
                         // into; z, w: the cascades built this frame, [z, w)

@@ -72,8 +72,8 @@ struct SunMap {
   real topHeight;  // m above the ground sphere: the highest drawn layer's top
   real baseHeight; // m: the lowest drawn layer's base
   // Each cascade's centre, camera-local: the camera where that cascade was
-  // last built (sun_map_plan.hpp rebuilds a cascade when what it resolves
-  // has moved, so the coarse ones are rebuilt less often than the fine).
+  // last built (sun_map_plan.hpp: a camera that moved rebuilds a cascade by
+  // its own extent, so the coarse ones less often than the fine).
   real3 origin;
   real3 origin1;
   real3 origin2;

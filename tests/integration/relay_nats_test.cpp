@@ -66,7 +66,7 @@ class RelayNats : public ::testing::Test {
   // docs/weather-server-scaling.md.
   void printEntrySize() {
     server::NatsLogOptions o;
-    o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+    o.urls = cluster_->urlList();
     auto log = server::NatsLog::connect(o);
     ASSERT_TRUE(log) << describe(log.error());
     auto range = (*log)->range();
@@ -340,7 +340,7 @@ TEST_F(RelayNats, AForecastLoadedOnTheLeaderIsDecodedOnTheStandbyAndTheRelay) {
   EXPECT_EQ(decodes(slow.log()), 1u) << slow.log();
 
   server::NatsLogOptions o;
-  o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+  o.urls = cluster_->urlList();
   auto nats = server::NatsLog::connect(o);
   ASSERT_TRUE(nats) << describe(nats.error());
   auto stored = (*nats)->getFile(key, gfs.size());

@@ -74,7 +74,7 @@ class WeatherdNats : public ::testing::Test {
   // The stream's newest entry, read with the server library's client.
   std::optional<server::LogEntry> lastEntry() {
     server::NatsLogOptions o;
-    o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+    o.urls = cluster_->urlList();
     auto log = server::NatsLog::connect(o);
     if (!log) {
       ADD_FAILURE() << describe(log.error());
@@ -235,7 +235,7 @@ TEST_F(WeatherdNats, AForeignEntryInTheLogIsDroppedAndCountedEverywhere) {
   ASSERT_EQ(a_->request("POST", "/api/changes", layerChange(7, 0.4))->status, 200);
   {
     server::NatsLogOptions o;
-    o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+    o.urls = cluster_->urlList();
     auto log = server::NatsLog::connect(o);
     ASSERT_TRUE(log) << describe(log.error());
     auto range = (*log)->range();
@@ -273,7 +273,7 @@ TEST_F(WeatherdNats, AForeignEntryInTheLogIsDroppedAndCountedEverywhere) {
 // up, one that is not a manifest) is refused, never read past.
 TEST_F(WeatherdNats, AForecastFileComesBackAsPutAndAForgedOneIsRefused) {
   server::NatsLogOptions o;
-  o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+  o.urls = cluster_->urlList();
   auto log = server::NatsLog::connect(o);
   ASSERT_TRUE(log) << describe(log.error());
   std::vector<std::byte> bytes(600000);
@@ -354,7 +354,7 @@ TEST_F(WeatherdNats, AStateLargerThanAnEntryGoesToTheFilesStream) {
   EXPECT_EQ(b_->metric("skyshell_nats_entries_dropped_total"), 0) << b_->log();
 
   server::NatsLogOptions o;
-  o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+  o.urls = cluster_->urlList();
   auto log = server::NatsLog::connect(o);
   ASSERT_TRUE(log) << describe(log.error());
   EXPECT_TRUE((*log)->getFile(stateFiles.back(), server::kMaxStateFile_bytes)) << "the newest state's file";
@@ -399,7 +399,7 @@ TEST_F(WeatherdNatsSmallPayload, AStateOverTheServersMaxPayloadGoesToTheFilesStr
   startTwo();
   if (HasFatalFailure()) return;
   server::NatsLogOptions o;
-  o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+  o.urls = cluster_->urlList();
   auto log = server::NatsLog::connect(o);
   ASSERT_TRUE(log) << describe(log.error());
   EXPECT_LE((*log)->messageLimit(), 64u * 1024) << "the limit the server announced";
@@ -436,7 +436,7 @@ TEST_F(WeatherdNatsSmallPayload, AStateOverTheServersMaxPayloadGoesToTheFilesStr
 
 TEST_F(WeatherdNats, JetStreamRefusesAStaleAppendAndAStaleLease) {
   server::NatsLogOptions o;
-  o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+  o.urls = cluster_->urlList();
   o.stream = "SKY_FENCE_TEST";
   o.subject = "sky.fence.test";
   o.leaseBucket = "sky_fence_test";
@@ -487,7 +487,7 @@ TEST_F(WeatherdNats, ARenewalWhoseAnswerWasLostIsNotALostLease) {
   startTwo();
   if (HasFatalFailure()) return;
   server::NatsLogOptions o;
-  o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+  o.urls = cluster_->urlList();
   auto connected = server::NatsLog::connect(o);
   ASSERT_TRUE(connected) << describe(connected.error());
   // Read and renew until the leader's own renewal does not slip in between.
@@ -524,7 +524,7 @@ TEST_F(WeatherdNats, KillingOneNatsNodeOfThreeKeepsChangesAcknowledged) {
   std::string streamLeader, leaseLeader;
   {
     server::NatsLogOptions o;
-    o.urls = {cluster_->url(0), cluster_->url(1), cluster_->url(2)};
+    o.urls = cluster_->urlList();
     auto log = server::NatsLog::connect(o);
     ASSERT_TRUE(log) << describe(log.error());
     auto l = (*log)->leaderOf();

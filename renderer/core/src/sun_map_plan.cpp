@@ -48,7 +48,7 @@ SunMapPlanner::Staleness SunMapPlanner::staleness(const Front& f, const FrameSet
   if (drift(f.anchors[0]) > kSunMapJumpTexels * halfTexel) return {"clouds drifted", true, 0, n};
   if (moved(f.anchors[0]) > settings.extent_m) return {"camera moved", true, 0, n};
   Staleness stale;
-  double scale = 1.0;  // cascade c's extent and texel over cascade 0's
+  double scale = 1.0;  // cascade c's extent over cascade 0's
   for (std::uint32_t c = 0; c < n; ++c, scale *= kCascadeRatio) {
     const Anchor& a = f.anchors[c];
     const char* why = weatherUploads != a.weatherUploads         ? "tiles changed"

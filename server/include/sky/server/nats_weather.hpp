@@ -181,13 +181,12 @@ class NatsWeather {
   std::chrono::steady_clock::time_point claimStarted_{};
   // A forecast being decoded for an entry (seconds for a large GRIB file),
   // or its state file read, off the io thread so that the weather stream
-  // and the HTTP API go on
-  // serving the weather folded so far; the entries that arrive meanwhile
-  // wait, in order, up to kMaxWaitingBytes (each holds the whole state: one
-  // dropped loses only its event from the history). decoding_ is atomic for
-  // the election thread, which does not count a decode as a stalled
-  // subscription. alive_ is false once closed: a decode that finishes after
-  // close() leaves this object alone.
+  // and the HTTP API go on serving the weather folded so far; the entries
+  // that arrive meanwhile wait, in order, up to kMaxWaitingBytes (each
+  // holds the whole state: one dropped loses only its event from the
+  // history). decoding_ is atomic for the election thread, which does not
+  // count a decode as a stalled subscription. alive_ is false once closed: a
+  // decode that finishes after close() leaves this object alone.
   std::atomic<bool> decoding_{false};
   std::deque<std::pair<std::uint64_t, std::string>> waiting_;
   std::size_t waitingBytes_ = 0;

@@ -361,8 +361,8 @@ struct SunMapReport {
   bool rebuilt = false;  // this frame built rows of a new map
   std::string reason;    // "first frame", "weather changed", "sun turned", "clouds drifted", "camera moved", ...
   std::uint32_t rowBegin = 0, rowEnd = 0;  // the rows it built of each cascade it rebuilds
-  // The cascades it rebuilds, [first, end): a cascade is rebuilt when what
-  // it resolves has moved, so the coarse ones less often.
+  // The cascades it rebuilds, [first, end): every one, or those the camera
+  // left by a quarter of their extent (the coarse ones less often).
   std::uint32_t firstCascade = 0, endCascade = 0;
   bool completed = false;  // it built the last rows, and read the new map
 };
