@@ -1,7 +1,9 @@
-// skyshell-relay: serves the weather stream near the renderers. It follows
-// the weather servers' NATS log (NatsWeather in relay mode: never leads,
-// refuses every change), keeps the current weather, and serves the same TCP
-// stream as skyshell-weatherd, so a renderer's --server may name either.
+// skyshell-relay: serves the weather stream near the renderers. It takes the
+// weather servers' weather from NATS (NatsWeather in relay mode: never leads,
+// refuses every change): by default only the global part and the S2 cells its
+// renderers' areas cover (nats_cells.hpp), or with --follow log every whole
+// state of the log. It serves the same TCP stream as skyshell-weatherd, so a
+// renderer's --server may name either.
 // This file is the edge: command line, logging to stderr, exit codes.
 #include <unistd.h>
 
@@ -40,6 +42,7 @@ struct RelayOptions {
   std::string natsUrls;
   std::string logLevel = "info";
   std::string gribDecoder;
+  std::string follow = "cells";
 };
 
 void addOptions(CLI::App& app, RelayOptions& o) {
@@ -67,6 +70,11 @@ void addOptions(CLI::App& app, RelayOptions& o) {
   app.add_option("--grib-decoder", o.gribDecoder,
                  "The GRIB decoder executable for the forecasts the log names (default: skyshell-grib-decode "
                  "beside this executable)");
+  app.add_option("--follow", o.follow,
+                 "cells: take the global part of the weather and the S2 cells (level 6) the renderers' areas "
+                 "cover; log: every whole state of the weather's log, as a standby server does")
+      ->check(CLI::IsMember({"cells", "log"}))
+      ->capture_default_str();
   app.add_option("--log-level", o.logLevel, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
@@ -141,6 +149,8 @@ int main(int argc, char** argv) {
   natsOptions.log.urls = splitUrls(o.natsUrls);
   natsOptions.serverId = o.stream.serverId;
   natsOptions.relay = true;
+  natsOptions.followCells = o.follow == "cells";
+  natsOptions.log.sharedDelivery = natsOptions.followCells;
   natsOptions.logger = log;
   natsOptions.gribDecoder.executable =
       o.gribDecoder.empty() ? sky::server::defaultGribDecoder() : std::filesystem::path(o.gribDecoder);

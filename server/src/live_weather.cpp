@@ -349,11 +349,21 @@ nlohmann::json LiveWeather::stateJson(const State& s, const std::vector<Timeline
                              r.summary));
   nlohmann::json regions = nlohmann::json::array();
   for (const auto& [id, r] : s.regions) regions.push_back(server::toJson(r));
+  // By sequence, then region id: a relay that joins a state cut by cell
+  // (state_cells.hpp) puts them back in this order. Ramps of one region run
+  // in the order of their changes, which this keeps.
+  std::vector<const RegionRamp*> byChange;
+  for (const RegionRamp& r : s.regionRamps) byChange.push_back(&r);
+  std::stable_sort(byChange.begin(), byChange.end(), [](const RegionRamp* a, const RegionRamp* b) {
+    return std::pair(a->sequence, a->regionId) < std::pair(b->sequence, b->regionId);
+  });
   nlohmann::json regionRamps = nlohmann::json::array();
-  for (const RegionRamp& r : s.regionRamps)
+  for (const RegionRamp* rp : byChange) {
+    const RegionRamp& r = *rp;
     regionRamps.push_back({{"sequence", r.sequence}, {"region_id", r.regionId}, {"start_s", r.start_s},
                            {"end_s", r.end_s}, {"from_absent", r.fromAbsent}, {"from", server::toJson(r.from)},
                            {"to", server::toJson(r.to)}, {"remove_at_end", r.removeAtEnd}, {"summary", r.summary}});
+  }
   return {{"layers", layers},
           {"ramps", ramps},
           {"regions", regions},

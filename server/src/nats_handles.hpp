@@ -4,6 +4,7 @@
 #pragma once
 
 #include <chrono>
+#include <map>
 #include <condition_variable>
 #include <memory>
 #include <mutex>
@@ -45,6 +46,9 @@ Result<int> ensureStream(jsCtx* js, jsStreamConfig& config);
 // The forecast files' stream (nats_files.cpp), made beside the log.
 Result<void> ensureFilesStream(jsCtx* js, const NatsLogOptions& options, int replicas);
 
+// InvalidArgument unless `key` may be a key of the areas bucket.
+Result<void> checkAreaKey(const std::string& key);
+
 // The message handler's state: outlives the subscription until nats.c says
 // no callback of it runs any more (natsSubscription_SetOnCompleteCB).
 struct FollowState {
@@ -57,18 +61,37 @@ struct FollowState {
 // How long stopFollowing waits for a message callback under way to finish.
 inline constexpr std::chrono::seconds kFollowStopWait{5};
 
+// The areas' watch handler, shared by every key's subscription; it outlives
+// the connection (declared before it in Handles), and `handler` is emptied
+// first, so a message delivered while the relay closes calls nothing.
+struct AreaWatch {
+  std::mutex mutex;
+  NatsLog::AreaHandler handler;
+  std::string subjectPrefix;  // "$KV.<bucket>."
+};
+
 struct NatsLog::Handles {
   NatsLogOptions options;
   int replicas = 1;
+  AreaWatch areaWatch;
   // Destruction order is the reverse: the subscription, then the JetStream
   // context, then the connection.
   ConnectionPtr connection;
   JsPtr js;
   KvPtr registry;  // the cluster's registry bucket
+  KvPtr areas;     // the weather by cell, for the relays
+  std::map<std::string, SubscriptionPtr> areaSubscriptions;  // by key
   std::shared_ptr<FollowState> follow;
   SubscriptionPtr subscription;
 
-  ~Handles() { stop(); }
+  ~Handles() {
+    stop();
+    {
+      std::lock_guard lock(areaWatch.mutex);
+      areaWatch.handler = nullptr;
+    }
+    for (auto& [key, sub] : areaSubscriptions) natsSubscription_Unsubscribe(sub.get());
+  }
 
   void stop() {
     if (!subscription) return;

@@ -95,7 +95,7 @@ Result<int> ensureStream(jsCtx* js, jsStreamConfig& config) {
 namespace {
 
 // Opens a KV bucket, making it when missing: one value per key (no
-// history), each expiring `ttl` after it was put.
+// history), each expiring `ttl` after it was put (0: never).
 Result<KvPtr> ensureBucket(jsCtx* js, const std::string& bucket, std::chrono::milliseconds ttl, int replicas) {
   kvStore* raw = nullptr;
   natsStatus s = js_KeyValue(&raw, js, bucket.c_str());
@@ -134,6 +134,7 @@ Result<std::unique_ptr<NatsLog>> NatsLog::connect(const NatsLogOptions& options)
   // The operator's order of servers is the order of preference.
   natsOptions_SetNoRandomize(opts.get(), true);
   natsOptions_SetTimeout(opts.get(), options.requestWait.count());
+  if (options.sharedDelivery) natsOptions_UseGlobalMessageDelivery(opts.get(), true);
   natsConnection* rawConnection = nullptr;
   if (natsStatus s = natsConnection_Connect(&rawConnection, opts.get()); s != NATS_OK)
     return tl::unexpected(natsError("NATS connect " + options.urls.front(), s));
@@ -164,11 +165,17 @@ Result<std::unique_ptr<NatsLog>> NatsLog::connect(const NatsLogOptions& options)
       auto lease = ensureBucket(h->js.get(), options.leaseBucket, options.leaseTtl, *replicas);
       registry = lease ? ensureBucket(h->js.get(), options.registryBucket, options.registryTtl, *replicas)
                        : Result<KvPtr>(tl::unexpected(lease.error()));
+      // The areas' values stand until replaced (no time to live).
+      auto areas = registry ? ensureBucket(h->js.get(), options.areasBucket, std::chrono::milliseconds{0}, *replicas)
+                            : Result<KvPtr>(tl::unexpected(registry.error()));
+      if (areas) h->areas = std::move(*areas);
+      else registry = tl::unexpected(areas.error());
       if (registry)
         if (auto files = ensureFilesStream(h->js.get(), options, *replicas); !files)
           registry = tl::unexpected(files.error());
     }
     if (registry) {
+      h->areaWatch.subjectPrefix = "$KV." + options.areasBucket + ".";
       h->replicas = *replicas;
       h->registry = std::move(*registry);
       break;
@@ -359,6 +366,23 @@ Result<std::optional<std::uint64_t>> NatsLog::takeLease(std::string_view value) 
 Result<std::optional<std::uint64_t>> NatsLog::renewLease(std::string_view value, std::uint64_t revision) {
   auto put = publishExpecting(h_->js.get(), leaseSubject(h_->options), value, kExpectedLastSubjectSeq, revision,
                               h_->options.requestWait);
+  if (!put) return tl::unexpected(put.error());
+  if (!put->stored) return std::optional<std::uint64_t>{};
+  return std::optional<std::uint64_t>(put->sequence);
+}
+
+Result<std::optional<std::uint64_t>> NatsLog::putArea(const std::string& key, std::string_view bytes,
+                                                      std::uint64_t lastRevision) {
+  if (auto ok = checkAreaKey(key); !ok) return tl::unexpected(ok.error());
+  if (lastRevision == 0) {
+    std::uint64_t revision = 0;
+    if (natsStatus s = kvStore_Put(&revision, h_->areas.get(), key.c_str(), bytes.data(), static_cast<int>(bytes.size()));
+        s != NATS_OK)
+      return tl::unexpected(natsError("areas put " + key, s));
+    return std::optional<std::uint64_t>(revision);
+  }
+  auto put = publishExpecting(h_->js.get(), "$KV." + h_->options.areasBucket + "." + key, bytes,
+                              kExpectedLastSubjectSeq, lastRevision, h_->options.requestWait);
   if (!put) return tl::unexpected(put.error());
   if (!put->stored) return std::optional<std::uint64_t>{};
   return std::optional<std::uint64_t>(put->sequence);

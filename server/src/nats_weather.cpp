@@ -12,6 +12,7 @@
 
 #include "sky/server/forecast_files.hpp"
 #include "sky/server/server.hpp"
+#include "sky/server/state_cells.hpp"
 
 namespace sky::server {
 
@@ -43,6 +44,10 @@ constexpr int kClaimAttempts = 250;
 constexpr std::chrono::seconds kFollowStall{1};
 // The longest leader id or API address read from another server's lease.
 constexpr std::size_t kMaxLeaseText = 512;
+// How often a relay by cell looks at its subscribers' areas: a renderer
+// subscribes anew when it has moved 30 km (area_of_interest.hpp), so the
+// cells it needs are known well before it gets there.
+constexpr std::chrono::milliseconds kAreasPoll{250};
 
 // The state an entry names in the files stream: its bytes must have the
 // entry's key and size, and be a JSON object.
@@ -81,6 +86,8 @@ Result<std::unique_ptr<NatsWeather>> NatsWeather::start(Server& server, NatsWeat
     if (!self->leading_) return fail(ErrorCode::Io, self->refusal());
     return self->natsLog_->putFile(key, bytes);
   });
+  if (!w->options_.relay) w->publisher_ = std::make_unique<CellPublisher>(*w->natsLog_, w->log_);
+  if (w->options_.relay && w->options_.followCells) return w;  // by cell, from elect()
   auto followed = w->follow();
   if (!followed) return tl::unexpected(followed.error());
   return w;
@@ -97,7 +104,8 @@ NatsWeather::NatsWeather(Server& server, NatsWeatherOptions options, std::unique
       options_(std::move(options)),
       log_(options_.logger ? options_.logger : std::make_shared<spdlog::logger>("sky_nats")),
       natsLog_(std::move(log)),
-      claimRetry_(server.io()) {}
+      claimRetry_(server.io()),
+      areasPoll_(server.io()) {}
 
 NatsWeather::~NatsWeather() { close(); }
 
@@ -183,6 +191,36 @@ void NatsWeather::onEntry(std::uint64_t sequence, const std::string& bytes) {
   foldOrDecode(sequence, std::move(*entry));
 }
 
+void NatsWeather::onCellState(std::uint64_t sequence, LogEntry entry) {
+  if (decoding_) {
+    cellWaiting_.emplace(sequence, std::move(entry));
+    return;
+  }
+  // A state joined again for other areas comes at the sequence folded.
+  if (sequence < applied_) return;
+  ++followed_;
+  if (entry.stateFile) return readStateThenFold(sequence, std::move(entry));
+  foldOrDecode(sequence, std::move(entry));
+}
+
+void NatsWeather::pollAreas() {
+  const std::vector<weather::SphericalCap> areas = server_.subscribedAreas();
+  std::size_t fingerprint = areas.size();
+  for (const auto& a : areas)
+    for (double v : {a.centerLat_deg, a.centerLon_deg, a.radius_m})
+      fingerprint = fingerprint * 1000003u ^ std::hash<double>{}(v);
+  if (fingerprint != areasFingerprint_ || areasFingerprint_ == 0) {
+    areasFingerprint_ = fingerprint == 0 ? 1 : fingerprint;
+    bool tooMany = false;
+    auto keys = cellsForAreas(areas, tooMany);
+    cellFollower_->want(std::move(keys), tooMany);
+  }
+  areasPoll_.expires_after(kAreasPoll);
+  areasPoll_.async_wait([this](const boost::system::error_code& ec) {
+    if (!ec && !closed_) pollAreas();
+  });
+}
+
 void NatsWeather::foldOrDecode(std::uint64_t sequence, LogEntry entry) {
   if (entry.state.is_object() && entry.state.contains("forecast") && !entry.state["forecast"].is_null() &&
       !server_.weather().holdsForecast(entry.state["forecast"]))
@@ -205,6 +243,7 @@ void NatsWeather::offIoThread(std::function<std::function<void()>()> work) {
       auto waiting = std::exchange(waiting_, {});
       waitingBytes_ = 0;
       for (auto& [next, bytes] : waiting) onEntry(next, bytes);
+      if (auto cell = std::exchange(cellWaiting_, std::nullopt)) onCellState(cell->first, std::move(cell->second));
     });
   });
 }
@@ -341,6 +380,7 @@ Result<void> NatsWeather::commit(const nlohmann::json& state, const ChangeEvent&
   ++appended_;
   dropUnusedFiles(state);
   stateFileStands(entry.stateFile);
+  if (publisher_) publisher_->offer(applied_, std::move(entry));
   return {};
 }
 
@@ -383,6 +423,17 @@ void NatsWeather::elect(std::string apiUrl, std::string streamAddress) {
     std::lock_guard lock(mutex_);
     apiUrl_ = std::move(apiUrl);
     streamAddress_ = std::move(streamAddress);
+  }
+  if (options_.relay && options_.followCells) {
+    cellFollower_ = std::make_unique<CellFollower>(
+        *natsLog_, log_,
+        [this, alive = alive_](std::uint64_t sequence, LogEntry entry) {
+          boost::asio::post(server_.io(), [this, alive, sequence, entry = std::move(entry)]() mutable {
+            if (*alive) onCellState(sequence, std::move(entry));
+          });
+        },
+        applied_.load());
+    pollAreas();
   }
   election_ = std::thread([this] { electionLoop(); });
   registry_ = std::make_unique<ClusterRegistry>(*natsLog_, server_.io(), [this] { return describeSelf(); }, log_);
@@ -472,7 +523,9 @@ std::uint64_t NatsWeather::tryTakeLease() {
 }
 
 void NatsWeather::watchLog(std::optional<std::pair<std::chrono::steady_clock::time_point, std::uint64_t>>& lagging) {
-  if (auto range = natsLog_->range(); range) {
+  // A relay by cell follows no log subscription (its CellFollower reads
+  // back what it missed).
+  if (auto range = cellFollower_ ? Result<NatsLog::Range>(tl::unexpected(Error{})) : natsLog_->range(); range) {
     const std::uint64_t applied = applied_.load();
     const auto now = std::chrono::steady_clock::now();
     // An entry read or decoded off the io thread holds the fold, not the
@@ -547,6 +600,7 @@ void NatsWeather::claim(std::uint64_t term, int attempt) {
     leaderId_ = entry.leaderId;
     leaderApi_ = entry.leaderApi;
   }
+  if (publisher_) publisher_->offer(applied_, entry);
   server_.weather().holdTimeline(false);
   server_.weatherReplaced();
   const auto took_ms =
@@ -561,6 +615,7 @@ void NatsWeather::stepDown(const std::string& why) {
   else log_->info("event=nats_not_leading why={:?}", why);
   leading_ = false;
   term_ = 0;
+  if (publisher_) publisher_->forget();
   {
     std::lock_guard lock(mutex_);
     leaseLost_ = true;
@@ -584,6 +639,9 @@ void NatsWeather::close() {
   wake_.notify_all();
   if (election_.joinable()) election_.join();
   if (registry_) registry_->stop();
+  areasPoll_.cancel();
+  if (cellFollower_) cellFollower_->stop();
+  if (publisher_) publisher_->stop();
   natsLog_->stopFollowing();
 }
 
@@ -655,6 +713,8 @@ std::string NatsWeather::metrics() const {
   line("skyshell_nats_entries_dropped_total", "counter", "log entries dropped: malformed, or not foldable here (a forecast whose files cannot be read or decoded)", dropped_.load());
   line("skyshell_nats_fenced_total", "counter", "appends refused by JetStream for a stale last sequence",
        fenced_.load());
+  if (publisher_) m += publisher_->metrics();
+  if (cellFollower_) m += cellFollower_->metrics();
   // A 64-bit hash does not fit a Prometheus value (a double): it is the
   // label of an info metric, compared as text.
   m += fmt::format("# HELP skyshell_state_hash_info the weather's state hash (FNV-1a of the canonical state "

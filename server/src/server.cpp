@@ -458,4 +458,12 @@ std::vector<RendererInfo> Server::renderers() const {
   return out;
 }
 
+std::vector<weather::SphericalCap> Server::subscribedAreas() const {
+  std::vector<weather::SphericalCap> out;
+  registry_.forEachConst([&](const Session& s) {
+    for (const auto& a : s.areas()) out.push_back(a);
+  });
+  return out;
+}
+
 }  // namespace sky::server

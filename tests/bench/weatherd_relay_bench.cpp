@@ -1,5 +1,6 @@
 // Relay benchmark (issue 27): one skyshell-weatherd --nats leading, N
-// skyshell-relay processes following its NATS log, and many subscribers
+// skyshell-relay processes taking its weather from NATS (by cell, or the
+// whole log with --follow log), and many subscribers
 // spread over the relays, each with its own area, under a storm of changes
 // sent to the leader's HTTP API. Real processes (a one-node nats-server with
 // JetStream, the server, the relays) on loopback; the subscribers share one
@@ -61,6 +62,8 @@ struct Options {
   std::string out = "/tmp/sky_weatherd_relay_bench";
   std::string json;
   bool regional = false;  // a region over every area (tiles in every snapshot), the storm a moving cell
+  std::string follow = "cells";  // the relays' --follow
+  int stations = 0;  // regions far from every subscriber (a continent of METAR stations), set before the storm
 };
 
 // One of our processes or nats-server, its CPU read from /proc.
@@ -161,6 +164,22 @@ std::string stormCellChange(std::size_t i) {
       "wind": {"speed_mps": 10, "from_deg": 250, "vertical_mps": 0}}]}}]})";
 }
 
+// Stations `first`..`first + count - 1` (ids from 100): 20 km regions on a
+// grid of 0.5 x 0.9 degrees over North America, 7000 km from every
+// subscriber, each ~450 bytes of state.
+std::string stationsChange(int first, int count) {
+  std::string body = R"({"author": "relay-bench", "changes": [)";
+  for (int k = first; k < first + count; ++k) {
+    body += std::string(k > first ? "," : "") + R"({"op": "set_region", "region": {"id": )" + std::to_string(100 + k) +
+            R"(, "center_lat_deg": )" + std::to_string(25 + 0.5 * (k / 60)) + R"(, "center_lon_deg": )" +
+            std::to_string(-125 + 0.9 * (k % 60)) +
+            R"(, "size_x_m": 20000, "size_y_m": 20000, "transition_m": 5000, "layers": [{"id": 3, "type": "cumulus",
+            "base_m": 1200, "thickness_m": 900, "transition_band_m": 50, "coverage": 0.5, "density": 0.6,
+            "wind": {"speed_mps": 5, "from_deg": 200, "vertical_mps": 0}}]}})";
+  }
+  return body + "]}";
+}
+
 bool parse(int argc, char** argv, Options& o) {
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
@@ -173,9 +192,12 @@ bool parse(int argc, char** argv, Options& o) {
     else if (k == "--out") o.out = v;
     else if (k == "--json") o.json = v;
     else if (k == "--regional") o.regional = v == "1";
+    else if (k == "--follow") o.follow = v;
+    else if (k == "--stations") o.stations = std::stoi(v);
     else return false;
   }
-  return argc % 2 == 1 && o.relays >= 1 && o.subscribers >= 1 && o.rate > 0;
+  return argc % 2 == 1 && o.relays >= 1 && o.subscribers >= 1 && o.rate > 0 && o.stations >= 0 &&
+         o.stations <= 60000 && (o.follow == "cells" || o.follow == "log");
 }
 
 // A one-node nats-server with JetStream and its monitoring port.
@@ -212,7 +234,8 @@ Process startOurs(const std::string& name, std::vector<std::string> args, const 
 int main(int argc, char** argv) {
   Options o;
   const char* usage = "usage: sky_weatherd_relay_bench [--relays N] [--subscribers N] [--rate HZ] [--seconds S] "
-                      "[--idle-seconds S] [--radius-m M] [--regional 0|1] [--out DIR] [--json FILE]\n";
+                      "[--idle-seconds S] [--radius-m M] [--regional 0|1] [--follow cells|log] [--stations N] "
+                      "[--out DIR] [--json FILE]\n";
   if (argc == 2 && std::string(argv[1]) == "--help") {
     std::printf("%s", usage);
     return 0;
@@ -276,8 +299,21 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
+  for (int first = 0; first < o.stations; first += 100) {
+    sky::sim::HttpRequest post;
+    post.method = "POST";
+    post.port = static_cast<unsigned short>(leaderHttp);
+    post.target = "/api/changes";
+    post.body = stationsChange(first, std::min(100, o.stations - first));
+    post.bearerToken = kToken;
+    const auto answer = sky::sim::httpRequest(post);
+    if (!answer || answer->status != 200) {
+      std::fprintf(stderr, "stations refused: %s\n", answer ? answer->body.c_str() : "no answer");
+      return 1;
+    }
+  }
   for (int r = 0; r < o.relays; ++r)
-    procs.push_back(startOurs("relay" + std::to_string(r), {SKY_RELAY, "--nats", url}, dir));
+    procs.push_back(startOurs("relay" + std::to_string(r), {SKY_RELAY, "--nats", url, "--follow", o.follow}, dir));
   const std::string hash = stateHash(leaderHttp);
   for (std::size_t p = 2; p < procs.size(); ++p)
     if (procs[p].httpPort == 0 || !waitUntil(30s, [&] { return stateHash(procs[p].httpPort) == hash; })) {
@@ -356,7 +392,11 @@ int main(int argc, char** argv) {
     relayBytes += metric(procs[2 + r].httpPort, "skyshell_stream_bytes_total") - relayBytes0[r];
   const double natsBytes = natsOutBytes(monitorPort) - natsBytes0;
   std::vector<std::string> hashes, names;
-  for (std::size_t p = 1; p < procs.size(); ++p) hashes.push_back(stateHash(procs[p].httpPort));
+  std::vector<double> sequences;
+  for (std::size_t p = 1; p < procs.size(); ++p) {
+    hashes.push_back(stateHash(procs[p].httpPort));
+    sequences.push_back(metric(procs[p].httpPort, "skyshell_nats_applied_sequence"));
+  }
   for (const auto& p : procs) names.push_back(p.name);
 
   for (auto& s : subs) asio::post(clientIo, [s] { s->close(); });
@@ -367,9 +407,11 @@ int main(int argc, char** argv) {
   std::lock_guard lock(shared.mutex);
   const double p50 = percentile(shared.latencies_ms, 50), p99 = percentile(shared.latencies_ms, 99);
   std::printf("relay bench: %d subscribers (%lld served a snapshot) over %d relays, radius %.0f km (level %d), "
-              "%zu changes at %.0f/s to the leader (%zu refused), %s weather, one-node nats-server with JetStream\n",
+              "%zu changes at %.0f/s to the leader (%zu refused), %s weather, %d stations far away, relays follow by "
+              "%s, one-node nats-server with JetStream\n",
               o.subscribers, static_cast<long long>(served), o.relays, o.radius_m / 1000, area.tileLevel, changes,
-              o.rate, refused, o.regional ? "regional (tiles in every snapshot; a storm cell moves)" : "uniform");
+              o.rate, refused, o.regional ? "regional (tiles in every snapshot; a storm cell moves)" : "uniform",
+              o.stations, o.follow.c_str());
   std::printf("  change-to-delivery latency  p50 %.2f ms  p99 %.2f ms  from sending the change (%llu deliveries, "
               "%llu coalesced of %.0f)\n",
               p50, p99, static_cast<unsigned long long>(shared.deliveries),
@@ -383,17 +425,27 @@ int main(int argc, char** argv) {
               selfStormPct);
   std::printf("  bytes per change            NATS out %.0f (all clients), relays' sockets %.0f (%.0f per subscriber)\n",
               natsBytes / double(changes), relayBytes / double(changes), relayBytes / double(changes) / o.subscribers);
+  // A relay by cell holds only its subscribers' cells of the stations (its
+  // hash is of that); it must have folded the leader's last sequence.
+  const bool partial = o.follow == "cells" && o.stations > 0;
   bool same = true;
-  for (const auto& h : hashes) same = same && h == hashes.front() && !h.empty();
-  std::printf("  state hash after the storm  %s on the server and every relay\n",
-              same ? hashes.front().c_str() : "NOT the same");
+  for (std::size_t k = 0; k < hashes.size(); ++k)
+    same = same && (partial ? sequences[k] == sequences.front() && sequences[k] > 0
+                            : hashes[k] == hashes.front() && !hashes[k].empty());
+  if (partial)
+    std::printf("  after the storm             %s applied sequence %.0f on the server and every relay\n",
+                same ? "the same" : "NOT the same", sequences.front());
+  else
+    std::printf("  state hash after the storm  %s on the server and every relay\n",
+                same ? hashes.front().c_str() : "NOT the same");
   if (!o.json.empty()) {
     nlohmann::json cpu = nlohmann::json::object();
     for (std::size_t p = 0; p < names.size(); ++p)
       cpu[names[p]] = {{"idle_pct", idlePct[p]}, {"storm_pct", stormPct[p]}};
     cpu["subscribers"] = {{"idle_pct", selfIdlePct}, {"storm_pct", selfStormPct}};
     const nlohmann::json j = {{"relays", o.relays}, {"subscribers", o.subscribers}, {"served", served},
-                              {"rate_hz", o.rate}, {"regional", o.regional}, {"changes", changes}, {"refused", refused},
+                              {"rate_hz", o.rate}, {"regional", o.regional}, {"follow", o.follow},
+                              {"stations", o.stations}, {"changes", changes}, {"refused", refused},
                               {"latency_p50_ms", p50}, {"latency_p99_ms", p99}, {"deliveries", shared.deliveries},
                               {"coalesced", shared.coalesced}, {"ack_p50_ms", percentile(ack_ms, 50)},
                               {"ack_p99_ms", percentile(ack_ms, 99)}, {"cpu", cpu},

@@ -5,8 +5,10 @@
 // large for an entry, the name of its file on the files stream); and the same bytes as a
 // record of the cluster's registry bucket (cluster_member.cpp), which any
 // publisher could have put there; and as the manifest of a forecast file on
-// the files stream (nats_files.cpp: "<bytes> <chunk bytes>"). One target for
-// all three (not one each): the inputs are text of the same origin, and each target costs deploy/test its
+// the files stream (nats_files.cpp: "<bytes> <chunk bytes>"); and as the
+// global part or a cell of the weather by S2 cell that a relay watches
+// (nats_cells.cpp), joined with the cell into a state a relay restores. One
+// target for all of them (not one each): the inputs are text of the same origin, and each target costs deploy/test its
 // fuzzing time. The decoders may refuse (with a reason), never crash, hang
 // or read out of bounds; what they accept re-encodes to the same; a state
 // passed on is restored or refused, never thrown.
@@ -17,6 +19,7 @@
 
 #include "sky/server/cluster_member.hpp"
 #include "sky/server/live_weather.hpp"
+#include "sky/server/nats_cells.hpp"
 #include "sky/server/nats_entry.hpp"
 #include "sky/server/nats_log.hpp"
 
@@ -45,12 +48,42 @@ void checkFileManifest(std::string_view bytes) {
   if (sky::server::encodeFileManifest(*m) != bytes) std::abort();
 }
 
+// The weather by cell: the parts decode or are refused with a reason; what
+// decodes re-encodes to the same; a global part joined with the bytes as a
+// cell is restored or refused.
+void checkCells(std::string_view bytes) {
+  auto cell = sky::server::decodeCellPart(bytes);
+  if (!cell && cell.error().detail.empty()) std::abort();
+  if (cell) {
+    auto again = sky::server::decodeCellPart(sky::server::encodeCellPart(cell->sequence, cell->content.dump()));
+    if (!again || again->sequence != cell->sequence || again->content != cell->content) std::abort();
+  }
+  auto global = sky::server::decodeGlobalPart(bytes);
+  if (!global) {
+    if (global.error().detail.empty()) std::abort();
+    return;
+  }
+  auto again = sky::server::decodeGlobalPart(sky::server::encodeGlobalPart(*global));
+  if (!again || again->sequence != global->sequence || again->log != global->log || again->cells != global->cells ||
+      again->entry.has_value() != global->entry.has_value() || (global->entry && again->entry->state != global->entry->state))
+    std::abort();
+  if (!global->entry) return;
+  std::vector<const nlohmann::json*> parts;
+  if (cell && !cell->content.is_null()) parts.push_back(&cell->content);
+  const sky::server::WallClock::time_point t0{std::chrono::hours(1000)};
+  sky::server::LiveWeather weather(sky::server::Scenario{}, t0, [t0] { return t0; },
+                                   [] { return std::int64_t{1700000000000}; });
+  auto restored = weather.restore(sky::server::joinState(global->entry->state, parts), {});
+  if (!restored && restored.error().detail.empty()) std::abort();
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);
   checkClusterMember(bytes);
   checkFileManifest(bytes);
+  checkCells(bytes);
   auto entry = sky::server::decodeLogEntry(bytes);
   if (!entry) {
     if (entry.error().detail.empty()) std::abort();

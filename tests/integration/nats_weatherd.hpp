@@ -43,6 +43,23 @@ inline std::string layerChange(int id, double coverage) {
          R"(, "density": 0.7, "wind": {"speed_mps": 5, "from_deg": 200, "vertical_mps": 0}}}]})";
 }
 
+// A change request setting `count` regions of cumulus from id `first` on,
+// on a grid of 60 columns from (lat0, lon0) by id, 0.5 degrees north and 0.9
+// east apart (North America by default; each ~450 bytes of state).
+inline std::string regionsRequest(int first, int count, double lat0 = 30, double lon0 = -120,
+                                  double coverage = 0.5) {
+  std::string body = R"({"author": "nats-test", "changes": [)";
+  for (int id = first; id < first + count; ++id) {
+    body += std::string(id > first ? "," : "") + R"({"op": "set_region", "region": {"id": )" + std::to_string(id) +
+            R"(, "center_lat_deg": )" + std::to_string(lat0 + 0.5 * (id / 60)) + R"(, "center_lon_deg": )" +
+            std::to_string(lon0 + 0.9 * (id % 60)) +
+            R"(, "size_x_m": 20000, "size_y_m": 20000, "transition_m": 5000, "layers": [{"id": 3, "type": "cumulus",
+            "base_m": 1200, "thickness_m": 900, "transition_band_m": 50, "coverage": )" + std::to_string(coverage) +
+            R"(, "density": 0.6, "wind": {"speed_mps": 5, "from_deg": 200, "vertical_mps": 0}}]}})";
+  }
+  return body + "]}";
+}
+
 // One request to a weather server's (or relay's) HTTP API on loopback, with
 // the tests' token; 10 s for the answer, twice a JetStream append's wait
 // (NatsLogOptions::requestWait), so a leader's answer is not given up on.

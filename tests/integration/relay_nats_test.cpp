@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,7 @@
 #include "child_process.hpp"
 #include "nats_cluster.hpp"
 #include "nats_weatherd.hpp"
+#include "../unit/server/stream_test_client.hpp"
 #include "sky/server/nats_entry.hpp"
 #include "sky/server/nats_log.hpp"
 
@@ -268,7 +270,10 @@ TEST_F(RelayNats, AForecastLoadedOnTheLeaderIsDecodedOnTheStandbyAndTheRelay) {
   const fs::path slowDecoder = root_ / "slow-grib-decode";
   std::ofstream(slowDecoder) << "#!/bin/sh\nsleep " << kSlowDecode_s << "\nexec '" << SKY_GRIB_DECODE << "' \"$@\"\n";
   fs::permissions(slowDecoder, fs::perms::owner_all);
-  NatsRelay slow(root_, "slow-relay", cluster_->urls(2), "grib-decoder = \"" + slowDecoder.string() + "\"\n");
+  // This relay follows the whole log (--follow log); the one of SetUp goes
+  // by cell: both decode.
+  NatsRelay slow(root_, "slow-relay", cluster_->urls(2),
+                 "grib-decoder = \"" + slowDecoder.string() + "\"\nfollow = \"log\"\n");
   ASSERT_NE(slow.httpPort, 0u) << slow.log();
   ASSERT_TRUE(waitUntil(10s, [&] { return slow.stateHash() == a_->stateHash(); })) << slow.log();
   std::ifstream in(SKY_GRIB_SAMPLE, std::ios::binary);
@@ -371,6 +376,114 @@ TEST_F(RelayNats, AForecastLoadedOnTheLeaderIsDecodedOnTheStandbyAndTheRelay) {
 // misspelt one (heartbeat_ms for heartbeat-ms) stops it with exit code 2,
 // the code its systemd unit does not restart on, and names the key. No
 // NATS server is needed: the relay never gets that far.
+// A relay takes the weather by S2 cell (nats_cells.hpp): with 600 regions
+// over Australia (a grid from 32 S 115 E, by id: regionsRequest) and one
+// station near a subscriber in Italy, it holds the
+// Italian station and none of Australia's; a change to an Australian
+// station costs it the global part, a small fraction of the log's entry; a
+// change to its own station reaches its subscriber; a subscriber that moves
+// to Australia brings that cell's stations within seconds. A standby
+// server still follows the whole log (its state hash is the leader's).
+TEST_F(RelayNats, ARelayTakesOnlyTheCellsItsSubscribersAreasCover) {
+  startStandby();
+  if (HasFatalFailure()) return;
+  auto regionIds = [](const HttpPeer& p) {
+    std::set<int> ids;
+    const auto j = p.state();
+    if (j.is_object() && j.contains("regions"))
+      for (const auto& r : j["regions"]) ids.insert(r.value("id", -1));
+    return ids;
+  };
+  auto sequence = [](const HttpPeer& p) { return p.metric("skyshell_nats_applied_sequence"); };
+  for (int first = 1000; first < 1600; first += 100)
+    ASSERT_EQ(a_->request("POST", "/api/changes", regionsRequest(first, 100, -40, 115))->status, 200);
+  // Station 1 (a region-only layer 6 of cumulonimbus) 15 km from the
+  // subscriber's centre.
+  const std::string station = R"({"author": "nats-test", "changes": [{"op": "set_region", "region": {"id": 1,
+      "center_lat_deg": 46.3, "center_lon_deg": 12.9, "size_x_m": 10000, "size_y_m": 10000, "transition_m": 3000,
+      "layers": [{"id": 6, "type": "cumulonimbus", "base_m": 900, "thickness_m": 6000, "transition_band_m": 50,
+      "coverage": COVER, "density": 0.8, "wind": {"speed_mps": 5, "from_deg": 200, "vertical_mps": 0}}]}}]})";
+  auto stationAt = [&](double cover) {
+    std::string body = station;
+    body.replace(body.find("COVER"), 5, std::to_string(cover));
+    return body;
+  };
+  ASSERT_EQ(a_->request("POST", "/api/changes", stationAt(0.5))->status, 200);
+  ASSERT_TRUE(waitUntil(10s, [&] { return b_->stateHash() == a_->stateHash(); })) << b_->log();
+  EXPECT_EQ(regionIds(*b_).size(), 601u);
+
+  // A subscriber near the station: the relay watches its area's cells and
+  // folds the weather joined from them.
+  server::TestClient client(static_cast<std::uint16_t>(relay_->streamPort));
+  ASSERT_TRUE(client.read());  // Hello
+  auto subscribe = [&](double lat, double lon) {
+    stream::Subscribe sub;
+    sub.area = {lat, lon, 120000};
+    sub.tileLevel = 12;
+    client.send(sub);
+  };
+  subscribe(46.2, 12.8);
+  ASSERT_TRUE(waitUntil(10s, [&] {
+    const auto ids = regionIds(*relay_);
+    return relay_->metric("skyshell_nats_cells_watched") > 0 && ids == std::set<int>{1};
+  })) << "relay holds " << regionIds(*relay_).size() << " regions\n" << relay_->log();
+  const double watched = relay_->metric("skyshell_nats_cells_watched");
+  EXPECT_GE(watched, 2);
+  EXPECT_LE(watched, 30);
+
+  // A change far away: the relay folds its sequence (the global part says
+  // so) for the global part's bytes only.
+  server::NatsLogOptions o;
+  o.urls = cluster_->urlList();
+  auto log = server::NatsLog::connect(o);
+  ASSERT_TRUE(log) << describe(log.error());
+  const double before = relay_->metric("skyshell_nats_cells_received_bytes_total");
+  ASSERT_EQ(a_->request("POST", "/api/changes", regionsRequest(1000, 1, -40, 115, 0.9))->status, 200);
+  ASSERT_TRUE(waitUntil(5s, [&] { return sequence(*relay_) >= sequence(*a_); })) << relay_->log();
+  const double farBytes = relay_->metric("skyshell_nats_cells_received_bytes_total") - before;
+  auto range = (*log)->range();
+  ASSERT_TRUE(range);
+  auto entry = (*log)->read(range->last);
+  ASSERT_TRUE(entry && *entry);
+  std::printf("a change to a station 16000 km away: %.0f bytes to the relay by cell, %zu bytes of log entry to a "
+              "follower of the log (600 regions in the state)\n",
+              farBytes, (*entry)->size());
+  EXPECT_GT(farBytes, 0);
+  EXPECT_LT(farBytes, double((*entry)->size()) / 10);
+  EXPECT_EQ(regionIds(*relay_), std::set<int>{1});
+
+  // A change to its own station reaches the subscriber.
+  ASSERT_EQ(a_->request("POST", "/api/changes", stationAt(0.9))->status, 200);
+  ASSERT_TRUE(waitUntil(5s, [&] {
+    const auto j = relay_->state();
+    return j.is_object() && j["regions"].size() == 1 && j["regions"][0]["layers"][0].value("coverage", 0.0) > 0.85;
+  })) << relay_->state().dump();
+  bool sawCover = false;
+  for (int k = 0; k < 40 && !sawCover; ++k) {
+    auto m = client.read(5s);
+    if (!m) break;
+    auto tiles = [&](const std::vector<weather::CoverageTile>& ts) {
+      for (const auto& t : ts)
+        if (t.layerId == 6 && t.coverage > 0.85) sawCover = true;
+    };
+    if (auto* snap = std::get_if<weather::WeatherSnapshot>(&*m)) tiles(snap->tiles);
+    if (auto* delta = std::get_if<weather::WeatherDelta>(&*m)) tiles(delta->tiles);
+  }
+  EXPECT_TRUE(sawCover) << "the subscriber never got the station's new cover";
+
+  // The subscriber moves to Australia: the relay takes those cells.
+  const auto moved = Clock::now();
+  subscribe(-30.0, 115.5);
+  ASSERT_TRUE(waitUntil(10s, [&] {
+    const auto ids = regionIds(*relay_);
+    return ids.count(1) == 0 && ids.count(1200) == 1 && ids.size() < 100;
+  })) << "relay holds " << regionIds(*relay_).size() << " regions\n" << relay_->log();
+  std::printf("the subscriber moved 15000 km: the relay held its new area's %zu stations %.2f s later\n",
+              regionIds(*relay_).size(), secondsSince(moved));
+  EXPECT_EQ(relay_->metric("skyshell_nats_cells_malformed_total"), 0);
+  EXPECT_EQ(b_->stateHash(), a_->stateHash());
+}
+
 TEST(RelayConfig, AMisspeltKeyIsRefusedWithItsName) {
   const fs::path dir = fs::path(SKY_TEST_OUTPUT_DIR) / "relay-config-misspelt";
   fs::remove_all(dir);

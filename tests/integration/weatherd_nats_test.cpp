@@ -29,21 +29,6 @@
 namespace sky::test {
 namespace {
 
-// A change request setting `count` regions of cumulus from id `first` on,
-// spread over a grid of North America (each ~450 bytes of state).
-std::string regionsRequest(int first, int count) {
-  std::string body = R"({"author": "nats-test", "changes": [)";
-  for (int id = first; id < first + count; ++id) {
-    body += std::string(id > first ? "," : "") + R"({"op": "set_region", "region": {"id": )" + std::to_string(id) +
-            R"(, "center_lat_deg": )" + std::to_string(30 + 0.5 * (id / 60)) + R"(, "center_lon_deg": )" +
-            std::to_string(-120 + 0.9 * (id % 60)) +
-            R"(, "size_x_m": 20000, "size_y_m": 20000, "transition_m": 5000, "layers": [{"id": 3, "type": "cumulus",
-            "base_m": 1200, "thickness_m": 900, "transition_band_m": 50, "coverage": 0.5, "density": 0.6,
-            "wind": {"speed_mps": 5, "from_deg": 200, "vertical_mps": 0}}]}})";
-  }
-  return body + "]}";
-}
-
 class WeatherdNats : public ::testing::Test {
  protected:
   void SetUp() override {

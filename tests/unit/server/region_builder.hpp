@@ -1,12 +1,14 @@
-// Test builders shared by the server's region, tile-cache and area-frame
-// tests: a square region (CIGI Environmental Region Control shape, no
-// rotation or rounding), and a cloud layer stacked by its id.
+// Test builders shared by the server's region, tile-cache, area-frame and
+// state-cell tests: a square region (CIGI Environmental Region Control
+// shape, no rotation or rounding), a cloud layer stacked by its id, and a
+// live weather on a test clock.
 #pragma once
 
 #include <cstdint>
 #include <utility>
 #include <vector>
 
+#include "sky/server/live_weather.hpp"
 #include "sky/weather/region.hpp"
 
 namespace sky::server::test {
@@ -37,5 +39,25 @@ inline weather::CloudLayer stackedLayer(std::uint32_t id, weather::CloudType typ
   l.wind = {10, 270, 0};
   return l;
 }
+
+// A live weather whose wall clock the test moves (`now`), started at weather
+// clock 1000 s, rate 1, with `layers`.
+struct WeatherFixture {
+  WallClock::time_point now{std::chrono::hours(1000)};
+  std::int64_t unixMs = 1'700'000'000'000;
+  LiveWeather weather;
+  explicit WeatherFixture(std::vector<weather::CloudLayer> layers)
+      : weather(
+            [&] {
+              Scenario s;
+              s.clock = {1000.0, 1.0};
+              s.layers = std::move(layers);
+              return s;
+            }(),
+            now, [this] { return now; }, [this] { return unixMs; }) {}
+  Result<AppliedChange> submit(std::vector<WeatherChange> changes) {
+    return weather.submit(ChangeRequest{std::move(changes), "test", "api"});
+  }
+};
 
 }  // namespace sky::server::test

@@ -39,22 +39,8 @@ weather::CloudLayer layer(std::uint32_t id, weather::CloudType type, double cove
 
 constexpr auto cell = test::squareRegion;
 
-struct Fixture {
-  WallClock::time_point now = kT0;
-  std::int64_t unixMs = 1'700'000'000'000;
-  LiveWeather weather;
-  Fixture()
-      : weather(
-            [] {
-              Scenario s;
-              s.clock = {1000.0, 1.0};
-              s.layers = {layer(1, weather::CloudType::Cumulus, 0.8)};
-              return s;
-            }(),
-            kT0, [this] { return now; }, [this] { return unixMs; }) {}
-  Result<AppliedChange> submit(std::vector<WeatherChange> changes) {
-    return weather.submit(ChangeRequest{std::move(changes), "test", "api"});
-  }
+struct Fixture : test::WeatherFixture {
+  Fixture() : WeatherFixture({layer(1, weather::CloudType::Cumulus, 0.8)}) {}
 };
 
 // Point `east_m` east and `north_m` north of (lat, lon) along a geodesic.

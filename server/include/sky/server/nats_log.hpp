@@ -36,6 +36,14 @@ struct NatsLogOptions {
   // names each by: chunks of a stream of their own, one message per subject.
   std::string filesStream = "SKY_WEATHER_FILES";
   std::string filesSubject = "sky.weather.file";
+  // The weather cut by S2 cell for the relays (state_cells.hpp,
+  // nats_cells.hpp): a KV bucket of the newest value of each cell and of the
+  // global part; a relay watches the keys of its renderers' areas.
+  std::string areasBucket = "sky_weather_areas";
+  // Deliver every subscription's messages from nats.c's shared pool of
+  // threads instead of one thread per subscription: a relay watches a
+  // hundred or more keys.
+  bool sharedDelivery = false;
   int replicas = 3;                           // the stream's and the bucket's; 1 on a single server
   std::uint64_t maxEntries = 10000;           // the stream keeps the newest this many
   // How long a publish, a read or a lease operation waits for its answer.
@@ -137,6 +145,25 @@ class NatsLog {
   Result<void> putFile(std::string_view key, std::span<const std::byte> bytes);
   Result<std::vector<std::byte>> getFile(std::string_view key, std::size_t maxBytes);
   Result<void> dropFile(std::string_view key);
+
+  // The areas bucket (nats_areas.cpp): putArea stores a key's newest value
+  // if the key's revision is still `lastRevision` (the one this writer put
+  // last), or whatever it is with lastRevision 0, and returns the new
+  // revision (nullopt: another writer's put came between, nothing stored);
+  // readArea reads the newest value (nullopt: none). watchArea
+  // subscribes to the key's puts and deletes (core NATS, on the KV's subject:
+  // no consumer per key), calling the handler set by onArea with the key and
+  // the value (empty: deleted) on a NATS client thread; a watch misses what
+  // is put while the connection is down, so a watcher reads back what it
+  // holds now and then. Errors: Io, Timeout; InvalidArgument for a key that
+  // is not [-_=.a-zA-Z0-9].
+  Result<std::optional<std::uint64_t>> putArea(const std::string& key, std::string_view bytes,
+                                               std::uint64_t lastRevision);
+  Result<std::optional<std::string>> readArea(const std::string& key);
+  using AreaHandler = std::function<void(const std::string& key, std::string bytes)>;
+  void onArea(AreaHandler handler);  // before the first watch; null: stop calling
+  Result<void> watchArea(const std::string& key);
+  void unwatchArea(const std::string& key);
 
  private:
   struct Handles;

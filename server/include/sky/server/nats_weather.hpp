@@ -33,6 +33,7 @@
 #include "sky/server/cluster_registry.hpp"
 #include "sky/server/grib_isolated.hpp"
 #include "sky/server/live_weather.hpp"
+#include "sky/server/nats_cells.hpp"
 #include "sky/server/nats_entry.hpp"
 #include "sky/server/nats_log.hpp"
 
@@ -58,6 +59,10 @@ struct NatsWeatherOptions {
   // never takes part in the election, so it never leads and refuses every
   // change. A standby server is the same without this.
   bool relay = false;
+  // A relay that takes the weather by S2 cell (nats_cells.hpp): the global
+  // part and the cells its renderers' areas cover, not every whole state of
+  // the log. Without it a relay follows the log as a standby server does.
+  bool followCells = false;
   std::shared_ptr<spdlog::logger> logger;  // null: log nothing
   // Decodes a forecast the leader loaded (its files read back from the
   // files stream) when this server or relay folds it.
@@ -106,6 +111,12 @@ class NatsWeather {
   // Follows the log from the entry after the last one folded; replaces the
   // subscription (the election thread's, once started).
   Result<void> follow();
+  // On the io thread: a state a CellFollower joined (or read whole), folded
+  // as an entry of the log is, after a decode under way.
+  void onCellState(std::uint64_t sequence, LogEntry entry);
+  // The io thread's, every kAreasPoll on a relay by cell: the cells its
+  // subscribers' areas cover, to the CellFollower when they changed.
+  void pollAreas();
   // On the io thread: one entry of the log, as the follower sees it. An
   // entry naming a forecast not held is decoded off the io thread
   // (decodeThenFold); the entries after it wait for it.
@@ -170,6 +181,15 @@ class NatsWeather {
   std::unique_ptr<NatsLog> natsLog_;
   std::unique_ptr<ClusterRegistry> registry_;  // after natsLog_, which it uses; made by elect()
   boost::asio::steady_timer claimRetry_;
+  boost::asio::steady_timer areasPoll_;
+  std::size_t areasFingerprint_ = 0;
+  // The leader's cells for the relays (not on a relay), and a relay's by
+  // cell; both after natsLog_, which they use.
+  std::unique_ptr<CellPublisher> publisher_;
+  std::unique_ptr<CellFollower> cellFollower_;
+  // A state a CellFollower handed over while a decode was under way: the
+  // newest, folded after it.
+  std::optional<std::pair<std::uint64_t, LogEntry>> cellWaiting_;
 
   // The io thread's: the last stream sequence folded into the weather (by
   // following or by this server's own append).

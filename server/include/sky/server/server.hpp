@@ -88,6 +88,9 @@ class Server final : private SessionHandler {
   // Every subscriber as the console sees it (area, last camera report), by
   // session id. Call on the io thread.
   std::vector<RendererInfo> renderers() const;
+  // Every area every subscriber asked for (a relay takes the weather of
+  // these: state_cells.hpp). Call on the io thread.
+  std::vector<weather::SphericalCap> subscribedAreas() const;
   // Runs on the io thread whenever a subscriber connects, subscribes, reports
   // its camera or goes away (the console coalesces these).
   void onRenderersChanged(std::function<void()> f) { onRenderersChanged_.push_back(std::move(f)); }
