@@ -105,9 +105,10 @@ TEST(StateCells, ARegionIsInEveryCellItsReachTouches) {
   Fixture f;
   fillWorld(f);
   CellReach reach;
-  const StateCells split = splitState(f.weather.toJson(), reach);
+  const nlohmann::json state = f.weather.toJson();
+  const StateCells split = splitState(state, reach);
   const auto& geod = GeographicLib::Geodesic::WGS84();
-  for (const auto& r : f.weather.toJson().at("regions")) {
+  for (const auto& r : state.at("regions")) {
     const auto id = r.at("id").get<std::uint64_t>();
     if (id == 6 || id == 7) continue;
     auto region = regionFromJson(r, "region", true);
