@@ -171,15 +171,15 @@ bool CellPublisher::put(const std::string& key, const std::string& bytes) {
 }
 
 void CellPublisher::publish(std::uint64_t sequence, LogEntry entry) {
-  StateCells split = splitState(entry.state, reach_);
+  StateCells split = splitState(std::move(entry.state), reach_);
   const std::size_t limit = nats_.messageLimit();
   bool ok = true, tooLarge = false;
   for (auto& [key, content] : split.cells) {
-    const std::string dumped = content.dump();
-    const std::size_t hash = std::hash<std::string>{}(dumped);
     Published& p = cells_[key];
-    if (p.revision != 0 && !p.empty && p.hash == hash) continue;
-    const std::string bytes = encodeCellPart(sequence, dumped);
+    // Compared as trees, not dumped: most cells are unchanged, and a
+    // comparison allocates nothing.
+    if (p.revision != 0 && !p.empty && p.content == content) continue;
+    const std::string bytes = encodeCellPart(sequence, content.dump());
     if (bytes.size() > limit) {
       tooLarge = true;
       continue;
@@ -188,7 +188,7 @@ void CellPublisher::publish(std::uint64_t sequence, LogEntry entry) {
       ok = false;
       break;
     }
-    p.hash = hash;
+    p.content = std::move(content);
     p.sequence = sequence;
     p.empty = false;
   }
@@ -201,6 +201,7 @@ void CellPublisher::publish(std::uint64_t sequence, LogEntry entry) {
       break;
     }
     p.empty = true;
+    p.content = nullptr;
     p.sequence = sequence;
   }
   if (!ok) {

@@ -285,7 +285,7 @@ Result<std::string> NatsWeather::entryBytes(LogEntry& entry) {
   const std::size_t limit = std::min(kMaxLogEntry_bytes, natsLog_->messageLimit());
   std::string json = entry.state.dump();
   if (json.size() + kAroundState_bytes <= limit)
-    if (std::string bytes = encodeLogEntry(entry); bytes.size() <= limit) return bytes;
+    if (std::string bytes = encodeLogEntry(entry, json); bytes.size() <= limit) return bytes;
   if (json.size() > kMaxStateFile_bytes)
     return fail(ErrorCode::TooLarge, "the weather's state is " + std::to_string(json.size()) +
                                          " bytes, more than the NATS log holds (" +

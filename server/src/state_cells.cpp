@@ -115,33 +115,39 @@ const std::vector<std::string>& CellReach::cellsOfCap(const weather::SphericalCa
   return byPlacement_.emplace(placement, std::move(keys)).first->second;
 }
 
-StateCells splitState(const nlohmann::json& state, CellReach& reach) {
+StateCells splitState(nlohmann::json state, CellReach& reach) {
   StateCells out;
-  out.global = state;
-  if (!state.is_object()) return out;
+  out.global = std::move(state);
+  if (!out.global.is_object()) return out;
   auto cellOf = [&out](const std::string& key) -> nlohmann::json& {
     auto [it, added] = out.cells.try_emplace(key);
     if (added) it->second = {{"regions", nlohmann::json::array()}, {"region_ramps", nlohmann::json::array()}};
     return it->second;
   };
-  if (const nlohmann::json* regions = member(state, "regions"); regions && regions->is_array()) {
+  // Each item moves to the global part or to its last cell, and is copied
+  // to the others: a state of thousands of regions is cut after every
+  // change.
+  auto cut = [&](const char* name, auto&& cellsOf) {
+    const auto found = out.global.find(name);
+    if (found == out.global.end() || !found->is_array()) return;
+    nlohmann::json items = std::move(*found);
     nlohmann::json kept = nlohmann::json::array();
-    for (const auto& r : *regions) {
-      const auto& cells = reach.cellsOf(r);
-      if (cells.empty()) kept.push_back(r);
-      for (const auto& key : cells) cellOf(key)["regions"].push_back(r);
+    for (auto& item : items) {
+      const std::vector<std::string> cells = cellsOf(item);
+      if (cells.empty()) {
+        kept.push_back(std::move(item));
+        continue;
+      }
+      for (std::size_t k = 0; k + 1 < cells.size(); ++k) cellOf(cells[k])[name].push_back(item);
+      cellOf(cells.back())[name].push_back(std::move(item));
     }
-    out.global["regions"] = std::move(kept);
-  }
-  if (const nlohmann::json* ramps = member(state, "region_ramps"); ramps && ramps->is_array()) {
-    nlohmann::json kept = nlohmann::json::array();
-    for (const auto& r : *ramps) {
-      const std::set<std::string> cells = rampCells(r, reach);
-      if (cells.empty()) kept.push_back(r);
-      for (const auto& key : cells) cellOf(key)["region_ramps"].push_back(r);
-    }
-    out.global["region_ramps"] = std::move(kept);
-  }
+    out.global[name] = std::move(kept);
+  };
+  cut("regions", [&](const nlohmann::json& r) { return reach.cellsOf(r); });
+  cut("region_ramps", [&](const nlohmann::json& r) {
+    const std::set<std::string> cells = rampCells(r, reach);
+    return std::vector<std::string>(cells.begin(), cells.end());
+  });
   return out;
 }
 

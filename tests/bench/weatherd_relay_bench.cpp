@@ -314,9 +314,17 @@ int main(int argc, char** argv) {
   }
   for (int r = 0; r < o.relays; ++r)
     procs.push_back(startOurs("relay" + std::to_string(r), {SKY_RELAY, "--nats", url, "--follow", o.follow}, dir));
+  // A relay by cell holds only its subscribers' cells of the stations (none
+  // before they subscribe): it has caught up once it folded the leader's
+  // sequence.
+  const bool partial = o.follow == "cells" && o.stations > 0;
   const std::string hash = stateHash(leaderHttp);
+  const double leaderSequence = metric(leaderHttp, "skyshell_nats_applied_sequence");
   for (std::size_t p = 2; p < procs.size(); ++p)
-    if (procs[p].httpPort == 0 || !waitUntil(30s, [&] { return stateHash(procs[p].httpPort) == hash; })) {
+    if (procs[p].httpPort == 0 || !waitUntil(30s, [&] {
+          return partial ? metric(procs[p].httpPort, "skyshell_nats_applied_sequence") >= leaderSequence
+                         : stateHash(procs[p].httpPort) == hash;
+        })) {
       std::fprintf(stderr, "%s did not follow the log (logs in %s)\n", procs[p].name.c_str(), dir.c_str());
       return 1;
     }
@@ -425,9 +433,6 @@ int main(int argc, char** argv) {
               selfStormPct);
   std::printf("  bytes per change            NATS out %.0f (all clients), relays' sockets %.0f (%.0f per subscriber)\n",
               natsBytes / double(changes), relayBytes / double(changes), relayBytes / double(changes) / o.subscribers);
-  // A relay by cell holds only its subscribers' cells of the stations (its
-  // hash is of that); it must have folded the leader's last sequence.
-  const bool partial = o.follow == "cells" && o.stations > 0;
   bool same = true;
   for (std::size_t k = 0; k < hashes.size(); ++k)
     same = same && (partial ? sequences[k] == sequences.front() && sequences[k] > 0

@@ -111,7 +111,7 @@ class CellPublisher {
 
   // The publisher thread's.
   struct Published {
-    std::size_t hash = 0;       // of the cell's content
+    nlohmann::json content;     // as last put
     std::uint64_t sequence = 0;  // at which it last changed
     std::uint64_t revision = 0;  // the key's revision this leader wrote
     bool empty = false;

@@ -57,6 +57,9 @@ std::string stateFileKey(std::string_view json);
 
 // The entry as bytes (JSON, one object).
 std::string encodeLogEntry(const LogEntry& entry);
+// The same for an entry whose state (inline, no state file) is already
+// dumped as `stateJson` (a JSON object).
+std::string encodeLogEntry(const LogEntry& entry, std::string_view stateJson);
 // Malformed (not JSON, a field missing or of the wrong type, an unknown
 // kind or format), TooLarge (over kMaxLogEntry_bytes or a text over
 // kMaxLogEntryText, a state file's key over it or its size over

@@ -64,8 +64,9 @@ class CellReach {
 // The key a cell goes by on NATS: "c" and its S2 token ("c.47a1").
 std::string cellKey(std::uint64_t cellId);
 
-// Cuts a saved state. A state without regions has no cells.
-StateCells splitState(const nlohmann::json& state, CellReach& reach);
+// Cuts a saved state (moved in: its items move to the parts). A state
+// without regions has no cells.
+StateCells splitState(nlohmann::json state, CellReach& reach);
 
 // The state again from the global part and the cells held: regions by id,
 // region ramps by sequence and region id (the order LiveWeather saves them
