@@ -129,6 +129,13 @@ int main(int argc, char** argv) {
                  "after the leader is lost)")
       ->check(CLI::Range(500, 60000))
       ->capture_default_str();
+  std::string natsCells = "on";
+  app.add_option("--nats-cells", natsCells,
+                 "With --nats: while leading, publish each state cut by S2 cell for the relays that take the weather "
+                 "by cell (on); off spares the leader that work when every relay follows the log (relays by cell "
+                 "then read whole states from the log)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
   app.add_option("--log-level", logLevel, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
@@ -199,6 +206,7 @@ int main(int argc, char** argv) {
     for (std::string url; std::getline(list, url, ',');)
       if (!url.empty()) natsOptions.log.urls.push_back(url);
     natsOptions.log.leaseTtl = std::chrono::milliseconds(natsLeaseMs);
+    natsOptions.publishCells = natsCells == "on";
     // Unique among the servers of one host: the lease names its holder.
     natsOptions.serverId = options.serverId + ":" + std::to_string(::getpid());
     natsOptions.logger = log;

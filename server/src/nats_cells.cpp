@@ -386,6 +386,20 @@ void CellFollower::run() {
     if (now - lastReadBack >= kReadBack) {
       readBack(kGlobalAreaKey);
       lastReadBack = now;
+      if (auto range = nats_.range(); range) logLast_.emplace_back(now, range->last);
+      // The newest sequence the log had at least kCellMismatchWait ago.
+      std::uint64_t due = 0;
+      while (!logLast_.empty() && now - logLast_.front().first >= kCellMismatchWait) {
+        due = logLast_.front().second;
+        logLast_.pop_front();
+      }
+      const std::uint64_t published = global_ ? global_->sequence : 0;
+      if (due > published && due > delivered_) {
+        log_->info("event=nats_cells_unpublished log={} global={}: reading the whole state from the log", due,
+                   published);
+        deliverWhole(due);
+        continue;
+      }
     }
     if (!global_) continue;
     const Global& g = *global_;

@@ -86,7 +86,8 @@ Result<std::unique_ptr<NatsWeather>> NatsWeather::start(Server& server, NatsWeat
     if (!self->leading_) return fail(ErrorCode::Io, self->refusal());
     return self->natsLog_->putFile(key, bytes);
   });
-  if (!w->options_.relay) w->publisher_ = std::make_unique<CellPublisher>(*w->natsLog_, w->log_);
+  if (!w->options_.relay && w->options_.publishCells)
+    w->publisher_ = std::make_unique<CellPublisher>(*w->natsLog_, w->log_);
   if (w->options_.relay && w->options_.followCells) return w;  // by cell, from elect()
   auto followed = w->follow();
   if (!followed) return tl::unexpected(followed.error());

@@ -484,6 +484,27 @@ TEST_F(RelayNats, ARelayTakesOnlyTheCellsItsSubscribersAreasCover) {
   EXPECT_EQ(b_->stateHash(), a_->stateHash());
 }
 
+// A relay by cell whose leader publishes no cells (--nats-cells off, or a
+// leader whose writes fail) still follows the weather: it reads the log's
+// newest entry once the log has been ahead of the cells' global part for
+// CellFollower::kCellMismatchWait.
+TEST_F(RelayNats, ARelayByCellFollowsALeaderThatPublishesNoCells) {
+  NatsWeatherd quiet(root_, "quiet", cluster_->urls(1), {"--nats-lease-ms", kLeaseMs, "--nats-cells", "off"});
+  ASSERT_NE(quiet.httpPort, 0u) << quiet.log();
+  ASSERT_TRUE(waitUntil(10s, [&] { return quiet.stateHash() == a_->stateHash(); })) << quiet.log();
+  a_->process->killNow();
+  ASSERT_TRUE(waitUntil(20s, [&] { return quiet.leads(); })) << quiet.log();
+  const double wholeBefore = relay_->metric("skyshell_nats_cells_whole_total");
+  const auto sent = Clock::now();
+  ASSERT_EQ(quiet.request("POST", "/api/changes", layerChange(40, 0.5))->status, 200);
+  ASSERT_TRUE(waitUntil(10s, [&] { return relay_->hasLayer(40) && relay_->stateHash() == quiet.stateHash(); }))
+      << relay_->log();
+  std::printf("a leader publishing no cells: its change on the relay by cell %.2f s after it was sent (from the "
+              "log)\n", secondsSince(sent));
+  EXPECT_GT(relay_->metric("skyshell_nats_cells_whole_total"), wholeBefore);
+  EXPECT_EQ(quiet.metric("skyshell_nats_cells_states_total"), -1) << "no publisher, no publisher's metrics";
+}
+
 TEST(RelayConfig, AMisspeltKeyIsRefusedWithItsName) {
   const fs::path dir = fs::path(SKY_TEST_OUTPUT_DIR) / "relay-config-misspelt";
   fs::remove_all(dir);

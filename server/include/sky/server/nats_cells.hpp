@@ -25,6 +25,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <deque>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -146,7 +147,11 @@ class CellFollower {
   // Longer than a leader takes to write a state's cells and global part.
   static constexpr std::chrono::milliseconds kCellMismatchWait{2000};
   // How often the held global part is read back (a watch misses what is
-  // put while the connection is down).
+  // put while the connection is down), and the log's last sequence read:
+  // a global part that has not reached the sequence the log had
+  // kCellMismatchWait ago (no leader publishing: one started with
+  // --nats-cells off, or whose writes fail) makes the relay read the log's
+  // newest entry instead.
   static constexpr std::chrono::milliseconds kReadBack{1000};
 
  private:
@@ -178,6 +183,8 @@ class CellFollower {
   bool wholeNow_ = false, dirty_ = false;
   std::uint64_t delivered_ = 0;  // the newest sequence handed over
   std::optional<std::chrono::steady_clock::time_point> mismatchSince_;
+  // The log's last sequence as read at each read-back, oldest first.
+  std::deque<std::pair<std::chrono::steady_clock::time_point, std::uint64_t>> logLast_;
   std::atomic<std::uint64_t> bytes_{0}, joined_{0}, wholes_{0}, watching_{0}, malformed_{0};
 };
 

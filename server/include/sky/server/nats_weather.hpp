@@ -63,6 +63,9 @@ struct NatsWeatherOptions {
   // part and the cells its renderers' areas cover, not every whole state of
   // the log. Without it a relay follows the log as a standby server does.
   bool followCells = false;
+  // A server that leads publishes the weather by cell for those relays
+  // (CellPublisher). Off: relays by cell read whole states from the log.
+  bool publishCells = true;
   std::shared_ptr<spdlog::logger> logger;  // null: log nothing
   // Decodes a forecast the leader loaded (its files read back from the
   // files stream) when this server or relay folds it.
