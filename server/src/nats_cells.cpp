@@ -384,9 +384,13 @@ void CellFollower::run() {
     for (const auto& [key, bytes] : arrived) take(key, bytes);
     const auto now = std::chrono::steady_clock::now();
     if (now - lastReadBack >= kReadBack) {
-      readBack(kGlobalAreaKey);
       lastReadBack = now;
-      if (auto range = nats_.range(); range) logLast_.emplace_back(now, range->last);
+      const auto range = nats_.range();
+      if (range) logLast_.emplace_back(now, range->last);
+      // Read back only when the log is ahead of the part held (a put this
+      // watch missed) or none is held: the part lists every non-empty cell,
+      // tens of kB for a continent of stations.
+      if (!global_ || !range || range->last > global_->sequence) readBack(kGlobalAreaKey);
       // The newest sequence the log had at least kCellMismatchWait ago.
       std::uint64_t due = 0;
       while (!logLast_.empty() && now - logLast_.front().first >= kCellMismatchWait) {

@@ -146,8 +146,9 @@ class CellFollower {
 
   // Longer than a leader takes to write a state's cells and global part.
   static constexpr std::chrono::milliseconds kCellMismatchWait{2000};
-  // How often the held global part is read back (a watch misses what is
-  // put while the connection is down), and the log's last sequence read:
+  // How often the log's last sequence is read, and the global part read
+  // back when the log is ahead of it (a watch misses what is put while the
+  // connection is down):
   // a global part that has not reached the sequence the log had
   // kCellMismatchWait ago (no leader publishing: one started with
   // --nats-cells off, or whose writes fail) makes the relay read the log's
