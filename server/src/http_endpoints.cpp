@@ -17,6 +17,7 @@
 #include "sky/server/forecast_files.hpp"
 #include "sky/server/http_api.hpp"
 #include "sky/server/metar_api.hpp"
+#include "sky/server/metrics_text.hpp"
 #include "sky/server/radar_api.hpp"
 #include "sky/server/scenario_api.hpp"
 #include "sky/server/wind_api.hpp"
@@ -78,8 +79,7 @@ std::optional<HttpReply> HttpApi::serve(Endpoint endpoint, const ApiRequest& r) 
 HttpReply HttpApi::metrics() {
   std::string m;
   auto line = [&m](const char* name, const char* help, const char* type, std::uint64_t v) {
-    m += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " " + type + "\n" + name + " " +
-         std::to_string(v) + "\n";
+    appendMetric(m, name, type, help, v);
   };
   line("skyshell_http_requests_total", "HTTP requests handled", "counter", counters_.requests);
   line("skyshell_http_connections", "HTTP connections in flight", "gauge", connectionsInFlight());

@@ -6,17 +6,14 @@
 
 #include <spdlog/spdlog.h>
 
+#include "sky/server/metrics_text.hpp"
+
 namespace sky::server {
 
 namespace {
 
 // A global part lists at most every level-6 cell.
 constexpr std::size_t kMaxListedCells = 6u << (2 * kStateCellLevel);
-
-void metricLine(std::string& m, const char* name, const char* type, const char* help, std::uint64_t v) {
-  m += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " " + type + "\n" + name + " " +
-       std::to_string(v) + "\n";
-}
 
 // A cell holds at most every region there may be (ids are 16 bits), and
 // a ramp of each.
@@ -236,13 +233,13 @@ void CellPublisher::publish(std::uint64_t sequence, LogEntry entry) {
 
 std::string CellPublisher::metrics() const {
   std::string m;
-  metricLine(m, "skyshell_nats_cells_states_total", "counter",
+  appendMetric(m, "skyshell_nats_cells_states_total", "counter",
              "states this leader published by S2 cell for the relays", states_.load());
-  metricLine(m, "skyshell_nats_cells_puts_total", "counter", "cell and global values put", puts_.load());
-  metricLine(m, "skyshell_nats_cells_put_bytes_total", "counter", "bytes of those values", bytes_.load());
-  metricLine(m, "skyshell_nats_cells_to_log_total", "counter",
+  appendMetric(m, "skyshell_nats_cells_puts_total", "counter", "cell and global values put", puts_.load());
+  appendMetric(m, "skyshell_nats_cells_put_bytes_total", "counter", "bytes of those values", bytes_.load());
+  appendMetric(m, "skyshell_nats_cells_to_log_total", "counter",
              "states with a part too large for a message (relays read them whole from the log)", toLog_.load());
-  metricLine(m, "skyshell_nats_cells_refused_total", "counter",
+  appendMetric(m, "skyshell_nats_cells_refused_total", "counter",
              "cell writes refused because another leader wrote the key since", refused_.load());
   return m;
 }
@@ -391,6 +388,16 @@ void CellFollower::run() {
       // watch missed) or none is held: the part lists every non-empty cell,
       // tens of kB for a continent of stations.
       if (!global_ || !range || range->last > global_->sequence) readBack(kGlobalAreaKey);
+      // A leader puts a global part only after the log stored its state:
+      // one past the log's last sequence (read again, after the part) was
+      // put by another client, and held it would hide every real one.
+      if (range && global_ && global_->sequence > range->last)
+        if (const auto after = nats_.range(); after && global_->sequence > after->last) {
+          ++malformed_;
+          log_->warn("event=nats_cells_dropped key=global sequence={} log={}: past the log", global_->sequence,
+                     after->last);
+          global_.reset();
+        }
       // The newest sequence the log had at least kCellMismatchWait ago.
       std::uint64_t due = 0;
       while (!logLast_.empty() && now - logLast_.front().first >= kCellMismatchWait) {
@@ -450,14 +457,14 @@ void CellFollower::run() {
 
 std::string CellFollower::metrics() const {
   std::string m;
-  metricLine(m, "skyshell_nats_cells_watched", "gauge", "S2 cells whose weather this relay watches",
+  appendMetric(m, "skyshell_nats_cells_watched", "gauge", "S2 cells whose weather this relay watches",
              watching_.load());
-  metricLine(m, "skyshell_nats_cells_received_bytes_total", "counter",
+  appendMetric(m, "skyshell_nats_cells_received_bytes_total", "counter",
              "bytes of cell and global values and whole log entries this relay received", bytes_.load());
-  metricLine(m, "skyshell_nats_cells_joined_total", "counter", "states joined from cells", joined_.load());
-  metricLine(m, "skyshell_nats_cells_whole_total", "counter",
+  appendMetric(m, "skyshell_nats_cells_joined_total", "counter", "states joined from cells", joined_.load());
+  appendMetric(m, "skyshell_nats_cells_whole_total", "counter",
              "states read whole from the log (areas too large, a part too large, or cells behind)", wholes_.load());
-  metricLine(m, "skyshell_nats_cells_malformed_total", "counter", "cell or global values dropped as malformed",
+  appendMetric(m, "skyshell_nats_cells_malformed_total", "counter", "cell or global values dropped as malformed",
              malformed_.load());
   return m;
 }

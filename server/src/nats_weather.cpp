@@ -11,6 +11,7 @@
 #include <spdlog/spdlog.h>
 
 #include "sky/server/forecast_files.hpp"
+#include "sky/server/metrics_text.hpp"
 #include "sky/server/server.hpp"
 #include "sky/server/state_cells.hpp"
 
@@ -210,10 +211,10 @@ void NatsWeather::pollAreas() {
   for (const auto& a : areas)
     for (double v : {a.centerLat_deg, a.centerLon_deg, a.radius_m})
       fingerprint = fingerprint * 1000003u ^ std::hash<double>{}(v);
-  if (fingerprint != areasFingerprint_ || areasFingerprint_ == 0) {
-    areasFingerprint_ = fingerprint == 0 ? 1 : fingerprint;
+  if (fingerprint != areasFingerprint_) {
+    areasFingerprint_ = fingerprint;
     bool tooMany = false;
-    auto keys = cellsForAreas(areas, tooMany);
+    auto keys = cellsForAreas(areas, areaCoverings_, tooMany);
     cellFollower_->want(std::move(keys), tooMany);
   }
   areasPoll_.expires_after(kAreasPoll);
@@ -697,8 +698,7 @@ nlohmann::json NatsWeather::cluster() const {
 std::string NatsWeather::metrics() const {
   std::string m;
   auto line = [&m](const char* name, const char* type, const char* help, std::uint64_t v) {
-    m += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " " + type + "\n" + name + " " +
-         std::to_string(v) + "\n";
+    appendMetric(m, name, type, help, v);
   };
   line("skyshell_nats_leader", "gauge", "1 while this server leads the weather on NATS", leading_ ? 1 : 0);
   line("skyshell_nats_relay", "gauge", "1 for a relay (follows the log, never leads)", options_.relay ? 1 : 0);

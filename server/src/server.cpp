@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include "sky/core/assert.hpp"
+#include "sky/server/metrics_text.hpp"
 #include "sky/stream/framing.hpp"
 
 namespace sky::server {
@@ -341,10 +342,7 @@ void Server::sessionStalled(Session&) { streamCounters_.stalledDropped.fetch_add
 
 std::string Server::streamMetrics() const {
   std::string m;
-  auto line = [&m](const char* name, const char* help, std::uint64_t v) {
-    m += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " counter\n" + name + " " +
-         std::to_string(v) + "\n";
-  };
+  auto line = [&m](const char* name, const char* help, std::uint64_t v) { appendMetric(m, name, "counter", help, v); };
   line("skyshell_stream_frames_total", "weather stream frames sent", streamCounters_.frames.load());
   line("skyshell_stream_bytes_total", "weather stream bytes sent", streamCounters_.bytes.load());
   line("skyshell_subscribers_dropped_total", "subscribers dropped for not reading",

@@ -174,16 +174,17 @@ nlohmann::json joinState(const nlohmann::json& global, const std::vector<const n
   return state;
 }
 
-std::vector<std::string> cellsForAreas(const std::vector<weather::SphericalCap>& areas, bool& tooMany) {
+std::vector<std::string> cellsForAreas(const std::vector<weather::SphericalCap>& areas, CellReach& cache,
+                                       bool& tooMany) {
   tooMany = false;
   std::set<std::string> keys;
   for (const auto& a : areas) {
-    const auto ids = weather::coverCap(a, kStateCellLevel, kMaxCellsPerArea);
-    if (ids.size() > kMaxCellsPerArea) {
+    const auto& covering = cache.cellsOfCap(a);
+    if (covering.size() > kMaxCellsPerArea) {
       tooMany = true;
       return {};
     }
-    for (const std::uint64_t id : ids) keys.insert(cellKey(id));
+    keys.insert(covering.begin(), covering.end());
   }
   return {keys.begin(), keys.end()};
 }

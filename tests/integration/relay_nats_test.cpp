@@ -25,6 +25,7 @@
 #include "nats_cluster.hpp"
 #include "nats_weatherd.hpp"
 #include "../unit/server/stream_test_client.hpp"
+#include "sky/server/nats_cells.hpp"
 #include "sky/server/nats_entry.hpp"
 #include "sky/server/nats_log.hpp"
 
@@ -482,6 +483,25 @@ TEST_F(RelayNats, ARelayTakesOnlyTheCellsItsSubscribersAreasCover) {
               regionIds(*relay_).size(), secondsSince(moved));
   EXPECT_EQ(relay_->metric("skyshell_nats_cells_malformed_total"), 0);
   EXPECT_EQ(b_->stateHash(), a_->stateHash());
+
+  // Another client puts a global part far past the log: the relay drops it
+  // (it would hide every real one) and still takes the leader's next change
+  // (from the log, whole, when the leader's own global part was refused for
+  // the forged revision).
+  server::GlobalPart forged;
+  forged.sequence = 1'000'000'000'000;
+  forged.log = true;
+  ASSERT_TRUE((*log)->putArea(server::kGlobalAreaKey, server::encodeGlobalPart(forged), 0));
+  subscribe(46.2, 12.8);
+  ASSERT_EQ(a_->request("POST", "/api/changes", stationAt(0.2))->status, 200);
+  ASSERT_TRUE(waitUntil(10s, [&] {
+    const auto j = relay_->state();
+    if (!j.is_object()) return false;
+    for (const auto& r : j["regions"])
+      if (r.value("id", 0) == 1) return r["layers"][0].value("coverage", 1.0) < 0.25;
+    return false;
+  })) << relay_->log();
+  EXPECT_GE(relay_->metric("skyshell_nats_cells_malformed_total"), 1);
 }
 
 // A relay by cell whose leader publishes no cells (--nats-cells off, or a

@@ -152,7 +152,7 @@ TEST(StateCells, TheAreasCellsGiveTheAreasSnapshot) {
                                           weather::SphericalCap{-33.0, 145.0, 900000},
                                           weather::SphericalCap{47.9, 12.6, 60000}}) {
     bool tooMany = true;
-    const auto keys = cellsForAreas({area}, tooMany);
+    const auto keys = cellsForAreas({area}, reach, tooMany);
     ASSERT_FALSE(tooMany);
     ASSERT_FALSE(keys.empty());
     std::vector<const nlohmann::json*> parts;
@@ -203,9 +203,11 @@ TEST(StateCells, TheAreasCellsGiveTheAreasSnapshot) {
 
 TEST(StateCells, AnAreaTooLargeAsksForTheWholeState) {
   bool tooMany = false;
-  EXPECT_TRUE(cellsForAreas({weather::SphericalCap{0, 0, 9'000'000}}, tooMany).empty());
+  CellReach cache;
+  EXPECT_TRUE(cellsForAreas({weather::SphericalCap{0, 0, 9'000'000}}, cache, tooMany).empty());
   EXPECT_TRUE(tooMany);
-  const auto keys = cellsForAreas({weather::SphericalCap{48, 11, 120000}, weather::SphericalCap{48, 11, 900000}}, tooMany);
+  const auto keys =
+      cellsForAreas({weather::SphericalCap{48, 11, 120000}, weather::SphericalCap{48, 11, 900000}}, cache, tooMany);
   EXPECT_FALSE(tooMany);
   EXPECT_TRUE(std::is_sorted(keys.begin(), keys.end()));
   EXPECT_GT(keys.size(), 50u);

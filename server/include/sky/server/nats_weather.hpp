@@ -185,7 +185,9 @@ class NatsWeather {
   std::unique_ptr<ClusterRegistry> registry_;  // after natsLog_, which it uses; made by elect()
   boost::asio::steady_timer claimRetry_;
   boost::asio::steady_timer areasPoll_;
-  std::size_t areasFingerprint_ = 0;
+  std::optional<std::size_t> areasFingerprint_;  // of the areas last handed to cellFollower_
+  CellReach areaCoverings_;                      // the io thread's, for pollAreas
+
   // The leader's cells for the relays (not on a relay), and a relay's by
   // cell; both after natsLog_, which they use.
   std::unique_ptr<CellPublisher> publisher_;

@@ -74,7 +74,10 @@ StateCells splitState(nlohmann::json state, CellReach& reach);
 nlohmann::json joinState(const nlohmann::json& global, const std::vector<const nlohmann::json*>& cells);
 
 // The cell keys covering the areas, sorted; empty (and `tooMany` set) when
-// one area needs more than kMaxCellsPerArea.
-std::vector<std::string> cellsForAreas(const std::vector<weather::SphericalCap>& areas, bool& tooMany);
+// one area needs more than kMaxCellsPerArea. Each area's covering comes from
+// `cache` (a relay's renderers subscribe anew one at a time, and the others'
+// areas stand).
+std::vector<std::string> cellsForAreas(const std::vector<weather::SphericalCap>& areas, CellReach& cache,
+                                       bool& tooMany);
 
 }  // namespace sky::server
